@@ -1,0 +1,17 @@
+#pragma once
+// Output files appear whole or not at all: write to a temporary sibling, then rename.
+#include <filesystem>
+#include <functional>
+#include <string>
+
+namespace weft {
+
+// Calls write(tmp_path) and renames tmp_path to 'path' on success. On any exception the
+// temporary is removed and the exception propagates, leaving no half-written 'path'.
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path& tmp_path)>& write);
+
+// Same, for text content.
+void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+
+}  // namespace weft

@@ -1,0 +1,64 @@
+#pragma once
+// Spectral bands of the project: 390-710 nm in 10 nm steps (33 bands, the paper's measurement
+// grid). Band i is centred at 390 + 10 i nm and covers [centre - 5, centre + 5) nm.
+#include <array>
+#include <cstddef>
+
+namespace weft {
+
+inline constexpr int kNumBands = 33;
+inline constexpr double kFirstBandNm = 390.0;
+inline constexpr double kBandStepNm = 10.0;
+
+constexpr double band_wavelength_nm(int band) { return kFirstBandNm + kBandStepNm * band; }
+
+using Spectrum = std::array<double, kNumBands>;
+
+struct Xyz {
+  double x = 0, y = 0, z = 0;
+};
+// Linear RGB triple; also the renderer's colour type.
+struct Rgb {
+  double r = 0, g = 0, b = 0;
+
+  constexpr Rgb() = default;
+  constexpr Rgb(double r_, double g_, double b_) : r(r_), g(g_), b(b_) {}
+  constexpr explicit Rgb(double v) : r(v), g(v), b(v) {}
+  constexpr Rgb& operator+=(const Rgb& o) { r += o.r; g += o.g; b += o.b; return *this; }
+  constexpr Rgb& operator*=(const Rgb& o) { r *= o.r; g *= o.g; b *= o.b; return *this; }
+  constexpr Rgb& operator*=(double s) { r *= s; g *= s; b *= s; return *this; }
+  constexpr double max_component() const { return r > g ? (r > b ? r : b) : (g > b ? g : b); }
+  constexpr double average() const { return (r + g + b) / 3.0; }
+  constexpr bool is_black() const { return r == 0 && g == 0 && b == 0; }
+  constexpr bool operator==(const Rgb&) const = default;
+};
+constexpr Rgb operator+(Rgb a, const Rgb& b) { return a += b; }
+constexpr Rgb operator*(Rgb a, const Rgb& b) { return a *= b; }
+constexpr Rgb operator*(Rgb a, double s) { return a *= s; }
+constexpr Rgb operator*(double s, Rgb a) { return a *= s; }
+constexpr Rgb operator/(Rgb a, double s) { return a *= (1.0 / s); }
+struct Hsv {
+  double h = 0, s = 0, v = 0;  // each in [0, 1]
+};
+
+// CIE 1931 2-degree colour matching functions averaged over each band (1 nm CIE data).
+const std::array<Xyz, kNumBands>& cie_cmf_bands();
+// CIE D65 relative spectral power averaged over each band.
+const Spectrum& d65_bands();
+
+// Colour of a reflectance (or radiance factor) spectrum under D65, normalized so that a
+// perfect white reflector has Y = 1.
+Xyz reflectance_to_xyz_d65(const Spectrum& reflectance);
+// Linear sRGB (D65 white) from XYZ (IEC 61966-2-1 matrix).
+Rgb xyz_to_linear_srgb(const Xyz& xyz);
+// Gamma-encoded sRGB component from linear.
+double linear_to_srgb_gamma(double linear);
+// HSV of an RGB triple (each component clamped to >= 0 before conversion is NOT done: negative
+// inputs, out of gamut, are reported as they are; callers decide).
+Hsv rgb_to_hsv(const Rgb& rgb);
+
+// Spectrum -> linear sRGB weights per band: rgb = sum_b w[b] * value[b], for rendering
+// spectral tables in an RGB renderer under D65 (white reflectance 1 -> rgb (1,1,1)).
+const std::array<Rgb, kNumBands>& srgb_band_weights_d65();
+
+}  // namespace weft

@@ -1,0 +1,42 @@
+#include "weft/core/atomic_file.h"
+
+#include <fstream>
+#include <system_error>
+
+#include "weft/core/error.h"
+
+namespace weft {
+
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path&)>& write) {
+  namespace fs = std::filesystem;
+  const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
+  if (!fs::is_directory(parent))
+    throw Error(path.string(), "", "output directory does not exist");
+  // Keep the extension last: writers such as OpenImageIO choose the format by it.
+  fs::path tmp = parent / (".tmp-" + path.stem().string() + "-partial" + path.extension().string());
+  try {
+    write(tmp);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(tmp, ec);
+    throw;
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw Error(path.string(), "", "cannot move the finished output into place");
+  }
+}
+
+void write_text_atomically(const std::filesystem::path& path, const std::string& text) {
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    out.close();
+    if (!out) throw Error(path.string(), "", "write failed");
+  });
+}
+
+}  // namespace weft

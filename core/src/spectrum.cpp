@@ -1,0 +1,134 @@
+#include "weft/core/spectrum.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "weft/core/error.h"
+
+namespace weft {
+namespace detail {
+extern const char* const kCieCmfCsv;
+extern const char* const kCieD65Csv;
+}  // namespace detail
+
+namespace {
+
+// wavelength (nm, integer) -> columns. The first line is a header.
+std::map<int, std::vector<double>> parse_csv(const char* text, size_t columns, const char* name) {
+  std::map<int, std::vector<double>> rows;
+  std::istringstream in(text);
+  std::string line;
+  std::getline(in, line);  // header
+  while (std::getline(in, line)) {
+    if (line.empty() || line == "\r") continue;
+    std::istringstream ls(line);
+    std::string cell;
+    std::vector<double> values;
+    while (std::getline(ls, cell, ',')) values.push_back(std::stod(cell));
+    if (values.size() != columns + 1) throw Error(name, "", "malformed CIE row: " + line);
+    const int nm = static_cast<int>(std::lround(values[0]));
+    values.erase(values.begin());
+    rows[nm] = std::move(values);
+  }
+  return rows;
+}
+
+// Trapezoid average of a 1 nm table over [centre - 5, centre + 5] nm.
+double band_average(const std::map<int, std::vector<double>>& rows, int band, size_t column) {
+  const int centre = static_cast<int>(band_wavelength_nm(band));
+  double sum = 0, weight = 0;
+  for (int nm = centre - 5; nm <= centre + 5; ++nm) {
+    const double w = (nm == centre - 5 || nm == centre + 5) ? 0.5 : 1.0;
+    sum += w * rows.at(nm)[column];
+    weight += w;
+  }
+  return sum / weight;
+}
+
+}  // namespace
+
+const std::array<Xyz, kNumBands>& cie_cmf_bands() {
+  static const std::array<Xyz, kNumBands> table = [] {
+    const auto rows = parse_csv(detail::kCieCmfCsv, 3, "CIE_xyz_1931_2deg_360-830.csv");
+    std::array<Xyz, kNumBands> t{};
+    for (int b = 0; b < kNumBands; ++b)
+      t[b] = {band_average(rows, b, 0), band_average(rows, b, 1), band_average(rows, b, 2)};
+    return t;
+  }();
+  return table;
+}
+
+const Spectrum& d65_bands() {
+  static const Spectrum table = [] {
+    const auto rows = parse_csv(detail::kCieD65Csv, 1, "CIE_std_illum_D65.csv");
+    Spectrum t{};
+    for (int b = 0; b < kNumBands; ++b) t[b] = band_average(rows, b, 0);
+    return t;
+  }();
+  return table;
+}
+
+Xyz reflectance_to_xyz_d65(const Spectrum& reflectance) {
+  const auto& cmf = cie_cmf_bands();
+  const auto& d65 = d65_bands();
+  double x = 0, y = 0, z = 0, norm = 0;
+  for (int b = 0; b < kNumBands; ++b) {
+    const double e = d65[b];
+    x += reflectance[b] * e * cmf[b].x;
+    y += reflectance[b] * e * cmf[b].y;
+    z += reflectance[b] * e * cmf[b].z;
+    norm += e * cmf[b].y;
+  }
+  return {x / norm, y / norm, z / norm};
+}
+
+Rgb xyz_to_linear_srgb(const Xyz& c) {
+  // IEC 61966-2-1 (sRGB) XYZ -> linear RGB, D65 white.
+  return {3.2406 * c.x - 1.5372 * c.y - 0.4986 * c.z, -0.9689 * c.x + 1.8758 * c.y + 0.0415 * c.z,
+          0.0557 * c.x - 0.2040 * c.y + 1.0570 * c.z};
+}
+
+double linear_to_srgb_gamma(double v) {
+  if (v <= 0.0031308) return 12.92 * v;
+  return 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
+}
+
+Hsv rgb_to_hsv(const Rgb& c) {
+  const double mx = std::max({c.r, c.g, c.b});
+  const double mn = std::min({c.r, c.g, c.b});
+  const double delta = mx - mn;
+  Hsv out;
+  out.v = mx;
+  out.s = mx > 0 ? delta / mx : 0;
+  if (delta <= 0) return out;
+  double h;
+  if (mx == c.r)
+    h = (c.g - c.b) / delta;
+  else if (mx == c.g)
+    h = 2 + (c.b - c.r) / delta;
+  else
+    h = 4 + (c.r - c.g) / delta;
+  h /= 6;
+  if (h < 0) h += 1;
+  out.h = h;
+  return out;
+}
+
+const std::array<Rgb, kNumBands>& srgb_band_weights_d65() {
+  static const std::array<Rgb, kNumBands> table = [] {
+    std::array<Rgb, kNumBands> w{};
+    for (int b = 0; b < kNumBands; ++b) {
+      Spectrum delta{};
+      delta[b] = 1;
+      w[b] = xyz_to_linear_srgb(reflectance_to_xyz_d65(delta));
+    }
+    return w;
+  }();
+  return table;
+}
+
+}  // namespace weft

@@ -1,0 +1,99 @@
+#include "cli_util.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include "weft/core/error.h"
+
+namespace weft::cli {
+namespace {
+std::atomic<bool> g_interrupted{false};  // set by the signal handler only
+extern "C" void on_sigint(int) { g_interrupted.store(true); }
+
+std::string format_duration(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
+  const long s = std::lround(seconds);
+  char buf[32];
+  if (s >= 3600)
+    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
+  else
+    std::snprintf(buf, sizeof buf, "%02ld:%02ld", s / 60, s % 60);
+  return buf;
+}
+}  // namespace
+
+void install_interrupt_handler() { std::signal(SIGINT, on_sigint); }
+bool interrupted() { return g_interrupted.load(); }
+
+ProgressCallback progress_bar(bool quiet) {
+  install_interrupt_handler();
+  using Clock = std::chrono::steady_clock;
+  struct State {
+    Clock::time_point start = Clock::now();
+    Clock::time_point last_draw{};
+    std::string stage;
+  };
+  auto state = std::make_shared<State>();
+  return [state, quiet](const ProgressUpdate& u) {
+    if (!quiet) {
+      const auto now = Clock::now();
+      if (u.stage != state->stage) {
+        state->stage = std::string(u.stage);
+        state->start = now;
+      }
+      const bool finished = u.total > 0 && u.done >= u.total;
+      if (finished || now - state->last_draw > std::chrono::milliseconds(200)) {
+        state->last_draw = now;
+        const double elapsed = std::chrono::duration<double>(now - state->start).count();
+        const double rate = elapsed > 0 ? static_cast<double>(u.done) / elapsed : 0;
+        const double frac = u.total > 0 ? static_cast<double>(u.done) / u.total : 0;
+        const double eta = rate > 0 && u.total > 0 ? (u.total - u.done) / rate : NAN;
+        std::fprintf(stderr, "\r%-10s %5.1f%%  %10.4g/s  ETA %s   ", state->stage.c_str(),
+                     100 * frac, rate, format_duration(eta).c_str());
+        if (finished) std::fprintf(stderr, "\n");
+        std::fflush(stderr);
+      }
+    }
+    return !g_interrupted.load();
+  };
+}
+
+std::vector<double> parse_range(const std::string& text, const std::string& option_name) {
+  auto to_number = [&](const std::string& s) {
+    size_t used = 0;
+    double v;
+    try {
+      v = std::stod(s, &used);
+    } catch (...) {
+      throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
+    }
+    if (used != s.size() || !std::isfinite(v))
+      throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
+    return v;
+  };
+  std::vector<double> out;
+  if (text.find(':') != std::string::npos) {
+    std::vector<std::string> parts;
+    std::stringstream ss(text);
+    std::string p;
+    while (std::getline(ss, p, ':')) parts.push_back(p);
+    if (parts.size() != 3) throw Error("", option_name, "range must be a:b:step, got '" + text + "'");
+    const double a = to_number(parts[0]), b = to_number(parts[1]), step = to_number(parts[2]);
+    if (!(step > 0) || b < a) throw Error("", option_name, "range needs a <= b and step > 0");
+    const long n = std::lround(std::floor((b - a) / step + 1e-9));
+    for (long i = 0; i <= n; ++i) out.push_back(a + step * i);
+    return out;
+  }
+  std::stringstream ss(text);
+  std::string p;
+  while (std::getline(ss, p, ',')) out.push_back(to_number(p));
+  if (out.empty()) throw Error("", option_name, "empty list");
+  return out;
+}
+
+}  // namespace weft::cli

@@ -1,0 +1,30 @@
+#pragma once
+// Shared pieces of the command-line front end: the subcommand registry, the progress bar on
+// stderr, and Ctrl-C handling that asks long work to stop cleanly.
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "weft/core/progress.h"
+
+namespace weft::cli {
+
+// A subcommand: its CLI11 app and what to run when it was chosen. run() returns the exit code.
+struct Command {
+  CLI::App* app = nullptr;
+  std::function<int()> run;
+};
+using Commands = std::vector<Command>;
+
+// A progress bar on stderr (percent, rate, ETA), silent when quiet. It returns false once the user
+// pressed Ctrl-C, so the library stops at the next task boundary and keeps what it has.
+ProgressCallback progress_bar(bool quiet);
+// Installs the SIGINT handler used by progress_bar (idempotent).
+void install_interrupt_handler();
+bool interrupted();
+
+// Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers.
+std::vector<double> parse_range(const std::string& text, const std::string& option_name);
+
+}  // namespace weft::cli

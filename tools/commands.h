@@ -1,0 +1,9 @@
+#pragma once
+// Every subcommand registers itself here; main.cpp calls each add_* once.
+#include "cli_util.h"
+
+namespace weft::cli {
+
+void add_spectrum_command(CLI::App& app, Commands& commands);
+
+}  // namespace weft::cli
