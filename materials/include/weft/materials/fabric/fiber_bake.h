@@ -1,0 +1,100 @@
+#pragma once
+// The fiber BSDF baker: photon transport in a smooth cylinder turned into a 4-D table over the
+// full sphere of both directions, in the local frame of a surface point (x = axis t, y = b,
+// z = outward normal n). Definitions, estimator and checks: docs/fiber-bsdf.md.
+#include <cstdint>
+#include <functional>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/core/rng.h"
+#include "weft/core/vec.h"
+
+namespace weft {
+
+// A photon leaving the fiber: position on the surface (world, axis = x), direction outside
+// (unit, away from the fiber), weight.
+struct FiberExit {
+  Vec3 position;
+  Vec3 direction;
+  double weight = 0;
+};
+
+// Receives exits while a photon is traced.
+using FiberExitSink = std::function<void(const FiberExit&)>;
+
+// Traces one photon that has just been refracted into the fiber at surface point 'p' (world
+// frame, axis x, radius R) travelling along unit 'd' with weight 'w', reporting every exit.
+// Must be deterministic given rng. Returns the number of scattering events.
+using FiberInteriorTracer =
+    std::function<uint64_t(const Vec3& p, const Vec3& d, double w, Rng& rng, const FiberExitSink& sink)>;
+
+// The rough surface seen from outside, in the local frame of the hit point (z = normal).
+struct FiberSurfaceModel {
+  // Samples the surface-reflected direction for light from 'w_light' (z > 0): returns false if
+  // none; else sets the reflected direction and its weight f * cos / pdf.
+  std::function<bool(const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out, double* weight)> sample;
+  // Directional albedo of the surface lobe for light at cos theta (its complement enters).
+  std::function<double(double cos_theta)> albedo;
+};
+
+struct FiberGeometry {
+  double radius_um = 10;
+  double n_fiber = 1.557;  // index inside
+  double n_outside = 1.0;
+};
+
+struct FiberBakeSettings {
+  int resolution = 8;             // R: R x R equal-area bins per direction over the sphere
+  uint64_t photons = 100000;      // photons per band
+  uint64_t seed = 1;
+  int threads = 0;                // 0 = all cores
+  uint64_t photons_per_task = 4096;
+};
+
+// The cosine-weighted cell averages of one band: value[i * R^2 + o] with i the incident (light)
+// direction bin and o the exit (view) bin, 1/sr. Also the raw tallies needed by the checks.
+struct FiberBandTable {
+  int resolution = 0;
+  std::vector<double> f;            // R^4 cell averages (1/sr)
+  std::vector<double> weighted_sum; // R^4 sums of f |cos_i| |cos_o| over the cell pair (sr^2)
+  double exit_fraction = 0;         // exiting energy / energy hitting the fiber
+  double surface_fraction = 0;      // of which reflected by the surface lobe
+  double absorbed_fraction = 0;     // 1 - exit_fraction, as traced
+  uint64_t photons = 0;             // photons traced (fewer than asked if cancelled)
+  uint64_t scattering_events = 0;
+  bool cancelled = false;
+};
+
+// D_k = integral over bin k of |cos theta| d omega, for the R x R equal-area bins.
+std::vector<double> cosine_weighted_bin_areas(int resolution);
+
+// Bin index of a unit direction on the R x R equal-area square.
+int direction_bin(const Vec3& d, int resolution);
+
+// The direct route: a parallel beam over the whole lit cylinder. 'stage' names progress.
+FiberBandTable bake_fiber_band_direct(const FiberGeometry& geometry, const FiberSurfaceModel& surface,
+                                      const FiberInteriorTracer& tracer,
+                                      const FiberBakeSettings& settings,
+                                      const ProgressCallback& progress);
+
+// The paper's route: photons enter a small area A from directions over its lit hemisphere; exits
+// are binned by their angular offset around the axis from A (u), summed over the axial offset
+// (v; shift invariance), and by exit direction, giving the BSSRDF; the BRDF of a cell is then the
+// paper's sum over lit cells A_i. Grid sizes: u bins around the circle, incident bins in
+// (s = axial cosine, azimuth about the axis).
+struct BssrdfGrid {
+  int u_bins = 180;
+  int incident_s_bins = 32;
+  int incident_psi_bins = 32;
+  int cell_quadrature = 8;  // points per side when integrating over a table bin of wi
+};
+FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& geometry, const FiberSurfaceModel& surface,
+                                      const FiberInteriorTracer& tracer,
+                                      const FiberBakeSettings& settings, const BssrdfGrid& grid,
+                                      const ProgressCallback& progress);
+
+// Sum of f |cos_i| |cos_o| over all cell pairs: pi * (1 - absorbed) for a correct table.
+double fiber_table_energy(const FiberBandTable& table);
+
+}  // namespace weft

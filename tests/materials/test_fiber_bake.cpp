@@ -1,0 +1,160 @@
+// Fiber baker: estimator normalization and the agreement of the direct and BSSRDF routes.
+// Analytic reference: a fiber whose surface is Lambertian (albedo rho) and whose interior absorbs
+// everything has, at every point, f = rho/pi for light and view above the point and 0 otherwise
+// (docs/fiber-bsdf.md); the cell averages follow from the cosine-weighted bin areas.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/sphere_mapping.h"
+#include "weft/materials/bsdf.h"
+#include "weft/materials/fabric/fiber_bake.h"
+
+using namespace weft;
+
+namespace {
+
+FiberSurfaceModel lambert_surface(double rho) {
+  FiberSurfaceModel m;
+  m.sample = [rho](const Vec3&, Vec2 u, double, Vec3* w_out, double* weight) {
+    *w_out = sample_cosine_hemisphere(u);
+    *weight = rho;
+    return w_out->z > 0;
+  };
+  m.albedo = [rho](double) { return rho; };
+  return m;
+}
+
+// Interior that absorbs everything that enters.
+uint64_t absorb_all(const Vec3&, const Vec3&, double, Rng&, const FiberExitSink&) { return 0; }
+
+// Cosine-weighted area of the upper-hemisphere part of each bin (same midpoint rule).
+std::vector<double> upper_bin_areas(int resolution) {
+  const int q = 64;
+  std::vector<double> d(resolution * resolution, 0.0);
+  for (int iy = 0; iy < resolution; ++iy)
+    for (int ix = 0; ix < resolution; ++ix) {
+      double sum = 0;
+      for (int a = 0; a < q; ++a)
+        for (int b = 0; b < q; ++b)
+          sum += std::max(0.0, equal_area_square_to_sphere({(ix + (b + 0.5) / q) / resolution,
+                                                            (iy + (a + 0.5) / q) / resolution})
+                                   .z);
+      d[iy * resolution + ix] = 4 * kPi / (resolution * resolution) * sum / (q * q);
+    }
+  return d;
+}
+
+void expect_lambert_table(const FiberBandTable& t, double rho, double rel_tol_for_full_cells) {
+  const int R = t.resolution, cells = R * R;
+  const auto d = cosine_weighted_bin_areas(R);
+  const auto up = upper_bin_areas(R);
+  for (int i = 0; i < cells; ++i)
+    for (int o = 0; o < cells; ++o) {
+      const double expected = rho / kPi * up[i] * up[o] / (d[i] * d[o]);
+      const double got = t.f[static_cast<size_t>(i) * cells + o];
+      if (up[i] == 0 || up[o] == 0) {
+        ASSERT_EQ(got, 0.0) << i << " " << o;
+      } else if (up[i] == d[i] && up[o] == d[o]) {
+        ASSERT_NEAR(got, expected, rel_tol_for_full_cells * expected) << i << " " << o;
+      }
+    }
+}
+
+}  // namespace
+
+TEST(FiberBake, CosineWeightedBinAreasSumToTwoPi) {
+  // integral of |cos theta| over the sphere = 2 pi; the per-bin integrals are exact.
+  for (int r : {2, 4, 8}) {
+    double sum = 0;
+    for (double v : cosine_weighted_bin_areas(r)) sum += v;
+    EXPECT_NEAR(sum, 2 * kPi, 1e-12) << r;
+  }
+}
+
+TEST(FiberBake, DirectRouteReproducesLambertSurface) {
+  FiberBakeSettings s;
+  s.resolution = 4;
+  s.photons = 400000;
+  s.threads = 2;
+  const double rho = 0.6;
+  const auto t = bake_fiber_band_direct({}, lambert_surface(rho), absorb_all, s, nullptr);
+  EXPECT_EQ(t.photons, s.photons);
+  EXPECT_NEAR(t.exit_fraction, rho, 1e-12);  // every photon reflects weight rho exactly
+  EXPECT_NEAR(fiber_table_energy(t), kPi * rho, 1e-9);
+  // 16 x 16 cells; about 400000 * 0.6 exits over ~64 lit cell pairs -> ~2 % noise per cell.
+  expect_lambert_table(t, rho, 0.1);
+}
+
+TEST(FiberBake, BssrdfRouteReproducesLambertSurface) {
+  FiberBakeSettings s;
+  s.resolution = 4;
+  s.photons = 200000;
+  s.threads = 2;
+  BssrdfGrid grid;
+  grid.u_bins = 90;
+  const double rho = 0.6;
+  const auto t = bake_fiber_band_bssrdf({}, lambert_surface(rho), absorb_all, s, grid, nullptr);
+  EXPECT_NEAR(t.exit_fraction, rho, 1e-12);
+  // The paper's sum over lit cells integrates cos theta_A over the incident bin by quadrature:
+  // pi * rho within the quadrature error (cq = 8 points per side).
+  EXPECT_NEAR(fiber_table_energy(t), kPi * rho, 0.01 * kPi * rho);
+  expect_lambert_table(t, rho, 0.1);
+}
+
+TEST(FiberBake, BitIdenticalAtOneAndTwoThreads) {
+  FiberBakeSettings s;
+  s.resolution = 4;
+  s.photons = 50000;
+  s.photons_per_task = 1000;
+  s.threads = 1;
+  const auto a = bake_fiber_band_direct({}, lambert_surface(0.5), absorb_all, s, nullptr);
+  s.threads = 2;
+  const auto b = bake_fiber_band_direct({}, lambert_surface(0.5), absorb_all, s, nullptr);
+  ASSERT_EQ(a.f.size(), b.f.size());
+  for (size_t k = 0; k < a.f.size(); ++k) ASSERT_EQ(a.f[k], b.f[k]) << k;
+}
+
+TEST(FiberBake, CancellationKeepsWhatIsDone) {
+  FiberBakeSettings s;
+  s.resolution = 4;
+  s.photons = 1000000;
+  s.photons_per_task = 1000;
+  int calls = 0;
+  const auto t = bake_fiber_band_direct({}, lambert_surface(0.5), absorb_all, s,
+                                        [&](const ProgressUpdate&) { return ++calls < 2; });
+  EXPECT_TRUE(t.cancelled);
+  EXPECT_GT(t.photons, 0u);
+  EXPECT_LT(t.photons, s.photons);
+  // What was done is normalized by what was done.
+  EXPECT_NEAR(fiber_table_energy(t), kPi * 0.5, 1e-9);
+}
+
+TEST(FiberBake, RejectsBadSettings) {
+  FiberBakeSettings s;
+  FiberGeometry g;
+  g.radius_um = -1;
+  EXPECT_THROW(bake_fiber_band_direct(g, lambert_surface(0.5), absorb_all, s, nullptr), Error);
+  g.radius_um = std::nan("");
+  EXPECT_THROW(bake_fiber_band_direct(g, lambert_surface(0.5), absorb_all, s, nullptr), Error);
+  g = {};
+  s.resolution = 1;
+  EXPECT_THROW(bake_fiber_band_direct(g, lambert_surface(0.5), absorb_all, s, nullptr), Error);
+}
+
+TEST(FiberBake, CosineWeightedBinAreasMatchFineQuadrature) {
+  // Independent check of the exact per-bin integrals by a 400 x 400 midpoint rule.
+  const int R = 5, q = 400;  // odd R: the middle bins straddle the axes
+  const auto d = cosine_weighted_bin_areas(R);
+  for (int iy = 0; iy < R; ++iy)
+    for (int ix = 0; ix < R; ++ix) {
+      double sum = 0;
+      for (int a = 0; a < q; ++a)
+        for (int b = 0; b < q; ++b)
+          sum += std::abs(
+              equal_area_square_to_sphere({(ix + (b + 0.5) / q) / R, (iy + (a + 0.5) / q) / R}).z);
+      EXPECT_NEAR(d[iy * R + ix], 4 * kPi / (R * R) * sum / (q * q), 2e-6) << ix << " " << iy;
+    }
+}
