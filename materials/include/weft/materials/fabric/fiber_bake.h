@@ -87,7 +87,7 @@ struct BssrdfGrid {
   int u_bins = 180;
   int incident_s_bins = 32;
   int incident_psi_bins = 32;
-  int cell_quadrature = 8;  // points per side when integrating over a table bin of wi
+  int cell_quadrature = 16;  // points per side when integrating over a table bin of wi
 };
 FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& geometry, const FiberSurfaceModel& surface,
                                       const FiberInteriorTracer& tracer,
