@@ -30,6 +30,59 @@ inline cd cdiv(cd a, cd b) {
   return {(a.real() * r + a.imag()) / den, (a.imag() * r - a.real()) / den};
 }
 
+// Small-sphere numerators. With da = D_n(mx)/m + n/x (a_n) or m D_n(mx) + n/x (b_n), the series
+// terms are a_n = P / (P - i Q), P = da psi_n(x) - psi_{n-1}(x), Q = da chi_n(x) - chi_{n-1}(x).
+// For small x, P is a difference of terms larger by 1/x^2, so it loses digits as eps / x^2
+// (b_1 and a_2, and hence g, first); Q does not cancel. MIEV0 switches to small-particle
+// formulas there; we expand P itself. Taylor series in x (derived with sympy from the series of
+// psi_n and D_n), every coefficient carrying the factor u - 1 = m^2 - 1 exactly:
+struct SmallNumerators {
+  cd a1, b1, a2, b2;
+};
+SmallNumerators small_sphere_numerators(cd m, double x) {
+  const cd u = m * m, um1 = (m - 1.0) * (m + 1.0);  // exact for m near 1
+  const double x2 = x * x;
+  const cd a1 =
+      um1 / u * x *
+      (-2.0 / 3 +
+       x2 * (1.0 / 15 + x2 * (-(4.0 * u + 5.0) / 2100.0 +
+                              x2 * (-(48.0 * u * u - 60.0 * u - 25.0) / 567000.0 +
+                                    x2 * (-(((7104.0 * u - 7680.0) * u + 4200.0) * u + 875.0) /
+                                          1746360000.0)))));
+  const cd b1 =
+      um1 * x * x2 *
+      (-1.0 / 15 +
+       x2 * (-(2.0 * u - 5.0) / 1050.0 +
+             x2 * (-((16.0 * u - 20.0) * u + 25.0) / 189000.0 +
+                   x2 * (-(((1776.0 * u - 1920.0) * u + 1050.0) * u - 875.0) / 436590000.0 +
+                         x2 * (-((((45312.0 * u - 47040.0) * u + 21600.0) * u - 7000.0) * u +
+                                 4375.0) /
+                               227026800000.0)))));
+  const cd a2 =
+      um1 / u * x2 *
+      (-1.0 / 5 +
+       x2 * (1.0 / 70 + x2 * (-(8.0 * u + 21.0) / 52920.0 +
+                              x2 * (-((32.0 * u - 56.0) * u - 49.0) / 8149680.0 +
+                                    x2 * (-(((6016.0 * u - 8960.0) * u + 7056.0) * u + 3087.0) /
+                                          53396703360.0)))));
+  const cd b2 =
+      um1 * x2 * x2 *
+      (-1.0 / 105 +
+       x2 * (-(2.0 * u - 7.0) / 13230.0 +
+             x2 * (-((16.0 * u - 28.0) * u + 49.0) / 4074840.0 +
+                   x2 * (-(((752.0 * u - 1120.0) * u + 882.0) * u - 1029.0) / 6674587920.0 +
+                         x2 * (-((((18688.0 * u - 26432.0) * u + 17248.0) * u - 8232.0) * u +
+                                 7203.0) /
+                               5606653852800.0)))));
+  return {a1, b1, a2, b2};
+}
+
+// Where the expansions are used: truncated after (m x)^8 relative terms, they are good to
+// 1e-16 for |m x| < 0.02; below x = 0.01 the direct difference would lose more than 1e-12.
+bool use_small_sphere_series(cd m, double x) {
+  return x < 0.01 && std::abs(m) * x < 0.02;
+}
+
 void validate_index_and_size(cd m, double x) {
   if (!std::isfinite(m.real()) || !std::isfinite(m.imag()))
     throw Error("", "m", "relative refractive index is not finite");
@@ -164,12 +217,13 @@ MieResult mie_sphere(cd m, double x, std::span<const double> mu) {
   // Riccati-Bessel psi_n(x) = x j_n(x) and chi_n(x) = -x y_n(x). chi grows with n, so its upward
   // recurrence is stable. psi's upward recurrence is fine for n up to ~x (MIEV0 and BHMIE use
   // it), but for x < 1 its first step sin x / x - cos x cancels (relative error eps / x^2), so
-  // there psi comes from the downward ratio recurrence normalized by psi_0 = sin x. That keeps
-  // the full series exact to rounding down to x = 1e-6 and below, which is what MIEV0's
-  // small-particle formulas exist for.
-  const bool small = x < 1;
+  // there psi comes from the downward ratio recurrence normalized by psi_0 = sin x. Below
+  // x = 0.01 the numerators P themselves come from their series (small_sphere_numerators).
+  const bool series = use_small_sphere_series(m, x);  // then nstop == 2
+  const SmallNumerators small = series ? small_sphere_numerators(m, x) : SmallNumerators{};
+  const bool small_x = x < 1;
   std::vector<double> psi_small;
-  if (small) {
+  if (small_x) {
     psi_small.assign(nstop + 1, 0.0);
     const int top = nstop + 20;
     double ratio = (2.0 * top + 3) / x;  // psi_top / psi_{top+1}, leading order
@@ -195,12 +249,17 @@ MieResult mie_sphere(cd m, double x, std::span<const double> mu) {
     const double dn_d = static_cast<double>(n);
     const double f = (2 * dn_d - 1) * inv_x;
     const double chi_n = f * chi_nm1 - chi_nm2;
-    const double psi_n = small ? psi_small[n] : f * psi_nm1 - psi_nm2;
-    const cd xi_n(psi_n, -chi_n), xi_nm1(psi_nm1, -chi_nm1);
+    const double psi_n = small_x ? psi_small[n] : f * psi_nm1 - psi_nm2;
     const double n_x = dn_d * inv_x;
     const cd da = dn[n] * inv_m + n_x, db = m * dn[n] + n_x;
-    const cd a = cdiv(da * psi_n - psi_nm1, da * xi_n - xi_nm1);
-    const cd b = cdiv(db * psi_n - psi_nm1, db * xi_n - xi_nm1);
+    cd pa = da * psi_n - psi_nm1, pb = db * psi_n - psi_nm1;
+    if (series && n <= 2) {
+      pa = n == 1 ? small.a1 : small.a2;
+      pb = n == 1 ? small.b1 : small.b2;
+    }
+    const cd qa = da * chi_n - chi_nm1, qb = db * chi_n - chi_nm1;
+    const cd a = cdiv(pa, pa - cd(0, 1) * qa);
+    const cd b = cdiv(pb, pb - cd(0, 1) * qb);
 
     const double w = 2 * dn_d + 1;
     sum_ext += w * (a.real() + b.real());

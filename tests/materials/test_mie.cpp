@@ -494,6 +494,41 @@ TEST(Mie, RayleighLimit) {
   }
 }
 
+TEST(Mie, SmallSpheresKeepEveryFigure) {
+  // Below x = 0.01 the numerators of a_1, b_1, a_2 come from Taylor series; above, from the
+  // direct formulas. Both against [MP] (2-term sums): m = 1.5, x = 1e-3: Q_sca =
+  // 2.306805237804225e-13, Q_back = 3.460206222719589e-13, g = 1.983333175635093e-7;
+  // m = 1.5 + i, x = 1e-4: Q_ext = 1.840255607652422e-4, Q_sca = 1.235356767485556e-16,
+  // g = 1.624842763101169e-9; m = 0.75, x = 0.01: Q_sca = 7.772627665421393e-10,
+  // g = 1.47540192749003e-5. g is the quantity the direct difference loses (as eps / x^2).
+  const MieResult a = mie_sphere({1.5, 0}, 1e-3);
+  EXPECT_LE(rel(a.qsca, 2.306805237804225e-13), 1e-13);
+  EXPECT_LE(rel(a.qback, 3.460206222719589e-13), 1e-13);
+  EXPECT_LE(rel(a.g, 1.983333175635093e-7), 1e-13);
+  const MieResult b = mie_sphere({1.5, 1}, 1e-4);
+  EXPECT_LE(rel(b.qext, 1.840255607652422e-4), 1e-13);
+  EXPECT_LE(rel(b.qsca, 1.235356767485556e-16), 1e-13);
+  EXPECT_LE(rel(b.g, 1.624842763101169e-9), 1e-13);
+  const MieResult c = mie_sphere({0.75, 0}, 0.01);
+  EXPECT_LE(rel(c.qsca, 7.772627665421393e-10), 1e-13);
+  EXPECT_LE(rel(c.g, 1.47540192749003e-5), 1e-10);
+  // m = 10 + 10i, x = 1e-3 [MP]: Q_ext = 6.002075807479446e-5, Q_sca = 2.666469885851701e-12,
+  // g = 1.165406186206481e-7. m = 1.0001, x = 5e-3 [MP]: Q_sca = 7.407086411558031e-18 (the
+  // double nearest 1.0001 moves it by 2e-13).
+  const MieResult d = mie_sphere({10, 10}, 1e-3);
+  EXPECT_LE(rel(d.qext, 6.002075807479446e-5), 1e-13);
+  EXPECT_LE(rel(d.qsca, 2.666469885851701e-12), 1e-13);
+  EXPECT_LE(rel(d.g, 1.165406186206481e-7), 1e-13);
+  EXPECT_LE(rel(mie_sphere({1.0001, 0}, 5e-3).qsca, 7.407086411558031e-18), 1e-12);
+  // Continuity where the series hands over to the direct formulas.
+  for (const cd m : {cd(1.5, 0), cd(1.33, 1e-5), cd(1.9, 0.2), cd(1.0001, 0)}) {
+    const MieResult below = mie_sphere(m, 0.999999e-2), above = mie_sphere(m, 1.000001e-2);
+    const double scale4 = std::pow(1.000001 / 0.999999, 4);
+    EXPECT_LE(rel(above.qsca, below.qsca * scale4), 1e-5) << m;
+    EXPECT_LE(rel(above.g, below.g), 1e-5) << m;
+  }
+}
+
 TEST(Mie, EnergyBalance) {
   // Non-absorbing spheres absorb nothing (to rounding); absorbing ones absorb a positive amount
   // that stays below extinction.

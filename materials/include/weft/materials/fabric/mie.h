@@ -39,8 +39,9 @@ inline constexpr double kMieMaxMx = 1e8;
 int mie_term_count(double x);
 
 // Mie efficiencies, g and (optionally) S1, S2 at the cosines mu, for relative index m and size
-// parameter x. Throws weft::Error (fields "m", "x", "mu") on non-finite, x <= 0, Re m <= 0,
-// Im m < 0, or beyond the limits above.
+// parameter x. For x < 0.01 (and |m| x < 0.02) the cancelling numerators of a_1, b_1, a_2, b_2
+// come from their Taylor series, as MIEV0 uses small-particle formulas there. Throws weft::Error
+// (fields "m", "x", "mu") on non-finite, x <= 0, Re m <= 0, Im m < 0, or beyond the limits above.
 MieResult mie_sphere(std::complex<double> m, double x, std::span<const double> mu = {});
 
 // The physical form: particle index n + i k in a host of real index host_n, sphere radius in
