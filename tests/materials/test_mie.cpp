@@ -12,7 +12,17 @@
 //     Appendix A, p. 482: BHMIE's sample output for m = 1.55, lambda = 0.6328 um, r = 0.525 um.
 // [MP] Independent 40-digit evaluations with mpmath (Bessel functions of half-integer order
 //     from mpmath.besselj/bessely, or for D_n at large n a 30-digit downward recurrence started
-//     2000 orders above 1.5 |z|, checked against a 4000-order start); written for these tests.
+//     2000 orders above 1.5 |z|, checked against a 4000-order start); written for these tests:
+//       import mpmath as mp; mp.mp.dps = 40
+//       h = lambda n, z: mp.sqrt(mp.pi * z / 2)
+//       psi = lambda n, z: h(n, z) * mp.besselj(n + 0.5, z)
+//       xi = lambda n, z: h(n, z) * (mp.besselj(n + 0.5, z) + 1j * mp.bessely(n + 0.5, z))
+//       d = lambda f, n, z: f(n - 1, z) - n * f(n, z) / z  # psi_n', xi_n'
+//       a_n = (m psi_n(mx) psi_n'(x) - psi_n(x) psi_n'(mx))
+//             / (m psi_n(mx) xi_n'(x) - xi_n(x) psi_n'(mx))
+//       b_n = (psi_n(mx) psi_n'(x) - m psi_n(x) psi_n'(mx))
+//             / (psi_n(mx) xi_n'(x) - m xi_n(x) psi_n'(mx))
+//     summed over as many terms as mie_term_count(x) with the BH formulas for Q and g.
 #include <gtest/gtest.h>
 
 #include <cmath>
