@@ -103,7 +103,8 @@ int run_mie(const MieOptions& o) {
     const double mr = positive(m_re, "--m-re");
     const double mi = non_negative(m_im, "--m-im");
     const double xv = positive(x, "--x");
-    if (xv > kMieMaxSizeParameter) throw Error("", "--x", "above the limit 1e7");
+    if (xv > kMieMaxSizeParameter || xv < kMieMinSizeParameter)
+      throw Error("", "--x", "outside the accepted range 1e-12 .. 1e7");
     if (std::abs(std::complex<double>(mr, mi)) * xv > kMieMaxMx)
       throw Error("", "--m-re", "|m| x above the limit 1e8");
     const MieResult res = mie_sphere({mr, mi}, xv, mu);
@@ -125,6 +126,8 @@ int run_mie(const MieOptions& o) {
     const double radius = positive(r, "--radius-um");
     const double lambda = positive(wl, "--wavelength-nm");
     const double xv = mie_size_parameter(h, radius, lambda);
+    if (xv < kMieMinSizeParameter)
+      throw Error("", "--radius-um", "sphere too small for the wavelength (x below 1e-12)");
     if (xv > kMieMaxSizeParameter || std::hypot(n, k) / h * xv > kMieMaxMx)
       throw Error("", "--radius-um",
                   "sphere too large for the wavelength (x or |m| x above the limit)");

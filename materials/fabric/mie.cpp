@@ -90,6 +90,10 @@ void validate_index_and_size(cd m, double x) {
   if (m.imag() < 0)
     throw Error("", "m", "imaginary part must be >= 0 (m = n + ik with k >= 0 absorbing)");
   if (!std::isfinite(x) || !(x > 0)) throw Error("", "x", "size parameter must be finite and > 0");
+  if (x < kMieMinSizeParameter)
+    throw Error("", "x",
+                "size parameter " + num(x) + " below the limit " + num(kMieMinSizeParameter) +
+                    " (use the Rayleigh limit)");
   if (x > kMieMaxSizeParameter)
     throw Error("", "x",
                 "size parameter " + num(x) + " above the limit " + num(kMieMaxSizeParameter));
@@ -117,7 +121,7 @@ cd ratio_continued_fraction(cd z, int n) {
     d = 1.0 / d;
     const cd delta = c * d;
     f *= delta;
-    if (std::abs(delta - 1.0) < 1e-16) break;
+    if (std::abs(delta - 1.0) < 4e-16) break;  // a couple of ulps: converged
   }
   return f;
 }

@@ -632,7 +632,7 @@ TEST(Mie, LogarithmicDerivative) {
 
 TEST(Mie, ExtremesStayFiniteAndBounded) {
   const double mu[] = {1.0, 0.5, 0.0, -1.0};
-  for (double x : {1e-6, 1e-3, 1.0, 1e3, 1e5, 1e6}) {
+  for (double x : {1e-12, 1e-6, 1e-3, 1.0, 1e3, 1e5, 1e6}) {
     for (const cd m :
          {cd(1.5, 0), cd(1.5, 10), cd(10, 10), cd(1.0001, 0), cd(0.75, 0), cd(1.33, 1e-8)}) {
       const MieResult r =
@@ -732,6 +732,8 @@ TEST(Mie, RejectsBadInput) {
   EXPECT_THROW(mie_sphere({1.5, 0}, nan), Error);
   EXPECT_THROW(mie_sphere({1.5, 0}, INFINITY), Error);
   EXPECT_THROW(mie_sphere({1.5, 0}, 2e7), Error);
+  EXPECT_THROW(mie_sphere({1.5, 0}, 1e-13), Error);
+  EXPECT_NO_THROW(mie_sphere({10, 10}, 1e-12));
   const double bad_mu[] = {1.5};
   EXPECT_THROW(mie_sphere({1.5, 0}, 1, bad_mu), Error);
   EXPECT_THROW(mie_sphere_physical(1.5, 0, 1.557, -0.1, 550), Error);

@@ -30,7 +30,9 @@ struct MieResult {
   std::vector<std::complex<double>> s1, s2;  // amplitudes at mu
 };
 
-// Largest size parameter and |m| x accepted (cost and memory grow linearly with them).
+// Size parameters accepted: below the minimum the Rayleigh limit is exact to double precision
+// and the series' chi_n would approach overflow; cost and memory grow linearly with x and |m| x.
+inline constexpr double kMieMinSizeParameter = 1e-12;
 inline constexpr double kMieMaxSizeParameter = 1e7;
 inline constexpr double kMieMaxMx = 1e8;
 
