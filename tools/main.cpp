@@ -12,6 +12,8 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   weft::cli::Commands commands;
   weft::cli::add_spectrum_command(app, commands);
+  weft::cli::add_mie_command(app, commands);
+  weft::cli::add_medium_command(app, commands);
 
   try {
     app.parse(argc, argv);

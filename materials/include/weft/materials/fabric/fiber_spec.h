@@ -1,0 +1,73 @@
+#pragma once
+// The fiber spec: what a fiber is made of, as a plain value. Parsed from JSON (file or bundled
+// preset), validated field by field (errors name the file and the field path), and hashed
+// canonically so caches and table headers can name the spec that produced them.
+//
+// JSON layout (every key is required unless marked optional; unknown keys are errors):
+// {
+//   "name": "red-cotton",
+//   "fiber_radius_um": 8.0,
+//   "roughness": {"distribution": "beckmann" | "ggx", "alpha": 0.35},
+//   "host": {"n": SPECTRAL, "absorption_per_um": SPECTRAL | "absorption_per_mm": SPECTRAL},
+//   "species": [{"name": "air voids", "n": SPECTRAL, "k": SPECTRAL, "volume_fraction": 0.02,
+//                "size": {"distribution": "monodisperse", "radius_um": 0.3} |
+//                        {"distribution": "lognormal", "median_radius_um": 0.3, "sigma": 0.5}}],
+//   "notes": "free text" (optional, not hashed)
+// }
+// host.absorption_* is optional (no dye: zero); species may be empty. SPECTRAL is one of
+//   - a number (the same in every band),
+//   - an array of 33 numbers, one per band 390, 400, ..., 710 nm,
+//   - {"points": [[wavelength_nm, value], ...]}: linearly interpolated, wavelengths strictly
+//     increasing and covering 390-710 nm (no extrapolation).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "weft/core/spectrum.h"
+#include "weft/materials/fabric/mie.h"
+
+namespace weft {
+
+enum class MicrofacetDistribution { kBeckmann, kGgx };
+
+struct ParticleSpecies {
+  std::string name;
+  Spectrum n{}, k{};  // particle refractive index n + i k per band (k >= 0)
+  SizeDistribution size;
+  double volume_fraction = 0;  // in [0, 0.74]
+};
+
+struct FiberSpec {
+  std::string name;
+  double fiber_radius_um = 0;
+  MicrofacetDistribution roughness_distribution = MicrofacetDistribution::kBeckmann;
+  double roughness_alpha = 0;         // in (0, 1]
+  Spectrum host_n{};                  // real refractive index of the fibre material
+  Spectrum host_absorption_per_um{};  // absorption coefficient of the host (dye), >= 0
+  std::vector<ParticleSpecies> species;
+};
+
+inline constexpr double kMaxVolumeFraction = 0.74;  // close packing of equal spheres
+
+// Parses a spec from JSON text; 'file' names the source in error messages.
+FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file);
+// Loads a spec from a file path, or from a bundled preset by name when no such file exists.
+// Errors: missing file (naming it and listing the presets), invalid JSON, invalid fields.
+FiberSpec load_fiber_spec(const std::string& path_or_preset);
+
+// Bundled presets ("red-cotton", "white-cotton", "polyester-delustered"), compiled in.
+std::vector<std::string> fiber_preset_names();
+// The preset's JSON text; throws weft::Error listing the valid names for an unknown one.
+const std::string& fiber_preset_json(const std::string& name);
+
+// Canonical JSON of the parsed spec (sorted keys, spectra resolved to 33 band values, shortest
+// round-trip numbers); the name and notes are left out, so two specs with the same physics hash
+// alike however they were written.
+std::string canonical_json(const FiberSpec& spec);
+// FNV-1a 64 of canonical_json(spec), and the same as 16 lower-case hex digits.
+uint64_t fiber_spec_hash(const FiberSpec& spec);
+std::string fiber_spec_hash_hex(const FiberSpec& spec);
+
+const char* to_string(MicrofacetDistribution d);
+
+}  // namespace weft
