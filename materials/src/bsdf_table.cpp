@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <numeric>
 #include <set>
 
@@ -69,6 +71,21 @@ OctahedralGrid::Footprint OctahedralGrid::bilinear(Vec2 p) const {
   return fp;
 }
 
+std::string TabulatedBsdfTable::checksum() const {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (const float v : values) {
+    uint32_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    for (int k = 0; k < 4; ++k) {
+      h ^= (bits >> (8 * k)) & 0xffu;
+      h *= 0x100000001b3ULL;
+    }
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
 std::string TabulatedBsdfTable::bands() const {
   return channels == kNumBands ? std::string(kSpectralBands) : std::string("rgb");
 }
@@ -95,6 +112,7 @@ const std::set<std::string>& reserved_attribute_names() {
                                               "bands",
                                               "units",
                                               "kind",
+                                              "values_fnv1a64",
                                               "channels",
                                               "compression",
                                               "dataWindow",
@@ -113,6 +131,10 @@ const std::set<std::string>& reserved_attribute_names() {
 }
 
 }  // namespace
+
+bool TabulatedBsdfTable::is_reserved_attribute(const std::string& name) {
+  return reserved_attribute_names().count(name) > 0;
+}
 
 void TabulatedBsdfTable::validate(const std::string& file) const {
   if (resolution < 1 || resolution > kMaxResolution)

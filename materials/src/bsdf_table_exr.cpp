@@ -10,6 +10,7 @@
 
 #include <fstream>
 #include <set>
+#include <string>
 
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
@@ -17,33 +18,6 @@
 #include "weft/materials/bsdf_table.h"
 
 namespace weft {
-namespace {
-
-const std::set<std::string>& format_attribute_names() {
-  static const std::set<std::string> names = {
-      "weft_format_version", "parameterization", "resolution", "bands", "units", "kind"};
-  return names;
-}
-
-const std::set<std::string>& exr_standard_attribute_names() {
-  static const std::set<std::string> names = {"channels",
-                                              "compression",
-                                              "dataWindow",
-                                              "displayWindow",
-                                              "lineOrder",
-                                              "pixelAspectRatio",
-                                              "screenWindowCenter",
-                                              "screenWindowWidth",
-                                              "tiles",
-                                              "type",
-                                              "name",
-                                              "version",
-                                              "chunkCount",
-                                              "view"};
-  return names;
-}
-
-}  // namespace
 
 void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
   const std::string file = path.string();
@@ -61,6 +35,7 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
       header.insert("bands", Imf::StringAttribute(bands()));
       header.insert("units", Imf::StringAttribute(kUnits));
       header.insert("kind", Imf::StringAttribute(kind));
+      header.insert("values_fnv1a64", Imf::StringAttribute(checksum()));
       for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
 
       Imf::FrameBuffer fb;
@@ -163,14 +138,18 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
     char* base = reinterpret_cast<char*>(table.values.data());
     for (int c = 0; c < table.channels; ++c)
       fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + sizeof(float) * c, x_stride, y_stride));
+    const std::string stored_checksum = string_attr("values_fnv1a64");
     in.setFrameBuffer(fb);
     if (!in.isComplete()) throw Error(file, "", "truncated: pixel data incomplete");
     in.readPixels(0, n - 1);
+    if (table.checksum() != stored_checksum)
+      throw Error(file, "values_fnv1a64",
+                  "pixel data is corrupt (checksum " + table.checksum() + " does not match " +
+                      stored_checksum + ")");
 
     for (auto it = h.begin(); it != h.end(); ++it) {
       const std::string name = it.name();
-      if (format_attribute_names().count(name) || exr_standard_attribute_names().count(name))
-        continue;
+      if (is_reserved_attribute(name)) continue;
       if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
         table.metadata[name] = s->value();
     }

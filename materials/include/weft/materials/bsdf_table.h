@@ -14,7 +14,9 @@
 // are bit-exact). Header attributes:
 //   weft_format_version (int) = 1, parameterization (string) = kParameterization,
 //   resolution (int) = R, bands (string) = "rgb" | "390:710:10", units (string) = "1/sr",
-//   kind (string) = "fiber" | "fabric",
+//   kind (string) = "fiber" | "fabric", values_fnv1a64 (string, 16 hex digits) = checksum() of the
+//   values (EXR itself has no checksum: an uncompressible table is stored raw, and damaged bytes
+//   would read back as other finite numbers),
 //   and every entry of 'metadata' as a string attribute (conventional keys: spec_hash, photons,
 //   seed, program_version).
 #include <cstdint>
@@ -82,6 +84,9 @@ struct TabulatedBsdfTable {
   float at(int wi_bin, int wo_bin, int channel) const {
     return values[index(wi_bin, wo_bin, channel)];
   }
+  // 64-bit FNV-1a over the values' bytes (IEEE binary32, little-endian, in index order), as 16
+  // lower-case hex digits.
+  std::string checksum() const;
   // "rgb" or "390:710:10"; channel names "R","G","B" or "w390".."w710".
   std::string bands() const;
   std::vector<std::string> channel_names() const;
@@ -90,6 +95,8 @@ struct TabulatedBsdfTable {
   // [1, kMaxResolution], channels 3 or 33, kind known, size matches, every value finite and >= 0,
   // metadata keys not reserved.
   static constexpr int kMaxResolution = 128;
+  // Attribute names the format or OpenEXR itself uses; metadata may not use them.
+  static bool is_reserved_attribute(const std::string& name);
   void validate(const std::string& file_for_errors) const;
 
   // Cell averages of an analytic f by stratified sampling: for each (wi bin, wo bin) pair,
