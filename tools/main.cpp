@@ -12,6 +12,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   weft::cli::Commands commands;
   weft::cli::add_spectrum_command(app, commands);
+  weft::cli::add_table_command(app, commands);
 
   try {
     app.parse(argc, argv);

@@ -171,7 +171,8 @@ void TabulatedBsdfTable::validate(const std::string& file) const {
 
 TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channels,
                                                      const TableFunction& f, int samples_per_cell,
-                                                     uint64_t seed, int threads) {
+                                                     uint64_t seed, int threads,
+                                                     const ProgressCallback& progress) {
   const std::string who = "TabulatedBsdfTable::from_function";
   if (samples_per_cell < 1) throw Error(who, "samples_per_cell", "must be >= 1");
   TabulatedBsdfTable table;
@@ -184,7 +185,9 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
   table.values.assign(static_cast<size_t>(n_bins) * n_bins * channels, 0.0f);
   const double r = resolution;
 
-  parallel_for(static_cast<uint64_t>(n_bins), threads, [&](uint64_t wi_task) {
+  // Rows (wi bins) in chunks, so progress is reported from this thread between chunks.
+  const int chunk = std::max(1, n_bins / 64);
+  auto row = [&](uint64_t wi_task) {
     const int wi_bin = static_cast<int>(wi_task);
     const int n = samples_per_cell;
     std::vector<double> sum(channels), value(channels);
@@ -220,7 +223,14 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
       for (int c = 0; c < channels; ++c)
         table.values[table.index(wi_bin, wo_bin, c)] = static_cast<float>(sum[c] / n);
     }
-  });
+  };
+  for (int first = 0; first < n_bins; first += chunk) {
+    const int count = std::min(chunk, n_bins - first);
+    parallel_for(static_cast<uint64_t>(count), threads,
+                 [&](uint64_t i) { row(static_cast<uint64_t>(first) + i); });
+    if (!progress({"table", static_cast<uint64_t>(first + count), static_cast<uint64_t>(n_bins)}))
+      throw Error(who, "", "cancelled");
+  }
   return table;
 }
 

@@ -182,6 +182,25 @@ TEST(TableFromFunction, SameBitsAtAnyThreadCountAndSeedMatters) {
   EXPECT_NE(a.values, c.values);
 }
 
+TEST(TableFromFunction, ReportsProgressAndCanBeCancelled) {
+  auto f = [](const Vec3&, const Vec3&, std::span<double> v) { v[0] = v[1] = v[2] = 1; };
+  uint64_t last = 0, total = 0;
+  int calls = 0;
+  TabulatedBsdfTable::from_function(4, 3, f, 1, 0, 2, [&](const ProgressUpdate& u) {
+    EXPECT_GT(u.done, last);
+    last = u.done, total = u.total, ++calls;
+    return true;
+  });
+  EXPECT_EQ(last, 16u);
+  EXPECT_EQ(total, 16u);
+  EXPECT_GT(calls, 1);
+  const std::string msg = error_of([&] {
+    TabulatedBsdfTable::from_function(4, 3, f, 1, 0, 2,
+                                      [](const ProgressUpdate&) { return false; });
+  });
+  EXPECT_NE(msg.find("cancelled"), std::string::npos) << msg;
+}
+
 TEST(TableFromFunction, RejectsBadInputAndBadValues) {
   auto ok = [](const Vec3&, const Vec3&, std::span<double> v) { v[0] = v[1] = v[2] = 1; };
   EXPECT_NE(error_of([&] { TabulatedBsdfTable::from_function(0, 3, ok, 1); }).find("resolution"),

@@ -27,6 +27,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/progress.h"
 #include "weft/core/vec.h"
 
 namespace weft {
@@ -102,9 +103,12 @@ struct TabulatedBsdfTable {
   // Cell averages of an analytic f by stratified sampling: for each (wi bin, wo bin) pair,
   // 'samples_per_cell' pairs of directions, each Latin-hypercube stratified within its cell (in
   // the equal-area square, i.e. uniform in solid angle). Random streams come from
-  // (seed, wi bin, wo bin), so the result is the same at any thread count.
+  // (seed, wi bin, wo bin), so the result is the same at any thread count. 'progress' is called
+  // on the calling thread between chunks of rows (stage "table"); returning false cancels with a
+  // weft::Error (a partial table is of no use).
   static TabulatedBsdfTable from_function(int resolution, int channels, const TableFunction& f,
-                                          int samples_per_cell, uint64_t seed = 0, int threads = 0);
+                                          int samples_per_cell, uint64_t seed = 0, int threads = 0,
+                                          const ProgressCallback& progress = no_progress());
 
   // Writes the OpenEXR file atomically (a complete file or none). Throws weft::Error.
   void write_exr(const std::filesystem::path& path) const;
