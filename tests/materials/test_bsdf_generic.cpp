@@ -23,7 +23,9 @@ struct Material {
 };
 
 std::vector<Material> all_materials() {
-  const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_generic_tmp";
+  // One folder per test: ctest runs tests as parallel processes.
+  const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_generic_tmp" /
+                       ::testing::UnitTest::GetInstance()->current_test_info()->name();
   fs::remove_all(dir);
   fs::create_directories(dir);
   const auto fiber = ClassicFiberBsdf::create(Rgb(0.6, 0.3, 0.2), {MicrofacetModel::kGgx, 0.3});

@@ -20,7 +20,9 @@ struct Fixture {
   fs::path dir;
   MaterialContext ctx;
   Fixture() {
-    dir = fs::path(WEFT_BINARY_DIR) / "test_registry_tmp";
+    // One folder per test: ctest runs tests as parallel processes.
+    dir = fs::path(WEFT_BINARY_DIR) / "test_registry_tmp" /
+          ::testing::UnitTest::GetInstance()->current_test_info()->name();
     fs::remove_all(dir);
     fs::create_directories(dir / "tables");
     auto f = [](const Vec3&, const Vec3& wi, std::span<double> v) {
