@@ -7,5 +7,6 @@ namespace weft::cli {
 void add_spectrum_command(CLI::App& app, Commands& commands);
 void add_mie_command(CLI::App& app, Commands& commands);
 void add_medium_command(CLI::App& app, Commands& commands);
+void add_table_command(CLI::App& app, Commands& commands);
 
 }  // namespace weft::cli

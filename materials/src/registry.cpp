@@ -1,10 +1,12 @@
 #include "weft/materials/registry.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
 
 #include "weft/core/error.h"
+#include "weft/materials/table_cache.h"
 
 namespace weft {
 namespace {
@@ -44,12 +46,128 @@ Rgb parse_rgb(const nlohmann::json& params, const std::string& key, Rgb fallback
   return Rgb(check(v));
 }
 
+double parse_number(const nlohmann::json& params, const std::string& key, double fallback,
+                    double lo, double hi, const MaterialContext& ctx) {
+  if (!params.contains(key)) return fallback;
+  const auto& v = params.at(key);
+  if (!v.is_number()) throw Error(ctx.source_file, field_name(ctx, key), "must be a number");
+  const double d = v.get<double>();
+  if (!std::isfinite(d) || d < lo || d > hi)
+    throw Error(
+        ctx.source_file, field_name(ctx, key),
+        "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
+  return d;
+}
+
+std::string parse_string(const nlohmann::json& params, const std::string& key,
+                         const MaterialContext& ctx) {
+  const auto& v = params.at(key);
+  if (!v.is_string() || v.get<std::string>().empty())
+    throw Error(ctx.source_file, field_name(ctx, key), "must be a non-empty string");
+  return v.get<std::string>();
+}
+
+// "distribution" plus "alpha" or "roughness" (alpha = roughness^2, the perceptual convention).
+MicrofacetDistribution parse_microfacet(const nlohmann::json& p, const MaterialContext& ctx) {
+  MicrofacetDistribution d;
+  d.model = MicrofacetModel::kBeckmann;  // Cook and Torrance's own choice
+  if (p.contains("distribution")) {
+    const std::string name = parse_string(p, "distribution", ctx);
+    if (name == "beckmann") {
+      d.model = MicrofacetModel::kBeckmann;
+    } else if (name == "ggx") {
+      d.model = MicrofacetModel::kGgx;
+    } else {
+      throw Error(ctx.source_file, field_name(ctx, "distribution"),
+                  "unknown distribution '" + name + "' (valid: beckmann, ggx)");
+    }
+  }
+  if (p.contains("alpha") && p.contains("roughness"))
+    throw Error(ctx.source_file, field_name(ctx, "roughness"),
+                "give either alpha or roughness, not both");
+  // Below 1e-3 the lobe is narrower than double-precision sampling resolves well.
+  constexpr double kMinAlpha = 1e-3, kMaxAlpha = 1.0;
+  d.alpha = 0.3;
+  if (p.contains("alpha")) d.alpha = parse_number(p, "alpha", 0.3, kMinAlpha, kMaxAlpha, ctx);
+  if (p.contains("roughness")) {
+    const double r = parse_number(p, "roughness", 0.0, std::sqrt(kMinAlpha), 1.0, ctx);
+    d.alpha = r * r;
+  }
+  return d;
+}
+
+double parse_ior(const nlohmann::json& p, const MaterialContext& ctx) {
+  return parse_number(p, "ior", kCottonIor, 1.0, 4.0, ctx);
+}
+
+// fiber_table / fabric_table: the table file (relative to base_dir), its kind, tint and scale.
+Bsdf make_table_bsdf(const nlohmann::json& p, const MaterialContext& ctx, const std::string& kind) {
+  reject_unknown_keys(p, {"file", "tint", "scale"}, ctx);
+  if (!p.contains("file")) throw Error(ctx.source_file, field_name(ctx, "file"), "is required");
+  std::filesystem::path file = parse_string(p, "file", ctx);
+  if (file.is_relative()) file = ctx.base_dir / file;
+  const Rgb tint = parse_rgb(p, "tint", Rgb(1.0), 0.0, 1.0, ctx);
+  const double scale = parse_number(p, "scale", 1.0, 0.0, 10.0, ctx);
+  std::shared_ptr<const TabulatedBsdfData> data;
+  try {
+    data = ctx.cache ? ctx.cache->tabulated(file) : load_tabulated_bsdf(file);
+  } catch (const Error& e) {
+    throw Error(ctx.source_file, field_name(ctx, "file"), e.what());
+  }
+  if (data->kind != kind)
+    throw Error(ctx.source_file, field_name(ctx, "file"),
+                file.string() + " holds a " + data->kind + " table, expected a " + kind + " table");
+  return TabulatedBsdf{data, tint * scale};
+}
+
 const std::map<std::string, Factory>& factories() {
   static const std::map<std::string, Factory> table = {
       {"lambert",
        [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
          reject_unknown_keys(p, {"reflectance"}, ctx);
          return LambertBsdf{parse_rgb(p, "reflectance", Rgb(0.5), 0.0, 1.0, ctx)};
+       }},
+      {"cook_torrance",
+       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
+         reject_unknown_keys(p, {"distribution", "alpha", "roughness", "ior", "tint"}, ctx);
+         return CookTorranceBsdf{parse_microfacet(p, ctx), parse_ior(p, ctx),
+                                 parse_rgb(p, "tint", Rgb(1.0), 0.0, 1.0, ctx)};
+       }},
+      {"classic_fiber",
+       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
+         reject_unknown_keys(p, {"reflectance", "distribution", "alpha", "roughness", "ior"}, ctx);
+         return ClassicFiberBsdf::create(parse_rgb(p, "reflectance", Rgb(0.5), 0.0, 1.0, ctx),
+                                         parse_microfacet(p, ctx), parse_ior(p, ctx));
+       }},
+      {"fiber_table",
+       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
+         return make_table_bsdf(p, ctx, "fiber");
+       }},
+      {"fabric_table",
+       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
+         return make_table_bsdf(p, ctx, "fabric");
+       }},
+      {"measured_nbrdf",
+       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
+         reject_unknown_keys(p, {"name", "file"}, ctx);
+         if (p.contains("name") == p.contains("file"))
+           throw Error(ctx.source_file, field_name(ctx, "name"),
+                       "give exactly one of name (a bundled material) or file");
+         std::filesystem::path file;
+         const std::string key = p.contains("name") ? "name" : "file";
+         try {
+           if (key == "name") {
+             file = find_measured_nbrdf(parse_string(p, "name", ctx));
+           } else {
+             file = parse_string(p, "file", ctx);
+             if (file.is_relative()) file = ctx.base_dir / file;
+           }
+           auto net = ctx.cache ? ctx.cache->nbrdf(file)
+                                : std::make_shared<const NbrdfNetwork>(NbrdfNetwork::load(file));
+           return MeasuredNbrdfBsdf{std::move(net)};
+         } catch (const Error& e) {
+           throw Error(ctx.source_file, field_name(ctx, key), e.what());
+         }
        }},
   };
   return table;

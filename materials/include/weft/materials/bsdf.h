@@ -19,30 +19,19 @@
 #include "weft/core/math.h"
 #include "weft/core/spectrum.h"
 #include "weft/core/vec.h"
+#include "weft/materials/bsdf_sample.h"
+#include "weft/materials/classic_fiber.h"
+#include "weft/materials/cook_torrance.h"
+#include "weft/materials/lambert.h"
+#include "weft/materials/measured_nbrdf.h"
+#include "weft/materials/tabulated_bsdf.h"
 
 namespace weft {
 
-struct BsdfSample {
-  Vec3 wi;
-  Rgb weight;          // f * |cos theta_i| / pdf
-  double pdf = 0;      // solid-angle density of wi
-  bool is_delta = false;
-};
-
-// Cosine-weighted direction on the upper (z > 0) hemisphere (Malley's method).
-Vec3 sample_cosine_hemisphere(Vec2 u);
-
-// Ideal diffuse reflector of albedo 'reflectance' on the side wo lies on (two-sided).
-struct LambertBsdf {
-  Rgb reflectance{0.5};
-
-  Rgb eval(const Vec3& wo, const Vec3& wi) const;
-  std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const;
-  double pdf(const Vec3& wo, const Vec3& wi) const;
-};
-
 // The closed set of BSDFs; other materials add their alternative here.
-using BsdfVariant = std::variant<LambertBsdf>;
+// fiber_table and fabric_table are both TabulatedBsdf (the table's kind tells them apart).
+using BsdfVariant =
+    std::variant<LambertBsdf, CookTorranceBsdf, ClassicFiberBsdf, TabulatedBsdf, MeasuredNbrdfBsdf>;
 
 class Bsdf {
  public:

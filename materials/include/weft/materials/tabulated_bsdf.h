@@ -1,0 +1,58 @@
+#pragma once
+// The fiber_table and fabric_table materials: a TabulatedBsdfTable reduced to RGB and prepared for
+// sampling, shared immutable between every material that uses the same file.
+//
+// Evaluation: bilinear interpolation over the 4 nearest bin centres in the octahedral square,
+// separately for wo and for wi (16 table entries), wrapping across the square's folded edges
+// (OctahedralGrid::wrapped_bin). This makes f continuous over the sphere instead of faceted;
+// the cell averages themselves are what the table stores.
+//
+// Sampling: for the bin b holding wo, a Distribution2D over the R x R wi cells with weights
+//   w(b, c) = cos_avg(c) * (m(b, c) + m3(b, c)) / 2,
+// where m is the channel mean of the table, m3 its mean over the 3 x 3 neighbourhoods of b and of
+// c (what bilinear eval can reach), and cos_avg(c) the mean |cos theta| over cell c. wi is uniform
+// (in solid angle) within the chosen cell. pdf(wo, wi) = p_square(wi | bin(wo)) / (4 pi), using
+// the same OctahedralGrid for both directions as sample does; the m3 term makes pdf > 0 wherever
+// the interpolated f > 0.
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "weft/core/distribution.h"
+#include "weft/materials/bsdf_sample.h"
+#include "weft/materials/bsdf_table.h"
+
+namespace weft {
+
+struct TabulatedBsdfData {
+  OctahedralGrid grid;
+  std::string kind;                             // "fiber" | "fabric"
+  std::map<std::string, std::string> metadata;  // from the table
+  std::vector<float> rgb;                       // [wi_bin][wo_bin][3]
+  std::vector<Distribution2D> sampling;         // one per wo bin, over wi cells
+  // Spectral tables: how many RGB components were negative (out of the sRGB gamut) after the
+  // D65 band reduction and were set to 0. Always 0 for RGB tables.
+  size_t clamped_components = 0;
+
+  // Reduces a (validated) table to RGB and builds the per-wo-bin sampling distributions.
+  static std::shared_ptr<const TabulatedBsdfData> prepare(const TabulatedBsdfTable& table);
+
+  Rgb lookup(int wi_bin, int wo_bin) const {
+    const size_t i = (static_cast<size_t>(wi_bin) * static_cast<size_t>(grid.bins()) +
+                      static_cast<size_t>(wo_bin)) *
+                     3;
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+
+struct TabulatedBsdf {
+  std::shared_ptr<const TabulatedBsdfData> data;
+  Rgb scale{1.0};  // tint * scale from the material parameters
+
+  Rgb eval(const Vec3& wo, const Vec3& wi) const;
+  std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const;
+  double pdf(const Vec3& wo, const Vec3& wi) const;
+};
+
+}  // namespace weft

@@ -1,0 +1,237 @@
+#include "weft/materials/bsdf_table.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <numeric>
+#include <set>
+
+#include "weft/core/error.h"
+#include "weft/core/parallel.h"
+#include "weft/core/rng.h"
+#include "weft/core/spectrum.h"
+#include "weft/core/sphere_mapping.h"
+
+namespace weft {
+
+Vec2 OctahedralGrid::to_square(const Vec3& d) {
+  return equal_area_sphere_to_square(d);
+}
+Vec3 OctahedralGrid::to_direction(Vec2 p) {
+  return equal_area_square_to_sphere(p);
+}
+
+int OctahedralGrid::bin_of_square(Vec2 p) const {
+  const int r = resolution;
+  const int x = std::clamp(static_cast<int>(std::floor(p.x * r)), 0, r - 1);
+  const int y = std::clamp(static_cast<int>(std::floor(p.y * r)), 0, r - 1);
+  return y * r + x;
+}
+
+Vec3 OctahedralGrid::bin_center(int bin) const {
+  const int x = bin % resolution, y = bin / resolution;
+  return to_direction({(x + 0.5) / resolution, (y + 0.5) / resolution});
+}
+
+int OctahedralGrid::wrapped_bin(int x, int y) const {
+  const int r = resolution;
+  if (x < 0) {
+    x = -x - 1;
+    y = r - 1 - y;
+  } else if (x >= r) {
+    x = 2 * r - 1 - x;
+    y = r - 1 - y;
+  }
+  if (y < 0) {
+    y = -y - 1;
+    x = r - 1 - x;
+  } else if (y >= r) {
+    y = 2 * r - 1 - y;
+    x = r - 1 - x;
+  }
+  return y * r + x;
+}
+
+OctahedralGrid::Footprint OctahedralGrid::bilinear(Vec2 p) const {
+  const double px = p.x * resolution - 0.5, py = p.y * resolution - 0.5;
+  const double fx0 = std::floor(px), fy0 = std::floor(py);
+  const int x0 = static_cast<int>(fx0), y0 = static_cast<int>(fy0);
+  const double tx = px - fx0, ty = py - fy0;
+  Footprint fp;
+  fp.bin[0] = wrapped_bin(x0, y0);
+  fp.bin[1] = wrapped_bin(x0 + 1, y0);
+  fp.bin[2] = wrapped_bin(x0, y0 + 1);
+  fp.bin[3] = wrapped_bin(x0 + 1, y0 + 1);
+  fp.weight[0] = (1 - tx) * (1 - ty);
+  fp.weight[1] = tx * (1 - ty);
+  fp.weight[2] = (1 - tx) * ty;
+  fp.weight[3] = tx * ty;
+  return fp;
+}
+
+std::string TabulatedBsdfTable::checksum() const {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  for (const float v : values) {
+    uint32_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    for (int k = 0; k < 4; ++k) {
+      h ^= (bits >> (8 * k)) & 0xffu;
+      h *= 0x100000001b3ULL;
+    }
+  }
+  char text[17];
+  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
+  return text;
+}
+
+std::string TabulatedBsdfTable::bands() const {
+  return channels == kNumBands ? std::string(kSpectralBands) : std::string("rgb");
+}
+
+std::vector<std::string> TabulatedBsdfTable::channel_names() const {
+  if (channels == 3) return {"R", "G", "B"};
+  std::vector<std::string> names;
+  for (int b = 0; b < channels; ++b) {
+    // Appending (rather than "w" + ...) sidesteps GCC 12's false -Wrestrict (PR 105329).
+    std::string name(1, 'w');
+    name += std::to_string(static_cast<int>(band_wavelength_nm(b)));
+    names.push_back(std::move(name));
+  }
+  return names;
+}
+
+namespace {
+
+// Attribute names the format itself uses, or that OpenEXR's header reserves.
+const std::set<std::string>& reserved_attribute_names() {
+  static const std::set<std::string> names = {"weft_format_version",
+                                              "parameterization",
+                                              "resolution",
+                                              "bands",
+                                              "units",
+                                              "kind",
+                                              "values_fnv1a64",
+                                              "channels",
+                                              "compression",
+                                              "dataWindow",
+                                              "displayWindow",
+                                              "lineOrder",
+                                              "pixelAspectRatio",
+                                              "screenWindowCenter",
+                                              "screenWindowWidth",
+                                              "tiles",
+                                              "type",
+                                              "name",
+                                              "version",
+                                              "chunkCount",
+                                              "view"};
+  return names;
+}
+
+}  // namespace
+
+bool TabulatedBsdfTable::is_reserved_attribute(const std::string& name) {
+  return reserved_attribute_names().count(name) > 0;
+}
+
+void TabulatedBsdfTable::validate(const std::string& file) const {
+  if (resolution < 1 || resolution > kMaxResolution)
+    throw Error(file, "resolution",
+                "must lie in [1, " + std::to_string(kMaxResolution) + "], got " +
+                    std::to_string(resolution));
+  if (channels != 3 && channels != kNumBands)
+    throw Error(file, "bands",
+                "need 3 (RGB) or 33 (390..710 nm) channels, got " + std::to_string(channels));
+  if (kind != "fiber" && kind != "fabric")
+    throw Error(file, "kind", "must be \"fiber\" or \"fabric\", got \"" + kind + "\"");
+  const size_t expected =
+      static_cast<size_t>(bins()) * static_cast<size_t>(bins()) * static_cast<size_t>(channels);
+  if (values.size() != expected)
+    throw Error(file, "values",
+                "holds " + std::to_string(values.size()) + " numbers, expected " +
+                    std::to_string(expected));
+  for (const auto& [key, value] : metadata) {
+    if (key.empty() || reserved_attribute_names().count(key))
+      throw Error(file, "metadata." + key, "name is reserved by the table format");
+  }
+  for (size_t i = 0; i < values.size(); ++i) {
+    const float v = values[i];
+    if (std::isfinite(v) && v >= 0) continue;
+    const size_t c = i % static_cast<size_t>(channels);
+    const size_t cell = i / static_cast<size_t>(channels);
+    const size_t wo = cell % static_cast<size_t>(bins()), wi = cell / static_cast<size_t>(bins());
+    throw Error(file,
+                "values[wi " + std::to_string(wi) + "][wo " + std::to_string(wo) + "][" +
+                    channel_names()[c] + "]",
+                std::isfinite(v) ? "is negative (" + std::to_string(v) + ")" : "is not finite");
+  }
+}
+
+TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channels,
+                                                     const TableFunction& f, int samples_per_cell,
+                                                     uint64_t seed, int threads,
+                                                     const ProgressCallback& progress) {
+  const std::string who = "TabulatedBsdfTable::from_function";
+  if (samples_per_cell < 1) throw Error(who, "samples_per_cell", "must be >= 1");
+  TabulatedBsdfTable table;
+  table.resolution = resolution;
+  table.channels = channels;
+  if (resolution < 1 || resolution > kMaxResolution || (channels != 3 && channels != kNumBands)) {
+    table.validate(who);  // throws the precise message
+  }
+  const int n_bins = table.bins();
+  table.values.assign(static_cast<size_t>(n_bins) * n_bins * channels, 0.0f);
+  const double r = resolution;
+
+  // Rows (wi bins) in chunks, so progress is reported from this thread between chunks.
+  const int chunk = std::max(1, n_bins / 64);
+  auto row = [&](uint64_t wi_task) {
+    const int wi_bin = static_cast<int>(wi_task);
+    const int n = samples_per_cell;
+    std::vector<double> sum(channels), value(channels);
+    std::array<std::vector<int>, 4> perm;
+    for (auto& p : perm) p.resize(n);
+    for (int wo_bin = 0; wo_bin < n_bins; ++wo_bin) {
+      Rng rng(seed, static_cast<uint64_t>(wi_bin), static_cast<uint64_t>(wo_bin));
+      // Latin hypercube: each of the 4 square coordinates visits each of its n strata once.
+      for (auto& p : perm) {
+        std::iota(p.begin(), p.end(), 0);
+        for (int i = n - 1; i > 0; --i)
+          std::swap(p[i], p[std::min<int>(i, static_cast<int>(rng.uniform() * (i + 1)))]);
+      }
+      std::fill(sum.begin(), sum.end(), 0.0);
+      const int xi = wi_bin % resolution, yi = wi_bin / resolution;
+      const int xo = wo_bin % resolution, yo = wo_bin / resolution;
+      for (int s = 0; s < n; ++s) {
+        const Vec2 pi{(xi + (perm[0][s] + rng.uniform()) / n) / r,
+                      (yi + (perm[1][s] + rng.uniform()) / n) / r};
+        const Vec2 po{(xo + (perm[2][s] + rng.uniform()) / n) / r,
+                      (yo + (perm[3][s] + rng.uniform()) / n) / r};
+        const Vec3 wi = OctahedralGrid::to_direction(pi), wo = OctahedralGrid::to_direction(po);
+        std::fill(value.begin(), value.end(), 0.0);
+        f(wo, wi, value);
+        for (int c = 0; c < channels; ++c) {
+          if (!std::isfinite(value[c]) || value[c] < 0)
+            throw Error(who, "f",
+                        "returned a negative or non-finite value at wo bin " +
+                            std::to_string(wo_bin) + ", wi bin " + std::to_string(wi_bin));
+          sum[c] += value[c];
+        }
+      }
+      for (int c = 0; c < channels; ++c)
+        table.values[table.index(wi_bin, wo_bin, c)] = static_cast<float>(sum[c] / n);
+    }
+  };
+  for (int first = 0; first < n_bins; first += chunk) {
+    const int count = std::min(chunk, n_bins - first);
+    parallel_for(static_cast<uint64_t>(count), threads,
+                 [&](uint64_t i) { row(static_cast<uint64_t>(first) + i); });
+    if (!progress({"table", static_cast<uint64_t>(first + count), static_cast<uint64_t>(n_bins)}))
+      throw Error(who, "", "cancelled");
+  }
+  return table;
+}
+
+}  // namespace weft

@@ -1,0 +1,141 @@
+#include "weft/materials/tabulated_bsdf.h"
+
+#include <array>
+#include <cmath>
+
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/parallel.h"
+#include "weft/core/spectrum.h"
+
+namespace weft {
+namespace {
+
+// Sub-samples per side for the mean |cos theta| of a cell.
+constexpr int kCosSubsamples = 8;
+
+// The 3 x 3 block of bins around 'bin' (across the octahedral fold where needed).
+std::array<int, 9> neighbourhood(const OctahedralGrid& grid, int bin) {
+  const int r = grid.resolution, x = bin % r, y = bin / r;
+  std::array<int, 9> out{};
+  int k = 0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) out[k++] = grid.wrapped_bin(x + dx, y + dy);
+  return out;
+}
+
+}  // namespace
+
+std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
+    const TabulatedBsdfTable& table) {
+  table.validate("");
+  auto data = std::make_shared<TabulatedBsdfData>();
+  const OctahedralGrid grid = table.grid();
+  const int n = grid.bins(), r = grid.resolution;
+  const size_t cells = static_cast<size_t>(n) * static_cast<size_t>(n);
+  data->grid = grid;
+  data->kind = table.kind;
+  data->metadata = table.metadata;
+  data->rgb.resize(cells * 3);
+
+  // RGB, and the channel mean m that drives sampling.
+  std::vector<float> mean(cells);
+  const auto& weights = srgb_band_weights_d65();
+  for (size_t cell = 0; cell < cells; ++cell) {
+    Rgb c;
+    if (table.channels == 3) {
+      c = {table.values[cell * 3], table.values[cell * 3 + 1], table.values[cell * 3 + 2]};
+    } else {
+      for (int b = 0; b < table.channels; ++b)
+        c += weights[b] * static_cast<double>(table.values[cell * table.channels + b]);
+      // Saturated spectra can fall outside the sRGB gamut; a BSDF cannot be negative.
+      for (double* v : {&c.r, &c.g, &c.b}) {
+        if (*v < 0) {
+          *v = 0;
+          ++data->clamped_components;
+        }
+      }
+    }
+    data->rgb[cell * 3] = static_cast<float>(c.r);
+    data->rgb[cell * 3 + 1] = static_cast<float>(c.g);
+    data->rgb[cell * 3 + 2] = static_cast<float>(c.b);
+    mean[cell] = static_cast<float>(c.average());
+  }
+
+  // m3: mean of m over the 3 x 3 neighbourhoods of the wi bin and of the wo bin (separably).
+  std::vector<std::array<int, 9>> nbr(n);
+  for (int b = 0; b < n; ++b) nbr[b] = neighbourhood(grid, b);
+  std::vector<float> tmp(cells), blur(cells);
+  auto at = [n](int wi, int wo) { return static_cast<size_t>(wi) * n + static_cast<size_t>(wo); };
+  for (int wi = 0; wi < n; ++wi)
+    for (int wo = 0; wo < n; ++wo) {
+      double s = 0;
+      for (int k : nbr[wi]) s += mean[at(k, wo)];
+      tmp[at(wi, wo)] = static_cast<float>(s / 9);
+    }
+  for (int wi = 0; wi < n; ++wi)
+    for (int wo = 0; wo < n; ++wo) {
+      double s = 0;
+      for (int k : nbr[wo]) s += tmp[at(wi, k)];
+      blur[at(wi, wo)] = static_cast<float>(s / 9);
+    }
+
+  std::vector<double> cos_avg(n);
+  for (int b = 0; b < n; ++b) {
+    const int x = b % r, y = b / r;
+    double s = 0;
+    for (int i = 0; i < kCosSubsamples; ++i)
+      for (int j = 0; j < kCosSubsamples; ++j) {
+        const Vec2 p{(x + (i + 0.5) / kCosSubsamples) / r, (y + (j + 0.5) / kCosSubsamples) / r};
+        s += std::abs(OctahedralGrid::to_direction(p).z);
+      }
+    cos_avg[b] = s / (kCosSubsamples * kCosSubsamples);
+  }
+
+  data->sampling.resize(n);
+  parallel_for(static_cast<uint64_t>(n), 0, [&](uint64_t task) {
+    const int wo = static_cast<int>(task);
+    std::vector<double> w(n);
+    for (int wi = 0; wi < n; ++wi)
+      w[wi] = cos_avg[wi] * 0.5 * (static_cast<double>(mean[at(wi, wo)]) + blur[at(wi, wo)]);
+    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(r), static_cast<size_t>(r));
+  });
+  return data;
+}
+
+Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
+  const OctahedralGrid& grid = data->grid;
+  const auto fo = grid.bilinear(OctahedralGrid::to_square(wo));
+  const auto fi = grid.bilinear(OctahedralGrid::to_square(wi));
+  Rgb sum;
+  for (int a = 0; a < 4; ++a) {
+    if (fi.weight[a] == 0) continue;
+    for (int b = 0; b < 4; ++b) {
+      const double w = fi.weight[a] * fo.weight[b];
+      if (w != 0) sum += data->lookup(fi.bin[a], fo.bin[b]) * w;
+    }
+  }
+  return sum * scale;
+}
+
+double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
+  const OctahedralGrid& grid = data->grid;
+  const Distribution2D& dist = data->sampling[grid.bin_of(wo)];
+  if (dist.integral() == 0) return 0;
+  // The density is constant over wi's cell: evaluate it at the centre of the cell the grid
+  // assigns, so the cell is decided by OctahedralGrid alone.
+  const int cell = grid.bin_of(wi), r = grid.resolution;
+  const Vec2 centre{(cell % r + 0.5) / r, (cell / r + 0.5) / r};
+  return dist.pdf(centre) * kInv4Pi;  // area on the unit square = solid angle / (4 pi)
+}
+
+std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double) const {
+  const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
+  if (dist.integral() == 0) return std::nullopt;
+  const Vec3 wi = OctahedralGrid::to_direction(dist.sample(u).p);
+  const double p = pdf(wo, wi);
+  if (!(p > 0)) return std::nullopt;
+  return BsdfSample{wi, eval(wo, wi) * (std::abs(wi.z) / p), p, false};
+}
+
+}  // namespace weft

@@ -1,0 +1,156 @@
+// make_bsdf: every material by name, and errors that name the file and field.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+
+#include "weft/core/error.h"
+#include "weft/materials/bsdf.h"
+#include "weft/materials/registry.h"
+#include "weft/materials/table_cache.h"
+
+using namespace weft;
+using json = nlohmann::json;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Fixture {
+  fs::path dir;
+  MaterialContext ctx;
+  Fixture() {
+    // One folder per test: ctest runs tests as parallel processes.
+    dir = fs::path(WEFT_BINARY_DIR) / "test_registry_tmp" /
+          ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::remove_all(dir);
+    fs::create_directories(dir / "tables");
+    auto f = [](const Vec3&, const Vec3& wi, std::span<double> v) {
+      v[0] = v[1] = v[2] = 0.1 + 0.1 * wi.z * wi.z;
+    };
+    auto fiber = TabulatedBsdfTable::from_function(4, 3, f, 1);
+    fiber.write_exr(dir / "tables" / "fiber.exr");
+    auto fabric = fiber;
+    fabric.kind = "fabric";
+    fabric.write_exr(dir / "tables" / "fabric.exr");
+    ctx.base_dir = dir;
+    ctx.source_file = "scene.json";
+    ctx.field_prefix = "materials.seat";
+    ctx.cache = std::make_shared<TableCache>();
+  }
+};
+
+std::string error_of(const std::string& type, const json& params, const MaterialContext& ctx) {
+  try {
+    make_bsdf(type, params, ctx);
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// The error must name the file and the full field path.
+void expect_error(const std::string& type, const json& params, const MaterialContext& ctx,
+                  const std::string& field, const std::string& also = "") {
+  const std::string msg = error_of(type, params, ctx);
+  ASSERT_FALSE(msg.empty()) << type << " accepted " << params.dump();
+  EXPECT_NE(msg.find("scene.json"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("'materials.seat." + field + "'"), std::string::npos) << msg;
+  if (!also.empty()) {
+    EXPECT_NE(msg.find(also), std::string::npos) << msg;
+  }
+}
+
+}  // namespace
+
+TEST(Registry, EveryNameConstructsFromValidParameters) {
+  Fixture fx;
+  const std::pair<std::string, json> valid[] = {
+      {"lambert", {{"reflectance", {0.8, 0.2, 0.1}}}},
+      {"cook_torrance", {{"distribution", "ggx"}, {"alpha", 0.2}, {"ior", 1.557}, {"tint", 0.9}}},
+      {"classic_fiber", {{"reflectance", 0.6}, {"distribution", "beckmann"}, {"roughness", 0.5}}},
+      {"fiber_table", {{"file", "tables/fiber.exr"}, {"tint", {1, 0.5, 0.5}}, {"scale", 2}}},
+      {"fabric_table", {{"file", "tables/fabric.exr"}}},
+      {"measured_nbrdf", {{"name", "merl-red-fabric"}}},
+  };
+  std::vector<std::string> names;
+  for (const auto& [type, params] : valid) {
+    names.push_back(type);
+    const Bsdf b = make_bsdf(type, params, fx.ctx);
+    const Vec3 wo{0.3, 0.1, std::sqrt(1 - 0.1)}, wi{-0.2, 0.3, std::sqrt(1 - 0.13)};
+    EXPECT_GT(b.eval(wo, wi).max_component(), 0.0) << type;
+    EXPECT_TRUE(b.sample(wo, {0.3, 0.6}, 0.4).has_value()) << type;
+  }
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, material_names()) << "every registered name is exercised here";
+  // Defaults work too (an empty object).
+  for (const std::string t : {"lambert", "cook_torrance", "classic_fiber"})
+    EXPECT_NO_THROW(make_bsdf(t, json::object(), fx.ctx)) << t;
+}
+
+TEST(Registry, ParametersReachTheMaterial) {
+  Fixture fx;
+  const Bsdf ct = make_bsdf("cook_torrance", {{"distribution", "ggx"}, {"roughness", 0.5}}, fx.ctx);
+  const auto& c = std::get<CookTorranceBsdf>(ct.variant());
+  EXPECT_EQ(c.distribution.model, MicrofacetModel::kGgx);
+  EXPECT_DOUBLE_EQ(c.distribution.alpha, 0.25);  // alpha = roughness^2
+  EXPECT_DOUBLE_EQ(c.ior, kCottonIor);
+  const Bsdf t =
+      make_bsdf("fiber_table", {{"file", "tables/fiber.exr"}, {"tint", 0.5}, {"scale", 2}}, fx.ctx);
+  EXPECT_EQ(std::get<TabulatedBsdf>(t.variant()).scale, Rgb(1.0));
+  // Two materials on one file share one table.
+  const Bsdf t2 = make_bsdf("fiber_table", {{"file", "./tables/../tables/fiber.exr"}}, fx.ctx);
+  EXPECT_EQ(std::get<TabulatedBsdf>(t.variant()).data.get(),
+            std::get<TabulatedBsdf>(t2.variant()).data.get());
+}
+
+TEST(Registry, UnknownTypeListsTheValidNames) {
+  Fixture fx;
+  const std::string msg = error_of("velvet", json::object(), fx.ctx);
+  EXPECT_NE(msg.find("velvet"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("materials.seat.type"), std::string::npos) << msg;
+  for (const auto& n : material_names())
+    EXPECT_NE(msg.find(n), std::string::npos) << n << ": " << msg;
+}
+
+TEST(Registry, BadParametersAreNamed) {
+  Fixture fx;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  expect_error("lambert", {{"reflectanse", 0.5}}, fx.ctx, "reflectanse", "unknown parameter");
+  expect_error("lambert", {{"reflectance", 1.5}}, fx.ctx, "reflectance");
+  expect_error("lambert", {{"reflectance", {0.5, 0.5}}}, fx.ctx, "reflectance");
+  expect_error("cook_torrance", {{"alpha", nan}}, fx.ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", 0.0}}, fx.ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", 2.0}}, fx.ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", "rough"}}, fx.ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", 0.2}, {"roughness", 0.4}}, fx.ctx, "roughness");
+  expect_error("cook_torrance", {{"distribution", "phong"}}, fx.ctx, "distribution", "ggx");
+  expect_error("cook_torrance", {{"ior", 0.5}}, fx.ctx, "ior");
+  expect_error("cook_torrance", {{"ior", nan}}, fx.ctx, "ior");
+  expect_error("cook_torrance", {{"tint", {0.5, nan, 0.5}}}, fx.ctx, "tint");
+  expect_error("classic_fiber", {{"reflectance", -0.1}}, fx.ctx, "reflectance");
+  expect_error("classic_fiber", {{"tint", 0.5}}, fx.ctx, "tint", "unknown parameter");
+  expect_error("fiber_table", json::object(), fx.ctx, "file", "required");
+  expect_error("fiber_table", {{"file", 3}}, fx.ctx, "file");
+  expect_error("fiber_table", {{"file", "tables/none.exr"}}, fx.ctx, "file", "none.exr");
+  expect_error("fiber_table", {{"file", "tables/fabric.exr"}}, fx.ctx, "file", "fabric table");
+  expect_error("fabric_table", {{"file", "tables/fiber.exr"}}, fx.ctx, "file", "fiber table");
+  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", -1}}, fx.ctx, "scale");
+  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", nan}}, fx.ctx, "scale");
+  expect_error("measured_nbrdf", {{"name", "blue-fabric"}}, fx.ctx, "name", "merl-white-fabric");
+  expect_error("measured_nbrdf", json::object(), fx.ctx, "name", "exactly one");
+  expect_error("measured_nbrdf", {{"file", "nbrdf.txt"}}, fx.ctx, "file", "nbrdf.txt");
+  expect_error("measured_nbrdf", {{"name", "merl-red-fabric"}, {"file", "x"}}, fx.ctx, "name");
+  // Parameters must be an object.
+  const std::string msg = error_of("lambert", json::array({1, 2}), fx.ctx);
+  EXPECT_NE(msg.find("JSON object"), std::string::npos) << msg;
+}
+
+TEST(Registry, MeasuredByFileResolvesAgainstBaseDir) {
+  Fixture fx;
+  fs::copy_file(find_measured_nbrdf("merl-white-fabric"), fx.dir / "w.txt");
+  const Bsdf by_file = make_bsdf("measured_nbrdf", {{"file", "w.txt"}}, fx.ctx);
+  const Bsdf by_name = make_bsdf("measured_nbrdf", {{"name", "merl-white-fabric"}}, fx.ctx);
+  const Vec3 wo{0, 0, 1}, wi{0.6, 0, 0.8};
+  EXPECT_EQ(by_file.eval(wo, wi), by_name.eval(wo, wi));
+}

@@ -1,0 +1,201 @@
+// fiber_table / fabric_table: the prepared table as a BSDF (interpolated eval, per-wo-bin
+// sampling), energy, spectral reduction, and the shared cache.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "chi2.h"
+#include "weft/core/error.h"
+#include "weft/core/spectrum.h"
+#include "weft/materials/bsdf.h"
+#include "weft/materials/table_cache.h"
+
+using namespace weft;
+using namespace weft::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+TabulatedBsdfTable table_of(int resolution, const std::function<Rgb(const Vec3&, const Vec3&)>& f,
+                            int spp = 16) {
+  return TabulatedBsdfTable::from_function(
+      resolution, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const Rgb c = f(wo, wi);
+        v[0] = c.r, v[1] = c.g, v[2] = c.b;
+      },
+      spp, 1);
+}
+
+Bsdf bsdf_of(const TabulatedBsdfTable& t, Rgb scale = Rgb(1.0)) {
+  return TabulatedBsdf{TabulatedBsdfData::prepare(t), scale};
+}
+
+// int eval(wo, wi) |cos theta_i| dwi, exact up to the midpoint rule on a 512^2 square grid.
+double albedo_by_quadrature(const Bsdf& b, const Vec3& wo) {
+  double sum = 0;
+  for (double c : OctahedralSquareGrid{1, 512}.integrate(
+           [&](const Vec3& wi) { return b.eval(wo, wi).g * std::abs(wi.z); }))
+    sum += c;
+  return sum;
+}
+
+// A lopsided, anisotropic, partly transmitting test function.
+Rgb lumpy(const Vec3& wo, const Vec3& wi) {
+  const Vec3 m{-wo.x, -wo.y, wo.z};
+  const double lobe = std::exp(-6 * length_squared(wi - m));
+  const double base = wo.z * wi.z > 0 ? 0.2 * (1 + 0.5 * wi.x * wo.x) : 0.03;
+  return Rgb(base + lobe, 0.5 * base + 0.3 * lobe, 0.1 * base);
+}
+
+const Vec3 kWos[] = {spherical_direction(0.1, 0.2), spherical_direction(0.9, 2.0),
+                     spherical_direction(1.5, -1.0), spherical_direction(2.4, 0.7)};
+
+}  // namespace
+
+TEST(TableBsdf, LosslessTwoSidedDiffuserPassesTheWhiteFurnace) {
+  // f = 1 / (2 pi) on the whole sphere scatters everything (half reflected, half transmitted):
+  // int f |cos| dw = 1 exactly, and a table holds it exactly, so only Monte Carlo noise remains.
+  const Bsdf b = bsdf_of(table_of(8, [](const Vec3&, const Vec3&) { return Rgb(0.5 * kInvPi); }));
+  uint64_t seed = 1;
+  for (double theta : {0.0, 0.7, 1.45, 1.5707, 2.2, 3.1}) {
+    const auto a = estimate_albedo(b, spherical_direction(theta, 0.4), 100000, seed++);
+    EXPECT_NEAR(a.mean.r, 1.0, 4 * a.standard_error.r + 1e-6) << "theta " << theta;
+    // The 512^2 midpoint rule itself is off by ~1.5e-5 here: |cos theta| has a kink along the
+    // equator, which runs diagonally through the square's cells.
+    EXPECT_NEAR(albedo_by_quadrature(b, spherical_direction(theta, 0.4)), 1.0, 5e-5);
+  }
+}
+
+TEST(TableBsdf, LambertOneTablePassesTheWhiteFurnaceAwayFromTheEquator) {
+  // Lambert(1) reflects everything on wo's side. The table's cells along the equator mix the lit
+  // and the unlit side, which costs the interpolated table ~1e-3 of albedo at R = 16 (falling as
+  // 1/R^2: measured 3e-3 at R = 8); wo cells that straddle the equator themselves (theta_o > ~75
+  // deg at R = 16) are excluded, since their cell average is half-lit by construction.
+  const Bsdf b = bsdf_of(table_of(
+      16, [](const Vec3& wo, const Vec3& wi) { return LambertBsdf{Rgb(1.0)}.eval(wo, wi); }));
+  uint64_t seed = 10;
+  for (double theta_deg : {0.0, 20.0, 45.0, 60.0, 70.0, 120.0, 170.0}) {
+    const Vec3 wo = spherical_direction(deg_to_rad(theta_deg), 0.3);
+    const double exact = albedo_by_quadrature(b, wo);
+    EXPECT_NEAR(exact, 1.0, 2e-3) << "theta " << theta_deg;
+    const auto a = estimate_albedo(b, wo, 100000, seed++);
+    EXPECT_NEAR(a.mean.g, exact, 4 * a.standard_error.g) << "theta " << theta_deg;
+  }
+}
+
+TEST(TableBsdf, EvalAtBinCentresReturnsTheTable) {
+  const auto t = table_of(6, lumpy, 4);
+  const Bsdf b = bsdf_of(t);
+  const OctahedralGrid g = t.grid();
+  for (int wi = 0; wi < g.bins(); wi += 5)
+    for (int wo = 0; wo < g.bins(); wo += 7) {
+      const Rgb f = b.eval(g.bin_center(wo), g.bin_center(wi));
+      EXPECT_NEAR(f.r, t.at(wi, wo, 0), 1e-6 * t.at(wi, wo, 0) + 1e-12);
+      EXPECT_NEAR(f.b, t.at(wi, wo, 2), 1e-6 * t.at(wi, wo, 2) + 1e-12);
+    }
+}
+
+// Mostly zero: a narrow lobe, so bilinear eval reaches into cells whose own value is 0.
+Rgb sparse(const Vec3& wo, const Vec3& wi) {
+  const Vec3 m{-wo.x, -wo.y, wo.z};
+  return dot(wi, m) > 0.9 ? Rgb(2.0) : Rgb(0.0);
+}
+
+TEST(TableBsdf, SampleWeightAndPdfAreConsistent) {
+  Rng rng(4);
+  for (const Bsdf& b :
+       {bsdf_of(table_of(8, lumpy, 4), Rgb(0.9, 0.8, 0.7)), bsdf_of(table_of(8, sparse, 4))}) {
+    for (const Vec3& wo : kWos) {
+      for (int i = 0; i < 2000; ++i) {
+        const auto s = b.sample(wo, {rng.uniform(), rng.uniform()}, rng.uniform());
+        if (!s) continue;
+        EXPECT_DOUBLE_EQ(s->pdf, b.pdf(wo, s->wi));
+        const Rgb expect = b.eval(wo, s->wi) * (std::abs(s->wi.z) / b.pdf(wo, s->wi));
+        EXPECT_NEAR(s->weight.r, expect.r, 1e-12 * std::max(1.0, expect.r));
+      }
+      // The pdf integrates to exactly 1: a piecewise-constant density on the table's own cells.
+      double total = 0;
+      for (double c : OctahedralSquareGrid{1, 64}.integrate(bsdf_pdf(b, wo))) total += c;
+      EXPECT_TRUE(total == 0 || std::abs(total - 1) < 1e-9) << total;
+    }
+  }
+}
+
+TEST(TableBsdf, PdfCoversWhereverInterpolationReaches) {
+  // Bilinear eval is positive next to non-zero cells, also inside cells whose own value is 0;
+  // the pdf must be positive there too or that light could never be sampled.
+  const auto t = table_of(8, sparse, 4);
+  const Bsdf b = bsdf_of(t);
+  const OctahedralGrid g = t.grid();
+  Rng rng(8);
+  int reached_from_neighbours = 0;
+  for (int i = 0; i < 200000; ++i) {
+    const Vec3 wo = equal_area_square_to_sphere({rng.uniform(), rng.uniform()});
+    const Vec3 wi = equal_area_square_to_sphere({rng.uniform(), rng.uniform()});
+    if (b.eval(wo, wi).max_component() <= 0) continue;
+    EXPECT_GT(b.pdf(wo, wi), 0.0);
+    reached_from_neighbours += t.at(g.bin_of(wi), g.bin_of(wo), 0) == 0;
+  }
+  EXPECT_GT(reached_from_neighbours, 100);
+}
+
+TEST(TableBsdf, ScaleMultipliesValueNotDensity) {
+  const auto t = table_of(4, lumpy, 4);
+  const Bsdf one = bsdf_of(t), half = bsdf_of(t, Rgb(0.5, 0.25, 1.0));
+  const Vec3 wo = kWos[1], wi = spherical_direction(0.6, 1.0);
+  EXPECT_DOUBLE_EQ(half.eval(wo, wi).r, 0.5 * one.eval(wo, wi).r);
+  EXPECT_DOUBLE_EQ(half.eval(wo, wi).g, 0.25 * one.eval(wo, wi).g);
+  EXPECT_DOUBLE_EQ(half.pdf(wo, wi), one.pdf(wo, wi));
+}
+
+TEST(TableBsdf, AllZeroColumnSamplesNothing) {
+  const Bsdf b = bsdf_of(table_of(
+      4, [](const Vec3&, const Vec3&) { return Rgb(0.0); }, 1));
+  EXPECT_FALSE(b.sample(kWos[0], {0.3, 0.3}, 0.5).has_value());
+  EXPECT_EQ(b.pdf(kWos[0], kWos[1]), 0.0);
+}
+
+TEST(TableBsdf, SpectralTablesReduceToRgbUnderD65) {
+  TabulatedBsdfTable t;
+  t.resolution = 2;
+  t.channels = kNumBands;
+  t.values.assign(static_cast<size_t>(t.bins()) * t.bins() * kNumBands, 0.3f);
+  // A flat spectrum reduces to grey: D65 white maps to linear sRGB (1, 1, 1) (IEC 61966-2-1
+  // white point), so 0.3 per band -> 0.3 per channel, to the matrix's 4 printed digits.
+  auto d = TabulatedBsdfData::prepare(t);
+  EXPECT_EQ(d->clamped_components, 0u);
+  const Rgb c = d->lookup(1, 2);
+  EXPECT_NEAR(c.r, 0.3, 1e-3);
+  EXPECT_NEAR(c.g, 0.3, 1e-3);
+  EXPECT_NEAR(c.b, 0.3, 1e-3);
+  // Monochromatic 500 nm light lies outside the sRGB gamut (negative red): clamped and counted.
+  std::fill(t.values.begin(), t.values.end(), 0.0f);
+  for (size_t cell = 0; cell < t.values.size() / kNumBands; ++cell)
+    t.values[cell * kNumBands + 11] = 1.0f;
+  d = TabulatedBsdfData::prepare(t);
+  EXPECT_EQ(d->clamped_components, static_cast<size_t>(t.bins() * t.bins()));
+  EXPECT_EQ(d->lookup(0, 0).r, 0.0);
+  EXPECT_GT(d->lookup(0, 0).g, 0.0);
+}
+
+TEST(TableCache, LoadsEachFileOnceUnderAnySpelling) {
+  const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_table_tmp" / "cache";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "sub");
+  table_of(4, lumpy, 1).write_exr(dir / "t.exr");
+  TableCache cache;
+  const auto a = cache.tabulated(dir / "t.exr");
+  const auto b = cache.tabulated(dir / "sub" / ".." / "t.exr");
+  EXPECT_EQ(a.get(), b.get());
+  EXPECT_EQ(cache.size(), 1u);
+  EXPECT_EQ(a->kind, "fiber");
+  try {
+    cache.tabulated(dir / "none.exr");
+    ADD_FAILURE() << "a missing file must throw";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("none.exr"), std::string::npos);
+  }
+  EXPECT_EQ(cache.size(), 1u);
+}

@@ -1,0 +1,350 @@
+// The tabulated-BSDF table: octahedral indexing, from_function, and the OpenEXR format with its
+// validation.
+#include <OpenEXR/ImfChannelList.h>
+#include <OpenEXR/ImfFrameBuffer.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfIntAttribute.h>
+#include <OpenEXR/ImfOutputFile.h>
+#include <OpenEXR/ImfStringAttribute.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/rng.h"
+#include "weft/core/spectrum.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/materials/lambert.h"
+
+using namespace weft;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path temp_dir(const std::string& name) {
+  const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_table_tmp" / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// A small table with distinct, exactly representable values and full metadata.
+TabulatedBsdfTable sample_table(int resolution, int channels) {
+  TabulatedBsdfTable t;
+  t.resolution = resolution;
+  t.channels = channels;
+  t.kind = "fabric";
+  t.metadata = {{"spec_hash", "3f9a0c"},
+                {"photons", "123456789012"},
+                {"seed", "42"},
+                {"program_version", "weft 0.1.0"}};
+  t.values.resize(static_cast<size_t>(t.bins()) * t.bins() * channels);
+  Rng rng(5);
+  for (float& v : t.values) v = static_cast<float>(rng.uniform() * 3);
+  t.values[7] = 0.0f;
+  t.values[8] = 1e-30f;  // denormal-adjacent values survive too
+  return t;
+}
+
+// Writes an EXR like write_exr does (checksum included), letting the edits damage the pixels
+// (before the checksum is taken) or the header.
+void write_raw(const fs::path& path, int resolution, const std::vector<std::string>& channels,
+               const std::function<void(Imf::Header&)>& edit_header,
+               const std::function<void(std::vector<float>&)>& edit_values = {}) {
+  const int n = resolution * resolution;
+  const size_t nc = channels.size();
+  std::vector<float> values(static_cast<size_t>(n) * n * nc, 0.25f);
+  if (edit_values) edit_values(values);
+  TabulatedBsdfTable for_checksum;
+  for_checksum.values = values;
+  Imf::Header h(n, n);
+  h.compression() = Imf::ZIP_COMPRESSION;
+  for (const auto& c : channels) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
+  h.insert("weft_format_version", Imf::IntAttribute(1));
+  h.insert("parameterization", Imf::StringAttribute(TabulatedBsdfTable::kParameterization));
+  h.insert("resolution", Imf::IntAttribute(resolution));
+  h.insert("bands", Imf::StringAttribute("rgb"));
+  h.insert("units", Imf::StringAttribute("1/sr"));
+  h.insert("kind", Imf::StringAttribute("fiber"));
+  h.insert("values_fnv1a64", Imf::StringAttribute(for_checksum.checksum()));
+  edit_header(h);
+  Imf::FrameBuffer fb;
+  for (size_t c = 0; c < nc; ++c)
+    fb.insert(channels[c], Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(values.data() + c),
+                                      sizeof(float) * nc, sizeof(float) * nc * n));
+  Imf::OutputFile out(path.c_str(), h);
+  out.setFrameBuffer(fb);
+  out.writePixels(n);
+}
+
+}  // namespace
+
+TEST(OctahedralGrid, BinsRoundTripAndCoverEqualSolidAngle) {
+  for (int r : {1, 2, 7, 16}) {
+    const OctahedralGrid g{r};
+    for (int b = 0; b < g.bins(); ++b) EXPECT_EQ(g.bin_of(g.bin_center(b)), b);
+  }
+  // Equal area: uniform directions fill the R^2 bins evenly (each 4 pi / R^2 of solid angle).
+  const OctahedralGrid g{4};
+  std::vector<int> counts(g.bins(), 0);
+  Rng rng(1);
+  const int n = 160000;
+  for (int i = 0; i < n; ++i) {
+    const double z = 2 * rng.uniform() - 1, phi = 2 * kPi * rng.uniform();
+    const double s = std::sqrt(1 - z * z);
+    ++counts[g.bin_of({s * std::cos(phi), s * std::sin(phi), z})];
+  }
+  const double expect = static_cast<double>(n) / g.bins();
+  for (int c : counts) EXPECT_NEAR(c, expect, 5 * std::sqrt(expect));
+}
+
+TEST(OctahedralGrid, FoldNeighboursAreAdjacentOnTheSphere) {
+  // Across each edge of the square the wrapped neighbour must be a geometric neighbour: its centre
+  // is about one cell away (cell width ~ sqrt(4 pi) / R radians), never across the sphere.
+  for (int r : {4, 8, 16}) {
+    const OctahedralGrid g{r};
+    const double cell = std::sqrt(4 * kPi) / r;
+    for (int i = -1; i <= r; ++i)
+      for (int j : {-1, r}) {
+        for (auto [x, y, xi, yi] :
+             {std::array{i, j, std::clamp(i, 0, r - 1), std::clamp(j, 0, r - 1)},
+              std::array{j, i, std::clamp(j, 0, r - 1), std::clamp(i, 0, r - 1)}}) {
+          const Vec3 a = g.bin_center(yi * r + xi), b = g.bin_center(g.wrapped_bin(x, y));
+          EXPECT_LT(safe_acos(dot(a, b)), 2.0 * cell)
+              << "r " << r << " cell (" << x << ", " << y << ")";
+        }
+      }
+  }
+}
+
+TEST(OctahedralGrid, BilinearIsContinuousAcrossTheFold) {
+  // (1 - e, v) and (1 - e, 1 - v) lie on either side of the fold; their interpolation weights over
+  // bins must agree as e -> 0 since they approach the same direction.
+  const OctahedralGrid g{8};
+  for (double v : {0.1, 0.37, 0.8}) {
+    const double e = 1e-9;
+    const auto a = g.bilinear({1 - e, v}), b = g.bilinear({1 - e, 1 - v});
+    std::map<int, double> wa, wb;
+    for (int k = 0; k < 4; ++k) wa[a.bin[k]] += a.weight[k], wb[b.bin[k]] += b.weight[k];
+    for (auto& [bin, w] : wa) EXPECT_NEAR(w, wb[bin], 1e-6) << "v " << v << " bin " << bin;
+    double sum = 0;
+    for (double w : a.weight) sum += w;
+    EXPECT_NEAR(sum, 1.0, 1e-15);
+  }
+}
+
+TEST(TableFromFunction, LambertGivesRhoOverPiInsideTheHemisphere) {
+  const LambertBsdf lambert{Rgb(0.8, 0.5, 0.2)};
+  const auto t = TabulatedBsdfTable::from_function(
+      8, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const Rgb f = lambert.eval(wo, wi);
+        v[0] = f.r, v[1] = f.g, v[2] = f.b;
+      },
+      4, 1);
+  const OctahedralGrid g = t.grid();
+  int checked = 0;
+  for (int wi = 0; wi < g.bins(); ++wi)
+    for (int wo = 0; wo < g.bins(); ++wo) {
+      // Only cells wholly on one side: the equator cuts the cells along the square's diagonal
+      // diamond, so test cell centres well away from it.
+      const double zi = g.bin_center(wi).z, zo = g.bin_center(wo).z;
+      if (std::abs(zi) < 0.3 || std::abs(zo) < 0.3) continue;
+      const double expect_g = zi * zo > 0 ? 0.5 / kPi : 0.0;
+      EXPECT_NEAR(t.at(wi, wo, 1), expect_g, 1e-7);
+      EXPECT_NEAR(t.at(wi, wo, 0), zi * zo > 0 ? 0.8 / kPi : 0.0, 1e-7);
+      ++checked;
+    }
+  EXPECT_GT(checked, 1000);
+}
+
+TEST(TableFromFunction, SameBitsAtAnyThreadCountAndSeedMatters) {
+  auto f = [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+    v[0] = std::exp(-3 * length_squared(wo - wi)), v[1] = wi.z * wi.z, v[2] = 0.1;
+  };
+  const auto a = TabulatedBsdfTable::from_function(4, 3, f, 9, 17, 1);
+  const auto b = TabulatedBsdfTable::from_function(4, 3, f, 9, 17, 2);
+  const auto c = TabulatedBsdfTable::from_function(4, 3, f, 9, 18, 2);
+  EXPECT_EQ(a.values, b.values);
+  EXPECT_NE(a.values, c.values);
+}
+
+TEST(TableFromFunction, ReportsProgressAndCanBeCancelled) {
+  auto f = [](const Vec3&, const Vec3&, std::span<double> v) { v[0] = v[1] = v[2] = 1; };
+  uint64_t last = 0, total = 0;
+  int calls = 0;
+  TabulatedBsdfTable::from_function(4, 3, f, 1, 0, 2, [&](const ProgressUpdate& u) {
+    EXPECT_GT(u.done, last);
+    last = u.done, total = u.total, ++calls;
+    return true;
+  });
+  EXPECT_EQ(last, 16u);
+  EXPECT_EQ(total, 16u);
+  EXPECT_GT(calls, 1);
+  const std::string msg = error_of([&] {
+    TabulatedBsdfTable::from_function(4, 3, f, 1, 0, 2,
+                                      [](const ProgressUpdate&) { return false; });
+  });
+  EXPECT_NE(msg.find("cancelled"), std::string::npos) << msg;
+}
+
+TEST(TableFromFunction, RejectsBadInputAndBadValues) {
+  auto ok = [](const Vec3&, const Vec3&, std::span<double> v) { v[0] = v[1] = v[2] = 1; };
+  EXPECT_NE(error_of([&] { TabulatedBsdfTable::from_function(0, 3, ok, 1); }).find("resolution"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { TabulatedBsdfTable::from_function(2, 4, ok, 1); }).find("bands"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of([&] { TabulatedBsdfTable::from_function(2, 3, ok, 0); }).find("samples_per_cell"),
+      std::string::npos);
+  auto nan = [](const Vec3&, const Vec3&, std::span<double> v) { v[0] = std::nan(""); };
+  EXPECT_NE(error_of([&] { TabulatedBsdfTable::from_function(2, 3, nan, 1); }).find("'f'"),
+            std::string::npos);
+}
+
+TEST(TableExr, RoundTripIsBitExactWithMetadata) {
+  const fs::path dir = temp_dir("roundtrip");
+  for (int channels : {3, kNumBands}) {
+    const auto t = sample_table(channels == 3 ? 6 : 3, channels);
+    const fs::path p = dir / ("t" + std::to_string(channels) + ".exr");
+    t.write_exr(p);
+    const auto back = TabulatedBsdfTable::read_exr(p);
+    EXPECT_EQ(back.resolution, t.resolution);
+    EXPECT_EQ(back.channels, t.channels);
+    EXPECT_EQ(back.kind, t.kind);
+    EXPECT_EQ(back.metadata, t.metadata);
+    ASSERT_EQ(back.values.size(), t.values.size());
+    EXPECT_EQ(std::memcmp(back.values.data(), t.values.data(), t.values.size() * sizeof(float)), 0);
+  }
+  // Spectral channels are named per band.
+  EXPECT_EQ(sample_table(2, kNumBands).channel_names().front(), "w390");
+  EXPECT_EQ(sample_table(2, kNumBands).channel_names().back(), "w710");
+}
+
+TEST(TableExr, WriteValidatesAndLeavesNoPartialFile) {
+  const fs::path dir = temp_dir("write");
+  auto t = sample_table(4, 3);
+  t.values[100] = -1.0f;
+  const fs::path p = dir / "bad.exr";
+  const std::string msg = error_of([&] { t.write_exr(p); });
+  EXPECT_NE(msg.find(p.string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("negative"), std::string::npos) << msg;
+  EXPECT_FALSE(fs::exists(p));
+  EXPECT_TRUE(fs::is_empty(dir)) << "no temporary left behind";
+  t.values[100] = 1.0f;
+  t.metadata["resolution"] = "9";
+  EXPECT_NE(error_of([&] { t.write_exr(p); }).find("reserved"), std::string::npos);
+  t.metadata.erase("resolution");
+  EXPECT_NE(error_of([&] { t.write_exr(dir / "missing" / "t.exr"); }).find("directory"),
+            std::string::npos);
+}
+
+TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
+  const fs::path dir = temp_dir("damaged");
+  const std::vector<std::string> rgb = {"R", "G", "B"};
+  struct Case {
+    std::string name, must_mention;
+    std::function<void(const fs::path&)> make;
+  };
+  const fs::path good = dir / "good.exr";
+  sample_table(8, 3).write_exr(good);
+  const auto good_size = fs::file_size(good);
+  auto copy_bytes = [&](const fs::path& p, size_t keep) {
+    std::ifstream in(good, std::ios::binary);
+    std::vector<char> bytes(keep);
+    in.read(bytes.data(), static_cast<std::streamsize>(keep));
+    std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(keep));
+  };
+  const Case cases[] = {
+      {"missing.exr", "no such", [](const fs::path&) {}},
+      {"text.exr", "not an OpenEXR", [](const fs::path& p) { std::ofstream(p) << "hello"; }},
+      {"truncated.exr", "truncated", [&](const fs::path& p) { copy_bytes(p, good_size * 2 / 3); }},
+      {"header_only.exr", "", [&](const fs::path& p) { copy_bytes(p, 300); }},
+      {"corrupt.exr", "corrupt",
+       [&](const fs::path& p) {
+         copy_bytes(p, good_size);
+         std::fstream f(p, std::ios::binary | std::ios::in | std::ios::out);
+         f.seekp(static_cast<std::streamoff>(good_size - 2000));
+         const std::string junk(600, '\x5a');
+         f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
+       }},
+      {"version.exr", "weft_format_version",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb,
+                   [](Imf::Header& h) { h.insert("weft_format_version", Imf::IntAttribute(2)); });
+       }},
+      {"nochecksum.exr", "values_fnv1a64",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb, [](Imf::Header& h) { h.erase("values_fnv1a64"); });
+       }},
+      {"noversion.exr", "weft_format_version",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb, [](Imf::Header& h) { h.erase("weft_format_version"); });
+       }},
+      {"param.exr", "parameterization",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb, [](Imf::Header& h) {
+           h.insert("parameterization", Imf::StringAttribute("theta-phi"));
+         });
+       }},
+      {"units.exr", "units",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb,
+                   [](Imf::Header& h) { h.insert("units", Imf::StringAttribute("1/m")); });
+       }},
+      {"kind.exr", "kind",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb,
+                   [](Imf::Header& h) { h.insert("kind", Imf::StringAttribute("hair")); });
+       }},
+      {"size.exr", "dataWindow",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb, [](Imf::Header& h) { h.insert("resolution", Imf::IntAttribute(3)); });
+       }},
+      {"bands.exr", "bands",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb,
+                   [](Imf::Header& h) { h.insert("bands", Imf::StringAttribute("xyz")); });
+       }},
+      {"channels.exr", "channels",
+       [&](const fs::path& p) {
+         write_raw(p, 2, {"R", "G"}, [](Imf::Header&) {});
+       }},
+      {"extra_channel.exr", "channels",
+       [&](const fs::path& p) {
+         write_raw(p, 2, {"A", "B", "G", "R"}, [](Imf::Header&) {});
+       }},
+      {"nan.exr", "values[wi 1][wo 2][G]",
+       [&](const fs::path& p) {
+         write_raw(
+             p, 2, rgb, [](Imf::Header&) {},
+             [](std::vector<float>& v) { v[(1 * 4 + 2) * 3 + 1] = std::nanf(""); });
+       }},
+      {"negative.exr", "negative",
+       [&](const fs::path& p) {
+         write_raw(
+             p, 2, rgb, [](Imf::Header&) {}, [](std::vector<float>& v) { v[5] = -0.5f; });
+       }},
+  };
+  for (const auto& c : cases) {
+    const fs::path p = dir / c.name;
+    c.make(p);
+    const std::string msg = error_of([&] { TabulatedBsdfTable::read_exr(p); });
+    ASSERT_FALSE(msg.empty()) << c.name << " was accepted";
+    EXPECT_NE(msg.find(p.string()), std::string::npos) << msg;
+    EXPECT_NE(msg.find(c.must_mention), std::string::npos) << c.name << ": " << msg;
+  }
+}
