@@ -227,7 +227,7 @@ int run_medium(const MediumCliOptions& o) {
                         {"hash", m.spec_hash},
                         {"fiber_radius_um", m.fiber_radius_um},
                         {"roughness",
-                         {{"distribution", to_string(spec.roughness_distribution)},
+                         {{"distribution", microfacet_model_name(spec.roughness_distribution)},
                           {"alpha", spec.roughness_alpha}}}};
   nlohmann::json arr = nlohmann::json::array();
   for (const auto& b : m.bands)

@@ -160,9 +160,6 @@ json spectrum_json(const Spectrum& s) {
 
 }  // namespace
 
-const char* to_string(MicrofacetDistribution d) {
-  return d == MicrofacetDistribution::kGgx ? "ggx" : "beckmann";
-}
 
 FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file) {
   json root;
@@ -186,9 +183,9 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
   const std::string dist =
       text(require(rough, file, "roughness", "distribution"), file, "roughness.distribution");
   if (dist == "beckmann")
-    spec.roughness_distribution = MicrofacetDistribution::kBeckmann;
+    spec.roughness_distribution = MicrofacetModel::kBeckmann;
   else if (dist == "ggx")
-    spec.roughness_distribution = MicrofacetDistribution::kGgx;
+    spec.roughness_distribution = MicrofacetModel::kGgx;
   else
     throw Error(file, "roughness.distribution", "unknown '" + dist + "' (beckmann, ggx)");
   spec.roughness_alpha =
@@ -289,7 +286,7 @@ std::string canonical_json(const FiberSpec& spec) {
   json j;
   j["format"] = "weft-fiber-spec-1";
   j["fiber_radius_um"] = spec.fiber_radius_um;
-  j["roughness"] = {{"distribution", to_string(spec.roughness_distribution)},
+  j["roughness"] = {{"distribution", microfacet_model_name(spec.roughness_distribution)},
                     {"alpha", spec.roughness_alpha}};
   j["host"] = {{"n", spectrum_json(spec.host_n)},
                {"absorption_per_um", spectrum_json(spec.host_absorption_per_um)}};

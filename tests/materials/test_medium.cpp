@@ -59,7 +59,7 @@ TEST(FiberSpec, ParsesMinimalSpec) {
   const FiberSpec s = parse_fiber_spec(kMinimal, "spec.json");
   EXPECT_EQ(s.name, "test");
   EXPECT_EQ(s.fiber_radius_um, 5);
-  EXPECT_EQ(s.roughness_distribution, MicrofacetDistribution::kGgx);
+  EXPECT_EQ(s.roughness_distribution, MicrofacetModel::kGgx);
   EXPECT_EQ(s.roughness_alpha, 0.2);
   for (int b = 0; b < kNumBands; ++b) {
     EXPECT_EQ(s.host_n[b], 1.5);

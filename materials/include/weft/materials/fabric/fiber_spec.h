@@ -25,10 +25,10 @@
 
 #include "weft/core/spectrum.h"
 #include "weft/materials/fabric/mie.h"
+#include "weft/materials/microfacet.h"
 
 namespace weft {
 
-enum class MicrofacetDistribution { kBeckmann, kGgx };
 
 struct ParticleSpecies {
   std::string name;
@@ -40,7 +40,7 @@ struct ParticleSpecies {
 struct FiberSpec {
   std::string name;
   double fiber_radius_um = 0;
-  MicrofacetDistribution roughness_distribution = MicrofacetDistribution::kBeckmann;
+  MicrofacetModel roughness_distribution = MicrofacetModel::kBeckmann;
   double roughness_alpha = 0;         // in (0, 1]
   Spectrum host_n{};                  // real refractive index of the fibre material
   Spectrum host_absorption_per_um{};  // absorption coefficient of the host (dye), >= 0
@@ -68,6 +68,5 @@ std::string canonical_json(const FiberSpec& spec);
 uint64_t fiber_spec_hash(const FiberSpec& spec);
 std::string fiber_spec_hash_hex(const FiberSpec& spec);
 
-const char* to_string(MicrofacetDistribution d);
 
 }  // namespace weft
