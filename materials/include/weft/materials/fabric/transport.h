@@ -71,7 +71,7 @@ struct TransportOptions {
   double roulette_survival = 0.1;    // MCML's "chance" (m = 10)
   // Cap on interactions per photon (scatterings plus internal reflections); the weight of a photon
   // that reaches it goes to PhotonTally::lost.
-  uint64_t max_events = 100'000'000;
+  uint64_t max_events = 10'000'000;
 
   void validate() const;
 };
