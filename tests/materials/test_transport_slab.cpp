@@ -126,6 +126,24 @@ TEST(TransportSlab, McmlVanDeHulstMatchedSlab) {
   EXPECT_NEAR(r.energy_imbalance, 0, 1e-12);
 }
 
+// The engine takes any phase function: a dense table of HG(0.75) must reproduce the same
+// van de Hulst values (references as in the previous test).
+TEST(TransportSlab, TabulatedPhaseFunctionReproducesHgSlab) {
+  const PhaseFunction hg = PhaseFunction::henyey_greenstein(0.75);
+  std::vector<double> mu, p;
+  const int n = 4000;
+  for (int i = 0; i <= n; ++i) {
+    const double t = static_cast<double>(i) / n;
+    mu.push_back(i == 0 ? -1.0 : 1 - 2 * (1 - t) * (1 - t));  // nodes crowd to the forward peak
+    p.push_back(hg.eval(mu.back()));
+  }
+  SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
+  s.medium.phase = PhaseFunction::tabulated(mu, p);
+  const SlabResult r = simulate_slab(s, batch(400000, 27));
+  EXPECT_TRUE(within_sigma(r.rd, 0.09739, 3));
+  EXPECT_TRUE(within_sigma(r.tt, 0.66096, 3));
+}
+
 // MCML 2.0 sample run 1b (lhvwang/MCML, V2/MCML2.0/samples/sample1/sample1b.mco): semi-infinite
 // medium n = 1.5 in air, mu_a = 10/cm, mu_s = 90/cm, g = 0, normal incidence, 1e5 photons:
 // Rsp = 0.04, Rd = 0.220348 +- 0.000916 (A = 0.739652). Rsp is exactly ((1.5-1)/(1.5+1))^2.
@@ -263,7 +281,7 @@ TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   int calls = 0;
   b.progress = [&](const ProgressUpdate& u) {
     EXPECT_EQ(u.total, 200000u);
-    return ++calls < 2;
+    return ++calls < 3;  // the first call comes before any work
   };
   const SlabResult cut = simulate_slab(s, b);
   EXPECT_TRUE(cut.cancelled);
@@ -273,6 +291,11 @@ TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   EXPECT_FALSE(ref.cancelled);
   EXPECT_EQ(cut.rd.mean, ref.rd.mean);
   EXPECT_EQ(cut.tt.mean, ref.tt.mean);
+  // Cancelling before the start traces nothing and says so.
+  b.progress = [](const ProgressUpdate&) { return false; };
+  const SlabResult none = simulate_slab(s, b);
+  EXPECT_TRUE(none.cancelled);
+  EXPECT_EQ(none.photons, 0u);
 }
 
 // Extremes stay finite and bounded.

@@ -51,7 +51,7 @@ struct BatchOptions {
   uint64_t seed = 0;
   int threads = 0;                   // 0: all hardware threads
   uint64_t photons_per_task = 4096;  // fixes the random streams: change it, change the bits
-  uint64_t tasks_per_wave = 0;       // 0: 16 per thread; lower it when tallies are large
+  uint64_t tasks_per_wave = 0;       // 0: 8 per thread; lower it when tallies are large
   ProgressCallback progress;         // may be empty
 
   void validate() const {
@@ -77,8 +77,13 @@ BatchStatus run_photon_tasks(const BatchOptions& options, const Tally& zero, Tal
   const uint64_t tasks = options.photons / per_task + (options.photons % per_task != 0 ? 1 : 0);
   const int threads = options.threads > 0 ? options.threads : hardware_threads();
   const uint64_t wave =
-      options.tasks_per_wave > 0 ? options.tasks_per_wave : 16 * static_cast<uint64_t>(threads);
+      options.tasks_per_wave > 0 ? options.tasks_per_wave : 8 * static_cast<uint64_t>(threads);
   BatchStatus status;
+  // A first report before any work starts the front end's clock and allows an early stop.
+  if (options.progress && !options.progress(ProgressUpdate{"photons", 0, options.photons})) {
+    status.cancelled = tasks > 0;
+    return status;
+  }
   std::vector<Tally> tallies;
   for (uint64_t start = 0; start < tasks; start += wave) {
     const uint64_t n = std::min(wave, tasks - start);
