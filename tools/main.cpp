@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", WEFT_VERSION);
   app.require_subcommand(1);
   weft::cli::Commands commands;
+  weft::cli::add_slab_command(app, commands);
   weft::cli::add_spectrum_command(app, commands);
   weft::cli::add_mie_command(app, commands);
   weft::cli::add_medium_command(app, commands);
