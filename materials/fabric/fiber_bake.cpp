@@ -58,10 +58,39 @@ uint64_t run_tasks_ordered(uint64_t count, int threads, uint64_t units_per_task,
   return done;
 }
 
+// Energy books of a batch of photons (weights, not yet divided by the flux launched).
+struct EnergyTally {
+  double launched = 0, exited = 0, surface = 0, absorbed = 0, roulette_net = 0, lost = 0, excess = 0;
+  uint64_t photons = 0, events = 0;
+
+  void add_trace(const FiberTraceResult& r) {
+    events += r.scattering_events;
+    absorbed += r.absorbed_weight;
+    roulette_net += r.roulette_net;
+    lost += r.lost_weight;
+  }
+  EnergyTally& operator+=(const EnergyTally& o) {
+    launched += o.launched, exited += o.exited, surface += o.surface, absorbed += o.absorbed;
+    roulette_net += o.roulette_net, lost += o.lost, excess += o.excess;
+    photons += o.photons, events += o.events;
+    return *this;
+  }
+  void fill(FiberBandTable& t) const {
+    const double inv = launched > 0 ? 1 / launched : 0;
+    t.photons = photons;
+    t.scattering_events = events;
+    t.exit_fraction = exited * inv;
+    t.surface_fraction = surface * inv;
+    t.absorbed_fraction = absorbed * inv;
+    t.roulette_net = roulette_net * inv;
+    t.lost_fraction = lost * inv;
+    t.surface_sampling_excess = excess * inv;
+  }
+};
+
 struct DirectTally {
   std::vector<double> sum;  // R^4, sum of exit weights per (i, o)
-  double exit_weight = 0, surface_weight = 0;
-  uint64_t photons = 0, events = 0;
+  EnergyTally energy;
 };
 
 }  // namespace
@@ -144,15 +173,20 @@ FiberBandTable finish_table(int resolution, std::vector<double> weighted_sum) {
 
 // Light hits the surface at 'point' (normal n_point, local frame 'frame') from world direction
 // 'omega' (towards the light). Emits the surface-reflected exit and traces the refracted part.
-// 'w0' is the photon's flux weight. Returns scattering events.
+// 'w0' is the photon's flux weight.
 template <class Frame_, class Sink>
-uint64_t hit_fiber(const FiberGeometry& g, const FiberSurfaceModel& surface,
-                   const FiberInteriorTracer& tracer, const Frame_& frame, const Vec3& point,
-                   const Vec3& omega, double w0, Rng& rng, const Sink& sink,
-                   double* surface_weight) {
+void hit_fiber(const FiberGeometry& g, const FiberSurfaceModel& surface,
+               const FiberInteriorTracer& tracer, const Frame_& frame, const Vec3& point,
+               const Vec3& omega, double w0, Rng& rng, const Sink& sink, EnergyTally& energy) {
+  energy.launched += w0;
+  ++energy.photons;
   const Vec3 omega_local = frame.to_local(omega);
   const double cos_a = omega_local.z;
-  if (!(cos_a > 0)) return 0;
+  if (!(cos_a > 0)) {  // a grazing edge ray (measure zero): book it, never drop it
+    energy.lost += w0;
+    return;
+  }
+  double sampled_surface = 0;
   // Surface lobe: one sampled reflected direction with weight f cos / pdf (expectation = albedo).
   Vec3 w_out;
   double weight = 0;
@@ -160,16 +194,21 @@ uint64_t hit_fiber(const FiberGeometry& g, const FiberSurfaceModel& surface,
   const double u_lobe = rng.uniform();
   if (surface.sample && surface.sample(omega_local, u, u_lobe, &w_out, &weight) && weight > 0) {
     const FiberExit e{point, frame.to_world(w_out), w0 * weight};
-    *surface_weight += e.weight;
+    sampled_surface = e.weight;
+    energy.surface += e.weight;
     sink(e);
   }
   // The rest enters, refracted at the macroscopic (smooth) normal.
   const double albedo = surface.albedo ? surface.albedo(cos_a) : 0.0;
+  energy.excess += sampled_surface - w0 * albedo;
   const double w_in = w0 * (1 - albedo);
-  if (!(w_in > 0)) return 0;
+  if (!(w_in > 0)) return;
   Vec3 d;
-  if (!refract(-omega, frame.n, g.n_outside, g.n_fiber, &d)) return 0;  // impossible from outside
-  return tracer(point, normalize(d), w_in, rng, sink);
+  if (!refract(-omega, frame.n, g.n_outside, g.n_fiber, &d)) {  // impossible from outside
+    energy.lost += w_in;
+    return;
+  }
+  energy.add_trace(tracer(point, normalize(d), w_in, rng, sink));
 }
 
 }  // namespace
@@ -182,8 +221,7 @@ FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurface
   const size_t cells = static_cast<size_t>(R) * R;
   const uint64_t tasks = (s.photons + s.photons_per_task - 1) / s.photons_per_task;
   std::vector<double> total(cells * cells, 0.0);
-  double exit_weight = 0, surface_weight = 0;
-  uint64_t photons = 0, events = 0;
+  EnergyTally energy;
 
   auto run_task = [&](uint64_t task, DirectTally& tally) {
     tally.sum.assign(cells * cells, 0.0);
@@ -208,31 +246,22 @@ FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurface
         const int i = direction_bin(frame_b.to_local(omega), R);
         const int o = direction_bin(frame_b.to_local(e.direction), R);
         tally.sum[static_cast<size_t>(i) * cells + o] += e.weight;
-        tally.exit_weight += e.weight;
+        tally.energy.exited += e.weight;
       };
-      tally.events += hit_fiber(g, surface, tracer, frame_a, point_a, omega, 1.0, rng, sink,
-                                &tally.surface_weight);
-      ++tally.photons;
+      hit_fiber(g, surface, tracer, frame_a, point_a, omega, 1.0, rng, sink, tally.energy);
     }
   };
   auto merge = [&](const DirectTally& t) {
     for (size_t k = 0; k < total.size(); ++k) total[k] += t.sum[k];
-    exit_weight += t.exit_weight;
-    surface_weight += t.surface_weight;
-    photons += t.photons;
-    events += t.events;
+    energy += t.energy;
   };
   const uint64_t done = run_tasks_ordered<DirectTally>(tasks, s.threads, s.photons_per_task, s.photons,
                                                        "photons", progress, run_task, merge);
   // Each photon stands for pi / N of the integral (see docs/fiber-bsdf.md).
-  const double scale = photons > 0 ? kPi / static_cast<double>(photons) : 0.0;
+  const double scale = energy.photons > 0 ? kPi / static_cast<double>(energy.photons) : 0.0;
   for (auto& v : total) v *= scale;
   FiberBandTable t = finish_table(R, std::move(total));
-  t.photons = photons;
-  t.scattering_events = events;
-  t.exit_fraction = photons > 0 ? exit_weight / photons : 0;
-  t.surface_fraction = photons > 0 ? surface_weight / photons : 0;
-  t.absorbed_fraction = 1 - t.exit_fraction;
+  energy.fill(t);
   t.cancelled = done < tasks;
   return t;
 }
@@ -259,12 +288,10 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
 
   struct Tally {
     std::vector<double> t, f_in;
-    double exit_weight = 0, surface_weight = 0, in_weight = 0;
-    uint64_t photons = 0, events = 0;
+    EnergyTally energy;
   };
   std::vector<double> t_total(t_size, 0.0), f_in_total(incident_bins, 0.0);
-  double exit_weight = 0, surface_weight = 0, in_weight = 0;
-  uint64_t photons = 0, events = 0;
+  EnergyTally energy;
 
   auto run_task = [&](uint64_t task, Tally& tally) {
     tally.t.assign(t_size, 0.0);
@@ -284,7 +311,6 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
       const Vec3 omega = frame_a.to_world(omega_local);
       const double w0 = omega_local.z;
       tally.f_in[a] += w0;
-      tally.in_weight += w0;
       auto sink = [&](const FiberExit& e) {
         const double phi_b = std::atan2(e.position.z, e.position.y);
         double offset = phi_b - kPi / 2;  // angular offset of B from A, wrapped to [-pi, pi)
@@ -294,21 +320,15 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
         const FiberPointFrame frame_b(phi_b);
         const int o = direction_bin(frame_b.to_local(e.direction), R);
         tally.t[(a * nu + j) * cells + o] += e.weight;
-        tally.exit_weight += e.weight;
+        tally.energy.exited += e.weight;
       };
-      tally.events += hit_fiber(g, surface, tracer, frame_a, point_a, omega, w0, rng, sink,
-                                &tally.surface_weight);
-      ++tally.photons;
+      hit_fiber(g, surface, tracer, frame_a, point_a, omega, w0, rng, sink, tally.energy);
     }
   };
   auto merge = [&](const Tally& t) {
     for (size_t k = 0; k < t_size; ++k) t_total[k] += t.t[k];
     for (size_t k = 0; k < incident_bins; ++k) f_in_total[k] += t.f_in[k];
-    exit_weight += t.exit_weight;
-    surface_weight += t.surface_weight;
-    in_weight += t.in_weight;
-    photons += t.photons;
-    events += t.events;
+    energy += t.energy;
   };
   const uint64_t done = run_tasks_ordered<Tally>(tasks, s.threads, s.photons_per_task, s.photons,
                                                  "photons", progress, run_task, merge);
@@ -348,11 +368,7 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
       }
   });
   FiberBandTable t = finish_table(R, std::move(weighted));
-  t.photons = photons;
-  t.scattering_events = events;
-  t.exit_fraction = in_weight > 0 ? exit_weight / in_weight : 0;
-  t.surface_fraction = in_weight > 0 ? surface_weight / in_weight : 0;
-  t.absorbed_fraction = 1 - t.exit_fraction;
+  energy.fill(t);
   t.cancelled = done < tasks;
   return t;
 }

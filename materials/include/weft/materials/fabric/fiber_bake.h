@@ -25,9 +25,15 @@ using FiberExitSink = std::function<void(const FiberExit&)>;
 
 // Traces one photon that has just been refracted into the fiber at surface point 'p' (world
 // frame, axis x, radius R) travelling along unit 'd' with weight 'w', reporting every exit.
-// Must be deterministic given rng. Returns the number of scattering events.
-using FiberInteriorTracer =
-    std::function<uint64_t(const Vec3& p, const Vec3& d, double w, Rng& rng, const FiberExitSink& sink)>;
+// Must be deterministic given rng.
+struct FiberTraceResult {
+  uint64_t scattering_events = 0;
+  double absorbed_weight = 0;
+  double roulette_net = 0;  // weight removed by Russian roulette minus weight added (mean 0)
+  double lost_weight = 0;   // weight the tracer could not follow (e.g. an interaction cap)
+};
+using FiberInteriorTracer = std::function<FiberTraceResult(const Vec3& p, const Vec3& d, double w,
+                                                           Rng& rng, const FiberExitSink& sink)>;
 
 // The rough surface seen from outside, in the local frame of the hit point (z = normal).
 struct FiberSurfaceModel {
@@ -58,9 +64,19 @@ struct FiberBandTable {
   int resolution = 0;
   std::vector<double> f;            // R^4 cell averages (1/sr)
   std::vector<double> weighted_sum; // R^4 sums of f |cos_i| |cos_o| over the cell pair (sr^2)
-  double exit_fraction = 0;         // exiting energy / energy hitting the fiber
+  // Energy, as fractions of the light hitting the fiber. Per photon the books balance exactly:
+  //   exit + absorbed + roulette_net + lost - surface_sampling_excess = 1   (to rounding),
+  // where surface_sampling_excess = mean(sampled surface weight - tabulated surface albedo) has
+  // mean zero: the surface lobe is sampled, the part that enters uses the lobe's albedo.
+  double exit_fraction = 0;         // everything that leaves (surface + volume)
   double surface_fraction = 0;      // of which reflected by the surface lobe
-  double absorbed_fraction = 0;     // 1 - exit_fraction, as traced
+  double absorbed_fraction = 0;     // absorbed inside, as traced
+  double roulette_net = 0;
+  double lost_fraction = 0;         // weight the interior tracer gave up on (reported, not hidden)
+  double surface_sampling_excess = 0;
+  double energy_balance() const {
+    return exit_fraction + absorbed_fraction + roulette_net + lost_fraction - surface_sampling_excess;
+  }
   uint64_t photons = 0;             // photons traced (fewer than asked if cancelled)
   uint64_t scattering_events = 0;
   bool cancelled = false;

@@ -1,0 +1,70 @@
+#pragma once
+// Bakes a fiber spec into a fiber BSDF table: Mie medium per band -> photon transport in the
+// cylinder -> cosine-weighted cell averages (docs/fiber-bsdf.md) plus the Cook-Torrance surface
+// lobe, for every band, stored as a spectral (33 bands) or RGB table.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/materials/fabric/fiber_spec.h"
+
+namespace weft {
+
+enum class FiberBakeRoute { kDirect, kBssrdf };
+
+struct FiberTableBakeOptions {
+  int resolution = 8;               // R x R equal-area bins per direction
+  uint64_t photons_per_band = 200000;
+  uint64_t seed = 1;
+  int threads = 0;                  // 0 = all cores; results do not depend on it
+  bool spectral = true;             // 33 bands, else linear sRGB (D65) from the 33 bands
+  FiberBakeRoute route = FiberBakeRoute::kDirect;
+  uint64_t max_events_per_photon = 10'000'000;  // beyond it the weight is reported as lost
+  // Photons are traced in this many passes over all bands; an interrupted bake keeps every
+  // finished pass (results depend on it, not on threads).
+  uint64_t passes = 8;
+};
+
+struct FiberBandSummary {
+  int band = 0;
+  double wavelength_nm = 0;
+  double mu_s_per_um = 0, mu_a_per_um = 0, g = 0;
+  double surface_fraction = 0;   // reflected by the surface lobe (of the light hitting the fiber)
+  double exit_fraction = 0;      // everything that leaves: surface + volume
+  double absorbed_fraction = 0;
+  double lost_fraction = 0;
+  double roulette_net = 0;       // Russian roulette's net removal (mean zero)
+  double surface_sampling_excess = 0;  // sampled minus tabulated surface albedo (mean zero)
+  double energy_balance = 0;     // exit + absorbed + roulette + lost - excess: 1 to rounding
+  double energy_table = 0;       // table energy sum / pi: equals exit_fraction (white furnace)
+  uint64_t photons = 0;
+  uint64_t scattering_events = 0;
+};
+
+struct FiberTableBakeResult {
+  TabulatedBsdfTable table;
+  std::vector<FiberBandSummary> bands;
+  uint64_t photons = 0;
+  uint64_t scattering_events = 0;
+  double rgb_negative_clipped = 0;  // largest negative RGB value set to 0 (out of sRGB gamut)
+  bool cancelled = false;  // the table then holds the passes finished (metadata "photons")
+};
+
+// Directional albedo of a Cook-Torrance lobe at cos theta, tabulated in cos theta and
+// interpolated linearly; computed by a deterministic stratified quadrature of the sample weights.
+class SurfaceAlbedoTable {
+ public:
+  SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes = 129,
+                     int samples_per_side = 64);
+  double operator()(double cos_theta) const;
+
+ private:
+  std::vector<double> albedo_;
+};
+
+FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
+                                      const ProgressCallback& progress = no_progress());
+
+}  // namespace weft
