@@ -1,6 +1,7 @@
 #include "weft/materials/fabric/fiber_table_bake.h"
 
 #include <algorithm>
+#include <map>
 #include <memory>
 #include <cmath>
 #include <string>
@@ -38,6 +39,45 @@ double SurfaceAlbedoTable::operator()(double cos_theta) const {
   return (1 - t) * albedo_[i] + t * albedo_[i + 1];
 }
 
+FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
+                                    uint64_t max_events_per_photon,
+                                    std::shared_ptr<const SurfaceAlbedoTable> albedo) {
+  FiberBandPhysics ph;
+  ph.geometry = FiberGeometry{spec.fiber_radius_um, mb.host_n, 1.0};
+  auto ct = std::make_shared<const CookTorranceBsdf>(
+      CookTorranceBsdf{{spec.roughness_distribution, spec.roughness_alpha}, mb.host_n, Rgb(1.0)});
+  if (!albedo)
+    albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
+                                                        spec.roughness_alpha, mb.host_n);
+  ph.surface.sample = [ct](const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out, double* weight) {
+    // Cook-Torrance is reciprocal: sampling the view direction given the light one uses the same
+    // routine with the roles swapped; the weight is f cos(out) / pdf.
+    const auto smp = ct->sample(w_light, u, u_lobe);
+    if (!smp || !(smp->wi.z > 0)) return false;
+    *w_out = smp->wi;
+    *weight = smp->weight.r;
+    return true;
+  };
+  ph.surface.albedo = [albedo](double c) { return (*albedo)(c); };
+  TransportOptions topt;
+  topt.max_events = max_events_per_photon;
+  auto transport = std::make_shared<const CylinderTransport>(
+      CylinderGeometry(spec.fiber_radius_um, 1.0),
+      TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt);
+  ph.tracer = [transport](const Vec3& p, const Vec3& d, double w, Rng& rng, const FiberExitSink& sink) {
+    struct Forward {
+      const FiberExitSink* sink;
+      void on_exit(const ExitEvent& e) { (*sink)(FiberExit{e.position, e.direction, e.weight}); }
+    } recorder{&sink};
+    PhotonTally tally;
+    // The entry point sits on the wall; nudge it inside so rounding cannot put it outside.
+    transport->launch_internal(p * (1 - 1e-12), d, w, rng, recorder, tally);
+    return FiberTraceResult{tally.scatterings, tally.absorbed, tally.roulette_loss - tally.roulette_gain,
+                            tally.lost};
+  };
+  return ph;
+}
+
 namespace {
 
 void validate(const FiberTableBakeOptions& o) {
@@ -61,31 +101,23 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
   const size_t cells = static_cast<size_t>(R) * R;
   const auto bin_areas = cosine_weighted_bin_areas(R);
 
-  // Per band: the transport set-up, and running sums over passes.
+  // Per band: the physics, and running sums over passes.
   struct BandState {
-    std::unique_ptr<CookTorranceBsdf> ct;
-    std::unique_ptr<SurfaceAlbedoTable> albedo;
-    std::unique_ptr<CylinderTransport> transport;
-    FiberGeometry geometry;
+    FiberBandPhysics physics;
     std::vector<double> weighted_sum;  // photon-weighted sum of per-pass cell sums
     double surface = 0, exit = 0, absorbed = 0, roulette = 0, lost = 0, excess = 0, energy = 0;
     uint64_t photons = 0, events = 0;
   };
   std::vector<BandState> states(kNumBands);
-  TransportOptions topt;
-  topt.max_events = o.max_events_per_photon;
+  std::map<double, std::shared_ptr<const SurfaceAlbedoTable>> albedo_by_ior;
   for (int band = 0; band < kNumBands; ++band) {
-    const MediumBand& mb = medium.bands[band];
-    BandState& st = states[band];
-    st.geometry = FiberGeometry{spec.fiber_radius_um, mb.host_n, 1.0};
-    st.ct = std::make_unique<CookTorranceBsdf>(CookTorranceBsdf{
-        {spec.roughness_distribution, spec.roughness_alpha}, mb.host_n, Rgb(1.0)});
-    st.albedo = std::make_unique<SurfaceAlbedoTable>(spec.roughness_distribution,
-                                                     spec.roughness_alpha, mb.host_n);
-    st.transport = std::make_unique<CylinderTransport>(
-        CylinderGeometry(spec.fiber_radius_um, 1.0),
-        TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt);
-    st.weighted_sum.assign(cells * cells, 0.0);
+    auto& albedo = albedo_by_ior[medium.bands[band].host_n];
+    if (!albedo)
+      albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
+                                                          spec.roughness_alpha, medium.bands[band].host_n);
+    states[band].physics =
+        fiber_band_physics(spec, medium.bands[band], o.max_events_per_photon, albedo);
+    states[band].weighted_sum.assign(cells * cells, 0.0);
   }
 
   // Photons are traced in passes over all bands, so an interrupted bake still has every band,
@@ -99,33 +131,7 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
     const uint64_t count = o.photons_per_band * (pass + 1) / passes - first;
     for (int band = 0; band < kNumBands && !result.cancelled; ++band) {
       BandState& st = states[band];
-      const CookTorranceBsdf& ct = *st.ct;
-      const SurfaceAlbedoTable& albedo = *st.albedo;
-      FiberSurfaceModel surface;
-      surface.sample = [&ct](const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out,
-                             double* weight) {
-        // Cook-Torrance is reciprocal: sampling the view direction given the light one uses the
-        // same routine with the roles swapped; the weight is f cos(out) / pdf.
-        const auto smp = ct.sample(w_light, u, u_lobe);
-        if (!smp || !(smp->wi.z > 0)) return false;
-        *w_out = smp->wi;
-        *weight = smp->weight.r;
-        return true;
-      };
-      surface.albedo = [&albedo](double c) { return albedo(c); };
-      const CylinderTransport& transport = *st.transport;
-      FiberInteriorTracer tracer = [&transport](const Vec3& p, const Vec3& d, double w, Rng& rng,
-                                                const FiberExitSink& sink) {
-        struct Forward {
-          const FiberExitSink* sink;
-          void on_exit(const ExitEvent& e) { (*sink)(FiberExit{e.position, e.direction, e.weight}); }
-        } recorder{&sink};
-        PhotonTally tally;
-        // The entry point sits on the wall; nudge it inside so rounding cannot put it outside.
-        transport.launch_internal(p * (1 - 1e-12), d, w, rng, recorder, tally);
-        return FiberTraceResult{tally.scatterings, tally.absorbed,
-                                tally.roulette_loss - tally.roulette_gain, tally.lost};
-      };
+      const FiberBandPhysics& ph = st.physics;
       FiberBakeSettings settings;
       settings.resolution = R;
       settings.photons = count;
@@ -138,8 +144,8 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       };
       const FiberBandTable t =
           o.route == FiberBakeRoute::kDirect
-              ? bake_fiber_band_direct(st.geometry, surface, tracer, settings, band_progress)
-              : bake_fiber_band_bssrdf(st.geometry, surface, tracer, settings, BssrdfGrid{},
+              ? bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, settings, band_progress)
+              : bake_fiber_band_bssrdf(ph.geometry, ph.surface, ph.tracer, settings, BssrdfGrid{},
                                        band_progress);
       const double n = static_cast<double>(t.photons);
       for (size_t k = 0; k < st.weighted_sum.size(); ++k) st.weighted_sum[k] += t.weighted_sum[k] * n;

@@ -3,12 +3,15 @@
 // cylinder -> cosine-weighted cell averages (docs/fiber-bsdf.md) plus the Cook-Torrance surface
 // lobe, for every band, stored as a spectral (33 bands) or RGB table.
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "weft/core/progress.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/fabric/fiber_bake.h"
 #include "weft/materials/fabric/fiber_spec.h"
+#include "weft/materials/fabric/medium.h"
 
 namespace weft {
 
@@ -57,12 +60,25 @@ struct FiberTableBakeResult {
 class SurfaceAlbedoTable {
  public:
   SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes = 129,
-                     int samples_per_side = 64);
+                     int samples_per_side = 48);
   double operator()(double cos_theta) const;
 
  private:
   std::vector<double> albedo_;
 };
+
+// Everything the band bakers need for one band of a spec: the geometry, the Cook-Torrance surface
+// lobe at the band's host index, and the interior tracer (cylinder photon transport). The
+// functions hold shared state, so copies stay valid.
+struct FiberBandPhysics {
+  FiberGeometry geometry;
+  FiberSurfaceModel surface;
+  FiberInteriorTracer tracer;
+};
+// 'albedo' may be shared between bands of equal host index; null computes it.
+FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& band,
+                                    uint64_t max_events_per_photon = 10'000'000,
+                                    std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr);
 
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
                                       const ProgressCallback& progress = no_progress());
