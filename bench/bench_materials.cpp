@@ -49,7 +49,6 @@ const Bsdf& table_bsdf(int resolution) {
   return it->second;
 }
 
-template <class F>
 void run_eval(benchmark::State& state, const Bsdf& b) {
   const Pairs& p = pairs();
   size_t i = 0;
@@ -70,14 +69,14 @@ void run_sample(benchmark::State& state, const Bsdf& b) {
 }
 
 void BM_LambertEval(benchmark::State& s) {
-  run_eval<void>(s, LambertBsdf{Rgb(0.5)});
+  run_eval(s, LambertBsdf{Rgb(0.5)});
 }
 void BM_LambertSample(benchmark::State& s) {
   run_sample(s, LambertBsdf{Rgb(0.5)});
 }
 void BM_CookTorranceEval(benchmark::State& s) {
   const auto model = s.range(0) ? MicrofacetModel::kGgx : MicrofacetModel::kBeckmann;
-  run_eval<void>(s, CookTorranceBsdf{{model, 0.3}, kCottonIor, Rgb(1.0)});
+  run_eval(s, CookTorranceBsdf{{model, 0.3}, kCottonIor, Rgb(1.0)});
 }
 void BM_CookTorranceSample(benchmark::State& s) {
   const auto model = s.range(0) ? MicrofacetModel::kGgx : MicrofacetModel::kBeckmann;
@@ -88,7 +87,7 @@ void BM_ClassicFiberCreate(benchmark::State& s) {
     benchmark::DoNotOptimize(ClassicFiberBsdf::create(Rgb(0.5), {MicrofacetModel::kBeckmann, 0.3}));
 }
 void BM_TableEval(benchmark::State& s) {
-  run_eval<void>(s, table_bsdf(static_cast<int>(s.range(0))));
+  run_eval(s, table_bsdf(static_cast<int>(s.range(0))));
 }
 void BM_TableSample(benchmark::State& s) {
   run_sample(s, table_bsdf(static_cast<int>(s.range(0))));
@@ -96,7 +95,7 @@ void BM_TableSample(benchmark::State& s) {
 void BM_MeasuredNbrdfEval(benchmark::State& s) {
   static const Bsdf b = MeasuredNbrdfBsdf{std::make_shared<const NbrdfNetwork>(
       NbrdfNetwork::load(find_measured_nbrdf("merl-red-fabric")))};
-  run_eval<void>(s, b);
+  run_eval(s, b);
 }
 
 }  // namespace

@@ -69,7 +69,7 @@ double ClassicFiberBsdf::surface_lobe_probability(const Vec3& wo_upper) const {
 }
 
 Rgb ClassicFiberBsdf::eval(const Vec3& wo, const Vec3& wi) const {
-  if (wo.z * wi.z <= 0) return Rgb(0.0);
+  if (!surface_albedo || wo.z * wi.z <= 0) return Rgb(0.0);  // default-constructed: black
   const double s = wo.z < 0 ? -1 : 1;
   const Vec3 o{wo.x, wo.y, s * wo.z}, i{wi.x, wi.y, s * wi.z};
   const SpecularAlbedoTable& e = *surface_albedo;
@@ -78,7 +78,7 @@ Rgb ClassicFiberBsdf::eval(const Vec3& wo, const Vec3& wi) const {
 }
 
 double ClassicFiberBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
-  if (wo.z * wi.z <= 0) return 0;
+  if (!surface_albedo || wo.z * wi.z <= 0) return 0;
   const double s = wo.z < 0 ? -1 : 1;
   const Vec3 o{wo.x, wo.y, s * wo.z}, i{wi.x, wi.y, s * wi.z};
   const double p = surface_lobe_probability(o);
@@ -86,7 +86,7 @@ double ClassicFiberBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
 }
 
 std::optional<BsdfSample> ClassicFiberBsdf::sample(const Vec3& wo, Vec2 u, double u_lobe) const {
-  if (wo.z == 0) return std::nullopt;
+  if (!surface_albedo || wo.z == 0) return std::nullopt;
   const double s = wo.z < 0 ? -1 : 1;
   const Vec3 o{wo.x, wo.y, s * wo.z};
   Vec3 wi;

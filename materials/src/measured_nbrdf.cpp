@@ -119,8 +119,7 @@ std::filesystem::path find_measured_nbrdf(const std::string& name) {
     known = known || n == name;
     valid += (valid.empty() ? "" : ", ") + n;
   }
-  if (!known)
-    throw Error("", "name", "unknown measured material '" + name + "' (valid: " + valid + ")");
+  if (!known) throw Error("unknown measured material '" + name + "' (valid: " + valid + ")");
   const fs::path rel = fs::path("measured") / name / "nbrdf_weights.txt";
   std::vector<fs::path> candidates;
   if (std::string(WEFT_DATA_DIR).size()) candidates.push_back(fs::path(WEFT_DATA_DIR) / rel);
@@ -132,22 +131,22 @@ std::filesystem::path find_measured_nbrdf(const std::string& name) {
     if (fs::is_regular_file(c, ec)) return c;
     tried += (tried.empty() ? "" : ", ") + c.string();
   }
-  throw Error("", "name", "data for '" + name + "' not found (tried: " + tried + ")");
+  throw Error("data for measured material '" + name + "' not found (tried: " + tried + ")");
 }
 
 Rgb MeasuredNbrdfBsdf::eval(const Vec3& wo, const Vec3& wi) const {
-  if (wo.z * wi.z <= 0) return Rgb(0.0);
+  if (!network || wo.z * wi.z <= 0) return Rgb(0.0);
   if (wo.z > 0) return network->eval_upper(wo, wi);
   return network->eval_upper({wo.x, wo.y, -wo.z}, {wi.x, wi.y, -wi.z});
 }
 
 double MeasuredNbrdfBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
-  if (wo.z * wi.z <= 0) return 0;
+  if (!network || wo.z * wi.z <= 0) return 0;
   return std::abs(wi.z) * kInvPi;
 }
 
 std::optional<BsdfSample> MeasuredNbrdfBsdf::sample(const Vec3& wo, Vec2 u, double) const {
-  if (wo.z == 0) return std::nullopt;
+  if (!network || wo.z == 0) return std::nullopt;
   Vec3 wi = sample_cosine_hemisphere(u);
   if (wi.z <= 0) return std::nullopt;
   if (wo.z < 0) wi.z = -wi.z;

@@ -104,6 +104,7 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
 }
 
 Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
+  if (!data) return Rgb(0.0);  // a default-constructed value is black, never a crash
   const OctahedralGrid& grid = data->grid;
   const auto fo = grid.bilinear(OctahedralGrid::to_square(wo));
   const auto fi = grid.bilinear(OctahedralGrid::to_square(wi));
@@ -119,6 +120,7 @@ Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
 }
 
 double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
+  if (!data) return 0;
   const OctahedralGrid& grid = data->grid;
   const Distribution2D& dist = data->sampling[grid.bin_of(wo)];
   if (dist.integral() == 0) return 0;
@@ -130,6 +132,7 @@ double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
 }
 
 std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double) const {
+  if (!data) return std::nullopt;
   const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
   if (dist.integral() == 0) return std::nullopt;
   const Vec3 wi = OctahedralGrid::to_direction(dist.sample(u).p);

@@ -95,7 +95,8 @@ struct TabulatedBsdfTable {
   // Throws weft::Error(file, field, ...) unless the table is well formed: resolution in
   // [1, kMaxResolution], channels 3 or 33, kind known, size matches, every value finite and >= 0,
   // metadata keys not reserved.
-  static constexpr int kMaxResolution = 128;
+  // R = 64 already means 16.8 M cell pairs (200 MB as RGB floats, ~700 MB while preparing).
+  static constexpr int kMaxResolution = 64;
   // Attribute names the format or OpenEXR itself uses; metadata may not use them.
   static bool is_reserved_attribute(const std::string& name);
   void validate(const std::string& file_for_errors) const;
