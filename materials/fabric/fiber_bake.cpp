@@ -89,7 +89,10 @@ struct EnergyTally {
 };
 
 struct DirectTally {
-  std::vector<double> sum;  // R^4, sum of exit weights per (i, o)
+  // Exits in the order they happened: (cell index, weight). Sparse, because a task's photons
+  // touch few of the R^4 cells; merged in task order, so sums are the same at any thread count.
+  std::vector<std::pair<uint64_t, double>> exits;
+  std::vector<std::pair<uint64_t, double>> far_field;  // likewise, if asked
   EnergyTally energy;
 };
 
@@ -222,9 +225,12 @@ FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurface
   const uint64_t tasks = (s.photons + s.photons_per_task - 1) / s.photons_per_task;
   std::vector<double> total(cells * cells, 0.0);
   EnergyTally energy;
+  const bool far_field = s.far_field_s_bins > 0 && s.far_field_psi_bins > 0;
+  const int ffs = s.far_field_s_bins, ffp = s.far_field_psi_bins;
+  std::vector<double> far_total(far_field ? static_cast<size_t>(ffs) * ffs * ffp : 0, 0.0);
 
   auto run_task = [&](uint64_t task, DirectTally& tally) {
-    tally.sum.assign(cells * cells, 0.0);
+    tally.exits.reserve(2 * s.photons_per_task);
     Rng rng(s.seed, task);
     const uint64_t first = task * s.photons_per_task;
     const uint64_t n = std::min(s.photons_per_task, s.photons - first);
@@ -245,14 +251,23 @@ FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurface
         const FiberPointFrame frame_b(phi_b);
         const int i = direction_bin(frame_b.to_local(omega), R);
         const int o = direction_bin(frame_b.to_local(e.direction), R);
-        tally.sum[static_cast<size_t>(i) * cells + o] += e.weight;
+        tally.exits.emplace_back(static_cast<uint64_t>(i) * cells + o, e.weight);
         tally.energy.exited += e.weight;
+        if (far_field) {
+          const int a = std::clamp(static_cast<int>((omega.x + 1) / 2 * ffs), 0, ffs - 1);
+          const int b = std::clamp(static_cast<int>((e.direction.x + 1) / 2 * ffs), 0, ffs - 1);
+          double dpsi = std::atan2(e.direction.z, e.direction.y) - std::atan2(omega.z, omega.y);
+          dpsi -= 2 * kPi * std::floor((dpsi + kPi) / (2 * kPi));
+          const int c = std::clamp(static_cast<int>((dpsi + kPi) / (2 * kPi) * ffp), 0, ffp - 1);
+          tally.far_field.emplace_back((static_cast<uint64_t>(a) * ffs + b) * ffp + c, e.weight);
+        }
       };
       hit_fiber(g, surface, tracer, frame_a, point_a, omega, 1.0, rng, sink, tally.energy);
     }
   };
   auto merge = [&](const DirectTally& t) {
-    for (size_t k = 0; k < total.size(); ++k) total[k] += t.sum[k];
+    for (const auto& [k, w] : t.exits) total[k] += w;
+    for (const auto& [k, w] : t.far_field) far_total[k] += w;
     energy += t.energy;
   };
   const uint64_t done = run_tasks_ordered<DirectTally>(tasks, s.threads, s.photons_per_task, s.photons,
@@ -260,7 +275,9 @@ FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurface
   // Each photon stands for pi / N of the integral (see docs/fiber-bsdf.md).
   const double scale = energy.photons > 0 ? kPi / static_cast<double>(energy.photons) : 0.0;
   for (auto& v : total) v *= scale;
+  for (auto& v : far_total) v *= scale;
   FiberBandTable t = finish_table(R, std::move(total));
+  t.far_field = std::move(far_total);
   energy.fill(t);
   t.cancelled = done < tasks;
   return t;
@@ -280,6 +297,10 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
   const size_t incident_bins = static_cast<size_t>(ns) * npsi;
   // T[a][j][o]: exit weight by incident bin a, angular offset bin j, exit direction bin o.
   const size_t t_size = incident_bins * nu * cells;
+  if (t_size > (size_t{1} << 27))  // 1 GiB of doubles
+    throw Error("", "bssrdf_grid",
+                "the BSSRDF table (incident bins x offsets x exit bins = " + std::to_string(t_size) +
+                    " values) is too large for this resolution; use the direct route or a coarser grid");
   const uint64_t tasks = (s.photons + s.photons_per_task - 1) / s.photons_per_task;
   const double du = 2 * kPi / nu;
   // A sits at the top of the fiber (phi = pi/2): its frame is the identity.
@@ -287,14 +308,15 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
   const Vec3 point_a = g.radius_um * frame_a.n;
 
   struct Tally {
-    std::vector<double> t, f_in;
+    std::vector<std::pair<uint64_t, double>> exits;  // (T index, weight), in order
+    std::vector<double> f_in;
     EnergyTally energy;
   };
   std::vector<double> t_total(t_size, 0.0), f_in_total(incident_bins, 0.0);
   EnergyTally energy;
 
   auto run_task = [&](uint64_t task, Tally& tally) {
-    tally.t.assign(t_size, 0.0);
+    tally.exits.reserve(2 * s.photons_per_task);
     tally.f_in.assign(incident_bins, 0.0);
     Rng rng(s.seed, task);
     const uint64_t first = task * s.photons_per_task;
@@ -319,14 +341,14 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
         const int j = static_cast<int>(std::floor((offset + kPi) / du + 0.5)) % nu;
         const FiberPointFrame frame_b(phi_b);
         const int o = direction_bin(frame_b.to_local(e.direction), R);
-        tally.t[(a * nu + j) * cells + o] += e.weight;
+        tally.exits.emplace_back((a * nu + j) * cells + o, e.weight);
         tally.energy.exited += e.weight;
       };
       hit_fiber(g, surface, tracer, frame_a, point_a, omega, w0, rng, sink, tally.energy);
     }
   };
   auto merge = [&](const Tally& t) {
-    for (size_t k = 0; k < t_size; ++k) t_total[k] += t.t[k];
+    for (const auto& [k, w] : t.exits) t_total[k] += w;
     for (size_t k = 0; k < incident_bins; ++k) f_in_total[k] += t.f_in[k];
     energy += t.energy;
   };
@@ -357,13 +379,25 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
         for (int j = 0; j < nu; ++j) {
           const Vec3 wa = frames_aj[j].to_local(omega);
           if (!(wa.z > 0)) continue;
+          // Bilinear interpolation between incident-bin centres in (s, psi): the BSSRDF varies
+          // quickly with the incident direction (the surface lobe moves with it), and a
+          // nearest-bin lookup would smear it by a bin width.
           const double psi = std::atan2(wa.y, wa.z);
-          const int is = std::clamp(static_cast<int>((wa.x + 1) / 2 * ns), 0, ns - 1);
-          const int ip = std::clamp(static_cast<int>((psi + kPi / 2) / kPi * npsi), 0, npsi - 1);
-          const size_t a = static_cast<size_t>(is) * npsi + ip;
+          const double xs = std::clamp((wa.x + 1) / 2 * ns - 0.5, 0.0, ns - 1.0);
+          const double xp = std::clamp((psi + kPi / 2) / kPi * npsi - 0.5, 0.0, npsi - 1.0);
+          const int s0 = std::min(static_cast<int>(xs), ns - 1), p0 = std::min(static_cast<int>(xp), npsi - 1);
+          const int s1 = std::min(s0 + 1, ns - 1), p1 = std::min(p0 + 1, npsi - 1);
+          const double fs = xs - s0, fp = xp - p0;
           const double w = point_solid_angle * wa.z;
-          const double* t = &t_total[(a * nu + j) * cells];
-          for (size_t o = 0; o < cells; ++o) row[o] += w * t[o];
+          const size_t corner[4] = {static_cast<size_t>(s0) * npsi + p0, static_cast<size_t>(s0) * npsi + p1,
+                                    static_cast<size_t>(s1) * npsi + p0, static_cast<size_t>(s1) * npsi + p1};
+          const double cw[4] = {(1 - fs) * (1 - fp), (1 - fs) * fp, fs * (1 - fp), fs * fp};
+          for (int c = 0; c < 4; ++c) {
+            if (cw[c] == 0) continue;
+            const double* t = &t_total[(corner[c] * nu + j) * cells];
+            const double wc = w * cw[c];
+            for (size_t o = 0; o < cells; ++o) row[o] += wc * t[o];
+          }
         }
       }
   });

@@ -61,6 +61,9 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
   ph.surface.albedo = [albedo](double c) { return (*albedo)(c); };
   TransportOptions topt;
   topt.max_events = max_events_per_photon;
+  // Leaving the fiber, light meets the same rough boundary it entered through: transmitted with
+  // 1 - (the surface lobe's albedo at the outside angle), as on entry.
+  topt.exit_reflectance = [albedo](double cos_outside) { return (*albedo)(cos_outside); };
   auto transport = std::make_shared<const CylinderTransport>(
       CylinderGeometry(spec.fiber_radius_um, 1.0),
       TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt);

@@ -36,6 +36,7 @@
 #include <cmath>
 #include <concepts>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <string>
 #include <utility>
@@ -72,6 +73,12 @@ struct TransportOptions {
   // Cap on interactions per photon (scatterings plus internal reflections); the weight of a photon
   // that reaches it goes to PhotonTally::lost.
   uint64_t max_events = 10'000'000;
+  // Optional reflectance of the boundary for a photon leaving the medium, as a function of the
+  // cosine OUTSIDE (after refraction). Empty: the smooth Fresnel reflectance. The fiber baker sets
+  // it to the rough surface's reflectance so that exits and entries see the same boundary
+  // transmittance, which keeps the fiber's scattering reciprocal. Total internal reflection is
+  // unaffected.
+  std::function<double(double cos_outside)> exit_reflectance;
 
   void validate() const;
 };
@@ -325,7 +332,8 @@ class PhotonTransport {
           return;
         }
         double cos_t = 0;
-        const double r = fresnel_dielectric(cos_i, n_in, n_out, &cos_t);
+        double r = fresnel_dielectric(cos_i, n_in, n_out, &cos_t);
+        if (options_.exit_reflectance && r < 1) r = options_.exit_reflectance(cos_t);
         if (r < 1 && rng.uniform() >= r) {
           const double eta = n_in / n_out;
           const Vec3 out = normalize(eta * d + (cos_t - eta * cos_i) * n);

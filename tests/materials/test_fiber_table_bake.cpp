@@ -1,0 +1,306 @@
+// The fiber baker end to end: Mie medium -> cylinder transport -> table. Energy books, the white
+// furnace, the agreement of the direct and the paper's BSSRDF route, the fiber's symmetries,
+// reproducibility, extremes and table sampling. Definitions: docs/fiber-bsdf.md.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "chi2.h"
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/sphere_mapping.h"
+#include "weft/materials/fabric/fiber_table_bake.h"
+#include "weft/materials/tabulated_bsdf.h"
+
+using namespace weft;
+
+namespace {
+
+// A minimal spec: cotton host with air voids; optional dye and overrides.
+FiberSpec test_spec(double radius_um = 8, double void_fraction = 0.02, double dye_per_um = 0,
+                    double void_radius_um = 0.3) {
+  const std::string json = R"({"name": "test", "fiber_radius_um": )" + std::to_string(radius_um) +
+                           R"(, "roughness": {"distribution": "ggx", "alpha": 0.3},
+    "host": {"n": 1.557, "absorption_per_um": )" + std::to_string(dye_per_um) + R"(},
+    "species": [{"name": "voids", "n": 1.0, "k": 0.0, "volume_fraction": )" +
+                           std::to_string(void_fraction) + R"(,
+      "size": {"distribution": "monodisperse", "radius_um": )" +
+                           std::to_string(void_radius_um) + R"(}}]})";
+  return parse_fiber_spec(json, "test-spec");
+}
+
+// Mean and standard error per cell over K independent bakes of one band.
+struct CellStats {
+  std::vector<double> mean, se;
+};
+template <class BakeFn>
+CellStats cell_stats(int k, const BakeFn& bake) {
+  std::vector<double> s, s2;
+  for (int i = 0; i < k; ++i) {
+    const FiberBandTable t = bake(static_cast<uint64_t>(1000 + i));
+    if (s.empty()) s.assign(t.f.size(), 0.0), s2.assign(t.f.size(), 0.0);
+    for (size_t c = 0; c < t.f.size(); ++c) s[c] += t.f[c], s2[c] += t.f[c] * t.f[c];
+  }
+  CellStats st;
+  for (size_t c = 0; c < s.size(); ++c) {
+    const double m = s[c] / k;
+    st.mean.push_back(m);
+    st.se.push_back(std::sqrt(std::max(0.0, s2[c] / k - m * m) / (k - 1)));
+  }
+  return st;
+}
+
+// Number of cells where |a - b| exceeds z standard errors (cells with both means 0 skipped).
+int count_outliers(const std::vector<double>& a, const std::vector<double>& sa,
+                   const std::vector<double>& b, const std::vector<double>& sb, double z) {
+  int n = 0;
+  for (size_t c = 0; c < a.size(); ++c) {
+    if (a[c] == 0 && b[c] == 0) continue;
+    const double se = std::sqrt(sa[c] * sa[c] + sb[c] * sb[c]);
+    if (std::abs(a[c] - b[c]) > z * se + 1e-12) ++n;
+  }
+  return n;
+}
+
+// Cell index of the mirror image of bin (ix, iy): flipping x (the axis t) maps u -> 1 - u on the
+// octahedral square, flipping y (the binormal b) maps v -> 1 - v.
+int mirror_bin(int bin, int resolution, bool flip_x) {
+  const int ix = bin % resolution, iy = bin / resolution;
+  return flip_x ? iy * resolution + (resolution - 1 - ix) : (resolution - 1 - iy) * resolution + ix;
+}
+
+}  // namespace
+
+TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
+  // No dye, non-absorbing inclusions: everything that hits the fiber leaves it.
+  FiberTableBakeOptions o;
+  o.resolution = 4;
+  o.photons_per_band = 1500;
+  o.passes = 2;
+  o.threads = 2;
+  const auto r = bake_fiber_table(load_fiber_spec("white-cotton"), o);
+  ASSERT_FALSE(r.cancelled);
+  ASSERT_EQ(r.bands.size(), static_cast<size_t>(kNumBands));
+  double excess_sum = 0;
+  for (const auto& b : r.bands) {
+    EXPECT_EQ(b.photons, o.photons_per_band);
+    EXPECT_EQ(b.absorbed_fraction, 0.0);
+    EXPECT_EQ(b.lost_fraction, 0.0);
+    EXPECT_EQ(b.roulette_net, 0.0);
+    // The books balance per photon; the only difference from 1 is the mean-zero excess of the
+    // sampled surface weight over the tabulated surface albedo.
+    EXPECT_NEAR(b.energy_balance, 1.0, 1e-12);
+    EXPECT_NEAR(b.exit_fraction - b.surface_sampling_excess, 1.0, 1e-12);
+    // The table holds exactly the exiting energy (sum of f D_i D_o = pi * exit).
+    EXPECT_NEAR(b.energy_table, b.exit_fraction, 1e-12);
+    excess_sum += b.surface_sampling_excess;
+  }
+  // The excess is an average of (w_s - albedo) over 49500 photons, |w_s - albedo| <= 1, so its
+  // mean is 0 within 5 / sqrt(49500) = 0.022 even in the worst case of unit spread.
+  EXPECT_LT(std::abs(excess_sum / kNumBands), 0.022);
+  // The stored float table keeps the furnace to float rounding.
+  const auto d = cosine_weighted_bin_areas(o.resolution);
+  const int cells = o.resolution * o.resolution;
+  for (int band : {0, 16, 32}) {
+    double e = 0;
+    for (int i = 0; i < cells; ++i)
+      for (int k = 0; k < cells; ++k) e += r.table.at(i, k, band) * d[i] * d[k];
+    EXPECT_NEAR(e / kPi, r.bands[band].exit_fraction, 1e-5) << band;
+  }
+}
+
+TEST(FiberTableBake, RedCottonBooksBalanceAndAbsorbsInTheGreen) {
+  FiberTableBakeOptions o;
+  o.resolution = 4;
+  o.photons_per_band = 1000;
+  o.passes = 1;
+  const auto r = bake_fiber_table(load_fiber_spec("red-cotton"), o);
+  for (const auto& b : r.bands) {
+    EXPECT_NEAR(b.energy_balance, 1.0, 1e-12) << b.wavelength_nm;
+    EXPECT_GE(b.absorbed_fraction, 0.0);
+    EXPECT_GE(b.exit_fraction, 0.0);
+    EXPECT_LE(b.exit_fraction, 1.1);
+  }
+  // The dye (docs/presets.md) absorbs around 520-530 nm and hardly at 700 nm.
+  EXPECT_GT(r.bands[14].absorbed_fraction, 3 * r.bands[31].absorbed_fraction);
+}
+
+TEST(FiberTableBake, DirectAndBssrdfRoutesAgreeWithinStatisticalError) {
+  // One band of a scattering, absorbing fiber (mu_s R ~ 5), R = 4 (16 x 16 cells), the paper's
+  // route at its default grid (64 x 64 incident bins, 180 offsets around the axis).
+  const FiberSpec spec = test_spec(20, 0.10, 0.01);
+  const MediumBand mb = compute_medium_band(spec, 16);
+  const FiberBandPhysics ph = fiber_band_physics(spec, mb);
+  FiberBakeSettings s;
+  s.resolution = 4;
+  s.photons = 60000;
+  s.threads = 2;
+  const int k = 5;
+  const CellStats direct = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed;
+    return bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+  });
+  const CellStats bssrdf = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed + 100;
+    return bake_fiber_band_bssrdf(ph.geometry, ph.surface, ph.tracer, s, BssrdfGrid{}, nullptr);
+  });
+  // 256 cells; at 4.5 standard errors a false alarm has probability 256 * 7e-6 = 0.002, but the
+  // standard errors themselves come from 5 bakes (t with 8 dof): allow one outlier cell.
+  EXPECT_LE(count_outliers(direct.mean, direct.se, bssrdf.mean, bssrdf.se, 4.5), 1);
+  // And the two agree on the total to the BSSRDF route's stated quadrature error (2e-3).
+  double a = 0, b = 0;
+  const auto d = cosine_weighted_bin_areas(4);
+  for (int i = 0; i < 16; ++i)
+    for (int o = 0; o < 16; ++o) a += direct.mean[i * 16 + o] * d[i] * d[o], b += bssrdf.mean[i * 16 + o] * d[i] * d[o];
+  EXPECT_NEAR(a, b, 2e-3 * a + 0.01 * a);
+}
+
+TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
+  const FiberSpec spec = test_spec(8, 0.03, 0.005);
+  const MediumBand mb = compute_medium_band(spec, 20);
+  const FiberBandPhysics ph = fiber_band_physics(spec, mb);
+  FiberBakeSettings s;
+  s.resolution = 4;
+  s.photons = 60000;
+  s.threads = 2;
+  const CellStats st = cell_stats(6, [&](uint64_t seed) {
+    s.seed = seed;
+    return bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+  });
+  const int R = 4, cells = R * R;
+  for (bool flip_x : {true, false}) {
+    std::vector<double> m(st.mean.size()), se(st.se.size());
+    for (int i = 0; i < cells; ++i)
+      for (int o = 0; o < cells; ++o) {
+        const size_t src = static_cast<size_t>(mirror_bin(i, R, flip_x)) * cells + mirror_bin(o, R, flip_x);
+        m[i * cells + o] = st.mean[src];
+        se[i * cells + o] = st.se[src];
+      }
+    EXPECT_LE(count_outliers(st.mean, st.se, m, se, 4.5), 2) << (flip_x ? "axis flip" : "binormal flip");
+  }
+}
+
+TEST(FiberTableBake, FiberScatteringIsReciprocal) {
+  // The fiber's scattering per unit length F(w_i, w_o) is reciprocal (the BSSRDF is, Fig. 1 of the
+  // paper with both media outside equal), while the point BSDF f is not (docs/fiber-bsdf.md).
+  // Binned by the axial cosines s_i, s_o and the azimuth difference, reciprocity reads
+  // H[a][b][c] = H[b][a][n - 1 - c]. Tested within noise over 6 independent bakes.
+  const FiberSpec spec = test_spec(6, 0.04, 0.003);
+  const MediumBand mb = compute_medium_band(spec, 10);
+  const FiberBandPhysics ph = fiber_band_physics(spec, mb);
+  FiberBakeSettings s;
+  s.resolution = 2;
+  s.photons = 50000;
+  s.threads = 2;
+  s.far_field_s_bins = 4;
+  s.far_field_psi_bins = 5;
+  const int k = 6, ns = 4, np = 5;
+  std::vector<double> sum, sum2;
+  for (int rep = 0; rep < k; ++rep) {
+    s.seed = 500 + rep;
+    const auto t = bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+    ASSERT_EQ(t.far_field.size(), static_cast<size_t>(ns * ns * np));
+    if (sum.empty()) sum.assign(t.far_field.size(), 0), sum2.assign(t.far_field.size(), 0);
+    for (size_t c = 0; c < t.far_field.size(); ++c)
+      sum[c] += t.far_field[c], sum2[c] += t.far_field[c] * t.far_field[c];
+  }
+  std::vector<double> mean(sum.size()), se(sum.size());
+  for (size_t c = 0; c < sum.size(); ++c) {
+    mean[c] = sum[c] / k;
+    se[c] = std::sqrt(std::max(0.0, sum2[c] / k - mean[c] * mean[c]) / (k - 1));
+  }
+  std::vector<double> swapped(sum.size()), swapped_se(sum.size());
+  for (int a = 0; a < ns; ++a)
+    for (int b = 0; b < ns; ++b)
+      for (int c = 0; c < np; ++c) {
+        const size_t src = (static_cast<size_t>(b) * ns + a) * np + (np - 1 - c);
+        swapped[(static_cast<size_t>(a) * ns + b) * np + c] = mean[src];
+        swapped_se[(static_cast<size_t>(a) * ns + b) * np + c] = se[src];
+      }
+  // 80 bins (40 distinct pairs): allow one 4.5-sigma outlier, as the errors come from 6 bakes.
+  EXPECT_LE(count_outliers(mean, se, swapped, swapped_se, 4.5), 1);
+  // The tally is not trivially symmetric: light mostly goes forward (s_o near s_i), so the
+  // bins differ a lot from each other.
+  double lo = 1e300, hi = 0;
+  for (double v : mean) lo = std::min(lo, v), hi = std::max(hi, v);
+  EXPECT_GT(hi, 5 * lo);
+}
+
+TEST(FiberTableBake, BitIdenticalAtOneAndTwoThreads) {
+  FiberTableBakeOptions o;
+  o.resolution = 4;
+  o.photons_per_band = 300;
+  o.passes = 2;
+  o.threads = 1;
+  const auto a = bake_fiber_table(load_fiber_spec("red-cotton"), o);
+  o.threads = 2;
+  const auto b = bake_fiber_table(load_fiber_spec("red-cotton"), o);
+  ASSERT_EQ(a.table.values.size(), b.table.values.size());
+  EXPECT_EQ(a.table.checksum(), b.table.checksum());
+  for (size_t i = 0; i < a.table.values.size(); ++i) ASSERT_EQ(a.table.values[i], b.table.values[i]);
+}
+
+TEST(FiberTableBake, ExtremesStayFiniteAndBalanced) {
+  struct Case {
+    const char* name;
+    FiberSpec spec;
+    uint64_t max_events;
+  };
+  const std::vector<Case> cases = {
+      {"no particles (mu_s = 0)", test_spec(8, 0.0, 0.0), 10'000'000},
+      {"total absorption (dye 1e4 / um)", test_spec(8, 0.02, 1e4), 10'000'000},
+      {"optically huge fiber (R = 2e4 um, mu_t R ~ 1e3)", test_spec(2e4, 0.02, 0.0), 20'000},
+      {"tiny fiber (R = 0.05 um)", test_spec(0.05, 0.02, 0.0), 10'000'000},
+      {"tiny particles (r = 1e-4 um, x ~ 1e-3)", test_spec(8, 0.05, 0.0, 1e-4), 10'000'000},
+      {"large particles (r = 50 um, x ~ 1e3)", test_spec(400, 0.05, 0.0, 50), 10'000'000},
+  };
+  for (const auto& c : cases) {
+    const MediumBand mb = compute_medium_band(c.spec, 16);
+    const FiberBandPhysics ph = fiber_band_physics(c.spec, mb, c.max_events);
+    FiberBakeSettings s;
+    s.resolution = 4;
+    s.photons = 400;
+    const auto t = bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+    EXPECT_NEAR(t.energy_balance(), 1.0, 1e-9) << c.name;
+    for (double v : t.f) ASSERT_TRUE(std::isfinite(v) && v >= 0) << c.name;
+    EXPECT_GE(t.lost_fraction, 0.0) << c.name;
+    if (std::string(c.name).rfind("total absorption", 0) == 0) {
+      // Nothing comes back out of the volume: only the surface lobe leaves.
+      EXPECT_NEAR(t.exit_fraction, t.surface_fraction, 1e-6) << c.name;
+    }
+    if (std::string(c.name).rfind("no particles", 0) == 0) {
+      EXPECT_EQ(t.scattering_events, 0u);
+      EXPECT_EQ(t.absorbed_fraction, 0.0);
+    }
+  }
+}
+
+TEST(FiberTableBake, BakedTableSamplingPassesChiSquare) {
+  // The renderer samples the baked table per view bin; chi^2 of sample() against pdf() for a
+  // red-cotton table, from the front, from behind and at grazing view.
+  FiberTableBakeOptions o;
+  o.resolution = 8;
+  o.photons_per_band = 3000;
+  o.passes = 1;
+  o.spectral = false;
+  const auto r = bake_fiber_table(load_fiber_spec("red-cotton"), o);
+  const Bsdf bsdf = TabulatedBsdf{TabulatedBsdfData::prepare(r.table)};
+  const weft::testing::OctahedralSquareGrid grid{15, 8};  // 15 * 8 = 120, a multiple of R = 8
+  const double significance = weft::testing::sidak_significance(0.01, 3);
+  for (const Vec3& wo : {normalize(Vec3{0.2, 0.3, 0.9}), normalize(Vec3{0.4, -0.2, -0.8}),
+                         normalize(Vec3{0.1, 0.99, 0.05})}) {
+    const auto res = weft::testing::chi2_test(weft::testing::bsdf_sampler(bsdf, wo), weft::testing::bsdf_pdf(bsdf, wo),
+                                        grid, 200000, significance, 77);
+    EXPECT_TRUE(res.passed) << res.message;
+  }
+}
+
+TEST(FiberTableBake, RejectsBadOptions) {
+  FiberTableBakeOptions o;
+  o.resolution = 1;
+  EXPECT_THROW(bake_fiber_table(load_fiber_spec("white-cotton"), o), Error);
+  o.resolution = 4;
+  o.photons_per_band = 0;
+  EXPECT_THROW(bake_fiber_table(load_fiber_spec("white-cotton"), o), Error);
+}
