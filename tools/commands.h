@@ -7,6 +7,7 @@ namespace weft::cli {
 void add_slab_command(CLI::App& app, Commands& commands);
 void add_spectrum_command(CLI::App& app, Commands& commands);
 void add_bake_command(CLI::App& app, Commands& commands);
+void add_bench_bake_command(CLI::App& app, Commands& commands);
 void add_mie_command(CLI::App& app, Commands& commands);
 void add_medium_command(CLI::App& app, Commands& commands);
 void add_table_command(CLI::App& app, Commands& commands);

@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   weft::cli::add_slab_command(app, commands);
   weft::cli::add_spectrum_command(app, commands);
   weft::cli::add_bake_command(app, commands);
+  weft::cli::add_bench_bake_command(app, commands);
   weft::cli::add_mie_command(app, commands);
   weft::cli::add_medium_command(app, commands);
   weft::cli::add_table_command(app, commands);
