@@ -128,6 +128,7 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
   const uint64_t total_units = o.photons_per_band * kNumBands;
   uint64_t units_done = 0;
+  bool stop_requested = false;
   FiberTableBakeResult result;
   for (uint64_t pass = 0; pass < passes && !result.cancelled; ++pass) {
     const uint64_t first = o.photons_per_band * pass / passes;
@@ -142,8 +143,10 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       settings.seed = mix64(mix64(o.seed) ^ (pass * kNumBands + static_cast<uint64_t>(band)));
       settings.threads = o.threads;
       const uint64_t base = units_done;
+      // A stop request may arrive after a band's last task: remember it for the loops here.
       ProgressCallback band_progress = [&](const ProgressUpdate& u) {
-        return progress({"photons", base + u.done, total_units});
+        if (!progress({"photons", base + u.done, total_units})) stop_requested = true;
+        return !stop_requested;
       };
       const FiberBandTable t =
           o.route == FiberBakeRoute::kDirect
@@ -164,7 +167,7 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       units_done += t.photons;
       result.photons += t.photons;
       result.scattering_events += t.scattering_events;
-      result.cancelled = t.cancelled;
+      result.cancelled = t.cancelled || stop_requested;
     }
   }
 

@@ -1,0 +1,158 @@
+// The weft program as a user meets it: bad input gives a clear error naming the file and field,
+// a non-zero exit and no output file; good input gives the promised JSON and a valid table;
+// Ctrl-C leaves either a complete table or none.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "weft/materials/bsdf_table.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+fs::path temp_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  fs::path dir = fs::temp_directory_path() / (std::string("weft-cli-") + info->name());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+CliRun run(const std::string& args, const fs::path& dir, const std::string& prefix = "") {
+  const std::string cmd = prefix + "'" + std::string(WEFT_EXE) + "' " + args + " >'" +
+                          (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(dir / "stdout");
+  r.err = slurp(dir / "stderr");
+  return r;
+}
+
+void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+const char* kGoodSpec = R"({"name": "cli-test", "fiber_radius_um": 6,
+  "roughness": {"distribution": "beckmann", "alpha": 0.3},
+  "host": {"n": 1.557},
+  "species": [{"name": "voids", "n": 1.0, "k": 0.0, "volume_fraction": 0.02,
+               "size": {"distribution": "monodisperse", "radius_um": 0.3}}]})";
+
+}  // namespace
+
+TEST(Cli, BakeFiberWritesTableAndJsonSummary) {
+  const fs::path dir = temp_dir();
+  const fs::path out = dir / "fiber.exr";
+  const CliRun r = run("bake fiber red-cotton --photons 60 --resolution 2 --passes 2 --json --quiet -o '" +
+                        out.string() + "'",
+                    dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* key : {"photons", "scattering_events", "events_per_s", "per_band", "spec_hash"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  ASSERT_EQ(j["per_band"].size(), 33u);
+  for (const auto& b : j["per_band"]) {
+    EXPECT_TRUE(b.contains("albedo"));
+    EXPECT_NEAR(b["energy_balance"].get<double>(), 1.0, 1e-9);
+  }
+  const auto table = weft::TabulatedBsdfTable::read_exr(out);
+  EXPECT_EQ(table.resolution, 2);
+  EXPECT_EQ(table.channels, 33);
+  EXPECT_EQ(table.metadata.at("spec_hash"), j["spec_hash"].get<std::string>());
+  EXPECT_EQ(table.metadata.at("photons"), "60");
+  EXPECT_EQ(table.metadata.at("seed"), "1");
+  EXPECT_TRUE(table.metadata.count("program_version"));
+}
+
+TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
+  const fs::path dir = temp_dir();
+  struct Case {
+    std::string name, text, expect_in_error;
+  };
+  std::string good = kGoodSpec;
+  auto with = [&](const std::string& from, const std::string& to) {
+    std::string s = good;
+    s.replace(s.find(from), from.size(), to);
+    return s;
+  };
+  const std::vector<Case> cases = {
+      {"negative-radius", with("\"fiber_radius_um\": 6", "\"fiber_radius_um\": -6"), "fiber_radius_um"},
+      {"packed-too-dense", with("\"volume_fraction\": 0.02", "\"volume_fraction\": 0.8"), "volume_fraction"},
+      {"unknown-key", with("\"name\": \"cli-test\"", "\"name\": \"cli-test\", \"colour\": 1"), "colour"},
+      {"nan", with("\"alpha\": 0.3", "\"alpha\": NaN"), ""},
+      {"truncated", good.substr(0, good.size() / 2), ""},
+  };
+  for (const auto& c : cases) {
+    const fs::path spec = dir / (c.name + ".json");
+    write(spec, c.text);
+    const fs::path out = dir / (c.name + ".exr");
+    const CliRun r = run("bake fiber '" + spec.string() + "' --photons 10 --quiet -o '" + out.string() + "'", dir);
+    EXPECT_EQ(r.exit_code, 2) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(spec.filename().string()), std::string::npos) << c.name << ": " << r.err;
+    if (!c.expect_in_error.empty())
+      EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << c.name << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.name;
+  }
+  // A missing file is named, and the presets are listed.
+  const CliRun missing = run("bake fiber '" + (dir / "nope.json").string() + "' -o '" + (dir / "x.exr").string() + "'", dir);
+  EXPECT_EQ(missing.exit_code, 2);
+  EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
+  EXPECT_NE(missing.err.find("red-cotton"), std::string::npos) << missing.err;
+  EXPECT_FALSE(fs::exists(dir / "x.exr"));
+  // Leftover temporaries would be half-written outputs.
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+}
+
+TEST(Cli, BadNumbersOnTheCommandLineAreRejected) {
+  const fs::path dir = temp_dir();
+  EXPECT_NE(run("bake fiber red-cotton --resolution 1 -o '" + (dir / "a.exr").string() + "'", dir).exit_code, 0);
+  EXPECT_NE(run("bake fiber red-cotton --photons 0 -o '" + (dir / "b.exr").string() + "'", dir).exit_code, 0);
+  EXPECT_NE(run("bake fiber red-cotton --bands xyz -o '" + (dir / "c.exr").string() + "'", dir).exit_code, 0);
+  EXPECT_FALSE(fs::exists(dir / "a.exr"));
+  const CliRun mie = run("mie --m-re nan --m-im 0 --x 10 --json", dir);
+  EXPECT_EQ(mie.exit_code, 2) << mie.err;
+  const CliRun slab = run("slab --mua-per-mm -1 --mus-per-mm 10 --g 0.9 --n-slab 1.4 --thickness-mm 1 "
+                       "--photons 10 --seed 1 --json", dir);
+  EXPECT_NE(slab.exit_code, 0);
+  EXPECT_NE(slab.err.find("mua"), std::string::npos) << slab.err;
+}
+
+TEST(Cli, InterruptedBakeLeavesACompleteTableOrNone) {
+  // SIGINT after 2 s into a long bake of many short passes: the program stops at a task
+  // boundary and writes the finished passes (exit 130, metadata "interrupted"), or, if not even
+  // one pass finished, writes nothing (exit 2). Never a partial file.
+  const fs::path dir = temp_dir();
+  const fs::path out = dir / "fiber.exr";
+  const CliRun r = run("bake fiber white-cotton --photons 100000000 --passes 100000 --resolution 2 --quiet -o '" +
+                        out.string() + "'",
+                    dir, "timeout --preserve-status -s INT 2 ");
+  if (r.exit_code == 130) {
+    const auto table = weft::TabulatedBsdfTable::read_exr(out);
+    EXPECT_EQ(table.metadata.at("interrupted"), "yes");
+    EXPECT_GT(std::stoull(table.metadata.at("photons")), 0u);
+  } else {
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+}
