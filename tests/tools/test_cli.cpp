@@ -107,8 +107,9 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
     const CliRun r = run("bake fiber '" + spec.string() + "' --photons 10 --quiet -o '" + out.string() + "'", dir);
     EXPECT_EQ(r.exit_code, 2) << c.name << ": " << r.err;
     EXPECT_NE(r.err.find(spec.filename().string()), std::string::npos) << c.name << ": " << r.err;
-    if (!c.expect_in_error.empty())
+    if (!c.expect_in_error.empty()) {
       EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << c.name << ": " << r.err;
+    }
     EXPECT_FALSE(fs::exists(out)) << c.name;
   }
   // A missing file is named, and the presets are listed.
