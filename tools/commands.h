@@ -5,5 +5,9 @@
 namespace weft::cli {
 
 void add_spectrum_command(CLI::App& app, Commands& commands);
+void add_render_command(CLI::App& app, Commands& commands);
+void add_sweep_command(CLI::App& app, Commands& commands);
+void add_weave_command(CLI::App& app, Commands& commands);
+void add_bench_render_command(CLI::App& app, Commands& commands);
 
 }  // namespace weft::cli

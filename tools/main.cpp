@@ -12,6 +12,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   weft::cli::Commands commands;
   weft::cli::add_spectrum_command(app, commands);
+  weft::cli::add_render_command(app, commands);
+  weft::cli::add_sweep_command(app, commands);
+  weft::cli::add_weave_command(app, commands);
+  weft::cli::add_bench_render_command(app, commands);
 
   try {
     app.parse(argc, argv);
