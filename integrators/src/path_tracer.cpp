@@ -43,7 +43,19 @@ RenderSettings render_settings_from(const RenderSpec& spec) {
 }
 
 Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings,
-               Rng& rng, RayCounts& rays, int64_t* first_mesh) {
+               Rng& rng, RayCounts& rays, int64_t* first_mesh, std::vector<LoggedRay>* log) {
+  auto record = [&](const Vec3& o, const Vec3& d, double tmax, bool shadow) {
+    if (log)
+      log->push_back({{float(o.x), float(o.y), float(o.z)},
+                      {float(d.x), float(d.y), float(d.z)},
+                      tmax > 3e38 ? INFINITY : float(tmax),
+                      shadow});
+  };
+  auto occluded = [&](const Vec3& o, const Vec3& d, double tmax) {
+    ++rays.shadow;
+    record(o, d, tmax, true);
+    return scene.occluded(o, d, tmax);
+  };
   const Lights& lights = scene.lights();
   const bool use_mis = settings.sampling == LightSampling::mis;
   const bool nee_area = settings.sampling != LightSampling::bsdf_only;
@@ -59,11 +71,12 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
     const Vec3 o = h.spawn_origin(target - h.p);
     const Vec3 to = target - o;
     const double d = length(to);
-    return d > 0 && scene.occluded(o, to / d, d * (1 - 1e-5));
+    return d > 0 && occluded(o, to / d, d * (1 - 1e-5));
   };
 
   for (int depth = 0;; ++depth) {
     SurfaceHit hit;
+    record(ray.o, ray.d, ray.tmax, false);
     const bool found = scene.intersect(ray, &hit);
     if (!found) {
       if (!env.is_black()) {
@@ -109,8 +122,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       if (!consistent(d.to_light, wi)) continue;
       const Rgb f = bsdf.eval(wo, wi);
       if (f.is_black()) continue;
-      ++rays.shadow;
-      if (!scene.occluded(hit.spawn_origin(d.to_light), d.to_light, 1e300))
+      if (!occluded(hit.spawn_origin(d.to_light), d.to_light, 1e300))
         L += beta * f * d.irradiance * std::abs(wi.z);
     }
     for (const auto& pl : lights.points) {
@@ -125,7 +137,6 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       if (!consistent(dir, wi)) continue;
       const Rgb f = bsdf.eval(wo, wi);
       if (f.is_black()) continue;
-      ++rays.shadow;
       if (!occluded_between(hit, pl.position))
         L += beta * f * pl.intensity * (fall * std::abs(wi.z) / (dist * dist));
     }
@@ -146,7 +157,6 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
           if (!f.is_black()) {
             const double light_pdf = ls.pdf_area * dist * dist / cos_l;
             const double w = use_mis ? power_heuristic(light_pdf, bsdf.pdf(wo, wi)) : 1.0;
-            ++rays.shadow;
             if (!occluded_between(hit, ls.p))
               L += beta * f * Le_l * (std::abs(wi.z) * w / light_pdf);
           }
@@ -159,8 +169,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       const Rgb f = consistent(dir, wi) ? bsdf.eval(wo, wi) : Rgb(0.0);
       if (!f.is_black()) {
         const double w = use_mis ? power_heuristic(env_pdf, bsdf.pdf(wo, wi)) : 1.0;
-        ++rays.shadow;
-        if (!scene.occluded(hit.spawn_origin(dir), dir, 1e300))
+        if (!occluded(hit.spawn_origin(dir), dir, 1e300))
           L += beta * f * env * (std::abs(wi.z) * w / env_pdf);
       }
     }
@@ -206,6 +215,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
             ty = (s.height + s.tile_size - 1) / s.tile_size;
   const uint64_t tiles = uint64_t(tx) * ty;
   std::vector<RayCounts> tile_rays(tiles);
+  std::vector<std::vector<LoggedRay>> tile_log(s.log_rays ? tiles : 0);
   std::vector<uint64_t> tile_nonfinite(tiles, 0);
   std::atomic<bool> cancel{false};
   std::atomic<uint64_t> done{0};
@@ -229,7 +239,8 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
           const Ray ray = camera.generate_ray(fx, fy, aspect);
           ++rays.camera;
           int64_t first = -1;
-          Rgb L = trace_path(scene, ray, s, rng, rays, &first);
+          Rgb L =
+              trace_path(scene, ray, s, rng, rays, &first, s.log_rays ? &tile_log[tile] : nullptr);
           if (!finite(L)) {
             ++tile_nonfinite[tile];
             L = Rgb(0.0);
@@ -257,6 +268,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
     if (!cancel.load() && !progress({"render", d, tiles})) cancel.store(true);
   });
   for (uint64_t t = 0; t < tiles; ++t) {
+    if (s.log_rays) out.ray_log.insert(out.ray_log.end(), tile_log[t].begin(), tile_log[t].end());
     out.rays += tile_rays[t];
     out.nonfinite_samples += tile_nonfinite[t];
   }

@@ -25,6 +25,11 @@ struct RenderBenchResult {
   double path_rays_per_s = 0;            // all path-tracer rays (camera, bounce, shadow), 'threads'
   double path_intersect_rays_per_s = 0;  // camera and bounce rays only
   double ratio = 0;                      // path_rays_per_s / embree_rays_per_s
+  // The path tracer's own rays (logged, then replayed through bare rtcIntersect1/rtcOccluded1 on
+  // 'threads' threads): the like-for-like baseline, so ratio_replay is the share of the path
+  // tracer's time that Embree takes.
+  double embree_replay_rays_per_s = 0;
+  double ratio_replay = 0;
   double path_rays_per_s_1thread = 0;
   double speedup = 0;  // path_rays_per_s / path_rays_per_s_1thread
 };

@@ -22,6 +22,12 @@ namespace weft {
 // next-event estimation). The single-strategy modes exist to test MIS against each of its parts.
 enum class LightSampling { mis, lights_only, bsdf_only };
 
+// A ray as the tracer handed it to Embree (for replaying the same rays in benchmarks).
+struct LoggedRay {
+  float org[3], dir[3], tmax;
+  bool shadow;  // rtcOccluded1 rather than rtcIntersect1
+};
+
 struct RenderSettings {
   int width = 256, height = 256;
   int spp = 16;
@@ -33,6 +39,7 @@ struct RenderSettings {
   LightSampling sampling = LightSampling::mis;
   // Per mesh: camera samples whose first hit is one of these count towards the mask outputs.
   std::vector<uint8_t> mask_meshes;
+  bool log_rays = false;  // keep every traced ray in RenderResult::ray_log (benchmarks only)
 };
 
 RenderSettings render_settings_from(const RenderSpec& spec);
@@ -53,6 +60,7 @@ struct RenderResult {
   std::vector<float> coverage;
   std::vector<double> masked_sum, masked_sum_sq;  // 3 per pixel
   RayCounts rays;
+  std::vector<LoggedRay> ray_log;  // with log_rays, in tile order
   uint64_t nonfinite_samples = 0;  // dropped (counted, never hidden)
   bool cancelled = false;          // the progress callback asked to stop; results are partial
 };
@@ -63,6 +71,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
 // Radiance arriving along 'ray' (one path sample). 'first_mesh' receives the mesh the ray hits
 // first (-1 for none). Exposed for tests of the estimator itself.
 Rgb trace_path(const RenderScene& scene, const Ray& ray, const RenderSettings& settings, Rng& rng,
-               RayCounts& rays, int64_t* first_mesh = nullptr);
+               RayCounts& rays, int64_t* first_mesh = nullptr,
+               std::vector<LoggedRay>* log = nullptr);
 
 }  // namespace weft
