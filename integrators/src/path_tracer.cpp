@@ -228,7 +228,9 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
     const int x0 = int(tile % tx) * s.tile_size, y0 = int(tile / tx) * s.tile_size;
     const int x1 = std::min(x0 + s.tile_size, s.width), y1 = std::min(y0 + s.tile_size, s.height);
     RayCounts rays;
-    for (int y = y0; y < y1; ++y)
+    for (int y = y0; y < y1; ++y) {
+      // A cancelled render is discarded anyway: stop within a row, not a whole tile.
+      if (cancel.load(std::memory_order_relaxed)) return;
       for (int x = x0; x < x1; ++x) {
         const uint64_t pixel = uint64_t(y) * s.width + x;
         double sum[3] = {0, 0, 0}, msum[3] = {0, 0, 0}, msq[3] = {0, 0, 0};
@@ -262,6 +264,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
           }
         }
       }
+    }
     tile_rays[tile] = rays;
     const uint64_t d = done.fetch_add(1) + 1;
     std::lock_guard lock(progress_mutex);

@@ -12,6 +12,13 @@
 
 namespace weft {
 
+namespace {
+struct EmbreeErrors {
+  std::mutex mutex;
+  std::string message;
+};
+}  // namespace
+
 struct RenderScene::Geometry {
   struct MeshRecord {
     std::shared_ptr<const TriangleMesh> mesh;
@@ -20,6 +27,7 @@ struct RenderScene::Geometry {
     bool emit_two_sided = false;
     int64_t light_offset = -1;  // first entry of this mesh's triangles in the light list
   };
+  EmbreeErrors errors;  // outlives the device, which reports into it
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<MeshRecord> meshes;
@@ -36,11 +44,6 @@ struct RenderScene::Geometry {
 };
 
 namespace {
-
-struct EmbreeErrors {
-  std::mutex mutex;
-  std::string message;
-};
 
 void on_embree_error(void* user, RTCError code, const char* str) {
   auto* e = static_cast<EmbreeErrors*>(user);
@@ -63,7 +66,7 @@ double triangle_area(const TriangleMesh& m, uint32_t prim) {
 
 RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions& options) {
   auto geo = std::make_shared<Geometry>();
-  EmbreeErrors errors;
+  EmbreeErrors& errors = geo->errors;
   geo->device = rtcNewDevice(nullptr);
   if (!geo->device) throw Error(desc.source, "", "cannot create the Embree device");
   rtcSetDeviceErrorFunction(geo->device, on_embree_error, &errors);
@@ -113,6 +116,9 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
       }
     }
     geo->meshes.push_back(rec);
+    geo->bounds.expand(mesh->bounds());
+    // Geometry IDs equal mesh indices; an empty mesh simply has no Embree geometry.
+    if (mesh->vertex_count() == 0 || mesh->triangle_count() == 0) continue;
 
     RTCGeometry g = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_TRIANGLE);
     auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
@@ -131,11 +137,9 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(geo->scene, g, static_cast<unsigned>(i));
     rtcReleaseGeometry(g);
-    geo->bounds.expand(mesh->bounds());
     geo->triangles += mesh->triangle_count();
   }
   rtcCommitScene(geo->scene);
-  rtcSetDeviceErrorFunction(geo->device, nullptr, nullptr);
   if (!errors.message.empty()) throw Error(desc.source, "", errors.message);
   if (!light_weights.empty()) geo->light_pick = Distribution1D(light_weights);
   geo_ = std::move(geo);

@@ -32,6 +32,9 @@ struct RenderBenchResult {
   double ratio_replay = 0;
   double path_rays_per_s_1thread = 0;
   double speedup = 0;  // path_rays_per_s / path_rays_per_s_1thread
+  // The same 1 -> 'threads' speed-up for pure arithmetic tasks, measured in the same run: what the
+  // machine offers right now (shared machines often do not give a second free core).
+  double machine_speedup = 0;
 };
 
 // A woven patch in memory (lambert warp and weft, a parallel light at 30 degrees, orthographic
