@@ -11,5 +11,9 @@ void add_bench_bake_command(CLI::App& app, Commands& commands);
 void add_mie_command(CLI::App& app, Commands& commands);
 void add_medium_command(CLI::App& app, Commands& commands);
 void add_table_command(CLI::App& app, Commands& commands);
+void add_render_command(CLI::App& app, Commands& commands);
+void add_sweep_command(CLI::App& app, Commands& commands);
+void add_weave_command(CLI::App& app, Commands& commands);
+void add_bench_render_command(CLI::App& app, Commands& commands);
 
 }  // namespace weft::cli

@@ -1,0 +1,76 @@
+#pragma once
+// Virtual gonioreflectometer (Voloboy et al. 2010, section 4): a parallel light of irradiance E
+// at (theta_i, phi_i) and a list of view directions. For each view the sample is rendered with an
+// orthographic camera that frames its bounding box exactly, the radiance of the camera samples
+// that hit the sample is summed (the mask), and the radiance coefficient is
+//   beta = L_sample / L_white,  L_sample = sum / footprint,  L_white = E cos(theta_i) / pi,
+// the radiance of an ideal white Lambertian reflector under the same light. The white reference
+// is also rendered (every material of the sample replaced by white Lambert) as a check. The
+// paper's normalization scales every beta so that beta at normal incidence and view equals a
+// given value. beta_err is the standard error from the per-pixel sample variance.
+//
+// Angles are in degrees in the description's AngleFrame. View directions lie in the plane at
+// azimuth phi_v (default phi_i, the plane of incidence); as in the paper's Fig. 7, a view zenith
+// theta_v > 0 lies on the mirror side (azimuth phi_v + 180) and theta_v < 0 on the light's side.
+// The scene's own lights and environment are not used; emissive surfaces still emit.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/integrators/path_tracer.h"
+#include "weft/scenes/description.h"
+
+namespace weft {
+
+struct GonioSettings {
+  std::string sample;  // object name (empty: every mesh)
+  double light_zenith_deg = 0, light_azimuth_deg = 0;
+  Rgb irradiance{1.0};
+  std::vector<double> view_zenith_deg;
+  std::optional<double> view_azimuth_deg;
+  std::optional<Rgb> normalize_to;
+  bool white_check = true;
+  int width = 64, height = 64, spp = 16;
+  int max_depth = 16, rr_depth = 3;
+  uint64_t seed = 0;
+  int threads = 0;
+};
+
+// Defaults from the description's "sweep" and "render" sections.
+GonioSettings gonio_settings_from(const SceneDescription& desc);
+
+// Signed view zenith / azimuth (degrees) to a unit direction towards the viewer.
+Vec3 gonio_view_direction(const AngleFrame& frame, double view_zenith_deg, double view_azimuth_deg);
+
+struct GonioRow {
+  double view_zenith_deg = 0, view_azimuth_deg = 0;
+  Rgb sum;                  // sum over pixels of the radiance of samples hitting the sample
+  double footprint_px = 0;  // pixels covered by the sample (sum of coverage)
+  Rgb beta, beta_err_rgb;
+  double beta_err = 0;       // standard error of the channel mean of beta
+  std::optional<Rgb> white;  // rendered white reference / (E cos theta_i / pi)
+  std::optional<Rgb> beta_norm;
+};
+
+struct GonioResult {
+  std::vector<GonioRow> rows;
+  double light_zenith_deg = 0, light_azimuth_deg = 0;
+  Rgb l_white;                       // E cos(theta_i) / pi
+  std::optional<Rgb> beta_normal;    // beta at normal incidence and view (when normalizing)
+  std::optional<Rgb> normalization;  // the factor applied to every beta
+  RayCounts rays;
+  uint64_t nonfinite_samples = 0;
+  bool cancelled = false;
+};
+
+GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& settings,
+                      const ProgressCallback& progress = no_progress());
+
+// One row per view: view_zenith_deg, view_azimuth_deg, light_zenith_deg, light_azimuth_deg,
+// sum_r, sum_g, sum_b, footprint_px, beta_r, beta_g, beta_b, beta_err, beta_err_r, beta_err_g,
+// beta_err_b, white_r, white_g, white_b (nan without the check), and beta_norm_r/g/b when
+// normalizing.
+std::string gonio_csv(const GonioResult& result);
+
+}  // namespace weft

@@ -1,0 +1,203 @@
+#include "weft/integrators/bench.h"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+
+#include "weft/core/distribution.h"
+#include "weft/core/frame.h"
+#include "weft/core/math.h"
+#include "weft/core/parallel.h"
+#include "weft/core/rng.h"
+#include "weft/integrators/path_tracer.h"
+#include "weft/materials/bsdf.h"
+#include "weft/scenes/render_scene.h"
+
+namespace weft {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Diffuse rays as a path tracer's bounces from opaque surfaces see them: from area-uniform surface
+// points, cosine distributed about the geometric normal on the side the vertex normals face (a
+// random side where the mesh has no normals).
+std::vector<Ray> diffuse_rays(const SceneDescription& desc, size_t n, uint64_t seed) {
+  std::vector<std::pair<size_t, uint32_t>> tris;
+  std::vector<double> areas;
+  for (size_t m = 0; m < desc.meshes.size(); ++m) {
+    const auto& mesh = *desc.meshes[m];
+    for (uint32_t t = 0; t < mesh.triangle_count(); ++t) {
+      const Vec3 p0 = mesh.position(mesh.indices[3 * t]);
+      tris.push_back({m, t});
+      areas.push_back(length(cross(mesh.position(mesh.indices[3 * t + 1]) - p0,
+                                   mesh.position(mesh.indices[3 * t + 2]) - p0)));
+    }
+  }
+  const Distribution1D pick(areas);
+  std::vector<Ray> rays(n);
+  for (size_t i = 0; i < n; ++i) {
+    Rng rng(seed, i);
+    const auto [m, t] = tris[pick.sample_discrete(rng.uniform())];
+    const auto& mesh = *desc.meshes[m];
+    const Vec3 p0 = mesh.position(mesh.indices[3 * t]), p1 = mesh.position(mesh.indices[3 * t + 1]),
+               p2 = mesh.position(mesh.indices[3 * t + 2]);
+    const double su = std::sqrt(rng.uniform()), b1 = 1 - su, b2 = rng.uniform() * su;
+    const Vec3 p = (1 - b1 - b2) * p0 + b1 * p1 + b2 * p2;
+    Vec3 ng = normalize(cross(p1 - p0, p2 - p0));
+    const double side = rng.uniform();
+    if (!mesh.normals.empty()) {
+      const uint32_t i0 = mesh.indices[3 * t];
+      if (dot(ng, Vec3{mesh.normals[3 * i0], mesh.normals[3 * i0 + 1], mesh.normals[3 * i0 + 2]}) <
+          0)
+        ng = -ng;
+    } else if (side < 0.5) {
+      ng = -ng;
+    }
+    const Vec3 d =
+        Frame::from_normal(ng).to_world(sample_cosine_hemisphere({rng.uniform(), rng.uniform()}));
+    double mag = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+    rays[i] = {p + ng * (1e-5 * mag + 1e-30), normalize(d)};
+  }
+  return rays;
+}
+
+double embree_rate(const RenderScene& scene, const std::vector<Ray>& rays, int threads) {
+  const uint64_t chunk = 4096, chunks = (rays.size() + chunk - 1) / chunk;
+  std::vector<uint64_t> hits(chunks, 0);
+  const auto t0 = Clock::now();
+  parallel_for(chunks, threads, [&](uint64_t c) {
+    uint64_t h = 0;
+    const size_t end = std::min<size_t>(rays.size(), (c + 1) * chunk);
+    for (size_t i = c * chunk; i < end; ++i) h += std::isfinite(scene.intersect_distance(rays[i]));
+    hits[c] = h;  // keeps the work observable
+  });
+  const double s = seconds_since(t0);
+  uint64_t total = 0;
+  for (auto h : hits) total += h;
+  return total <= rays.size() ? rays.size() / s : 0;
+}
+
+double replay_rate(const RenderScene& scene, const std::vector<LoggedRay>& log, int threads) {
+  const uint64_t chunk = 4096, chunks = (log.size() + chunk - 1) / chunk;
+  std::vector<uint64_t> hits(chunks, 0);
+  const auto t0 = Clock::now();
+  parallel_for(chunks, threads, [&](uint64_t c) {
+    uint64_t h = 0;
+    const size_t end = std::min<size_t>(log.size(), (c + 1) * chunk);
+    for (size_t i = c * chunk; i < end; ++i) {
+      const LoggedRay& r = log[i];
+      const Vec3 o{r.org[0], r.org[1], r.org[2]}, d{r.dir[0], r.dir[1], r.dir[2]};
+      h += r.shadow ? scene.occluded(o, d, r.tmax)
+                    : std::isfinite(scene.intersect_distance({o, d, r.tmax}));
+    }
+    hits[c] = h;
+  });
+  const double s = seconds_since(t0);
+  uint64_t total = 0;
+  for (auto h : hits) total += h;
+  return total <= log.size() ? log.size() / s : 0;
+}
+
+// Seconds for a fixed amount of floating-point work split into tasks, on 'threads' threads.
+double arithmetic_seconds(int threads) {
+  std::vector<double> out(64);
+  const auto t0 = Clock::now();
+  parallel_for(64, threads, [&](uint64_t task) {
+    Rng rng(1, task);
+    double x = rng.uniform();
+    for (int i = 0; i < 2000000; ++i) x = x * 0.999999 + 1e-7;
+    out[task] = x;
+  });
+  const double s = seconds_since(t0);
+  double sum = 0;
+  for (double v : out) sum += v;
+  return sum > 0 ? s : 0;
+}
+
+struct PathRate {
+  double all = 0, intersect = 0;
+};
+PathRate path_rate(const RenderScene& scene, const Camera& cam, const RenderBenchOptions& o,
+                   int threads) {
+  RenderSettings s;
+  s.width = o.width;
+  s.height = o.height;
+  s.spp = o.spp;
+  s.seed = o.seed;
+  s.threads = threads;
+  const auto t0 = Clock::now();
+  const RenderResult r = render(scene, cam, s);
+  const double sec = seconds_since(t0);
+  return {r.rays.total() / sec, (r.rays.camera + r.rays.bounce) / sec};
+}
+
+}  // namespace
+
+SceneDescription weave_bench_scene(const WeaveParams& params) {
+  SceneDescription d;
+  d.source = "weave bench scene";
+  for (auto& m : make_weave(params))
+    d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+  MaterialBinding warp, weft;
+  warp.type = weft.type = "lambert";
+  warp.params = {{"reflectance", {0.6, 0.15, 0.1}}};
+  weft.params = {{"reflectance", 0.5}};
+  warp.field = "materials.warp";
+  weft.field = "materials.weft";
+  d.materials["warp"] = warp;
+  d.materials["weft"] = weft;
+  d.lights.directional.push_back({d.frame.direction(deg_to_rad(30), 0), Rgb(1.0)});
+  d.camera = frame_box_orthographic(d.object_bounds(""), d.frame.direction(deg_to_rad(20), kPi),
+                                    d.frame.normal);
+  return d;
+}
+
+RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::string& name,
+                                     const RenderBenchOptions& o) {
+  RenderBenchResult r;
+  r.name = name;
+  auto t0 = Clock::now();
+  const RenderScene scene(desc);
+  r.build_s = seconds_since(t0);
+  r.triangles = scene.triangle_count();
+  const auto rays = diffuse_rays(desc, o.diffuse_rays, o.seed);
+  const Camera cam = desc.camera ? *desc.camera
+                                 : frame_box_orthographic(scene.bounds(),
+                                                          desc.frame.direction(deg_to_rad(20), kPi),
+                                                          desc.frame.normal);
+  std::vector<LoggedRay> log;
+  {
+    RenderSettings s;
+    s.width = o.width;
+    s.height = o.height;
+    s.spp = o.spp;
+    s.seed = o.seed;
+    s.threads = o.threads;
+    s.log_rays = true;
+    log = render(scene, cam, s).ray_log;
+  }
+  // Best of two runs each: the machines are shared, and the best run is the least disturbed one.
+  for (int rep = 0; rep < 2; ++rep) {
+    r.machine_speedup =
+        std::max(r.machine_speedup, arithmetic_seconds(1) / arithmetic_seconds(o.threads));
+    r.embree_replay_rays_per_s =
+        std::max(r.embree_replay_rays_per_s, replay_rate(scene, log, o.threads));
+    r.embree_rays_per_s = std::max(r.embree_rays_per_s, embree_rate(scene, rays, o.threads));
+    const PathRate one = path_rate(scene, cam, o, 1);
+    const PathRate many = path_rate(scene, cam, o, o.threads);
+    r.path_rays_per_s_1thread = std::max(r.path_rays_per_s_1thread, one.all);
+    if (many.all > r.path_rays_per_s) {
+      r.path_rays_per_s = many.all;
+      r.path_intersect_rays_per_s = many.intersect;
+    }
+  }
+  r.ratio = r.path_rays_per_s / r.embree_rays_per_s;
+  r.ratio_replay = r.path_rays_per_s / r.embree_replay_rays_per_s;
+  r.speedup = r.path_rays_per_s / r.path_rays_per_s_1thread;
+  return r;
+}
+
+}  // namespace weft

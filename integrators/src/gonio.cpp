@@ -1,0 +1,254 @@
+#include "weft/integrators/gonio.h"
+
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/scenes/render_scene.h"
+
+namespace weft {
+namespace {
+
+struct ViewMeasure {
+  Rgb sum;       // sum over pixels of the masked radiance (per-pixel sample means)
+  Rgb mean;      // sum / footprint: the sample's mean radiance
+  Rgb var_mean;  // variance of that mean
+  double footprint = 0;
+};
+
+// The sample's mean radiance is a ratio estimator, R = sum(h x) / sum(h), with h = 1 for camera
+// samples that hit the sample and x their radiance. Its variance follows from the residuals
+// y = h (x - R) (delta method; Cochran, Sampling Techniques, 3rd ed., section 6.3), estimated from
+// each pixel's sample variance. Edge pixels that are partly covered add no variance by themselves.
+ViewMeasure measure(const RenderResult& r, int spp) {
+  ViewMeasure m;
+  const size_t npx = r.coverage.size();
+  double s[3] = {0, 0, 0}, fp = 0;
+  for (size_t p = 0; p < npx; ++p) {
+    fp += r.coverage[p];
+    for (int c = 0; c < 3; ++c) s[c] += r.masked_sum[3 * p + c];
+  }
+  m.sum = {s[0], s[1], s[2]};
+  m.footprint = fp;
+  const double R[3] = {s[0] / fp, s[1] / fp, s[2] / fp};
+  double v[3] = {0, 0, 0};
+  for (size_t p = 0; p < npx; ++p) {
+    const double h = r.coverage[p];
+    for (int c = 0; c < 3; ++c) {
+      // Per-sample moments of y over the pixel's spp samples (the stored sums are divided by spp).
+      const double hx = r.masked_sum[3 * p + c], hx2 = r.masked_sum_sq[3 * p + c];
+      const double ey = hx - R[c] * h;
+      const double ey2 = hx2 - 2 * R[c] * hx + R[c] * R[c] * h;
+      // Unbiased sample variance of y, divided by spp for the pixel mean.
+      v[c] += spp > 1 ? std::max(0.0, (ey2 - ey * ey) * spp / (spp - 1)) / spp : NAN;
+    }
+  }
+  m.mean = {R[0], R[1], R[2]};
+  m.var_mean = Rgb(v[0], v[1], v[2]) / (fp * fp);
+  return m;
+}
+
+Rgb divide(const Rgb& a, const Rgb& b) {
+  return {a.r / b.r, a.g / b.g, a.b / b.b};
+}
+
+std::string fmt(double v) {
+  if (std::isnan(v)) return "nan";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.9g", v);
+  return buf;
+}
+
+}  // namespace
+
+GonioSettings gonio_settings_from(const SceneDescription& desc) {
+  GonioSettings g;
+  g.max_depth = desc.render.max_depth;
+  g.rr_depth = desc.render.rr_depth;
+  g.seed = desc.render.seed;
+  if (desc.sweep) {
+    const SweepSpec& s = *desc.sweep;
+    g.sample = s.sample;
+    g.light_zenith_deg = s.light_zenith_deg;
+    g.light_azimuth_deg = s.light_azimuth_deg;
+    g.irradiance = s.irradiance;
+    g.view_zenith_deg = s.view_zenith_deg;
+    g.view_azimuth_deg = s.view_azimuth_deg;
+    g.normalize_to = s.normalize_to;
+    g.white_check = s.white_check;
+    g.width = s.width;
+    g.height = s.height;
+    g.spp = s.spp;
+  }
+  return g;
+}
+
+Vec3 gonio_view_direction(const AngleFrame& frame, double view_zenith_deg,
+                          double view_azimuth_deg) {
+  const double azimuth = view_azimuth_deg + (view_zenith_deg > 0 ? 180.0 : 0.0);
+  return frame.direction(deg_to_rad(std::abs(view_zenith_deg)), deg_to_rad(azimuth));
+}
+
+GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
+                      const ProgressCallback& progress) {
+  const std::string src = desc.source;
+  if (!(g.light_zenith_deg >= 0 && g.light_zenith_deg < 90))
+    throw Error(src, "light_zenith_deg", "must lie in [0, 90)");
+  if (g.view_zenith_deg.empty()) throw Error(src, "view_zenith_deg", "no view directions");
+  for (double v : g.view_zenith_deg)
+    if (!(std::abs(v) < 90)) throw Error(src, "view_zenith_deg", "views must lie in (-90, 90)");
+  if (!(g.irradiance.r > 0 && g.irradiance.g > 0 && g.irradiance.b > 0))
+    throw Error(src, "irradiance", "must be positive in every channel");
+  if (g.width < 1 || g.height < 1 || g.spp < 1)
+    throw Error(src, "sweep", "width, height and spp must be positive");
+
+  const std::vector<uint8_t> sel = desc.select_object(g.sample);
+  const Bounds3 box = desc.object_bounds(g.sample);
+  const double phi_v = g.view_azimuth_deg.value_or(g.light_azimuth_deg);
+
+  auto light_set = [&](double zenith_deg, double azimuth_deg) {
+    Lights l;  // the scene's own lights and environment are not part of the instrument
+    l.directional.push_back(
+        {desc.frame.direction(deg_to_rad(zenith_deg), deg_to_rad(azimuth_deg)), g.irradiance});
+    return l;
+  };
+  const RenderScene sample_scene =
+      RenderScene(desc).with_lights(light_set(g.light_zenith_deg, g.light_azimuth_deg));
+  std::optional<RenderScene> white_scene;
+  if (g.white_check) {
+    RenderSceneOptions opt;
+    opt.override_meshes = sel;
+    MaterialBinding white;
+    white.type = "lambert";
+    white.params = {{"reflectance", 1.0}};
+    white.field = "white reference";
+    opt.override_binding = white;
+    white_scene =
+        RenderScene(desc, opt).with_lights(light_set(g.light_zenith_deg, g.light_azimuth_deg));
+  }
+
+  // Normalization needs beta at normal incidence and view; reuse a row when the sweep has it.
+  const bool need_normal_render =
+      g.normalize_to &&
+      !(g.light_zenith_deg == 0 && std::find(g.view_zenith_deg.begin(), g.view_zenith_deg.end(),
+                                             0.0) != g.view_zenith_deg.end());
+  const int per_view = g.white_check ? 2 : 1;
+  const uint64_t renders = g.view_zenith_deg.size() * per_view + (need_normal_render ? 1 : 0);
+  RenderSettings rs;
+  rs.width = g.width;
+  rs.height = g.height;
+  rs.spp = g.spp;
+  rs.max_depth = g.max_depth;
+  rs.rr_depth = g.rr_depth;
+  rs.seed = g.seed;
+  rs.threads = g.threads;
+  rs.mask_meshes = sel;
+  const uint64_t tiles_per = uint64_t((g.width + rs.tile_size - 1) / rs.tile_size) *
+                             ((g.height + rs.tile_size - 1) / rs.tile_size);
+  uint64_t renders_done = 0;
+
+  GonioResult res;
+  res.light_zenith_deg = g.light_zenith_deg;
+  res.light_azimuth_deg = g.light_azimuth_deg;
+  const double cos_i = std::cos(deg_to_rad(g.light_zenith_deg));
+  res.l_white = g.irradiance * (cos_i * kInvPi);
+
+  // Renders one view; returns nullopt when cancelled.
+  auto render_view = [&](const RenderScene& scene, double zen, double azi,
+                         const Rgb& l_white) -> std::optional<std::pair<ViewMeasure, Rgb>> {
+    const Vec3 towards_viewer = gonio_view_direction(desc.frame, zen, azi);
+    // Film "up" follows the sample normal except near normal view.
+    const Vec3 up_hint = std::abs(zen) > 5 ? desc.frame.normal : desc.frame.tangent;
+    const Camera cam = frame_box_orthographic(box, towards_viewer, up_hint);
+    const uint64_t base = renders_done * tiles_per;
+    const RenderResult r = render(scene, cam, rs, [&](const ProgressUpdate& u) {
+      return progress({"sweep", base + u.done, renders * tiles_per});
+    });
+    ++renders_done;
+    res.rays += r.rays;
+    res.nonfinite_samples += r.nonfinite_samples;
+    if (r.cancelled) return std::nullopt;
+    const ViewMeasure m = measure(r, g.spp);  // NaN when the sample is not seen at all
+    return std::make_pair(m, divide(m.mean, l_white));
+  };
+
+  for (double zen : g.view_zenith_deg) {
+    GonioRow row;
+    row.view_zenith_deg = zen;
+    row.view_azimuth_deg = phi_v;
+    const auto s = render_view(sample_scene, zen, phi_v, res.l_white);
+    if (!s) {
+      res.cancelled = true;
+      return res;
+    }
+    const auto& [m, beta] = *s;
+    row.sum = m.sum;
+    row.footprint_px = m.footprint;
+    row.beta = beta;
+    row.beta_err_rgb = {std::sqrt(m.var_mean.r) / res.l_white.r,
+                        std::sqrt(m.var_mean.g) / res.l_white.g,
+                        std::sqrt(m.var_mean.b) / res.l_white.b};
+    // Channel mean: channels of one sample are strongly correlated, so bound the error of the
+    // mean by the mean of the errors (exact for perfectly correlated channels).
+    row.beta_err = row.beta_err_rgb.average();
+    if (white_scene) {
+      const auto w = render_view(*white_scene, zen, phi_v, res.l_white);
+      if (!w) {
+        res.cancelled = true;
+        return res;
+      }
+      row.white = w->second;
+    }
+    res.rows.push_back(row);
+  }
+
+  if (g.normalize_to) {
+    Rgb beta00;
+    if (need_normal_render) {
+      const RenderScene normal_scene = sample_scene.with_lights(light_set(0, 0));
+      const Rgb l_white00 = g.irradiance * kInvPi;
+      const auto s = render_view(normal_scene, 0, 0, l_white00);
+      if (!s) {
+        res.cancelled = true;
+        return res;
+      }
+      beta00 = s->second;
+    } else {
+      for (const auto& row : res.rows)
+        if (row.view_zenith_deg == 0) beta00 = row.beta;
+    }
+    res.beta_normal = beta00;
+    res.normalization = divide(*g.normalize_to, beta00);
+    for (auto& row : res.rows) row.beta_norm = row.beta * *res.normalization;
+  }
+  return res;
+}
+
+std::string gonio_csv(const GonioResult& r) {
+  std::ostringstream os;
+  os << "view_zenith_deg,view_azimuth_deg,light_zenith_deg,light_azimuth_deg,sum_r,sum_g,sum_b,"
+        "footprint_px,"
+        "beta_r,beta_g,beta_b,beta_err,beta_err_r,beta_err_g,beta_err_b,white_r,white_g,white_b";
+  const bool norm = r.normalization.has_value();
+  if (norm) os << ",beta_norm_r,beta_norm_g,beta_norm_b";
+  os << "\n";
+  for (const auto& row : r.rows) {
+    const Rgb w = row.white.value_or(Rgb(NAN));
+    os << fmt(row.view_zenith_deg) << ',' << fmt(row.view_azimuth_deg) << ','
+       << fmt(r.light_zenith_deg) << ',' << fmt(r.light_azimuth_deg) << ',' << fmt(row.sum.r) << ','
+       << fmt(row.sum.g) << ',' << fmt(row.sum.b) << ',' << fmt(row.footprint_px) << ','
+       << fmt(row.beta.r) << ',' << fmt(row.beta.g) << ',' << fmt(row.beta.b) << ','
+       << fmt(row.beta_err) << ',' << fmt(row.beta_err_rgb.r) << ',' << fmt(row.beta_err_rgb.g)
+       << ',' << fmt(row.beta_err_rgb.b) << ',' << fmt(w.r) << ',' << fmt(w.g) << ',' << fmt(w.b);
+    if (norm) {
+      const Rgb b = row.beta_norm.value_or(Rgb(NAN));
+      os << ',' << fmt(b.r) << ',' << fmt(b.g) << ',' << fmt(b.b);
+    }
+    os << "\n";
+  }
+  return os.str();
+}
+
+}  // namespace weft

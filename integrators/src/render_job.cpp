@@ -1,0 +1,42 @@
+#include "weft/integrators/render_job.h"
+
+#include "weft/core/error.h"
+#include "weft/integrators/image.h"
+#include "weft/scenes/render_scene.h"
+
+namespace weft {
+namespace {
+
+void check_output(const std::filesystem::path& p, const std::string& ext, const std::string& what) {
+  if (p.extension() != ext) throw Error(p.string(), what, "must end in " + ext);
+  const auto dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
+  std::error_code ec;
+  if (!std::filesystem::is_directory(dir, ec))
+    throw Error(p.string(), what, "output directory does not exist");
+}
+
+}  // namespace
+
+RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& job,
+                                const ProgressCallback& progress) {
+  // Everything that can be checked is checked before the (long) render.
+  check_output(job.exr, ".exr", "output");
+  if (job.png) check_output(*job.png, ".png", "preview");
+  if (job.mask) check_output(*job.mask, ".exr", "mask");
+  if (!desc.camera) throw Error(desc.source, "camera", "no camera: add 'camera' or a glTF camera");
+  RenderSettings settings = job.settings;
+  if (job.mask) settings.mask_meshes = desc.select_object(job.mask_object);
+  const RenderScene scene(desc);
+  const RenderResult r = render(scene, *desc.camera, settings, progress);
+  RenderJobResult out;
+  out.rays = r.rays;
+  out.nonfinite_samples = r.nonfinite_samples;
+  out.cancelled = r.cancelled;
+  if (r.cancelled) return out;  // nothing half-finished reaches the disk
+  write_exr(job.exr, r.image);
+  if (job.png) write_png_preview(*job.png, r.image);
+  if (job.mask) write_mask_exr(*job.mask, settings.width, settings.height, r.coverage);
+  return out;
+}
+
+}  // namespace weft

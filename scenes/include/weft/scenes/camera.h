@@ -1,0 +1,34 @@
+#pragma once
+// Cameras: perspective and orthographic, as an orthonormal basis and a film extent.
+#include "weft/core/vec.h"
+#include "weft/scenes/mesh.h"
+
+namespace weft {
+
+struct Ray {
+  Vec3 o, d;  // origin, unit direction
+  double tmax = 1e300;
+};
+
+struct Camera {
+  enum class Type { perspective, orthographic };
+  Type type = Type::perspective;
+  Vec3 position{0, 0, 0};
+  // Orthonormal basis: the camera looks along 'forward'; 'up' is the film's up direction.
+  Vec3 right{1, 0, 0}, up{0, 1, 0}, forward{0, 0, -1};
+  double yfov_rad = 0.8;                   // perspective: vertical field of view
+  double half_width = 1, half_height = 1;  // orthographic: film half extents (glTF xmag, ymag)
+
+  // Ray through film point (fx, fy) in [0,1]^2, fx to the right, fy downwards. 'aspect' is the
+  // image width / height (perspective only; an orthographic film is given by its half extents).
+  Ray generate_ray(double fx, double fy, double aspect) const;
+
+  // Camera with basis from a viewing direction and an up hint (Gram-Schmidt).
+  static Camera look_at(Type type, const Vec3& position, const Vec3& target, const Vec3& up_hint);
+};
+
+// Orthographic camera looking along -towards_viewer whose film is exactly the projection of the
+// box's 8 corners; 'up_hint' orients the film (replaced when nearly parallel to the view).
+Camera frame_box_orthographic(const Bounds3& box, const Vec3& towards_viewer, const Vec3& up_hint);
+
+}  // namespace weft

@@ -1,0 +1,113 @@
+#pragma once
+// The scene description file (JSON): glTF files (relative paths), bindings of glTF material names
+// to Weft materials, lights, camera, render settings and an optional gonioreflectometer sweep.
+// Parsing only: the result is plain data; render_scene.h turns it into something renderable.
+//
+// {
+//   "gltf": "plane.gltf" | ["a.gltf", "b.glb"],
+//   "objects": [ inline primitives, for tests:
+//     {"type": "quad", "name": N, "material": KEY, "center": [3], "normal": [3], "tangent": [3],
+//      "size": [w, h]} |
+//     {"type": "sphere", "name": N, "material": KEY, "center": [3], "radius": r,
+//      "subdivisions": k, "inward": false, "smooth": true} ],
+//   "materials": { KEY: {"type": T, "params": {...}, "emission": c, "double_sided": b} },
+//   "default_material": {"type": T, "params": {...}},      // for keys with no binding
+//   "frame": {"normal": [0,1,0], "tangent": [1,0,0]},      // zenith/azimuth reference (glTF Y up)
+//   "lights": [ {"type": "parallel", "irradiance": c, "zenith_deg": t, "azimuth_deg": p} |
+//               {"type": "parallel", "irradiance": c, "direction": [3]}  (towards the light) |
+//               {"type": "environment", "radiance": c} |
+//               {"type": "point", "position": [3], "intensity": c} |
+//               {"type": "spot", "position": [3], "direction": [3], "intensity": c,
+//                "inner_cone_deg": a, "outer_cone_deg": b} ],
+//   "camera": {"gltf_camera": NAME} |
+//             {"type": "perspective", "position": [3], "look_at": [3], "up": [3], "yfov_deg": f} |
+//             {"type": "orthographic", "position": [3], "look_at": [3], "up": [3],
+//              "half_width": w, "half_height": h} |
+//             {"type": "orthographic", "frame_object": NAME, "zenith_deg": t, "azimuth_deg": p},
+//   "render": {"width": 256, "height": 256, "spp": 16, "max_depth": 16, "rr_depth": 3, "seed": 0},
+//   "sweep": {"sample": NAME, "light_zenith_deg": t, "light_azimuth_deg": p, "irradiance": c,
+//             "view_zenith_deg": [list] | {"from": a, "to": b, "step": s}, "view_azimuth_deg": p,
+//             "normalize_to": c, "white_check": true, "width": 64, "height": 64, "spp": 16}
+// }
+// A colour c is a number or [r, g, b]. Unknown keys, wrong types, out-of-range values and missing
+// files are weft::Error naming the file and the field.
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "weft/core/spectrum.h"
+#include "weft/scenes/camera.h"
+#include "weft/scenes/gltf.h"
+#include "weft/scenes/lights.h"
+#include "weft/scenes/mesh.h"
+
+namespace weft {
+
+struct MaterialBinding {
+  std::string type;  // a name make_bsdf knows
+  nlohmann::json params = nlohmann::json::object();
+  std::optional<Rgb> emission;  // overrides the glTF emissive colour when set
+  std::optional<bool> double_sided;
+  std::string field;  // where it was declared, for error messages
+};
+
+// The reference frame of zenith/azimuth angles: zenith from 'normal', azimuth from 'tangent'
+// towards normal x tangent.
+struct AngleFrame {
+  Vec3 normal{0, 1, 0};
+  Vec3 tangent{1, 0, 0};
+  Vec3 direction(double zenith_rad, double azimuth_rad) const;
+};
+
+struct RenderSpec {
+  int width = 256, height = 256;
+  int spp = 16;
+  int max_depth = 16;  // bounces
+  int rr_depth = 3;    // bounces before Russian roulette starts
+  uint64_t seed = 0;
+};
+
+struct SweepSpec {
+  std::string sample;  // object name; empty = every mesh
+  double light_zenith_deg = 0, light_azimuth_deg = 0;
+  Rgb irradiance{1.0};
+  std::vector<double> view_zenith_deg;
+  std::optional<double> view_azimuth_deg;  // default: the light's azimuth (plane of incidence)
+  std::optional<Rgb> normalize_to;
+  bool white_check = true;
+  int width = 64, height = 64, spp = 16;
+};
+
+struct SceneDescription {
+  std::string source;  // the description file, for error messages
+  std::filesystem::path base_dir = ".";
+  std::vector<std::shared_ptr<const TriangleMesh>> meshes;
+  std::map<std::string, GltfMaterialInfo> gltf_materials;  // emissive info by binding key
+  std::map<std::string, MaterialBinding> materials;        // bindings by key
+  std::optional<MaterialBinding> default_material;
+  Lights lights;
+  std::optional<Camera> camera;
+  AngleFrame frame;
+  RenderSpec render;
+  std::optional<SweepSpec> sweep;
+  std::vector<std::string> warnings;
+
+  // Bounding box of the meshes selected by 'object' (every mesh when empty); Error when none.
+  Bounds3 object_bounds(const std::string& object) const;
+  // Per-mesh flags of the meshes selected by 'object'; Error listing known names when none.
+  std::vector<uint8_t> select_object(const std::string& object) const;
+  // The binding for a mesh's material key (default_material where unbound); Error when neither.
+  const MaterialBinding& binding_for(const std::string& key) const;
+};
+
+SceneDescription load_scene_description(const std::filesystem::path& path);
+// Same from parsed JSON; relative paths resolve against base_dir, errors name 'source'.
+SceneDescription parse_scene_description(const nlohmann::json& j,
+                                         const std::filesystem::path& base_dir,
+                                         const std::string& source);
+
+}  // namespace weft

@@ -1,0 +1,63 @@
+#include "weft/scenes/camera.h"
+
+#include <cmath>
+
+#include "weft/core/error.h"
+
+namespace weft {
+
+Ray Camera::generate_ray(double fx, double fy, double aspect) const {
+  const double sx = 2 * fx - 1, sy = 1 - 2 * fy;  // film coordinates in [-1, 1], y up
+  if (type == Type::orthographic)
+    return {position + right * (sx * half_width) + up * (sy * half_height), forward};
+  const double th = std::tan(0.5 * yfov_rad);
+  return {position, normalize(forward + right * (sx * th * aspect) + up * (sy * th))};
+}
+
+Camera Camera::look_at(Type type, const Vec3& position, const Vec3& target, const Vec3& up_hint) {
+  Camera c;
+  c.type = type;
+  c.position = position;
+  const Vec3 f = target - position;
+  if (!(length(f) > 0)) throw Error("", "camera", "look_at equals position");
+  c.forward = normalize(f);
+  Vec3 r = cross(c.forward, up_hint);
+  if (!(length(r) > 1e-12 * length(up_hint)))
+    throw Error("", "camera", "up is parallel to the view");
+  c.right = normalize(r);
+  c.up = cross(c.right, c.forward);
+  return c;
+}
+
+Camera frame_box_orthographic(const Bounds3& box, const Vec3& towards_viewer, const Vec3& up_hint) {
+  Camera c;
+  c.type = Camera::Type::orthographic;
+  c.forward = -normalize(towards_viewer);
+  Vec3 hint = up_hint;
+  // Replace a hint (nearly) parallel to the view by any perpendicular direction.
+  if (std::abs(dot(normalize(hint), c.forward)) > 0.999)
+    hint = std::abs(c.forward.x) < 0.9 ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+  c.right = normalize(cross(c.forward, hint));
+  c.up = cross(c.right, c.forward);
+  double xlo = 1e300, xhi = -1e300, ylo = 1e300, yhi = -1e300, zlo = 1e300;
+  const Vec3 centre = box.center();
+  for (int i = 0; i < 8; ++i) {
+    const Vec3 d = box.corner(i) - centre;
+    xlo = std::min(xlo, dot(d, c.right)), xhi = std::max(xhi, dot(d, c.right));
+    ylo = std::min(ylo, dot(d, c.up)), yhi = std::max(yhi, dot(d, c.up));
+    zlo = std::min(zlo, dot(d, c.forward));
+  }
+  c.half_width = 0.5 * (xhi - xlo);
+  c.half_height = 0.5 * (yhi - ylo);
+  // A flat box seen edge-on would give an empty film; keep it finite and non-zero.
+  const double extent = length(box.hi - box.lo);
+  const double min_half = 1e-9 * std::max(extent, 1e-30);
+  c.half_width = std::max(c.half_width, min_half);
+  c.half_height = std::max(c.half_height, min_half);
+  // Film centre on the projected box centre, in front of the nearest corner.
+  c.position = centre + c.right * (0.5 * (xlo + xhi)) + c.up * (0.5 * (ylo + yhi)) +
+               c.forward * (zlo - 0.01 * extent - 1e-9);
+  return c;
+}
+
+}  // namespace weft

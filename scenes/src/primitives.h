@@ -1,0 +1,13 @@
+#pragma once
+// Built-in primitives for inline test geometry (the bundled examples use glTF files).
+#include "weft/scenes/mesh.h"
+
+namespace weft::detail {
+
+// A w x h rectangle centred at 'center' facing 'normal', its first side along 'tangent'.
+TriangleMesh make_quad(const Vec3& center, const Vec3& normal, const Vec3& tangent, double w,
+                       double h);
+// An icosphere (subdivided icosahedron, vertices on the sphere) facing outwards, or inwards.
+TriangleMesh make_sphere(const Vec3& center, double radius, int subdivisions, bool inward);
+
+}  // namespace weft::detail

@@ -1,0 +1,85 @@
+// weft render: path-trace a scene description to OpenEXR (+ sRGB PNG preview, + object mask).
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "weft/core/error.h"
+#include "weft/integrators/render_job.h"
+#include "weft/scenes/description.h"
+
+namespace weft::cli {
+
+void add_render_command(CLI::App& app, Commands& commands) {
+  struct Options {
+    std::string scene, output, preview, mask, mask_object;
+    int spp = 0, threads = 0, width = 0, height = 0, max_depth = -1;
+    uint64_t seed = 0;
+    bool seed_given = false, quiet = false, json = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* sub =
+      app.add_subcommand("render", "Path-trace a scene description (JSON) to an OpenEXR image");
+  sub->add_option("scene", o->scene, "scene description (.json)")->required();
+  sub->add_option("-o,--output", o->output, "linear RGB OpenEXR output (.exr)")->required();
+  sub->add_option("--preview", o->preview, "sRGB PNG preview (.png)");
+  sub->add_option("--mask", o->mask, "coverage of --mask-object per pixel (.exr)");
+  sub->add_option("--mask-object", o->mask_object, "object (glTF node or mesh name) for --mask");
+  sub->add_option("--spp", o->spp, "samples per pixel (default: the scene's)")
+      ->check(CLI::Range(1, 1 << 20));
+  sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
+  auto* seed = sub->add_option("--seed", o->seed, "random seed (default: the scene's)");
+  sub->add_option("--width", o->width, "image width (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  sub->add_option("--height", o->height, "image height (default: the scene's)")
+      ->check(CLI::Range(1, 16384));
+  sub->add_option("--max-depth", o->max_depth, "maximum bounces (default: the scene's)")
+      ->check(CLI::Range(0, 100000));
+  sub->add_flag("--quiet", o->quiet, "no progress bar");
+  sub->add_flag("--json", o->json, "print a JSON summary on stdout");
+  commands.push_back(
+      {sub, [o, seed] {
+         if (!o->mask.empty() && o->mask_object.empty())
+           throw Error("", "--mask-object", "is required with --mask");
+         const SceneDescription desc = load_scene_description(o->scene);
+         for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
+         RenderJob job;
+         job.exr = o->output;
+         if (!o->preview.empty()) job.png = o->preview;
+         if (!o->mask.empty()) job.mask = o->mask;
+         job.mask_object = o->mask_object;
+         job.settings = render_settings_from(desc.render);
+         if (o->spp) job.settings.spp = o->spp;
+         if (o->width) job.settings.width = o->width;
+         if (o->height) job.settings.height = o->height;
+         if (o->max_depth >= 0) job.settings.max_depth = o->max_depth;
+         if (seed->count()) job.settings.seed = o->seed;
+         job.settings.threads = o->threads;
+         const auto t0 = std::chrono::steady_clock::now();
+         const RenderJobResult r = render_to_files(desc, job, progress_bar(o->quiet));
+         const double sec =
+             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+         if (r.cancelled) {
+           std::fprintf(stderr, "\nweft: render cancelled; nothing was written\n");
+           return 130;
+         }
+         if (r.nonfinite_samples)
+           std::fprintf(stderr, "weft: warning: %llu non-finite samples were dropped\n",
+                        static_cast<unsigned long long>(r.nonfinite_samples));
+         if (o->json) {
+           nlohmann::json j = {{"output", o->output},
+                               {"width", job.settings.width},
+                               {"height", job.settings.height},
+                               {"spp", job.settings.spp},
+                               {"seconds", sec},
+                               {"rays", r.rays.total()},
+                               {"rays_per_s", r.rays.total() / sec},
+                               {"nonfinite_samples", r.nonfinite_samples}};
+           std::cout << j.dump(2) << "\n";
+         }
+         return 0;
+       }});
+}
+
+}  // namespace weft::cli
