@@ -78,6 +78,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     throw Error(desc.source, "", "override mask does not match the mesh count");
   // One BSDF per binding, created once and shared by every mesh that uses it.
   std::map<const MaterialBinding*, uint32_t> bsdf_of;
+  const auto cache = options.table_cache ? options.table_cache : std::make_shared<TableCache>();
   auto bsdf_index = [&](const MaterialBinding& b) {
     const auto it = bsdf_of.find(&b);
     if (it != bsdf_of.end()) return it->second;
@@ -85,6 +86,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     ctx.base_dir = desc.base_dir;
     ctx.source_file = desc.source;
     ctx.field_prefix = b.field.empty() ? "materials" : b.field + ".params";
+    ctx.cache = cache;
     geo->bsdfs.push_back(make_bsdf(b.type, b.params, ctx));
     const auto id = static_cast<uint32_t>(geo->bsdfs.size() - 1);
     bsdf_of[&b] = id;

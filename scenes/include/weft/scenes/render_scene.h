@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/materials/table_cache.h"
 #include "weft/core/distribution.h"
 #include "weft/core/frame.h"
 #include "weft/core/spectrum.h"
@@ -45,6 +46,9 @@ struct RenderSceneOptions {
   // Material keys replaced by another binding (e.g. the white reference of the gonioreflectometer).
   std::vector<uint8_t> override_meshes;  // per mesh; empty = none
   std::optional<MaterialBinding> override_binding;
+  // Tables (fiber/fabric BSDFs, measured networks) are loaded once into this cache and shared
+  // between bindings and between scenes that pass the same cache; null: one cache per scene.
+  std::shared_ptr<TableCache> table_cache;
 };
 
 class RenderScene {
