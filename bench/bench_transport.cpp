@@ -76,7 +76,7 @@ void BM_FiberBeamBatch(benchmark::State& state) {
   s.medium = cotton_medium();
   s.radius = kRadiusUm;
   s.direction = kBeam;
-  BatchOptions b;
+  PhotonBatchOptions b;
   b.photons = 1u << 18;
   b.seed = 1;
   b.threads = static_cast<int>(state.range(0));
@@ -91,7 +91,7 @@ void BM_FiberBssrdfBatch(benchmark::State& state) {
   s.radius = kRadiusUm;
   s.incident = normalize(Vec3{0.3, 0.1, 1});
   s.grid = table_grid();
-  BatchOptions b;
+  PhotonBatchOptions b;
   b.photons = 1u << 20;
   b.photons_per_task = 16384;
   b.seed = 1;

@@ -134,7 +134,7 @@ Vec3 BssrdfTable::direction_center(int it, int ip) const {
   return {s * std::cos(phi), s * std::sin(phi), c};
 }
 
-BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch) {
+BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const PhotonBatchOptions& batch) {
   setup.validate();
   const CylinderTransport transport(CylinderGeometry(setup.radius, setup.n_outside), setup.medium,
                                     setup.options);
@@ -145,7 +145,7 @@ BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch)
   const BssrdfBinner binner(setup.grid, setup.radius);
   BssrdfTally total;
   total.table.emplace(setup.grid, setup.radius);
-  const BatchStatus status =
+  const PhotonBatchStatus status =
       run_photon_tasks(batch, BssrdfTally{}, total,
                        [&](uint64_t, uint64_t, uint64_t count, Rng& rng, BssrdfTally& tally) {
                          tally.exits.reserve(count);
@@ -190,7 +190,7 @@ BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch)
         const double scale = 1 / (area * t.projected_solid_angle(it));
         for (int ip = 0; ip < t.grid.phi_bins; ++ip) {
           const size_t k = t.grid.index(iu, iv, it, ip);
-          const Estimate e =
+          const MeanEstimate e =
               MeanAccumulator{total.table->weight_sum()[k], total.table->weight_sum2()[k]}.estimate(
                   n);
           t.value[k] = e.mean * scale;

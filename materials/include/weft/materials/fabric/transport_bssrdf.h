@@ -110,7 +110,7 @@ struct BssrdfTable {
   std::vector<double> value;      // BSSRDF per cell [1 / (sr length^2)], grid.index() order
   std::vector<double> std_error;  // its standard error
   // Fractions of F_in.
-  Estimate specular, exited, absorbed, roulette, lost;
+  MeanEstimate specular, exited, absorbed, roulette, lost;
   double overflow = 0;  // exited outside the axial window (part of 'exited')
   uint64_t photons = 0;
   uint64_t scatterings = 0;
@@ -126,6 +126,6 @@ struct BssrdfTable {
 
 // Traces batch.photons photons into A. Tasks keep compact lists of (cell, weight) exits, which are
 // added to the table in task order, so the table has the same bits at any thread count.
-BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch);
+BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const PhotonBatchOptions& batch);
 
 }  // namespace weft
