@@ -79,7 +79,7 @@ SlabSetup make_setup(const SlabOptions& o) {
 
 int run_slab(const SlabOptions& o) {
   const SlabSetup setup = make_setup(o);
-  BatchOptions batch;
+  PhotonBatchOptions batch;
   batch.photons = static_cast<uint64_t>(o.photons);
   batch.seed = o.seed;
   batch.threads = o.threads;
@@ -87,15 +87,15 @@ int run_slab(const SlabOptions& o) {
   batch.progress = progress_bar(o.quiet);
   const SlabResult r = simulate_slab(setup, batch);
 
-  const std::pair<const char*, Estimate> values[] = {{"rsp", r.rsp},
-                                                     {"rb", r.rb},
-                                                     {"rd", r.rd},
-                                                     {"tb", r.tb},
-                                                     {"td", r.td},
-                                                     {"tt", r.tt},
-                                                     {"absorbed", r.absorbed},
-                                                     {"roulette", r.roulette},
-                                                     {"lost", r.lost}};
+  const std::pair<const char*, MeanEstimate> values[] = {{"rsp", r.rsp},
+                                                         {"rb", r.rb},
+                                                         {"rd", r.rd},
+                                                         {"tb", r.tb},
+                                                         {"td", r.td},
+                                                         {"tt", r.tt},
+                                                         {"absorbed", r.absorbed},
+                                                         {"roulette", r.roulette},
+                                                         {"lost", r.lost}};
   if (o.json) {
     nlohmann::json j;
     for (const auto& [key, e] : values) {

@@ -2,17 +2,27 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace weft {
 namespace {
 
+// One tally type serves as task tally (a list of exits, no table) and as the total (the table):
+// adding a task tally to the total replays its exits in order.
 struct BssrdfTally {
-  BssrdfRecorder exits;
+  struct Exit {
+    uint32_t cell;
+    double weight;
+  };
+  std::vector<Exit> exits;
+  double overflow = 0;
+  std::optional<BssrdfRecorder> table;  // the total only
   MeanAccumulator specular, exited, absorbed, roulette, lost;
   uint64_t photons = 0, scatterings = 0;
 
   BssrdfTally& operator+=(const BssrdfTally& o) {
-    exits += o.exits;
+    for (const Exit& e : o.exits) table->add(e.cell, e.weight);
+    table->add_overflow(o.overflow);
     specular += o.specular;
     exited += o.exited;
     absorbed += o.absorbed;
@@ -21,6 +31,19 @@ struct BssrdfTally {
     photons += o.photons;
     scatterings += o.scatterings;
     return *this;
+  }
+};
+
+// Records into a task's exit list.
+struct ExitListRecorder {
+  const BssrdfBinner* binner;
+  BssrdfTally* tally;
+  void on_exit(const ExitEvent& e) {
+    const int64_t k = binner->cell(e);
+    if (k < 0)
+      tally->overflow += e.weight;
+    else
+      tally->exits.push_back({static_cast<uint32_t>(k), e.weight});
   }
 };
 
@@ -36,25 +59,22 @@ void BssrdfGridSpec::validate() const {
   if (cells() > (size_t{1} << 28)) throw Error("", "grid", "more than 2^28 cells");
 }
 
-BssrdfRecorder::BssrdfRecorder(const BssrdfGridSpec& grid, double radius)
+BssrdfBinner::BssrdfBinner(const BssrdfGridSpec& grid, double radius)
     : grid_(grid), radius_(radius) {
   grid_.validate();
+  if (!std::isfinite(radius) || !(radius > 0)) throw Error("", "radius", "must be finite and > 0");
   u_scale_ = grid_.u_bins / (2 * kPi);
   v_scale_ = grid_.v_bins / (2 * grid_.v_range);
   phi_scale_ = grid_.phi_bins / (2 * kPi);
-  sum_.assign(grid_.cells(), 0.0);
-  sum2_.assign(grid_.cells(), 0.0);
 }
 
-void BssrdfRecorder::on_exit(const ExitEvent& e) {
+int64_t BssrdfBinner::cell(const ExitEvent& e) const {
   const Vec3& p = e.position;
-  const int iv = static_cast<int>(std::floor((p.x + grid_.v_range) * v_scale_));
-  if (iv < 0 || iv >= grid_.v_bins) {
-    overflow_ += e.weight;
-    return;
-  }
+  const double fv = std::floor((p.x + grid_.v_range) * v_scale_);
+  if (!(fv >= 0 && fv < grid_.v_bins)) return -1;
+  const int iv = static_cast<int>(fv);
   // A sits at angle 0 (the point (0, r, 0)); cell k is centred on 2 pi k / u_bins.
-  const double u = std::atan2(p.z, p.y);  // (-pi, pi]
+  const double u = std::atan2(p.z, p.y);  // [-pi, pi]
   int iu = static_cast<int>(std::floor(u * u_scale_ + 0.5));
   iu = ((iu % grid_.u_bins) + grid_.u_bins) % grid_.u_bins;
   // Local frame at the exit point: t = x, b = n x t = (0, n.z, -n.y), n = (0, y, z) / r.
@@ -65,18 +85,12 @@ void BssrdfRecorder::on_exit(const ExitEvent& e) {
   double phi = std::atan2(ly, lx);
   if (phi < 0) phi += 2 * kPi;
   const int ip = std::min(static_cast<int>(phi * phi_scale_), grid_.phi_bins - 1);
-  const size_t k = grid_.index(iu, iv, it, ip);
-  sum_[k] += e.weight;
-  sum2_[k] += e.weight * e.weight;
+  return static_cast<int64_t>(grid_.index(iu, iv, it, ip));
 }
 
-BssrdfRecorder& BssrdfRecorder::operator+=(const BssrdfRecorder& o) {
-  for (size_t i = 0; i < sum_.size(); ++i) {
-    sum_[i] += o.sum_[i];
-    sum2_[i] += o.sum2_[i];
-  }
-  overflow_ += o.overflow_;
-  return *this;
+BssrdfRecorder::BssrdfRecorder(const BssrdfGridSpec& grid, double radius) : binner_(grid, radius) {
+  sum_.assign(grid.cells(), 0.0);
+  sum2_.assign(grid.cells(), 0.0);
 }
 
 double BssrdfRecorder::binned() const {
@@ -120,7 +134,7 @@ Vec3 BssrdfTable::direction_center(int it, int ip) const {
   return {s * std::cos(phi), s * std::sin(phi), c};
 }
 
-BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch_in) {
+BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const PhotonBatchOptions& batch) {
   setup.validate();
   const CylinderTransport transport(CylinderGeometry(setup.radius, setup.n_outside), setup.medium,
                                     setup.options);
@@ -128,27 +142,27 @@ BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch_
   const Vec3 entry = transport.geometry().surface_point(0, 0);
   const Vec3 travel = -normalize(frame_a.to_world(setup.incident));
 
-  BatchOptions batch = batch_in;
-  if (batch.tasks_per_wave == 0)
-    batch.tasks_per_wave =
-        2 * static_cast<uint64_t>(batch.threads > 0 ? batch.threads : hardware_threads());
-  const BssrdfTally zero{BssrdfRecorder(setup.grid, setup.radius), {}, {}, {}, {}, {}, 0, 0};
-  BssrdfTally total = zero;
-  const BatchStatus status = run_photon_tasks(
-      batch, zero, total, [&](uint64_t, uint64_t, uint64_t count, Rng& rng, BssrdfTally& tally) {
-        for (uint64_t i = 0; i < count; ++i) {
-          PhotonTally photon;
-          transport.launch_external(CylinderGeometry::kSurface, entry, travel, 1.0, rng,
-                                    tally.exits, photon);
-          tally.specular.add(photon.specular);
-          tally.exited.add(photon.exited);
-          tally.absorbed.add(photon.absorbed);
-          tally.roulette.add(photon.roulette_loss - photon.roulette_gain);
-          tally.lost.add(photon.lost);
-          tally.photons += 1;
-          tally.scatterings += photon.scatterings;
-        }
-      });
+  const BssrdfBinner binner(setup.grid, setup.radius);
+  BssrdfTally total;
+  total.table.emplace(setup.grid, setup.radius);
+  const PhotonBatchStatus status =
+      run_photon_tasks(batch, BssrdfTally{}, total,
+                       [&](uint64_t, uint64_t, uint64_t count, Rng& rng, BssrdfTally& tally) {
+                         tally.exits.reserve(count);
+                         ExitListRecorder recorder{&binner, &tally};
+                         for (uint64_t i = 0; i < count; ++i) {
+                           PhotonTally photon;
+                           transport.launch_external(CylinderGeometry::kSurface, entry, travel, 1.0,
+                                                     rng, recorder, photon);
+                           tally.specular.add(photon.specular);
+                           tally.exited.add(photon.exited);
+                           tally.absorbed.add(photon.absorbed);
+                           tally.roulette.add(photon.roulette_loss - photon.roulette_gain);
+                           tally.lost.add(photon.lost);
+                           tally.photons += 1;
+                           tally.scatterings += photon.scatterings;
+                         }
+                       });
 
   BssrdfTable t;
   t.grid = setup.grid;
@@ -163,24 +177,27 @@ BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch_
   t.absorbed = total.absorbed.estimate(n);
   t.roulette = total.roulette.estimate(n);
   t.lost = total.lost.estimate(n);
-  t.overflow = n > 0 ? total.exits.overflow() / static_cast<double>(n) : 0.0;
+  t.overflow = n > 0 ? total.table->overflow() / static_cast<double>(n) : 0.0;
   t.value.assign(setup.grid.cells(), 0.0);
   t.std_error.assign(setup.grid.cells(), 0.0);
   if (n == 0) return t;
   const double area = t.cell_area();
-  for (int iu = 0; iu < t.grid.u_bins; ++iu)
+  // Cells are independent: convert them in parallel (same bits at any thread count).
+  parallel_for(static_cast<uint64_t>(t.grid.u_bins), batch.threads, [&](uint64_t task) {
+    const int iu = static_cast<int>(task);
     for (int iv = 0; iv < t.grid.v_bins; ++iv)
       for (int it = 0; it < t.grid.theta_bins; ++it) {
         const double scale = 1 / (area * t.projected_solid_angle(it));
         for (int ip = 0; ip < t.grid.phi_bins; ++ip) {
           const size_t k = t.grid.index(iu, iv, it, ip);
-          const Estimate e =
-              MeanAccumulator{total.exits.weight_sum()[k], total.exits.weight_sum2()[k]}.estimate(
+          const MeanEstimate e =
+              MeanAccumulator{total.table->weight_sum()[k], total.table->weight_sum2()[k]}.estimate(
                   n);
           t.value[k] = e.mean * scale;
           t.std_error[k] = e.std_error * scale;
         }
       }
+  });
   return t;
 }
 

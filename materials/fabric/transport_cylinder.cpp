@@ -47,12 +47,12 @@ void CylinderBeamSetup::validate() const {
 }
 
 CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup,
-                                          const BatchOptions& batch) {
+                                          const PhotonBatchOptions& batch) {
   setup.validate();
   const CylinderTransport transport(CylinderGeometry(setup.radius, setup.n_outside), setup.medium,
                                     setup.options);
   CylinderTally total;
-  const BatchStatus status = run_photon_tasks(
+  const PhotonBatchStatus status = run_photon_tasks(
       batch, CylinderTally{}, total,
       [&](uint64_t, uint64_t, uint64_t count, Rng& rng, CylinderTally& tally) {
         NullRecorder none;

@@ -30,8 +30,8 @@ BssrdfSetup setup(double mua, double mus, double g, double n, const Vec3& incide
   return s;
 }
 
-BatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
-  BatchOptions b;
+PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
+  PhotonBatchOptions b;
   b.photons = photons;
   b.seed = seed;
   b.threads = threads;
@@ -56,8 +56,8 @@ double exited_fraction(const BssrdfTable& t, Keep keep) {
 
 // The same with its standard error (a photon lands in one cell: per-cell variances add).
 template <class Keep>
-Estimate exited_marginal(const BssrdfTable& t, Keep keep) {
-  Estimate e;
+MeanEstimate exited_marginal(const BssrdfTable& t, Keep keep) {
+  MeanEstimate e;
   double var = 0;
   for (int iu = 0; iu < t.grid.u_bins; ++iu)
     for (int iv = 0; iv < t.grid.v_bins; ++iv)
@@ -146,24 +146,25 @@ TEST(TransportBssrdf, ScatteringFiberEnergyAndMirrorSymmetry) {
   // Mirror: cell (u, v, theta, phi) <-> (-u, v, theta, -phi). Compare per-u marginals.
   const int nu = s.grid.u_bins, np = s.grid.phi_bins;
   for (int iu = 1; iu < nu / 2; ++iu) {
-    const Estimate a = exited_marginal(t, [&](int u, int, int, int) { return u == iu; });
-    const Estimate b = exited_marginal(t, [&](int u, int, int, int) { return u == nu - iu; });
+    const MeanEstimate a = exited_marginal(t, [&](int u, int, int, int) { return u == iu; });
+    const MeanEstimate b = exited_marginal(t, [&](int u, int, int, int) { return u == nu - iu; });
     EXPECT_GT(a.std_error, 0.0);
     EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.std_error, b.std_error)) << "u bin " << iu;
   }
   // ... and the azimuth: bins ip <-> np - 1 - ip, over the whole surface.
   for (int ip = 0; ip < np / 2; ++ip) {
-    const Estimate a = exited_marginal(t, [&](int, int, int, int p) { return p == ip; });
-    const Estimate b = exited_marginal(t, [&](int, int, int, int p) { return p == np - 1 - ip; });
+    const MeanEstimate a = exited_marginal(t, [&](int, int, int, int p) { return p == ip; });
+    const MeanEstimate b =
+        exited_marginal(t, [&](int, int, int, int p) { return p == np - 1 - ip; });
     EXPECT_NEAR(a.mean, b.mean, 4.5 * std::hypot(a.std_error, b.std_error)) << "phi bin " << ip;
   }
   // The mirror must be a real constraint: an oblique light tilted along b breaks it.
   BssrdfSetup tilted = s;
   tilted.incident = normalize(Vec3{0, 0.7, 0.7});
   const BssrdfTable t2 = simulate_bssrdf(tilted, batch(50000, 5));
-  const Estimate plus =
+  const MeanEstimate plus =
       exited_marginal(t2, [&](int u, int, int, int) { return u > 0 && u < nu / 2; });
-  const Estimate minus = exited_marginal(t2, [&](int u, int, int, int) { return u > nu / 2; });
+  const MeanEstimate minus = exited_marginal(t2, [&](int u, int, int, int) { return u > nu / 2; });
   EXPECT_GT(std::abs(plus.mean - minus.mean), 6 * std::hypot(plus.std_error, minus.std_error));
 }
 

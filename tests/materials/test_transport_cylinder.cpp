@@ -34,8 +34,8 @@ CylinderBeamSetup beam(const TransportMedium& m, double radius, double n_out, co
   return s;
 }
 
-BatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
-  BatchOptions b;
+PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
+  PhotonBatchOptions b;
   b.photons = photons;
   b.seed = seed;
   b.threads = threads;
@@ -43,7 +43,7 @@ BatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
   return b;
 }
 
-::testing::AssertionResult within_sigma(const Estimate& e, double reference, double k,
+::testing::AssertionResult within_sigma(const MeanEstimate& e, double reference, double k,
                                         double reference_error = 0) {
   const double se = std::sqrt(e.std_error * e.std_error + reference_error * reference_error);
   const double dev = std::abs(e.mean - reference);
@@ -302,7 +302,7 @@ TEST(TransportCylinder, Extremes) {
         beam(medium(0.005, 0.05, 0.8, 1.557), 10, 1.0, {std::sin(a), 0, -std::cos(a)}),
         batch(5000, 41));
     EXPECT_GT(res.specular.mean, 0.98);
-    for (const Estimate& e : {res.exited, res.absorbed})
+    for (const MeanEstimate& e : {res.exited, res.absorbed})
       EXPECT_TRUE(std::isfinite(e.mean) && e.mean >= 0 && e.mean <= 1 &&
                   std::isfinite(e.std_error));
     EXPECT_NEAR(res.energy_imbalance, 0, 1e-12);

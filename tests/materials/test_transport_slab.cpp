@@ -25,8 +25,8 @@ SlabSetup make_slab(double mua, double mus, double g, double n, double thickness
   return s;
 }
 
-BatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
-  BatchOptions b;
+PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
+  PhotonBatchOptions b;
   b.photons = photons;
   b.seed = seed;
   b.threads = threads;
@@ -35,7 +35,7 @@ BatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
 }
 
 // |measured - reference| <= k * standard error (the reference's own error added in quadrature).
-::testing::AssertionResult within_sigma(const Estimate& e, double reference, double k,
+::testing::AssertionResult within_sigma(const MeanEstimate& e, double reference, double k,
                                         double reference_error = 0) {
   const double se = std::sqrt(e.std_error * e.std_error + reference_error * reference_error);
   const double dev = std::abs(e.mean - reference);
@@ -148,7 +148,7 @@ TEST(TransportSlab, TabulatedPhaseFunctionReproducesHgSlab) {
 // medium n = 1.5 in air, mu_a = 10/cm, mu_s = 90/cm, g = 0, normal incidence, 1e5 photons:
 // Rsp = 0.04, Rd = 0.220348 +- 0.000916 (A = 0.739652). Rsp is exactly ((1.5-1)/(1.5+1))^2.
 TEST(TransportSlab, McmlMismatchedSemiInfinite) {
-  const SlabSetup s = make_slab(1, 9, 0.0, 1.5, kInfinity);
+  const SlabSetup s = make_slab(1, 9, 0.0, 1.5, kTransportInfinity);
   const SlabResult r = simulate_slab(s, batch(100000, 12));
   EXPECT_NEAR(r.rsp.mean, 0.04, 1e-15);
   EXPECT_TRUE(within_sigma(r.rd, 0.220348, 3, 0.000916));
@@ -167,7 +167,7 @@ TEST(TransportSlab, ChandrasekharPlaneAlbedoIsotropic) {
   ASSERT_NEAR(h.moment0(), 2 / a * (1 - std::sqrt(1 - a)), 1e-10);
   for (double mu0 : {1.0, 0.5}) {
     const double reference = 1 - h(mu0) * std::sqrt(1 - a);
-    SlabSetup s = make_slab(1, 9, 0.0, 1.0, kInfinity);
+    SlabSetup s = make_slab(1, 9, 0.0, 1.0, kTransportInfinity);
     s.incidence_rad = std::acos(mu0);
     const SlabResult r = simulate_slab(s, batch(60000, 13));
     EXPECT_TRUE(within_sigma(r.rd, reference, 3)) << "mu0 = " << mu0 << " H = " << h(mu0);
@@ -222,7 +222,7 @@ TEST(TransportSlab, NonAbsorbingSlabConservesEnergyExactly) {
 // A semi-infinite non-absorbing medium returns everything: R = 1. Return times have a heavy tail,
 // so a few photons hit the interaction cap; their weight is reported as lost, never dropped.
 TEST(TransportSlab, NonAbsorbingSemiInfiniteReflectsEverything) {
-  SlabSetup s = make_slab(0, 10, 0.5, 1.0, kInfinity);
+  SlabSetup s = make_slab(0, 10, 0.5, 1.0, kTransportInfinity);
   s.options.max_events = 20000;
   const SlabResult r = simulate_slab(s, batch(4000, 16));
   EXPECT_NEAR(r.rd.mean + r.rb.mean + r.lost.mean, 1.0, 1e-12);
@@ -276,7 +276,7 @@ TEST(TransportSlab, SameBitsAtOneAndTwoThreads) {
 // Cancellation keeps whole tasks: the result equals a run of exactly the photons done.
 TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
-  BatchOptions b = batch(200000, 22, 2);
+  PhotonBatchOptions b = batch(200000, 22, 2);
   b.tasks_per_wave = 3;
   int calls = 0;
   b.progress = [&](const ProgressUpdate& u) {
@@ -286,7 +286,7 @@ TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   const SlabResult cut = simulate_slab(s, b);
   EXPECT_TRUE(cut.cancelled);
   EXPECT_EQ(cut.photons, 6u * 2048u);
-  BatchOptions whole = batch(cut.photons, 22, 1);
+  PhotonBatchOptions whole = batch(cut.photons, 22, 1);
   const SlabResult ref = simulate_slab(s, whole);
   EXPECT_FALSE(ref.cancelled);
   EXPECT_EQ(cut.rd.mean, ref.rd.mean);
@@ -318,7 +318,7 @@ TEST(TransportSlab, Extremes) {
     const SlabResult r = simulate_slab(s, batch(20000, 25));
     EXPECT_NEAR(r.rsp.mean, fresnel_dielectric(std::cos(s.incidence_rad), 1.0, 1.5), 1e-12);
     EXPECT_GT(r.rsp.mean, 0.98);
-    for (const Estimate& e : {r.rd, r.tt, r.absorbed}) {
+    for (const MeanEstimate& e : {r.rd, r.tt, r.absorbed}) {
       EXPECT_TRUE(std::isfinite(e.mean) && e.mean >= 0 && e.mean <= 1);
       EXPECT_TRUE(std::isfinite(e.std_error));
     }
@@ -351,7 +351,7 @@ TEST(TransportSlab, BadInputIsRejectedWithTheFieldNamed) {
   EXPECT_NE(message_of(s).find("'n'"), std::string::npos);
   s = make_slab(1, 1, 0, 1, 0);
   EXPECT_NE(message_of(s).find("thickness"), std::string::npos);
-  s = make_slab(0, 0, 0, 1, kInfinity);
+  s = make_slab(0, 0, 0, 1, kTransportInfinity);
   EXPECT_NE(message_of(s).find("thickness"), std::string::npos);
   s = make_slab(1, 1, 0, 1, 1);
   s.incidence_rad = kPi / 2;
@@ -362,7 +362,7 @@ TEST(TransportSlab, BadInputIsRejectedWithTheFieldNamed) {
   s = make_slab(1, 1, 0, 1, 1);
   s.options.roulette_survival = 0;
   EXPECT_NE(message_of(s).find("roulette_survival"), std::string::npos);
-  BatchOptions b = batch(10, 1);
+  PhotonBatchOptions b = batch(10, 1);
   b.photons_per_task = 0;
   EXPECT_THROW(simulate_slab(make_slab(1, 1, 0, 1, 1), b), Error);
 }

@@ -51,7 +51,8 @@
 
 namespace weft {
 
-inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// +infinity, named once: a semi-infinite slab thickness, a ray that never meets the boundary.
+inline constexpr double kTransportInfinity = std::numeric_limits<double>::infinity();
 
 // The medium inside the boundary.
 struct TransportMedium {
@@ -134,7 +135,8 @@ struct NullRecorder {
 };
 
 struct BoundaryHit {
-  double distance = kInfinity;  // along the unit direction; +inf when the ray never meets it
+  double distance =
+      kTransportInfinity;  // along the unit direction; +inf when the ray never meets it
   int boundary = 0;
 };
 
@@ -156,7 +158,7 @@ class SlabGeometry {
     // reflection never re-hits it at distance ~0.
     if (d.z > 0) return {std::max(0.0, -p.z / d.z), kTop};
     if (d.z < 0 && !semi_infinite()) return {std::max(0.0, (-thickness_ - p.z) / d.z), kBottom};
-    return {kInfinity, kTop};
+    return {kTransportInfinity, kTop};
   }
   Vec3 outward_normal(const Vec3&, int boundary) const {
     return boundary == kTop ? Vec3{0, 0, 1} : Vec3{0, 0, -1};
@@ -189,7 +191,7 @@ class CylinderGeometry {
   BoundaryHit distance_to_boundary(const Vec3& p, const Vec3& d) const {
     // |p2 + t d2|^2 = r^2 in the cross-section: a t^2 + 2 b t + c = 0, c <= 0 inside.
     const double a = d.y * d.y + d.z * d.z;
-    if (!(a > 0)) return {kInfinity, kSurface};  // along the axis: never meets the wall
+    if (!(a > 0)) return {kTransportInfinity, kSurface};  // along the axis: never meets the wall
     const double b = p.y * d.y + p.z * d.z;
     const double c = p.y * p.y + p.z * p.z - radius2_;
     const double sq = std::sqrt(std::max(0.0, b * b - a * c));
@@ -254,7 +256,7 @@ class PhotonTransport {
     options_.validate();
     mu_t_ = medium_.mu_a + medium_.mu_s;
     if (!std::isfinite(mu_t_)) throw Error("", "mu_a", "mu_a + mu_s overflows");
-    inv_mu_t_ = mu_t_ > 0 ? 1.0 / mu_t_ : kInfinity;
+    inv_mu_t_ = mu_t_ > 0 ? 1.0 / mu_t_ : kTransportInfinity;
     absorb_fraction_ = mu_t_ > 0 ? medium_.mu_a / mu_t_ : 0.0;
     inv_survival_ = 1.0 / options_.roulette_survival;
   }
@@ -318,7 +320,7 @@ class PhotonTransport {
     uint64_t events = 0, scatterings = 0;
     while (w > 0) {
       const BoundaryHit hit = geometry_.distance_to_boundary(p, d);
-      const double s = mu_t_ > 0 ? -std::log(rng.uniform_open0()) * inv_mu_t_ : kInfinity;
+      const double s = mu_t_ > 0 ? -std::log(rng.uniform_open0()) * inv_mu_t_ : kTransportInfinity;
       if (s >= hit.distance) {
         if (!std::isfinite(hit.distance)) break;  // never interacts, never leaves: lost
         p = geometry_.snap(p + hit.distance * d, hit.boundary);

@@ -17,7 +17,7 @@
 namespace weft {
 
 // A Monte Carlo mean and its standard error.
-struct Estimate {
+struct MeanEstimate {
   double mean = 0;
   double std_error = 0;
 };
@@ -36,7 +36,7 @@ struct MeanAccumulator {
     return *this;
   }
   // Mean over n samples and the standard error of that mean (unbiased sample variance / n).
-  Estimate estimate(uint64_t n) const {
+  MeanEstimate estimate(uint64_t n) const {
     if (n == 0) return {};
     const double nd = static_cast<double>(n);
     const double mean = sum / nd;
@@ -46,7 +46,7 @@ struct MeanAccumulator {
   }
 };
 
-struct BatchOptions {
+struct PhotonBatchOptions {
   uint64_t photons = 0;
   uint64_t seed = 0;
   int threads = 0;                   // 0: all hardware threads
@@ -60,7 +60,7 @@ struct BatchOptions {
   }
 };
 
-struct BatchStatus {
+struct PhotonBatchStatus {
   uint64_t photons_done = 0;
   uint64_t tasks_done = 0;
   bool cancelled = false;
@@ -70,15 +70,15 @@ struct BatchStatus {
 // empty tally, already sized), and adds the tallies to 'total' in task order with
 // total += tally. Exceptions from fn propagate.
 template <class Tally, class TaskFn>
-BatchStatus run_photon_tasks(const BatchOptions& options, const Tally& zero, Tally& total,
-                             TaskFn&& fn) {
+PhotonBatchStatus run_photon_tasks(const PhotonBatchOptions& options, const Tally& zero,
+                                   Tally& total, TaskFn&& fn) {
   options.validate();
   const uint64_t per_task = options.photons_per_task;
   const uint64_t tasks = options.photons / per_task + (options.photons % per_task != 0 ? 1 : 0);
   const int threads = options.threads > 0 ? options.threads : hardware_threads();
   const uint64_t wave =
       options.tasks_per_wave > 0 ? options.tasks_per_wave : 8 * static_cast<uint64_t>(threads);
-  BatchStatus status;
+  PhotonBatchStatus status;
   // A first report before any work starts the front end's clock and allows an early stop.
   if (options.progress && !options.progress(ProgressUpdate{"photons", 0, options.photons})) {
     status.cancelled = tasks > 0;

@@ -42,16 +42,43 @@ struct BssrdfGridSpec {
   }
 };
 
-// Bins exits relative to the entry point A = (x 0, angle 0) of CylinderGeometry (the point
-// (0, r, 0)); an ExitRecorder and a tally for run_photon_tasks (operator+=).
+// Maps an exit to its cell relative to the entry point A = (x 0, angle 0) of CylinderGeometry
+// (the point (0, r, 0)).
+class BssrdfBinner {
+ public:
+  BssrdfBinner(const BssrdfGridSpec& grid, double radius);
+
+  const BssrdfGridSpec& grid() const { return grid_; }
+  // grid.index() of the cell, or -1 when the exit lies outside the axial window.
+  int64_t cell(const ExitEvent& e) const;
+
+ private:
+  BssrdfGridSpec grid_;
+  double radius_;
+  double u_scale_, v_scale_, phi_scale_;
+};
+
+// Dense table of exit weights per cell: an ExitRecorder for single-threaded use and the merged
+// result of simulate_bssrdf.
 class BssrdfRecorder {
  public:
   BssrdfRecorder(const BssrdfGridSpec& grid, double radius);
 
-  void on_exit(const ExitEvent& e);
-  BssrdfRecorder& operator+=(const BssrdfRecorder& o);
+  void on_exit(const ExitEvent& e) {
+    const int64_t k = binner_.cell(e);
+    if (k < 0)
+      overflow_ += e.weight;
+    else
+      add(static_cast<size_t>(k), e.weight);
+  }
+  void add(size_t cell, double weight) {
+    sum_[cell] += weight;
+    sum2_[cell] += weight * weight;
+  }
+  void add_overflow(double weight) { overflow_ += weight; }
 
-  const BssrdfGridSpec& grid() const { return grid_; }
+  const BssrdfGridSpec& grid() const { return binner_.grid(); }
+  const BssrdfBinner& binner() const { return binner_; }
   // Sum of exit weights per cell and of their squares (a photon exits once, so per-photon
   // contributions are single weights).
   const std::vector<double>& weight_sum() const { return sum_; }
@@ -60,9 +87,7 @@ class BssrdfRecorder {
   double binned() const;                         // weight that landed in cells
 
  private:
-  BssrdfGridSpec grid_;
-  double radius_;
-  double u_scale_, v_scale_, phi_scale_;
+  BssrdfBinner binner_;
   std::vector<double> sum_, sum2_;
   double overflow_ = 0;
 };
@@ -85,7 +110,7 @@ struct BssrdfTable {
   std::vector<double> value;      // BSSRDF per cell [1 / (sr length^2)], grid.index() order
   std::vector<double> std_error;  // its standard error
   // Fractions of F_in.
-  Estimate specular, exited, absorbed, roulette, lost;
+  MeanEstimate specular, exited, absorbed, roulette, lost;
   double overflow = 0;  // exited outside the axial window (part of 'exited')
   uint64_t photons = 0;
   uint64_t scatterings = 0;
@@ -99,8 +124,8 @@ struct BssrdfTable {
   Vec3 direction_center(int it, int ip) const;
 };
 
-// Traces batch.photons photons into A (tasks of batch.photons_per_task photons; the tallies are
-// large, so unless batch.tasks_per_wave is set a wave holds 2 tasks per thread).
-BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const BatchOptions& batch);
+// Traces batch.photons photons into A. Tasks keep compact lists of (cell, weight) exits, which are
+// added to the table in task order, so the table has the same bits at any thread count.
+BssrdfTable simulate_bssrdf(const BssrdfSetup& setup, const PhotonBatchOptions& batch);
 
 }  // namespace weft

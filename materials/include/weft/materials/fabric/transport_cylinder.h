@@ -26,11 +26,11 @@ struct CylinderBeamSetup {
 
 // Fractions of the power hitting the cylinder.
 struct CylinderBeamResult {
-  Estimate specular;  // Fresnel reflection at entry
-  Estimate exited;    // left the cylinder after entering (anywhere on the wall)
-  Estimate absorbed;
-  Estimate roulette;            // roulette losses minus gains (mean zero)
-  Estimate lost;                // interaction cap
+  MeanEstimate specular;  // Fresnel reflection at entry
+  MeanEstimate exited;    // left the cylinder after entering (anywhere on the wall)
+  MeanEstimate absorbed;
+  MeanEstimate roulette;        // roulette losses minus gains (mean zero)
+  MeanEstimate lost;            // interaction cap
   double energy_imbalance = 0;  // 1 - sum of the above means: zero up to rounding
   uint64_t photons = 0;
   uint64_t scatterings = 0;
@@ -39,6 +39,6 @@ struct CylinderBeamResult {
 };
 
 CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup,
-                                          const BatchOptions& batch);
+                                          const PhotonBatchOptions& batch);
 
 }  // namespace weft

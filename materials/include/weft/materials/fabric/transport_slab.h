@@ -11,7 +11,7 @@ namespace weft {
 
 struct SlabSetup {
   TransportMedium medium;
-  double thickness = kInfinity;  // > 0; +infinity: semi-infinite
+  double thickness = kTransportInfinity;  // > 0; +infinity: semi-infinite
   double n_above = 1, n_below = 1;
   double incidence_rad = 0;  // angle of the incident beam from the normal, in [0, pi/2)
   TransportOptions options;
@@ -21,15 +21,15 @@ struct SlabSetup {
 };
 
 struct SlabResult {
-  Estimate rsp;       // specular: Fresnel reflection at entry
-  Estimate rb;        // unscattered light leaving the top face after entering (internal bounces)
-  Estimate rd;        // diffuse reflectance: scattered light leaving the top face
-  Estimate tb;        // ballistic transmittance: unscattered light leaving the bottom face
-  Estimate td;        // diffuse transmittance: scattered light leaving the bottom face
-  Estimate tt;        // total transmittance td + tb
-  Estimate absorbed;  // weight deposited in the medium
-  Estimate roulette;  // roulette losses minus gains (mean zero; nonzero by chance only)
-  Estimate lost;      // interaction cap reached (see TransportOptions::max_events)
+  MeanEstimate rsp;  // specular: Fresnel reflection at entry
+  MeanEstimate rb;   // unscattered light leaving the top face after entering (internal bounces)
+  MeanEstimate rd;   // diffuse reflectance: scattered light leaving the top face
+  MeanEstimate tb;   // ballistic transmittance: unscattered light leaving the bottom face
+  MeanEstimate td;   // diffuse transmittance: scattered light leaving the bottom face
+  MeanEstimate tt;   // total transmittance td + tb
+  MeanEstimate absorbed;  // weight deposited in the medium
+  MeanEstimate roulette;  // roulette losses minus gains (mean zero; nonzero by chance only)
+  MeanEstimate lost;      // interaction cap reached (see TransportOptions::max_events)
   // 1 - (rsp + rb + rd + tb + td + absorbed + roulette + lost): zero up to rounding.
   double energy_imbalance = 0;
   uint64_t photons = 0;      // photons actually traced (fewer than asked when cancelled)
@@ -38,6 +38,6 @@ struct SlabResult {
   bool cancelled = false;
 };
 
-SlabResult simulate_slab(const SlabSetup& setup, const BatchOptions& batch);
+SlabResult simulate_slab(const SlabSetup& setup, const PhotonBatchOptions& batch);
 
 }  // namespace weft
