@@ -13,7 +13,9 @@
 namespace weft::cli {
 namespace {
 std::atomic<bool> g_interrupted{false};  // set by the signal handler only
-extern "C" void on_sigint(int) { g_interrupted.store(true); }
+extern "C" void on_sigint(int) {
+  g_interrupted.store(true);
+}
 
 std::string format_duration(double seconds) {
   if (!std::isfinite(seconds) || seconds < 0) return "--:--";
@@ -27,8 +29,12 @@ std::string format_duration(double seconds) {
 }
 }  // namespace
 
-void install_interrupt_handler() { std::signal(SIGINT, on_sigint); }
-bool interrupted() { return g_interrupted.load(); }
+void install_interrupt_handler() {
+  std::signal(SIGINT, on_sigint);
+}
+bool interrupted() {
+  return g_interrupted.load();
+}
 
 ProgressCallback progress_bar(bool quiet) {
   install_interrupt_handler();
@@ -82,7 +88,8 @@ std::vector<double> parse_range(const std::string& text, const std::string& opti
     std::stringstream ss(text);
     std::string p;
     while (std::getline(ss, p, ':')) parts.push_back(p);
-    if (parts.size() != 3) throw Error("", option_name, "range must be a:b:step, got '" + text + "'");
+    if (parts.size() != 3)
+      throw Error("", option_name, "range must be a:b:step, got '" + text + "'");
     const double a = to_number(parts[0]), b = to_number(parts[1]), step = to_number(parts[2]);
     if (!(step > 0) || b < a) throw Error("", option_name, "range needs a <= b and step > 0");
     const long n = std::lround(std::floor((b - a) / step + 1e-9));

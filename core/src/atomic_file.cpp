@@ -11,8 +11,7 @@ void write_atomically(const std::filesystem::path& path,
                       const std::function<void(const std::filesystem::path&)>& write) {
   namespace fs = std::filesystem;
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
-  if (!fs::is_directory(parent))
-    throw Error(path.string(), "", "output directory does not exist");
+  if (!fs::is_directory(parent)) throw Error(path.string(), "", "output directory does not exist");
   // Keep the extension last: writers such as OpenImageIO choose the format by it.
   fs::path tmp = parent / (".tmp-" + path.stem().string() + "-partial" + path.extension().string());
   try {

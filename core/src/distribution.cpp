@@ -54,7 +54,9 @@ size_t Distribution1D::bin_of(double x) const {
   return static_cast<size_t>(std::clamp<long long>(i, 0, static_cast<long long>(func_.size()) - 1));
 }
 
-double Distribution1D::pmf(size_t bin) const { return cdf_[bin + 1] - cdf_[bin]; }
+double Distribution1D::pmf(size_t bin) const {
+  return cdf_[bin + 1] - cdf_[bin];
+}
 
 double Distribution1D::pdf(double x) const {
   return pmf(bin_of(x)) * static_cast<double>(func_.size());

@@ -7,7 +7,9 @@
 
 namespace weft {
 
-int hardware_threads() { return tbb::info::default_concurrency(); }
+int hardware_threads() {
+  return tbb::info::default_concurrency();
+}
 
 void parallel_for(uint64_t count, int threads, const std::function<void(uint64_t)>& fn) {
   if (count == 0) return;

@@ -41,9 +41,10 @@ void validate(const FiberGeometry& g, const FiberBakeSettings& s) {
 // task's tally into 'total' in task order (bit-identical at any thread count), and reports
 // progress between chunks. Returns the number of tasks completed (< count if cancelled).
 template <class Tally, class RunTask, class Merge>
-uint64_t run_tasks_ordered(uint64_t count, int threads, uint64_t units_per_task, uint64_t total_units,
-                           std::string_view stage, const ProgressCallback& progress,
-                           const RunTask& run_task, const Merge& merge) {
+uint64_t run_tasks_ordered(uint64_t count, int threads, uint64_t units_per_task,
+                           uint64_t total_units, std::string_view stage,
+                           const ProgressCallback& progress, const RunTask& run_task,
+                           const Merge& merge) {
   const uint64_t chunk = 32;
   uint64_t done = 0;
   while (done < count) {
@@ -60,7 +61,8 @@ uint64_t run_tasks_ordered(uint64_t count, int threads, uint64_t units_per_task,
 
 // Energy books of a batch of photons (weights, not yet divided by the flux launched).
 struct EnergyTally {
-  double launched = 0, exited = 0, surface = 0, absorbed = 0, roulette_net = 0, lost = 0, excess = 0;
+  double launched = 0, exited = 0, surface = 0, absorbed = 0, roulette_net = 0, lost = 0,
+         excess = 0;
   uint64_t photons = 0, events = 0;
 
   void add_trace(const FiberTraceResult& r) {
@@ -125,7 +127,8 @@ double cos_integral_quadrant_rect(double a, double b, double c, double d) {
     const double p0 = std::clamp(breaks[k], lo, hi), p1 = std::clamp(breaks[k + 1], lo, hi);
     if (!(p1 > p0)) continue;
     const double mid = 0.5 * (p0 + p1), half = 0.5 * (p1 - p0);
-    for (int q = 0; q < 3; ++q) sum += w[q] * half * abs_cos(mid + half * x[q]) * m(mid + half * x[q]);
+    for (int q = 0; q < 3; ++q)
+      sum += w[q] * half * abs_cos(mid + half * x[q]) * m(mid + half * x[q]);
   }
   return kPi * sum;
 }
@@ -144,8 +147,10 @@ std::vector<double> cosine_weighted_bin_areas(int resolution) {
         for (auto [va, vb] : {std::pair{v0, std::min(v1, 0.0)}, std::pair{std::max(v0, 0.0), v1}}) {
           if (!(ub > ua) || !(vb > va)) continue;
           // Reflect into the first quadrant.
-          const double a = std::min(std::abs(ua), std::abs(ub)), b = std::max(std::abs(ua), std::abs(ub));
-          const double c = std::min(std::abs(va), std::abs(vb)), d = std::max(std::abs(va), std::abs(vb));
+          const double a = std::min(std::abs(ua), std::abs(ub)),
+                       b = std::max(std::abs(ua), std::abs(ub));
+          const double c = std::min(std::abs(va), std::abs(vb)),
+                       d = std::max(std::abs(va), std::abs(vb));
           total += cos_integral_quadrant_rect(a, b, c, d);
         }
       out[static_cast<size_t>(iy) * resolution + ix] = total;
@@ -169,7 +174,8 @@ FiberBandTable finish_table(int resolution, std::vector<double> weighted_sum) {
   t.f.assign(weighted_sum.size(), 0.0);
   for (int i = 0; i < cells; ++i)
     for (int o = 0; o < cells; ++o)
-      t.f[static_cast<size_t>(i) * cells + o] = weighted_sum[static_cast<size_t>(i) * cells + o] / (d[i] * d[o]);
+      t.f[static_cast<size_t>(i) * cells + o] =
+          weighted_sum[static_cast<size_t>(i) * cells + o] / (d[i] * d[o]);
   t.weighted_sum = std::move(weighted_sum);
   return t;
 }
@@ -217,8 +223,8 @@ void hit_fiber(const FiberGeometry& g, const FiberSurfaceModel& surface,
 }  // namespace
 
 FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurfaceModel& surface,
-                                      const FiberInteriorTracer& tracer,
-                                      const FiberBakeSettings& s, const ProgressCallback& progress) {
+                                      const FiberInteriorTracer& tracer, const FiberBakeSettings& s,
+                                      const ProgressCallback& progress) {
   validate(g, s);
   const int R = s.resolution;
   const size_t cells = static_cast<size_t>(R) * R;
@@ -270,8 +276,8 @@ FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurface
     for (const auto& [k, w] : t.far_field) far_total[k] += w;
     energy += t.energy;
   };
-  const uint64_t done = run_tasks_ordered<DirectTally>(tasks, s.threads, s.photons_per_task, s.photons,
-                                                       "photons", progress, run_task, merge);
+  const uint64_t done = run_tasks_ordered<DirectTally>(
+      tasks, s.threads, s.photons_per_task, s.photons, "photons", progress, run_task, merge);
   // Each photon stands for pi / N of the integral (see docs/fiber-bsdf.md).
   const double scale = energy.photons > 0 ? kPi / static_cast<double>(energy.photons) : 0.0;
   for (auto& v : total) v *= scale;
@@ -284,12 +290,11 @@ FiberBandTable bake_fiber_band_direct(const FiberGeometry& g, const FiberSurface
 }
 
 FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurfaceModel& surface,
-                                      const FiberInteriorTracer& tracer,
-                                      const FiberBakeSettings& s, const BssrdfGrid& grid,
-                                      const ProgressCallback& progress) {
+                                      const FiberInteriorTracer& tracer, const FiberBakeSettings& s,
+                                      const BssrdfGrid& grid, const ProgressCallback& progress) {
   validate(g, s);
-  if (grid.u_bins < 2 || grid.u_bins % 2 != 0 || grid.incident_s_bins < 1 || grid.incident_psi_bins < 1 ||
-      grid.cell_quadrature < 1)
+  if (grid.u_bins < 2 || grid.u_bins % 2 != 0 || grid.incident_s_bins < 1 ||
+      grid.incident_psi_bins < 1 || grid.cell_quadrature < 1)
     throw Error("", "bssrdf_grid", "grid sizes must be positive and u_bins even");
   const int R = s.resolution;
   const size_t cells = static_cast<size_t>(R) * R;
@@ -298,9 +303,10 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
   // T[a][j][o]: exit weight by incident bin a, angular offset bin j, exit direction bin o.
   const size_t t_size = incident_bins * nu * cells;
   if (t_size > (size_t{1} << 27))  // 1 GiB of doubles
-    throw Error("", "bssrdf_grid",
-                "the BSSRDF table (incident bins x offsets x exit bins = " + std::to_string(t_size) +
-                    " values) is too large for this resolution; use the direct route or a coarser grid");
+    throw Error(
+        "", "bssrdf_grid",
+        "the BSSRDF table (incident bins x offsets x exit bins = " + std::to_string(t_size) +
+            " values) is too large for this resolution; use the direct route or a coarser grid");
   const uint64_t tasks = (s.photons + s.photons_per_task - 1) / s.photons_per_task;
   const double du = 2 * kPi / nu;
   // A sits at the top of the fiber (phi = pi/2): its frame is the identity.
@@ -385,12 +391,14 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& g, const FiberSurface
           const double psi = std::atan2(wa.y, wa.z);
           const double xs = std::clamp((wa.x + 1) / 2 * ns - 0.5, 0.0, ns - 1.0);
           const double xp = std::clamp((psi + kPi / 2) / kPi * npsi - 0.5, 0.0, npsi - 1.0);
-          const int s0 = std::min(static_cast<int>(xs), ns - 1), p0 = std::min(static_cast<int>(xp), npsi - 1);
+          const int s0 = std::min(static_cast<int>(xs), ns - 1),
+                    p0 = std::min(static_cast<int>(xp), npsi - 1);
           const int s1 = std::min(s0 + 1, ns - 1), p1 = std::min(p0 + 1, npsi - 1);
           const double fs = xs - s0, fp = xp - p0;
           const double w = point_solid_angle * wa.z;
-          const size_t corner[4] = {static_cast<size_t>(s0) * npsi + p0, static_cast<size_t>(s0) * npsi + p1,
-                                    static_cast<size_t>(s1) * npsi + p0, static_cast<size_t>(s1) * npsi + p1};
+          const size_t corner[4] = {
+              static_cast<size_t>(s0) * npsi + p0, static_cast<size_t>(s0) * npsi + p1,
+              static_cast<size_t>(s1) * npsi + p0, static_cast<size_t>(s1) * npsi + p1};
           const double cw[4] = {(1 - fs) * (1 - fp), (1 - fs) * fp, fs * (1 - fp), fs * fp};
           for (int c = 0; c < 4; ++c) {
             if (cw[c] == 0) continue;

@@ -160,7 +160,6 @@ json spectrum_json(const Spectrum& s) {
 
 }  // namespace
 
-
 FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file) {
   json root;
   try {

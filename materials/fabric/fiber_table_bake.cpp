@@ -1,9 +1,9 @@
 #include "weft/materials/fabric/fiber_table_bake.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <memory>
-#include <cmath>
 #include <string>
 
 #include "weft/core/error.h"
@@ -49,7 +49,8 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
   if (!albedo)
     albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
                                                         spec.roughness_alpha, mb.host_n);
-  ph.surface.sample = [ct](const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out, double* weight) {
+  ph.surface.sample = [ct](const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out,
+                           double* weight) {
     // Cook-Torrance is reciprocal: sampling the view direction given the light one uses the same
     // routine with the roles swapped; the weight is f cos(out) / pdf.
     const auto smp = ct->sample(w_light, u, u_lobe);
@@ -67,7 +68,8 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
   auto transport = std::make_shared<const CylinderTransport>(
       CylinderGeometry(spec.fiber_radius_um, 1.0),
       TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt);
-  ph.tracer = [transport](const Vec3& p, const Vec3& d, double w, Rng& rng, const FiberExitSink& sink) {
+  ph.tracer = [transport](const Vec3& p, const Vec3& d, double w, Rng& rng,
+                          const FiberExitSink& sink) {
     struct Forward {
       const FiberExitSink* sink;
       void on_exit(const ExitEvent& e) { (*sink)(FiberExit{e.position, e.direction, e.weight}); }
@@ -75,8 +77,8 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
     PhotonTally tally;
     // The entry point sits on the wall; nudge it inside so rounding cannot put it outside.
     transport->launch_internal(p * (1 - 1e-12), d, w, rng, recorder, tally);
-    return FiberTraceResult{tally.scatterings, tally.absorbed, tally.roulette_loss - tally.roulette_gain,
-                            tally.lost};
+    return FiberTraceResult{tally.scatterings, tally.absorbed,
+                            tally.roulette_loss - tally.roulette_gain, tally.lost};
   };
   return ph;
 }
@@ -116,8 +118,8 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
   for (int band = 0; band < kNumBands; ++band) {
     auto& albedo = albedo_by_ior[medium.bands[band].host_n];
     if (!albedo)
-      albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
-                                                          spec.roughness_alpha, medium.bands[band].host_n);
+      albedo = std::make_shared<const SurfaceAlbedoTable>(
+          spec.roughness_distribution, spec.roughness_alpha, medium.bands[band].host_n);
     states[band].physics =
         fiber_band_physics(spec, medium.bands[band], o.max_events_per_photon, albedo);
     states[band].weighted_sum.assign(cells * cells, 0.0);
@@ -154,7 +156,8 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
               : bake_fiber_band_bssrdf(ph.geometry, ph.surface, ph.tracer, settings, BssrdfGrid{},
                                        band_progress);
       const double n = static_cast<double>(t.photons);
-      for (size_t k = 0; k < st.weighted_sum.size(); ++k) st.weighted_sum[k] += t.weighted_sum[k] * n;
+      for (size_t k = 0; k < st.weighted_sum.size(); ++k)
+        st.weighted_sum[k] += t.weighted_sum[k] * n;
       st.surface += t.surface_fraction * n;
       st.exit += t.exit_fraction * n;
       st.lost += t.lost_fraction * n;
@@ -218,7 +221,8 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
   const auto& w = srgb_band_weights_d65();
   for (size_t k = 0; k < cells * cells; ++k) {
     if (o.spectral) {
-      for (int b = 0; b < kNumBands; ++b) table.values[k * kNumBands + b] = static_cast<float>(band_f[b][k]);
+      for (int b = 0; b < kNumBands; ++b)
+        table.values[k * kNumBands + b] = static_cast<float>(band_f[b][k]);
     } else {
       Rgb rgb;
       for (int b = 0; b < kNumBands; ++b) rgb += w[b] * band_f[b][k];
@@ -244,9 +248,11 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       {"fiber_radius_um", std::to_string(spec.fiber_radius_um)},
       {"roughness", std::string(microfacet_model_name(spec.roughness_distribution)) + " alpha " +
                         std::to_string(spec.roughness_alpha)},
-      {"definition", "f = L_o / (E |cos theta_i|); cosine-weighted cell averages (docs/fiber-bsdf.md)"},
+      {"definition",
+       "f = L_o / (E |cos theta_i|); cosine-weighted cell averages (docs/fiber-bsdf.md)"},
   };
-  if (!o.spectral) table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
+  if (!o.spectral)
+    table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
   table.validate("");
   return result;
 }

@@ -27,7 +27,8 @@ PhaseFunction PhaseFunction::tabulated(std::span<const double> mu, std::span<con
   f.cdf_.assign(mu.size(), 0.0);
   for (size_t i = 0; i < mu.size(); ++i) {
     if (!std::isfinite(p[i]) || p[i] < 0)
-      throw Error("", "phase_function", "value " + std::to_string(i) + " is negative or not finite");
+      throw Error("", "phase_function",
+                  "value " + std::to_string(i) + " is negative or not finite");
     if (i > 0) {
       if (!(mu[i] > mu[i - 1])) throw Error("", "phase_function", "nodes must increase strictly");
       f.cdf_[i] = f.cdf_[i - 1] + 0.5 * (p[i] + p[i - 1]) * (mu[i] - mu[i - 1]);
@@ -49,8 +50,8 @@ double PhaseFunction::sample_cos_theta(double u) const {
   }
   // Find the segment, then invert the CDF of a linear density on it exactly.
   const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), u);
-  size_t i = static_cast<size_t>(std::clamp<std::ptrdiff_t>((it - cdf_.begin()) - 1, 0,
-                                                            static_cast<std::ptrdiff_t>(mu_.size()) - 2));
+  size_t i = static_cast<size_t>(std::clamp<std::ptrdiff_t>(
+      (it - cdf_.begin()) - 1, 0, static_cast<std::ptrdiff_t>(mu_.size()) - 2));
   const double h = mu_[i + 1] - mu_[i];
   const double a = p_[i], b = p_[i + 1];
   const double target = u - cdf_[i];  // area to accumulate inside the segment
@@ -84,8 +85,8 @@ double PhaseFunction::eval(double cos_theta) const {
   }
   cos_theta = std::clamp(cos_theta, -1.0, 1.0);
   const auto it = std::upper_bound(mu_.begin(), mu_.end(), cos_theta);
-  const size_t i = static_cast<size_t>(
-      std::clamp<std::ptrdiff_t>((it - mu_.begin()) - 1, 0, static_cast<std::ptrdiff_t>(mu_.size()) - 2));
+  const size_t i = static_cast<size_t>(std::clamp<std::ptrdiff_t>(
+      (it - mu_.begin()) - 1, 0, static_cast<std::ptrdiff_t>(mu_.size()) - 2));
   const double t = (cos_theta - mu_[i]) / (mu_[i + 1] - mu_[i]);
   // Density in mu spread uniformly in azimuth.
   return ((1 - t) * p_[i] + t * p_[i + 1]) / (2 * kPi);

@@ -21,8 +21,9 @@ const fs::path kExamples = fs::path(WEFT_SOURCE_DIR) / "scenes/examples";
 
 // One file per test: ctest runs tests as parallel processes.
 fs::path lambert_table(double rho) {
-  const fs::path dir = fs::temp_directory_path() /
-                       (std::string("weft-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  const fs::path dir =
+      fs::temp_directory_path() /
+      (std::string("weft-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
   fs::create_directories(dir);
   const fs::path file = dir / "lambert.exr";
   const auto table = TabulatedBsdfTable::from_function(
@@ -76,7 +77,8 @@ TEST(TableMaterial, LambertTableRendersTheLambertImage) {
     sa += a.image.rgb[i];
     sb += b.image.rgb[i];
     if (a.image.rgb[i] > 0)
-      max_rel = std::max(max_rel, std::abs(double(a.image.rgb[i]) - b.image.rgb[i]) / a.image.rgb[i]);
+      max_rel =
+          std::max(max_rel, std::abs(double(a.image.rgb[i]) - b.image.rgb[i]) / a.image.rgb[i]);
   }
   ASSERT_GT(sa, 0);
   EXPECT_NEAR(sb / sa, 1.0, 1e-5);

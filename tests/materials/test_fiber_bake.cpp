@@ -28,7 +28,9 @@ FiberSurfaceModel lambert_surface(double rho) {
 }
 
 // Interior that absorbs everything that enters.
-FiberTraceResult absorb_all(const Vec3&, const Vec3&, double, Rng&, const FiberExitSink&) { return {}; }
+FiberTraceResult absorb_all(const Vec3&, const Vec3&, double, Rng&, const FiberExitSink&) {
+  return {};
+}
 
 // Cosine-weighted area of the upper-hemisphere part of each bin (same midpoint rule).
 std::vector<double> upper_bin_areas(int resolution) {

@@ -22,7 +22,8 @@ FiberSpec test_spec(double radius_um = 8, double void_fraction = 0.02, double dy
                     double void_radius_um = 0.3) {
   const std::string json = R"({"name": "test", "fiber_radius_um": )" + std::to_string(radius_um) +
                            R"(, "roughness": {"distribution": "ggx", "alpha": 0.3},
-    "host": {"n": 1.557, "absorption_per_um": )" + std::to_string(dye_per_um) + R"(},
+    "host": {"n": 1.557, "absorption_per_um": )" +
+                           std::to_string(dye_per_um) + R"(},
     "species": [{"name": "voids", "n": 1.0, "k": 0.0, "volume_fraction": )" +
                            std::to_string(void_fraction) + R"(,
       "size": {"distribution": "monodisperse", "radius_um": )" +
@@ -152,7 +153,8 @@ TEST(FiberTableBake, DirectAndBssrdfRoutesAgreeWithinStatisticalError) {
   double a = 0, b = 0;
   const auto d = cosine_weighted_bin_areas(4);
   for (int i = 0; i < 16; ++i)
-    for (int o = 0; o < 16; ++o) a += direct.mean[i * 16 + o] * d[i] * d[o], b += bssrdf.mean[i * 16 + o] * d[i] * d[o];
+    for (int o = 0; o < 16; ++o)
+      a += direct.mean[i * 16 + o] * d[i] * d[o], b += bssrdf.mean[i * 16 + o] * d[i] * d[o];
   EXPECT_NEAR(a, b, 2e-3 * a + 0.01 * a);
 }
 
@@ -173,11 +175,13 @@ TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
     std::vector<double> m(st.mean.size()), se(st.se.size());
     for (int i = 0; i < cells; ++i)
       for (int o = 0; o < cells; ++o) {
-        const size_t src = static_cast<size_t>(mirror_bin(i, R, flip_x)) * cells + mirror_bin(o, R, flip_x);
+        const size_t src =
+            static_cast<size_t>(mirror_bin(i, R, flip_x)) * cells + mirror_bin(o, R, flip_x);
         m[i * cells + o] = st.mean[src];
         se[i * cells + o] = st.se[src];
       }
-    EXPECT_LE(count_outliers(st.mean, st.se, m, se, 4.5), 2) << (flip_x ? "axis flip" : "binormal flip");
+    EXPECT_LE(count_outliers(st.mean, st.se, m, se, 4.5), 2)
+        << (flip_x ? "axis flip" : "binormal flip");
   }
 }
 
@@ -238,7 +242,8 @@ TEST(FiberTableBake, BitIdenticalAtOneAndTwoThreads) {
   const auto b = bake_fiber_table(load_fiber_spec("red-cotton"), o);
   ASSERT_EQ(a.table.values.size(), b.table.values.size());
   EXPECT_EQ(a.table.checksum(), b.table.checksum());
-  for (size_t i = 0; i < a.table.values.size(); ++i) ASSERT_EQ(a.table.values[i], b.table.values[i]);
+  for (size_t i = 0; i < a.table.values.size(); ++i)
+    ASSERT_EQ(a.table.values[i], b.table.values[i]);
 }
 
 TEST(FiberTableBake, ExtremesStayFiniteAndBalanced) {
@@ -290,8 +295,9 @@ TEST(FiberTableBake, BakedTableSamplingPassesChiSquare) {
   const double significance = weft::testing::sidak_significance(0.01, 3);
   for (const Vec3& wo : {normalize(Vec3{0.2, 0.3, 0.9}), normalize(Vec3{0.4, -0.2, -0.8}),
                          normalize(Vec3{0.1, 0.99, 0.05})}) {
-    const auto res = weft::testing::chi2_test(weft::testing::bsdf_sampler(bsdf, wo), weft::testing::bsdf_pdf(bsdf, wo),
-                                        grid, 200000, significance, 77);
+    const auto res =
+        weft::testing::chi2_test(weft::testing::bsdf_sampler(bsdf, wo),
+                                 weft::testing::bsdf_pdf(bsdf, wo), grid, 200000, significance, 77);
     EXPECT_TRUE(res.passed) << res.message;
   }
 }

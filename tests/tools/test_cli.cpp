@@ -48,7 +48,9 @@ CliRun run(const std::string& args, const fs::path& dir, const std::string& pref
   return r;
 }
 
-void write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
 
 const char* kGoodSpec = R"({"name": "cli-test", "fiber_radius_um": 6,
   "roughness": {"distribution": "beckmann", "alpha": 0.3},
@@ -61,9 +63,10 @@ const char* kGoodSpec = R"({"name": "cli-test", "fiber_radius_um": 6,
 TEST(Cli, BakeFiberWritesTableAndJsonSummary) {
   const fs::path dir = temp_dir();
   const fs::path out = dir / "fiber.exr";
-  const CliRun r = run("bake fiber red-cotton --photons 60 --resolution 2 --passes 2 --json --quiet -o '" +
-                        out.string() + "'",
-                    dir);
+  const CliRun r =
+      run("bake fiber red-cotton --photons 60 --resolution 2 --passes 2 --json --quiet -o '" +
+              out.string() + "'",
+          dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"photons", "scattering_events", "events_per_s", "per_band", "spec_hash"})
@@ -94,9 +97,12 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
     return s;
   };
   const std::vector<Case> cases = {
-      {"negative-radius", with("\"fiber_radius_um\": 6", "\"fiber_radius_um\": -6"), "fiber_radius_um"},
-      {"packed-too-dense", with("\"volume_fraction\": 0.02", "\"volume_fraction\": 0.8"), "volume_fraction"},
-      {"unknown-key", with("\"name\": \"cli-test\"", "\"name\": \"cli-test\", \"colour\": 1"), "colour"},
+      {"negative-radius", with("\"fiber_radius_um\": 6", "\"fiber_radius_um\": -6"),
+       "fiber_radius_um"},
+      {"packed-too-dense", with("\"volume_fraction\": 0.02", "\"volume_fraction\": 0.8"),
+       "volume_fraction"},
+      {"unknown-key", with("\"name\": \"cli-test\"", "\"name\": \"cli-test\", \"colour\": 1"),
+       "colour"},
       {"nan", with("\"alpha\": 0.3", "\"alpha\": NaN"), ""},
       {"truncated", good.substr(0, good.size() / 2), ""},
   };
@@ -104,7 +110,8 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
     const fs::path spec = dir / (c.name + ".json");
     write(spec, c.text);
     const fs::path out = dir / (c.name + ".exr");
-    const CliRun r = run("bake fiber '" + spec.string() + "' --photons 10 --quiet -o '" + out.string() + "'", dir);
+    const CliRun r = run(
+        "bake fiber '" + spec.string() + "' --photons 10 --quiet -o '" + out.string() + "'", dir);
     EXPECT_EQ(r.exit_code, 2) << c.name << ": " << r.err;
     EXPECT_NE(r.err.find(spec.filename().string()), std::string::npos) << c.name << ": " << r.err;
     if (!c.expect_in_error.empty()) {
@@ -113,7 +120,9 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
     EXPECT_FALSE(fs::exists(out)) << c.name;
   }
   // A missing file is named, and the presets are listed.
-  const CliRun missing = run("bake fiber '" + (dir / "nope.json").string() + "' -o '" + (dir / "x.exr").string() + "'", dir);
+  const CliRun missing =
+      run("bake fiber '" + (dir / "nope.json").string() + "' -o '" + (dir / "x.exr").string() + "'",
+          dir);
   EXPECT_EQ(missing.exit_code, 2);
   EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
   EXPECT_NE(missing.err.find("red-cotton"), std::string::npos) << missing.err;
@@ -125,14 +134,22 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
 
 TEST(Cli, BadNumbersOnTheCommandLineAreRejected) {
   const fs::path dir = temp_dir();
-  EXPECT_NE(run("bake fiber red-cotton --resolution 1 -o '" + (dir / "a.exr").string() + "'", dir).exit_code, 0);
-  EXPECT_NE(run("bake fiber red-cotton --photons 0 -o '" + (dir / "b.exr").string() + "'", dir).exit_code, 0);
-  EXPECT_NE(run("bake fiber red-cotton --bands xyz -o '" + (dir / "c.exr").string() + "'", dir).exit_code, 0);
+  EXPECT_NE(run("bake fiber red-cotton --resolution 1 -o '" + (dir / "a.exr").string() + "'", dir)
+                .exit_code,
+            0);
+  EXPECT_NE(
+      run("bake fiber red-cotton --photons 0 -o '" + (dir / "b.exr").string() + "'", dir).exit_code,
+      0);
+  EXPECT_NE(
+      run("bake fiber red-cotton --bands xyz -o '" + (dir / "c.exr").string() + "'", dir).exit_code,
+      0);
   EXPECT_FALSE(fs::exists(dir / "a.exr"));
   const CliRun mie = run("mie --m-re nan --m-im 0 --x 10 --json", dir);
   EXPECT_EQ(mie.exit_code, 2) << mie.err;
-  const CliRun slab = run("slab --mua-per-mm -1 --mus-per-mm 10 --g 0.9 --n-slab 1.4 --thickness-mm 1 "
-                       "--photons 10 --seed 1 --json", dir);
+  const CliRun slab =
+      run("slab --mua-per-mm -1 --mus-per-mm 10 --g 0.9 --n-slab 1.4 --thickness-mm 1 "
+          "--photons 10 --seed 1 --json",
+          dir);
   EXPECT_NE(slab.exit_code, 0);
   EXPECT_NE(slab.err.find("mua"), std::string::npos) << slab.err;
 }
@@ -143,9 +160,10 @@ TEST(Cli, InterruptedBakeLeavesACompleteTableOrNone) {
   // one pass finished, writes nothing (exit 2). Never a partial file.
   const fs::path dir = temp_dir();
   const fs::path out = dir / "fiber.exr";
-  const CliRun r = run("bake fiber white-cotton --photons 100000000 --passes 100000 --resolution 2 --quiet -o '" +
-                        out.string() + "'",
-                    dir, "timeout --preserve-status -s INT 2 ");
+  const CliRun r = run(
+      "bake fiber white-cotton --photons 100000000 --passes 100000 --resolution 2 --quiet -o '" +
+          out.string() + "'",
+      dir, "timeout --preserve-status -s INT 2 ");
   if (r.exit_code == 130) {
     const auto table = weft::TabulatedBsdfTable::read_exr(out);
     EXPECT_EQ(table.metadata.at("interrupted"), "yes");

@@ -26,9 +26,9 @@ class Distribution1D {
   };
   Sample sample_continuous(double u) const;
   size_t sample_discrete(double u, double* pmf = nullptr) const;
-  double pdf(double x) const;           // density at x in [0,1)
-  double pmf(size_t bin) const;         // probability of a bin
-  size_t bin_of(double x) const;        // the bin holding x (clamped to the range)
+  double pdf(double x) const;     // density at x in [0,1)
+  double pmf(size_t bin) const;   // probability of a bin
+  size_t bin_of(double x) const;  // the bin holding x (clamped to the range)
 
  private:
   std::vector<double> func_, cdf_;

@@ -19,8 +19,8 @@ struct Frame {
     const double sign = std::copysign(1.0, n.z);
     const double a = -1.0 / (sign + n.z);
     const double b = n.x * n.y * a;
-    return {Vec3{1 + sign * n.x * n.x * a, sign * b, -sign * n.x}, Vec3{b, sign + n.y * n.y * a, -n.y},
-            n};
+    return {Vec3{1 + sign * n.x * n.x * a, sign * b, -sign * n.x},
+            Vec3{b, sign + n.y * n.y * a, -n.y}, n};
   }
   // Frame from a unit normal and a tangent hint (e.g. the fiber axis); the tangent is
   // Gram-Schmidt orthogonalised against n. Falls back to from_normal if the hint is parallel to n.
@@ -37,7 +37,9 @@ struct Frame {
 };
 
 // Spherical helpers in a local frame (z up).
-inline double cos_theta(const Vec3& w) { return w.z; }
+inline double cos_theta(const Vec3& w) {
+  return w.z;
+}
 inline Vec3 spherical_direction(double theta, double phi) {
   const double st = std::sin(theta);
   return {st * std::cos(phi), st * std::sin(phi), std::cos(theta)};

@@ -10,7 +10,9 @@ inline constexpr int kNumBands = 33;
 inline constexpr double kFirstBandNm = 390.0;
 inline constexpr double kBandStepNm = 10.0;
 
-constexpr double band_wavelength_nm(int band) { return kFirstBandNm + kBandStepNm * band; }
+constexpr double band_wavelength_nm(int band) {
+  return kFirstBandNm + kBandStepNm * band;
+}
 
 using Spectrum = std::array<double, kNumBands>;
 
@@ -24,19 +26,44 @@ struct Rgb {
   constexpr Rgb() = default;
   constexpr Rgb(double r_, double g_, double b_) : r(r_), g(g_), b(b_) {}
   constexpr explicit Rgb(double v) : r(v), g(v), b(v) {}
-  constexpr Rgb& operator+=(const Rgb& o) { r += o.r; g += o.g; b += o.b; return *this; }
-  constexpr Rgb& operator*=(const Rgb& o) { r *= o.r; g *= o.g; b *= o.b; return *this; }
-  constexpr Rgb& operator*=(double s) { r *= s; g *= s; b *= s; return *this; }
+  constexpr Rgb& operator+=(const Rgb& o) {
+    r += o.r;
+    g += o.g;
+    b += o.b;
+    return *this;
+  }
+  constexpr Rgb& operator*=(const Rgb& o) {
+    r *= o.r;
+    g *= o.g;
+    b *= o.b;
+    return *this;
+  }
+  constexpr Rgb& operator*=(double s) {
+    r *= s;
+    g *= s;
+    b *= s;
+    return *this;
+  }
   constexpr double max_component() const { return r > g ? (r > b ? r : b) : (g > b ? g : b); }
   constexpr double average() const { return (r + g + b) / 3.0; }
   constexpr bool is_black() const { return r == 0 && g == 0 && b == 0; }
   constexpr bool operator==(const Rgb&) const = default;
 };
-constexpr Rgb operator+(Rgb a, const Rgb& b) { return a += b; }
-constexpr Rgb operator*(Rgb a, const Rgb& b) { return a *= b; }
-constexpr Rgb operator*(Rgb a, double s) { return a *= s; }
-constexpr Rgb operator*(double s, Rgb a) { return a *= s; }
-constexpr Rgb operator/(Rgb a, double s) { return a *= (1.0 / s); }
+constexpr Rgb operator+(Rgb a, const Rgb& b) {
+  return a += b;
+}
+constexpr Rgb operator*(Rgb a, const Rgb& b) {
+  return a *= b;
+}
+constexpr Rgb operator*(Rgb a, double s) {
+  return a *= s;
+}
+constexpr Rgb operator*(double s, Rgb a) {
+  return a *= s;
+}
+constexpr Rgb operator/(Rgb a, double s) {
+  return a *= (1.0 / s);
+}
 struct Hsv {
   double h = 0, s = 0, v = 0;  // each in [0, 1]
 };

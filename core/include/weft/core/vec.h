@@ -15,30 +15,67 @@ struct Vec3 {
   constexpr double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
   constexpr double& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
   constexpr Vec3 operator-() const { return {-x, -y, -z}; }
-  constexpr Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
-  constexpr Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  constexpr Vec3& operator*=(double s) { x *= s; y *= s; z *= s; return *this; }
+  constexpr Vec3& operator+=(const Vec3& o) {
+    x += o.x;
+    y += o.y;
+    z += o.z;
+    return *this;
+  }
+  constexpr Vec3& operator-=(const Vec3& o) {
+    x -= o.x;
+    y -= o.y;
+    z -= o.z;
+    return *this;
+  }
+  constexpr Vec3& operator*=(double s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+  }
   constexpr bool operator==(const Vec3&) const = default;
 };
 
-constexpr Vec3 operator+(Vec3 a, const Vec3& b) { return a += b; }
-constexpr Vec3 operator-(Vec3 a, const Vec3& b) { return a -= b; }
-constexpr Vec3 operator*(Vec3 a, double s) { return a *= s; }
-constexpr Vec3 operator*(double s, Vec3 a) { return a *= s; }
-constexpr Vec3 operator/(Vec3 a, double s) { return a *= (1.0 / s); }
-constexpr Vec3 mul(const Vec3& a, const Vec3& b) { return {a.x * b.x, a.y * b.y, a.z * b.z}; }
-constexpr double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr Vec3 operator+(Vec3 a, const Vec3& b) {
+  return a += b;
+}
+constexpr Vec3 operator-(Vec3 a, const Vec3& b) {
+  return a -= b;
+}
+constexpr Vec3 operator*(Vec3 a, double s) {
+  return a *= s;
+}
+constexpr Vec3 operator*(double s, Vec3 a) {
+  return a *= s;
+}
+constexpr Vec3 operator/(Vec3 a, double s) {
+  return a *= (1.0 / s);
+}
+constexpr Vec3 mul(const Vec3& a, const Vec3& b) {
+  return {a.x * b.x, a.y * b.y, a.z * b.z};
+}
+constexpr double dot(const Vec3& a, const Vec3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 constexpr Vec3 cross(const Vec3& a, const Vec3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-constexpr double length_squared(const Vec3& a) { return dot(a, a); }
-inline double length(const Vec3& a) { return std::sqrt(dot(a, a)); }
-inline Vec3 normalize(const Vec3& a) { return a / length(a); }
+constexpr double length_squared(const Vec3& a) {
+  return dot(a, a);
+}
+inline double length(const Vec3& a) {
+  return std::sqrt(dot(a, a));
+}
+inline Vec3 normalize(const Vec3& a) {
+  return a / length(a);
+}
 inline bool is_finite(const Vec3& a) {
   return std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
 }
 // Mirror d about the unit normal n (both pointing away from the surface).
-constexpr Vec3 reflect(const Vec3& d, const Vec3& n) { return 2.0 * dot(d, n) * n - d; }
+constexpr Vec3 reflect(const Vec3& d, const Vec3& n) {
+  return 2.0 * dot(d, n) * n - d;
+}
 
 inline std::ostream& operator<<(std::ostream& os, const Vec3& v) {
   return os << '(' << v.x << ", " << v.y << ", " << v.z << ')';

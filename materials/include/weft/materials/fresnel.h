@@ -9,7 +9,8 @@ namespace weft {
 
 // Reflectance for light arriving with cosine cos_i (> 0) from the side of index n_i into index
 // n_t. Returns 1 for total internal reflection. cos_t_out receives the transmitted cosine (> 0).
-inline double fresnel_dielectric(double cos_i, double n_i, double n_t, double* cos_t_out = nullptr) {
+inline double fresnel_dielectric(double cos_i, double n_i, double n_t,
+                                 double* cos_t_out = nullptr) {
   cos_i = std::clamp(cos_i, 0.0, 1.0);
   const double eta = n_i / n_t;
   const double sin2_t = eta * eta * (1 - cos_i * cos_i);

@@ -17,8 +17,8 @@ namespace weft {
 // instances and loaded once through 'cache'.
 struct MaterialContext {
   std::filesystem::path base_dir = ".";
-  std::string source_file;  // for error messages
-  std::string field_prefix; // e.g. "materials.seat" for error messages
+  std::string source_file;                   // for error messages
+  std::string field_prefix;                  // e.g. "materials.seat" for error messages
   std::shared_ptr<struct TableCache> cache;  // may be null: then nothing is shared
 };
 

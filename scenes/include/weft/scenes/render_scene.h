@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
-#include "weft/materials/table_cache.h"
 #include "weft/core/distribution.h"
 #include "weft/core/frame.h"
 #include "weft/core/spectrum.h"
 #include "weft/materials/bsdf.h"
+#include "weft/materials/table_cache.h"
 #include "weft/scenes/camera.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/lights.h"

@@ -39,7 +39,8 @@ using FiberInteriorTracer = std::function<FiberTraceResult(const Vec3& p, const 
 struct FiberSurfaceModel {
   // Samples the surface-reflected direction for light from 'w_light' (z > 0): returns false if
   // none; else sets the reflected direction and its weight f * cos / pdf.
-  std::function<bool(const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out, double* weight)> sample;
+  std::function<bool(const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out, double* weight)>
+      sample;
   // Directional albedo of the surface lobe for light at cos theta (its complement enters).
   std::function<double(double cos_theta)> albedo;
 };
@@ -51,10 +52,10 @@ struct FiberGeometry {
 };
 
 struct FiberBakeSettings {
-  int resolution = 8;             // R: R x R equal-area bins per direction over the sphere
-  uint64_t photons = 100000;      // photons per band
+  int resolution = 8;         // R: R x R equal-area bins per direction over the sphere
+  uint64_t photons = 100000;  // photons per band
   uint64_t seed = 1;
-  int threads = 0;                // 0 = all cores
+  int threads = 0;  // 0 = all cores
   uint64_t photons_per_task = 4096;
   // Optional far-field tally of the direct route (0 = off): the fiber's scattering per unit
   // length binned by the axial cosines of both directions and their azimuth difference about the
@@ -67,25 +68,26 @@ struct FiberBakeSettings {
 // direction bin and o the exit (view) bin, 1/sr. Also the raw tallies needed by the checks.
 struct FiberBandTable {
   int resolution = 0;
-  std::vector<double> f;            // R^4 cell averages (1/sr)
-  std::vector<double> weighted_sum; // R^4 sums of f |cos_i| |cos_o| over the cell pair (sr^2)
+  std::vector<double> f;             // R^4 cell averages (1/sr)
+  std::vector<double> weighted_sum;  // R^4 sums of f |cos_i| |cos_o| over the cell pair (sr^2)
   // Energy, as fractions of the light hitting the fiber. Per photon the books balance exactly:
   //   exit + absorbed + roulette_net + lost - surface_sampling_excess = 1   (to rounding),
   // where surface_sampling_excess = mean(sampled surface weight - tabulated surface albedo) has
   // mean zero: the surface lobe is sampled, the part that enters uses the lobe's albedo.
-  double exit_fraction = 0;         // everything that leaves (surface + volume)
-  double surface_fraction = 0;      // of which reflected by the surface lobe
-  double absorbed_fraction = 0;     // absorbed inside, as traced
+  double exit_fraction = 0;      // everything that leaves (surface + volume)
+  double surface_fraction = 0;   // of which reflected by the surface lobe
+  double absorbed_fraction = 0;  // absorbed inside, as traced
   double roulette_net = 0;
-  double lost_fraction = 0;         // weight the interior tracer gave up on (reported, not hidden)
+  double lost_fraction = 0;  // weight the interior tracer gave up on (reported, not hidden)
   double surface_sampling_excess = 0;
   double energy_balance() const {
-    return exit_fraction + absorbed_fraction + roulette_net + lost_fraction - surface_sampling_excess;
+    return exit_fraction + absorbed_fraction + roulette_net + lost_fraction -
+           surface_sampling_excess;
   }
   // Far field (if asked): [s_i bin][s_o bin][azimuth-difference bin], integrals of F over the
   // bins (sr^2 per unit length in fiber radii); reciprocity: [a][b][c] = [b][a][n - 1 - c].
   std::vector<double> far_field;
-  uint64_t photons = 0;             // photons traced (fewer than asked if cancelled)
+  uint64_t photons = 0;  // photons traced (fewer than asked if cancelled)
   uint64_t scattering_events = 0;
   bool cancelled = false;
 };
@@ -97,7 +99,8 @@ std::vector<double> cosine_weighted_bin_areas(int resolution);
 int direction_bin(const Vec3& d, int resolution);
 
 // The direct route: a parallel beam over the whole lit cylinder. 'stage' names progress.
-FiberBandTable bake_fiber_band_direct(const FiberGeometry& geometry, const FiberSurfaceModel& surface,
+FiberBandTable bake_fiber_band_direct(const FiberGeometry& geometry,
+                                      const FiberSurfaceModel& surface,
                                       const FiberInteriorTracer& tracer,
                                       const FiberBakeSettings& settings,
                                       const ProgressCallback& progress);
@@ -116,7 +119,8 @@ struct BssrdfGrid {
   int incident_psi_bins = 64;
   int cell_quadrature = 16;  // points per side when integrating over a table bin of wi
 };
-FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& geometry, const FiberSurfaceModel& surface,
+FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& geometry,
+                                      const FiberSurfaceModel& surface,
                                       const FiberInteriorTracer& tracer,
                                       const FiberBakeSettings& settings, const BssrdfGrid& grid,
                                       const ProgressCallback& progress);

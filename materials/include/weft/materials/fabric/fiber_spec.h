@@ -29,7 +29,6 @@
 
 namespace weft {
 
-
 struct ParticleSpecies {
   std::string name;
   Spectrum n{}, k{};  // particle refractive index n + i k per band (k >= 0)
@@ -67,6 +66,5 @@ std::string canonical_json(const FiberSpec& spec);
 // FNV-1a 64 of canonical_json(spec), and the same as 16 lower-case hex digits.
 uint64_t fiber_spec_hash(const FiberSpec& spec);
 std::string fiber_spec_hash_hex(const FiberSpec& spec);
-
 
 }  // namespace weft

@@ -18,11 +18,11 @@ namespace weft {
 enum class FiberBakeRoute { kDirect, kBssrdf };
 
 struct FiberTableBakeOptions {
-  int resolution = 8;               // R x R equal-area bins per direction
+  int resolution = 8;  // R x R equal-area bins per direction
   uint64_t photons_per_band = 200000;
   uint64_t seed = 1;
-  int threads = 0;                  // 0 = all cores; results do not depend on it
-  bool spectral = true;             // 33 bands, else linear sRGB (D65) from the 33 bands
+  int threads = 0;       // 0 = all cores; results do not depend on it
+  bool spectral = true;  // 33 bands, else linear sRGB (D65) from the 33 bands
   FiberBakeRoute route = FiberBakeRoute::kDirect;
   uint64_t max_events_per_photon = 10'000'000;  // beyond it the weight is reported as lost
   // Photons are traced in this many passes over all bands; an interrupted bake keeps every
@@ -34,14 +34,14 @@ struct FiberBandSummary {
   int band = 0;
   double wavelength_nm = 0;
   double mu_s_per_um = 0, mu_a_per_um = 0, g = 0;
-  double surface_fraction = 0;   // reflected by the surface lobe (of the light hitting the fiber)
-  double exit_fraction = 0;      // everything that leaves: surface + volume
+  double surface_fraction = 0;  // reflected by the surface lobe (of the light hitting the fiber)
+  double exit_fraction = 0;     // everything that leaves: surface + volume
   double absorbed_fraction = 0;
   double lost_fraction = 0;
-  double roulette_net = 0;       // Russian roulette's net removal (mean zero)
+  double roulette_net = 0;             // Russian roulette's net removal (mean zero)
   double surface_sampling_excess = 0;  // sampled minus tabulated surface albedo (mean zero)
-  double energy_balance = 0;     // exit + absorbed + roulette + lost - excess: 1 to rounding
-  double energy_table = 0;       // table energy sum / pi: equals exit_fraction (white furnace)
+  double energy_balance = 0;           // exit + absorbed + roulette + lost - excess: 1 to rounding
+  double energy_table = 0;  // table energy sum / pi: equals exit_fraction (white furnace)
   uint64_t photons = 0;
   uint64_t scattering_events = 0;
 };
@@ -52,7 +52,7 @@ struct FiberTableBakeResult {
   uint64_t photons = 0;
   uint64_t scattering_events = 0;
   double rgb_negative_clipped = 0;  // largest negative RGB value set to 0 (out of sRGB gamut)
-  bool cancelled = false;  // the table then holds the passes finished (metadata "photons")
+  bool cancelled = false;           // the table then holds the passes finished (metadata "photons")
 };
 
 // Directional albedo of a Cook-Torrance lobe at cos theta, tabulated in cos theta and

@@ -30,8 +30,8 @@ class PhaseFunction {
   bool is_henyey_greenstein() const { return mu_.empty(); }
 
  private:
-  double g_ = 0;                         // HG parameter
-  std::vector<double> mu_, p_, cdf_;     // tabulated: nodes, density in mu (integrates to 1), cdf
+  double g_ = 0;                      // HG parameter
+  std::vector<double> mu_, p_, cdf_;  // tabulated: nodes, density in mu (integrates to 1), cdf
 };
 
 }  // namespace weft
