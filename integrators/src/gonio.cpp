@@ -115,7 +115,13 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
     return l;
   };
   const RenderScene sample_scene =
-      RenderScene(desc).with_lights(light_set(g.light_zenith_deg, g.light_azimuth_deg));
+      RenderScene(desc,
+                  [&] {
+                    RenderSceneOptions o;
+                    o.material_progress = progress;
+                    return o;
+                  }())
+          .with_lights(light_set(g.light_zenith_deg, g.light_azimuth_deg));
   std::optional<RenderScene> white_scene;
   if (g.white_check) {
     RenderSceneOptions opt;

@@ -26,7 +26,9 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   if (!desc.camera) throw Error(desc.source, "camera", "no camera: add 'camera' or a glTF camera");
   RenderSettings settings = job.settings;
   if (job.mask) settings.mask_meshes = desc.select_object(job.mask_object);
-  const RenderScene scene(desc);
+  RenderSceneOptions scene_options;
+  scene_options.material_progress = progress;
+  const RenderScene scene(desc, scene_options);
   const RenderResult r = render(scene, *desc.camera, settings, progress);
   RenderJobResult out;
   out.rays = r.rays;

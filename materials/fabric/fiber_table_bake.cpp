@@ -147,7 +147,7 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       const uint64_t base = units_done;
       // A stop request may arrive after a band's last task: remember it for the loops here.
       ProgressCallback band_progress = [&](const ProgressUpdate& u) {
-        if (!progress({"photons", base + u.done, total_units})) stop_requested = true;
+        if (progress && !progress({"photons", base + u.done, total_units})) stop_requested = true;
         return !stop_requested;
       };
       const FiberBandTable t =

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <map>
 
 #include "weft/core/error.h"
+#include "weft/materials/fabric/fiber_table_bake.h"
 #include "weft/materials/table_cache.h"
 
 namespace weft {
@@ -100,11 +102,79 @@ double parse_ior(const nlohmann::json& p, const MaterialContext& ctx) {
   return parse_number(p, "ior", kCottonIor, 1.0, 4.0, ctx);
 }
 
-// fiber_table / fabric_table: the table file (relative to base_dir), its kind, tint and scale.
+// A fiber table for a spec, baked on first use and kept in the bake cache under a name derived
+// from everything that determines its bits (spec physics, resolution, photons, seed, format).
+std::filesystem::path baked_fiber_table(const nlohmann::json& p, const MaterialContext& ctx) {
+  const std::string spec_name = parse_string(p, "spec", ctx);
+  std::filesystem::path spec_path = spec_name;
+  if (spec_path.is_relative() && std::filesystem::exists(ctx.base_dir / spec_path))
+    spec_path = ctx.base_dir / spec_path;
+  FiberSpec spec;
+  try {
+    spec = load_fiber_spec(std::filesystem::exists(spec_path) ? spec_path.string() : spec_name);
+  } catch (const Error& e) {
+    throw Error(ctx.source_file, field_name(ctx, "spec"), e.what());
+  }
+  FiberTableBakeOptions o;
+  o.spectral = false;
+  const double resolution =
+      parse_number(p, "resolution", 8, 2, TabulatedBsdfTable::kMaxResolution, ctx);
+  if (resolution != std::floor(resolution))
+    throw Error(ctx.source_file, field_name(ctx, "resolution"), "must be an integer");
+  o.resolution = static_cast<int>(resolution);
+  const double photons = parse_number(p, "photons", 100000, 1, 1e12, ctx);
+  if (photons != std::floor(photons))
+    throw Error(ctx.source_file, field_name(ctx, "photons"), "must be an integer");
+  o.photons_per_band = static_cast<uint64_t>(photons);
+  const double seed = parse_number(p, "seed", 1, 0, 9.0e15, ctx);
+  if (seed != std::floor(seed))
+    throw Error(ctx.source_file, field_name(ctx, "seed"), "must be an integer");
+  o.seed = static_cast<uint64_t>(seed);
+  const std::string key = canonical_json(spec) + "|R" + std::to_string(o.resolution) + "|N" +
+                          std::to_string(o.photons_per_band) + "|S" + std::to_string(o.seed) +
+                          "|P" + std::to_string(o.passes) + "|rgb|v" +
+                          std::to_string(TabulatedBsdfTable::kFormatVersion);
+  uint64_t h = 1469598103934665603ULL;  // FNV-1a 64
+  for (unsigned char c : key) h = (h ^ c) * 1099511628211ULL;
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+  const std::filesystem::path dir =
+      ctx.bake_cache_dir.empty() ? ctx.base_dir / ".weft-cache" : ctx.bake_cache_dir;
+  const std::filesystem::path file =
+      dir / ("fiber-" + fiber_spec_hash_hex(spec) + "-" + hex + ".exr");
+  if (std::filesystem::exists(file)) return file;
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error(dir.string(), "", "cannot create the bake cache folder: " + ec.message());
+  FiberTableBakeResult r = bake_fiber_table(spec, o, ctx.progress);
+  if (r.cancelled) throw Error(ctx.source_file, field_name(ctx, "spec"), "bake interrupted");
+  r.table.metadata["cache_key"] = hex;
+  r.table.write_exr(file);
+  return file;
+}
+
+// fiber_table / fabric_table: the table file (relative to base_dir) or, for fiber tables, a fiber
+// spec to bake on demand; its kind, tint and scale.
 Bsdf make_table_bsdf(const nlohmann::json& p, const MaterialContext& ctx, const std::string& kind) {
-  reject_unknown_keys(p, {"file", "tint", "scale"}, ctx);
-  if (!p.contains("file")) throw Error(ctx.source_file, field_name(ctx, "file"), "is required");
-  std::filesystem::path file = parse_string(p, "file", ctx);
+  if (kind == "fiber")
+    reject_unknown_keys(p, {"file", "spec", "resolution", "photons", "seed", "tint", "scale"}, ctx);
+  else
+    reject_unknown_keys(p, {"file", "tint", "scale"}, ctx);
+  if (!p.contains("file") && !p.contains("spec"))
+    throw Error(ctx.source_file, field_name(ctx, "file"),
+                kind == "fiber"
+                    ? "is required (a baked table), or give 'spec' (a fiber spec or preset "
+                      "to bake on demand)"
+                    : "is required");
+  if (p.contains("file") && p.contains("spec"))
+    throw Error(ctx.source_file, field_name(ctx, "spec"), "give either 'file' or 'spec', not both");
+  if (!p.contains("spec"))
+    for (const char* k : {"resolution", "photons", "seed"})
+      if (p.contains(k))
+        throw Error(ctx.source_file, field_name(ctx, k), "applies only with 'spec'");
+  std::filesystem::path file = p.contains("spec")
+                                   ? baked_fiber_table(p, ctx)
+                                   : std::filesystem::path(parse_string(p, "file", ctx));
   if (file.is_relative()) file = ctx.base_dir / file;
   const Rgb tint = parse_rgb(p, "tint", Rgb(1.0), 0.0, 1.0, ctx);
   const double scale = parse_number(p, "scale", 1.0, 0.0, 10.0, ctx);

@@ -87,6 +87,8 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     ctx.source_file = desc.source;
     ctx.field_prefix = b.field.empty() ? "materials" : b.field + ".params";
     ctx.cache = cache;
+    ctx.progress = options.material_progress;
+    ctx.bake_cache_dir = options.bake_cache_dir;
     geo->bsdfs.push_back(make_bsdf(b.type, b.params, ctx));
     const auto id = static_cast<uint32_t>(geo->bsdfs.size() - 1);
     bsdf_of[&b] = id;

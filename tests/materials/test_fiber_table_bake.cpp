@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <vector>
 
 #include "chi2.h"
@@ -11,6 +12,7 @@
 #include "weft/core/math.h"
 #include "weft/core/sphere_mapping.h"
 #include "weft/materials/fabric/fiber_table_bake.h"
+#include "weft/materials/registry.h"
 #include "weft/materials/tabulated_bsdf.h"
 
 using namespace weft;
@@ -309,4 +311,54 @@ TEST(FiberTableBake, RejectsBadOptions) {
   o.resolution = 4;
   o.photons_per_band = 0;
   EXPECT_THROW(bake_fiber_table(load_fiber_spec("white-cotton"), o), Error);
+}
+
+TEST(FiberTableBake, FiberTableMaterialBakesASpecOnDemandOnce) {
+  // "model only what a scene requires": a fiber_table named by its spec is baked on first use,
+  // kept in the cache under a content key, and read back (not re-baked) afterwards.
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "weft-bake-on-demand";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  MaterialContext ctx;
+  ctx.base_dir = dir;
+  ctx.source_file = "scene.json";
+  ctx.field_prefix = "materials.seat.params";
+  int progress_calls = 0;
+  ctx.progress = [&](const ProgressUpdate&) { return ++progress_calls > 0; };
+  const nlohmann::json params = {{"spec", "white-cotton"}, {"resolution", 4}, {"photons", 200}};
+  const Bsdf a = make_bsdf("fiber_table", params, ctx);
+  EXPECT_GT(progress_calls, 0);
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(dir / ".weft-cache")) files.push_back(e.path());
+  ASSERT_EQ(files.size(), 1u);
+  const auto table = TabulatedBsdfTable::read_exr(files[0]);
+  EXPECT_EQ(table.resolution, 4);
+  EXPECT_EQ(table.metadata.at("spec_hash"), fiber_spec_hash_hex(load_fiber_spec("white-cotton")));
+  const auto written = fs::last_write_time(files[0]);
+  progress_calls = 0;
+  const Bsdf b = make_bsdf("fiber_table", params, ctx);
+  EXPECT_EQ(progress_calls, 0);  // no second bake
+  EXPECT_EQ(fs::last_write_time(files[0]), written);
+  const Vec3 wo = normalize(Vec3{0.2, 0.1, 0.9}), wi = normalize(Vec3{-0.3, 0.2, 0.8});
+  EXPECT_EQ(a.eval(wo, wi), b.eval(wo, wi));
+  // Another photon count is another table.
+  make_bsdf("fiber_table", {{"spec", "white-cotton"}, {"resolution", 4}, {"photons", 300}}, ctx);
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir / ".weft-cache"), fs::directory_iterator{}),
+            2);
+  // Bad parameters name the field.
+  for (const auto& [bad, field] : std::vector<std::pair<nlohmann::json, std::string>>{
+           {{{"spec", "white-cotton"}, {"file", "x.exr"}}, "spec"},
+           {{{"spec", "white-cotton"}, {"photons", 0.5}}, "photons"},
+           {{{"spec", "white-cotton"}, {"resolution", 1}}, "resolution"},
+           {{{"file", "x.exr"}, {"photons", 10}}, "photons"},
+           {{{"spec", "no-such-preset"}}, "spec"}}) {
+    try {
+      make_bsdf("fiber_table", bad, ctx);
+      ADD_FAILURE() << bad.dump();
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("materials.seat.params." + field), std::string::npos)
+          << e.what();
+    }
+  }
 }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/progress.h"
 #include "weft/materials/bsdf.h"
 
 namespace weft {
@@ -20,6 +21,10 @@ struct MaterialContext {
   std::string source_file;                   // for error messages
   std::string field_prefix;                  // e.g. "materials.seat" for error messages
   std::shared_ptr<struct TableCache> cache;  // may be null: then nothing is shared
+  // Where fiber tables baked on demand (fiber_table with "spec") are kept; empty: base_dir /
+  // ".weft-cache". And the progress of such bakes (the library never prints).
+  std::filesystem::path bake_cache_dir;
+  ProgressCallback progress = no_progress();
 };
 
 // Builds a BSDF of the named type from its JSON parameters.

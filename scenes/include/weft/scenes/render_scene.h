@@ -49,6 +49,10 @@ struct RenderSceneOptions {
   // Tables (fiber/fabric BSDFs, measured networks) are loaded once into this cache and shared
   // between bindings and between scenes that pass the same cache; null: one cache per scene.
   std::shared_ptr<TableCache> table_cache;
+  // Fiber tables a material asks to bake on demand ("spec"): progress, and where they are kept
+  // (empty: next to the scene description, in .weft-cache).
+  ProgressCallback material_progress = no_progress();
+  std::filesystem::path bake_cache_dir;
 };
 
 class RenderScene {
