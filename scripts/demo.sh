@@ -14,7 +14,7 @@ scripts/build.sh
 out=${WEFT_OUT:-out}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
-weft=build/tools/weft
+weft=${WEFT_BUILD_DIR:-build}/tools/weft
 photons=${WEFT_PHOTONS:-100000}
 spp=${WEFT_SPP:-16}
 examples=$(pwd)/scenes/examples
