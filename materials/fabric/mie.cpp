@@ -6,6 +6,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/quadrature.h"
 
 namespace weft {
 namespace {
@@ -136,31 +137,6 @@ int log_derivative_start(cd z, int n_max) {
   const double az = std::abs(z);
   const double turning = az + 10.0 * std::cbrt(0.5 * az);
   return static_cast<int>(std::ceil(std::max(static_cast<double>(n_max), turning))) + 16;
-}
-
-// Nodes and weights of n-point Gauss-Legendre on [-1, 1] (Newton on P_n).
-void gauss_legendre(int n, std::vector<double>& nodes, std::vector<double>& weights) {
-  nodes.assign(n, 0.0);
-  weights.assign(n, 0.0);
-  for (int i = 0; i < (n + 1) / 2; ++i) {
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5));
-    double dp = 1;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (std::abs(dz) < 1e-15) break;
-    }
-    nodes[i] = -z;
-    nodes[n - 1 - i] = z;
-    weights[i] = weights[n - 1 - i] = 2 / ((1 - z * z) * dp * dp);
-  }
 }
 
 void validate_mu(std::span<const double> mu) {

@@ -62,6 +62,25 @@ double triangle_area(const TriangleMesh& m, uint32_t prim) {
                             vertex(m, m.indices[3 * prim + 2]) - p0));
 }
 
+// An Embree ray query for 'ray' (single precision, no hit yet).
+RTCRayHit embree_ray(const Ray& ray) {
+  RTCRayHit rh;
+  rh.ray.org_x = static_cast<float>(ray.o.x);
+  rh.ray.org_y = static_cast<float>(ray.o.y);
+  rh.ray.org_z = static_cast<float>(ray.o.z);
+  rh.ray.dir_x = static_cast<float>(ray.d.x);
+  rh.ray.dir_y = static_cast<float>(ray.d.y);
+  rh.ray.dir_z = static_cast<float>(ray.d.z);
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = ray.tmax > 3e38 ? INFINITY : static_cast<float>(ray.tmax);
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.time = 0.0f;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  return rh;
+}
+
 }  // namespace
 
 RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions& options) {
@@ -151,22 +170,9 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
 }
 
 bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit) const {
+  RTCRayHit rh = embree_ray(ray);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  rh.ray.org_x = static_cast<float>(ray.o.x);
-  rh.ray.org_y = static_cast<float>(ray.o.y);
-  rh.ray.org_z = static_cast<float>(ray.o.z);
-  rh.ray.dir_x = static_cast<float>(ray.d.x);
-  rh.ray.dir_y = static_cast<float>(ray.d.y);
-  rh.ray.dir_z = static_cast<float>(ray.d.z);
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = ray.tmax > 3e38 ? INFINITY : static_cast<float>(ray.tmax);
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.time = 0.0f;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(geo_->scene, &ctx, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
 
@@ -213,22 +219,9 @@ bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit) const {
 }
 
 double RenderScene::intersect_distance(const Ray& ray) const {
+  RTCRayHit rh = embree_ray(ray);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
-  RTCRayHit rh;
-  rh.ray.org_x = static_cast<float>(ray.o.x);
-  rh.ray.org_y = static_cast<float>(ray.o.y);
-  rh.ray.org_z = static_cast<float>(ray.o.z);
-  rh.ray.dir_x = static_cast<float>(ray.d.x);
-  rh.ray.dir_y = static_cast<float>(ray.d.y);
-  rh.ray.dir_z = static_cast<float>(ray.d.z);
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = ray.tmax > 3e38 ? INFINITY : static_cast<float>(ray.tmax);
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.time = 0.0f;
-  rh.ray.flags = 0;
-  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   rtcIntersect1(geo_->scene, &ctx, &rh);
   return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
 }

@@ -8,6 +8,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/quadrature.h"
 #include "weft/materials/fabric/transport_slab.h"
 #include "weft/materials/fresnel.h"
 
@@ -45,28 +46,10 @@ PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
          << reference_error << ": " << dev / se << " sigma";
 }
 
-// Gauss-Legendre nodes and weights on [0, 1] (Newton iteration on P_n; Numerical Recipes' gauleg
-// idea, written from the recurrence).
+// Gauss-Legendre nodes and weights on [0, 1], from the library's rule on [-1, 1].
 void gauss_legendre_01(int n, std::vector<double>& x, std::vector<double>& w) {
-  x.assign(n, 0);
-  w.assign(n, 0);
-  for (int i = 0; i < n; ++i) {
-    double z = std::cos(kPi * (i + 0.75) / (n + 0.5)), dp = 0;
-    for (int it = 0; it < 100; ++it) {
-      double p0 = 1, p1 = z;
-      for (int k = 2; k <= n; ++k) {
-        const double p2 = ((2 * k - 1) * z * p1 - (k - 1) * p0) / k;
-        p0 = p1;
-        p1 = p2;
-      }
-      dp = n * (z * p1 - p0) / (z * z - 1);
-      const double dz = p1 / dp;
-      z -= dz;
-      if (std::abs(dz) < 1e-15) break;
-    }
-    x[i] = 0.5 * (1 - z);
-    w[i] = 1.0 / ((1 - z * z) * dp * dp);  // 2/((1-z^2) P'^2), halved for [0, 1]
-  }
+  gauss_legendre(n, x, w);
+  for (int i = 0; i < n; ++i) x[i] = 0.5 * (1 + x[i]), w[i] *= 0.5;
 }
 
 // Chandrasekhar's H function for isotropic scattering of albedo a < 1, from the non-linear
