@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "transport_test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/materials/fabric/transport_bssrdf.h"
@@ -31,12 +32,7 @@ BssrdfSetup setup(double mua, double mus, double g, double n, const Vec3& incide
 }
 
 PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
-  PhotonBatchOptions b;
-  b.photons = photons;
-  b.seed = seed;
-  b.threads = threads;
-  b.photons_per_task = 4096;
-  return b;
+  return weft::testing::batch_options(photons, seed, threads, 4096);
 }
 
 // Sum of BSSRDF * cell area * projected solid angle over cells matching 'keep', i.e. the fraction

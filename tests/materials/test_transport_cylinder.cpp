@@ -7,6 +7,7 @@
 #include <cstring>
 #include <functional>
 
+#include "transport_test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/materials/fabric/transport_cylinder.h"
@@ -35,23 +36,10 @@ CylinderBeamSetup beam(const TransportMedium& m, double radius, double n_out, co
 }
 
 PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
-  PhotonBatchOptions b;
-  b.photons = photons;
-  b.seed = seed;
-  b.threads = threads;
-  b.photons_per_task = 1024;
-  return b;
+  return weft::testing::batch_options(photons, seed, threads, 1024);
 }
 
-::testing::AssertionResult within_sigma(const MeanEstimate& e, double reference, double k,
-                                        double reference_error = 0) {
-  const double se = std::sqrt(e.std_error * e.std_error + reference_error * reference_error);
-  const double dev = std::abs(e.mean - reference);
-  if (se > 0 && dev <= k * se) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure()
-         << "measured " << e.mean << " +- " << e.std_error << ", reference " << reference << " +- "
-         << reference_error << ": " << dev / se << " sigma";
-}
+using weft::testing::within_sigma;
 
 // Composite Simpson rule on [a, b] with n (even) intervals.
 double simpson(const std::function<double(double)>& f, double a, double b, int n) {

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <vector>
 
+#include "transport_test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/quadrature.h"
@@ -27,24 +28,10 @@ SlabSetup make_slab(double mua, double mus, double g, double n, double thickness
 }
 
 PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
-  PhotonBatchOptions b;
-  b.photons = photons;
-  b.seed = seed;
-  b.threads = threads;
-  b.photons_per_task = 2048;
-  return b;
+  return weft::testing::batch_options(photons, seed, threads, 2048);
 }
 
-// |measured - reference| <= k * standard error (the reference's own error added in quadrature).
-::testing::AssertionResult within_sigma(const MeanEstimate& e, double reference, double k,
-                                        double reference_error = 0) {
-  const double se = std::sqrt(e.std_error * e.std_error + reference_error * reference_error);
-  const double dev = std::abs(e.mean - reference);
-  if (se > 0 && dev <= k * se) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure()
-         << "measured " << e.mean << " +- " << e.std_error << ", reference " << reference << " +- "
-         << reference_error << ": " << dev / se << " sigma";
-}
+using weft::testing::within_sigma;
 
 // Gauss-Legendre nodes and weights on [0, 1], from the library's rule on [-1, 1].
 void gauss_legendre_01(int n, std::vector<double>& x, std::vector<double>& w) {

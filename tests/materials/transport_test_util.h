@@ -1,0 +1,34 @@
+#pragma once
+// Helpers shared by the photon-transport tests.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+
+#include "weft/materials/fabric/transport_batch.h"
+
+namespace weft::testing {
+
+// Batch options for a test run of 'photons' photons in tasks of 'photons_per_task'.
+inline PhotonBatchOptions batch_options(uint64_t photons, uint64_t seed, int threads,
+                                        uint64_t photons_per_task) {
+  PhotonBatchOptions b;
+  b.photons = photons;
+  b.seed = seed;
+  b.threads = threads;
+  b.photons_per_task = photons_per_task;
+  return b;
+}
+
+// |measured - reference| <= k * standard error (the reference's own error added in quadrature).
+inline ::testing::AssertionResult within_sigma(const MeanEstimate& e, double reference, double k,
+                                               double reference_error = 0) {
+  const double se = std::sqrt(e.std_error * e.std_error + reference_error * reference_error);
+  const double dev = std::abs(e.mean - reference);
+  if (se > 0 && dev <= k * se) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure()
+         << "measured " << e.mean << " +- " << e.std_error << ", reference " << reference << " +- "
+         << reference_error << ": " << dev / se << " sigma";
+}
+
+}  // namespace weft::testing
