@@ -7,7 +7,7 @@
 
 #include "weft/core/rng.h"
 #include "weft/core/sphere_mapping.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 
 namespace {
 

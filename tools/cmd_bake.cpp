@@ -18,12 +18,12 @@ void add_bake_command(CLI::App& app, Commands& commands) {
   struct Options {
     std::string spec;
     std::string output;
-    uint64_t photons = 200000;
-    int resolution = 8;
+    uint64_t photons = FiberTableBakeOptions{}.photons_per_band;
+    int resolution = FiberTableBakeOptions{}.resolution;
     std::string bands = "spectral";
     std::string route = "direct";
-    uint64_t seed = 1;
-    uint64_t passes = 8;
+    uint64_t seed = FiberTableBakeOptions{}.seed;
+    uint64_t passes = FiberTableBakeOptions{}.passes;
     int threads = 0;
     bool json = false;
     bool quiet = false;
@@ -44,7 +44,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
       ->required();
   fiber->add_option("-o,--output", opt->output, "output table (.exr)")->required();
   fiber->add_option("--photons", opt->photons, "photons per band")
-      ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 40));
+      ->check(CLI::Range(uint64_t{1}, kMaxPhotonsPerBand));
   fiber
       ->add_option("--resolution", opt->resolution,
                    "bins per side of the equal-area square per direction")

@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "weft/core/error.h"
 #include "weft/integrators/render_job.h"
+#include "weft/materials/fabric/bake_cache.h"
 #include "weft/scenes/description.h"
 
 namespace weft::cli {
@@ -57,7 +58,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
          if (seed->count()) job.settings.seed = o->seed;
          job.settings.threads = o->threads;
          const auto t0 = std::chrono::steady_clock::now();
-         const RenderJobResult r = render_to_files(desc, job, progress_bar(o->quiet));
+         const RenderJobResult r = render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());
          const double sec =
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
          if (r.cancelled) {

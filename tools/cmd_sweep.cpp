@@ -8,6 +8,7 @@
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/integrators/gonio.h"
+#include "weft/materials/fabric/bake_cache.h"
 #include "weft/scenes/description.h"
 
 namespace weft::cli {
@@ -87,7 +88,7 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          const auto parent = std::filesystem::path(o->output).parent_path();
          if (!parent.empty() && !std::filesystem::is_directory(parent))
            throw Error(o->output, "", "output directory does not exist");
-         const GonioResult r = run_gonio(desc, g, progress_bar(o->quiet));
+         const GonioResult r = run_gonio(desc, g, progress_bar(o->quiet), fiber_table_resolver());
          if (r.cancelled) {
            std::fprintf(stderr, "\nweft: sweep cancelled; nothing was written\n");
            return 130;

@@ -7,24 +7,13 @@
 
 #include "commands.h"
 #include "weft/core/error.h"
+#include "weft/core/hash.h"
 #include "weft/core/math.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/registry.h"
 
 namespace weft::cli {
 namespace {
-
-// 64-bit FNV-1a of a string, as 16 hex digits: the spec hash of an analytic bake.
-std::string fnv1a_hex(const std::string& text) {
-  uint64_t h = 0xcbf29ce484222325ULL;
-  for (unsigned char c : text) {
-    h ^= c;
-    h *= 0x100000001b3ULL;
-  }
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(h));
-  return buf;
-}
 
 // Directional albedo int f |cos| dwi of wo's bin, per channel, from the cell averages (the mean
 // |cos| of each wi cell by an 8 x 8 midpoint rule).
@@ -135,7 +124,7 @@ void add_table_command(CLI::App& app, Commands& commands) {
                         t.kind = bake->kind;
                         const std::string spec = bake->type + " " + params.dump();
                         t.metadata = {{"source", "analytic " + spec},
-                                      {"spec_hash", fnv1a_hex(spec)},
+                                      {"spec_hash", hex64(fnv1a64(spec))},
                                       {"seed", std::to_string(bake->seed)},
                                       {"samples_per_cell", std::to_string(bake->samples)},
                                       {"program_version", std::string("weft ") + WEFT_VERSION}};

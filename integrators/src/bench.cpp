@@ -10,7 +10,7 @@
 #include "weft/core/parallel.h"
 #include "weft/core/rng.h"
 #include "weft/integrators/path_tracer.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {

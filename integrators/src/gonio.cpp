@@ -92,7 +92,7 @@ Vec3 gonio_view_direction(const AngleFrame& frame, double view_zenith_deg,
 }
 
 GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
-                      const ProgressCallback& progress) {
+                      const ProgressCallback& progress, const FiberTableResolver& fiber_tables) {
   const std::string src = desc.source;
   if (!(g.light_zenith_deg >= 0 && g.light_zenith_deg < 90))
     throw Error(src, "light_zenith_deg", "must lie in [0, 90)");
@@ -119,6 +119,7 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
                   [&] {
                     RenderSceneOptions o;
                     o.material_progress = progress;
+                    o.fiber_tables = fiber_tables;
                     return o;
                   }())
           .with_lights(light_set(g.light_zenith_deg, g.light_azimuth_deg));

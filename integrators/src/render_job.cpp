@@ -18,7 +18,8 @@ void check_output(const std::filesystem::path& p, const std::string& ext, const 
 }  // namespace
 
 RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& job,
-                                const ProgressCallback& progress) {
+                                const ProgressCallback& progress,
+                                const FiberTableResolver& fiber_tables) {
   // Everything that can be checked is checked before the (long) render.
   check_output(job.exr, ".exr", "output");
   if (job.png) check_output(*job.png, ".png", "preview");
@@ -28,6 +29,7 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   if (job.mask) settings.mask_meshes = desc.select_object(job.mask_object);
   RenderSceneOptions scene_options;
   scene_options.material_progress = progress;
+  scene_options.fiber_tables = fiber_tables;
   const RenderScene scene(desc, scene_options);
   const RenderResult r = render(scene, *desc.camera, settings, progress);
   RenderJobResult out;

@@ -9,6 +9,7 @@
 #include <set>
 
 #include "weft/core/error.h"
+#include "weft/core/hash.h"
 #include "weft/core/parallel.h"
 #include "weft/core/rng.h"
 #include "weft/core/spectrum.h"
@@ -72,18 +73,15 @@ OctahedralGrid::Footprint OctahedralGrid::bilinear(Vec2 p) const {
 }
 
 std::string TabulatedBsdfTable::checksum() const {
-  uint64_t h = 0xcbf29ce484222325ULL;
+  uint64_t h = kFnv1a64Basis;
   for (const float v : values) {
     uint32_t bits = 0;
     std::memcpy(&bits, &v, sizeof bits);
-    for (int k = 0; k < 4; ++k) {
-      h ^= (bits >> (8 * k)) & 0xffu;
-      h *= 0x100000001b3ULL;
-    }
+    unsigned char bytes[4];
+    for (int k = 0; k < 4; ++k) bytes[k] = static_cast<unsigned char>((bits >> (8 * k)) & 0xffu);
+    h = fnv1a64(bytes, 4, h);  // little-endian bytes whatever the host's order
   }
-  char text[17];
-  std::snprintf(text, sizeof text, "%016llx", static_cast<unsigned long long>(h));
-  return text;
+  return hex64(h);
 }
 
 std::string TabulatedBsdfTable::bands() const {

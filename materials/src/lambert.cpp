@@ -1,6 +1,8 @@
+#include "weft/materials/lambert.h"
+
 #include <cmath>
 
-#include "weft/materials/bsdf.h"
+#include "weft/core/math.h"
 
 namespace weft {
 

@@ -1,244 +1,133 @@
 #include "weft/materials/registry.h"
 
-#include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <functional>
 #include <map>
 
 #include "weft/core/error.h"
-#include "weft/materials/fabric/fiber_table_bake.h"
 #include "weft/materials/table_cache.h"
 
 namespace weft {
 namespace {
 
-using Factory = std::function<Bsdf(const nlohmann::json&, const MaterialContext&)>;
+using Factory = std::function<Bsdf(ParamReader&, const MaterialContext&)>;
 
 std::string field_name(const MaterialContext& ctx, const std::string& key) {
   return ctx.field_prefix.empty() ? key : ctx.field_prefix + "." + key;
 }
 
-void reject_unknown_keys(const nlohmann::json& params, const std::vector<std::string>& allowed,
-                         const MaterialContext& ctx) {
-  if (!params.is_object()) throw Error(ctx.source_file, ctx.field_prefix, "must be a JSON object");
-  for (const auto& [key, value] : params.items()) {
-    if (std::find(allowed.begin(), allowed.end(), key) == allowed.end())
-      throw Error(ctx.source_file, field_name(ctx, key), "unknown parameter");
-  }
-}
-
-// A colour parameter: a number (grey) or an array of 3 numbers, each finite and in [lo, hi].
-Rgb parse_rgb(const nlohmann::json& params, const std::string& key, Rgb fallback, double lo,
-              double hi, const MaterialContext& ctx) {
-  if (!params.contains(key)) return fallback;
-  const auto& v = params.at(key);
-  auto check = [&](const nlohmann::json& x) {
-    if (!x.is_number()) throw Error(ctx.source_file, field_name(ctx, key), "must be a number");
-    const double d = x.get<double>();
-    if (!std::isfinite(d) || d < lo || d > hi)
-      throw Error(ctx.source_file, field_name(ctx, key),
-                  "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-    return d;
-  };
-  if (v.is_array()) {
-    if (v.size() != 3) throw Error(ctx.source_file, field_name(ctx, key), "needs 3 components");
-    return {check(v[0]), check(v[1]), check(v[2])};
-  }
-  return Rgb(check(v));
-}
-
-double parse_number(const nlohmann::json& params, const std::string& key, double fallback,
-                    double lo, double hi, const MaterialContext& ctx) {
-  if (!params.contains(key)) return fallback;
-  const auto& v = params.at(key);
-  if (!v.is_number()) throw Error(ctx.source_file, field_name(ctx, key), "must be a number");
-  const double d = v.get<double>();
-  if (!std::isfinite(d) || d < lo || d > hi)
-    throw Error(
-        ctx.source_file, field_name(ctx, key),
-        "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + v.dump());
-  return d;
-}
-
-std::string parse_string(const nlohmann::json& params, const std::string& key,
-                         const MaterialContext& ctx) {
-  const auto& v = params.at(key);
-  if (!v.is_string() || v.get<std::string>().empty())
-    throw Error(ctx.source_file, field_name(ctx, key), "must be a non-empty string");
-  return v.get<std::string>();
-}
-
 // "distribution" plus "alpha" or "roughness" (alpha = roughness^2, the perceptual convention).
-MicrofacetDistribution parse_microfacet(const nlohmann::json& p, const MaterialContext& ctx) {
+MicrofacetDistribution read_microfacet(ParamReader& p) {
   MicrofacetDistribution d;
-  d.model = MicrofacetModel::kBeckmann;  // Cook and Torrance's own choice
-  if (p.contains("distribution")) {
-    const std::string name = parse_string(p, "distribution", ctx);
-    if (name == "beckmann") {
-      d.model = MicrofacetModel::kBeckmann;
-    } else if (name == "ggx") {
-      d.model = MicrofacetModel::kGgx;
-    } else {
-      throw Error(ctx.source_file, field_name(ctx, "distribution"),
-                  "unknown distribution '" + name + "' (valid: beckmann, ggx)");
-    }
-  }
-  if (p.contains("alpha") && p.contains("roughness"))
-    throw Error(ctx.source_file, field_name(ctx, "roughness"),
-                "give either alpha or roughness, not both");
+  d.model = p.choice("distribution", "beckmann", {"beckmann", "ggx"}) == "ggx"
+                ? MicrofacetModel::kGgx
+                : MicrofacetModel::kBeckmann;  // Cook and Torrance's own choice
+  if (p.has("alpha") && p.has("roughness"))
+    throw Error(p.file(), p.field("roughness"), "give either alpha or roughness, not both");
   // Below 1e-3 the lobe is narrower than double-precision sampling resolves well.
   constexpr double kMinAlpha = 1e-3, kMaxAlpha = 1.0;
-  d.alpha = 0.3;
-  if (p.contains("alpha")) d.alpha = parse_number(p, "alpha", 0.3, kMinAlpha, kMaxAlpha, ctx);
-  if (p.contains("roughness")) {
-    const double r = parse_number(p, "roughness", 0.0, std::sqrt(kMinAlpha), 1.0, ctx);
+  d.alpha = p.number("alpha", 0.3, kMinAlpha, kMaxAlpha);
+  if (p.has("roughness")) {
+    const double r = p.number("roughness", std::sqrt(kMinAlpha), 1.0);
     d.alpha = r * r;
   }
   return d;
 }
 
-double parse_ior(const nlohmann::json& p, const MaterialContext& ctx) {
-  return parse_number(p, "ior", kCottonIor, 1.0, 4.0, ctx);
-}
-
-// A fiber table for a spec, baked on first use and kept in the bake cache under a name derived
-// from everything that determines its bits (spec physics, resolution, photons, seed, format).
-std::filesystem::path baked_fiber_table(const nlohmann::json& p, const MaterialContext& ctx) {
-  const std::string spec_name = parse_string(p, "spec", ctx);
-  std::filesystem::path spec_path = spec_name;
-  if (spec_path.is_relative() && std::filesystem::exists(ctx.base_dir / spec_path))
-    spec_path = ctx.base_dir / spec_path;
-  FiberSpec spec;
-  try {
-    spec = load_fiber_spec(std::filesystem::exists(spec_path) ? spec_path.string() : spec_name);
-  } catch (const Error& e) {
-    throw Error(ctx.source_file, field_name(ctx, "spec"), e.what());
-  }
-  FiberTableBakeOptions o;
-  o.spectral = false;
-  const double resolution =
-      parse_number(p, "resolution", 8, 2, TabulatedBsdfTable::kMaxResolution, ctx);
-  if (resolution != std::floor(resolution))
-    throw Error(ctx.source_file, field_name(ctx, "resolution"), "must be an integer");
-  o.resolution = static_cast<int>(resolution);
-  const double photons = parse_number(p, "photons", 100000, 1, 1e12, ctx);
-  if (photons != std::floor(photons))
-    throw Error(ctx.source_file, field_name(ctx, "photons"), "must be an integer");
-  o.photons_per_band = static_cast<uint64_t>(photons);
-  const double seed = parse_number(p, "seed", 1, 0, 9.0e15, ctx);
-  if (seed != std::floor(seed))
-    throw Error(ctx.source_file, field_name(ctx, "seed"), "must be an integer");
-  o.seed = static_cast<uint64_t>(seed);
-  const std::string key = canonical_json(spec) + "|R" + std::to_string(o.resolution) + "|N" +
-                          std::to_string(o.photons_per_band) + "|S" + std::to_string(o.seed) +
-                          "|P" + std::to_string(o.passes) + "|rgb|v" +
-                          std::to_string(TabulatedBsdfTable::kFormatVersion);
-  uint64_t h = 1469598103934665603ULL;  // FNV-1a 64
-  for (unsigned char c : key) h = (h ^ c) * 1099511628211ULL;
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
-  const std::filesystem::path dir =
-      ctx.bake_cache_dir.empty() ? ctx.base_dir / ".weft-cache" : ctx.bake_cache_dir;
-  const std::filesystem::path file =
-      dir / ("fiber-" + fiber_spec_hash_hex(spec) + "-" + hex + ".exr");
-  if (std::filesystem::exists(file)) return file;
-  std::error_code ec;
-  std::filesystem::create_directories(dir, ec);
-  if (ec) throw Error(dir.string(), "", "cannot create the bake cache folder: " + ec.message());
-  FiberTableBakeResult r = bake_fiber_table(spec, o, ctx.progress);
-  if (r.cancelled) throw Error(ctx.source_file, field_name(ctx, "spec"), "bake interrupted");
-  r.table.metadata["cache_key"] = hex;
-  r.table.write_exr(file);
-  return file;
+double read_ior(ParamReader& p) {
+  return p.number("ior", kCottonIor, 1.0, 4.0);
 }
 
 // fiber_table / fabric_table: the table file (relative to base_dir) or, for fiber tables, a fiber
-// spec to bake on demand; its kind, tint and scale.
-Bsdf make_table_bsdf(const nlohmann::json& p, const MaterialContext& ctx, const std::string& kind) {
-  if (kind == "fiber")
-    reject_unknown_keys(p, {"file", "spec", "resolution", "photons", "seed", "tint", "scale"}, ctx);
-  else
-    reject_unknown_keys(p, {"file", "tint", "scale"}, ctx);
-  if (!p.contains("file") && !p.contains("spec"))
-    throw Error(ctx.source_file, field_name(ctx, "file"),
-                kind == "fiber"
-                    ? "is required (a baked table), or give 'spec' (a fiber spec or preset "
-                      "to bake on demand)"
-                    : "is required");
-  if (p.contains("file") && p.contains("spec"))
-    throw Error(ctx.source_file, field_name(ctx, "spec"), "give either 'file' or 'spec', not both");
-  if (!p.contains("spec"))
-    for (const char* k : {"resolution", "photons", "seed"})
-      if (p.contains(k))
-        throw Error(ctx.source_file, field_name(ctx, k), "applies only with 'spec'");
-  std::filesystem::path file = p.contains("spec")
-                                   ? baked_fiber_table(p, ctx)
-                                   : std::filesystem::path(parse_string(p, "file", ctx));
-  if (file.is_relative()) file = ctx.base_dir / file;
-  const Rgb tint = parse_rgb(p, "tint", Rgb(1.0), 0.0, 1.0, ctx);
-  const double scale = parse_number(p, "scale", 1.0, 0.0, 10.0, ctx);
+// spec that the context's resolver bakes on demand; its tint and scale.
+Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::string& kind) {
+  const bool from_spec = kind == "fiber" && p.has("spec");
+  const std::string key = from_spec ? "spec" : "file";
+  if (from_spec && p.has("file"))
+    throw Error(p.file(), p.field("spec"), "give either 'file' or 'spec', not both");
+  std::filesystem::path file;
+  if (from_spec) {
+    if (!ctx.fiber_tables)
+      throw Error(p.file(), p.field("spec"),
+                  "baking a fiber table on demand is not available here; give a baked 'file'");
+    file = ctx.fiber_tables(p, ctx);
+  } else {
+    if (!p.has("file"))
+      throw Error(p.file(), p.field("file"),
+                  kind == "fiber" ? "is required (a baked table), or give 'spec' (a fiber spec or "
+                                    "preset to bake on demand)"
+                                  : "is required");
+    file = p.string("file");
+    if (file.is_relative()) file = ctx.base_dir / file;
+    if (kind == "fiber")
+      for (const char* k : {"resolution", "photons", "seed"})
+        p.reject_unused(k, "applies only with 'spec'");
+  }
+  const Rgb tint = p.rgb("tint", Rgb(1.0), 0.0, 1.0);
+  const double scale = p.number("scale", 1.0, 0.0, 10.0);
+  p.finish();
   std::shared_ptr<const TabulatedBsdfData> data;
   try {
     data = ctx.cache ? ctx.cache->tabulated(file) : load_tabulated_bsdf(file);
   } catch (const Error& e) {
-    throw Error(ctx.source_file, field_name(ctx, "file"), e.what());
+    throw Error(p.file(), p.field(key), e.what());
   }
   if (data->kind != kind)
-    throw Error(ctx.source_file, field_name(ctx, "file"),
+    throw Error(p.file(), p.field(key),
                 file.string() + " holds a " + data->kind + " table, expected a " + kind + " table");
   return TabulatedBsdf{data, tint * scale};
 }
 
+Bsdf make_measured(ParamReader& p, const MaterialContext& ctx) {
+  if (p.has("name") == p.has("file"))
+    throw Error(p.file(), p.field("name"), "give exactly one of name (a bundled material) or file");
+  const std::string key = p.has("name") ? "name" : "file";
+  std::filesystem::path file = p.string(key);
+  p.finish();
+  try {
+    if (key == "name") {
+      file = find_measured_nbrdf(file.string());
+    } else if (file.is_relative()) {
+      file = ctx.base_dir / file;
+    }
+    auto net = ctx.cache ? ctx.cache->nbrdf(file)
+                         : std::make_shared<const NbrdfNetwork>(NbrdfNetwork::load(file));
+    return MeasuredNbrdfBsdf{std::move(net)};
+  } catch (const Error& e) {
+    throw Error(p.file(), p.field(key), e.what());
+  }
+}
+
+// Factories that read every key they use and then call finish().
+template <class Make>
+Factory simple(Make make) {
+  return [make](ParamReader& p, const MaterialContext&) -> Bsdf {
+    Bsdf b = make(p);
+    p.finish();
+    return b;
+  };
+}
+
 const std::map<std::string, Factory>& factories() {
   static const std::map<std::string, Factory> table = {
-      {"lambert",
-       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
-         reject_unknown_keys(p, {"reflectance"}, ctx);
-         return LambertBsdf{parse_rgb(p, "reflectance", Rgb(0.5), 0.0, 1.0, ctx)};
-       }},
-      {"cook_torrance",
-       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
-         reject_unknown_keys(p, {"distribution", "alpha", "roughness", "ior", "tint"}, ctx);
-         return CookTorranceBsdf{parse_microfacet(p, ctx), parse_ior(p, ctx),
-                                 parse_rgb(p, "tint", Rgb(1.0), 0.0, 1.0, ctx)};
-       }},
-      {"classic_fiber",
-       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
-         reject_unknown_keys(p, {"reflectance", "distribution", "alpha", "roughness", "ior"}, ctx);
-         return ClassicFiberBsdf::create(parse_rgb(p, "reflectance", Rgb(0.5), 0.0, 1.0, ctx),
-                                         parse_microfacet(p, ctx), parse_ior(p, ctx));
-       }},
+      {"lambert", simple([](ParamReader& p) -> Bsdf {
+         return LambertBsdf{p.rgb("reflectance", Rgb(0.5), 0.0, 1.0)};
+       })},
+      {"cook_torrance", simple([](ParamReader& p) -> Bsdf {
+         const MicrofacetDistribution d = read_microfacet(p);
+         const double ior = read_ior(p);
+         return CookTorranceBsdf{d, ior, p.rgb("tint", Rgb(1.0), 0.0, 1.0)};
+       })},
+      {"classic_fiber", simple([](ParamReader& p) -> Bsdf {
+         const Rgb reflectance = p.rgb("reflectance", Rgb(0.5), 0.0, 1.0);
+         const MicrofacetDistribution d = read_microfacet(p);
+         return ClassicFiberBsdf::create(reflectance, d, read_ior(p));
+       })},
       {"fiber_table",
-       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
-         return make_table_bsdf(p, ctx, "fiber");
-       }},
+       [](ParamReader& p, const MaterialContext& ctx) { return make_table_bsdf(p, ctx, "fiber"); }},
       {"fabric_table",
-       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
-         return make_table_bsdf(p, ctx, "fabric");
-       }},
-      {"measured_nbrdf",
-       [](const nlohmann::json& p, const MaterialContext& ctx) -> Bsdf {
-         reject_unknown_keys(p, {"name", "file"}, ctx);
-         if (p.contains("name") == p.contains("file"))
-           throw Error(ctx.source_file, field_name(ctx, "name"),
-                       "give exactly one of name (a bundled material) or file");
-         std::filesystem::path file;
-         const std::string key = p.contains("name") ? "name" : "file";
-         try {
-           if (key == "name") {
-             file = find_measured_nbrdf(parse_string(p, "name", ctx));
-           } else {
-             file = parse_string(p, "file", ctx);
-             if (file.is_relative()) file = ctx.base_dir / file;
-           }
-           auto net = ctx.cache ? ctx.cache->nbrdf(file)
-                                : std::make_shared<const NbrdfNetwork>(NbrdfNetwork::load(file));
-           return MeasuredNbrdfBsdf{std::move(net)};
-         } catch (const Error& e) {
-           throw Error(ctx.source_file, field_name(ctx, key), e.what());
-         }
-       }},
+       [](ParamReader& p, const MaterialContext& ctx) { return make_table_bsdf(p, ctx, "fabric"); }},
+      {"measured_nbrdf", make_measured},
   };
   return table;
 }
@@ -260,7 +149,8 @@ Bsdf make_bsdf(const std::string& type, const nlohmann::json& params, const Mate
     throw Error(ctx.source_file, field_name(ctx, "type"),
                 "unknown material '" + type + "' (valid: " + valid + ")");
   }
-  return it->second(params, ctx);
+  ParamReader reader(params, ctx.source_file, ctx.field_prefix);
+  return it->second(reader, ctx);
 }
 
 }  // namespace weft

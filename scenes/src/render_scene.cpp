@@ -107,7 +107,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     ctx.field_prefix = b.field.empty() ? "materials" : b.field + ".params";
     ctx.cache = cache;
     ctx.progress = options.material_progress;
-    ctx.bake_cache_dir = options.bake_cache_dir;
+    ctx.fiber_tables = options.fiber_tables;
     geo->bsdfs.push_back(make_bsdf(b.type, b.params, ctx));
     const auto id = static_cast<uint32_t>(geo->bsdfs.size() - 1);
     bsdf_of[&b] = id;

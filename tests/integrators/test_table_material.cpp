@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "weft/core/math.h"
 #include "weft/integrators/gonio.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/materials/bsdf_table.h"

@@ -20,7 +20,7 @@
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
 #include "weft/core/sphere_mapping.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 
 namespace weft::testing {
 

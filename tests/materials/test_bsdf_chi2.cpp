@@ -5,7 +5,7 @@
 #include <cmath>
 
 #include "chi2.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 #include "weft/materials/measured_nbrdf.h"
 #include "weft/materials/tabulated_bsdf.h"
 

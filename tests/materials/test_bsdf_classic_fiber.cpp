@@ -5,7 +5,7 @@
 
 #include "chi2.h"
 #include "weft/core/rng.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 
 using namespace weft;
 using namespace weft::testing;

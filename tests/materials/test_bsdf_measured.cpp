@@ -8,7 +8,7 @@
 
 #include "chi2.h"
 #include "weft/core/error.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 #include "weft/materials/measured_nbrdf.h"
 
 using namespace weft;

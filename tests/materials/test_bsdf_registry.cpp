@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "weft/core/error.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
 
@@ -116,7 +116,7 @@ TEST(Registry, UnknownTypeListsTheValidNames) {
 TEST(Registry, BadParametersAreNamed) {
   Fixture fx;
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  expect_error("lambert", {{"reflectanse", 0.5}}, fx.ctx, "reflectanse", "unknown parameter");
+  expect_error("lambert", {{"reflectanse", 0.5}}, fx.ctx, "reflectanse", "unknown key");
   expect_error("lambert", {{"reflectance", 1.5}}, fx.ctx, "reflectance");
   expect_error("lambert", {{"reflectance", {0.5, 0.5}}}, fx.ctx, "reflectance");
   expect_error("cook_torrance", {{"alpha", nan}}, fx.ctx, "alpha");
@@ -127,9 +127,9 @@ TEST(Registry, BadParametersAreNamed) {
   expect_error("cook_torrance", {{"distribution", "phong"}}, fx.ctx, "distribution", "ggx");
   expect_error("cook_torrance", {{"ior", 0.5}}, fx.ctx, "ior");
   expect_error("cook_torrance", {{"ior", nan}}, fx.ctx, "ior");
-  expect_error("cook_torrance", {{"tint", {0.5, nan, 0.5}}}, fx.ctx, "tint");
+  expect_error("cook_torrance", {{"tint", {0.5, nan, 0.5}}}, fx.ctx, "tint[1]");
   expect_error("classic_fiber", {{"reflectance", -0.1}}, fx.ctx, "reflectance");
-  expect_error("classic_fiber", {{"tint", 0.5}}, fx.ctx, "tint", "unknown parameter");
+  expect_error("classic_fiber", {{"tint", 0.5}}, fx.ctx, "tint", "unknown key");
   expect_error("fiber_table", json::object(), fx.ctx, "file", "required");
   expect_error("fiber_table", {{"file", 3}}, fx.ctx, "file");
   expect_error("fiber_table", {{"file", "tables/none.exr"}}, fx.ctx, "file", "none.exr");

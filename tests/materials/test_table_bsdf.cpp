@@ -8,7 +8,7 @@
 #include "chi2.h"
 #include "weft/core/error.h"
 #include "weft/core/spectrum.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 #include "weft/materials/table_cache.h"
 
 using namespace weft;

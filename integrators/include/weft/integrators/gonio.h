@@ -19,6 +19,7 @@
 
 #include "weft/core/progress.h"
 #include "weft/integrators/path_tracer.h"
+#include "weft/materials/registry.h"
 #include "weft/scenes/description.h"
 
 namespace weft {
@@ -64,8 +65,11 @@ struct GonioResult {
   bool cancelled = false;
 };
 
+// 'fiber_tables' makes the fiber tables that materials name by spec (null: such materials are an
+// error).
 GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& settings,
-                      const ProgressCallback& progress = no_progress());
+                      const ProgressCallback& progress = no_progress(),
+                      const FiberTableResolver& fiber_tables = {});
 
 // One row per view: view_zenith_deg, view_azimuth_deg, light_zenith_deg, light_azimuth_deg,
 // sum_r, sum_g, sum_b, footprint_px, beta_r, beta_g, beta_b, beta_err, beta_err_r, beta_err_g,

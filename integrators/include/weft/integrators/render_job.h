@@ -7,6 +7,7 @@
 
 #include "weft/core/progress.h"
 #include "weft/integrators/path_tracer.h"
+#include "weft/materials/registry.h"
 #include "weft/scenes/description.h"
 
 namespace weft {
@@ -25,7 +26,10 @@ struct RenderJobResult {
   bool cancelled = false;
 };
 
+// 'fiber_tables' makes the fiber tables that materials name by spec (null: such materials are an
+// error).
 RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& job,
-                                const ProgressCallback& progress = no_progress());
+                                const ProgressCallback& progress = no_progress(),
+                                const FiberTableResolver& fiber_tables = {});
 
 }  // namespace weft

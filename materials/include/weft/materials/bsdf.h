@@ -13,45 +13,32 @@
 //   weight = f(wo, wi) * |cos theta_i| / pdf. It returns nullopt when no direction can be drawn.
 // * pdf(wo, wi) is the solid-angle density of sample; it agrees with sample to rounding.
 // * Colours are linear RGB (weft::Rgb). Spectral tables are reduced to RGB when loaded.
+//
+// Every material is a small value type with eval, sample and pdf as below (the BsdfModel concept);
+// the closed set a scene can name is weft::Bsdf in bsdfs.h.
+#include <concepts>
 #include <optional>
-#include <variant>
 
-#include "weft/core/math.h"
 #include "weft/core/spectrum.h"
 #include "weft/core/vec.h"
-#include "weft/materials/bsdf_sample.h"
-#include "weft/materials/classic_fiber.h"
-#include "weft/materials/cook_torrance.h"
-#include "weft/materials/lambert.h"
-#include "weft/materials/measured_nbrdf.h"
-#include "weft/materials/tabulated_bsdf.h"
 
 namespace weft {
 
-// The closed set of BSDFs; other materials add their alternative here.
-// fiber_table and fabric_table are both TabulatedBsdf (the table's kind tells them apart).
-using BsdfVariant =
-    std::variant<LambertBsdf, CookTorranceBsdf, ClassicFiberBsdf, TabulatedBsdf, MeasuredNbrdfBsdf>;
-
-class Bsdf {
- public:
-  Bsdf() = default;
-  template <class T>
-  Bsdf(T value) : impl_(std::move(value)) {}  // NOLINT: implicit from any member of the set
-
-  Rgb eval(const Vec3& wo, const Vec3& wi) const {
-    return std::visit([&](const auto& b) { return b.eval(wo, wi); }, impl_);
-  }
-  std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const {
-    return std::visit([&](const auto& b) { return b.sample(wo, u, u_lobe); }, impl_);
-  }
-  double pdf(const Vec3& wo, const Vec3& wi) const {
-    return std::visit([&](const auto& b) { return b.pdf(wo, wi); }, impl_);
-  }
-  const BsdfVariant& variant() const { return impl_; }
-
- private:
-  BsdfVariant impl_;
+struct BsdfSample {
+  Vec3 wi;
+  Rgb weight;      // f * |cos theta_i| / pdf
+  double pdf = 0;  // solid-angle density of wi
+  bool is_delta = false;
 };
+
+template <class B>
+concept BsdfModel = requires(const B& b, const Vec3& w, Vec2 u, double u_lobe) {
+  { b.eval(w, w) } -> std::same_as<Rgb>;
+  { b.sample(w, u, u_lobe) } -> std::same_as<std::optional<BsdfSample>>;
+  { b.pdf(w, w) } -> std::same_as<double>;
+};
+
+// Cosine-weighted direction on the upper (z > 0) hemisphere (Malley's method).
+Vec3 sample_cosine_hemisphere(Vec2 u);
 
 }  // namespace weft

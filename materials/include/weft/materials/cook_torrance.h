@@ -8,7 +8,7 @@
 // plane, so the back side is the same interface seen from below.
 #include <optional>
 
-#include "weft/materials/bsdf_sample.h"
+#include "weft/materials/bsdf.h"
 #include "weft/materials/microfacet.h"
 
 namespace weft {

@@ -2,7 +2,7 @@
 // Ideal diffuse reflection.
 #include <optional>
 
-#include "weft/materials/bsdf_sample.h"
+#include "weft/materials/bsdf.h"
 
 namespace weft {
 

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "weft/materials/bsdf_sample.h"
+#include "weft/materials/bsdf.h"
 
 namespace weft {
 

@@ -1,17 +1,29 @@
 #pragma once
 // Materials by name: one explicit name -> factory table (no static self-registration). The error
-// for an unknown name lists the valid ones; unknown or malformed parameters are errors naming the
-// field.
+// for an unknown name lists the valid ones; unknown, unused or malformed parameters are errors
+// naming the field's JSON path. Parameters are read with the one ParamReader (core/params.h).
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "weft/core/params.h"
 #include "weft/core/progress.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
 
 namespace weft {
+
+struct MaterialContext;
+
+// Turns a fiber_table given by a fiber spec ("spec" and its bake settings) into a table file,
+// baking it on first use. The registry only reads tables; whoever builds scenes supplies this
+// (the fabric library's bake cache, fabric/bake_cache.h), so baking lives in one place above
+// both. It reads the keys it owns from 'params' and returns an absolute path or one relative to
+// the working directory (never to ctx.base_dir).
+using FiberTableResolver =
+    std::function<std::filesystem::path(ParamReader& params, const MaterialContext& ctx)>;
 
 // What a factory may need beyond its parameters: where relative table paths resolve, and the
 // name of the file the parameters came from (for error messages). Tables are shared between
@@ -19,12 +31,10 @@ namespace weft {
 struct MaterialContext {
   std::filesystem::path base_dir = ".";
   std::string source_file;                   // for error messages
-  std::string field_prefix;                  // e.g. "materials.seat" for error messages
+  std::string field_prefix;                  // JSON path of the parameters, e.g. "materials.seat.params"
   std::shared_ptr<struct TableCache> cache;  // may be null: then nothing is shared
-  // Where fiber tables baked on demand (fiber_table with "spec") are kept; empty: base_dir /
-  // ".weft-cache". And the progress of such bakes (the library never prints).
-  std::filesystem::path bake_cache_dir;
-  ProgressCallback progress = no_progress();
+  FiberTableResolver fiber_tables;           // may be null: then "spec" is an error
+  ProgressCallback progress = no_progress();  // of work the resolver does (the library never prints)
 };
 
 // Builds a BSDF of the named type from its JSON parameters.

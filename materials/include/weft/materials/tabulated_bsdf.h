@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "weft/core/distribution.h"
-#include "weft/materials/bsdf_sample.h"
+#include "weft/materials/bsdf.h"
 #include "weft/materials/bsdf_table.h"
 
 namespace weft {

@@ -12,7 +12,8 @@
 #include "weft/core/distribution.h"
 #include "weft/core/frame.h"
 #include "weft/core/spectrum.h"
-#include "weft/materials/bsdf.h"
+#include "weft/materials/bsdfs.h"
+#include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
 #include "weft/scenes/camera.h"
 #include "weft/scenes/description.h"
@@ -49,10 +50,10 @@ struct RenderSceneOptions {
   // Tables (fiber/fabric BSDFs, measured networks) are loaded once into this cache and shared
   // between bindings and between scenes that pass the same cache; null: one cache per scene.
   std::shared_ptr<TableCache> table_cache;
-  // Fiber tables a material asks to bake on demand ("spec"): progress, and where they are kept
-  // (empty: next to the scene description, in .weft-cache).
+  // Fiber tables a material names by spec: who makes them (null: "spec" is an error) and the
+  // progress of that work.
+  FiberTableResolver fiber_tables;
   ProgressCallback material_progress = no_progress();
-  std::filesystem::path bake_cache_dir;
 };
 
 class RenderScene {

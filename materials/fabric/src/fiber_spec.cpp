@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "weft/core/error.h"
+#include "weft/core/hash.h"
 
 namespace weft {
 namespace detail {
@@ -308,18 +309,11 @@ std::string canonical_json(const FiberSpec& spec) {
 }
 
 uint64_t fiber_spec_hash(const FiberSpec& spec) {
-  uint64_t h = 14695981039346656037ull;  // FNV-1a 64 offset basis
-  for (const unsigned char c : canonical_json(spec)) {
-    h ^= c;
-    h *= 1099511628211ull;  // FNV prime
-  }
-  return h;
+  return fnv1a64(canonical_json(spec));
 }
 
 std::string fiber_spec_hash_hex(const FiberSpec& spec) {
-  char buf[17];
-  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(fiber_spec_hash(spec)));
-  return buf;
+  return hex64(fiber_spec_hash(spec));
 }
 
 }  // namespace weft

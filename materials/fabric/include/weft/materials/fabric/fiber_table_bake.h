@@ -17,6 +17,10 @@ namespace weft {
 
 enum class FiberBakeRoute { kDirect, kBssrdf };
 
+// Upper bound on photons per band that any front end accepts (about a day of work per band).
+inline constexpr uint64_t kMaxPhotonsPerBand = uint64_t{1} << 40;
+
+// The defaults here are the only ones: `weft bake fiber` and the bake cache start from them.
 struct FiberTableBakeOptions {
   int resolution = 8;  // R x R equal-area bins per direction
   uint64_t photons_per_band = 200000;

@@ -11,6 +11,7 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/sphere_mapping.h"
+#include "weft/materials/fabric/bake_cache.h"
 #include "weft/materials/fabric/fiber_table_bake.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/tabulated_bsdf.h"
@@ -136,6 +137,7 @@ TEST(FiberTableBake, DirectAndBssrdfRoutesAgreeWithinStatisticalError) {
   const MediumBand mb = compute_medium_band(spec, 16);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
   FiberBakeSettings s;
+  s.seed = 1;
   s.resolution = 4;
   s.photons = 60000;
   s.threads = 2;
@@ -165,6 +167,7 @@ TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
   const MediumBand mb = compute_medium_band(spec, 20);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
   FiberBakeSettings s;
+  s.seed = 1;
   s.resolution = 4;
   s.photons = 60000;
   s.threads = 2;
@@ -196,6 +199,7 @@ TEST(FiberTableBake, FiberScatteringIsReciprocal) {
   const MediumBand mb = compute_medium_band(spec, 10);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
   FiberBakeSettings s;
+  s.seed = 1;
   s.resolution = 2;
   s.photons = 50000;
   s.threads = 2;
@@ -324,6 +328,7 @@ TEST(FiberTableBake, FiberTableMaterialBakesASpecOnDemandOnce) {
   ctx.base_dir = dir;
   ctx.source_file = "scene.json";
   ctx.field_prefix = "materials.seat.params";
+  ctx.fiber_tables = fiber_table_resolver();
   int progress_calls = 0;
   ctx.progress = [&](const ProgressUpdate&) { return ++progress_calls > 0; };
   const nlohmann::json params = {{"spec", "white-cotton"}, {"resolution", 4}, {"photons", 200}};
@@ -361,4 +366,34 @@ TEST(FiberTableBake, FiberTableMaterialBakesASpecOnDemandOnce) {
           << e.what();
     }
   }
+}
+
+TEST(FiberTableBake, SpecBakedForASceneInARelativeFolderLoadsItsOwnCache) {
+  // A scene named by a relative path with a folder in it ("scenes/x.json") has a relative base
+  // folder. Its cache entry must be found where it was written (the base folder was once
+  // prepended twice: "scenes/scenes/.weft-cache/..."), and errors name the key the user wrote.
+  namespace fs = std::filesystem;
+  const fs::path rel = fs::path("weft-relative-bake") / "scenes";
+  fs::remove_all(rel.parent_path());
+  fs::create_directories(rel);
+  MaterialContext ctx;
+  ctx.base_dir = rel;
+  ctx.source_file = (rel / "scene.json").string();
+  ctx.field_prefix = "materials.seat.params";
+  ctx.fiber_tables = fiber_table_resolver();
+  const nlohmann::json params = {{"spec", "white-cotton"}, {"resolution", 2}, {"photons", 64}};
+  EXPECT_NO_THROW(make_bsdf("fiber_table", params, ctx));
+  ASSERT_TRUE(fs::is_directory(rel / ".weft-cache"));
+  EXPECT_FALSE(fs::exists(rel / rel));
+  // Without a resolver, a spec is a clear error at the spec field.
+  MaterialContext bare = ctx;
+  bare.fiber_tables = nullptr;
+  try {
+    make_bsdf("fiber_table", params, bare);
+    ADD_FAILURE() << "a spec without a resolver was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("materials.seat.params.spec"), std::string::npos)
+        << e.what();
+  }
+  fs::remove_all(rel.parent_path());
 }

@@ -1,0 +1,82 @@
+#pragma once
+// The one reader of JSON parameters (scene descriptions, material parameters, fiber specs, render
+// and sweep settings). It reads an object field by field with errors that name the file and the
+// JSON path of the field, remembers which keys were asked for, and finish() rejects the rest:
+// a misspelt or misplaced key is an error naming its path, never a silent default. A key that is
+// valid but has no effect in the configuration given is rejected by reject_unused().
+//
+// The code that uses a setting reads it: a library hands the sub-object it does not own to the
+// library that does (ParamReader::object), and each calls finish() on what it read.
+#include <cstdint>
+#include <initializer_list>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "weft/core/spectrum.h"
+#include "weft/core/vec.h"
+
+namespace weft {
+
+class ParamReader {
+ public:
+  // 'file' names the source in errors; 'path' is the JSON path of this object ("" at the root).
+  // Throws weft::Error unless j is an object.
+  ParamReader(const nlohmann::json& j, std::string file, std::string path);
+
+  const std::string& file() const { return file_; }
+  const std::string& path() const { return path_; }
+  // The JSON path of a key of this object, e.g. "materials.seat.params.alpha".
+  std::string field(const std::string& key) const;
+
+  // Whether the key is present; counts as asking for it.
+  bool has(const std::string& key);
+  // The raw value; Error "is required" when absent.
+  const nlohmann::json& at(const std::string& key);
+  // A nested object, read by its own reader (whose finish() checks its keys).
+  ParamReader object(const std::string& key);
+
+  // Finite numbers in [lo, hi]; the overloads with a fallback return it when the key is absent.
+  double number(const std::string& key, double lo, double hi);
+  double number(const std::string& key, double fallback, double lo, double hi);
+  // Integers in [lo, hi]. Written as an integer or as an integral number (1e5 is 100000).
+  int64_t integer(const std::string& key, int64_t lo, int64_t hi);
+  int64_t integer(const std::string& key, int64_t fallback, int64_t lo, int64_t hi);
+  uint64_t count(const std::string& key, uint64_t lo, uint64_t hi);
+  uint64_t count(const std::string& key, uint64_t fallback, uint64_t lo, uint64_t hi);
+  bool boolean(const std::string& key, bool fallback);
+  // A non-empty string.
+  std::string string(const std::string& key);
+  std::string string(const std::string& key, const std::string& fallback);
+  // One of 'valid'; the error lists them.
+  std::string choice(const std::string& key, const std::string& fallback,
+                     std::initializer_list<const char*> valid);
+  Vec3 vec3(const std::string& key);
+  Vec3 unit_vec3(const std::string& key);
+  // A colour: a number (grey) or [r, g, b], each finite and in [lo, hi].
+  Rgb rgb(const std::string& key, double lo, double hi);
+  Rgb rgb(const std::string& key, const Rgb& fallback, double lo, double hi);
+
+  // A key that is valid elsewhere but has no effect here: Error "<why>" when present.
+  void reject_unused(const std::string& key, const std::string& why);
+  // Error on the first key that nobody asked for, listing the keys this object knows.
+  void finish() const;
+
+  // Checks of a value found elsewhere (array elements): 'name' is its full path.
+  double check_number(const nlohmann::json& v, const std::string& name, double lo,
+                      double hi) const;
+  Vec3 check_vec3(const nlohmann::json& v, const std::string& name) const;
+  // Shortest readable form of a number for messages.
+  static std::string fmt(double d);
+
+ private:
+  int64_t check_integer(const nlohmann::json& v, const std::string& name, int64_t lo,
+                        int64_t hi) const;
+
+  const nlohmann::json& j_;
+  std::string file_, path_;
+  std::set<std::string> asked_;
+};
+
+}  // namespace weft

@@ -1,0 +1,180 @@
+#include "weft/core/params.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "weft/core/error.h"
+
+namespace weft {
+
+ParamReader::ParamReader(const nlohmann::json& j, std::string file, std::string path)
+    : j_(j), file_(std::move(file)), path_(std::move(path)) {
+  if (!j_.is_object()) throw Error(file_, path_.empty() ? "(root)" : path_, "must be a JSON object");
+}
+
+std::string ParamReader::field(const std::string& key) const {
+  return path_.empty() ? key : path_ + "." + key;
+}
+
+bool ParamReader::has(const std::string& key) {
+  asked_.insert(key);
+  return j_.contains(key);
+}
+
+const nlohmann::json& ParamReader::at(const std::string& key) {
+  asked_.insert(key);
+  if (!j_.contains(key)) throw Error(file_, field(key), "is required");
+  return j_.at(key);
+}
+
+ParamReader ParamReader::object(const std::string& key) {
+  return ParamReader(at(key), file_, field(key));
+}
+
+double ParamReader::number(const std::string& key, double lo, double hi) {
+  return check_number(at(key), field(key), lo, hi);
+}
+
+double ParamReader::number(const std::string& key, double fallback, double lo, double hi) {
+  return has(key) ? number(key, lo, hi) : fallback;
+}
+
+int64_t ParamReader::integer(const std::string& key, int64_t lo, int64_t hi) {
+  return check_integer(at(key), field(key), lo, hi);
+}
+
+int64_t ParamReader::integer(const std::string& key, int64_t fallback, int64_t lo, int64_t hi) {
+  return has(key) ? integer(key, lo, hi) : fallback;
+}
+
+uint64_t ParamReader::count(const std::string& key, uint64_t lo, uint64_t hi) {
+  const nlohmann::json& v = at(key);
+  if (v.is_number_unsigned()) {
+    const uint64_t x = v.get<uint64_t>();
+    if (x < lo || x > hi)
+      throw Error(file_, field(key),
+                  "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                      std::to_string(x));
+    return x;
+  }
+  // Negative integers, integral doubles (1e5) and everything else go through the checks below.
+  const double d = check_number(v, field(key), -1e300, 1e300);
+  if (d != std::floor(d)) throw Error(file_, field(key), "must be an integer, got " + fmt(d));
+  if (d < static_cast<double>(lo) || d > static_cast<double>(hi))
+    throw Error(file_, field(key),
+                "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                    fmt(d));
+  return static_cast<uint64_t>(d);
+}
+
+uint64_t ParamReader::count(const std::string& key, uint64_t fallback, uint64_t lo, uint64_t hi) {
+  return has(key) ? count(key, lo, hi) : fallback;
+}
+
+bool ParamReader::boolean(const std::string& key, bool fallback) {
+  if (!has(key)) return fallback;
+  const auto& v = at(key);
+  if (!v.is_boolean()) throw Error(file_, field(key), "must be true or false");
+  return v.get<bool>();
+}
+
+std::string ParamReader::string(const std::string& key) {
+  const auto& v = at(key);
+  if (!v.is_string()) throw Error(file_, field(key), "must be a string");
+  std::string s = v.get<std::string>();
+  if (s.empty()) throw Error(file_, field(key), "must not be empty");
+  return s;
+}
+
+std::string ParamReader::string(const std::string& key, const std::string& fallback) {
+  return has(key) ? string(key) : fallback;
+}
+
+std::string ParamReader::choice(const std::string& key, const std::string& fallback,
+                                std::initializer_list<const char*> valid) {
+  const std::string s = string(key, fallback);
+  std::string list;
+  for (const char* v : valid) {
+    if (s == v) return s;
+    list += std::string(list.empty() ? "" : ", ") + v;
+  }
+  throw Error(file_, field(key), "unknown value '" + s + "' (valid: " + list + ")");
+}
+
+Vec3 ParamReader::vec3(const std::string& key) {
+  return check_vec3(at(key), field(key));
+}
+
+Vec3 ParamReader::unit_vec3(const std::string& key) {
+  const Vec3 v = vec3(key);
+  const double len = length(v);
+  if (!(len > 0)) throw Error(file_, field(key), "must not be the zero vector");
+  return v / len;
+}
+
+Rgb ParamReader::rgb(const std::string& key, double lo, double hi) {
+  const auto& v = at(key);
+  if (v.is_array()) {
+    if (v.size() != 3) throw Error(file_, field(key), "needs 3 components");
+    return {check_number(v[0], field(key) + "[0]", lo, hi),
+            check_number(v[1], field(key) + "[1]", lo, hi),
+            check_number(v[2], field(key) + "[2]", lo, hi)};
+  }
+  return Rgb(check_number(v, field(key), lo, hi));
+}
+
+Rgb ParamReader::rgb(const std::string& key, const Rgb& fallback, double lo, double hi) {
+  return has(key) ? rgb(key, lo, hi) : fallback;
+}
+
+void ParamReader::reject_unused(const std::string& key, const std::string& why) {
+  if (has(key)) throw Error(file_, field(key), why);
+}
+
+void ParamReader::finish() const {
+  for (const auto& [key, value] : j_.items()) {
+    if (asked_.count(key)) continue;
+    std::string known;
+    for (const auto& k : asked_) known += (known.empty() ? "" : ", ") + k;
+    throw Error(file_, field(key),
+                "unknown key" + (known.empty() ? std::string(" (this object takes no keys)")
+                                               : " (known here: " + known + ")"));
+  }
+}
+
+double ParamReader::check_number(const nlohmann::json& v, const std::string& name, double lo,
+                                 double hi) const {
+  if (!v.is_number()) throw Error(file_, name, "must be a number");
+  const double d = v.get<double>();
+  if (!std::isfinite(d)) throw Error(file_, name, "must be finite");
+  if (d < lo || d > hi)
+    throw Error(file_, name, "must lie in [" + fmt(lo) + ", " + fmt(hi) + "], got " + fmt(d));
+  return d;
+}
+
+int64_t ParamReader::check_integer(const nlohmann::json& v, const std::string& name, int64_t lo,
+                                   int64_t hi) const {
+  const double d = check_number(v, name, -9.2e18, 9.2e18);
+  if (d != std::floor(d)) throw Error(file_, name, "must be an integer, got " + fmt(d));
+  const auto x = v.is_number_integer() ? v.get<int64_t>() : static_cast<int64_t>(d);
+  if (x < lo || x > hi)
+    throw Error(file_, name,
+                "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
+                    std::to_string(x));
+  return x;
+}
+
+Vec3 ParamReader::check_vec3(const nlohmann::json& v, const std::string& name) const {
+  if (!v.is_array() || v.size() != 3) throw Error(file_, name, "must be an array of 3 numbers");
+  return {check_number(v[0], name + "[0]", -1e30, 1e30),
+          check_number(v[1], name + "[1]", -1e30, 1e30),
+          check_number(v[2], name + "[2]", -1e30, 1e30)};
+}
+
+std::string ParamReader::fmt(double d) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g", d);
+  return buf;
+}
+
+}  // namespace weft

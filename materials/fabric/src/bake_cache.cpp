@@ -1,0 +1,65 @@
+#include "weft/materials/fabric/bake_cache.h"
+
+#include <system_error>
+
+#include "weft/core/error.h"
+#include "weft/core/hash.h"
+
+namespace weft {
+
+std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
+                                             const FiberSpec& spec,
+                                             const FiberTableBakeOptions& o) {
+  const std::string key = canonical_json(spec) + "|R" + std::to_string(o.resolution) + "|N" +
+                          std::to_string(o.photons_per_band) + "|S" + std::to_string(o.seed) +
+                          "|P" + std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") +
+                          "|v" + std::to_string(TabulatedBsdfTable::kFormatVersion);
+  return dir / ("fiber-" + fiber_spec_hash_hex(spec) + "-" + hex64(fnv1a64(key)) + ".exr");
+}
+
+std::filesystem::path cached_fiber_table(const std::filesystem::path& dir, const FiberSpec& spec,
+                                         const FiberTableBakeOptions& options,
+                                         const ProgressCallback& progress) {
+  const std::filesystem::path file = fiber_table_cache_file(dir, spec, options);
+  std::error_code ec;
+  if (std::filesystem::exists(file, ec)) return file;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw Error(dir.string(), "", "cannot create the bake cache folder: " + ec.message());
+  FiberTableBakeResult r = bake_fiber_table(spec, options, progress);
+  if (r.cancelled) throw Error(file.string(), "", "bake interrupted; nothing was cached");
+  r.table.metadata["cache_key"] = file.stem().string();
+  r.table.write_exr(file);
+  return file;
+}
+
+FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir) {
+  return [cache_dir](ParamReader& p, const MaterialContext& ctx) {
+    const std::string name = p.string("spec");
+    std::filesystem::path spec_path = name;
+    std::error_code ec;
+    if (spec_path.is_relative() && std::filesystem::exists(ctx.base_dir / spec_path, ec))
+      spec_path = ctx.base_dir / spec_path;
+    FiberSpec spec;
+    try {
+      spec = load_fiber_spec(std::filesystem::exists(spec_path, ec) ? spec_path.string() : name);
+    } catch (const Error& e) {
+      throw Error(p.file(), p.field("spec"), e.what());
+    }
+    const FiberTableBakeOptions defaults;
+    FiberTableBakeOptions o;
+    o.spectral = false;  // the renderer is RGB
+    o.resolution = static_cast<int>(
+        p.integer("resolution", defaults.resolution, 2, TabulatedBsdfTable::kMaxResolution));
+    o.photons_per_band = p.count("photons", defaults.photons_per_band, 1, kMaxPhotonsPerBand);
+    o.seed = p.count("seed", defaults.seed, 0, uint64_t{1} << 53);
+    const std::filesystem::path dir =
+        cache_dir.empty() ? ctx.base_dir / ".weft-cache" : cache_dir;
+    try {
+      return cached_fiber_table(dir, spec, o, ctx.progress);
+    } catch (const Error& e) {
+      throw Error(p.file(), p.field("spec"), e.what());
+    }
+  };
+}
+
+}  // namespace weft
