@@ -58,7 +58,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
          if (seed->count()) job.settings.seed = o->seed;
          job.settings.threads = o->threads;
          const auto t0 = std::chrono::steady_clock::now();
-         const RenderJobResult r = render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());
+         const RenderJobResult r =
+             render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());
          const double sec =
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
          if (r.cancelled) {

@@ -9,7 +9,8 @@ namespace weft {
 
 ParamReader::ParamReader(const nlohmann::json& j, std::string file, std::string path)
     : j_(j), file_(std::move(file)), path_(std::move(path)) {
-  if (!j_.is_object()) throw Error(file_, path_.empty() ? "(root)" : path_, "must be a JSON object");
+  if (!j_.is_object())
+    throw Error(file_, path_.empty() ? "(root)" : path_, "must be a JSON object");
 }
 
 std::string ParamReader::field(const std::string& key) const {
@@ -61,9 +62,9 @@ uint64_t ParamReader::count(const std::string& key, uint64_t lo, uint64_t hi) {
   const double d = check_number(v, field(key), -1e300, 1e300);
   if (d != std::floor(d)) throw Error(file_, field(key), "must be an integer, got " + fmt(d));
   if (d < static_cast<double>(lo) || d > static_cast<double>(hi))
-    throw Error(file_, field(key),
-                "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                    fmt(d));
+    throw Error(
+        file_, field(key),
+        "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + fmt(d));
   return static_cast<uint64_t>(d);
 }
 

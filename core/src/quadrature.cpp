@@ -11,6 +11,21 @@ void gauss_legendre(int n, std::vector<double>& nodes, std::vector<double>& weig
   if (n < 1) throw Error("", "n", "Gauss-Legendre needs at least one node");
   nodes.assign(n, 0.0);
   weights.assign(n, 0.0);
+  // The smallest rules in closed form, correctly rounded (Newton's weights are off by a few ulp).
+  if (n == 1) {
+    weights[0] = 2;
+    return;
+  }
+  if (n == 2) {
+    nodes = {-1 / std::sqrt(3.0), 1 / std::sqrt(3.0)};
+    weights = {1.0, 1.0};
+    return;
+  }
+  if (n == 3) {
+    nodes = {-std::sqrt(0.6), 0.0, std::sqrt(0.6)};
+    weights = {5.0 / 9, 8.0 / 9, 5.0 / 9};
+    return;
+  }
   for (int i = 0; i < (n + 1) / 2; ++i) {
     double z = std::cos(kPi * (i + 0.75) / (n + 0.5));  // initial guess for the i-th root
     double dp = 1;

@@ -10,7 +10,9 @@
 
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
+#include "weft/core/math.h"
 #include "weft/core/parallel.h"
+#include "weft/core/quadrature.h"
 #include "weft/core/rng.h"
 #include "weft/core/spectrum.h"
 #include "weft/core/sphere_mapping.h"
@@ -70,6 +72,58 @@ OctahedralGrid::Footprint OctahedralGrid::bilinear(Vec2 p) const {
   fp.weight[2] = (1 - tx) * ty;
   fp.weight[3] = tx * ty;
   return fp;
+}
+
+namespace {
+
+// Integral of |cos theta| over the preimage of [a,b] x [c,d] (0 <= a < b, 0 <= c < d) in the
+// octahedral square coordinates u', v' in [-1, 1], where d omega = pi du' dv'. On this map
+// |cos theta| depends on rho = u' + v' only (1 - rho^2 on the upper half, 1 - (2 - rho)^2 on the
+// lower), so the integral is one-dimensional: int |cos|(rho) m(rho) d rho with m(rho) the length
+// of the cut u' + v' = rho through the rectangle. Both factors are polynomial between the
+// breakpoints, so 3-point Gauss-Legendre per piece is exact.
+double cos_integral_quadrant_rect(double a, double b, double c, double d) {
+  double breaks[] = {a + c, a + d, b + c, b + d, 1.0};
+  std::sort(std::begin(breaks), std::end(breaks));
+  const double lo = a + c, hi = b + d;
+  auto m = [&](double rho) { return std::max(0.0, std::min(b, rho - c) - std::max(a, rho - d)); };
+  auto abs_cos = [](double rho) { return rho <= 1 ? 1 - rho * rho : 1 - (2 - rho) * (2 - rho); };
+  std::vector<double> x, w;
+  gauss_legendre(3, x, w);
+  double sum = 0;
+  for (int k = 0; k + 1 < 5; ++k) {
+    const double p0 = std::clamp(breaks[k], lo, hi), p1 = std::clamp(breaks[k + 1], lo, hi);
+    if (!(p1 > p0)) continue;
+    const double mid = 0.5 * (p0 + p1), half = 0.5 * (p1 - p0);
+    for (int q = 0; q < 3; ++q)
+      sum += w[q] * half * abs_cos(mid + half * x[q]) * m(mid + half * x[q]);
+  }
+  return kPi * sum;
+}
+
+}  // namespace
+
+std::vector<double> OctahedralGrid::cosine_weighted_areas() const {
+  std::vector<double> out(static_cast<size_t>(resolution) * resolution, 0.0);
+  for (int iy = 0; iy < resolution; ++iy)
+    for (int ix = 0; ix < resolution; ++ix) {
+      // The bin in u', v', split at the axes so that each piece lies in one quadrant.
+      const double u0 = 2.0 * ix / resolution - 1, u1 = 2.0 * (ix + 1) / resolution - 1;
+      const double v0 = 2.0 * iy / resolution - 1, v1 = 2.0 * (iy + 1) / resolution - 1;
+      double total = 0;
+      for (auto [ua, ub] : {std::pair{u0, std::min(u1, 0.0)}, std::pair{std::max(u0, 0.0), u1}})
+        for (auto [va, vb] : {std::pair{v0, std::min(v1, 0.0)}, std::pair{std::max(v0, 0.0), v1}}) {
+          if (!(ub > ua) || !(vb > va)) continue;
+          // Reflect into the first quadrant.
+          const double a = std::min(std::abs(ua), std::abs(ub)),
+                       b = std::max(std::abs(ua), std::abs(ub));
+          const double c = std::min(std::abs(va), std::abs(vb)),
+                       d = std::max(std::abs(va), std::abs(vb));
+          total += cos_integral_quadrant_rect(a, b, c, d);
+        }
+      out[static_cast<size_t>(iy) * resolution + ix] = total;
+    }
+  return out;
 }
 
 std::string TabulatedBsdfTable::checksum() const {

@@ -126,7 +126,9 @@ const std::map<std::string, Factory>& factories() {
       {"fiber_table",
        [](ParamReader& p, const MaterialContext& ctx) { return make_table_bsdf(p, ctx, "fiber"); }},
       {"fabric_table",
-       [](ParamReader& p, const MaterialContext& ctx) { return make_table_bsdf(p, ctx, "fabric"); }},
+       [](ParamReader& p, const MaterialContext& ctx) {
+         return make_table_bsdf(p, ctx, "fabric");
+       }},
       {"measured_nbrdf", make_measured},
   };
   return table;

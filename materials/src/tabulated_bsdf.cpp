@@ -40,27 +40,22 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
 
   // RGB, and the channel mean m that drives sampling.
   std::vector<float> mean(cells);
-  const auto& weights = srgb_band_weights_d65();
+  GamutClip gamut;
   for (size_t cell = 0; cell < cells; ++cell) {
     Rgb c;
     if (table.channels == 3) {
       c = {table.values[cell * 3], table.values[cell * 3 + 1], table.values[cell * 3 + 2]};
     } else {
-      for (int b = 0; b < table.channels; ++b)
-        c += weights[b] * static_cast<double>(table.values[cell * table.channels + b]);
-      // Saturated spectra can fall outside the sRGB gamut; a BSDF cannot be negative.
-      for (double* v : {&c.r, &c.g, &c.b}) {
-        if (*v < 0) {
-          *v = 0;
-          ++data->clamped_components;
-        }
-      }
+      const float* v = &table.values[cell * table.channels];
+      c = bands_to_linear_srgb([v](int b) { return v[b]; });
+      gamut.clip(c);
     }
     data->rgb[cell * 3] = static_cast<float>(c.r);
     data->rgb[cell * 3 + 1] = static_cast<float>(c.g);
     data->rgb[cell * 3 + 2] = static_cast<float>(c.b);
     mean[cell] = static_cast<float>(c.average());
   }
+  data->clamped_components = gamut.components;
 
   // m3: mean of m over the 3 x 3 neighbourhoods of the wi bin and of the wo bin (separably).
   std::vector<std::array<int, 9>> nbr(n);

@@ -52,8 +52,7 @@ FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir) {
         p.integer("resolution", defaults.resolution, 2, TabulatedBsdfTable::kMaxResolution));
     o.photons_per_band = p.count("photons", defaults.photons_per_band, 1, kMaxPhotonsPerBand);
     o.seed = p.count("seed", defaults.seed, 0, uint64_t{1} << 53);
-    const std::filesystem::path dir =
-        cache_dir.empty() ? ctx.base_dir / ".weft-cache" : cache_dir;
+    const std::filesystem::path dir = cache_dir.empty() ? ctx.base_dir / ".weft-cache" : cache_dir;
     try {
       return cached_fiber_table(dir, spec, o, ctx.progress);
     } catch (const Error& e) {

@@ -8,80 +8,10 @@
 
 #include "weft/core/error.h"
 #include "weft/core/spectrum.h"
-#include "weft/materials/cook_torrance.h"
 #include "weft/materials/fabric/fiber_bake.h"
 #include "weft/materials/fabric/medium.h"
-#include "weft/materials/fabric/transport.h"
 
 namespace weft {
-
-SurfaceAlbedoTable::SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes,
-                                       int samples_per_side) {
-  const CookTorranceBsdf ct{{model, alpha}, ior, Rgb(1.0)};
-  albedo_.resize(nodes);
-  for (int k = 0; k < nodes; ++k) {
-    const double cos_t = std::max(1e-4, static_cast<double>(k) / (nodes - 1));
-    const Vec3 w{safe_sqrt(1 - cos_t * cos_t), 0, cos_t};
-    double sum = 0;
-    for (int a = 0; a < samples_per_side; ++a)
-      for (int b = 0; b < samples_per_side; ++b) {
-        const Vec2 u{(a + 0.5) / samples_per_side, (b + 0.5) / samples_per_side};
-        if (const auto s = ct.sample(w, u, 0.5)) sum += s->weight.r;
-      }
-    albedo_[k] = sum / (samples_per_side * samples_per_side);
-  }
-}
-
-double SurfaceAlbedoTable::operator()(double cos_theta) const {
-  const double x = std::clamp(cos_theta, 0.0, 1.0) * (albedo_.size() - 1);
-  const size_t i = std::min(static_cast<size_t>(x), albedo_.size() - 2);
-  const double t = x - i;
-  return (1 - t) * albedo_[i] + t * albedo_[i + 1];
-}
-
-FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
-                                    uint64_t max_events_per_photon,
-                                    std::shared_ptr<const SurfaceAlbedoTable> albedo) {
-  FiberBandPhysics ph;
-  ph.geometry = FiberGeometry{spec.fiber_radius_um, mb.host_n, 1.0};
-  auto ct = std::make_shared<const CookTorranceBsdf>(
-      CookTorranceBsdf{{spec.roughness_distribution, spec.roughness_alpha}, mb.host_n, Rgb(1.0)});
-  if (!albedo)
-    albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
-                                                        spec.roughness_alpha, mb.host_n);
-  ph.surface.sample = [ct](const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out,
-                           double* weight) {
-    // Cook-Torrance is reciprocal: sampling the view direction given the light one uses the same
-    // routine with the roles swapped; the weight is f cos(out) / pdf.
-    const auto smp = ct->sample(w_light, u, u_lobe);
-    if (!smp || !(smp->wi.z > 0)) return false;
-    *w_out = smp->wi;
-    *weight = smp->weight.r;
-    return true;
-  };
-  ph.surface.albedo = [albedo](double c) { return (*albedo)(c); };
-  TransportOptions topt;
-  topt.max_events = max_events_per_photon;
-  // Leaving the fiber, light meets the same rough boundary it entered through: transmitted with
-  // 1 - (the surface lobe's albedo at the outside angle), as on entry.
-  topt.exit_reflectance = [albedo](double cos_outside) { return (*albedo)(cos_outside); };
-  auto transport = std::make_shared<const CylinderTransport>(
-      CylinderGeometry(spec.fiber_radius_um, 1.0),
-      TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt);
-  ph.tracer = [transport](const Vec3& p, const Vec3& d, double w, Rng& rng,
-                          const FiberExitSink& sink) {
-    struct Forward {
-      const FiberExitSink* sink;
-      void on_exit(const ExitEvent& e) { (*sink)(FiberExit{e.position, e.direction, e.weight}); }
-    } recorder{&sink};
-    PhotonTally tally;
-    // The entry point sits on the wall; nudge it inside so rounding cannot put it outside.
-    transport->launch_internal(p * (1 - 1e-12), d, w, rng, recorder, tally);
-    return FiberTraceResult{tally.scatterings, tally.absorbed,
-                            tally.roulette_loss - tally.roulette_gain, tally.lost};
-  };
-  return ph;
-}
 
 namespace {
 
@@ -104,7 +34,7 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
 
   const int R = o.resolution;
   const size_t cells = static_cast<size_t>(R) * R;
-  const auto bin_areas = cosine_weighted_bin_areas(R);
+  const auto bin_areas = OctahedralGrid{R}.cosine_weighted_areas();
 
   // Per band: the physics, and running sums over passes.
   struct BandState {
@@ -152,9 +82,8 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       };
       const FiberBandTable t =
           o.route == FiberBakeRoute::kDirect
-              ? bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, settings, band_progress)
-              : bake_fiber_band_bssrdf(ph.geometry, ph.surface, ph.tracer, settings, BssrdfGrid{},
-                                       band_progress);
+              ? bake_fiber_band_direct(ph, settings, band_progress)
+              : bake_fiber_band_bssrdf(ph, settings, BssrdfRouteSettings{}, band_progress);
       const double n = static_cast<double>(t.photons);
       for (size_t k = 0; k < st.weighted_sum.size(); ++k)
         st.weighted_sum[k] += t.weighted_sum[k] * n;
@@ -218,25 +147,20 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
   table.kind = "fiber";
   table.channels = o.spectral ? kNumBands : 3;
   table.values.assign(cells * cells * table.channels, 0.0f);
-  const auto& w = srgb_band_weights_d65();
+  GamutClip gamut;
   for (size_t k = 0; k < cells * cells; ++k) {
     if (o.spectral) {
       for (int b = 0; b < kNumBands; ++b)
         table.values[k * kNumBands + b] = static_cast<float>(band_f[b][k]);
     } else {
-      Rgb rgb;
-      for (int b = 0; b < kNumBands; ++b) rgb += w[b] * band_f[b][k];
-      for (double* c : {&rgb.r, &rgb.g, &rgb.b}) {
-        if (*c < 0) {
-          result.rgb_negative_clipped = std::max(result.rgb_negative_clipped, -*c);
-          *c = 0;
-        }
-      }
+      Rgb rgb = bands_to_linear_srgb([&](int b) { return band_f[b][k]; });
+      gamut.clip(rgb);
       table.values[k * 3 + 0] = static_cast<float>(rgb.r);
       table.values[k * 3 + 1] = static_cast<float>(rgb.g);
       table.values[k * 3 + 2] = static_cast<float>(rgb.b);
     }
   }
+  result.rgb_negative_clipped = gamut.largest;
   table.metadata = {
       {"spec_hash", fiber_spec_hash_hex(spec)},
       {"spec_name", spec.name},

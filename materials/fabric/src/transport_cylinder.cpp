@@ -3,26 +3,6 @@
 #include <cmath>
 
 namespace weft {
-namespace {
-
-struct CylinderTally {
-  MeanAccumulator specular, exited, absorbed, roulette, lost;
-  uint64_t photons = 0, scatterings = 0, reflections = 0;
-
-  CylinderTally& operator+=(const CylinderTally& o) {
-    specular += o.specular;
-    exited += o.exited;
-    absorbed += o.absorbed;
-    roulette += o.roulette;
-    lost += o.lost;
-    photons += o.photons;
-    scatterings += o.scatterings;
-    reflections += o.reflections;
-    return *this;
-  }
-};
-
-}  // namespace
 
 Vec3 cylinder_beam_entry(const CylinderGeometry& geometry, const Vec3& direction, double u) {
   const double s = std::hypot(direction.y, direction.z);
@@ -51,26 +31,20 @@ CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup,
   setup.validate();
   const CylinderTransport transport(CylinderGeometry(setup.radius, setup.n_outside), setup.medium,
                                     setup.options);
-  CylinderTally total;
-  const PhotonBatchStatus status = run_photon_tasks(
-      batch, CylinderTally{}, total,
-      [&](uint64_t, uint64_t, uint64_t count, Rng& rng, CylinderTally& tally) {
+  PhotonStats total;
+  const PhotonBatchStatus status = run_photon_tasks<PhotonStats>(
+      batch,
+      [&](uint64_t, uint64_t, uint64_t count, Rng& rng, PhotonStats& tally) {
         NullRecorder none;
         for (uint64_t i = 0; i < count; ++i) {
           PhotonTally photon;
           const Vec3 p = cylinder_beam_entry(transport.geometry(), setup.direction, rng.uniform());
           transport.launch_external(CylinderGeometry::kSurface, p, setup.direction, 1.0, rng, none,
                                     photon);
-          tally.specular.add(photon.specular);
-          tally.exited.add(photon.exited);
-          tally.absorbed.add(photon.absorbed);
-          tally.roulette.add(photon.roulette_loss - photon.roulette_gain);
-          tally.lost.add(photon.lost);
-          tally.photons += 1;
-          tally.scatterings += photon.scatterings;
-          tally.reflections += photon.reflections;
+          tally.add(photon);
         }
-      });
+      },
+      [&](const PhotonStats& t) { total += t; });
   CylinderBeamResult r;
   const uint64_t n = total.photons;
   r.specular = total.specular.estimate(n);

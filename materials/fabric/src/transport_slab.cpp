@@ -18,23 +18,18 @@ struct SlabExitRecorder {
   }
 };
 
+// The energy books and, beyond them, the exits split by face and by scattering.
 struct SlabTally {
-  MeanAccumulator rsp, rb, rd, tb, td, tt, absorbed, roulette, lost;
-  uint64_t photons = 0, scatterings = 0, reflections = 0;
+  PhotonStats books;
+  MeanAccumulator rb, rd, tb, td, tt;
 
   SlabTally& operator+=(const SlabTally& o) {
-    rsp += o.rsp;
+    books += o.books;
     rb += o.rb;
     rd += o.rd;
     tb += o.tb;
     td += o.td;
     tt += o.tt;
-    absorbed += o.absorbed;
-    roulette += o.roulette;
-    lost += o.lost;
-    photons += o.photons;
-    scatterings += o.scatterings;
-    reflections += o.reflections;
     return *this;
   }
 };
@@ -59,46 +54,42 @@ SlabResult simulate_slab(const SlabSetup& setup, const PhotonBatchOptions& batch
   const Vec3 direction{std::sin(setup.incidence_rad), 0, -std::cos(setup.incidence_rad)};
 
   SlabTally total;
-  const PhotonBatchStatus status =
-      run_photon_tasks(batch, SlabTally{}, total,
-                       [&](uint64_t, uint64_t, uint64_t count, Rng& rng, SlabTally& tally) {
-                         for (uint64_t i = 0; i < count; ++i) {
-                           PhotonTally photon;
-                           SlabExitRecorder exits;
-                           transport.launch_external(SlabGeometry::kTop, Vec3{0, 0, 0}, direction,
-                                                     1.0, rng, exits, photon);
-                           tally.rsp.add(photon.specular);
-                           tally.rb.add(exits.top_unscattered);
-                           tally.rd.add(exits.top_scattered);
-                           tally.tb.add(exits.bottom_unscattered);
-                           tally.td.add(exits.bottom_scattered);
-                           tally.tt.add(exits.bottom_unscattered + exits.bottom_scattered);
-                           tally.absorbed.add(photon.absorbed);
-                           tally.roulette.add(photon.roulette_loss - photon.roulette_gain);
-                           tally.lost.add(photon.lost);
-                           tally.photons += 1;
-                           tally.scatterings += photon.scatterings;
-                           tally.reflections += photon.reflections;
-                         }
-                       });
+  const PhotonBatchStatus status = run_photon_tasks<SlabTally>(
+      batch,
+      [&](uint64_t, uint64_t, uint64_t count, Rng& rng, SlabTally& tally) {
+        for (uint64_t i = 0; i < count; ++i) {
+          PhotonTally photon;
+          SlabExitRecorder exits;
+          transport.launch_external(SlabGeometry::kTop, Vec3{0, 0, 0}, direction, 1.0, rng, exits,
+                                    photon);
+          tally.books.add(photon);
+          tally.rb.add(exits.top_unscattered);
+          tally.rd.add(exits.top_scattered);
+          tally.tb.add(exits.bottom_unscattered);
+          tally.td.add(exits.bottom_scattered);
+          tally.tt.add(exits.bottom_unscattered + exits.bottom_scattered);
+        }
+      },
+      [&](const SlabTally& t) { total += t; });
 
   SlabResult r;
-  const uint64_t n = total.photons;
-  r.rsp = total.rsp.estimate(n);
+  const PhotonStats& books = total.books;
+  const uint64_t n = books.photons;
+  r.rsp = books.specular.estimate(n);
   r.rb = total.rb.estimate(n);
   r.rd = total.rd.estimate(n);
   r.tb = total.tb.estimate(n);
   r.td = total.td.estimate(n);
   r.tt = total.tt.estimate(n);
-  r.absorbed = total.absorbed.estimate(n);
-  r.roulette = total.roulette.estimate(n);
-  r.lost = total.lost.estimate(n);
+  r.absorbed = books.absorbed.estimate(n);
+  r.roulette = books.roulette.estimate(n);
+  r.lost = books.lost.estimate(n);
   r.energy_imbalance = n == 0 ? 0.0
                               : 1.0 - (r.rsp.mean + r.rb.mean + r.rd.mean + r.tb.mean + r.td.mean +
                                        r.absorbed.mean + r.roulette.mean + r.lost.mean);
   r.photons = n;
-  r.scatterings = total.scatterings;
-  r.reflections = total.reflections;
+  r.scatterings = books.scatterings;
+  r.reflections = books.reflections;
   r.cancelled = status.cancelled;
   return r;
 }

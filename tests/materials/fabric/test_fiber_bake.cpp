@@ -9,6 +9,7 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/sphere_mapping.h"
+#include "weft/materials/bsdf_table.h"
 #include "weft/materials/bsdfs.h"
 #include "weft/materials/fabric/fiber_bake.h"
 
@@ -27,9 +28,19 @@ FiberSurfaceModel lambert_surface(double rho) {
   return m;
 }
 
-// Interior that absorbs everything that enters.
-FiberTraceResult absorb_all(const Vec3&, const Vec3&, double, Rng&, const FiberExitSink&) {
-  return {};
+// A fiber whose surface is Lambertian (albedo rho) and whose interior absorbs all that enters.
+FiberBandPhysics lambert_fiber(double rho) {
+  FiberBandPhysics ph;
+  ph.surface = lambert_surface(rho);
+  ph.interior.geometry = CylinderGeometry(10, 1.0);
+  ph.interior.n_inside = 1.557;
+  ph.interior.trace = [](const Vec3&, const Vec3&, double w, Rng&, const ExitSink&) {
+    PhotonTally t;
+    t.photons = 1;
+    t.launched = t.absorbed = w;
+    return t;
+  };
+  return ph;
 }
 
 // Cosine-weighted area of the upper-hemisphere part of each bin (same midpoint rule).
@@ -51,7 +62,7 @@ std::vector<double> upper_bin_areas(int resolution) {
 
 void expect_lambert_table(const FiberBandTable& t, double rho, double rel_tol_for_full_cells) {
   const int R = t.resolution, cells = R * R;
-  const auto d = cosine_weighted_bin_areas(R);
+  const auto d = OctahedralGrid{R}.cosine_weighted_areas();
   const auto up = upper_bin_areas(R);
   for (int i = 0; i < cells; ++i)
     for (int o = 0; o < cells; ++o) {
@@ -71,7 +82,7 @@ TEST(FiberBake, CosineWeightedBinAreasSumToTwoPi) {
   // integral of |cos theta| over the sphere = 2 pi; the per-bin integrals are exact.
   for (int r : {2, 4, 8}) {
     double sum = 0;
-    for (double v : cosine_weighted_bin_areas(r)) sum += v;
+    for (double v : OctahedralGrid{r}.cosine_weighted_areas()) sum += v;
     EXPECT_NEAR(sum, 2 * kPi, 1e-12) << r;
   }
 }
@@ -83,7 +94,7 @@ TEST(FiberBake, DirectRouteReproducesLambertSurface) {
   s.photons = 400000;
   s.threads = 2;
   const double rho = 0.6;
-  const auto t = bake_fiber_band_direct({}, lambert_surface(rho), absorb_all, s, nullptr);
+  const auto t = bake_fiber_band_direct(lambert_fiber(rho), s, nullptr);
   EXPECT_EQ(t.photons, s.photons);
   EXPECT_NEAR(t.exit_fraction, rho, 1e-12);  // every photon reflects weight rho exactly
   EXPECT_NEAR(fiber_table_energy(t), kPi * rho, 1e-9);
@@ -97,10 +108,10 @@ TEST(FiberBake, BssrdfRouteReproducesLambertSurface) {
   s.resolution = 4;
   s.photons = 200000;
   s.threads = 2;
-  BssrdfGrid grid;
+  BssrdfRouteSettings grid;
   grid.u_bins = 90;
   const double rho = 0.6;
-  const auto t = bake_fiber_band_bssrdf({}, lambert_surface(rho), absorb_all, s, grid, nullptr);
+  const auto t = bake_fiber_band_bssrdf(lambert_fiber(rho), s, grid, nullptr);
   EXPECT_NEAR(t.exit_fraction, rho, 1e-12);
   // The paper's sum over lit cells integrates cos theta_A over each incident table bin with a
   // cq x cq midpoint rule; its error is O(1/cq^2) (measured: a deficit of 1/(4 cq^2), 1e-3 at the
@@ -117,9 +128,9 @@ TEST(FiberBake, BitIdenticalAtOneAndTwoThreads) {
   s.photons = 50000;
   s.photons_per_task = 1000;
   s.threads = 1;
-  const auto a = bake_fiber_band_direct({}, lambert_surface(0.5), absorb_all, s, nullptr);
+  const auto a = bake_fiber_band_direct(lambert_fiber(0.5), s, nullptr);
   s.threads = 2;
-  const auto b = bake_fiber_band_direct({}, lambert_surface(0.5), absorb_all, s, nullptr);
+  const auto b = bake_fiber_band_direct(lambert_fiber(0.5), s, nullptr);
   ASSERT_EQ(a.f.size(), b.f.size());
   for (size_t k = 0; k < a.f.size(); ++k) ASSERT_EQ(a.f[k], b.f[k]) << k;
 }
@@ -131,7 +142,7 @@ TEST(FiberBake, CancellationKeepsWhatIsDone) {
   s.photons = 1000000;
   s.photons_per_task = 1000;
   int calls = 0;
-  const auto t = bake_fiber_band_direct({}, lambert_surface(0.5), absorb_all, s,
+  const auto t = bake_fiber_band_direct(lambert_fiber(0.5), s,
                                         [&](const ProgressUpdate&) { return ++calls < 2; });
   EXPECT_TRUE(t.cancelled);
   EXPECT_GT(t.photons, 0u);
@@ -143,20 +154,27 @@ TEST(FiberBake, CancellationKeepsWhatIsDone) {
 TEST(FiberBake, RejectsBadSettings) {
   FiberBakeSettings s;
   s.seed = 1;
-  FiberGeometry g;
-  g.radius_um = -1;
-  EXPECT_THROW(bake_fiber_band_direct(g, lambert_surface(0.5), absorb_all, s, nullptr), Error);
-  g.radius_um = std::nan("");
-  EXPECT_THROW(bake_fiber_band_direct(g, lambert_surface(0.5), absorb_all, s, nullptr), Error);
-  g = {};
+  s.photons = 100;
+  FiberBandPhysics ph = lambert_fiber(0.5);
+  ph.interior.n_inside = 0.5;
+  EXPECT_THROW(bake_fiber_band_direct(ph, s, nullptr), Error);
+  ph.interior.n_inside = std::nan("");
+  EXPECT_THROW(bake_fiber_band_direct(ph, s, nullptr), Error);
+  ph = lambert_fiber(0.5);
+  ph.interior.trace = nullptr;
+  EXPECT_THROW(bake_fiber_band_direct(ph, s, nullptr), Error);
+  ph = lambert_fiber(0.5);
   s.resolution = 1;
-  EXPECT_THROW(bake_fiber_band_direct(g, lambert_surface(0.5), absorb_all, s, nullptr), Error);
+  EXPECT_THROW(bake_fiber_band_direct(ph, s, nullptr), Error);
+  s.resolution = 4;
+  s.photons = 0;
+  EXPECT_THROW(bake_fiber_band_direct(ph, s, nullptr), Error);
 }
 
 TEST(FiberBake, CosineWeightedBinAreasMatchFineQuadrature) {
   // Independent check of the exact per-bin integrals by a 400 x 400 midpoint rule.
   const int R = 5, q = 400;  // odd R: the middle bins straddle the axes
-  const auto d = cosine_weighted_bin_areas(R);
+  const auto d = OctahedralGrid{R}.cosine_weighted_areas();
   for (int iy = 0; iy < R; ++iy)
     for (int ix = 0; ix < R; ++ix) {
       double sum = 0;

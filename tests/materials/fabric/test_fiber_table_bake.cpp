@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "chi2.h"
+#include "transport_test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/sphere_mapping.h"
@@ -67,12 +68,6 @@ int count_outliers(const std::vector<double>& a, const std::vector<double>& sa,
   return n;
 }
 
-// Cell index of the mirror image of bin (ix, iy): flipping x (the axis t) maps u -> 1 - u on the
-// octahedral square, flipping y (the binormal b) maps v -> 1 - v.
-int mirror_bin(int bin, int resolution, bool flip_x) {
-  const int ix = bin % resolution, iy = bin / resolution;
-  return flip_x ? iy * resolution + (resolution - 1 - ix) : (resolution - 1 - iy) * resolution + ix;
-}
 
 }  // namespace
 
@@ -104,7 +99,7 @@ TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
   // mean is 0 within 5 / sqrt(49500) = 0.022 even in the worst case of unit spread.
   EXPECT_LT(std::abs(excess_sum / kNumBands), 0.022);
   // The stored float table keeps the furnace to float rounding.
-  const auto d = cosine_weighted_bin_areas(o.resolution);
+  const auto d = OctahedralGrid{o.resolution}.cosine_weighted_areas();
   const int cells = o.resolution * o.resolution;
   for (int band : {0, 16, 32}) {
     double e = 0;
@@ -144,18 +139,18 @@ TEST(FiberTableBake, DirectAndBssrdfRoutesAgreeWithinStatisticalError) {
   const int k = 5;
   const CellStats direct = cell_stats(k, [&](uint64_t seed) {
     s.seed = seed;
-    return bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+    return bake_fiber_band_direct(ph, s, nullptr);
   });
   const CellStats bssrdf = cell_stats(k, [&](uint64_t seed) {
     s.seed = seed + 100;
-    return bake_fiber_band_bssrdf(ph.geometry, ph.surface, ph.tracer, s, BssrdfGrid{}, nullptr);
+    return bake_fiber_band_bssrdf(ph, s, BssrdfRouteSettings{}, nullptr);
   });
   // 256 cells; at 4.5 standard errors a false alarm has probability 256 * 7e-6 = 0.002, but the
   // standard errors themselves come from 5 bakes (t with 8 dof): allow one outlier cell.
   EXPECT_LE(count_outliers(direct.mean, direct.se, bssrdf.mean, bssrdf.se, 4.5), 1);
   // And the two agree on the total to the BSSRDF route's stated quadrature error (2e-3).
   double a = 0, b = 0;
-  const auto d = cosine_weighted_bin_areas(4);
+  const auto d = OctahedralGrid{4}.cosine_weighted_areas();
   for (int i = 0; i < 16; ++i)
     for (int o = 0; o < 16; ++o)
       a += direct.mean[i * 16 + o] * d[i] * d[o], b += bssrdf.mean[i * 16 + o] * d[i] * d[o];
@@ -173,7 +168,7 @@ TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
   s.threads = 2;
   const CellStats st = cell_stats(6, [&](uint64_t seed) {
     s.seed = seed;
-    return bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+    return bake_fiber_band_direct(ph, s, nullptr);
   });
   const int R = 4, cells = R * R;
   for (bool flip_x : {true, false}) {
@@ -181,7 +176,7 @@ TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
     for (int i = 0; i < cells; ++i)
       for (int o = 0; o < cells; ++o) {
         const size_t src =
-            static_cast<size_t>(mirror_bin(i, R, flip_x)) * cells + mirror_bin(o, R, flip_x);
+            static_cast<size_t>(weft::testing::mirror_bin(i, R, flip_x)) * cells + weft::testing::mirror_bin(o, R, flip_x);
         m[i * cells + o] = st.mean[src];
         se[i * cells + o] = st.se[src];
       }
@@ -209,7 +204,7 @@ TEST(FiberTableBake, FiberScatteringIsReciprocal) {
   std::vector<double> sum, sum2;
   for (int rep = 0; rep < k; ++rep) {
     s.seed = 500 + rep;
-    const auto t = bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+    const auto t = bake_fiber_band_direct(ph, s, nullptr);
     ASSERT_EQ(t.far_field.size(), static_cast<size_t>(ns * ns * np));
     if (sum.empty()) sum.assign(t.far_field.size(), 0), sum2.assign(t.far_field.size(), 0);
     for (size_t c = 0; c < t.far_field.size(); ++c)
@@ -272,7 +267,7 @@ TEST(FiberTableBake, ExtremesStayFiniteAndBalanced) {
     FiberBakeSettings s;
     s.resolution = 4;
     s.photons = 400;
-    const auto t = bake_fiber_band_direct(ph.geometry, ph.surface, ph.tracer, s, nullptr);
+    const auto t = bake_fiber_band_direct(ph, s, nullptr);
     EXPECT_NEAR(t.energy_balance(), 1.0, 1e-9) << c.name;
     for (double v : t.f) ASSERT_TRUE(std::isfinite(v) && v >= 0) << c.name;
     EXPECT_GE(t.lost_fraction, 0.0) << c.name;

@@ -1,5 +1,5 @@
 #pragma once
-// Helpers shared by the photon-transport tests.
+// Helpers shared by the photon-transport and fiber-bake tests.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -29,6 +29,13 @@ inline ::testing::AssertionResult within_sigma(const MeanEstimate& e, double ref
   return ::testing::AssertionFailure()
          << "measured " << e.mean << " +- " << e.std_error << ", reference " << reference << " +- "
          << reference_error << ": " << dev / se << " sigma";
+}
+
+// Bin index of the mirror image of octahedral bin 'bin' (bsdf_table.h): flipping local x (the
+// fiber axis t) maps u -> 1 - u on the square, flipping y (the binormal b) maps v -> 1 - v.
+inline int mirror_bin(int bin, int resolution, bool flip_x) {
+  const int ix = bin % resolution, iy = bin / resolution;
+  return flip_x ? iy * resolution + (resolution - 1 - ix) : (resolution - 1 - iy) * resolution + ix;
 }
 
 }  // namespace weft::testing

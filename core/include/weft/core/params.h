@@ -64,8 +64,7 @@ class ParamReader {
   void finish() const;
 
   // Checks of a value found elsewhere (array elements): 'name' is its full path.
-  double check_number(const nlohmann::json& v, const std::string& name, double lo,
-                      double hi) const;
+  double check_number(const nlohmann::json& v, const std::string& name, double lo, double hi) const;
   Vec3 check_vec3(const nlohmann::json& v, const std::string& name) const;
   // Shortest readable form of a number for messages.
   static std::string fmt(double d);

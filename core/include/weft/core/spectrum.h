@@ -1,6 +1,7 @@
 #pragma once
 // Spectral bands of the project: 390-710 nm in 10 nm steps (33 bands, the paper's measurement
 // grid). Band i is centred at 390 + 10 i nm and covers [centre - 5, centre + 5) nm.
+#include <algorithm>
 #include <array>
 #include <cstddef>
 
@@ -87,5 +88,32 @@ Hsv rgb_to_hsv(const Rgb& rgb);
 // Spectrum -> linear sRGB weights per band: rgb = sum_b w[b] * value[b], for rendering
 // spectral tables in an RGB renderer under D65 (white reflectance 1 -> rgb (1,1,1)).
 const std::array<Rgb, kNumBands>& srgb_band_weights_d65();
+
+// The one spectral -> RGB reduction of tabulated quantities (BSDF tables, albedos): linear sRGB
+// under D65 of the band values value_of_band(0 .. kNumBands - 1). Saturated spectra can give
+// negative components (outside the sRGB gamut); GamutClip removes them.
+template <class ValueOfBand>
+Rgb bands_to_linear_srgb(ValueOfBand&& value_of_band) {
+  const auto& w = srgb_band_weights_d65();
+  Rgb c;
+  for (int b = 0; b < kNumBands; ++b) c += w[b] * static_cast<double>(value_of_band(b));
+  return c;
+}
+
+// Sets negative components to 0 (a reflectance or BSDF cannot be negative), counting what it
+// removed so that callers can report it.
+struct GamutClip {
+  size_t components = 0;  // components set to 0
+  double largest = 0;     // largest magnitude removed
+
+  void clip(Rgb& c) {
+    for (double* v : {&c.r, &c.g, &c.b})
+      if (*v < 0) {
+        largest = std::max(largest, -*v);
+        ++components;
+        *v = 0;
+      }
+  }
+};
 
 }  // namespace weft

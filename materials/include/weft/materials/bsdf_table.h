@@ -56,6 +56,10 @@ struct OctahedralGrid {
     double weight[4];
   };
   Footprint bilinear(Vec2 p) const;
+
+  // D_k = integral over bin k of |cos theta| d omega (exact, to rounding): the weight of a
+  // cosine-weighted cell average, and sum_k D_k = 2 pi.
+  std::vector<double> cosine_weighted_areas() const;
 };
 
 // f(wo, wi) -> one value per channel (written into 'values'); must be thread-safe.

@@ -21,8 +21,8 @@ class Bsdf {
  public:
   Bsdf() = default;
   template <BsdfModel T>
-    requires(!std::same_as<T, Bsdf>)
-  Bsdf(T value) : impl_(std::move(value)) {}  // NOLINT: implicit from any member of the set
+  requires(!std::same_as<T, Bsdf>) Bsdf(T value)
+      : impl_(std::move(value)) {}  // NOLINT: implicit from any member of the set
 
   Rgb eval(const Vec3& wo, const Vec3& wi) const {
     return std::visit([&](const auto& b) { return b.eval(wo, wi); }, impl_);

@@ -30,11 +30,12 @@ using FiberTableResolver =
 // instances and loaded once through 'cache'.
 struct MaterialContext {
   std::filesystem::path base_dir = ".";
-  std::string source_file;                   // for error messages
-  std::string field_prefix;                  // JSON path of the parameters, e.g. "materials.seat.params"
+  std::string source_file;   // for error messages
+  std::string field_prefix;  // JSON path of the parameters, e.g. "materials.seat.params"
   std::shared_ptr<struct TableCache> cache;  // may be null: then nothing is shared
   FiberTableResolver fiber_tables;           // may be null: then "spec" is an error
-  ProgressCallback progress = no_progress();  // of work the resolver does (the library never prints)
+  ProgressCallback progress =
+      no_progress();  // of work the resolver does (the library never prints)
 };
 
 // Builds a BSDF of the named type from its JSON parameters.

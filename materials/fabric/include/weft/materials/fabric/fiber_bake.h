@@ -1,60 +1,21 @@
 #pragma once
-// The fiber BSDF baker: photon transport in a smooth cylinder turned into a 4-D table over the
-// full sphere of both directions, in the local frame of a surface point (x = axis t, y = b,
-// z = outward normal n). Definitions, estimator and checks: docs/fiber-bsdf.md.
+// The fiber BSDF baker: photon transport in a cylinder turned into a 4-D table over the full
+// sphere of both directions, in the local frame of a surface point (x = axis t, y = b, z = outward
+// normal n). Definitions, estimators and checks: docs/fiber-bsdf.md. Two routes estimate the same
+// table: the direct one (a parallel beam over the whole lit cylinder) and the paper's (its BSSRDF,
+// bssrdf.h, summed over the lit cells).
 #include <cstdint>
-#include <functional>
 #include <vector>
 
 #include "weft/core/progress.h"
-#include "weft/core/rng.h"
-#include "weft/core/vec.h"
+#include "weft/materials/fabric/fiber_physics.h"
 
 namespace weft {
 
-// A photon leaving the fiber: position on the surface (world, axis = x), direction outside
-// (unit, away from the fiber), weight.
-struct FiberExit {
-  Vec3 position;
-  Vec3 direction;
-  double weight = 0;
-};
-
-// Receives exits while a photon is traced.
-using FiberExitSink = std::function<void(const FiberExit&)>;
-
-// Traces one photon that has just been refracted into the fiber at surface point 'p' (world
-// frame, axis x, radius R) travelling along unit 'd' with weight 'w', reporting every exit.
-// Must be deterministic given rng.
-struct FiberTraceResult {
-  uint64_t scattering_events = 0;
-  double absorbed_weight = 0;
-  double roulette_net = 0;  // weight removed by Russian roulette minus weight added (mean 0)
-  double lost_weight = 0;   // weight the tracer could not follow (e.g. an interaction cap)
-};
-using FiberInteriorTracer = std::function<FiberTraceResult(const Vec3& p, const Vec3& d, double w,
-                                                           Rng& rng, const FiberExitSink& sink)>;
-
-// The rough surface seen from outside, in the local frame of the hit point (z = normal).
-struct FiberSurfaceModel {
-  // Samples the surface-reflected direction for light from 'w_light' (z > 0): returns false if
-  // none; else sets the reflected direction and its weight f * cos / pdf.
-  std::function<bool(const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out, double* weight)>
-      sample;
-  // Directional albedo of the surface lobe for light at cos theta (its complement enters).
-  std::function<double(double cos_theta)> albedo;
-};
-
-struct FiberGeometry {
-  double radius_um = 10;
-  double n_fiber = 1.557;  // index inside
-  double n_outside = 1.0;
-};
-
 struct FiberBakeSettings {
-  int resolution = 8;         // R: R x R equal-area bins per direction over the sphere
-  uint64_t photons = 100000;  // photons per band
-  uint64_t seed = 1;
+  int resolution = 8;    // R: R x R equal-area bins per direction (OctahedralGrid)
+  uint64_t photons = 0;  // photons per band (callers say how many)
+  uint64_t seed = 0;
   int threads = 0;  // 0 = all cores
   uint64_t photons_per_task = 4096;
   // Optional far-field tally of the direct route (0 = off): the fiber's scattering per unit
@@ -92,26 +53,16 @@ struct FiberBandTable {
   bool cancelled = false;
 };
 
-// D_k = integral over bin k of |cos theta| d omega, for the R x R equal-area bins.
-std::vector<double> cosine_weighted_bin_areas(int resolution);
-
-// Bin index of a unit direction on the R x R equal-area square.
-int direction_bin(const Vec3& d, int resolution);
-
-// The direct route: a parallel beam over the whole lit cylinder. 'stage' names progress.
-FiberBandTable bake_fiber_band_direct(const FiberGeometry& geometry,
-                                      const FiberSurfaceModel& surface,
-                                      const FiberInteriorTracer& tracer,
+// The direct route: a parallel beam over the whole lit cylinder.
+FiberBandTable bake_fiber_band_direct(const FiberBandPhysics& fiber,
                                       const FiberBakeSettings& settings,
                                       const ProgressCallback& progress);
 
-// The paper's route: photons enter a small area A from directions over its lit hemisphere; exits
-// are binned by their angular offset around the axis from A (u), summed over the axial offset
-// (v; shift invariance), and by exit direction, giving the BSSRDF; the BRDF of a cell is then the
-// paper's sum over lit cells A_i. Grid sizes: u bins around the circle, incident bins in
-// (s = axial cosine, azimuth about the axis).
-struct BssrdfGrid {
-  int u_bins = 180;
+// The paper's route: the BSSRDF (bssrdf.h) for incident directions over A's lit hemisphere in
+// (s = axial cosine, azimuth about the axis) bins, summed over the axial offset, then the paper's
+// sum over lit cells A_i for each table cell.
+struct BssrdfRouteSettings {
+  int u_bins = 180;  // offsets around the axis
   // The BSSRDF is averaged over each incident bin, which blurs how the exit direction follows the
   // incident one: a first-order bias in the bin width, largest for clear fibers (measured in
   // docs/fiber-bsdf.md). 64 x 64 keeps it below the noise of scattering fibers.
@@ -119,10 +70,9 @@ struct BssrdfGrid {
   int incident_psi_bins = 64;
   int cell_quadrature = 16;  // points per side when integrating over a table bin of wi
 };
-FiberBandTable bake_fiber_band_bssrdf(const FiberGeometry& geometry,
-                                      const FiberSurfaceModel& surface,
-                                      const FiberInteriorTracer& tracer,
-                                      const FiberBakeSettings& settings, const BssrdfGrid& grid,
+FiberBandTable bake_fiber_band_bssrdf(const FiberBandPhysics& fiber,
+                                      const FiberBakeSettings& settings,
+                                      const BssrdfRouteSettings& route,
                                       const ProgressCallback& progress);
 
 // Sum of f |cos_i| |cos_o| over all cell pairs: pi * (1 - absorbed) for a correct table.

@@ -10,6 +10,7 @@
 #include "weft/core/progress.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/fabric/fiber_bake.h"
+#include "weft/materials/fabric/fiber_physics.h"
 #include "weft/materials/fabric/fiber_spec.h"
 #include "weft/materials/fabric/medium.h"
 
@@ -58,31 +59,6 @@ struct FiberTableBakeResult {
   double rgb_negative_clipped = 0;  // largest negative RGB value set to 0 (out of sRGB gamut)
   bool cancelled = false;           // the table then holds the passes finished (metadata "photons")
 };
-
-// Directional albedo of a Cook-Torrance lobe at cos theta, tabulated in cos theta and
-// interpolated linearly; computed by a deterministic stratified quadrature of the sample weights.
-class SurfaceAlbedoTable {
- public:
-  SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes = 129,
-                     int samples_per_side = 48);
-  double operator()(double cos_theta) const;
-
- private:
-  std::vector<double> albedo_;
-};
-
-// Everything the band bakers need for one band of a spec: the geometry, the Cook-Torrance surface
-// lobe at the band's host index, and the interior tracer (cylinder photon transport). The
-// functions hold shared state, so copies stay valid.
-struct FiberBandPhysics {
-  FiberGeometry geometry;
-  FiberSurfaceModel surface;
-  FiberInteriorTracer tracer;
-};
-// 'albedo' may be shared between bands of equal host index; null computes it.
-FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& band,
-                                    uint64_t max_events_per_photon = 10'000'000,
-                                    std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr);
 
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
                                       const ProgressCallback& progress = no_progress());

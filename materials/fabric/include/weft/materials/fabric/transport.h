@@ -93,12 +93,18 @@ struct ExitEvent {
   uint64_t scatterings = 0;  // scattering events before the exit (0: unscattered)
 };
 
-// Weight and event counts, per photon or accumulated over many (operator+=).
+// The energy books of photon transport: weight and event counts, per photon or accumulated over
+// many (operator+=). The project's one energy tally: the slab, the cylinder beam, the BSSRDF and
+// the fiber bakers all keep their books in it.
 struct PhotonTally {
   uint64_t photons = 0;  // launches
   double launched = 0;   // weight launched
-  double specular = 0;   // reflected at entry (external launches)
-  double exited = 0;     // passed to the recorder
+  double specular = 0;   // reflected at entry (external launches; the fiber's surface lobe)
+  // Where the reflection at entry is sampled rather than split (the fiber bakers draw one
+  // direction of the rough surface lobe, weight f cos / pdf, while 1 - albedo enters), the sampled
+  // weight minus its expectation: mean zero, kept so that the books still close exactly.
+  double specular_excess = 0;
+  double exited = 0;  // passed to the recorder (after entering)
   double absorbed = 0;
   double roulette_gain = 0;  // weight added to roulette survivors
   double roulette_loss = 0;  // weight of photons killed by roulette
@@ -110,6 +116,7 @@ struct PhotonTally {
     photons += o.photons;
     launched += o.launched;
     specular += o.specular;
+    specular_excess += o.specular_excess;
     exited += o.exited;
     absorbed += o.absorbed;
     roulette_gain += o.roulette_gain;
@@ -121,7 +128,8 @@ struct PhotonTally {
   }
   // launched - (everything accounted for): zero up to rounding.
   double imbalance() const {
-    return launched - (specular + exited + absorbed + roulette_loss - roulette_gain + lost);
+    return launched - (specular - specular_excess + exited + absorbed + roulette_loss -
+                       roulette_gain + lost);
   }
 };
 

@@ -1,7 +1,7 @@
 #pragma once
 // Deterministic parallel photon batches. Photons are split into fixed-size tasks; task k draws
-// from Rng(seed, k) and fills its own tally; tallies are added to the total in task order. So the
-// result has the same bits at any thread count. Tasks run in waves; between waves the progress
+// from Rng(seed, k) and fills its own tally; tallies are merged into the result in task order. So
+// the result has the same bits at any thread count. Tasks run in waves; between waves the progress
 // callback is called on the calling thread and may cancel: the tasks done so far are kept, and
 // the status says how many photons they hold.
 #include <algorithm>
@@ -13,6 +13,7 @@
 #include "weft/core/parallel.h"
 #include "weft/core/progress.h"
 #include "weft/core/rng.h"
+#include "weft/materials/fabric/transport.h"
 
 namespace weft {
 
@@ -46,6 +47,35 @@ struct MeanAccumulator {
   }
 };
 
+// Per-photon statistics of the energy books (PhotonTally): mean and standard error of each
+// fraction of the launched power, over the photons added.
+struct PhotonStats {
+  MeanAccumulator specular, exited, absorbed, roulette, lost;
+  uint64_t photons = 0, scatterings = 0, reflections = 0;
+
+  void add(const PhotonTally& photon) {
+    specular.add(photon.specular);
+    exited.add(photon.exited);
+    absorbed.add(photon.absorbed);
+    roulette.add(photon.roulette_loss - photon.roulette_gain);
+    lost.add(photon.lost);
+    photons += 1;
+    scatterings += photon.scatterings;
+    reflections += photon.reflections;
+  }
+  PhotonStats& operator+=(const PhotonStats& o) {
+    specular += o.specular;
+    exited += o.exited;
+    absorbed += o.absorbed;
+    roulette += o.roulette;
+    lost += o.lost;
+    photons += o.photons;
+    scatterings += o.scatterings;
+    reflections += o.reflections;
+    return *this;
+  }
+};
+
 struct PhotonBatchOptions {
   uint64_t photons = 0;
   uint64_t seed = 0;
@@ -66,12 +96,11 @@ struct PhotonBatchStatus {
   bool cancelled = false;
 };
 
-// Runs fn(task, first_photon, count, rng, tally) for every task, each on a copy of 'zero' (the
-// empty tally, already sized), and adds the tallies to 'total' in task order with
-// total += tally. Exceptions from fn propagate.
-template <class Tally, class TaskFn>
-PhotonBatchStatus run_photon_tasks(const PhotonBatchOptions& options, const Tally& zero,
-                                   Tally& total, TaskFn&& fn) {
+// The one photon task runner. Runs run(task, first_photon, count, rng, tally) for every task, each
+// on a default-constructed TaskTally, and hands the tallies to merge(tally) in task order, so the
+// merged result has the same bits at any thread count. Exceptions from run propagate.
+template <class TaskTally, class Run, class Merge>
+PhotonBatchStatus run_photon_tasks(const PhotonBatchOptions& options, Run&& run, Merge&& merge) {
   options.validate();
   const uint64_t per_task = options.photons_per_task;
   const uint64_t tasks = options.photons / per_task + (options.photons % per_task != 0 ? 1 : 0);
@@ -84,18 +113,18 @@ PhotonBatchStatus run_photon_tasks(const PhotonBatchOptions& options, const Tall
     status.cancelled = tasks > 0;
     return status;
   }
-  std::vector<Tally> tallies;
+  std::vector<TaskTally> tallies;
   for (uint64_t start = 0; start < tasks; start += wave) {
     const uint64_t n = std::min(wave, tasks - start);
-    tallies.assign(n, zero);
+    tallies.assign(n, TaskTally{});
     parallel_for(n, threads, [&](uint64_t i) {
       const uint64_t task = start + i;
       const uint64_t first = task * per_task;
       const uint64_t count = std::min(per_task, options.photons - first);
       Rng rng(options.seed, task);
-      fn(task, first, count, rng, tallies[i]);
+      run(task, first, count, rng, tallies[i]);
     });
-    for (uint64_t i = 0; i < n; ++i) total += tallies[i];
+    for (uint64_t i = 0; i < n; ++i) merge(tallies[i]);
     status.tasks_done = start + n;
     status.photons_done = std::min(options.photons, status.tasks_done * per_task);
     if (options.progress &&
