@@ -39,7 +39,8 @@ BssrdfGrid table_grid() {
 // does for a single incident direction.
 struct TableRecorder {
   BssrdfGrid grid = table_grid();
-  std::vector<double> sum = std::vector<double>(grid.cells()), sum2 = std::vector<double>(grid.cells());
+  std::vector<double> sum = std::vector<double>(grid.cells()),
+                      sum2 = std::vector<double>(grid.cells());
   double overflow = 0;
   void on_exit(const ExitEvent& e) {
     const int64_t k = grid.cell_of(e);
@@ -111,8 +112,7 @@ void BM_FiberBssrdfBatch(benchmark::State& state) {
   b.photons_per_task = 16384;
   b.seed = 1;
   b.threads = static_cast<int>(state.range(0));
-  for (auto _ : state)
-    benchmark::DoNotOptimize(simulate_bssrdf(fiber, table_grid(), incidence, b));
+  for (auto _ : state) benchmark::DoNotOptimize(simulate_bssrdf(fiber, table_grid(), incidence, b));
 }
 BENCHMARK(BM_FiberBssrdfBatch)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMillisecond);
 

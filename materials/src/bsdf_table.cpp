@@ -126,6 +126,22 @@ std::vector<double> OctahedralGrid::cosine_weighted_areas() const {
   return out;
 }
 
+std::vector<double> TabulatedBsdfTable::averages_from_weighted_sums(
+    int resolution, const std::vector<double>& weighted_sums) {
+  const OctahedralGrid grid{resolution};
+  const size_t cells = static_cast<size_t>(grid.bins());
+  if (weighted_sums.size() != cells * cells)
+    throw Error("", "weighted_sums",
+                "holds " + std::to_string(weighted_sums.size()) + " values, expected " +
+                    std::to_string(cells * cells));
+  const auto d = grid.cosine_weighted_areas();
+  std::vector<double> out(weighted_sums.size());
+  for (size_t i = 0; i < cells; ++i)
+    for (size_t o = 0; o < cells; ++o)
+      out[i * cells + o] = weighted_sums[i * cells + o] / (d[i] * d[o]);
+  return out;
+}
+
 std::string TabulatedBsdfTable::checksum() const {
   uint64_t h = kFnv1a64Basis;
   for (const float v : values) {
@@ -159,6 +175,7 @@ namespace {
 // Attribute names the format itself uses, or that OpenEXR's header reserves.
 const std::set<std::string>& reserved_attribute_names() {
   static const std::set<std::string> names = {"weft_format_version",
+                                              "cell_average",
                                               "parameterization",
                                               "resolution",
                                               "bands",
@@ -254,6 +271,7 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
           std::swap(p[i], p[std::min<int>(i, static_cast<int>(rng.uniform() * (i + 1)))]);
       }
       std::fill(sum.begin(), sum.end(), 0.0);
+      double weight_sum = 0;
       const int xi = wi_bin % resolution, yi = wi_bin / resolution;
       const int xo = wo_bin % resolution, yo = wo_bin / resolution;
       for (int s = 0; s < n; ++s) {
@@ -264,16 +282,20 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
         const Vec3 wi = OctahedralGrid::to_direction(pi), wo = OctahedralGrid::to_direction(po);
         std::fill(value.begin(), value.end(), 0.0);
         f(wo, wi, value);
+        const double w = std::abs(wi.z) * std::abs(wo.z);
+        weight_sum += w;
         for (int c = 0; c < channels; ++c) {
           if (!std::isfinite(value[c]) || value[c] < 0)
             throw Error(who, "f",
                         "returned a negative or non-finite value at wo bin " +
                             std::to_string(wo_bin) + ", wi bin " + std::to_string(wi_bin));
-          sum[c] += value[c];
+          sum[c] += value[c] * w;
         }
       }
+      // Every cell has |cos| > 0 almost everywhere, so the weights cannot all vanish.
       for (int c = 0; c < channels; ++c)
-        table.values[table.index(wi_bin, wo_bin, c)] = static_cast<float>(sum[c] / n);
+        table.values[table.index(wi_bin, wo_bin, c)] =
+            static_cast<float>(weight_sum > 0 ? sum[c] / weight_sum : 0.0);
     }
   };
   for (int first = 0; first < n_bins; first += chunk) {

@@ -30,6 +30,7 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
       const std::vector<std::string> names = channel_names();
       for (const auto& name : names) header.channels().insert(name, Imf::Channel(Imf::FLOAT));
       header.insert("weft_format_version", Imf::IntAttribute(kFormatVersion));
+      header.insert("cell_average", Imf::StringAttribute(kCellAverage));
       header.insert("parameterization", Imf::StringAttribute(kParameterization));
       header.insert("resolution", Imf::IntAttribute(resolution));
       header.insert("bands", Imf::StringAttribute(bands()));
@@ -83,9 +84,9 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
     };
 
     const int version = int_attr("weft_format_version");
-    if (version != kFormatVersion)
+    if (version != kFormatVersion && version != 1)
       throw Error(file, "weft_format_version",
-                  "is " + std::to_string(version) + "; this program reads version " +
+                  "is " + std::to_string(version) + "; this program reads versions 1 and " +
                       std::to_string(kFormatVersion));
     if (string_attr("parameterization") != kParameterization)
       throw Error(
@@ -152,6 +153,20 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
       if (is_reserved_attribute(name)) continue;
       if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
         table.metadata[name] = s->value();
+    }
+    // The stored quantity: stated since version 2; in version 1 only fiber bakes said (in their
+    // "definition") that they hold cosine-weighted averages.
+    if (version >= 2) {
+      if (string_attr("cell_average") != kCellAverage)
+        throw Error(file, "cell_average",
+                    "is \"" + string_attr("cell_average") + "\"; this program reads \"" +
+                        kCellAverage + "\" cell averages");
+    } else {
+      const auto def = table.metadata.find("definition");
+      if (def == table.metadata.end() || def->second.find("cosine-weighted") == std::string::npos)
+        throw Error(file, "cell_average",
+                    "a version 1 table without a stated cell average holds plain solid-angle "
+                    "averages ('weft table bake' before format version 2): re-bake it");
     }
   } catch (const Error&) {
     throw;

@@ -76,7 +76,10 @@ void write_raw(const fs::path& path, int resolution, const std::vector<std::stri
   Imf::Header h(n, n);
   h.compression() = Imf::ZIP_COMPRESSION;
   for (const auto& c : channels) h.channels().insert(c, Imf::Channel(Imf::FLOAT));
-  if (!omit.count("weft_format_version")) h.insert("weft_format_version", Imf::IntAttribute(1));
+  if (!omit.count("weft_format_version"))
+    h.insert("weft_format_version", Imf::IntAttribute(TabulatedBsdfTable::kFormatVersion));
+  if (!omit.count("cell_average"))
+    h.insert("cell_average", Imf::StringAttribute(TabulatedBsdfTable::kCellAverage));
   if (!omit.count("parameterization"))
     h.insert("parameterization", Imf::StringAttribute(TabulatedBsdfTable::kParameterization));
   if (!omit.count("resolution")) h.insert("resolution", Imf::IntAttribute(resolution));
@@ -289,7 +292,22 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
       {"version.exr", "weft_format_version",
        [&](const fs::path& p) {
          write_raw(p, 2, rgb,
-                   [](Imf::Header& h) { h.insert("weft_format_version", Imf::IntAttribute(2)); });
+                   [](Imf::Header& h) { h.insert("weft_format_version", Imf::IntAttribute(3)); });
+       }},
+      // The stored quantity must be the one every reader assumes.
+      {"plain_average.exr", "cell_average",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb,
+                   [](Imf::Header& h) { h.insert("cell_average", Imf::StringAttribute("plain")); });
+       }},
+      {"no_cell_average.exr", "cell_average",
+       [&](const fs::path& p) { write_raw(p, 2, rgb, [](Imf::Header&) {}, {}, {"cell_average"}); }},
+      // Version 1 tables of 'weft table bake' held plain averages and did not say so.
+      {"v1_plain.exr", "re-bake",
+       [&](const fs::path& p) {
+         write_raw(p, 2, rgb,
+                   [](Imf::Header& h) { h.insert("weft_format_version", Imf::IntAttribute(1)); },
+                   {}, {"cell_average"});
        }},
       {"nochecksum.exr", "values_fnv1a64",
        [&](const fs::path& p) {
@@ -352,4 +370,21 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
     EXPECT_NE(msg.find(p.string()), std::string::npos) << msg;
     EXPECT_NE(msg.find(c.must_mention), std::string::npos) << c.name << ": " << msg;
   }
+}
+
+TEST(TableExr, VersionOneFiberBakesAreReadAsCosineWeighted) {
+  // Fiber bakes of format version 1 stated their quantity in their "definition"; they stay
+  // readable. (Plain averages of version 1 are rejected: DamagedFilesNameTheFileAndTheFault.)
+  const fs::path p = temp_dir("v1") / "fiber.exr";
+  write_raw(p, 2, {"R", "G", "B"},
+            [](Imf::Header& h) {
+              h.insert("weft_format_version", Imf::IntAttribute(1));
+              h.insert("definition",
+                       Imf::StringAttribute("f = L_o / (E |cos theta_i|); cosine-weighted "
+                                            "cell averages (docs/fiber-bsdf.md)"));
+            },
+            {}, {"cell_average"});
+  const auto t = TabulatedBsdfTable::read_exr(p);
+  EXPECT_EQ(t.resolution, 2);
+  EXPECT_EQ(t.values.front(), 0.25f);
 }

@@ -40,13 +40,7 @@ FiberBandTable finish_table(int resolution, std::vector<double> weighted_sum,
                             const PhotonTally& books, bool cancelled) {
   FiberBandTable t;
   t.resolution = resolution;
-  const int cells = resolution * resolution;
-  const auto d = OctahedralGrid{resolution}.cosine_weighted_areas();
-  t.f.assign(weighted_sum.size(), 0.0);
-  for (int i = 0; i < cells; ++i)
-    for (int o = 0; o < cells; ++o)
-      t.f[static_cast<size_t>(i) * cells + o] =
-          weighted_sum[static_cast<size_t>(i) * cells + o] / (d[i] * d[o]);
+  t.f = TabulatedBsdfTable::averages_from_weighted_sums(resolution, weighted_sum);
   t.weighted_sum = std::move(weighted_sum);
   const double inv = books.launched > 0 ? 1 / books.launched : 0;
   t.photons = books.photons;
@@ -167,7 +161,8 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberBandPhysics& fiber, const Fiber
   // by a cq x cq midpoint rule. B sits at the top; A_j at angle pi/2 - offset_j.
   const double du = 2 * kPi / nu;
   std::vector<Frame> frames_aj;
-  for (int j = 0; j < nu; ++j) frames_aj.push_back(CylinderGeometry::cylinder_frame(kPi / 2 - (-kPi + j * du)));
+  for (int j = 0; j < nu; ++j)
+    frames_aj.push_back(CylinderGeometry::cylinder_frame(kPi / 2 - (-kPi + j * du)));
   const int cq = route.cell_quadrature;
   const double point_solid_angle = 4 * kPi / (static_cast<double>(R) * R) / (cq * cq);
   std::vector<double> weighted(cells * cells, 0.0);

@@ -41,8 +41,7 @@ FiberBandPhysics smooth_fiber_physics(const TransportMedium& medium, double radi
                                       double n_outside, TransportOptions options) {
   FiberBandPhysics ph;
   const double n_in = medium.n;
-  ph.surface.sample = [n_outside, n_in](const Vec3& w, Vec2, double, Vec3* w_out,
-                                        double* weight) {
+  ph.surface.sample = [n_outside, n_in](const Vec3& w, Vec2, double, Vec3* w_out, double* weight) {
     *w_out = Vec3{-w.x, -w.y, w.z};  // the mirror direction, weight R (a delta lobe)
     *weight = n_outside == n_in ? 0.0 : fresnel_dielectric(w.z, n_outside, n_in);
     return *weight > 0;
@@ -109,8 +108,8 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
   return ph;
 }
 
-void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0,
-                 Rng& rng, const ExitSink& surface_exits, const ExitSink& interior_exits,
+void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
+                 const ExitSink& surface_exits, const ExitSink& interior_exits,
                  PhotonTally& books) {
   const FiberInterior& in = fiber.interior;
   const Frame frame = CylinderGeometry::cylinder_frame(phi);

@@ -34,7 +34,6 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
 
   const int R = o.resolution;
   const size_t cells = static_cast<size_t>(R) * R;
-  const auto bin_areas = OctahedralGrid{R}.cosine_weighted_areas();
 
   // Per band: the physics, and running sums over passes.
   struct BandState {
@@ -126,11 +125,10 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       s.energy_balance = s.exit_fraction + s.absorbed_fraction + s.roulette_net + s.lost_fraction -
                          s.surface_sampling_excess;
       s.energy_table = st.energy * inv;
-      band_f[band].resize(cells * cells);
-      for (size_t i = 0; i < cells; ++i)
-        for (size_t k = 0; k < cells; ++k)
-          band_f[band][i * cells + k] =
-              st.weighted_sum[i * cells + k] * inv / (bin_areas[i] * bin_areas[k]);
+      // The photon-weighted mean of the passes' sums, then cell averages.
+      std::vector<double> mean_sum(st.weighted_sum.size());
+      for (size_t k = 0; k < mean_sum.size(); ++k) mean_sum[k] = st.weighted_sum[k] * inv;
+      band_f[band] = TabulatedBsdfTable::averages_from_weighted_sums(R, mean_sum);
     }
     result.bands.push_back(s);
   }

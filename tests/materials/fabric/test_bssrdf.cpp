@@ -77,10 +77,9 @@ TEST(Bssrdf, MatchedNonScatteringFiberHitsOneCellExactly) {
   const double alpha = deg_to_rad(20);
   for (double mua : {0.0, 0.01}) {
     const BssrdfGrid g = grid();
-    const BssrdfResult r =
-        simulate_bssrdf(fiber(mua, 0, 0, 1.0), g,
-                        BssrdfIncidence::from({std::sin(alpha), 0, std::cos(alpha)}),
-                        batch(20000, 1));
+    const BssrdfResult r = simulate_bssrdf(
+        fiber(mua, 0, 0, 1.0), g, BssrdfIncidence::from({std::sin(alpha), 0, std::cos(alpha)}),
+        batch(20000, 1));
     const double weight = std::exp(-mua * 2 * kRadius / std::cos(alpha));
     const int iu = g.u_bins / 2;  // u = pi
     const double v = -2 * kRadius * std::tan(alpha);
@@ -164,8 +163,8 @@ TEST(Bssrdf, ScatteringFiberEnergyAndMirrorSymmetry) {
     EXPECT_TRUE(weft::testing::within_sigma(a, b.mean, 4.5, b.std_error)) << "direction " << d;
   }
   // The mirror must be a real constraint: an oblique light tilted along b breaks it.
-  const BssrdfResult t = simulate_bssrdf(ph, g, BssrdfIncidence::from(normalize(Vec3{0, 0.7, 0.7})),
-                                         batch(50000, 5));
+  const BssrdfResult t =
+      simulate_bssrdf(ph, g, BssrdfIncidence::from(normalize(Vec3{0, 0.7, 0.7})), batch(50000, 5));
   const MeanEstimate plus = exited(t, [&](int u, int, int) { return u > 0 && u < nu / 2; });
   const MeanEstimate minus = exited(t, [&](int u, int, int) { return u > nu / 2; });
   EXPECT_GT(std::abs(plus.mean - minus.mean), 6 * std::hypot(plus.std_error, minus.std_error));

@@ -68,7 +68,6 @@ int count_outliers(const std::vector<double>& a, const std::vector<double>& sa,
   return n;
 }
 
-
 }  // namespace
 
 TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
@@ -175,8 +174,8 @@ TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
     std::vector<double> m(st.mean.size()), se(st.se.size());
     for (int i = 0; i < cells; ++i)
       for (int o = 0; o < cells; ++o) {
-        const size_t src =
-            static_cast<size_t>(weft::testing::mirror_bin(i, R, flip_x)) * cells + weft::testing::mirror_bin(o, R, flip_x);
+        const size_t src = static_cast<size_t>(weft::testing::mirror_bin(i, R, flip_x)) * cells +
+                           weft::testing::mirror_bin(o, R, flip_x);
         m[i * cells + o] = st.mean[src];
         se[i * cells + o] = st.se[src];
       }

@@ -6,13 +6,18 @@
 // (core/sphere_mapping.h) at R x R bins over the FULL sphere (light may arrive from behind and
 // transmission is included), so every bin covers the solid angle 4 pi / R^2. Directions are in
 // the local frame x = tangent (fiber / yarn / warp axis), y = binormal, z = normal.
-// Values: f in 1/sr (BSDF without cosine), the average over the (wi bin, wo bin) cell pair,
-// indexed [wi_bin][wo_bin][channel]. Bin index = y * R + x for the square cell (x, y).
+// Values: f in 1/sr (BSDF without cosine), indexed [wi_bin][wo_bin][channel]; bin index =
+// y * R + x for the square cell (x, y). Every table, whoever made it, stores the same quantity,
+// the COSINE-WEIGHTED average over the (wi bin, wo bin) cell pair
+//   f[i][o] = int_{C_i} int_{C_o} f |cos theta_i| |cos theta_o| dwo dwi / (D_i D_o),
+//   D_k = int_{C_k} |cos theta| dw   (OctahedralGrid::cosine_weighted_areas),
+// which makes f[i][o] D_i D_o exactly the energy the cell pair carries (docs/fiber-bsdf.md).
 //
 // File: one scanline OpenEXR image, height R^2 (row = wi bin), width R^2 (column = wo bin), FLOAT
 // channels R,G,B or w390..w710 (one per 10 nm band), ZIP compression (lossless, so round trips
 // are bit-exact). Header attributes:
-//   weft_format_version (int) = 1, parameterization (string) = kParameterization,
+//   weft_format_version (int) = 2, parameterization (string) = kParameterization,
+//   cell_average (string) = "cosine-weighted" (the stored quantity; readers reject any other),
 //   resolution (int) = R, bands (string) = "rgb" | "390:710:10", units (string) = "1/sr",
 //   kind (string) = "fiber" | "fabric", values_fnv1a64 (string, 16 hex digits) = checksum() of the
 //   values (EXR itself has no checksum: an uncompressible table is stored raw, and damaged bytes
@@ -66,7 +71,11 @@ struct OctahedralGrid {
 using TableFunction = std::function<void(const Vec3& wo, const Vec3& wi, std::span<double> values)>;
 
 struct TabulatedBsdfTable {
-  static constexpr int kFormatVersion = 1;
+  // 2: the stored quantity is stated (cell_average). Version 1 files are read when their quantity
+  // is known to be the cosine-weighted average (fiber bakes, whose "definition" says so); plain
+  // solid-angle averages of version 1 ('weft table bake') are rejected with a request to re-bake.
+  static constexpr int kFormatVersion = 2;
+  static constexpr const char* kCellAverage = "cosine-weighted";
   static constexpr const char* kParameterization =
       "equal-area-octahedral x equal-area-octahedral, local frame x=t y=b z=n";
   static constexpr const char* kUnits = "1/sr";
@@ -105,15 +114,23 @@ struct TabulatedBsdfTable {
   static bool is_reserved_attribute(const std::string& name);
   void validate(const std::string& file_for_errors) const;
 
-  // Cell averages of an analytic f by stratified sampling: for each (wi bin, wo bin) pair,
-  // 'samples_per_cell' pairs of directions, each Latin-hypercube stratified within its cell (in
-  // the equal-area square, i.e. uniform in solid angle). Random streams come from
+  // Cosine-weighted cell averages of an analytic f by stratified sampling: for each (wi bin,
+  // wo bin) pair, 'samples_per_cell' pairs of directions, each Latin-hypercube stratified within
+  // its cell (in the equal-area square, i.e. uniform in solid angle), averaged with the weights
+  // |cos theta_i| |cos theta_o| (a ratio estimator: a constant f is reproduced exactly). Random
+  // streams come from
   // (seed, wi bin, wo bin), so the result is the same at any thread count. 'progress' is called
   // on the calling thread between chunks of rows (stage "table"); returning false cancels with a
   // weft::Error (a partial table is of no use).
   static TabulatedBsdfTable from_function(int resolution, int channels, const TableFunction& f,
                                           int samples_per_cell, uint64_t seed = 0, int threads = 0,
                                           const ProgressCallback& progress = no_progress());
+
+  // A table from sums of f |cos_i| |cos_o| d wi d wo over each cell pair, as a Monte Carlo
+  // estimator of the integral gathers them (the fiber baker): divides by D_i D_o. 'weighted_sums'
+  // is [wi_bin][wo_bin] for one channel; returns the cell averages in the same order.
+  static std::vector<double> averages_from_weighted_sums(int resolution,
+                                                         const std::vector<double>& weighted_sums);
 
   // Writes the OpenEXR file atomically (a complete file or none). Throws weft::Error.
   void write_exr(const std::filesystem::path& path) const;

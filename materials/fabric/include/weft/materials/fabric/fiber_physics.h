@@ -42,8 +42,7 @@ struct FiberSurfaceModel {
 struct FiberInterior {
   CylinderGeometry geometry{1, 1};
   double n_inside = 1;
-  std::function<PhotonTally(const Vec3& p, const Vec3& d, double w, Rng& rng,
-                            const ExitSink& sink)>
+  std::function<PhotonTally(const Vec3& p, const Vec3& d, double w, Rng& rng, const ExitSink& sink)>
       trace;
 
   // Photon transport in the homogeneous medium of 'transport' (geometry and index from it).
@@ -89,8 +88,7 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& ban
 // 'surface_exits' (may be empty; booked as specular and specular_excess either way); the rest,
 // 1 - albedo, enters refracted at the smooth normal and is traced, its exits going to
 // 'interior_exits'. Adds one launched photon to 'books'. Deterministic given rng.
-void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0,
-                 Rng& rng, const ExitSink& surface_exits, const ExitSink& interior_exits,
-                 PhotonTally& books);
+void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
+                 const ExitSink& surface_exits, const ExitSink& interior_exits, PhotonTally& books);
 
 }  // namespace weft

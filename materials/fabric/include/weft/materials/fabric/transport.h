@@ -128,8 +128,8 @@ struct PhotonTally {
   }
   // launched - (everything accounted for): zero up to rounding.
   double imbalance() const {
-    return launched - (specular - specular_excess + exited + absorbed + roulette_loss -
-                       roulette_gain + lost);
+    return launched -
+           (specular - specular_excess + exited + absorbed + roulette_loss - roulette_gain + lost);
   }
 };
 
