@@ -87,7 +87,7 @@ int run_slab(const SlabOptions& o) {
   batch.progress = progress_bar(o.quiet);
   const SlabResult r = simulate_slab(setup, batch);
 
-  const std::pair<const char*, MeanEstimate> values[] = {{"rsp", r.rsp},
+  const std::pair<const char*, MeanEstimate> values[] = {{"rsp", r.specular},
                                                          {"rb", r.rb},
                                                          {"rd", r.rd},
                                                          {"tb", r.tb},

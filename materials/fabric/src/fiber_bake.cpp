@@ -26,13 +26,12 @@ void validate(const FiberBandPhysics& fiber, const FiberBakeSettings& s) {
 }
 
 PhotonBatchOptions batch_of(const FiberBakeSettings& s, const ProgressCallback& progress) {
-  PhotonBatchOptions b;
-  b.photons = s.photons;
-  b.seed = s.seed;
-  b.threads = s.threads;
-  b.photons_per_task = s.photons_per_task;
-  b.progress = progress;
-  return b;
+  return {.photons = s.photons,
+          .seed = s.seed,
+          .threads = s.threads,
+          .photons_per_task = s.photons_per_task,
+          .tasks_per_wave = 0,
+          .progress = progress};
 }
 
 // The table from the sums of f |cos_i| |cos_o| per cell pair, and the books' fractions.

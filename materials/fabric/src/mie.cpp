@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <initializer_list>
+#include <iterator>
 #include <string>
 
 #include "weft/core/error.h"
@@ -40,42 +42,35 @@ inline cd cdiv(cd a, cd b) {
 struct SmallNumerators {
   cd a1, b1, a2, b2;
 };
+
+// One coefficient of a series in x^2: a polynomial in u (highest power first) over an integer.
+struct SeriesCoefficient {
+  std::initializer_list<double> poly;
+  double denominator;
+};
+
+// sum_k x2^k c_k(u), nested from the highest term (Horner in x2 and in u).
+cd series_in_x2(std::initializer_list<SeriesCoefficient> terms, cd u, double x2) {
+  cd sum = 0.0;
+  for (auto t = std::rbegin(terms); t != std::rend(terms); ++t) {
+    cd c = 0.0;
+    for (const double p : t->poly) c = c * u + p;
+    sum = c / t->denominator + x2 * sum;
+  }
+  return sum;
+}
+
 SmallNumerators small_sphere_numerators(cd m, double x) {
   const cd u = m * m, um1 = (m - 1.0) * (m + 1.0);  // exact for m near 1
   const double x2 = x * x;
-  const cd a1 =
-      um1 / u * x *
-      (-2.0 / 3 +
-       x2 * (1.0 / 15 + x2 * (-(4.0 * u + 5.0) / 2100.0 +
-                              x2 * (-(48.0 * u * u - 60.0 * u - 25.0) / 567000.0 +
-                                    x2 * (-(((7104.0 * u - 7680.0) * u + 4200.0) * u + 875.0) /
-                                          1746360000.0)))));
-  const cd b1 =
-      um1 * x * x2 *
-      (-1.0 / 15 +
-       x2 * (-(2.0 * u - 5.0) / 1050.0 +
-             x2 * (-((16.0 * u - 20.0) * u + 25.0) / 189000.0 +
-                   x2 * (-(((1776.0 * u - 1920.0) * u + 1050.0) * u - 875.0) / 436590000.0 +
-                         x2 * (-((((45312.0 * u - 47040.0) * u + 21600.0) * u - 7000.0) * u +
-                                 4375.0) /
-                               227026800000.0)))));
-  const cd a2 =
-      um1 / u * x2 *
-      (-1.0 / 5 +
-       x2 * (1.0 / 70 + x2 * (-(8.0 * u + 21.0) / 52920.0 +
-                              x2 * (-((32.0 * u - 56.0) * u - 49.0) / 8149680.0 +
-                                    x2 * (-(((6016.0 * u - 8960.0) * u + 7056.0) * u + 3087.0) /
-                                          53396703360.0)))));
-  const cd b2 =
-      um1 * x2 * x2 *
-      (-1.0 / 105 +
-       x2 * (-(2.0 * u - 7.0) / 13230.0 +
-             x2 * (-((16.0 * u - 28.0) * u + 49.0) / 4074840.0 +
-                   x2 * (-(((752.0 * u - 1120.0) * u + 882.0) * u - 1029.0) / 6674587920.0 +
-                         x2 * (-((((18688.0 * u - 26432.0) * u + 17248.0) * u - 8232.0) * u +
-                                 7203.0) /
-                               5606653852800.0)))));
-  return {a1, b1, a2, b2};
+  // One series per line: a1, b1, a2, b2 (coefficients of x2^0 .. x2^4).
+  // clang-format off
+  const cd s_a1 = series_in_x2({{{-2}, 3}, {{1}, 15}, {{-4, -5}, 2100}, {{-48, 60, 25}, 567000}, {{-7104, 7680, -4200, -875}, 1746360000}}, u, x2);
+  const cd s_b1 = series_in_x2({{{-1}, 15}, {{-2, 5}, 1050}, {{-16, 20, -25}, 189000}, {{-1776, 1920, -1050, 875}, 436590000}, {{-45312, 47040, -21600, 7000, -4375}, 227026800000}}, u, x2);
+  const cd s_a2 = series_in_x2({{{-1}, 5}, {{1}, 70}, {{-8, -21}, 52920}, {{-32, 56, 49}, 8149680}, {{-6016, 8960, -7056, -3087}, 53396703360}}, u, x2);
+  const cd s_b2 = series_in_x2({{{-1}, 105}, {{-2, 7}, 13230}, {{-16, 28, -49}, 4074840}, {{-752, 1120, -882, 1029}, 6674587920}, {{-18688, 26432, -17248, 8232, -7203}, 5606653852800}}, u, x2);
+  // clang-format on
+  return {um1 / u * x * s_a1, um1 * x * x2 * s_b1, um1 / u * x2 * s_a2, um1 * x2 * x2 * s_b2};
 }
 
 // Where the expansions are used: truncated after (m x)^8 relative terms, they are good to

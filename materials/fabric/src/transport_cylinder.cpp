@@ -46,18 +46,7 @@ CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup,
       },
       [&](const PhotonStats& t) { total += t; });
   CylinderBeamResult r;
-  const uint64_t n = total.photons;
-  r.specular = total.specular.estimate(n);
-  r.exited = total.exited.estimate(n);
-  r.absorbed = total.absorbed.estimate(n);
-  r.roulette = total.roulette.estimate(n);
-  r.lost = total.lost.estimate(n);
-  r.energy_imbalance = n == 0 ? 0.0
-                              : 1.0 - (r.specular.mean + r.exited.mean + r.absorbed.mean +
-                                       r.roulette.mean + r.lost.mean);
-  r.photons = n;
-  r.scatterings = total.scatterings;
-  r.reflections = total.reflections;
+  static_cast<PhotonFractions&>(r) = total.fractions();
   r.cancelled = status.cancelled;
   return r;
 }

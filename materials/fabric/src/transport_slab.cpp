@@ -1,5 +1,6 @@
 #include "weft/materials/fabric/transport_slab.h"
 
+#include <array>
 #include <cmath>
 
 namespace weft {
@@ -18,18 +19,15 @@ struct SlabExitRecorder {
   }
 };
 
-// The energy books and, beyond them, the exits split by face and by scattering.
+// The energy books and, beyond them, the exits split by face and by scattering: rb, rd, tb, td,
+// tt in that order.
 struct SlabTally {
   PhotonStats books;
-  MeanAccumulator rb, rd, tb, td, tt;
+  std::array<MeanAccumulator, 5> faces;
 
   SlabTally& operator+=(const SlabTally& o) {
     books += o.books;
-    rb += o.rb;
-    rd += o.rd;
-    tb += o.tb;
-    td += o.td;
-    tt += o.tt;
+    for (size_t k = 0; k < faces.size(); ++k) faces[k] += o.faces[k];
     return *this;
   }
 };
@@ -63,33 +61,19 @@ SlabResult simulate_slab(const SlabSetup& setup, const PhotonBatchOptions& batch
           transport.launch_external(SlabGeometry::kTop, Vec3{0, 0, 0}, direction, 1.0, rng, exits,
                                     photon);
           tally.books.add(photon);
-          tally.rb.add(exits.top_unscattered);
-          tally.rd.add(exits.top_scattered);
-          tally.tb.add(exits.bottom_unscattered);
-          tally.td.add(exits.bottom_scattered);
-          tally.tt.add(exits.bottom_unscattered + exits.bottom_scattered);
+          const double faces[5] = {exits.top_unscattered, exits.top_scattered,
+                                   exits.bottom_unscattered, exits.bottom_scattered,
+                                   exits.bottom_unscattered + exits.bottom_scattered};
+          for (size_t k = 0; k < 5; ++k) tally.faces[k].add(faces[k]);
         }
       },
       [&](const SlabTally& t) { total += t; });
 
   SlabResult r;
-  const PhotonStats& books = total.books;
-  const uint64_t n = books.photons;
-  r.rsp = books.specular.estimate(n);
-  r.rb = total.rb.estimate(n);
-  r.rd = total.rd.estimate(n);
-  r.tb = total.tb.estimate(n);
-  r.td = total.td.estimate(n);
-  r.tt = total.tt.estimate(n);
-  r.absorbed = books.absorbed.estimate(n);
-  r.roulette = books.roulette.estimate(n);
-  r.lost = books.lost.estimate(n);
-  r.energy_imbalance = n == 0 ? 0.0
-                              : 1.0 - (r.rsp.mean + r.rb.mean + r.rd.mean + r.tb.mean + r.td.mean +
-                                       r.absorbed.mean + r.roulette.mean + r.lost.mean);
-  r.photons = n;
-  r.scatterings = books.scatterings;
-  r.reflections = books.reflections;
+  static_cast<PhotonFractions&>(r) = total.books.fractions();
+  const uint64_t n = total.books.photons;
+  MeanEstimate* faces[5] = {&r.rb, &r.rd, &r.tb, &r.td, &r.tt};
+  for (size_t k = 0; k < 5; ++k) *faces[k] = total.faces[k].estimate(n);
   r.cancelled = status.cancelled;
   return r;
 }

@@ -17,12 +17,7 @@ namespace {
 constexpr double kRadius = 10;
 
 FiberBandPhysics fiber(double mua, double mus, double g, double n) {
-  TransportMedium m;
-  m.mu_a = mua;
-  m.mu_s = mus;
-  m.n = n;
-  m.phase = PhaseFunction::henyey_greenstein(g);
-  return smooth_fiber_physics(m, kRadius, 1.0);
+  return smooth_fiber_physics(weft::testing::hg_medium(mua, mus, g, n), kRadius, 1.0);
 }
 
 // The subsurface BSSRDF with standard errors, on an odd direction grid (R = 5: the plane y = 0
@@ -214,13 +209,9 @@ TEST(Bssrdf, BinnedIncidenceCoversTheLitHemisphereWithFluxCosine) {
 }
 
 TEST(Bssrdf, BadInputIsRejectedWithTheFieldNamed) {
-  auto message_of = [](const BssrdfGrid& g, const BssrdfIncidence& in) -> std::string {
-    try {
-      simulate_bssrdf(fiber(0.005, 0.05, 0.8, 1.557), g, in, batch(10, 1));
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "";
+  auto message_of = [](const BssrdfGrid& g, const BssrdfIncidence& in) {
+    return weft::testing::error_of(
+        [&] { simulate_bssrdf(fiber(0.005, 0.05, 0.8, 1.557), g, in, batch(10, 1)); });
   };
   const BssrdfIncidence normal = BssrdfIncidence::from({0, 0, 1});
   EXPECT_NE(message_of(grid(), BssrdfIncidence::from({0, 0, -1})).find("incident"),

@@ -6,6 +6,7 @@
 
 #include <cmath>
 
+#include "transport_test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/sphere_mapping.h"
@@ -88,11 +89,7 @@ TEST(FiberBake, CosineWeightedBinAreasSumToTwoPi) {
 }
 
 TEST(FiberBake, DirectRouteReproducesLambertSurface) {
-  FiberBakeSettings s;
-  s.seed = 1;
-  s.resolution = 4;
-  s.photons = 400000;
-  s.threads = 2;
+  FiberBakeSettings s = weft::testing::bake_settings(4, 400000, 2);
   const double rho = 0.6;
   const auto t = bake_fiber_band_direct(lambert_fiber(rho), s, nullptr);
   EXPECT_EQ(t.photons, s.photons);
@@ -103,11 +100,7 @@ TEST(FiberBake, DirectRouteReproducesLambertSurface) {
 }
 
 TEST(FiberBake, BssrdfRouteReproducesLambertSurface) {
-  FiberBakeSettings s;
-  s.seed = 1;
-  s.resolution = 4;
-  s.photons = 200000;
-  s.threads = 2;
+  FiberBakeSettings s = weft::testing::bake_settings(4, 200000, 2);
   BssrdfRouteSettings grid;
   grid.u_bins = 90;
   const double rho = 0.6;
@@ -122,12 +115,8 @@ TEST(FiberBake, BssrdfRouteReproducesLambertSurface) {
 }
 
 TEST(FiberBake, BitIdenticalAtOneAndTwoThreads) {
-  FiberBakeSettings s;
-  s.seed = 1;
-  s.resolution = 4;
-  s.photons = 50000;
+  FiberBakeSettings s = weft::testing::bake_settings(4, 50000, 1);
   s.photons_per_task = 1000;
-  s.threads = 1;
   const auto a = bake_fiber_band_direct(lambert_fiber(0.5), s, nullptr);
   s.threads = 2;
   const auto b = bake_fiber_band_direct(lambert_fiber(0.5), s, nullptr);
@@ -136,10 +125,7 @@ TEST(FiberBake, BitIdenticalAtOneAndTwoThreads) {
 }
 
 TEST(FiberBake, CancellationKeepsWhatIsDone) {
-  FiberBakeSettings s;
-  s.seed = 1;
-  s.resolution = 4;
-  s.photons = 1000000;
+  FiberBakeSettings s = weft::testing::bake_settings(4, 1000000, 0);
   s.photons_per_task = 1000;
   int calls = 0;
   const auto t = bake_fiber_band_direct(lambert_fiber(0.5), s,

@@ -72,11 +72,8 @@ int count_outliers(const std::vector<double>& a, const std::vector<double>& sa,
 
 TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
   // No dye, non-absorbing inclusions: everything that hits the fiber leaves it.
-  FiberTableBakeOptions o;
-  o.resolution = 4;
-  o.photons_per_band = 1500;
-  o.passes = 2;
-  o.threads = 2;
+  const FiberTableBakeOptions o{
+      .resolution = 4, .photons_per_band = 1500, .threads = 2, .passes = 2};
   const auto r = bake_fiber_table(load_fiber_spec("white-cotton"), o);
   ASSERT_FALSE(r.cancelled);
   ASSERT_EQ(r.bands.size(), static_cast<size_t>(kNumBands));
@@ -130,11 +127,7 @@ TEST(FiberTableBake, DirectAndBssrdfRoutesAgreeWithinStatisticalError) {
   const FiberSpec spec = test_spec(20, 0.10, 0.01);
   const MediumBand mb = compute_medium_band(spec, 16);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
-  FiberBakeSettings s;
-  s.seed = 1;
-  s.resolution = 4;
-  s.photons = 60000;
-  s.threads = 2;
+  FiberBakeSettings s = weft::testing::bake_settings(4, 60000, 2);
   const int k = 5;
   const CellStats direct = cell_stats(k, [&](uint64_t seed) {
     s.seed = seed;
@@ -160,11 +153,7 @@ TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
   const FiberSpec spec = test_spec(8, 0.03, 0.005);
   const MediumBand mb = compute_medium_band(spec, 20);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
-  FiberBakeSettings s;
-  s.seed = 1;
-  s.resolution = 4;
-  s.photons = 60000;
-  s.threads = 2;
+  FiberBakeSettings s = weft::testing::bake_settings(4, 60000, 2);
   const CellStats st = cell_stats(6, [&](uint64_t seed) {
     s.seed = seed;
     return bake_fiber_band_direct(ph, s, nullptr);
@@ -192,11 +181,7 @@ TEST(FiberTableBake, FiberScatteringIsReciprocal) {
   const FiberSpec spec = test_spec(6, 0.04, 0.003);
   const MediumBand mb = compute_medium_band(spec, 10);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
-  FiberBakeSettings s;
-  s.seed = 1;
-  s.resolution = 2;
-  s.photons = 50000;
-  s.threads = 2;
+  FiberBakeSettings s = weft::testing::bake_settings(2, 50000, 2);
   s.far_field_s_bins = 4;
   s.far_field_psi_bins = 5;
   const int k = 6, ns = 4, np = 5;
@@ -232,11 +217,7 @@ TEST(FiberTableBake, FiberScatteringIsReciprocal) {
 }
 
 TEST(FiberTableBake, BitIdenticalAtOneAndTwoThreads) {
-  FiberTableBakeOptions o;
-  o.resolution = 4;
-  o.photons_per_band = 300;
-  o.passes = 2;
-  o.threads = 1;
+  FiberTableBakeOptions o{.resolution = 4, .photons_per_band = 300, .threads = 1, .passes = 2};
   const auto a = bake_fiber_table(load_fiber_spec("red-cotton"), o);
   o.threads = 2;
   const auto b = bake_fiber_table(load_fiber_spec("red-cotton"), o);

@@ -17,22 +17,10 @@ using namespace weft;
 
 namespace {
 
-TransportMedium medium(double mua, double mus, double g, double n) {
-  TransportMedium m;
-  m.mu_a = mua;
-  m.mu_s = mus;
-  m.n = n;
-  m.phase = PhaseFunction::henyey_greenstein(g);
-  return m;
-}
+const auto medium = weft::testing::hg_medium;
 
 CylinderBeamSetup beam(const TransportMedium& m, double radius, double n_out, const Vec3& dir) {
-  CylinderBeamSetup s;
-  s.medium = m;
-  s.radius = radius;
-  s.n_outside = n_out;
-  s.direction = dir;
-  return s;
+  return {.medium = m, .radius = radius, .n_outside = n_out, .direction = dir, .options = {}};
 }
 
 PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
@@ -298,13 +286,8 @@ TEST(TransportCylinder, Extremes) {
 }
 
 TEST(TransportCylinder, BadInputIsRejectedWithTheFieldNamed) {
-  auto message_of = [](const CylinderBeamSetup& s) -> std::string {
-    try {
-      simulate_cylinder_beam(s, batch(10, 1));
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "";
+  auto message_of = [](const CylinderBeamSetup& s) {
+    return weft::testing::error_of([&] { simulate_cylinder_beam(s, batch(10, 1)); });
   };
   EXPECT_NE(message_of(beam(medium(1, 1, 0, 1.5), 0, 1, {0, 0, -1})).find("radius"),
             std::string::npos);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdint>
 
+#include "weft/core/error.h"
+#include "weft/materials/fabric/fiber_bake.h"
 #include "weft/materials/fabric/transport_batch.h"
 
 namespace weft::testing {
@@ -18,6 +20,29 @@ inline PhotonBatchOptions batch_options(uint64_t photons, uint64_t seed, int thr
   b.threads = threads;
   b.photons_per_task = photons_per_task;
   return b;
+}
+
+// Settings of a one-band fiber bake (seed 1).
+inline FiberBakeSettings bake_settings(int resolution, uint64_t photons, int threads = 2) {
+  FiberBakeSettings s;
+  s.resolution = resolution, s.photons = photons, s.seed = 1, s.threads = threads;
+  return s;
+}
+
+// A homogeneous medium with a Henyey-Greenstein phase function.
+inline TransportMedium hg_medium(double mu_a, double mu_s, double g, double n) {
+  return {.mu_a = mu_a, .mu_s = mu_s, .n = n, .phase = PhaseFunction::henyey_greenstein(g)};
+}
+
+// The message of the weft::Error that f() throws, or "" when it throws none.
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
 }
 
 // |measured - reference| <= k * standard error (the reference's own error added in quadrature).

@@ -11,8 +11,8 @@
 //   z = -thickness (kBottom) has outward normal -z and index n_below outside.
 // * Cylinder: the axis is the x axis, the cross-section is the (y, z) plane and the medium fills
 //   y^2 + z^2 <= radius^2 (boundary kSurface, index n_outside outside). At the surface point of
-//   angle phi the fiber frame of DESIGN.md is n = (0, cos phi, sin phi) (outward), t = (1, 0, 0)
-//   (the axis) and b = n x t = (0, sin phi, -cos phi): cylinder_frame() returns it.
+//   angle phi the fiber frame (docs/fiber-bsdf.md) is n = (0, cos phi, sin phi) (outward), t = (1,
+//   0, 0) (the axis) and b = n x t = (0, sin phi, -cos phi): cylinder_frame() returns it.
 // * Boundaries: unpolarized Fresnel reflectance R at every hit from inside, total internal
 //   reflection included. The photon is reflected with probability R and transmitted otherwise
 //   (no splitting: every photon keeps one path, which keeps the walk free of recursion and the

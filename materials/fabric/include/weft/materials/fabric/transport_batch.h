@@ -5,6 +5,7 @@
 // callback is called on the calling thread and may cancel: the tasks done so far are kept, and
 // the status says how many photons they hold.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -47,32 +48,54 @@ struct MeanAccumulator {
   }
 };
 
-// Per-photon statistics of the energy books (PhotonTally): mean and standard error of each
-// fraction of the launched power, over the photons added.
+// Where the power of unit-weight photons went, as fractions with standard errors.
+struct PhotonFractions {
+  MeanEstimate specular;  // reflected at entry (MCML's rsp)
+  MeanEstimate exited;    // left the medium after entering
+  MeanEstimate absorbed;
+  MeanEstimate roulette;  // roulette losses minus gains (mean zero; nonzero by chance only)
+  MeanEstimate lost;      // interaction cap or endless path (see TransportOptions::max_events)
+  double energy_imbalance = 0;  // 1 - the sum of the means: zero up to rounding
+  uint64_t photons = 0;         // photons traced (fewer than asked when cancelled)
+  uint64_t scatterings = 0;     // scattering events in all
+  uint64_t reflections = 0;     // internal reflections in all
+};
+
+// Per-photon statistics of the energy books (PhotonTally): accumulators for each part of the
+// launched power, over the photons added.
 struct PhotonStats {
-  MeanAccumulator specular, exited, absorbed, roulette, lost;
+  enum Part { kSpecular, kExited, kAbsorbed, kRoulette, kLost, kParts };
+  std::array<MeanAccumulator, kParts> part;
   uint64_t photons = 0, scatterings = 0, reflections = 0;
 
   void add(const PhotonTally& photon) {
-    specular.add(photon.specular);
-    exited.add(photon.exited);
-    absorbed.add(photon.absorbed);
-    roulette.add(photon.roulette_loss - photon.roulette_gain);
-    lost.add(photon.lost);
+    const double values[kParts] = {photon.specular, photon.exited, photon.absorbed,
+                                   photon.roulette_loss - photon.roulette_gain, photon.lost};
+    for (int k = 0; k < kParts; ++k) part[k].add(values[k]);
     photons += 1;
     scatterings += photon.scatterings;
     reflections += photon.reflections;
   }
   PhotonStats& operator+=(const PhotonStats& o) {
-    specular += o.specular;
-    exited += o.exited;
-    absorbed += o.absorbed;
-    roulette += o.roulette;
-    lost += o.lost;
+    for (int k = 0; k < kParts; ++k) part[k] += o.part[k];
     photons += o.photons;
     scatterings += o.scatterings;
     reflections += o.reflections;
     return *this;
+  }
+  PhotonFractions fractions() const {
+    PhotonFractions f;
+    MeanEstimate* out[kParts] = {&f.specular, &f.exited, &f.absorbed, &f.roulette, &f.lost};
+    double sum = 0;
+    for (int k = 0; k < kParts; ++k) {
+      *out[k] = part[k].estimate(photons);
+      sum += out[k]->mean;
+    }
+    f.energy_imbalance = photons == 0 ? 0.0 : 1.0 - sum;
+    f.photons = photons;
+    f.scatterings = scatterings;
+    f.reflections = reflections;
+    return f;
   }
 };
 

@@ -24,17 +24,9 @@ struct CylinderBeamSetup {
   void validate() const;  // weft::Error naming the field
 };
 
-// Fractions of the power hitting the cylinder.
-struct CylinderBeamResult {
-  MeanEstimate specular;  // Fresnel reflection at entry
-  MeanEstimate exited;    // left the cylinder after entering (anywhere on the wall)
-  MeanEstimate absorbed;
-  MeanEstimate roulette;        // roulette losses minus gains (mean zero)
-  MeanEstimate lost;            // interaction cap
-  double energy_imbalance = 0;  // 1 - sum of the above means: zero up to rounding
-  uint64_t photons = 0;
-  uint64_t scatterings = 0;
-  uint64_t reflections = 0;
+// Fractions of the power hitting the cylinder (specular: Fresnel reflection at entry; exited:
+// left the cylinder after entering, anywhere on the wall).
+struct CylinderBeamResult : PhotonFractions {
   bool cancelled = false;
 };
 

@@ -20,21 +20,14 @@ struct SlabSetup {
   void validate() const;
 };
 
-struct SlabResult {
-  MeanEstimate rsp;  // specular: Fresnel reflection at entry
-  MeanEstimate rb;   // unscattered light leaving the top face after entering (internal bounces)
-  MeanEstimate rd;   // diffuse reflectance: scattered light leaving the top face
-  MeanEstimate tb;   // ballistic transmittance: unscattered light leaving the bottom face
-  MeanEstimate td;   // diffuse transmittance: scattered light leaving the bottom face
-  MeanEstimate tt;   // total transmittance td + tb
-  MeanEstimate absorbed;  // weight deposited in the medium
-  MeanEstimate roulette;  // roulette losses minus gains (mean zero; nonzero by chance only)
-  MeanEstimate lost;      // interaction cap reached (see TransportOptions::max_events)
-  // 1 - (rsp + rb + rd + tb + td + absorbed + roulette + lost): zero up to rounding.
-  double energy_imbalance = 0;
-  uint64_t photons = 0;      // photons actually traced (fewer than asked when cancelled)
-  uint64_t scatterings = 0;  // scattering events in all
-  uint64_t reflections = 0;  // internal reflections in all
+// The books (specular is MCML's rsp; exited = rb + rd + tb + td) and the exits split by face and
+// by whether the photon scattered.
+struct SlabResult : PhotonFractions {
+  MeanEstimate rb;  // unscattered light leaving the top face after entering (internal bounces)
+  MeanEstimate rd;  // diffuse reflectance: scattered light leaving the top face
+  MeanEstimate tb;  // ballistic transmittance: unscattered light leaving the bottom face
+  MeanEstimate td;  // diffuse transmittance: scattered light leaving the bottom face
+  MeanEstimate tt;  // total transmittance td + tb
   bool cancelled = false;
 };
 
