@@ -1,0 +1,105 @@
+// write_atomically: an output file appears whole or not at all, and no temporary is left behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include "test_util.h"
+#include "weft/core/atomic_file.h"
+
+using namespace weft;
+using weft::testing::error_of;
+using weft::testing::fresh_test_dir;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// The names in 'dir', to check that nothing but the expected files is there.
+std::vector<std::string> entries(const fs::path& dir) {
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+}  // namespace
+
+TEST(AtomicFile, FailingWriterLeavesNoFileAndNoTemporary) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "image.exr";
+  fs::path seen_tmp;
+  EXPECT_THROW(write_atomically(out,
+                                [&](const fs::path& tmp) {
+                                  seen_tmp = tmp;
+                                  std::ofstream(tmp) << "half written";
+                                  throw std::runtime_error("disk full");
+                                }),
+               std::runtime_error);
+  // The writer was given a sibling of the output, not the output itself.
+  EXPECT_EQ(seen_tmp.parent_path(), dir);
+  EXPECT_NE(seen_tmp, out);
+  EXPECT_TRUE(entries(dir).empty());
+}
+
+TEST(AtomicFile, FailureKeepsTheOldFile) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "table.exr";
+  std::ofstream(out) << "old";
+  EXPECT_THROW(write_atomically(out,
+                                [](const fs::path& tmp) {
+                                  std::ofstream(tmp) << "new but broken";
+                                  throw Error("broken");
+                                }),
+               Error);
+  EXPECT_EQ(slurp(out), "old");
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"table.exr"});
+}
+
+TEST(AtomicFile, SuccessReplacesTheFileWhole) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "image.png";
+  std::ofstream(out) << "a much longer old content that must not survive in part";
+  write_atomically(out, [&](const fs::path& tmp) {
+    // Writers such as OpenImageIO choose the format by the extension: the temporary keeps it.
+    EXPECT_EQ(tmp.extension(), ".png");
+    EXPECT_FALSE(fs::exists(tmp));
+    std::ofstream(tmp) << "new";
+    // Until the writer returns, the old file is still in place.
+    EXPECT_EQ(slurp(out), "a much longer old content that must not survive in part");
+  });
+  EXPECT_EQ(slurp(out), "new");
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"image.png"});
+}
+
+TEST(AtomicFile, TextVariantWritesTheBytesAsGiven) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "summary.json";
+  const std::string text("line 1\r\nline 2\n\0binary tail", 27);
+  write_text_atomically(out, text);
+  EXPECT_EQ(slurp(out), text);
+  write_text_atomically(out, "short");
+  EXPECT_EQ(slurp(out), "short");
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"summary.json"});
+}
+
+TEST(AtomicFile, MissingDirectoryIsAnErrorNamingThePath) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "missing" / "out.txt";
+  bool called = false;
+  const std::string msg =
+      error_of([&] { write_atomically(out, [&](const fs::path&) { called = true; }); });
+  EXPECT_NE(msg.find(out.string()), std::string::npos) << msg;
+  EXPECT_NE(msg.find("directory"), std::string::npos) << msg;
+  EXPECT_FALSE(called);  // fails before any work
+  EXPECT_NE(error_of([&] { write_text_atomically(out, "x"); }), "");
+  EXPECT_TRUE(entries(dir).empty());
+}

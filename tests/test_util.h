@@ -1,0 +1,54 @@
+#pragma once
+// Helpers every test executable may use: a fresh folder per test, the message of a weft::Error,
+// and the mean of repeated samples with its standard error.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include "weft/core/error.h"
+
+namespace weft::testing {
+
+// An empty folder for the running test, under the build folder: <build>/test_tmp/<suite>.<test>.
+// One per test, because ctest runs the tests of one executable as parallel processes.
+inline std::filesystem::path fresh_test_dir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  const std::filesystem::path dir = std::filesystem::path(WEFT_BINARY_DIR) / "test_tmp" /
+                                    (std::string(info->test_suite_name()) + "." + info->name());
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+// The message of the weft::Error that f throws, or "" when it throws none (any other exception
+// propagates and fails the test).
+inline std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// Mean of n samples sample(i), i = 0 .. n-1, and the standard error of that mean (from the
+// sample variance).
+struct SampleMean {
+  double mean = 0, std_error = 0;
+};
+inline SampleMean sample_mean(int n, const std::function<double(int i)>& sample) {
+  double sum = 0, sum2 = 0;
+  for (int i = 0; i < n; ++i) {
+    const double v = sample(i);
+    sum += v;
+    sum2 += v * v;
+  }
+  const double mean = sum / n;
+  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1))};
+}
+
+}  // namespace weft::testing
