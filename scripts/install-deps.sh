@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# Installs Weft's build and run dependencies from Debian 12 packages (see docs/PLATFORM notes in
-# README.md). Skips apt entirely when everything is already present.
+# Installs Weft's build and run dependencies from Debian 12 packages (the platform of README.md's
+# quick start). Skips apt entirely when everything is already present.
 set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config
   libembree-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev

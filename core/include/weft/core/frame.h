@@ -1,7 +1,8 @@
 #pragma once
 // Orthonormal frames. Local coordinates are (s, t, n) = (x, y, z), z along the normal.
-// A fiber frame uses the DESIGN.md convention: normal n (outward from the cylinder), tangent t
-// (fiber axis) and binormal b = n x t; in local coordinates t is x, b is y, n is z.
+// A fiber frame (the project's one convention, used by the fiber tables and docs/fiber-bsdf.md):
+// normal n (outward from the cylinder), tangent t (fiber axis) and binormal b = n x t; in local
+// coordinates t is x, b is y, n is z, so from_normal_tangent(n, t) builds it.
 #include <cmath>
 
 #include "weft/core/vec.h"
