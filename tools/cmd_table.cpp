@@ -1,5 +1,4 @@
 // weft table: inspect tabulated BSDF tables (info) and bake analytic materials into them (bake).
-#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -8,35 +7,10 @@
 #include "commands.h"
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
-#include "weft/core/math.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/registry.h"
 
 namespace weft::cli {
-namespace {
-
-// Directional albedo int f |cos| dwi of wo's bin, per channel, from the cell averages (the mean
-// |cos| of each wi cell by an 8 x 8 midpoint rule).
-std::vector<double> bin_albedo(const TabulatedBsdfTable& t, int wo_bin) {
-  const OctahedralGrid g = t.grid();
-  std::vector<double> out(t.channels, 0.0);
-  const double cell_sr = 4 * kPi / g.bins();
-  for (int wi = 0; wi < g.bins(); ++wi) {
-    const int x = wi % g.resolution, y = wi / g.resolution;
-    double cos_avg = 0;
-    for (int i = 0; i < 8; ++i)
-      for (int j = 0; j < 8; ++j)
-        cos_avg += std::abs(OctahedralGrid::to_direction({(x + (i + 0.5) / 8) / g.resolution,
-                                                          (y + (j + 0.5) / 8) / g.resolution})
-                                .z) /
-                   64;
-    for (int c = 0; c < t.channels; ++c) out[c] += t.at(wi, wo_bin, c) * cos_avg * cell_sr;
-  }
-  return out;
-}
-
-}  // namespace
-
 void add_table_command(CLI::App& app, Commands& commands) {
   auto* table = app.add_subcommand("table", "Tabulated BSDF tables (.exr): inspect or bake");
   table->require_subcommand(1);
@@ -55,6 +29,10 @@ void add_table_command(CLI::App& app, Commands& commands) {
                         float lo = t.values.front(), hi = lo;
                         for (float v : t.values) lo = std::min(lo, v), hi = std::max(hi, v);
                         const OctahedralGrid g = t.grid();
+                        // Light arriving along the normal (w_i = n), summed over all exits.
+                        const auto normal = t.directional_albedo(g.bin_of({0, 0, 1}));
+                        std::vector<double> albedo(t.channels);
+                        for (int c = 0; c < t.channels; ++c) albedo[c] = normal.total(c);
                         nlohmann::json j = {
                             {"file", info->file},
                             {"format_version", TabulatedBsdfTable::kFormatVersion},
@@ -66,7 +44,9 @@ void add_table_command(CLI::App& app, Commands& commands) {
                             {"checksum", t.checksum()},
                             {"min_per_sr", lo},
                             {"max_per_sr", hi},
-                            {"albedo_normal_incidence", bin_albedo(t, g.bin_of({0, 0, 1}))}};
+                            {"albedo_normal_incidence", albedo},
+                            {"reflectance_normal_incidence", normal.reflectance},
+                            {"transmittance_normal_incidence", normal.transmittance}};
                         if (info->json) {
                           std::cout << j.dump(2) << "\n";
                         } else {

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <numeric>
 #include <set>
+#include <utility>
 
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
@@ -77,12 +78,14 @@ OctahedralGrid::Footprint OctahedralGrid::bilinear(Vec2 p) const {
 namespace {
 
 // Integral of |cos theta| over the preimage of [a,b] x [c,d] (0 <= a < b, 0 <= c < d) in the
-// octahedral square coordinates u', v' in [-1, 1], where d omega = pi du' dv'. On this map
-// |cos theta| depends on rho = u' + v' only (1 - rho^2 on the upper half, 1 - (2 - rho)^2 on the
-// lower), so the integral is one-dimensional: int |cos|(rho) m(rho) d rho with m(rho) the length
-// of the cut u' + v' = rho through the rectangle. Both factors are polynomial between the
-// breakpoints, so 3-point Gauss-Legendre per piece is exact.
-double cos_integral_quadrant_rect(double a, double b, double c, double d) {
+// octahedral square coordinates u', v' in [-1, 1], where d omega = pi du' dv', above and below
+// the horizon. On this map |cos theta| depends on rho = u' + v' only (1 - rho^2 on the upper half,
+// 1 - (2 - rho)^2 on the lower), so the integral is one-dimensional: int |cos|(rho) m(rho) d rho
+// with m(rho) the length of the cut u' + v' = rho through the rectangle. Both factors are
+// polynomial between the breakpoints (the horizon rho = 1 among them, so every piece lies on one
+// side), so 3-point Gauss-Legendre per piece is exact.
+OctahedralGrid::CosineWeightedArea cos_integral_quadrant_rect(double a, double b, double c,
+                                                              double d) {
   double breaks[] = {a + c, a + d, b + c, b + d, 1.0};
   std::sort(std::begin(breaks), std::end(breaks));
   const double lo = a + c, hi = b + d;
@@ -90,27 +93,30 @@ double cos_integral_quadrant_rect(double a, double b, double c, double d) {
   auto abs_cos = [](double rho) { return rho <= 1 ? 1 - rho * rho : 1 - (2 - rho) * (2 - rho); };
   std::vector<double> x, w;
   gauss_legendre(3, x, w);
-  double sum = 0;
+  OctahedralGrid::CosineWeightedArea out;
   for (int k = 0; k + 1 < 5; ++k) {
     const double p0 = std::clamp(breaks[k], lo, hi), p1 = std::clamp(breaks[k + 1], lo, hi);
     if (!(p1 > p0)) continue;
     const double mid = 0.5 * (p0 + p1), half = 0.5 * (p1 - p0);
+    double sum = 0;
     for (int q = 0; q < 3; ++q)
       sum += w[q] * half * abs_cos(mid + half * x[q]) * m(mid + half * x[q]);
+    (mid < 1 ? out.upper : out.lower) += kPi * sum;
   }
-  return kPi * sum;
+  return out;
 }
 
 }  // namespace
 
-std::vector<double> OctahedralGrid::cosine_weighted_areas() const {
-  std::vector<double> out(static_cast<size_t>(resolution) * resolution, 0.0);
+std::vector<OctahedralGrid::CosineWeightedArea> OctahedralGrid::cosine_weighted_areas_by_side()
+    const {
+  std::vector<CosineWeightedArea> out(static_cast<size_t>(resolution) * resolution);
   for (int iy = 0; iy < resolution; ++iy)
     for (int ix = 0; ix < resolution; ++ix) {
       // The bin in u', v', split at the axes so that each piece lies in one quadrant.
       const double u0 = 2.0 * ix / resolution - 1, u1 = 2.0 * (ix + 1) / resolution - 1;
       const double v0 = 2.0 * iy / resolution - 1, v1 = 2.0 * (iy + 1) / resolution - 1;
-      double total = 0;
+      CosineWeightedArea& bin = out[static_cast<size_t>(iy) * resolution + ix];
       for (auto [ua, ub] : {std::pair{u0, std::min(u1, 0.0)}, std::pair{std::max(u0, 0.0), u1}})
         for (auto [va, vb] : {std::pair{v0, std::min(v1, 0.0)}, std::pair{std::max(v0, 0.0), v1}}) {
           if (!(ub > ua) || !(vb > va)) continue;
@@ -119,10 +125,18 @@ std::vector<double> OctahedralGrid::cosine_weighted_areas() const {
                        b = std::max(std::abs(ua), std::abs(ub));
           const double c = std::min(std::abs(va), std::abs(vb)),
                        d = std::max(std::abs(va), std::abs(vb));
-          total += cos_integral_quadrant_rect(a, b, c, d);
+          const CosineWeightedArea piece = cos_integral_quadrant_rect(a, b, c, d);
+          bin.upper += piece.upper;
+          bin.lower += piece.lower;
         }
-      out[static_cast<size_t>(iy) * resolution + ix] = total;
     }
+  return out;
+}
+
+std::vector<double> OctahedralGrid::cosine_weighted_areas() const {
+  const auto by_side = cosine_weighted_areas_by_side();
+  std::vector<double> out(by_side.size());
+  for (size_t k = 0; k < out.size(); ++k) out[k] = by_side[k].total();
   return out;
 }
 
@@ -306,6 +320,29 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
       throw Error(who, "", "cancelled");
   }
   return table;
+}
+
+TabulatedBsdfTable::DirectionalAlbedo TabulatedBsdfTable::directional_albedo(int wi_bin) const {
+  const OctahedralGrid g = grid();
+  if (wi_bin < 0 || wi_bin >= g.bins())
+    throw Error(
+        "", "wi_bin",
+        "must lie in [0, " + std::to_string(g.bins() - 1) + "], got " + std::to_string(wi_bin));
+  const auto d = g.cosine_weighted_areas_by_side();
+  const auto& di = d[static_cast<size_t>(wi_bin)];
+  DirectionalAlbedo out{std::vector<double>(channels, 0.0), std::vector<double>(channels, 0.0)};
+  for (int wo = 0; wo < g.bins(); ++wo) {
+    const auto& d_o = d[static_cast<size_t>(wo)];
+    // The shares of D_i D_o with both directions on one side, and on opposite sides, over D_i.
+    const double same = (di.upper * d_o.upper + di.lower * d_o.lower) / di.total();
+    const double opposite = (di.upper * d_o.lower + di.lower * d_o.upper) / di.total();
+    for (int c = 0; c < channels; ++c) {
+      const double f = at(wi_bin, wo, c);
+      out.reflectance[c] += f * same;
+      out.transmittance[c] += f * opposite;
+    }
+  }
+  return out;
 }
 
 }  // namespace weft

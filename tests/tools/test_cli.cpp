@@ -175,3 +175,29 @@ TEST(Cli, InterruptedBakeLeavesACompleteTableOrNone) {
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
 }
+
+TEST(Cli, TableInfoReportsTheAlbedoForLightFromTheNormal) {
+  // A Lambert table of reflectance 0.5: light from the normal is reflected, nothing transmitted.
+  // The figures are the library's (TabulatedBsdfTable::directional_albedo), printed per channel.
+  const fs::path dir = temp_dir();
+  const fs::path table = dir / "lambert.exr";
+  const CliRun bake =
+      run("table bake lambert --params '{\"reflectance\": 0.5}' -R 8 --spp 4 "
+          "--quiet -o '" +
+              table.string() + "'",
+          dir);
+  ASSERT_EQ(bake.exit_code, 0) << bake.err;
+  const CliRun info = run("table info --json '" + table.string() + "'", dir);
+  ASSERT_EQ(info.exit_code, 0) << info.err;
+  const auto j = nlohmann::json::parse(info.out);
+  const auto t = weft::TabulatedBsdfTable::read_exr(table);
+  const auto normal = t.directional_albedo(t.grid().bin_of({0, 0, 1}));
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(j["albedo_normal_incidence"][c].get<double>(), normal.total(c));
+    EXPECT_EQ(j["reflectance_normal_incidence"][c].get<double>(), normal.reflectance[c]);
+    EXPECT_EQ(j["transmittance_normal_incidence"][c].get<double>(), normal.transmittance[c]);
+  }
+  // Reflected, not transmitted: at R = 8 the exit bins straddling the horizon can shift at most
+  // 0.5 / pi times their projected solid angle on one side (0.245 sr) between the two: 0.039.
+  EXPECT_GT(normal.reflectance[0], 10 * normal.transmittance[0]);
+}

@@ -65,6 +65,14 @@ struct OctahedralGrid {
   // D_k = integral over bin k of |cos theta| d omega (exact, to rounding): the weight of a
   // cosine-weighted cell average, and sum_k D_k = 2 pi.
   std::vector<double> cosine_weighted_areas() const;
+  // The same split at the horizon: upper = int max(cos theta, 0) d omega and lower =
+  // int max(-cos theta, 0) d omega over bin k. Bins along the square's inner diamond straddle the
+  // horizon and have both parts.
+  struct CosineWeightedArea {
+    double upper = 0, lower = 0;
+    double total() const { return upper + lower; }
+  };
+  std::vector<CosineWeightedArea> cosine_weighted_areas_by_side() const;
 };
 
 // f(wo, wi) -> one value per channel (written into 'values'); must be thread-safe.
@@ -138,6 +146,20 @@ struct TabulatedBsdfTable {
   // field at fault (missing file, not EXR, truncated or corrupt data, wrong version, sizes,
   // channels, non-finite or negative values).
   static TabulatedBsdfTable read_exr(const std::filesystem::path& path);
+
+  // Where the light arriving in one wi bin goes, per channel: the directional albedo
+  // rho(w_i) = int f(w_i, w_o) |cos theta_o| d w_o over all exits, averaged over the wi bin with
+  // weight |cos theta_i| (the weighting of the cells, docs/fiber-bsdf.md "What a table cell
+  // stores", which makes the total exact for a table of such cells: sum_o f[i][o] D_o).
+  // reflectance counts exits on the side of the surface the light came from (cos theta_o and
+  // cos theta_i of one sign), transmittance the others. A bin straddling the horizon holds one
+  // average for both sides, so each side of it gets its share of the bin's projected solid angle:
+  // the split is approximate in those bins, the total is not.
+  struct DirectionalAlbedo {
+    std::vector<double> reflectance, transmittance;  // per channel
+    double total(int channel) const { return reflectance[channel] + transmittance[channel]; }
+  };
+  DirectionalAlbedo directional_albedo(int wi_bin) const;
 };
 
 }  // namespace weft
