@@ -69,18 +69,22 @@ ProgressCallback progress_bar(bool quiet) {
   };
 }
 
+std::optional<double> finite_number(const std::string& text) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (...) {
+    return std::nullopt;
+  }
+  if (used != text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 std::vector<double> parse_range(const std::string& text, const std::string& option_name) {
   auto to_number = [&](const std::string& s) {
-    size_t used = 0;
-    double v;
-    try {
-      v = std::stod(s, &used);
-    } catch (...) {
-      throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
-    }
-    if (used != s.size() || !std::isfinite(v))
-      throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
-    return v;
+    if (const auto v = finite_number(s)) return *v;
+    throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
   };
   std::vector<double> out;
   if (text.find(':') != std::string::npos) {

@@ -3,6 +3,7 @@
 // stderr, and Ctrl-C handling that asks long work to stop cleanly.
 #include <CLI/CLI.hpp>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ ProgressCallback progress_bar(bool quiet);
 // Installs the SIGINT handler used by progress_bar (idempotent).
 void install_interrupt_handler();
 bool interrupted();
+
+// The finite number that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
+std::optional<double> finite_number(const std::string& text);
 
 // Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers.
 std::vector<double> parse_range(const std::string& text, const std::string& option_name);

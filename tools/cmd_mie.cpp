@@ -18,7 +18,8 @@ namespace weft::cli {
 namespace {
 
 // Options arrive as text so that malformed and non-finite values are reported with the option's
-// name, like every other input error.
+// name, like every other input error. Ranges are the library's to check (mie.h): its errors name
+// the field (m, x, particle_n, host_n, radius_um, wavelength_nm, size.sigma).
 struct MieOptions {
   std::string m_re, m_im, x;
   std::string particle_n, particle_k, host_n, radius_um, wavelength_nm, sigma;
@@ -28,16 +29,13 @@ struct MieOptions {
 
 std::optional<double> number(const std::string& text, const std::string& option) {
   if (text.empty()) return std::nullopt;
-  size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (...) {
-    throw Error("", option, "'" + text + "' is not a number");
-  }
-  if (used != text.size()) throw Error("", option, "'" + text + "' is not a number");
-  if (!std::isfinite(v)) throw Error("", option, "must be finite, got '" + text + "'");
-  return v;
+  if (const auto v = finite_number(text)) return v;
+  throw Error("", option, "'" + text + "' is not a finite number");
+}
+
+double required(const std::optional<double>& v, const std::string& option) {
+  if (!v) throw Error("", option, "is required here");
+  return *v;
 }
 
 std::string format_g(double v) {
@@ -46,22 +44,27 @@ std::string format_g(double v) {
   return buf;
 }
 
-double positive(const std::optional<double>& v, const std::string& option) {
-  if (!v) throw Error("", option, "is required here");
-  if (!(*v > 0)) throw Error("", option, "must be > 0");
-  return *v;
-}
-
-double non_negative(const std::optional<double>& v, const std::string& option) {
-  if (!v) return 0.0;
-  if (*v < 0) throw Error("", option, "must be >= 0 (k >= 0 is absorbing)");
-  return *v;
-}
-
 nlohmann::json complex_parts(const std::vector<std::complex<double>>& s, bool imag) {
   nlohmann::json a = nlohmann::json::array();
   for (const auto& v : s) a.push_back(imag ? v.imag() : v.real());
   return a;
+}
+
+// One sphere's efficiencies, g, and (at the requested angles) amplitudes and phase function.
+void add_sphere(nlohmann::json& j, const MieResult& res, const std::vector<double>& angles_deg) {
+  j["qext"] = res.qext;
+  j["qsca"] = res.qsca;
+  j["qabs"] = res.qabs;
+  j["qback"] = res.qback;
+  j["g"] = res.g;
+  j["terms"] = res.terms;
+  if (angles_deg.empty()) return;
+  j["angles_deg"] = angles_deg;
+  j["s1_re"] = complex_parts(res.s1, false);
+  j["s1_im"] = complex_parts(res.s1, true);
+  j["s2_re"] = complex_parts(res.s2, false);
+  j["s2_im"] = complex_parts(res.s2, true);
+  j["phase_function_per_sr"] = mie_phase_function(res);
 }
 
 int run_mie(const MieOptions& o) {
@@ -89,6 +92,7 @@ int run_mie(const MieOptions& o) {
     throw Error("", "--m-re",
                 "give --m-re/--m-im/--x, or --particle-n/--host-n/--radius-um/--wavelength-nm");
 
+  // Scattering angles are this command's input: the library sees only their cosines.
   std::vector<double> angles_deg, mu;
   if (!o.angles_deg.empty()) {
     angles_deg = parse_range(o.angles_deg, "--angles-deg");
@@ -100,42 +104,18 @@ int run_mie(const MieOptions& o) {
 
   nlohmann::json j;
   if (relative) {
-    const double mr = positive(m_re, "--m-re");
-    const double mi = non_negative(m_im, "--m-im");
-    const double xv = positive(x, "--x");
-    if (xv > kMieMaxSizeParameter || xv < kMieMinSizeParameter)
-      throw Error("", "--x", "outside the accepted range 1e-12 .. 1e7");
-    if (std::abs(std::complex<double>(mr, mi)) * xv > kMieMaxMx)
-      throw Error("", "--m-re", "|m| x above the limit 1e8");
-    const MieResult res = mie_sphere({mr, mi}, xv, mu);
-    j = {{"x", res.x},         {"m_re", mr},       {"m_im", mi},
-         {"qext", res.qext},   {"qsca", res.qsca}, {"qabs", res.qabs},
-         {"qback", res.qback}, {"g", res.g},       {"terms", res.terms}};
-    if (!mu.empty()) {
-      j["angles_deg"] = angles_deg;
-      j["s1_re"] = complex_parts(res.s1, false);
-      j["s1_im"] = complex_parts(res.s1, true);
-      j["s2_re"] = complex_parts(res.s2, false);
-      j["s2_im"] = complex_parts(res.s2, true);
-      j["phase_function_per_sr"] = mie_phase_function(res);
-    }
+    const std::complex<double> m(required(m_re, "--m-re"), m_im.value_or(0.0));
+    const MieResult res = mie_sphere(m, required(x, "--x"), mu);
+    j = {{"x", res.x}, {"m_re", m.real()}, {"m_im", m.imag()}};
+    add_sphere(j, res, angles_deg);
   } else {
-    const double n = positive(pn, "--particle-n");
-    const double k = non_negative(pk, "--particle-k");
-    const double h = positive(hn, "--host-n");
-    const double radius = positive(r, "--radius-um");
-    const double lambda = positive(wl, "--wavelength-nm");
+    const double n = required(pn, "--particle-n"), k = pk.value_or(0.0);
+    const double h = required(hn, "--host-n"), radius = required(r, "--radius-um");
+    const double lambda = required(wl, "--wavelength-nm");
     const double xv = mie_size_parameter(h, radius, lambda);
-    if (xv < kMieMinSizeParameter)
-      throw Error("", "--radius-um", "sphere too small for the wavelength (x below 1e-12)");
-    if (xv > kMieMaxSizeParameter || std::hypot(n, k) / h * xv > kMieMaxMx)
-      throw Error("", "--radius-um",
-                  "sphere too large for the wavelength (x or |m| x above the limit)");
     j = {{"particle_n", n},         {"particle_k", k}, {"host_n", h},   {"radius_um", radius},
          {"wavelength_nm", lambda}, {"x", xv},         {"m_re", n / h}, {"m_im", k / h}};
     if (sigma) {
-      if (!(*sigma > 0) || *sigma > kMaxLognormalSigma)
-        throw Error("", "--lognormal-sigma", "must lie in (0, 1]");
       const MieEnsemble e =
           mie_ensemble(n, k, h, SizeDistribution::lognormal(radius, *sigma), lambda, mu);
       j["distribution"] = "lognormal";
@@ -157,23 +137,10 @@ int run_mie(const MieOptions& o) {
       const MieResult res = mie_sphere_physical(n, k, h, radius, lambda, mu);
       const double area = kPi * radius * radius;
       j["distribution"] = "monodisperse";
-      j["qext"] = res.qext;
-      j["qsca"] = res.qsca;
-      j["qabs"] = res.qabs;
-      j["qback"] = res.qback;
-      j["g"] = res.g;
-      j["terms"] = res.terms;
+      add_sphere(j, res, angles_deg);
       j["cext_um2"] = res.qext * area;
       j["csca_um2"] = res.qsca * area;
       j["cabs_um2"] = res.qabs * area;
-      if (!mu.empty()) {
-        j["angles_deg"] = angles_deg;
-        j["s1_re"] = complex_parts(res.s1, false);
-        j["s1_im"] = complex_parts(res.s1, true);
-        j["s2_re"] = complex_parts(res.s2, false);
-        j["s2_im"] = complex_parts(res.s2, true);
-        j["phase_function_per_sr"] = mie_phase_function(res);
-      }
     }
   }
 

@@ -33,17 +33,10 @@ void require_finite(double v, const char* option, bool non_negative) {
 
 double parse_thickness_mm(const std::string& text) {
   if (text == "inf" || text == "infinity") return std::numeric_limits<double>::infinity();
-  size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (...) {
-    throw Error("", "--thickness-mm", "'" + text + "' is not a number or 'inf'");
-  }
-  if (used != text.size() || !std::isfinite(v))
-    throw Error("", "--thickness-mm", "'" + text + "' is not a finite number or 'inf'");
-  if (!(v > 0)) throw Error("", "--thickness-mm", "must be > 0");
-  return v;
+  const auto v = finite_number(text);
+  if (!v) throw Error("", "--thickness-mm", "'" + text + "' is not a finite number or 'inf'");
+  if (!(*v > 0)) throw Error("", "--thickness-mm", "must be > 0");
+  return *v;
 }
 
 SlabSetup make_setup(const SlabOptions& o) {
