@@ -1,5 +1,8 @@
 #include "weft/materials/table_cache.h"
 
+#include <map>
+#include <memory>
+#include <string>
 #include <system_error>
 
 #include "weft/core/error.h"
@@ -14,6 +17,23 @@ std::string canonical_key(const std::filesystem::path& file) {
   return canon.string();
 }
 
+// The entry of 'slots' for the canonical path of 'file', loaded on first use; a load that fails
+// leaves no entry, so the next request tries again. The caller holds the cache's lock.
+template <class T, class Load>
+std::shared_ptr<const T> load_once(std::map<std::string, std::shared_ptr<const T>>& slots,
+                                   const std::string& key, const Load& load) {
+  auto& slot = slots[key];
+  if (!slot) {
+    try {
+      slot = load(key);
+    } catch (...) {
+      slots.erase(key);
+      throw;
+    }
+  }
+  return slot;
+}
+
 }  // namespace
 
 std::shared_ptr<const TabulatedBsdfData> load_tabulated_bsdf(const std::filesystem::path& file) {
@@ -23,31 +43,15 @@ std::shared_ptr<const TabulatedBsdfData> load_tabulated_bsdf(const std::filesyst
 std::shared_ptr<const TabulatedBsdfData> TableCache::tabulated(const std::filesystem::path& file) {
   const std::string key = canonical_key(file);
   std::lock_guard lock(mutex_);
-  auto& slot = tables_[key];
-  if (!slot) {
-    try {
-      slot = load_tabulated_bsdf(key);
-    } catch (...) {
-      tables_.erase(key);
-      throw;
-    }
-  }
-  return slot;
+  return load_once(tables_, key, [](const std::string& path) { return load_tabulated_bsdf(path); });
 }
 
 std::shared_ptr<const NbrdfNetwork> TableCache::nbrdf(const std::filesystem::path& file) {
   const std::string key = canonical_key(file);
   std::lock_guard lock(mutex_);
-  auto& slot = networks_[key];
-  if (!slot) {
-    try {
-      slot = std::make_shared<const NbrdfNetwork>(NbrdfNetwork::load(key));
-    } catch (...) {
-      networks_.erase(key);
-      throw;
-    }
-  }
-  return slot;
+  return load_once(networks_, key, [](const std::string& path) {
+    return std::make_shared<const NbrdfNetwork>(NbrdfNetwork::load(path));
+  });
 }
 
 size_t TableCache::size() const {
