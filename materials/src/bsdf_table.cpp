@@ -41,20 +41,14 @@ Vec3 OctahedralGrid::bin_center(int bin) const {
 
 int OctahedralGrid::wrapped_bin(int x, int y) const {
   const int r = resolution;
-  if (x < 0) {
-    x = -x - 1;
-    y = r - 1 - y;
-  } else if (x >= r) {
-    x = 2 * r - 1 - x;
-    y = r - 1 - y;
-  }
-  if (y < 0) {
-    y = -y - 1;
-    x = r - 1 - x;
-  } else if (y >= r) {
-    y = 2 * r - 1 - y;
-    x = r - 1 - x;
-  }
+  // Crossing the edge across 'a' reflects a back inside and mirrors the other coordinate b.
+  auto fold = [r](int& a, int& b) {
+    if (a >= 0 && a < r) return;
+    a = a < 0 ? -a - 1 : 2 * r - 1 - a;
+    b = r - 1 - b;
+  };
+  fold(x, y);
+  fold(y, x);
   return y * r + x;
 }
 
