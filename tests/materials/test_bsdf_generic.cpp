@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "chi2.h"
+#include "test_util.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
 
@@ -23,11 +24,7 @@ struct Material {
 };
 
 std::vector<Material> all_materials() {
-  // One folder per test: ctest runs tests as parallel processes.
-  const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_generic_tmp" /
-                       ::testing::UnitTest::GetInstance()->current_test_info()->name();
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_test_dir();
   const auto fiber = ClassicFiberBsdf::create(Rgb(0.6, 0.3, 0.2), {MicrofacetModel::kGgx, 0.3});
   auto t = TabulatedBsdfTable::from_function(
       8, 3,

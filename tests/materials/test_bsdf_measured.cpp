@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "chi2.h"
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/materials/bsdfs.h"
 #include "weft/materials/measured_nbrdf.h"
@@ -42,15 +43,6 @@ std::vector<InplaneRow> read_inplane(const fs::path& file) {
     rows.push_back({v.at(0), v.at(1), {v.at(2), v.at(3), v.at(4)}});
   }
   return rows;
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
 }
 
 }  // namespace
@@ -119,8 +111,7 @@ TEST(MeasuredNbrdf, UnknownNameListsTheValidOnes) {
 }
 
 TEST(MeasuredNbrdf, MalformedWeightFilesNameFileAndBlock) {
-  const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_measured_tmp";
-  fs::create_directories(dir);
+  const fs::path dir = fresh_test_dir();
   std::ifstream src(kData / "merl-red-fabric" / "nbrdf_weights.txt");
   const std::string good((std::istreambuf_iterator<char>(src)), std::istreambuf_iterator<char>());
   auto write = [&](const std::string& name, const std::string& text) {
@@ -149,5 +140,4 @@ TEST(MeasuredNbrdf, MalformedWeightFilesNameFileAndBlock) {
   }
   const std::string missing = error_of([&] { NbrdfNetwork::load(dir / "none.txt"); });
   EXPECT_NE(missing.find("none.txt"), std::string::npos) << missing;
-  fs::remove_all(dir);
 }

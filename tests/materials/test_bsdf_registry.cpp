@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/materials/bsdfs.h"
 #include "weft/materials/registry.h"
@@ -20,10 +21,7 @@ struct Fixture {
   fs::path dir;
   MaterialContext ctx;
   Fixture() {
-    // One folder per test: ctest runs tests as parallel processes.
-    dir = fs::path(WEFT_BINARY_DIR) / "test_registry_tmp" /
-          ::testing::UnitTest::GetInstance()->current_test_info()->name();
-    fs::remove_all(dir);
+    dir = weft::testing::fresh_test_dir();
     fs::create_directories(dir / "tables");
     auto f = [](const Vec3&, const Vec3& wi, std::span<double> v) {
       v[0] = v[1] = v[2] = 0.1 + 0.1 * wi.z * wi.z;
@@ -41,12 +39,7 @@ struct Fixture {
 };
 
 std::string error_of(const std::string& type, const json& params, const MaterialContext& ctx) {
-  try {
-    make_bsdf(type, params, ctx);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of([&] { make_bsdf(type, params, ctx); });
 }
 
 // The error must name the file and the full field path.

@@ -14,6 +14,7 @@
 #include <fstream>
 #include <set>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
@@ -22,25 +23,10 @@
 #include "weft/materials/lambert.h"
 
 using namespace weft;
+using namespace weft::testing;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path temp_dir(const std::string& name) {
-  const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_table_tmp" / name;
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 // A small table with distinct, exactly representable values and full metadata.
 TabulatedBsdfTable sample_table(int resolution, int channels) {
@@ -224,7 +210,7 @@ TEST(TableFromFunction, RejectsBadInputAndBadValues) {
 }
 
 TEST(TableExr, RoundTripIsBitExactWithMetadata) {
-  const fs::path dir = temp_dir("roundtrip");
+  const fs::path dir = fresh_test_dir();
   for (int channels : {3, kNumBands}) {
     const auto t = sample_table(channels == 3 ? 6 : 3, channels);
     const fs::path p = dir / ("t" + std::to_string(channels) + ".exr");
@@ -243,7 +229,7 @@ TEST(TableExr, RoundTripIsBitExactWithMetadata) {
 }
 
 TEST(TableExr, WriteValidatesAndLeavesNoPartialFile) {
-  const fs::path dir = temp_dir("write");
+  const fs::path dir = fresh_test_dir();
   auto t = sample_table(4, 3);
   t.values[100] = -1.0f;
   const fs::path p = dir / "bad.exr";
@@ -261,7 +247,7 @@ TEST(TableExr, WriteValidatesAndLeavesNoPartialFile) {
 }
 
 TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
-  const fs::path dir = temp_dir("damaged");
+  const fs::path dir = fresh_test_dir();
   const std::vector<std::string> rgb = {"R", "G", "B"};
   struct Case {
     std::string name, must_mention;
@@ -276,6 +262,21 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
     in.read(bytes.data(), static_cast<std::streamsize>(keep));
     std::ofstream(p, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(keep));
   };
+  // Otherwise good 2 x 2 RGB tables with one header attribute changed or left out.
+  auto with_int = [&](const char* name, int value) {
+    return [&rgb, name, value](const fs::path& p) {
+      write_raw(p, 2, rgb, [&](Imf::Header& h) { h.insert(name, Imf::IntAttribute(value)); });
+    };
+  };
+  auto with_string = [&](const char* name, const char* value) {
+    return [&rgb, name, value](const fs::path& p) {
+      write_raw(p, 2, rgb, [&](Imf::Header& h) { h.insert(name, Imf::StringAttribute(value)); });
+    };
+  };
+  auto without = [&](const char* name) {
+    return
+        [&rgb, name](const fs::path& p) { write_raw(p, 2, rgb, [](Imf::Header&) {}, {}, {name}); };
+  };
   const Case cases[] = {
       {"missing.exr", "no such", [](const fs::path&) {}},
       {"text.exr", "not an OpenEXR", [](const fs::path& p) { std::ofstream(p) << "hello"; }},
@@ -289,19 +290,10 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
          const std::string junk(600, '\x5a');
          f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
        }},
-      {"version.exr", "weft_format_version",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb,
-                   [](Imf::Header& h) { h.insert("weft_format_version", Imf::IntAttribute(3)); });
-       }},
+      {"version.exr", "weft_format_version", with_int("weft_format_version", 3)},
       // The stored quantity must be the one every reader assumes.
-      {"plain_average.exr", "cell_average",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb,
-                   [](Imf::Header& h) { h.insert("cell_average", Imf::StringAttribute("plain")); });
-       }},
-      {"no_cell_average.exr", "cell_average",
-       [&](const fs::path& p) { write_raw(p, 2, rgb, [](Imf::Header&) {}, {}, {"cell_average"}); }},
+      {"plain_average.exr", "cell_average", with_string("cell_average", "plain")},
+      {"no_cell_average.exr", "cell_average", without("cell_average")},
       // Version 1 tables of 'weft table bake' held plain averages and did not say so.
       {"v1_plain.exr", "re-bake",
        [&](const fs::path& p) {
@@ -309,39 +301,13 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
                    [](Imf::Header& h) { h.insert("weft_format_version", Imf::IntAttribute(1)); },
                    {}, {"cell_average"});
        }},
-      {"nochecksum.exr", "values_fnv1a64",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb, [](Imf::Header&) {}, {}, {"values_fnv1a64"});
-       }},
-      {"noversion.exr", "weft_format_version",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb, [](Imf::Header&) {}, {}, {"weft_format_version"});
-       }},
-      {"param.exr", "parameterization",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb, [](Imf::Header& h) {
-           h.insert("parameterization", Imf::StringAttribute("theta-phi"));
-         });
-       }},
-      {"units.exr", "units",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb,
-                   [](Imf::Header& h) { h.insert("units", Imf::StringAttribute("1/m")); });
-       }},
-      {"kind.exr", "kind",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb,
-                   [](Imf::Header& h) { h.insert("kind", Imf::StringAttribute("hair")); });
-       }},
-      {"size.exr", "dataWindow",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb, [](Imf::Header& h) { h.insert("resolution", Imf::IntAttribute(3)); });
-       }},
-      {"bands.exr", "bands",
-       [&](const fs::path& p) {
-         write_raw(p, 2, rgb,
-                   [](Imf::Header& h) { h.insert("bands", Imf::StringAttribute("xyz")); });
-       }},
+      {"nochecksum.exr", "values_fnv1a64", without("values_fnv1a64")},
+      {"noversion.exr", "weft_format_version", without("weft_format_version")},
+      {"param.exr", "parameterization", with_string("parameterization", "theta-phi")},
+      {"units.exr", "units", with_string("units", "1/m")},
+      {"kind.exr", "kind", with_string("kind", "hair")},
+      {"size.exr", "dataWindow", with_int("resolution", 3)},
+      {"bands.exr", "bands", with_string("bands", "xyz")},
       {"channels.exr", "channels",
        [&](const fs::path& p) {
          write_raw(p, 2, {"R", "G"}, [](Imf::Header&) {});
@@ -375,7 +341,7 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
 TEST(TableExr, VersionOneFiberBakesAreReadAsCosineWeighted) {
   // Fiber bakes of format version 1 stated their quantity in their "definition"; they stay
   // readable. (Plain averages of version 1 are rejected: DamagedFilesNameTheFileAndTheFault.)
-  const fs::path p = temp_dir("v1") / "fiber.exr";
+  const fs::path p = fresh_test_dir() / "fiber.exr";
   write_raw(p, 2, {"R", "G", "B"},
             [](Imf::Header& h) {
               h.insert("weft_format_version", Imf::IntAttribute(1));
