@@ -10,44 +10,39 @@
 
 #include <cmath>
 
+#include "test_util.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 
 using namespace weft;
 using nlohmann::json;
+using weft::testing::sample_mean;
+using weft::testing::SampleMean;
 
 namespace {
 
-struct Estimate {
-  double mean = 0, stderr_ = 0;
-};
-
 // Mean channel-average radiance over n camera samples spread over the film.
-Estimate estimate(const RenderScene& scene, const Camera& cam, const RenderSettings& s, int n) {
-  double sum = 0, sum2 = 0;
+SampleMean estimate(const RenderScene& scene, const Camera& cam, const RenderSettings& s, int n) {
   RayCounts rays;
-  for (int i = 0; i < n; ++i) {
+  return sample_mean(n, [&](int i) {
     Rng rng(s.seed, uint64_t(i), 0);
     const Ray ray = cam.generate_ray(rng.uniform(), rng.uniform(), 1.0);
-    const double v = trace_path(scene, ray, s, rng, rays).average();
-    sum += v;
-    sum2 += v * v;
-  }
-  const double mean = sum / n;
-  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1))};
+    return trace_path(scene, ray, s, rng, rays).average();
+  });
+}
+
+// A faceted unit sphere at the origin; 'inward' turns its normals to the inside.
+json unit_sphere(const std::string& name, const std::string& material, int subdivisions,
+                 bool inward) {
+  return {{"type", "sphere"},    {"name", name},   {"material", material},
+          {"center", {0, 0, 0}}, {"radius", 1.0},  {"subdivisions", subdivisions},
+          {"inward", inward},    {"smooth", false}};
 }
 
 SceneDescription sphere_in_environment(double albedo) {
   const json j = {
-      {"objects",
-       {{{"type", "sphere"},
-         {"name", "ball"},
-         {"material", "white"},
-         {"center", {0, 0, 0}},
-         {"radius", 1.0},
-         {"subdivisions", 3},
-         {"smooth", false}}}},
+      {"objects", {unit_sphere("ball", "white", 3, false)}},
       {"materials", {{"white", {{"type", "lambert"}, {"params", {{"reflectance", albedo}}}}}}},
       {"lights", {{{"type", "environment"}, {"radiance", 1.0}}}}};
   return parse_scene_description(j, ".", "furnace.json");
@@ -55,15 +50,7 @@ SceneDescription sphere_in_environment(double albedo) {
 
 SceneDescription emitting_enclosure(double albedo, double emission) {
   const json j = {
-      {"objects",
-       {{{"type", "sphere"},
-         {"name", "room"},
-         {"material", "wall"},
-         {"center", {0, 0, 0}},
-         {"radius", 1.0},
-         {"subdivisions", 2},
-         {"inward", true},
-         {"smooth", false}}}},
+      {"objects", {unit_sphere("room", "wall", 2, true)}},
       {"materials",
        {{"wall",
          {{"type", "lambert"}, {"params", {{"reflectance", albedo}}}, {"emission", emission}}}}}};
@@ -91,10 +78,9 @@ TEST(Furnace, SphereInUniformEnvironmentHasRadianceAlbedo) {
       s.sampling = mode;
       s.seed = 7;
       // Only rays that hit the sphere: aim at points on the sphere's silhouette disc.
-      double sum = 0, sum2 = 0;
-      const int n = 40000;
       RayCounts rays;
-      for (int i = 0; i < n; ++i) {
+      int missed = 0;
+      const SampleMean e = sample_mean(40000, [&](int i) {
         Rng rng(s.seed, uint64_t(i));
         const double r = 0.95 * std::sqrt(rng.uniform()), phi = 2 * M_PI * rng.uniform();
         const Vec3 target{r * std::cos(phi), r * std::sin(phi), 0};
@@ -102,13 +88,12 @@ TEST(Furnace, SphereInUniformEnvironmentHasRadianceAlbedo) {
         const double v = trace_path(scene, {cam.position, normalize(target - cam.position)}, s, rng,
                                     rays, &first)
                              .average();
-        ASSERT_EQ(first, 0);
-        sum += v;
-        sum2 += v * v;
-      }
-      const double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1));
-      EXPECT_LT(se, 0.01 * albedo);  // the check below must be able to fail
-      EXPECT_NEAR(mean, albedo, 4 * se + 1e-12);
+        missed += first != 0;
+        return v;
+      });
+      ASSERT_EQ(missed, 0);
+      EXPECT_LT(e.std_error, 0.01 * albedo);  // the check below must be able to fail
+      EXPECT_NEAR(e.mean, albedo, 4 * e.std_error + 1e-12);
     }
   }
 }
@@ -134,9 +119,9 @@ TEST(Furnace, EmittingEnclosureReachesLeOverOneMinusAlbedo) {
     s.max_depth = 200;
     s.sampling = mode;
     s.seed = 3;
-    const Estimate e = estimate(scene, cam, s, 40000);
-    EXPECT_LT(e.stderr_, 0.01);
-    EXPECT_NEAR(e.mean, le / (1 - albedo), 4 * e.stderr_);
+    const SampleMean e = estimate(scene, cam, s, 40000);
+    EXPECT_LT(e.std_error, 0.01);
+    EXPECT_NEAR(e.mean, le / (1 - albedo), 4 * e.std_error);
   }
 }
 
@@ -151,8 +136,8 @@ TEST(Furnace, MaxDepthTruncatesTheSeries) {
     s.max_depth = depth;
     s.rr_depth = 1000;  // no roulette: the truncation alone is tested
     s.seed = 11;
-    const Estimate e = estimate(scene, cam, s, 20000);
+    const SampleMean e = estimate(scene, cam, s, 20000);
     const double expected = le * (1 - std::pow(albedo, depth + 1)) / (1 - albedo);
-    EXPECT_NEAR(e.mean, expected, 4 * e.stderr_ + 1e-12);
+    EXPECT_NEAR(e.mean, expected, 4 * e.std_error + 1e-12);
   }
 }

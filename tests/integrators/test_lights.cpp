@@ -16,27 +16,37 @@
 
 #include <cmath>
 
+#include "test_util.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 
 using namespace weft;
 using nlohmann::json;
+using weft::testing::sample_mean;
+using weft::testing::SampleMean;
 
 namespace {
 
 constexpr double kRho = 0.8;
 
+// A quad with its first side along x.
+json quad(const std::string& name, const std::string& material, const json& center,
+          const json& normal, const json& size) {
+  return {{"type", "quad"},   {"name", name},         {"material", material}, {"center", center},
+          {"normal", normal}, {"tangent", {1, 0, 0}}, {"size", size}};
+}
+
 json floor_scene() {
-  return {{"objects",
-           {{{"type", "quad"},
-             {"name", "floor"},
-             {"material", "floor"},
-             {"center", {0, 0, 0}},
-             {"normal", {0, 1, 0}},
-             {"tangent", {1, 0, 0}},
-             {"size", {40, 40}}}}},
+  return {{"objects", {quad("floor", "floor", {0, 0, 0}, {0, 1, 0}, {40, 40})}},
           {"materials", {{"floor", {{"type", "lambert"}, {"params", {{"reflectance", kRho}}}}}}}};
+}
+
+// Adds a black emitter of radiance 1 (object and material "lamp").
+void add_lamp(json& j, const json& center, const json& normal, const json& size) {
+  j["objects"].push_back(quad("lamp", "lamp", center, normal, size));
+  j["materials"]["lamp"] = {
+      {"type", "lambert"}, {"params", {{"reflectance", 0.0}}}, {"emission", 1.0}};
 }
 
 // A camera ray that hits the floor at p from 60 degrees off the normal, starting 1 m away (below
@@ -53,21 +63,13 @@ double corner_factor(double a, double b, double c) {
   return (X / sx * std::atan(Y / sx) + Y / sy * std::atan(X / sy)) / (2 * M_PI);
 }
 
-struct Estimate {
-  double mean = 0, se = 0;
-};
-
-Estimate estimate(const RenderScene& scene, const Ray& ray, const RenderSettings& s, int n) {
-  double sum = 0, sum2 = 0;
+// Mean channel-average radiance of n paths along one ray, with its standard error.
+SampleMean estimate(const RenderScene& scene, const Ray& ray, const RenderSettings& s, int n) {
   RayCounts rays;
-  for (int i = 0; i < n; ++i) {
+  return sample_mean(n, [&](int i) {
     Rng rng(s.seed, uint64_t(i));
-    const double v = trace_path(scene, ray, s, rng, rays).average();
-    sum += v;
-    sum2 += v * v;
-  }
-  const double mean = sum / n;
-  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / (n - 1))};
+    return trace_path(scene, ray, s, rng, rays).average();
+  });
 }
 
 }  // namespace
@@ -134,19 +136,11 @@ TEST(Lights, RectangleConfigurationFactorMatchesQuadrature) {
 TEST(Lights, AreaLightEachStrategyAndMisAgreeWithClosedForm) {
   json j = floor_scene();
   // 1 m (x) by 2 m (z) emitter of radiance 1 at height 1, facing down.
-  j["objects"].push_back({{"type", "quad"},
-                          {"name", "lamp"},
-                          {"material", "lamp"},
-                          {"center", {0, 1, 0}},
-                          {"normal", {0, -1, 0}},
-                          {"tangent", {1, 0, 0}},
-                          {"size", {1, 2}}});
-  j["materials"]["lamp"] = {
-      {"type", "lambert"}, {"params", {{"reflectance", 0.0}}}, {"emission", 1.0}};
+  add_lamp(j, {0, 1, 0}, {0, -1, 0}, {1, 2});
   const RenderScene scene(parse_scene_description(j, ".", "area.json"));
   const double expected = kRho * 1.0 * 4 * corner_factor(0.5, 1.0, 1.0);
   const Ray ray = ray_to({0, 0, 0});
-  Estimate e[3];
+  SampleMean e[3];
   const LightSampling modes[3] = {LightSampling::mis, LightSampling::lights_only,
                                   LightSampling::bsdf_only};
   for (int m = 0; m < 3; ++m) {
@@ -156,31 +150,24 @@ TEST(Lights, AreaLightEachStrategyAndMisAgreeWithClosedForm) {
     s.sampling = modes[m];
     s.seed = 100 + m;  // independent samples for the pairwise comparison
     e[m] = estimate(scene, ray, s, 60000);
-    EXPECT_LT(e[m].se, 0.01 * expected);
-    EXPECT_NEAR(e[m].mean, expected, 4 * e[m].se);
+    EXPECT_LT(e[m].std_error, 0.01 * expected);
+    EXPECT_NEAR(e[m].mean, expected, 4 * e[m].std_error);
   }
   // Light sampling alone versus BSDF sampling alone: independent estimates, two-sided z-test.
-  const double z = (e[1].mean - e[2].mean) / std::sqrt(e[1].se * e[1].se + e[2].se * e[2].se);
+  const double z = (e[1].mean - e[2].mean) /
+                   std::sqrt(e[1].std_error * e[1].std_error + e[2].std_error * e[2].std_error);
   EXPECT_LT(std::abs(z), 4.0);
   // MIS should not be noisier than the worse of its two strategies.
-  EXPECT_LE(e[0].se, std::max(e[1].se, e[2].se));
+  EXPECT_LE(e[0].std_error, std::max(e[1].std_error, e[2].std_error));
 }
 
 TEST(Lights, OneSidedEmitterIsDarkFromBehind) {
   json j = floor_scene();
-  j["objects"].push_back({{"type", "quad"},
-                          {"name", "lamp"},
-                          {"material", "lamp"},
-                          {"center", {0, 1, 0}},
-                          {"normal", {0, 1, 0}},
-                          {"tangent", {1, 0, 0}},
-                          {"size", {1, 2}}});  // faces up
-  j["materials"]["lamp"] = {
-      {"type", "lambert"}, {"params", {{"reflectance", 0.0}}}, {"emission", 1.0}};
+  add_lamp(j, {0, 1, 0}, {0, 1, 0}, {1, 2});  // faces up
   const RenderScene scene(parse_scene_description(j, ".", "back.json"));
   RenderSettings s;
   s.max_depth = 1;
-  const Estimate e = estimate(scene, ray_to({0, 0, 0}), s, 2000);
+  const SampleMean e = estimate(scene, ray_to({0, 0, 0}), s, 2000);
   EXPECT_EQ(e.mean, 0.0);
 }
 
@@ -192,22 +179,8 @@ TEST(Lights, NeeAndBsdfSamplingAgreePerPixel) {
   // sampling hits it often: its samples are then 0 or rho Le, and sample variances are reliable
   // (with a small emitter they are heavy-tailed and underestimated at any affordable spp).
   json j = floor_scene();
-  j["objects"].push_back({{"type", "quad"},
-                          {"name", "lamp"},
-                          {"material", "lamp"},
-                          {"center", {0, 1.0, 0}},
-                          {"normal", {0, -1, 0}},
-                          {"tangent", {1, 0, 0}},
-                          {"size", {3, 3}}});
-  j["objects"].push_back({{"type", "quad"},
-                          {"name", "blocker"},
-                          {"material", "floor"},
-                          {"center", {0.2, 0.5, 0}},
-                          {"normal", {0, 1, 0}},
-                          {"tangent", {1, 0, 0}},
-                          {"size", {0.6, 0.6}}});
-  j["materials"]["lamp"] = {
-      {"type", "lambert"}, {"params", {{"reflectance", 0.0}}}, {"emission", 1.0}};
+  add_lamp(j, {0, 1.0, 0}, {0, -1, 0}, {3, 3});
+  j["objects"].push_back(quad("blocker", "floor", {0.2, 0.5, 0}, {0, 1, 0}, {0.6, 0.6}));
   // Under the blocker, looking straight down at the floor.
   j["camera"] = {{"type", "orthographic"}, {"position", {0, 0.3, 0}}, {"look_at", {0, 0, 0}},
                  {"up", {0, 0, -1}},       {"half_width", 1.5},       {"half_height", 1.5}};
