@@ -50,13 +50,19 @@ nlohmann::json complex_parts(const std::vector<std::complex<double>>& s, bool im
   return a;
 }
 
+// Efficiencies and g, of one sphere (MieResult) or of an ensemble (MieEnsemble).
+template <class Result>
+void add_efficiencies(nlohmann::json& j, const Result& r) {
+  j["qext"] = r.qext;
+  j["qsca"] = r.qsca;
+  j["qabs"] = r.qabs;
+  j["qback"] = r.qback;
+  j["g"] = r.g;
+}
+
 // One sphere's efficiencies, g, and (at the requested angles) amplitudes and phase function.
 void add_sphere(nlohmann::json& j, const MieResult& res, const std::vector<double>& angles_deg) {
-  j["qext"] = res.qext;
-  j["qsca"] = res.qsca;
-  j["qabs"] = res.qabs;
-  j["qback"] = res.qback;
-  j["g"] = res.g;
+  add_efficiencies(j, res);
   j["terms"] = res.terms;
   if (angles_deg.empty()) return;
   j["angles_deg"] = angles_deg;
@@ -120,11 +126,7 @@ int run_mie(const MieOptions& o) {
           mie_ensemble(n, k, h, SizeDistribution::lognormal(radius, *sigma), lambda, mu);
       j["distribution"] = "lognormal";
       j["sigma"] = *sigma;
-      j["qext"] = e.qext;
-      j["qsca"] = e.qsca;
-      j["qabs"] = e.qabs;
-      j["qback"] = e.qback;
-      j["g"] = e.g;
+      add_efficiencies(j, e);
       j["cext_um2"] = e.mean_cext_um2;
       j["csca_um2"] = e.mean_csca_um2;
       j["cabs_um2"] = e.mean_cabs_um2;

@@ -11,30 +11,23 @@
 #include "weft/materials/registry.h"
 
 namespace weft::cli {
-void add_table_command(CLI::App& app, Commands& commands) {
-  auto* table = app.add_subcommand("table", "Tabulated BSDF tables (.exr): inspect or bake");
-  table->require_subcommand(1);
+namespace {
 
-  struct InfoOptions {
-    std::string file;
-    bool json = false;
-  };
-  auto info = std::make_shared<InfoOptions>();
-  auto* info_cmd =
-      table->add_subcommand("info", "Validate a table and print its header and figures");
-  info_cmd->add_option("file", info->file, "table .exr")->required();
-  info_cmd->add_flag("--json", info->json, "print JSON with stable keys");
-  commands.push_back({info_cmd, [info] {
-                        const auto t = TabulatedBsdfTable::read_exr(info->file);
-                        float lo = t.values.front(), hi = lo;
-                        for (float v : t.values) lo = std::min(lo, v), hi = std::max(hi, v);
-                        const OctahedralGrid g = t.grid();
-                        // Light arriving along the normal (w_i = n), summed over all exits.
-                        const auto normal = t.directional_albedo(g.bin_of({0, 0, 1}));
-                        std::vector<double> albedo(t.channels);
-                        for (int c = 0; c < t.channels; ++c) albedo[c] = normal.total(c);
-                        nlohmann::json j = {
-                            {"file", info->file},
+struct InfoOptions {
+  std::string file;
+  bool json = false;
+};
+
+int run_info(const InfoOptions& o) {
+  const auto t = TabulatedBsdfTable::read_exr(o.file);
+  float lo = t.values.front(), hi = lo;
+  for (float v : t.values) lo = std::min(lo, v), hi = std::max(hi, v);
+  const OctahedralGrid g = t.grid();
+  // Light arriving along the normal (w_i = n), summed over all exits.
+  const auto normal = t.directional_albedo(g.bin_of({0, 0, 1}));
+  std::vector<double> albedo(t.channels);
+  for (int c = 0; c < t.channels; ++c) albedo[c] = normal.total(c);
+  const nlohmann::json j = {{"file", o.file},
                             {"format_version", TabulatedBsdfTable::kFormatVersion},
                             {"resolution", t.resolution},
                             {"bins", g.bins()},
@@ -47,21 +40,75 @@ void add_table_command(CLI::App& app, Commands& commands) {
                             {"albedo_normal_incidence", albedo},
                             {"reflectance_normal_incidence", normal.reflectance},
                             {"transmittance_normal_incidence", normal.transmittance}};
-                        if (info->json) {
-                          std::cout << j.dump(2) << "\n";
-                        } else {
-                          for (const auto& [k, v] : j.items())
-                            std::cout << k << ": " << v.dump() << "\n";
-                        }
-                        return 0;
-                      }});
+  if (o.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    for (const auto& [k, v] : j.items()) std::cout << k << ": " << v.dump() << "\n";
+  }
+  return 0;
+}
 
-  struct BakeOptions {
-    std::string type, params = "{}", output, kind = "fiber";
-    int resolution = 16, samples = 16, threads = 0;
-    uint64_t seed = 1;
-    bool quiet = false, json = false;
-  };
+struct BakeOptions {
+  std::string type, params = "{}", output, kind = "fiber";
+  int resolution = 16, samples = 16, threads = 0;
+  uint64_t seed = 1;
+  bool quiet = false, json = false;
+};
+
+int run_bake(const BakeOptions& o) {
+  nlohmann::json params;
+  try {
+    params = nlohmann::json::parse(o.params);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error("", "--params", std::string("not valid JSON: ") + e.what());
+  }
+  // Fail before the work, not after it.
+  const std::filesystem::path out_dir = std::filesystem::absolute(o.output).parent_path();
+  if (!std::filesystem::is_directory(out_dir))
+    throw Error(o.output, "", "output directory does not exist");
+  MaterialContext ctx;
+  ctx.field_prefix = "--params";
+  const Bsdf bsdf = make_bsdf(o.type, params, ctx);
+  auto t = TabulatedBsdfTable::from_function(
+      o.resolution, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const Rgb f = bsdf.eval(wo, wi);
+        v[0] = f.r, v[1] = f.g, v[2] = f.b;
+      },
+      o.samples, o.seed, o.threads, progress_bar(o.quiet));
+  t.kind = o.kind;
+  const std::string spec = o.type + " " + params.dump();
+  t.metadata = {{"source", "analytic " + spec},
+                {"spec_hash", hex64(fnv1a64(spec))},
+                {"seed", std::to_string(o.seed)},
+                {"samples_per_cell", std::to_string(o.samples)},
+                {"program_version", std::string("weft ") + WEFT_VERSION}};
+  t.write_exr(o.output);
+  if (o.json) {
+    std::cout << nlohmann::json{{"output", o.output},
+                                {"resolution", t.resolution},
+                                {"kind", t.kind},
+                                {"spec_hash", t.metadata["spec_hash"]},
+                                {"checksum", t.checksum()}}
+                     .dump(2)
+              << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_table_command(CLI::App& app, Commands& commands) {
+  auto* table = app.add_subcommand("table", "Tabulated BSDF tables (.exr): inspect or bake");
+  table->require_subcommand(1);
+
+  auto info = std::make_shared<InfoOptions>();
+  auto* info_cmd =
+      table->add_subcommand("info", "Validate a table and print its header and figures");
+  info_cmd->add_option("file", info->file, "table .exr")->required();
+  info_cmd->add_flag("--json", info->json, "print JSON with stable keys");
+  commands.push_back({info_cmd, [info] { return run_info(*info); }});
+
   auto bake = std::make_shared<BakeOptions>();
   auto* bake_cmd = table->add_subcommand(
       "bake", "Bake an analytic material (e.g. classic_fiber) into an RGB table, as a reference");
@@ -79,47 +126,7 @@ void add_table_command(CLI::App& app, Commands& commands) {
   bake_cmd->add_option("-o,--output", bake->output, "output .exr")->required();
   bake_cmd->add_flag("--quiet", bake->quiet, "no progress bar");
   bake_cmd->add_flag("--json", bake->json, "print a JSON summary");
-  commands.push_back({bake_cmd, [bake] {
-                        nlohmann::json params;
-                        try {
-                          params = nlohmann::json::parse(bake->params);
-                        } catch (const nlohmann::json::exception& e) {
-                          throw Error("", "--params", std::string("not valid JSON: ") + e.what());
-                        }
-                        // Fail before the work, not after it.
-                        const std::filesystem::path out_dir =
-                            std::filesystem::absolute(bake->output).parent_path();
-                        if (!std::filesystem::is_directory(out_dir))
-                          throw Error(bake->output, "", "output directory does not exist");
-                        MaterialContext ctx;
-                        ctx.field_prefix = "--params";
-                        const Bsdf bsdf = make_bsdf(bake->type, params, ctx);
-                        auto t = TabulatedBsdfTable::from_function(
-                            bake->resolution, 3,
-                            [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-                              const Rgb f = bsdf.eval(wo, wi);
-                              v[0] = f.r, v[1] = f.g, v[2] = f.b;
-                            },
-                            bake->samples, bake->seed, bake->threads, progress_bar(bake->quiet));
-                        t.kind = bake->kind;
-                        const std::string spec = bake->type + " " + params.dump();
-                        t.metadata = {{"source", "analytic " + spec},
-                                      {"spec_hash", hex64(fnv1a64(spec))},
-                                      {"seed", std::to_string(bake->seed)},
-                                      {"samples_per_cell", std::to_string(bake->samples)},
-                                      {"program_version", std::string("weft ") + WEFT_VERSION}};
-                        t.write_exr(bake->output);
-                        if (bake->json) {
-                          std::cout << nlohmann::json{{"output", bake->output},
-                                                      {"resolution", t.resolution},
-                                                      {"kind", t.kind},
-                                                      {"spec_hash", t.metadata["spec_hash"]},
-                                                      {"checksum", t.checksum()}}
-                                           .dump(2)
-                                    << "\n";
-                        }
-                        return 0;
-                      }});
+  commands.push_back({bake_cmd, [bake] { return run_bake(*bake); }});
 }
 
 }  // namespace weft::cli
