@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "chi2.h"
+#include "table_context.h"
 #include "test_util.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
@@ -26,25 +27,20 @@ struct Material {
 std::vector<Material> all_materials() {
   const fs::path dir = fresh_test_dir();
   const auto fiber = ClassicFiberBsdf::create(Rgb(0.6, 0.3, 0.2), {MicrofacetModel::kGgx, 0.3});
-  auto t = TabulatedBsdfTable::from_function(
-      8, 3,
-      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        const Rgb f = wo.z * wi.z > 0 ? fiber.eval(wo, wi) : Rgb(0.05);
-        v[0] = f.r, v[1] = f.g, v[2] = f.b;
-      },
-      4, 3);
-  t.write_exr(dir / "fiber.exr");
-  t.kind = "fabric";
-  t.write_exr(dir / "fabric.exr");
-  MaterialContext ctx;
-  ctx.base_dir = dir;
-  ctx.cache = std::make_shared<TableCache>();
+  const MaterialContext ctx =
+      context_with_tables(dir, TabulatedBsdfTable::from_function(
+                                   8, 3,
+                                   [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+                                     const Rgb f = wo.z * wi.z > 0 ? fiber.eval(wo, wi) : Rgb(0.05);
+                                     v[0] = f.r, v[1] = f.g, v[2] = f.b;
+                                   },
+                                   4, 3));
   return {
       {"lambert", make_bsdf("lambert", {{"reflectance", 0.9}}, ctx), false},
       {"cook_torrance", make_bsdf("cook_torrance", {{"alpha", 0.2}}, ctx), false},
       {"classic_fiber", make_bsdf("classic_fiber", {{"reflectance", 1.0}}, ctx), false},
-      {"fiber_table", make_bsdf("fiber_table", {{"file", "fiber.exr"}}, ctx), true},
-      {"fabric_table", make_bsdf("fabric_table", {{"file", "fabric.exr"}}, ctx), true},
+      {"fiber_table", make_bsdf("fiber_table", {{"file", "tables/fiber.exr"}}, ctx), true},
+      {"fabric_table", make_bsdf("fabric_table", {{"file", "tables/fabric.exr"}}, ctx), true},
       {"measured_nbrdf", make_bsdf("measured_nbrdf", {{"name", "merl-white-fabric"}}, ctx), false},
   };
 }

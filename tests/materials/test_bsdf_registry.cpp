@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <limits>
 
+#include "table_context.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/materials/bsdfs.h"
@@ -22,19 +23,12 @@ struct Fixture {
   MaterialContext ctx;
   Fixture() {
     dir = weft::testing::fresh_test_dir();
-    fs::create_directories(dir / "tables");
     auto f = [](const Vec3&, const Vec3& wi, std::span<double> v) {
       v[0] = v[1] = v[2] = 0.1 + 0.1 * wi.z * wi.z;
     };
-    auto fiber = TabulatedBsdfTable::from_function(4, 3, f, 1);
-    fiber.write_exr(dir / "tables" / "fiber.exr");
-    auto fabric = fiber;
-    fabric.kind = "fabric";
-    fabric.write_exr(dir / "tables" / "fabric.exr");
-    ctx.base_dir = dir;
+    ctx = weft::testing::context_with_tables(dir, TabulatedBsdfTable::from_function(4, 3, f, 1));
     ctx.source_file = "scene.json";
     ctx.field_prefix = "materials.seat";
-    ctx.cache = std::make_shared<TableCache>();
   }
 };
 
