@@ -15,7 +15,8 @@ namespace weft::cli {
 void add_render_command(CLI::App& app, Commands& commands) {
   struct Options {
     std::string scene, output, preview, mask, mask_object;
-    int spp = 0, threads = 0, width = 0, height = 0, max_depth = -1;
+    int spp = 0, width = 0, height = 0, max_depth = -1;  // 0, -1: the scene's
+    int threads = RenderSettings{}.threads;
     uint64_t seed = 0;
     bool seed_given = false, quiet = false, json = false;
   };
@@ -50,7 +51,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
          if (!o->preview.empty()) job.png = o->preview;
          if (!o->mask.empty()) job.mask = o->mask;
          job.mask_object = o->mask_object;
-         job.settings = render_settings_from(desc.render);
+         job.settings = render_settings_from(desc);
          if (o->spp) job.settings.spp = o->spp;
          if (o->width) job.settings.width = o->width;
          if (o->height) job.settings.height = o->height;
@@ -58,7 +59,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
          if (seed->count()) job.settings.seed = o->seed;
          job.settings.threads = o->threads;
          const auto t0 = std::chrono::steady_clock::now();
-         const RenderJobResult r = render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());
+         const RenderJobResult r =
+             render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());
          const double sec =
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
          if (r.cancelled) {

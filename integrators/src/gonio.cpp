@@ -6,6 +6,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
@@ -54,6 +55,28 @@ Rgb divide(const Rgb& a, const Rgb& b) {
   return {a.r / b.r, a.g / b.g, a.b / b.b};
 }
 
+// Signed view zeniths in degrees: a list, or {from, to, step} (inclusive).
+std::vector<double> read_angle_list(ParamReader& p, const std::string& key) {
+  const auto& v = p.at(key);
+  std::vector<double> out;
+  if (v.is_array()) {
+    for (size_t i = 0; i < v.size(); ++i)
+      out.push_back(p.check_number(v[i], p.field(key) + "[" + std::to_string(i) + "]", -90, 90));
+  } else if (v.is_object()) {
+    ParamReader r(v, p.file(), p.field(key));
+    const double a = r.number("from", -90, 90), b = r.number("to", -90, 90),
+                 s = r.number("step", 1e-6, 180);
+    r.finish();
+    if (b < a) throw Error(p.file(), p.field(key), "needs from <= to");
+    const long n = std::lround(std::floor((b - a) / s + 1e-9));
+    for (long i = 0; i <= n; ++i) out.push_back(a + s * i);
+  } else {
+    throw Error(p.file(), p.field(key), "must be a list of angles or {from, to, step}");
+  }
+  if (out.empty()) throw Error(p.file(), p.field(key), "is empty");
+  return out;
+}
+
 std::string fmt(double v) {
   if (std::isnan(v)) return "nan";
   char buf[40];
@@ -65,23 +88,25 @@ std::string fmt(double v) {
 
 GonioSettings gonio_settings_from(const SceneDescription& desc) {
   GonioSettings g;
-  g.max_depth = desc.render.max_depth;
-  g.rr_depth = desc.render.rr_depth;
-  g.seed = desc.render.seed;
-  if (desc.sweep) {
-    const SweepSpec& s = *desc.sweep;
-    g.sample = s.sample;
-    g.light_zenith_deg = s.light_zenith_deg;
-    g.light_azimuth_deg = s.light_azimuth_deg;
-    g.irradiance = s.irradiance;
-    g.view_zenith_deg = s.view_zenith_deg;
-    g.view_azimuth_deg = s.view_azimuth_deg;
-    g.normalize_to = s.normalize_to;
-    g.white_check = s.white_check;
-    g.width = s.width;
-    g.height = s.height;
-    g.spp = s.spp;
-  }
+  const RenderSettings r = render_settings_from(desc);
+  g.max_depth = r.max_depth;
+  g.rr_depth = r.rr_depth;
+  g.seed = r.seed;
+  if (!desc.sweep) return g;
+  ParamReader p(*desc.sweep, desc.source, "sweep");
+  constexpr double kMax = kMaxDescriptionRadiometric;
+  g.sample = p.string("sample", g.sample);
+  g.light_zenith_deg = p.number("light_zenith_deg", g.light_zenith_deg, 0.0, 89.9);
+  g.light_azimuth_deg = p.number("light_azimuth_deg", g.light_azimuth_deg, -360.0, 360.0);
+  g.irradiance = p.rgb("irradiance", g.irradiance, 1e-12, kMax);
+  if (p.has("view_zenith_deg")) g.view_zenith_deg = read_angle_list(p, "view_zenith_deg");
+  if (p.has("view_azimuth_deg")) g.view_azimuth_deg = p.number("view_azimuth_deg", -360.0, 360.0);
+  if (p.has("normalize_to")) g.normalize_to = p.rgb("normalize_to", 1e-12, kMax);
+  g.white_check = p.boolean("white_check", g.white_check);
+  g.width = static_cast<int>(p.integer("width", g.width, 1, 16384));
+  g.height = static_cast<int>(p.integer("height", g.height, 1, 16384));
+  g.spp = static_cast<int>(p.integer("spp", g.spp, 1, 1 << 20));
+  p.finish();
   return g;
 }
 

@@ -31,17 +31,6 @@ bool finite(const Rgb& c) {
 
 }  // namespace
 
-RenderSettings render_settings_from(const RenderSpec& spec) {
-  RenderSettings s;
-  s.width = spec.width;
-  s.height = spec.height;
-  s.spp = spec.spp;
-  s.max_depth = spec.max_depth;
-  s.rr_depth = spec.rr_depth;
-  s.seed = spec.seed;
-  return s;
-}
-
 Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings,
                Rng& rng, RayCounts& rays, int64_t* first_mesh, std::vector<LoggedRay>* log) {
   auto record = [&](const Vec3& o, const Vec3& d, double tmax, bool shadow) {

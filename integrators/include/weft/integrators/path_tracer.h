@@ -12,37 +12,17 @@
 #include "weft/core/progress.h"
 #include "weft/core/rng.h"
 #include "weft/integrators/image.h"
+#include "weft/integrators/render_settings.h"
 #include "weft/scenes/camera.h"
-#include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
-
-// Which strategies estimate light from area lights and the environment (delta lights always use
-// next-event estimation). The single-strategy modes exist to test MIS against each of its parts.
-enum class LightSampling { mis, lights_only, bsdf_only };
 
 // A ray as the tracer handed it to Embree (for replaying the same rays in benchmarks).
 struct LoggedRay {
   float org[3], dir[3], tmax;
   bool shadow;  // rtcOccluded1 rather than rtcIntersect1
 };
-
-struct RenderSettings {
-  int width = 256, height = 256;
-  int spp = 16;
-  int max_depth = 16;  // bounces; 0 = emitted light only, 1 = direct lighting
-  int rr_depth = 3;    // bounces before Russian roulette
-  uint64_t seed = 0;
-  int threads = 0;  // 0 = all cores
-  int tile_size = 16;
-  LightSampling sampling = LightSampling::mis;
-  // Per mesh: camera samples whose first hit is one of these count towards the mask outputs.
-  std::vector<uint8_t> mask_meshes;
-  bool log_rays = false;  // keep every traced ray in RenderResult::ray_log (benchmarks only)
-};
-
-RenderSettings render_settings_from(const RenderSpec& spec);
 
 struct RayCounts {
   uint64_t camera = 0, bounce = 0, shadow = 0;
