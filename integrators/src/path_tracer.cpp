@@ -18,13 +18,6 @@ double power_heuristic(double pdf_a, double pdf_b) {
   return a + b > 0 ? a / (a + b) : 0;
 }
 
-Vec3 uniform_sphere(double u1, double u2) {
-  const double z = 1 - 2 * u1;
-  const double r = safe_sqrt(1 - z * z);
-  const double phi = 2 * kPi * u2;
-  return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
 bool finite(const Rgb& c) {
   return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
 }
@@ -45,11 +38,8 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
     record(o, d, tmax, true);
     return scene.occluded(o, d, tmax);
   };
-  const Lights& lights = scene.lights();
   const bool use_mis = settings.sampling == LightSampling::mis;
   const bool nee_area = settings.sampling != LightSampling::bsdf_only;
-  const Rgb env = lights.environment;
-  const double env_pdf = kInv4Pi;  // uniform sphere sampling of the constant environment
   Rgb L(0.0), beta(1.0);
   Ray ray = camera_ray;
   bool specular = true;  // camera rays and delta bounces are not covered by next-event estimation
@@ -62,36 +52,29 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
     const double d = length(to);
     return d > 0 && occluded(o, to / d, d * (1 - 1e-5));
   };
+  // Radiance from a light that the last BSDF sample found, weighted against next-event estimation
+  // of the same light.
+  auto add_found_light = [&](const Light& light, const LightHit& at) {
+    const Rgb Le = light.eval(at);
+    if (Le.is_black()) return;
+    double w = 1;
+    if (!specular) w = use_mis ? power_heuristic(prev_pdf, light.pdf(at)) : (nee_area ? 0.0 : 1.0);
+    L += beta * Le * w;
+  };
 
   for (int depth = 0;; ++depth) {
     SurfaceHit hit;
     record(ray.o, ray.d, ray.tmax, false);
     const bool found = scene.intersect(ray, &hit);
     if (!found) {
-      if (!env.is_black()) {
-        double w = 1;
-        if (!specular) w = use_mis ? power_heuristic(prev_pdf, env_pdf) : (nee_area ? 0.0 : 1.0);
-        L += beta * env * w;
-      }
+      const LightHit escaped = LightHit::escaped_along(ray.d);
+      for (const Light& light : scene.lights()) add_found_light(light, escaped);
       break;
     }
     if (depth == 0 && first_mesh) *first_mesh = hit.mesh;
     const Vec3 wo_world = -ray.d;
-    const Rgb Le = scene.emitted(hit.mesh, hit.ng, wo_world);
-    if (!Le.is_black()) {
-      double w = 1;
-      if (!specular) {
-        if (use_mis) {
-          const double cos_l = std::abs(dot(hit.ng, ray.d));
-          const double light_pdf =
-              cos_l > 0 ? scene.area_light_pdf(hit.mesh, hit.prim) * hit.t * hit.t / cos_l : 0;
-          w = power_heuristic(prev_pdf, light_pdf);
-        } else {
-          w = nee_area ? 0.0 : 1.0;
-        }
-      }
-      L += beta * Le * w;
-    }
+    if (const Light* light = scene.surface_light(hit.mesh))
+      add_found_light(*light, LightHit::on_surface(ray.d, hit.mesh, hit.prim, hit.ng, hit.t));
     if (depth >= settings.max_depth) break;
 
     const Bsdf& bsdf = scene.bsdf(hit.mesh);
@@ -105,62 +88,21 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       return (wo_ng * dot(wi_world, hit.ng) > 0) == (wo.z * wi_local.z > 0);
     };
 
-    // Next-event estimation: delta lights.
-    for (const auto& d : lights.directional) {
-      const Vec3 wi = frame.to_local(d.to_light);
-      if (!consistent(d.to_light, wi)) continue;
+    // Next-event estimation: one sample of every light; area lights and the environment weighted
+    // against BSDF sampling (lights.h states what a sample holds).
+    for (const Light& light : scene.lights()) {
+      const bool delta = light.is_delta();
+      if (!delta && !nee_area) continue;
+      const std::optional<LightSample> ls = light.sample(hit.p, rng);
+      if (!ls) continue;
+      const Vec3 wi = frame.to_local(ls->wi);
+      if (!consistent(ls->wi, wi)) continue;
       const Rgb f = bsdf.eval(wo, wi);
       if (f.is_black()) continue;
-      if (!occluded(hit.spawn_origin(d.to_light), d.to_light, 1e300))
-        L += beta * f * d.irradiance * std::abs(wi.z);
-    }
-    for (const auto& pl : lights.points) {
-      // Radiometry from the surface point itself; only the shadow ray starts off the surface.
-      const Vec3 to = pl.position - hit.p;
-      const double dist = length(to);
-      if (!(dist > 0)) continue;
-      const Vec3 dir = to / dist;
-      const double fall = pl.falloff(-dir);
-      if (fall <= 0) continue;
-      const Vec3 wi = frame.to_local(dir);
-      if (!consistent(dir, wi)) continue;
-      const Rgb f = bsdf.eval(wo, wi);
-      if (f.is_black()) continue;
-      if (!occluded_between(hit, pl.position))
-        L += beta * f * pl.intensity * (fall * std::abs(wi.z) / (dist * dist));
-    }
-    // Next-event estimation: area lights and environment, weighted against BSDF sampling.
-    if (nee_area && scene.has_area_lights()) {
-      const double u_pick = rng.uniform();
-      const Vec2 u{rng.uniform(), rng.uniform()};
-      const AreaLightSample ls = scene.sample_area_light(u_pick, u);
-      const Vec3 to = ls.p - hit.p;
-      const double dist = length(to);
-      if (dist > 0 && ls.pdf_area > 0) {
-        const Vec3 dir = to / dist;
-        const double cos_l = std::abs(dot(ls.n, dir));
-        const Rgb Le_l = scene.emitted(ls.mesh, ls.n, -dir);
-        const Vec3 wi = frame.to_local(dir);
-        if (cos_l > 0 && !Le_l.is_black() && consistent(dir, wi)) {
-          const Rgb f = bsdf.eval(wo, wi);
-          if (!f.is_black()) {
-            const double light_pdf = ls.pdf_area * dist * dist / cos_l;
-            const double w = use_mis ? power_heuristic(light_pdf, bsdf.pdf(wo, wi)) : 1.0;
-            if (!occluded_between(hit, ls.p))
-              L += beta * f * Le_l * (std::abs(wi.z) * w / light_pdf);
-          }
-        }
-      }
-    }
-    if (nee_area && !env.is_black()) {
-      const Vec3 dir = uniform_sphere(rng.uniform(), rng.uniform());
-      const Vec3 wi = frame.to_local(dir);
-      const Rgb f = consistent(dir, wi) ? bsdf.eval(wo, wi) : Rgb(0.0);
-      if (!f.is_black()) {
-        const double w = use_mis ? power_heuristic(env_pdf, bsdf.pdf(wo, wi)) : 1.0;
-        if (!occluded(hit.spawn_origin(dir), dir, 1e300))
-          L += beta * f * env * (std::abs(wi.z) * w / env_pdf);
-      }
+      const double w = delta || !use_mis ? 1.0 : power_heuristic(ls->pdf, bsdf.pdf(wo, wi));
+      const bool blocked = ls->at_infinity ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300)
+                                           : occluded_between(hit, ls->p_light);
+      if (!blocked) L += beta * f * ls->L * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
     }
 
     // Continue the path by sampling the BSDF.

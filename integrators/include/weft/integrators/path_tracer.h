@@ -1,10 +1,11 @@
 #pragma once
-// Unidirectional path tracer over a RenderScene. Next-event estimation for parallel, point and spot
-// lights, and for area lights and the environment combined with BSDF sampling by multiple
-// importance sampling (power heuristic, Veach 1997 ch. 9); Russian roulette after rr_depth bounces;
-// shading in the mesh's tangent frame; two-sided (the BSDF sees wo below its normal and decides);
-// transmission continues through the surface. Every random number of a camera sample comes from
-// Rng(seed, pixel index, sample index) and tiles write disjoint pixels, so images are
+// Unidirectional path tracer over a RenderScene. At every surface, next-event estimation takes one
+// sample of every light through the Light interface (lights.h); for area lights and the
+// environment it is combined with BSDF sampling by multiple importance sampling (power heuristic,
+// Veach 1997 ch. 9), delta lights have only that one strategy. Russian roulette after rr_depth
+// bounces; shading in the mesh's tangent frame; two-sided (the BSDF sees wo below its normal and
+// decides); transmission continues through the surface. Every random number of a camera sample
+// comes from Rng(seed, pixel index, sample index) and tiles write disjoint pixels, so images are
 // bit-identical at any thread count.
 #include <cstdint>
 #include <vector>
