@@ -175,9 +175,16 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
     s.height = o.height;
     s.spp = o.spp;
     s.seed = o.seed;
-    s.threads = o.threads;
-    s.log_rays = true;
-    log = render(scene, cam, s).ray_log;
+    s.threads = 1;  // the log then needs no lock and holds the rays in the tracer's tile order
+    RenderObservers observers;
+    observers.on_ray = [&](const Ray& ray, bool shadow) {
+      const Vec3 &p = ray.o, &d = ray.d;
+      log.push_back({{float(p.x), float(p.y), float(p.z)},
+                     {float(d.x), float(d.y), float(d.z)},
+                     ray.tmax > 3e38 ? INFINITY : float(ray.tmax),
+                     shadow});
+    };
+    render(scene, cam, s, no_progress(), observers);
   }
   // Best of two runs each: the machines are shared, and the best run is the least disturbed one.
   for (int rep = 0; rep < 2; ++rep) {

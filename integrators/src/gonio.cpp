@@ -7,6 +7,7 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/params.h"
+#include "weft/integrators/masked_render.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
@@ -23,13 +24,13 @@ struct ViewMeasure {
 // samples that hit the sample and x their radiance. Its variance follows from the residuals
 // y = h (x - R) (delta method; Cochran, Sampling Techniques, 3rd ed., section 6.3), estimated from
 // each pixel's sample variance. Edge pixels that are partly covered add no variance by themselves.
-ViewMeasure measure(const RenderResult& r, int spp) {
+ViewMeasure measure(const MaskedRender& r, int spp) {
   ViewMeasure m;
   const size_t npx = r.coverage.size();
   double s[3] = {0, 0, 0}, fp = 0;
   for (size_t p = 0; p < npx; ++p) {
     fp += r.coverage[p];
-    for (int c = 0; c < 3; ++c) s[c] += r.masked_sum[3 * p + c];
+    for (int c = 0; c < 3; ++c) s[c] += r.sum[3 * p + c];
   }
   m.sum = {s[0], s[1], s[2]};
   m.footprint = fp;
@@ -39,7 +40,7 @@ ViewMeasure measure(const RenderResult& r, int spp) {
     const double h = r.coverage[p];
     for (int c = 0; c < 3; ++c) {
       // Per-sample moments of y over the pixel's spp samples (the stored sums are divided by spp).
-      const double hx = r.masked_sum[3 * p + c], hx2 = r.masked_sum_sq[3 * p + c];
+      const double hx = r.sum[3 * p + c], hx2 = r.sum_sq[3 * p + c];
       const double ey = hx - R[c] * h;
       const double ey2 = hx2 - 2 * R[c] * hx + R[c] * R[c] * h;
       // Unbiased sample variance of y, divided by spp for the pixel mean.
@@ -176,7 +177,6 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   rs.rr_depth = g.rr_depth;
   rs.seed = g.seed;
   rs.threads = g.threads;
-  rs.mask_meshes = sel;
   const uint64_t tiles_per = uint64_t((g.width + rs.tile_size - 1) / rs.tile_size) *
                              ((g.height + rs.tile_size - 1) / rs.tile_size);
   uint64_t renders_done = 0;
@@ -195,13 +195,13 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
     const Vec3 up_hint = std::abs(zen) > 5 ? desc.frame.normal : desc.frame.tangent;
     const Camera cam = frame_box_orthographic(box, towards_viewer, up_hint);
     const uint64_t base = renders_done * tiles_per;
-    const RenderResult r = render(scene, cam, rs, [&](const ProgressUpdate& u) {
+    const MaskedRender r = render_masked(scene, cam, rs, sel, [&](const ProgressUpdate& u) {
       return progress({"sweep", base + u.done, renders * tiles_per});
     });
     ++renders_done;
-    res.rays += r.rays;
-    res.nonfinite_samples += r.nonfinite_samples;
-    if (r.cancelled) return std::nullopt;
+    res.rays += r.render.rays;
+    res.nonfinite_samples += r.render.nonfinite_samples;
+    if (r.render.cancelled) return std::nullopt;
     const ViewMeasure m = measure(r, g.spp);  // NaN when the sample is not seen at all
     return std::make_pair(m, divide(m.mean, l_white));
   };

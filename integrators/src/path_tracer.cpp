@@ -25,17 +25,10 @@ bool finite(const Rgb& c) {
 }  // namespace
 
 Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings,
-               Rng& rng, RayCounts& rays, int64_t* first_mesh, std::vector<LoggedRay>* log) {
-  auto record = [&](const Vec3& o, const Vec3& d, double tmax, bool shadow) {
-    if (log)
-      log->push_back({{float(o.x), float(o.y), float(o.z)},
-                      {float(d.x), float(d.y), float(d.z)},
-                      tmax > 3e38 ? INFINITY : float(tmax),
-                      shadow});
-  };
+               Rng& rng, RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
   auto occluded = [&](const Vec3& o, const Vec3& d, double tmax) {
     ++rays.shadow;
-    record(o, d, tmax, true);
+    if (on_ray) (*on_ray)({o, d, tmax}, true);
     return scene.occluded(o, d, tmax);
   };
   const bool use_mis = settings.sampling == LightSampling::mis;
@@ -64,7 +57,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
 
   for (int depth = 0;; ++depth) {
     SurfaceHit hit;
-    record(ray.o, ray.d, ray.tmax, false);
+    if (on_ray) (*on_ray)(ray, false);
     const bool found = scene.intersect(ray, &hit);
     if (!found) {
       const LightHit escaped = LightHit::escaped_along(ray.d);
@@ -127,26 +120,17 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
 }
 
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
-                    const ProgressCallback& progress) {
+                    const ProgressCallback& progress, const RenderObservers& observers) {
   if (s.width < 1 || s.height < 1 || s.spp < 1 || s.tile_size < 1 || s.max_depth < 0 ||
       s.rr_depth < 0)
     throw Error("", "render", "width, height, spp and tile size must be positive");
-  const bool masked = !s.mask_meshes.empty();
-  if (masked && s.mask_meshes.size() != scene.mesh_count())
-    throw Error("", "render", "mask does not match the mesh count");
   RenderResult out;
   out.image = Image(s.width, s.height);
-  const size_t npx = size_t(s.width) * s.height;
-  if (masked) {
-    out.coverage.assign(npx, 0.0f);
-    out.masked_sum.assign(3 * npx, 0.0);
-    out.masked_sum_sq.assign(3 * npx, 0.0);
-  }
+  const RayObserver* on_ray = observers.on_ray ? &observers.on_ray : nullptr;
   const int tx = (s.width + s.tile_size - 1) / s.tile_size,
             ty = (s.height + s.tile_size - 1) / s.tile_size;
   const uint64_t tiles = uint64_t(tx) * ty;
   std::vector<RayCounts> tile_rays(tiles);
-  std::vector<std::vector<LoggedRay>> tile_log(s.log_rays ? tiles : 0);
   std::vector<uint64_t> tile_nonfinite(tiles, 0);
   std::atomic<bool> cancel{false};
   std::atomic<uint64_t> done{0};
@@ -164,36 +148,23 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
       if (cancel.load(std::memory_order_relaxed)) return;
       for (int x = x0; x < x1; ++x) {
         const uint64_t pixel = uint64_t(y) * s.width + x;
-        double sum[3] = {0, 0, 0}, msum[3] = {0, 0, 0}, msq[3] = {0, 0, 0};
-        int hits = 0;
+        double sum[3] = {0, 0, 0};
         for (int k = 0; k < s.spp; ++k) {
           Rng rng(s.seed, pixel, uint64_t(k));
           const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
           const Ray ray = camera.generate_ray(fx, fy, aspect);
           ++rays.camera;
           int64_t first = -1;
-          Rgb L =
-              trace_path(scene, ray, s, rng, rays, &first, s.log_rays ? &tile_log[tile] : nullptr);
+          Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray);
           if (!finite(L)) {
             ++tile_nonfinite[tile];
             L = Rgb(0.0);
           }
-          const double c[3] = {L.r, L.g, L.b};
-          for (int i = 0; i < 3; ++i) sum[i] += c[i];
-          if (masked && first >= 0 && s.mask_meshes[first]) {
-            ++hits;
-            for (int i = 0; i < 3; ++i) msum[i] += c[i], msq[i] += c[i] * c[i];
-          }
+          sum[0] += L.r, sum[1] += L.g, sum[2] += L.b;
+          if (observers.on_sample) observers.on_sample(pixel, first, L);
         }
         for (int i = 0; i < 3; ++i)
           out.image.rgb[3 * pixel + i] = static_cast<float>(sum[i] * inv_spp);
-        if (masked) {
-          out.coverage[pixel] = static_cast<float>(hits * inv_spp);
-          for (int i = 0; i < 3; ++i) {
-            out.masked_sum[3 * pixel + i] = msum[i] * inv_spp;
-            out.masked_sum_sq[3 * pixel + i] = msq[i] * inv_spp;
-          }
-        }
       }
     }
     tile_rays[tile] = rays;
@@ -202,7 +173,6 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
     if (!cancel.load() && !progress({"render", d, tiles})) cancel.store(true);
   });
   for (uint64_t t = 0; t < tiles; ++t) {
-    if (s.log_rays) out.ray_log.insert(out.ray_log.end(), tile_log[t].begin(), tile_log[t].end());
     out.rays += tile_rays[t];
     out.nonfinite_samples += tile_nonfinite[t];
   }

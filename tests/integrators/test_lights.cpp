@@ -18,6 +18,7 @@
 #include <cmath>
 
 #include "weft/core/math.h"
+#include "weft/integrators/masked_render.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
@@ -219,17 +220,17 @@ TEST(Lights, NeeAndBsdfSamplingAgreePerPixel) {
   s.width = s.height = 24;
   s.spp = 256;
   s.max_depth = 1;
-  s.mask_meshes = d.select_object("floor");  // per-pixel sample moments of floor hits
+  const std::vector<uint8_t> floor = d.select_object("floor");  // sample moments of floor hits
   s.sampling = LightSampling::lights_only;
   s.seed = 1;
-  const RenderResult a = render(scene, *d.camera, s);
+  const MaskedRender a = render_masked(scene, *d.camera, s, floor);
   s.sampling = LightSampling::bsdf_only;
   s.seed = 2;
-  const RenderResult b = render(scene, *d.camera, s);
-  auto moments = [&](const RenderResult& r, size_t p, double* mean, double* var) {
+  const MaskedRender b = render_masked(scene, *d.camera, s, floor);
+  auto moments = [&](const MaskedRender& r, size_t p, double* mean, double* var) {
     // Channel 1 (all channels are equal here); variance of the pixel mean from the sample variance.
-    *mean = r.masked_sum[3 * p + 1];
-    *var = std::max(0.0, r.masked_sum_sq[3 * p + 1] - *mean * *mean) / (s.spp - 1);
+    *mean = r.sum[3 * p + 1];
+    *var = std::max(0.0, r.sum_sq[3 * p + 1] - *mean * *mean) / (s.spp - 1);
   };
   double chi2 = 0;
   int dof = 0, lit = 0;

@@ -10,6 +10,12 @@
 
 namespace weft {
 
+// A ray as the path tracer handed it to Embree (for replaying the same rays).
+struct LoggedRay {
+  float org[3], dir[3], tmax;
+  bool shadow;  // rtcOccluded1 rather than rtcIntersect1
+};
+
 struct RenderBenchOptions {
   size_t diffuse_rays = 1 << 20;
   int width = 256, height = 256, spp = 4;

@@ -6,7 +6,6 @@
 // Every key is optional; the defaults are RenderSettings{}, the renderer's one set of defaults
 // (the command line and the benchmarks start from it too).
 #include <cstdint>
-#include <vector>
 
 #include "weft/scenes/description.h"
 
@@ -25,9 +24,6 @@ struct RenderSettings {
   int threads = 0;  // 0 = all cores
   int tile_size = 16;
   LightSampling sampling = LightSampling::mis;
-  // Per mesh: camera samples whose first hit is one of these count towards the mask outputs.
-  std::vector<uint8_t> mask_meshes;
-  bool log_rays = false;  // keep every traced ray in RenderResult::ray_log (benchmarks only)
 };
 
 // RenderSettings{} with the description's "render" section applied. Unknown keys and bad values
