@@ -219,12 +219,8 @@ bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit) const {
   return true;
 }
 
-double RenderScene::intersect_distance(const Ray& ray) const {
-  RTCRayHit rh = embree_ray(ray);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  rtcIntersect1(geo_->scene, &ctx, &rh);
-  return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
+RTCSceneTy* RenderScene::embree_scene() const {
+  return geo_->scene;
 }
 
 bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax) const {

@@ -20,6 +20,8 @@
 #include "weft/scenes/lights.h"
 #include "weft/scenes/mesh.h"
 
+struct RTCSceneTy;  // Embree's scene (RTCScene is a pointer to it)
+
 namespace weft {
 
 struct SurfaceHit {
@@ -56,8 +58,9 @@ class RenderScene {
 
   bool intersect(const Ray& ray, SurfaceHit* hit) const;
   bool occluded(const Vec3& origin, const Vec3& dir, double tmax) const;
-  // Bare rtcIntersect1: hit distance or infinity, no surface reconstruction (for benchmarks).
-  double intersect_distance(const Ray& ray) const;
+  // The committed Embree scene, for measurements against bare Embree queries (bench/); rendering
+  // goes through intersect and occluded.
+  RTCSceneTy* embree_scene() const;
 
   const Bsdf& bsdf(uint32_t mesh) const;
 
