@@ -17,8 +17,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
     std::string scene, output, preview, mask, mask_object;
     int spp = 0, width = 0, height = 0, max_depth = -1;  // 0, -1: the scene's
     int threads = RenderSettings{}.threads;
-    uint64_t seed = 0;
-    bool seed_given = false, quiet = false, json = false;
+    uint64_t seed = 0;  // used only when --seed is given
+    bool quiet = false, json = false;
   };
   auto o = std::make_shared<Options>();
   auto* sub =
