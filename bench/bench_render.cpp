@@ -5,9 +5,9 @@
 
 #include <memory>
 
+#include "weft/bench/render_bench.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
-#include "weft/integrators/bench.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/render_scene.h"
 
@@ -41,8 +41,8 @@ void BM_EmbreeIntersectRandomRays(benchmark::State& state) {
                        b.lo.z + (b.hi.z - b.lo.z) * rng.uniform()};
     const double z = 1 - 2 * rng.uniform(), phi = 2 * weft::kPi * rng.uniform(),
                  r = std::sqrt(1 - z * z);
-    benchmark::DoNotOptimize(
-        f.scene->intersect_distance({o, {r * std::cos(phi), r * std::sin(phi), z}}));
+    const weft::Ray ray{o, {r * std::cos(phi), r * std::sin(phi), z}};
+    benchmark::DoNotOptimize(weft::embree_hit_distance(*f.scene, weft::to_embree(ray, false)));
     ++rays;
   }
   state.counters["rays_per_s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);

@@ -1,52 +1,40 @@
 // weft bench render: Embree rtcIntersect1 throughput against the path tracer's on the same scene,
-// and the path tracer's 1 -> 2 thread speed-up. Without a scene: woven patches of ~65k and ~1M
+// and the path tracer's 1 -> 2 thread speed-up (the measurement is
+// bench/include/weft/bench/render_bench.h). Without a scene: woven patches of ~65k and ~1M
 // triangles from the weave generator.
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "weft/integrators/bench.h"
+#include "weft/bench/render_bench.h"
 #include "weft/scenes/description.h"
 
 namespace weft::cli {
 
-void add_bench_render_command(CLI::App& app, Commands& commands) {
+void add_bench_render_command(CLI::App& bench, Commands& commands) {
   struct Options {
     std::string scene;
     bool json = false;
-    int threads = 2;
-    int spp = 4;
-    size_t rays = 1 << 20;
+    RenderBenchOptions bench;
   };
   auto o = std::make_shared<Options>();
-  // "bench" may be shared with other benchmark subcommands: reuse it when it exists.
-  CLI::App* bench = nullptr;
-  try {
-    bench = app.get_subcommand("bench");
-  } catch (const CLI::OptionNotFound&) {
-    bench = app.add_subcommand("bench", "Benchmarks");
-    bench->require_subcommand(1);
-  }
   auto* sub =
-      bench->add_subcommand("render", "Embree vs path-tracer rays per second, and thread scaling");
+      bench.add_subcommand("render", "Embree vs path-tracer rays per second, and thread scaling");
   sub->add_option("scene", o->scene, "scene description (.json); default: generated woven patches");
-  sub->add_option("--threads", o->threads, "threads for the parallel runs")
+  sub->add_option("--threads", o->bench.threads, "threads for the parallel runs")
       ->check(CLI::Range(1, 4096))
       ->capture_default_str();
-  sub->add_option("--spp", o->spp, "samples per pixel of the path-traced image")
+  sub->add_option("--spp", o->bench.render.spp, "samples per pixel of the path-traced image")
       ->check(CLI::Range(1, 4096))
       ->capture_default_str();
-  sub->add_option("--rays", o->rays, "diffuse rays for the Embree measurement")
+  sub->add_option("--rays", o->bench.diffuse_rays, "diffuse rays for the Embree measurement")
       ->check(CLI::Range(1024, 1 << 26))
       ->capture_default_str();
   sub->add_flag("--json", o->json, "JSON output");
   commands.push_back(
       {sub, [o] {
-         RenderBenchOptions opt;
-         opt.threads = o->threads;
-         opt.spp = o->spp;
-         opt.diffuse_rays = o->rays;
+         const RenderBenchOptions& opt = o->bench;
          std::vector<RenderBenchResult> results;
          if (!o->scene.empty()) {
            results.push_back(bench_render_scene(load_scene_description(o->scene), o->scene, opt));

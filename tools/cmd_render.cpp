@@ -15,9 +15,10 @@ namespace weft::cli {
 void add_render_command(CLI::App& app, Commands& commands) {
   struct Options {
     std::string scene, output, preview, mask, mask_object;
-    int spp = 0, threads = 0, width = 0, height = 0, max_depth = -1;
-    uint64_t seed = 0;
-    bool seed_given = false, quiet = false, json = false;
+    int spp = 0, width = 0, height = 0, max_depth = -1;  // 0, -1: the scene's
+    int threads = RenderSettings{}.threads;
+    uint64_t seed = 0;  // used only when --seed is given
+    bool quiet = false, json = false;
   };
   auto o = std::make_shared<Options>();
   auto* sub =
@@ -50,7 +51,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
          if (!o->preview.empty()) job.png = o->preview;
          if (!o->mask.empty()) job.mask = o->mask;
          job.mask_object = o->mask_object;
-         job.settings = render_settings_from(desc.render);
+         job.settings = render_settings_from(desc);
          if (o->spp) job.settings.spp = o->spp;
          if (o->width) job.settings.width = o->width;
          if (o->height) job.settings.height = o->height;

@@ -17,8 +17,9 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   struct Options {
     std::string scene, output, views, sample, normalize_to;
     double light_zenith = 0, light_azimuth = 0, view_azimuth = 0, irradiance = 1;
-    int spp = 0, threads = 0, resolution = 0;
-    uint64_t seed = 0;
+    int spp = 0, resolution = 0;  // 0: the scene's
+    int threads = GonioSettings{}.threads;
+    uint64_t seed = 0;  // used only when --seed is given
     bool no_white = false, quiet = false, json = false;
   };
   auto o = std::make_shared<Options>();

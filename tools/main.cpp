@@ -14,14 +14,13 @@ int main(int argc, char** argv) {
   weft::cli::add_slab_command(app, commands);
   weft::cli::add_spectrum_command(app, commands);
   weft::cli::add_bake_command(app, commands);
-  weft::cli::add_bench_bake_command(app, commands);
+  weft::cli::add_bench_command(app, commands);
   weft::cli::add_mie_command(app, commands);
   weft::cli::add_medium_command(app, commands);
   weft::cli::add_table_command(app, commands);
   weft::cli::add_render_command(app, commands);
   weft::cli::add_sweep_command(app, commands);
   weft::cli::add_weave_command(app, commands);
-  weft::cli::add_bench_render_command(app, commands);
 
   try {
     app.parse(argc, argv);

@@ -6,6 +6,8 @@
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
+#include "weft/integrators/masked_render.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
@@ -22,13 +24,13 @@ struct ViewMeasure {
 // samples that hit the sample and x their radiance. Its variance follows from the residuals
 // y = h (x - R) (delta method; Cochran, Sampling Techniques, 3rd ed., section 6.3), estimated from
 // each pixel's sample variance. Edge pixels that are partly covered add no variance by themselves.
-ViewMeasure measure(const RenderResult& r, int spp) {
+ViewMeasure measure(const MaskedRender& r, int spp) {
   ViewMeasure m;
   const size_t npx = r.coverage.size();
   double s[3] = {0, 0, 0}, fp = 0;
   for (size_t p = 0; p < npx; ++p) {
     fp += r.coverage[p];
-    for (int c = 0; c < 3; ++c) s[c] += r.masked_sum[3 * p + c];
+    for (int c = 0; c < 3; ++c) s[c] += r.sum[3 * p + c];
   }
   m.sum = {s[0], s[1], s[2]};
   m.footprint = fp;
@@ -38,7 +40,7 @@ ViewMeasure measure(const RenderResult& r, int spp) {
     const double h = r.coverage[p];
     for (int c = 0; c < 3; ++c) {
       // Per-sample moments of y over the pixel's spp samples (the stored sums are divided by spp).
-      const double hx = r.masked_sum[3 * p + c], hx2 = r.masked_sum_sq[3 * p + c];
+      const double hx = r.sum[3 * p + c], hx2 = r.sum_sq[3 * p + c];
       const double ey = hx - R[c] * h;
       const double ey2 = hx2 - 2 * R[c] * hx + R[c] * R[c] * h;
       // Unbiased sample variance of y, divided by spp for the pixel mean.
@@ -54,6 +56,28 @@ Rgb divide(const Rgb& a, const Rgb& b) {
   return {a.r / b.r, a.g / b.g, a.b / b.b};
 }
 
+// Signed view zeniths in degrees: a list, or {from, to, step} (inclusive).
+std::vector<double> read_angle_list(ParamReader& p, const std::string& key) {
+  const auto& v = p.at(key);
+  std::vector<double> out;
+  if (v.is_array()) {
+    for (size_t i = 0; i < v.size(); ++i)
+      out.push_back(p.check_number(v[i], p.field(key) + "[" + std::to_string(i) + "]", -90, 90));
+  } else if (v.is_object()) {
+    ParamReader r(v, p.file(), p.field(key));
+    const double a = r.number("from", -90, 90), b = r.number("to", -90, 90),
+                 s = r.number("step", 1e-6, 180);
+    r.finish();
+    if (b < a) throw Error(p.file(), p.field(key), "needs from <= to");
+    const long n = std::lround(std::floor((b - a) / s + 1e-9));
+    for (long i = 0; i <= n; ++i) out.push_back(a + s * i);
+  } else {
+    throw Error(p.file(), p.field(key), "must be a list of angles or {from, to, step}");
+  }
+  if (out.empty()) throw Error(p.file(), p.field(key), "is empty");
+  return out;
+}
+
 std::string fmt(double v) {
   if (std::isnan(v)) return "nan";
   char buf[40];
@@ -65,23 +89,25 @@ std::string fmt(double v) {
 
 GonioSettings gonio_settings_from(const SceneDescription& desc) {
   GonioSettings g;
-  g.max_depth = desc.render.max_depth;
-  g.rr_depth = desc.render.rr_depth;
-  g.seed = desc.render.seed;
-  if (desc.sweep) {
-    const SweepSpec& s = *desc.sweep;
-    g.sample = s.sample;
-    g.light_zenith_deg = s.light_zenith_deg;
-    g.light_azimuth_deg = s.light_azimuth_deg;
-    g.irradiance = s.irradiance;
-    g.view_zenith_deg = s.view_zenith_deg;
-    g.view_azimuth_deg = s.view_azimuth_deg;
-    g.normalize_to = s.normalize_to;
-    g.white_check = s.white_check;
-    g.width = s.width;
-    g.height = s.height;
-    g.spp = s.spp;
-  }
+  const RenderSettings r = render_settings_from(desc);
+  g.max_depth = r.max_depth;
+  g.rr_depth = r.rr_depth;
+  g.seed = r.seed;
+  if (!desc.sweep) return g;
+  ParamReader p(*desc.sweep, desc.source, "sweep");
+  constexpr double kMax = kMaxDescriptionRadiometric;
+  g.sample = p.string("sample", g.sample);
+  g.light_zenith_deg = p.number("light_zenith_deg", g.light_zenith_deg, 0.0, 89.9);
+  g.light_azimuth_deg = p.number("light_azimuth_deg", g.light_azimuth_deg, -360.0, 360.0);
+  g.irradiance = p.rgb("irradiance", g.irradiance, 1e-12, kMax);
+  if (p.has("view_zenith_deg")) g.view_zenith_deg = read_angle_list(p, "view_zenith_deg");
+  if (p.has("view_azimuth_deg")) g.view_azimuth_deg = p.number("view_azimuth_deg", -360.0, 360.0);
+  if (p.has("normalize_to")) g.normalize_to = p.rgb("normalize_to", 1e-12, kMax);
+  g.white_check = p.boolean("white_check", g.white_check);
+  g.width = static_cast<int>(p.integer("width", g.width, 1, 16384));
+  g.height = static_cast<int>(p.integer("height", g.height, 1, 16384));
+  g.spp = static_cast<int>(p.integer("spp", g.spp, 1, 1 << 20));
+  p.finish();
   return g;
 }
 
@@ -151,7 +177,6 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   rs.rr_depth = g.rr_depth;
   rs.seed = g.seed;
   rs.threads = g.threads;
-  rs.mask_meshes = sel;
   const uint64_t tiles_per = uint64_t((g.width + rs.tile_size - 1) / rs.tile_size) *
                              ((g.height + rs.tile_size - 1) / rs.tile_size);
   uint64_t renders_done = 0;
@@ -170,13 +195,13 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
     const Vec3 up_hint = std::abs(zen) > 5 ? desc.frame.normal : desc.frame.tangent;
     const Camera cam = frame_box_orthographic(box, towards_viewer, up_hint);
     const uint64_t base = renders_done * tiles_per;
-    const RenderResult r = render(scene, cam, rs, [&](const ProgressUpdate& u) {
+    const MaskedRender r = render_masked(scene, cam, rs, sel, [&](const ProgressUpdate& u) {
       return progress({"sweep", base + u.done, renders * tiles_per});
     });
     ++renders_done;
-    res.rays += r.rays;
-    res.nonfinite_samples += r.nonfinite_samples;
-    if (r.cancelled) return std::nullopt;
+    res.rays += r.render.rays;
+    res.nonfinite_samples += r.render.nonfinite_samples;
+    if (r.render.cancelled) return std::nullopt;
     const ViewMeasure m = measure(r, g.spp);  // NaN when the sample is not seen at all
     return std::make_pair(m, divide(m.mean, l_white));
   };

@@ -18,49 +18,21 @@ double power_heuristic(double pdf_a, double pdf_b) {
   return a + b > 0 ? a / (a + b) : 0;
 }
 
-Vec3 uniform_sphere(double u1, double u2) {
-  const double z = 1 - 2 * u1;
-  const double r = safe_sqrt(1 - z * z);
-  const double phi = 2 * kPi * u2;
-  return {r * std::cos(phi), r * std::sin(phi), z};
-}
-
 bool finite(const Rgb& c) {
   return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
 }
 
 }  // namespace
 
-RenderSettings render_settings_from(const RenderSpec& spec) {
-  RenderSettings s;
-  s.width = spec.width;
-  s.height = spec.height;
-  s.spp = spec.spp;
-  s.max_depth = spec.max_depth;
-  s.rr_depth = spec.rr_depth;
-  s.seed = spec.seed;
-  return s;
-}
-
 Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings,
-               Rng& rng, RayCounts& rays, int64_t* first_mesh, std::vector<LoggedRay>* log) {
-  auto record = [&](const Vec3& o, const Vec3& d, double tmax, bool shadow) {
-    if (log)
-      log->push_back({{float(o.x), float(o.y), float(o.z)},
-                      {float(d.x), float(d.y), float(d.z)},
-                      tmax > 3e38 ? INFINITY : float(tmax),
-                      shadow});
-  };
+               Rng& rng, RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
   auto occluded = [&](const Vec3& o, const Vec3& d, double tmax) {
     ++rays.shadow;
-    record(o, d, tmax, true);
+    if (on_ray) (*on_ray)({o, d, tmax}, true);
     return scene.occluded(o, d, tmax);
   };
-  const Lights& lights = scene.lights();
   const bool use_mis = settings.sampling == LightSampling::mis;
   const bool nee_area = settings.sampling != LightSampling::bsdf_only;
-  const Rgb env = lights.environment;
-  const double env_pdf = kInv4Pi;  // uniform sphere sampling of the constant environment
   Rgb L(0.0), beta(1.0);
   Ray ray = camera_ray;
   bool specular = true;  // camera rays and delta bounces are not covered by next-event estimation
@@ -73,36 +45,29 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
     const double d = length(to);
     return d > 0 && occluded(o, to / d, d * (1 - 1e-5));
   };
+  // Radiance from a light that the last BSDF sample found, weighted against next-event estimation
+  // of the same light.
+  auto add_found_light = [&](const Light& light, const LightHit& at) {
+    const Rgb Le = light.eval(at);
+    if (Le.is_black()) return;
+    double w = 1;
+    if (!specular) w = use_mis ? power_heuristic(prev_pdf, light.pdf(at)) : (nee_area ? 0.0 : 1.0);
+    L += beta * Le * w;
+  };
 
   for (int depth = 0;; ++depth) {
     SurfaceHit hit;
-    record(ray.o, ray.d, ray.tmax, false);
+    if (on_ray) (*on_ray)(ray, false);
     const bool found = scene.intersect(ray, &hit);
     if (!found) {
-      if (!env.is_black()) {
-        double w = 1;
-        if (!specular) w = use_mis ? power_heuristic(prev_pdf, env_pdf) : (nee_area ? 0.0 : 1.0);
-        L += beta * env * w;
-      }
+      const LightHit escaped = LightHit::escaped_along(ray.d);
+      for (const Light& light : scene.lights()) add_found_light(light, escaped);
       break;
     }
     if (depth == 0 && first_mesh) *first_mesh = hit.mesh;
     const Vec3 wo_world = -ray.d;
-    const Rgb Le = scene.emitted(hit.mesh, hit.ng, wo_world);
-    if (!Le.is_black()) {
-      double w = 1;
-      if (!specular) {
-        if (use_mis) {
-          const double cos_l = std::abs(dot(hit.ng, ray.d));
-          const double light_pdf =
-              cos_l > 0 ? scene.area_light_pdf(hit.mesh, hit.prim) * hit.t * hit.t / cos_l : 0;
-          w = power_heuristic(prev_pdf, light_pdf);
-        } else {
-          w = nee_area ? 0.0 : 1.0;
-        }
-      }
-      L += beta * Le * w;
-    }
+    if (const Light* light = scene.surface_light(hit.mesh))
+      add_found_light(*light, LightHit::on_surface(ray.d, hit.mesh, hit.prim, hit.ng, hit.t));
     if (depth >= settings.max_depth) break;
 
     const Bsdf& bsdf = scene.bsdf(hit.mesh);
@@ -116,62 +81,21 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       return (wo_ng * dot(wi_world, hit.ng) > 0) == (wo.z * wi_local.z > 0);
     };
 
-    // Next-event estimation: delta lights.
-    for (const auto& d : lights.directional) {
-      const Vec3 wi = frame.to_local(d.to_light);
-      if (!consistent(d.to_light, wi)) continue;
+    // Next-event estimation: one sample of every light; area lights and the environment weighted
+    // against BSDF sampling (lights.h states what a sample holds).
+    for (const Light& light : scene.lights()) {
+      const bool delta = light.is_delta();
+      if (!delta && !nee_area) continue;
+      const std::optional<LightSample> ls = light.sample(hit.p, rng);
+      if (!ls) continue;
+      const Vec3 wi = frame.to_local(ls->wi);
+      if (!consistent(ls->wi, wi)) continue;
       const Rgb f = bsdf.eval(wo, wi);
       if (f.is_black()) continue;
-      if (!occluded(hit.spawn_origin(d.to_light), d.to_light, 1e300))
-        L += beta * f * d.irradiance * std::abs(wi.z);
-    }
-    for (const auto& pl : lights.points) {
-      // Radiometry from the surface point itself; only the shadow ray starts off the surface.
-      const Vec3 to = pl.position - hit.p;
-      const double dist = length(to);
-      if (!(dist > 0)) continue;
-      const Vec3 dir = to / dist;
-      const double fall = pl.falloff(-dir);
-      if (fall <= 0) continue;
-      const Vec3 wi = frame.to_local(dir);
-      if (!consistent(dir, wi)) continue;
-      const Rgb f = bsdf.eval(wo, wi);
-      if (f.is_black()) continue;
-      if (!occluded_between(hit, pl.position))
-        L += beta * f * pl.intensity * (fall * std::abs(wi.z) / (dist * dist));
-    }
-    // Next-event estimation: area lights and environment, weighted against BSDF sampling.
-    if (nee_area && scene.has_area_lights()) {
-      const double u_pick = rng.uniform();
-      const Vec2 u{rng.uniform(), rng.uniform()};
-      const AreaLightSample ls = scene.sample_area_light(u_pick, u);
-      const Vec3 to = ls.p - hit.p;
-      const double dist = length(to);
-      if (dist > 0 && ls.pdf_area > 0) {
-        const Vec3 dir = to / dist;
-        const double cos_l = std::abs(dot(ls.n, dir));
-        const Rgb Le_l = scene.emitted(ls.mesh, ls.n, -dir);
-        const Vec3 wi = frame.to_local(dir);
-        if (cos_l > 0 && !Le_l.is_black() && consistent(dir, wi)) {
-          const Rgb f = bsdf.eval(wo, wi);
-          if (!f.is_black()) {
-            const double light_pdf = ls.pdf_area * dist * dist / cos_l;
-            const double w = use_mis ? power_heuristic(light_pdf, bsdf.pdf(wo, wi)) : 1.0;
-            if (!occluded_between(hit, ls.p))
-              L += beta * f * Le_l * (std::abs(wi.z) * w / light_pdf);
-          }
-        }
-      }
-    }
-    if (nee_area && !env.is_black()) {
-      const Vec3 dir = uniform_sphere(rng.uniform(), rng.uniform());
-      const Vec3 wi = frame.to_local(dir);
-      const Rgb f = consistent(dir, wi) ? bsdf.eval(wo, wi) : Rgb(0.0);
-      if (!f.is_black()) {
-        const double w = use_mis ? power_heuristic(env_pdf, bsdf.pdf(wo, wi)) : 1.0;
-        if (!occluded(hit.spawn_origin(dir), dir, 1e300))
-          L += beta * f * env * (std::abs(wi.z) * w / env_pdf);
-      }
+      const double w = delta || !use_mis ? 1.0 : power_heuristic(ls->pdf, bsdf.pdf(wo, wi));
+      const bool blocked = ls->at_infinity ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300)
+                                           : occluded_between(hit, ls->p_light);
+      if (!blocked) L += beta * f * ls->L * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
     }
 
     // Continue the path by sampling the BSDF.
@@ -196,26 +120,17 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
 }
 
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
-                    const ProgressCallback& progress) {
+                    const ProgressCallback& progress, const RenderObservers& observers) {
   if (s.width < 1 || s.height < 1 || s.spp < 1 || s.tile_size < 1 || s.max_depth < 0 ||
       s.rr_depth < 0)
     throw Error("", "render", "width, height, spp and tile size must be positive");
-  const bool masked = !s.mask_meshes.empty();
-  if (masked && s.mask_meshes.size() != scene.mesh_count())
-    throw Error("", "render", "mask does not match the mesh count");
   RenderResult out;
   out.image = Image(s.width, s.height);
-  const size_t npx = size_t(s.width) * s.height;
-  if (masked) {
-    out.coverage.assign(npx, 0.0f);
-    out.masked_sum.assign(3 * npx, 0.0);
-    out.masked_sum_sq.assign(3 * npx, 0.0);
-  }
+  const RayObserver* on_ray = observers.on_ray ? &observers.on_ray : nullptr;
   const int tx = (s.width + s.tile_size - 1) / s.tile_size,
             ty = (s.height + s.tile_size - 1) / s.tile_size;
   const uint64_t tiles = uint64_t(tx) * ty;
   std::vector<RayCounts> tile_rays(tiles);
-  std::vector<std::vector<LoggedRay>> tile_log(s.log_rays ? tiles : 0);
   std::vector<uint64_t> tile_nonfinite(tiles, 0);
   std::atomic<bool> cancel{false};
   std::atomic<uint64_t> done{0};
@@ -233,36 +148,23 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
       if (cancel.load(std::memory_order_relaxed)) return;
       for (int x = x0; x < x1; ++x) {
         const uint64_t pixel = uint64_t(y) * s.width + x;
-        double sum[3] = {0, 0, 0}, msum[3] = {0, 0, 0}, msq[3] = {0, 0, 0};
-        int hits = 0;
+        double sum[3] = {0, 0, 0};
         for (int k = 0; k < s.spp; ++k) {
           Rng rng(s.seed, pixel, uint64_t(k));
           const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
           const Ray ray = camera.generate_ray(fx, fy, aspect);
           ++rays.camera;
           int64_t first = -1;
-          Rgb L =
-              trace_path(scene, ray, s, rng, rays, &first, s.log_rays ? &tile_log[tile] : nullptr);
+          Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray);
           if (!finite(L)) {
             ++tile_nonfinite[tile];
             L = Rgb(0.0);
           }
-          const double c[3] = {L.r, L.g, L.b};
-          for (int i = 0; i < 3; ++i) sum[i] += c[i];
-          if (masked && first >= 0 && s.mask_meshes[first]) {
-            ++hits;
-            for (int i = 0; i < 3; ++i) msum[i] += c[i], msq[i] += c[i] * c[i];
-          }
+          sum[0] += L.r, sum[1] += L.g, sum[2] += L.b;
+          if (observers.on_sample) observers.on_sample(pixel, first, L);
         }
         for (int i = 0; i < 3; ++i)
           out.image.rgb[3 * pixel + i] = static_cast<float>(sum[i] * inv_spp);
-        if (masked) {
-          out.coverage[pixel] = static_cast<float>(hits * inv_spp);
-          for (int i = 0; i < 3; ++i) {
-            out.masked_sum[3 * pixel + i] = msum[i] * inv_spp;
-            out.masked_sum_sq[3 * pixel + i] = msq[i] * inv_spp;
-          }
-        }
       }
     }
     tile_rays[tile] = rays;
@@ -271,7 +173,6 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
     if (!cancel.load() && !progress({"render", d, tiles})) cancel.store(true);
   });
   for (uint64_t t = 0; t < tiles; ++t) {
-    if (s.log_rays) out.ray_log.insert(out.ray_log.end(), tile_log[t].begin(), tile_log[t].end());
     out.rays += tile_rays[t];
     out.nonfinite_samples += tile_nonfinite[t];
   }

@@ -2,6 +2,7 @@
 
 #include "weft/core/error.h"
 #include "weft/integrators/image.h"
+#include "weft/integrators/masked_render.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
@@ -25,13 +26,21 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   if (job.png) check_output(*job.png, ".png", "preview");
   if (job.mask) check_output(*job.mask, ".exr", "mask");
   if (!desc.camera) throw Error(desc.source, "camera", "no camera: add 'camera' or a glTF camera");
-  RenderSettings settings = job.settings;
-  if (job.mask) settings.mask_meshes = desc.select_object(job.mask_object);
+  const std::vector<uint8_t> mask =
+      job.mask ? desc.select_object(job.mask_object) : std::vector<uint8_t>();
   RenderSceneOptions scene_options;
   scene_options.material_progress = progress;
   scene_options.fiber_tables = fiber_tables;
   const RenderScene scene(desc, scene_options);
-  const RenderResult r = render(scene, *desc.camera, settings, progress);
+  RenderResult r;
+  std::vector<float> coverage;
+  if (job.mask) {
+    MaskedRender m = render_masked(scene, *desc.camera, job.settings, mask, progress);
+    r = std::move(m.render);
+    coverage = std::move(m.coverage);
+  } else {
+    r = render(scene, *desc.camera, job.settings, progress);
+  }
   RenderJobResult out;
   out.rays = r.rays;
   out.nonfinite_samples = r.nonfinite_samples;
@@ -39,7 +48,7 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   if (r.cancelled) return out;  // nothing half-finished reaches the disk
   write_exr(job.exr, r.image);
   if (job.png) write_png_preview(*job.png, r.image);
-  if (job.mask) write_mask_exr(*job.mask, settings.width, settings.height, r.coverage);
+  if (job.mask) write_mask_exr(*job.mask, job.settings.width, job.settings.height, coverage);
   return out;
 }
 

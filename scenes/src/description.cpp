@@ -3,20 +3,18 @@
 #include <fstream>
 #include <sstream>
 
-#include "json_fields.h"
 #include "primitives.h"
 #include "weft/core/error.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
 
 namespace weft {
 namespace {
 
-using detail::Fields;
+constexpr double kMaxRadiometric = kMaxDescriptionRadiometric;
 
-constexpr double kMaxRadiometric = 1e12;  // generous bound on colours; rejects typos like 1e300
-
-MaterialBinding parse_binding(Fields f, bool allow_emission) {
+MaterialBinding parse_binding(ParamReader f, bool allow_emission) {
   MaterialBinding b;
   b.field = f.path();
   b.type = f.string("type");
@@ -32,7 +30,7 @@ MaterialBinding parse_binding(Fields f, bool allow_emission) {
   return b;
 }
 
-AngleFrame parse_frame(Fields f) {
+AngleFrame parse_frame(ParamReader f) {
   AngleFrame a;
   if (f.has("normal")) a.normal = f.unit_vec3("normal");
   if (f.has("tangent")) a.tangent = f.unit_vec3("tangent");
@@ -44,7 +42,7 @@ AngleFrame parse_frame(Fields f) {
 }
 
 // Zenith/azimuth in degrees, or an explicit direction vector, read from fields with these names.
-Vec3 parse_direction(Fields& f, const AngleFrame& frame, const std::string& vec_key) {
+Vec3 parse_direction(ParamReader& f, const AngleFrame& frame, const std::string& vec_key) {
   if (f.has(vec_key)) {
     if (f.has("zenith_deg") || f.has("azimuth_deg"))
       throw Error(f.file(), f.field(vec_key), "give either a vector or zenith_deg/azimuth_deg");
@@ -55,7 +53,7 @@ Vec3 parse_direction(Fields& f, const AngleFrame& frame, const std::string& vec_
   return frame.direction(deg_to_rad(zen), deg_to_rad(azi));
 }
 
-void parse_light(Fields f, const AngleFrame& frame, Lights& lights) {
+void parse_light(ParamReader f, const AngleFrame& frame, Lights& lights) {
   const std::string type = f.string("type");
   if (type == "parallel") {
     DirectionalLight d;
@@ -85,57 +83,7 @@ void parse_light(Fields f, const AngleFrame& frame, Lights& lights) {
   f.finish();
 }
 
-std::vector<double> parse_angle_list(Fields& f, const std::string& key) {
-  const auto& v = f.at(key);
-  std::vector<double> out;
-  if (v.is_array()) {
-    for (size_t i = 0; i < v.size(); ++i)
-      out.push_back(f.check_number(v[i], f.field(key) + "[" + std::to_string(i) + "]", -90, 90));
-  } else if (v.is_object()) {
-    Fields r(v, f.file(), f.field(key));
-    const double a = r.number("from", -90, 90), b = r.number("to", -90, 90),
-                 s = r.number("step", 1e-6, 180);
-    r.finish();
-    if (b < a) throw Error(f.file(), f.field(key), "needs from <= to");
-    const long n = std::lround(std::floor((b - a) / s + 1e-9));
-    for (long i = 0; i <= n; ++i) out.push_back(a + s * i);
-  } else {
-    throw Error(f.file(), f.field(key), "must be a list of angles or {from, to, step}");
-  }
-  if (out.empty()) throw Error(f.file(), f.field(key), "is empty");
-  return out;
-}
-
-SweepSpec parse_sweep(Fields f) {
-  SweepSpec s;
-  if (f.has("sample")) s.sample = f.string("sample");
-  s.light_zenith_deg = f.number("light_zenith_deg", 0.0, 0.0, 89.9);
-  s.light_azimuth_deg = f.number("light_azimuth_deg", 0.0, -360.0, 360.0);
-  if (f.has("irradiance")) s.irradiance = f.rgb("irradiance", 1e-12, kMaxRadiometric);
-  if (f.has("view_zenith_deg")) s.view_zenith_deg = parse_angle_list(f, "view_zenith_deg");
-  if (f.has("view_azimuth_deg")) s.view_azimuth_deg = f.number("view_azimuth_deg", -360.0, 360.0);
-  if (f.has("normalize_to")) s.normalize_to = f.rgb("normalize_to", 1e-12, kMaxRadiometric);
-  s.white_check = f.boolean("white_check", true);
-  s.width = f.integer("width", s.width, 1, 16384);
-  s.height = f.integer("height", s.height, 1, 16384);
-  s.spp = f.integer("spp", s.spp, 1, 1 << 20);
-  f.finish();
-  return s;
-}
-
-RenderSpec parse_render(Fields f) {
-  RenderSpec r;
-  r.width = f.integer("width", r.width, 1, 16384);
-  r.height = f.integer("height", r.height, 1, 16384);
-  r.spp = f.integer("spp", r.spp, 1, 1 << 20);
-  r.max_depth = f.integer("max_depth", r.max_depth, 0, 100000);
-  r.rr_depth = f.integer("rr_depth", r.rr_depth, 0, 100000);
-  r.seed = f.unsigned_integer("seed", r.seed);
-  f.finish();
-  return r;
-}
-
-Camera parse_camera(Fields f, const SceneDescription& d,
+Camera parse_camera(ParamReader f, const SceneDescription& d,
                     const std::vector<NamedCamera>& gltf_cameras) {
   Camera cam;
   if (f.has("gltf_camera")) {
@@ -178,7 +126,7 @@ Camera parse_camera(Fields f, const SceneDescription& d,
   return cam;
 }
 
-void parse_object(Fields f, SceneDescription& d) {
+void parse_object(ParamReader f, SceneDescription& d) {
   const std::string type = f.string("type");
   TriangleMesh m;
   if (type == "quad") {
@@ -198,7 +146,7 @@ void parse_object(Fields f, SceneDescription& d) {
   } else if (type == "sphere") {
     const Vec3 c = f.vec3("center");
     const double r = f.number("radius", 1e-30, 1e30);
-    const int sub = f.integer("subdivisions", 3, 0, 7);
+    const int sub = static_cast<int>(f.integer("subdivisions", 3, 0, 7));
     const bool inward = f.boolean("inward", false);
     m = detail::make_sphere(c, r, sub, inward);
     // Flat facets (no vertex normals) make shading and geometry agree exactly (furnace tests).
@@ -263,7 +211,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
   SceneDescription d;
   d.source = source;
   d.base_dir = base_dir;
-  Fields f(j, source, "");
+  ParamReader f(j, source, "");
   if (f.has("frame")) d.frame = parse_frame(f.object("frame"));
 
   std::vector<NamedCamera> gltf_cameras;
@@ -301,13 +249,13 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     const auto& objs = f.at("objects");
     if (!objs.is_array()) throw Error(source, "objects", "must be a list");
     for (size_t i = 0; i < objs.size(); ++i)
-      parse_object(Fields(objs[i], source, "objects[" + std::to_string(i) + "]"), d);
+      parse_object(ParamReader(objs[i], source, "objects[" + std::to_string(i) + "]"), d);
   }
   if (f.has("materials")) {
     const auto& mats = f.at("materials");
     if (!mats.is_object()) throw Error(source, "materials", "must be an object of bindings");
     for (const auto& [key, value] : mats.items())
-      d.materials[key] = parse_binding(Fields(value, source, "materials." + key), true);
+      d.materials[key] = parse_binding(ParamReader(value, source, "materials." + key), true);
   }
   if (f.has("default_material"))
     d.default_material = parse_binding(f.object("default_material"), false);
@@ -315,10 +263,11 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     const auto& ls = f.at("lights");
     if (!ls.is_array()) throw Error(source, "lights", "must be a list");
     for (size_t i = 0; i < ls.size(); ++i)
-      parse_light(Fields(ls[i], source, "lights[" + std::to_string(i) + "]"), d.frame, d.lights);
+      parse_light(ParamReader(ls[i], source, "lights[" + std::to_string(i) + "]"), d.frame,
+                  d.lights);
   }
-  if (f.has("render")) d.render = parse_render(f.object("render"));
-  if (f.has("sweep")) d.sweep = parse_sweep(f.object("sweep"));
+  if (f.has("render")) d.render = f.at("render");
+  if (f.has("sweep")) d.sweep = f.at("sweep");
   if (f.has("camera"))
     d.camera = parse_camera(f.object("camera"), d, gltf_cameras);
   else if (!gltf_cameras.empty())

@@ -23,17 +23,14 @@ struct RenderScene::Geometry {
   struct MeshRecord {
     std::shared_ptr<const TriangleMesh> mesh;
     uint32_t bsdf = 0;
-    Rgb emission{0.0};
-    bool emit_two_sided = false;
-    int64_t light_offset = -1;  // first entry of this mesh's triangles in the light list
+    bool emits = false;  // part of the area light
   };
   EmbreeErrors errors;  // outlives the device, which reports into it
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
   std::vector<MeshRecord> meshes;
   std::vector<Bsdf> bsdfs;
-  std::vector<std::pair<uint32_t, uint32_t>> light_tris;  // (mesh, prim)
-  Distribution1D light_pick;
+  AreaLight area_light;  // the emissive triangles
   Bounds3 bounds;
   size_t triangles = 0;
 
@@ -54,12 +51,6 @@ void on_embree_error(void* user, RTCError code, const char* str) {
 
 Vec3 vertex(const TriangleMesh& m, uint32_t i) {
   return m.position(i);
-}
-
-double triangle_area(const TriangleMesh& m, uint32_t prim) {
-  const Vec3 p0 = vertex(m, m.indices[3 * prim]);
-  return 0.5 * length(cross(vertex(m, m.indices[3 * prim + 1]) - p0,
-                            vertex(m, m.indices[3 * prim + 2]) - p0));
 }
 
 // An Embree ray query for 'ray' (single precision, no hit yet).
@@ -114,7 +105,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     return id;
   };
 
-  std::vector<double> light_weights;
+  std::vector<AreaLight::Emission> emission;
   for (size_t i = 0; i < desc.meshes.size(); ++i) {
     const auto& mesh = desc.meshes[i];
     const bool overridden = !options.override_meshes.empty() && options.override_meshes[i];
@@ -128,16 +119,8 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     const auto info = desc.gltf_materials.find(mesh->material);
     const GltfMaterialInfo gl =
         info != desc.gltf_materials.end() ? info->second : GltfMaterialInfo{};
-    rec.emission = b.emission ? *b.emission : gl.emission;
-    rec.emit_two_sided = b.double_sided ? *b.double_sided : gl.double_sided;
-    if (!rec.emission.is_black()) {
-      rec.light_offset = static_cast<int64_t>(geo->light_tris.size());
-      for (uint32_t t = 0; t < mesh->triangle_count(); ++t) {
-        geo->light_tris.push_back({static_cast<uint32_t>(i), t});
-        light_weights.push_back(triangle_area(*mesh, t) * rec.emission.average() *
-                                (rec.emit_two_sided ? 2 : 1));
-      }
-    }
+    emission.push_back({b.emission ? *b.emission : gl.emission,
+                        b.double_sided ? *b.double_sided : gl.double_sided});
     geo->meshes.push_back(rec);
     geo->bounds.expand(mesh->bounds());
     // Geometry IDs equal mesh indices; an empty mesh simply has no Embree geometry.
@@ -164,9 +147,27 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   }
   rtcCommitScene(geo->scene);
   if (!errors.message.empty()) throw Error(desc.source, "", errors.message);
-  if (!light_weights.empty()) geo->light_pick = Distribution1D(light_weights);
+  geo->area_light = AreaLight(desc.meshes, emission);
+  for (size_t i = 0; i < geo->meshes.size(); ++i)
+    geo->meshes[i].emits = geo->area_light.emits(static_cast<uint32_t>(i));
   geo_ = std::move(geo);
-  lights_ = desc.lights;
+  set_lights(desc.lights);
+}
+
+const Light* RenderScene::surface_light(uint32_t mesh) const {
+  return surface_light_ >= 0 && geo_->meshes[mesh].emits ? &lights_[surface_light_] : nullptr;
+}
+
+void RenderScene::set_lights(const Lights& lights) {
+  lights_.clear();
+  for (const auto& d : lights.directional) lights_.push_back(d);
+  for (const auto& p : lights.points) lights_.push_back(p);
+  surface_light_ = -1;
+  if (!geo_->area_light.empty()) {
+    surface_light_ = static_cast<int>(lights_.size());
+    lights_.push_back(geo_->area_light);
+  }
+  if (!lights.environment.is_black()) lights_.push_back(EnvironmentLight{lights.environment});
 }
 
 bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit) const {
@@ -218,12 +219,8 @@ bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit) const {
   return true;
 }
 
-double RenderScene::intersect_distance(const Ray& ray) const {
-  RTCRayHit rh = embree_ray(ray);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  rtcIntersect1(geo_->scene, &ctx, &rh);
-  return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
+RTCSceneTy* RenderScene::embree_scene() const {
+  return geo_->scene;
 }
 
 bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax) const {
@@ -249,48 +246,10 @@ const Bsdf& RenderScene::bsdf(uint32_t mesh) const {
   return geo_->bsdfs[geo_->meshes[mesh].bsdf];
 }
 
-Rgb RenderScene::emitted(uint32_t mesh, const Vec3& ng, const Vec3& w) const {
-  const auto& rec = geo_->meshes[mesh];
-  if (rec.emission.is_black()) return Rgb(0.0);
-  if (!rec.emit_two_sided && dot(ng, w) <= 0) return Rgb(0.0);
-  return rec.emission;
-}
-
-bool RenderScene::has_area_lights() const {
-  return !geo_->light_tris.empty();
-}
-
-AreaLightSample RenderScene::sample_area_light(double u_pick, Vec2 u) const {
-  double pmf = 0;
-  const size_t k = geo_->light_pick.sample_discrete(u_pick, &pmf);
-  const auto [mesh, prim] = geo_->light_tris[k];
-  const TriangleMesh& m = *geo_->meshes[mesh].mesh;
-  const Vec3 p0 = vertex(m, m.indices[3 * prim]), p1 = vertex(m, m.indices[3 * prim + 1]),
-             p2 = vertex(m, m.indices[3 * prim + 2]);
-  // Uniform point on the triangle (square-root parameterisation).
-  const double su = std::sqrt(u.x);
-  const double b1 = 1 - su, b2 = u.y * su;
-  AreaLightSample s;
-  s.p = (1 - b1 - b2) * p0 + b1 * p1 + b2 * p2;
-  const Vec3 c = cross(p1 - p0, p2 - p0);
-  const double area = 0.5 * length(c);
-  s.n = area > 0 ? c / (2 * area) : Vec3{0, 0, 1};
-  s.mesh = mesh;
-  s.pdf_area = area > 0 ? pmf / area : 0;
-  return s;
-}
-
-double RenderScene::area_light_pdf(uint32_t mesh, uint32_t prim) const {
-  const auto& rec = geo_->meshes[mesh];
-  if (rec.light_offset < 0) return 0;
-  const double area = triangle_area(*rec.mesh, prim);
-  return area > 0 ? geo_->light_pick.pmf(static_cast<size_t>(rec.light_offset) + prim) / area : 0;
-}
-
-RenderScene RenderScene::with_lights(Lights lights) const {
+RenderScene RenderScene::with_lights(const Lights& lights) const {
   RenderScene r;
   r.geo_ = geo_;
-  r.lights_ = std::move(lights);
+  r.set_lights(lights);
   return r;
 }
 

@@ -11,12 +11,15 @@
 //    a/c, Y = b/c). The closed form is cross-checked against direct quadrature of cos(theta)
 //    cos(theta') / (pi r^2) over the rectangle.
 // Next-event estimation alone, BSDF sampling alone and their MIS combination must each agree with
-// the closed form, and with each other, within their standard errors.
+// the closed form, and with each other, within their standard errors. Delta lights add up: the
+// image with all of them is the sum of the images with each.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "test_util.h"
+#include "weft/core/math.h"
+#include "weft/integrators/masked_render.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
@@ -190,17 +193,17 @@ TEST(Lights, NeeAndBsdfSamplingAgreePerPixel) {
   s.width = s.height = 24;
   s.spp = 256;
   s.max_depth = 1;
-  s.mask_meshes = d.select_object("floor");  // per-pixel sample moments of floor hits
+  const std::vector<uint8_t> floor = d.select_object("floor");  // sample moments of floor hits
   s.sampling = LightSampling::lights_only;
   s.seed = 1;
-  const RenderResult a = render(scene, *d.camera, s);
+  const MaskedRender a = render_masked(scene, *d.camera, s, floor);
   s.sampling = LightSampling::bsdf_only;
   s.seed = 2;
-  const RenderResult b = render(scene, *d.camera, s);
-  auto moments = [&](const RenderResult& r, size_t p, double* mean, double* var) {
+  const MaskedRender b = render_masked(scene, *d.camera, s, floor);
+  auto moments = [&](const MaskedRender& r, size_t p, double* mean, double* var) {
     // Channel 1 (all channels are equal here); variance of the pixel mean from the sample variance.
-    *mean = r.masked_sum[3 * p + 1];
-    *var = std::max(0.0, r.masked_sum_sq[3 * p + 1] - *mean * *mean) / (s.spp - 1);
+    *mean = r.sum[3 * p + 1];
+    *var = std::max(0.0, r.sum_sq[3 * p + 1] - *mean * *mean) / (s.spp - 1);
   };
   double chi2 = 0;
   int dof = 0, lit = 0;
@@ -221,4 +224,53 @@ TEST(Lights, NeeAndBsdfSamplingAgreePerPixel) {
   EXPECT_GT(lit, 300);
   const double k = dof, z = (std::cbrt(chi2 / k) - (1 - 2 / (9 * k))) / std::sqrt(2 / (9 * k));
   EXPECT_LT(z, 4.0) << "chi2 " << chi2 << " for " << dof << " pixels";
+}
+
+TEST(Lights, DeltaLightsAddUp) {
+  // The estimate is linear in the lights: delta lights draw no random numbers, so every camera
+  // sample follows the same path with each light alone and with all of them, and the images add
+  // up to float rounding. Two bounces and a blocker make shadows and inter-reflection count.
+  json j = floor_scene();
+  j["objects"].push_back({{"type", "quad"},
+                          {"name", "blocker"},
+                          {"material", "floor"},
+                          {"center", {0.2, 0.5, 0}},
+                          {"normal", {0, 1, 0}},
+                          {"tangent", {1, 0, 0}},
+                          {"size", {0.6, 0.6}}});
+  j["camera"] = {{"type", "orthographic"}, {"position", {0, 3, 0}}, {"look_at", {0, 0, 0}},
+                 {"up", {0, 0, -1}},       {"half_width", 1.5},     {"half_height", 1.5}};
+  const SceneDescription d = parse_scene_description(j, ".", "sum.json");
+  const RenderScene geometry(d);
+  Lights all;
+  all.directional.push_back({normalize(Vec3{0.3, 1, 0.2}), Rgb(1.0, 0.5, 0.25)});
+  all.points.push_back({{0.5, 1.5, 0.5}, Rgb(2.0)});
+  PointLight spot;
+  spot.position = {-0.5, 2, 0};
+  spot.intensity = Rgb(0.5, 1, 3);
+  spot.spot_direction = {0, -1, 0};
+  spot.cos_inner = std::cos(deg_to_rad(20));
+  spot.cos_outer = std::cos(deg_to_rad(40));
+  all.points.push_back(spot);
+  RenderSettings s;
+  s.width = s.height = 24;
+  s.spp = 2;
+  s.max_depth = 2;
+  s.seed = 4;
+  const RenderResult together = render(geometry.with_lights(all), *d.camera, s);
+  std::vector<double> sum(together.image.rgb.size(), 0.0);
+  auto add = [&](const Lights& one) {
+    const RenderResult r = render(geometry.with_lights(one), *d.camera, s);
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += r.image.rgb[i];
+  };
+  add({{all.directional[0]}, {}, Rgb(0.0)});
+  add({{}, {all.points[0]}, Rgb(0.0)});
+  add({{}, {all.points[1]}, Rgb(0.0)});
+  double total = 0;
+  for (size_t i = 0; i < sum.size(); ++i) {
+    total += sum[i];
+    // Each image is stored as float: a few float roundings of the larger value.
+    ASSERT_NEAR(together.image.rgb[i], sum[i], 4e-7 * std::max(sum[i], 1e-30)) << i;
+  }
+  EXPECT_GT(total, 0);
 }

@@ -2,25 +2,38 @@
 // round-trip.
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <cstring>
 #include <filesystem>
 
 #include "weft/core/error.h"
-#include "weft/integrators/bench.h"
+#include "weft/core/math.h"
 #include "weft/integrators/image.h"
+#include "weft/integrators/masked_render.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/integrators/render_job.h"
 #include "weft/scenes/render_scene.h"
+#include "weft/scenes/weave.h"
 
 using namespace weft;
 namespace fs = std::filesystem;
 
 namespace {
+// A small woven patch (lambert warp and weft) under a parallel light and an environment (which
+// adds MIS paths), seen by an orthographic camera from 20 degrees.
 SceneDescription woven() {
   WeaveParams p;
   p.yarns = 4, p.segments = 32, p.sides = 6;
-  SceneDescription d = weave_bench_scene(p);
-  d.lights.environment = Rgb(0.2);  // adds area-like MIS paths to the directional light
+  SceneDescription d;
+  d.source = "woven";
+  for (auto& m : make_weave(p))
+    d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+  d.materials["warp"] = {"lambert", {{"reflectance", {0.6, 0.15, 0.1}}}, {}, {}, "materials.warp"};
+  d.materials["weft"] = {"lambert", {{"reflectance", 0.5}}, {}, {}, "materials.weft"};
+  d.lights.directional.push_back({d.frame.direction(deg_to_rad(30), 0), Rgb(1.0)});
+  d.lights.environment = Rgb(0.2);
+  d.camera = frame_box_orthographic(d.object_bounds(""), d.frame.direction(deg_to_rad(20), kPi),
+                                    d.frame.normal);
   return d;
 }
 
@@ -45,29 +58,64 @@ fs::path fresh_dir(const std::string& name) {
 TEST(Render, BitIdenticalAtAnyThreadCount) {
   const SceneDescription d = woven();
   const RenderScene scene(d);
-  RenderSettings s1 = small(1);
-  s1.mask_meshes = d.select_object("warp");
-  const RenderResult a = render(scene, *d.camera, s1);
+  const std::vector<uint8_t> mask = d.select_object("warp");
+  const MaskedRender a = render_masked(scene, *d.camera, small(1), mask);
   double total = 0;
-  for (float v : a.image.rgb) total += v;
+  for (float v : a.render.image.rgb) total += v;
   ASSERT_GT(total, 0);
   for (int threads : {2, 0}) {  // 0 = all cores
-    RenderSettings sn = s1;
-    sn.threads = threads;
-    const RenderResult b = render(scene, *d.camera, sn);
-    ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
-    EXPECT_EQ(
-        0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
-    EXPECT_EQ(a.masked_sum, b.masked_sum);
+    const MaskedRender b = render_masked(scene, *d.camera, small(threads), mask);
+    const auto &ia = a.render.image.rgb, &ib = b.render.image.rgb;
+    ASSERT_EQ(ia.size(), ib.size());
+    EXPECT_EQ(0, std::memcmp(ia.data(), ib.data(), ia.size() * sizeof(float)));
+    EXPECT_EQ(a.sum, b.sum);
     EXPECT_EQ(a.coverage, b.coverage);
-    EXPECT_EQ(a.rays.total(), b.rays.total());
+    EXPECT_EQ(a.render.rays.total(), b.render.rays.total());
   }
+  // The mask only observes: the image is render()'s.
+  const RenderResult plain = render(scene, *d.camera, small(2));
+  EXPECT_EQ(plain.image.rgb, a.render.image.rgb);
   // A different seed gives a different image (the comparison above can fail).
-  RenderSettings other = s1;
+  RenderSettings other = small(1);
   other.seed = 6;
   const RenderResult c = render(scene, *d.camera, other);
-  EXPECT_NE(
-      0, std::memcmp(a.image.rgb.data(), c.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
+  EXPECT_NE(0, std::memcmp(a.render.image.rgb.data(), c.image.rgb.data(),
+                           a.render.image.rgb.size() * sizeof(float)));
+}
+
+TEST(Render, ObserversSeeEverySampleAndRay) {
+  const SceneDescription d = woven();
+  const RenderScene scene(d);
+  const RenderSettings s = small(2);
+  std::vector<uint32_t> samples(size_t(s.width) * s.height, 0);
+  std::vector<double> sums(3 * samples.size(), 0.0);
+  std::atomic<uint64_t> rays{0}, shadow_rays{0};
+  RenderObservers observers;
+  observers.on_sample = [&](uint64_t pixel, int64_t first_mesh, const Rgb& L) {
+    ASSERT_LT(pixel, samples.size());
+    ASSERT_GE(first_mesh, -1);
+    ASSERT_LT(first_mesh, int64_t(scene.mesh_count()));
+    ++samples[pixel];
+    sums[3 * pixel] += L.r, sums[3 * pixel + 1] += L.g, sums[3 * pixel + 2] += L.b;
+  };
+  observers.on_ray = [&](const Ray&, bool shadow) {
+    ++rays;
+    if (shadow) ++shadow_rays;
+  };
+  const RenderResult r = render(scene, *d.camera, s, no_progress(), observers);
+  for (size_t p = 0; p < samples.size(); ++p) {
+    ASSERT_EQ(samples[p], uint32_t(s.spp));
+    // The pixel is the mean of the samples it was shown.
+    for (int c = 0; c < 3; ++c)
+      ASSERT_EQ(r.image.rgb[3 * p + c], static_cast<float>(sums[3 * p + c] * (1.0 / s.spp)));
+  }
+  EXPECT_EQ(shadow_rays.load(), r.rays.shadow);
+  // Every camera ray is traced; RayCounts::bounce also counts the bounces that Russian roulette
+  // ends before they are traced.
+  const uint64_t traced = rays.load() - shadow_rays.load();
+  EXPECT_GE(traced, r.rays.camera);
+  EXPECT_LE(traced, r.rays.camera + r.rays.bounce);
+  EXPECT_GT(traced, r.rays.camera);  // some paths bounce
 }
 
 TEST(Render, CancellationWritesNothing) {

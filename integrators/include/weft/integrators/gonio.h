@@ -13,6 +13,15 @@
 // azimuth phi_v (default phi_i, the plane of incidence); as in the paper's Fig. 7, a view zenith
 // theta_v > 0 lies on the mirror side (azimuth phi_v + 180) and theta_v < 0 on the light's side.
 // The scene's own lights and environment are not used; emissive surfaces still emit.
+//
+// The scene description's "sweep" section sets the instrument (every key optional; the defaults
+// are GonioSettings{}):
+//
+//   "sweep": {"sample": NAME, "light_zenith_deg": t, "light_azimuth_deg": p, "irradiance": c,
+//             "view_zenith_deg": [list] | {"from": a, "to": b, "step": s}, "view_azimuth_deg": p,
+//             "normalize_to": c, "white_check": true, "width": 64, "height": 64, "spp": 16}
+//
+// and its "render" section the path tracer's max_depth, rr_depth and seed.
 #include <optional>
 #include <string>
 #include <vector>
@@ -29,16 +38,21 @@ struct GonioSettings {
   double light_zenith_deg = 0, light_azimuth_deg = 0;
   Rgb irradiance{1.0};
   std::vector<double> view_zenith_deg;
-  std::optional<double> view_azimuth_deg;
+  std::optional<double> view_azimuth_deg;  // default: the light's azimuth (plane of incidence)
   std::optional<Rgb> normalize_to;
   bool white_check = true;
+  // Each view's image: the sweep's own settings, not the "render" section's (a sweep renders many
+  // small views of one object, a render one large image).
   int width = 64, height = 64, spp = 16;
-  int max_depth = 16, rr_depth = 3;
-  uint64_t seed = 0;
-  int threads = 0;
+  // The path tracer's own settings, shared with renders.
+  int max_depth = RenderSettings{}.max_depth, rr_depth = RenderSettings{}.rr_depth;
+  uint64_t seed = RenderSettings{}.seed;
+  int threads = RenderSettings{}.threads;
 };
 
-// Defaults from the description's "sweep" and "render" sections.
+// GonioSettings{} with the description's "sweep" section and the path tracer's settings of its
+// "render" section applied. Unknown keys and bad values are weft::Error naming the description's
+// file and the key's path ("sweep.view_zenith_deg.step").
 GonioSettings gonio_settings_from(const SceneDescription& desc);
 
 // Signed view zenith / azimuth (degrees) to a unit direction towards the viewer.

@@ -1,48 +1,24 @@
 #pragma once
-// Unidirectional path tracer over a RenderScene. Next-event estimation for parallel, point and spot
-// lights, and for area lights and the environment combined with BSDF sampling by multiple
-// importance sampling (power heuristic, Veach 1997 ch. 9); Russian roulette after rr_depth bounces;
-// shading in the mesh's tangent frame; two-sided (the BSDF sees wo below its normal and decides);
-// transmission continues through the surface. Every random number of a camera sample comes from
-// Rng(seed, pixel index, sample index) and tiles write disjoint pixels, so images are
+// Unidirectional path tracer over a RenderScene. At every surface, next-event estimation takes one
+// sample of every light through the Light interface (lights.h); for area lights and the
+// environment it is combined with BSDF sampling by multiple importance sampling (power heuristic,
+// Veach 1997 ch. 9), delta lights have only that one strategy. Russian roulette after rr_depth
+// bounces; shading in the mesh's tangent frame; two-sided (the BSDF sees wo below its normal and
+// decides); transmission continues through the surface. Every random number of a camera sample
+// comes from Rng(seed, pixel index, sample index) and tiles write disjoint pixels, so images are
 // bit-identical at any thread count.
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "weft/core/progress.h"
 #include "weft/core/rng.h"
 #include "weft/integrators/image.h"
+#include "weft/integrators/render_settings.h"
 #include "weft/scenes/camera.h"
-#include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
-
-// Which strategies estimate light from area lights and the environment (delta lights always use
-// next-event estimation). The single-strategy modes exist to test MIS against each of its parts.
-enum class LightSampling { mis, lights_only, bsdf_only };
-
-// A ray as the tracer handed it to Embree (for replaying the same rays in benchmarks).
-struct LoggedRay {
-  float org[3], dir[3], tmax;
-  bool shadow;  // rtcOccluded1 rather than rtcIntersect1
-};
-
-struct RenderSettings {
-  int width = 256, height = 256;
-  int spp = 16;
-  int max_depth = 16;  // bounces; 0 = emitted light only, 1 = direct lighting
-  int rr_depth = 3;    // bounces before Russian roulette
-  uint64_t seed = 0;
-  int threads = 0;  // 0 = all cores
-  int tile_size = 16;
-  LightSampling sampling = LightSampling::mis;
-  // Per mesh: camera samples whose first hit is one of these count towards the mask outputs.
-  std::vector<uint8_t> mask_meshes;
-  bool log_rays = false;  // keep every traced ray in RenderResult::ray_log (benchmarks only)
-};
-
-RenderSettings render_settings_from(const RenderSpec& spec);
 
 struct RayCounts {
   uint64_t camera = 0, bounce = 0, shadow = 0;
@@ -55,23 +31,35 @@ struct RayCounts {
 
 struct RenderResult {
   Image image;  // mean radiance per pixel, linear RGB
-  // With mask_meshes set (else empty), per pixel: the fraction of samples whose camera ray hit the
-  // mask, and over those samples the sums of radiance and squared radiance divided by spp.
-  std::vector<float> coverage;
-  std::vector<double> masked_sum, masked_sum_sq;  // 3 per pixel
   RayCounts rays;
-  std::vector<LoggedRay> ray_log;  // with log_rays, in tile order
   uint64_t nonfinite_samples = 0;  // dropped (counted, never hidden)
   bool cancelled = false;          // the progress callback asked to stop; results are partial
 };
 
+// After every camera sample: its pixel (row-major), the mesh its camera ray hit first (-1: none)
+// and its radiance (0 for a dropped non-finite sample).
+using SampleObserver = std::function<void(uint64_t pixel, int64_t first_mesh, const Rgb& radiance)>;
+// Every ray handed to the scene: camera and bounce rays (shadow = false) and shadow rays (shadow =
+// true, ending at ray.tmax).
+using RayObserver = std::function<void(const Ray& ray, bool shadow)>;
+
+// What instruments built on the renderer see of a render (the gonioreflectometer's object mask in
+// masked_render.h, the render benchmark's ray log); the path tracer keeps nothing for them. An
+// empty observer costs one test where it would be called. Both are called from the worker
+// threads: every sample of a pixel from one thread and in sample order, so per-pixel state needs
+// no lock; the ray observer is called concurrently and in trace order within a tile.
+struct RenderObservers {
+  SampleObserver on_sample;
+  RayObserver on_ray;
+};
+
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& settings,
-                    const ProgressCallback& progress = no_progress());
+                    const ProgressCallback& progress = no_progress(),
+                    const RenderObservers& observers = {});
 
 // Radiance arriving along 'ray' (one path sample). 'first_mesh' receives the mesh the ray hits
-// first (-1 for none). Exposed for tests of the estimator itself.
+// first (-1 for none); 'on_ray' sees every ray traced. Exposed for tests of the estimator itself.
 Rgb trace_path(const RenderScene& scene, const Ray& ray, const RenderSettings& settings, Rng& rng,
-               RayCounts& rays, int64_t* first_mesh = nullptr,
-               std::vector<LoggedRay>* log = nullptr);
+               RayCounts& rays, int64_t* first_mesh = nullptr, const RayObserver* on_ray = nullptr);
 
 }  // namespace weft

@@ -2,6 +2,8 @@
 // The scene description file (JSON): glTF files (relative paths), bindings of glTF material names
 // to Weft materials, lights, camera, render settings and an optional gonioreflectometer sweep.
 // Parsing only: the result is plain data; render_scene.h turns it into something renderable.
+// The "render" and "sweep" sections are kept as written: the integrators own those settings and
+// read them (render_settings.h documents "render", gonio.h "sweep").
 //
 // {
 //   "gltf": "plane.gltf" | ["a.gltf", "b.glb"],
@@ -24,10 +26,8 @@
 //             {"type": "orthographic", "position": [3], "look_at": [3], "up": [3],
 //              "half_width": w, "half_height": h} |
 //             {"type": "orthographic", "frame_object": NAME, "zenith_deg": t, "azimuth_deg": p},
-//   "render": {"width": 256, "height": 256, "spp": 16, "max_depth": 16, "rr_depth": 3, "seed": 0},
-//   "sweep": {"sample": NAME, "light_zenith_deg": t, "light_azimuth_deg": p, "irradiance": c,
-//             "view_zenith_deg": [list] | {"from": a, "to": b, "step": s}, "view_azimuth_deg": p,
-//             "normalize_to": c, "white_check": true, "width": 64, "height": 64, "spp": 16}
+//   "render": {...},                                       // weft/integrators/render_settings.h
+//   "sweep": {...}                                         // weft/integrators/gonio.h
 // }
 // A colour c is a number or [r, g, b]. Unknown keys, wrong types, out-of-range values and missing
 // files are weft::Error naming the file and the field.
@@ -63,24 +63,8 @@ struct AngleFrame {
   Vec3 direction(double zenith_rad, double azimuth_rad) const;
 };
 
-struct RenderSpec {
-  int width = 256, height = 256;
-  int spp = 16;
-  int max_depth = 16;  // bounces
-  int rr_depth = 3;    // bounces before Russian roulette starts
-  uint64_t seed = 0;
-};
-
-struct SweepSpec {
-  std::string sample;  // object name; empty = every mesh
-  double light_zenith_deg = 0, light_azimuth_deg = 0;
-  Rgb irradiance{1.0};
-  std::vector<double> view_zenith_deg;
-  std::optional<double> view_azimuth_deg;  // default: the light's azimuth (plane of incidence)
-  std::optional<Rgb> normalize_to;
-  bool white_check = true;
-  int width = 64, height = 64, spp = 16;
-};
+// Upper bound on colours a description gives: generous, but it rejects typos like 1e300.
+inline constexpr double kMaxDescriptionRadiometric = 1e12;
 
 struct SceneDescription {
   std::string source;  // the description file, for error messages
@@ -92,8 +76,9 @@ struct SceneDescription {
   Lights lights;
   std::optional<Camera> camera;
   AngleFrame frame;
-  RenderSpec render;
-  std::optional<SweepSpec> sweep;
+  // The "render" and "sweep" sections as written (absent: nullopt), read by the integrators with
+  // errors naming 'source' and the section.
+  std::optional<nlohmann::json> render, sweep;
   std::vector<std::string> warnings;
 
   // Bounding box of the meshes selected by 'object' (every mesh when empty); Error when none.

@@ -1,15 +1,15 @@
 #pragma once
 // The immutable, renderable form of a SceneDescription: an Embree 3 scene committed once, one BSDF
-// per material binding (created once through the material registry), emissive triangles as area
-// lights, and the non-geometric lights. Copies share the geometry; with_lights() swaps the
-// lights without rebuilding anything. Thread-safe for concurrent queries.
+// per material binding (created once through the material registry), and its lights (lights.h):
+// the description's, plus the emissive triangles as one area light. Copies share the geometry;
+// with_lights() swaps the description's lights without rebuilding anything. Thread-safe for
+// concurrent queries.
 #include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "weft/core/distribution.h"
 #include "weft/core/frame.h"
 #include "weft/core/spectrum.h"
 #include "weft/materials/bsdfs.h"
@@ -19,6 +19,8 @@
 #include "weft/scenes/description.h"
 #include "weft/scenes/lights.h"
 #include "weft/scenes/mesh.h"
+
+struct RTCSceneTy;  // Embree's scene (RTCScene is a pointer to it)
 
 namespace weft {
 
@@ -35,12 +37,6 @@ struct SurfaceHit {
   // Origin for a ray leaving the surface in direction d: offset along ng to d's side, so rays
   // continue through the surface for transmission and do not re-hit it.
   Vec3 spawn_origin(const Vec3& d) const { return p + ng * (dot(d, ng) > 0 ? offset : -offset); }
-};
-
-struct AreaLightSample {
-  Vec3 p, n;            // point on the emitter, its unit geometric normal
-  uint32_t mesh = 0;    // emitted(mesh, n, w) gives its radiance towards w
-  double pdf_area = 0;  // density w.r.t. area of the chosen point
 };
 
 struct RenderSceneOptions {
@@ -62,20 +58,20 @@ class RenderScene {
 
   bool intersect(const Ray& ray, SurfaceHit* hit) const;
   bool occluded(const Vec3& origin, const Vec3& dir, double tmax) const;
-  // Bare rtcIntersect1: hit distance or infinity, no surface reconstruction (for benchmarks).
-  double intersect_distance(const Ray& ray) const;
+  // The committed Embree scene, for measurements against bare Embree queries (bench/); rendering
+  // goes through intersect and occluded.
+  RTCSceneTy* embree_scene() const;
 
   const Bsdf& bsdf(uint32_t mesh) const;
-  // Radiance emitted by the mesh towards w (unit, pointing away from the surface).
-  Rgb emitted(uint32_t mesh, const Vec3& ng, const Vec3& w) const;
-  bool has_area_lights() const;
-  // Samples an emissive triangle by power and a point on it uniformly.
-  AreaLightSample sample_area_light(double u_pick, Vec2 u) const;
-  // Area density with which sample_area_light picks a point on (mesh, prim).
-  double area_light_pdf(uint32_t mesh, uint32_t prim) const;
 
-  const Lights& lights() const { return lights_; }
-  RenderScene with_lights(Lights lights) const;
+  // Every light, in the order their contributions are summed: parallel, point and spot (in the
+  // description's order), the emissive surfaces, the environment. Lights that cannot contribute
+  // (no emissive triangle, a black environment) are left out.
+  const std::vector<Light>& lights() const { return lights_; }
+  // The light a mesh's surface belongs to; null when the mesh does not emit.
+  const Light* surface_light(uint32_t mesh) const;
+  // The same scene lit by 'lights' instead of the description's (emissive surfaces still emit).
+  RenderScene with_lights(const Lights& lights) const;
 
   size_t mesh_count() const;
   size_t triangle_count() const;
@@ -84,8 +80,10 @@ class RenderScene {
  private:
   struct Geometry;
   RenderScene() = default;
+  void set_lights(const Lights& lights);
   std::shared_ptr<const Geometry> geo_;
-  Lights lights_;
+  std::vector<Light> lights_;
+  int surface_light_ = -1;  // index of the area light in lights_
 };
 
 }  // namespace weft

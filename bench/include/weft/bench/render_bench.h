@@ -1,20 +1,39 @@
 #pragma once
-// Render throughput measurements: raw Embree rtcIntersect1 on diffuse rays against the path
-// tracer's rays per second on the same scene, and the path tracer's 1 -> 2 thread speed-up.
-// Timing lives here and in bench/, never in unit tests.
+// Render throughput measurements (`weft bench render`, bench_render.cpp): raw Embree
+// rtcIntersect1 on diffuse rays against the path tracer's rays per second on the same scene, the
+// path tracer's own rays replayed through bare Embree, and the path tracer's 1 -> 2 thread
+// speed-up. Timing lives here and in bench/, never in unit tests.
+#include <cstddef>
 #include <cstdint>
 #include <string>
 
+#include "weft/integrators/render_settings.h"
+#include "weft/scenes/camera.h"
 #include "weft/scenes/description.h"
+#include "weft/scenes/render_scene.h"
 #include "weft/scenes/weave.h"
 
 namespace weft {
 
+// A ray in Embree's single precision, as the path tracer hands it over (RenderScene's queries
+// convert the same way).
+struct EmbreeRay {
+  float org[3], dir[3], tmax;
+  bool shadow;  // rtcOccluded1 rather than rtcIntersect1
+};
+EmbreeRay to_embree(const Ray& ray, bool shadow);
+
+// Bare Embree queries on the scene's BVH, without surface reconstruction: the baseline.
+// Hit distance (infinity for none); whether anything lies within tmax.
+double embree_hit_distance(const RenderScene& scene, const EmbreeRay& ray);
+bool embree_occluded(const RenderScene& scene, const EmbreeRay& ray);
+
 struct RenderBenchOptions {
-  size_t diffuse_rays = 1 << 20;
-  int width = 256, height = 256, spp = 4;
-  int threads = 2;  // the "many threads" side of the speed-up and of the throughput ratio
-  uint64_t seed = 1;
+  size_t diffuse_rays = 1 << 20;  // for the Embree baseline
+  int threads = 2;  // the "many threads" side of the speed-up and of the throughput ratios
+  // The path-traced image (its own 'threads' is replaced: 1, then 'threads'); its seed also seeds
+  // the diffuse rays.
+  RenderSettings render;
 };
 
 struct RenderBenchResult {

@@ -1,6 +1,8 @@
-#include "weft/integrators/bench.h"
+#include "weft/bench/render_bench.h"
 
-#include <atomic>
+#include <embree3/rtcore.h>
+
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -71,7 +73,8 @@ double embree_rate(const RenderScene& scene, const std::vector<Ray>& rays, int t
   parallel_for(chunks, threads, [&](uint64_t c) {
     uint64_t h = 0;
     const size_t end = std::min<size_t>(rays.size(), (c + 1) * chunk);
-    for (size_t i = c * chunk; i < end; ++i) h += std::isfinite(scene.intersect_distance(rays[i]));
+    for (size_t i = c * chunk; i < end; ++i)
+      h += std::isfinite(embree_hit_distance(scene, to_embree(rays[i], false)));
     hits[c] = h;  // keeps the work observable
   });
   const double s = seconds_since(t0);
@@ -80,7 +83,7 @@ double embree_rate(const RenderScene& scene, const std::vector<Ray>& rays, int t
   return total <= rays.size() ? rays.size() / s : 0;
 }
 
-double replay_rate(const RenderScene& scene, const std::vector<LoggedRay>& log, int threads) {
+double replay_rate(const RenderScene& scene, const std::vector<EmbreeRay>& log, int threads) {
   const uint64_t chunk = 4096, chunks = (log.size() + chunk - 1) / chunk;
   std::vector<uint64_t> hits(chunks, 0);
   const auto t0 = Clock::now();
@@ -88,10 +91,8 @@ double replay_rate(const RenderScene& scene, const std::vector<LoggedRay>& log, 
     uint64_t h = 0;
     const size_t end = std::min<size_t>(log.size(), (c + 1) * chunk);
     for (size_t i = c * chunk; i < end; ++i) {
-      const LoggedRay& r = log[i];
-      const Vec3 o{r.org[0], r.org[1], r.org[2]}, d{r.dir[0], r.dir[1], r.dir[2]};
-      h += r.shadow ? scene.occluded(o, d, r.tmax)
-                    : std::isfinite(scene.intersect_distance({o, d, r.tmax}));
+      const EmbreeRay& r = log[i];
+      h += r.shadow ? embree_occluded(scene, r) : std::isfinite(embree_hit_distance(scene, r));
     }
     hits[c] = h;
   });
@@ -122,11 +123,7 @@ struct PathRate {
 };
 PathRate path_rate(const RenderScene& scene, const Camera& cam, const RenderBenchOptions& o,
                    int threads) {
-  RenderSettings s;
-  s.width = o.width;
-  s.height = o.height;
-  s.spp = o.spp;
-  s.seed = o.seed;
+  RenderSettings s = o.render;
   s.threads = threads;
   const auto t0 = Clock::now();
   const RenderResult r = render(scene, cam, s);
@@ -135,6 +132,45 @@ PathRate path_rate(const RenderScene& scene, const Camera& cam, const RenderBenc
 }
 
 }  // namespace
+
+EmbreeRay to_embree(const Ray& ray, bool shadow) {
+  return {{static_cast<float>(ray.o.x), static_cast<float>(ray.o.y), static_cast<float>(ray.o.z)},
+          {static_cast<float>(ray.d.x), static_cast<float>(ray.d.y), static_cast<float>(ray.d.z)},
+          ray.tmax > 3e38 ? INFINITY : static_cast<float>(ray.tmax),
+          shadow};
+}
+
+double embree_hit_distance(const RenderScene& scene, const EmbreeRay& r) {
+  RTCRayHit rh;
+  rh.ray.org_x = r.org[0], rh.ray.org_y = r.org[1], rh.ray.org_z = r.org[2];
+  rh.ray.dir_x = r.dir[0], rh.ray.dir_y = r.dir[1], rh.ray.dir_z = r.dir[2];
+  rh.ray.tnear = 0.0f;
+  rh.ray.tfar = r.tmax;
+  rh.ray.mask = 0xFFFFFFFFu;
+  rh.ray.time = 0.0f;
+  rh.ray.flags = 0;
+  rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+  rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  rtcIntersect1(scene.embree_scene(), &ctx, &rh);
+  return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
+}
+
+bool embree_occluded(const RenderScene& scene, const EmbreeRay& r) {
+  RTCRay ray;
+  ray.org_x = r.org[0], ray.org_y = r.org[1], ray.org_z = r.org[2];
+  ray.dir_x = r.dir[0], ray.dir_y = r.dir[1], ray.dir_z = r.dir[2];
+  ray.tnear = 0.0f;
+  ray.tfar = r.tmax;
+  ray.mask = 0xFFFFFFFFu;
+  ray.time = 0.0f;
+  ray.flags = 0;
+  RTCIntersectContext ctx;
+  rtcInitIntersectContext(&ctx);
+  rtcOccluded1(scene.embree_scene(), &ctx, &ray);
+  return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
+}
 
 SceneDescription weave_bench_scene(const WeaveParams& params) {
   SceneDescription d;
@@ -163,21 +199,18 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
   const RenderScene scene(desc);
   r.build_s = seconds_since(t0);
   r.triangles = scene.triangle_count();
-  const auto rays = diffuse_rays(desc, o.diffuse_rays, o.seed);
+  const auto rays = diffuse_rays(desc, o.diffuse_rays, o.render.seed);
   const Camera cam = desc.camera ? *desc.camera
                                  : frame_box_orthographic(scene.bounds(),
                                                           desc.frame.direction(deg_to_rad(20), kPi),
                                                           desc.frame.normal);
-  std::vector<LoggedRay> log;
+  std::vector<EmbreeRay> log;
   {
-    RenderSettings s;
-    s.width = o.width;
-    s.height = o.height;
-    s.spp = o.spp;
-    s.seed = o.seed;
-    s.threads = o.threads;
-    s.log_rays = true;
-    log = render(scene, cam, s).ray_log;
+    RenderSettings s = o.render;
+    s.threads = 1;  // the log then needs no lock and holds the rays in the tracer's tile order
+    RenderObservers observers;
+    observers.on_ray = [&](const Ray& ray, bool shadow) { log.push_back(to_embree(ray, shadow)); };
+    render(scene, cam, s, no_progress(), observers);
   }
   // Best of two runs each: the machines are shared, and the best run is the least disturbed one.
   for (int rep = 0; rep < 2; ++rep) {
