@@ -18,20 +18,11 @@ namespace {
 // Directional albedo int f |cos| dwi of wo's bin, per channel, from the cell averages (the mean
 // |cos| of each wi cell by an 8 x 8 midpoint rule).
 std::vector<double> bin_albedo(const TabulatedBsdfTable& t, int wo_bin) {
-  const OctahedralGrid g = t.grid();
+  const DirectionGrid g = t.grid();
+  const auto d = g.cosine_weighted_areas();
   std::vector<double> out(t.channels, 0.0);
-  const double cell_sr = 4 * kPi / g.bins();
-  for (int wi = 0; wi < g.bins(); ++wi) {
-    const int x = wi % g.resolution, y = wi / g.resolution;
-    double cos_avg = 0;
-    for (int i = 0; i < 8; ++i)
-      for (int j = 0; j < 8; ++j)
-        cos_avg += std::abs(OctahedralGrid::to_direction({(x + (i + 0.5) / 8) / g.resolution,
-                                                          (y + (j + 0.5) / 8) / g.resolution})
-                                .z) /
-                   64;
-    for (int c = 0; c < t.channels; ++c) out[c] += t.at(wi, wo_bin, c) * cos_avg * cell_sr;
-  }
+  for (int wi = 0; wi < g.bins(); ++wi)
+    for (int c = 0; c < t.channels; ++c) out[c] += t.at(wi, wo_bin, c) * d[wi];
   return out;
 }
 
@@ -54,7 +45,7 @@ void add_table_command(CLI::App& app, Commands& commands) {
                         const auto t = TabulatedBsdfTable::read_exr(info->file);
                         float lo = t.values.front(), hi = lo;
                         for (float v : t.values) lo = std::min(lo, v), hi = std::max(hi, v);
-                        const OctahedralGrid g = t.grid();
+                        const DirectionGrid g = t.grid();
                         nlohmann::json j = {
                             {"file", info->file},
                             {"format_version", TabulatedBsdfTable::kFormatVersion},
