@@ -22,7 +22,7 @@ int run_info(const InfoOptions& o) {
   const auto t = TabulatedBsdfTable::read_exr(o.file);
   float lo = t.values.front(), hi = lo;
   for (float v : t.values) lo = std::min(lo, v), hi = std::max(hi, v);
-  const OctahedralGrid g = t.grid();
+  const DirectionGrid g = t.grid();
   // Light arriving along the normal (w_i = n), summed over all exits.
   const auto normal = t.directional_albedo(g.bin_of({0, 0, 1}));
   std::vector<double> albedo(t.channels);

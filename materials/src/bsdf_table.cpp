@@ -13,130 +13,14 @@
 #include "weft/core/hash.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
-#include "weft/core/quadrature.h"
 #include "weft/core/rng.h"
 #include "weft/core/spectrum.h"
-#include "weft/core/sphere_mapping.h"
 
 namespace weft {
 
-Vec2 OctahedralGrid::to_square(const Vec3& d) {
-  return equal_area_sphere_to_square(d);
-}
-Vec3 OctahedralGrid::to_direction(Vec2 p) {
-  return equal_area_square_to_sphere(p);
-}
-
-int OctahedralGrid::bin_of_square(Vec2 p) const {
-  const int r = resolution;
-  const int x = std::clamp(static_cast<int>(std::floor(p.x * r)), 0, r - 1);
-  const int y = std::clamp(static_cast<int>(std::floor(p.y * r)), 0, r - 1);
-  return y * r + x;
-}
-
-Vec3 OctahedralGrid::bin_center(int bin) const {
-  const int x = bin % resolution, y = bin / resolution;
-  return to_direction({(x + 0.5) / resolution, (y + 0.5) / resolution});
-}
-
-int OctahedralGrid::wrapped_bin(int x, int y) const {
-  const int r = resolution;
-  // Crossing the edge across 'a' reflects a back inside and mirrors the other coordinate b.
-  auto fold = [r](int& a, int& b) {
-    if (a >= 0 && a < r) return;
-    a = a < 0 ? -a - 1 : 2 * r - 1 - a;
-    b = r - 1 - b;
-  };
-  fold(x, y);
-  fold(y, x);
-  return y * r + x;
-}
-
-OctahedralGrid::Footprint OctahedralGrid::bilinear(Vec2 p) const {
-  const double px = p.x * resolution - 0.5, py = p.y * resolution - 0.5;
-  const double fx0 = std::floor(px), fy0 = std::floor(py);
-  const int x0 = static_cast<int>(fx0), y0 = static_cast<int>(fy0);
-  const double tx = px - fx0, ty = py - fy0;
-  Footprint fp;
-  fp.bin[0] = wrapped_bin(x0, y0);
-  fp.bin[1] = wrapped_bin(x0 + 1, y0);
-  fp.bin[2] = wrapped_bin(x0, y0 + 1);
-  fp.bin[3] = wrapped_bin(x0 + 1, y0 + 1);
-  fp.weight[0] = (1 - tx) * (1 - ty);
-  fp.weight[1] = tx * (1 - ty);
-  fp.weight[2] = (1 - tx) * ty;
-  fp.weight[3] = tx * ty;
-  return fp;
-}
-
-namespace {
-
-// Integral of |cos theta| over the preimage of [a,b] x [c,d] (0 <= a < b, 0 <= c < d) in the
-// octahedral square coordinates u', v' in [-1, 1], where d omega = pi du' dv', above and below
-// the horizon. On this map |cos theta| depends on rho = u' + v' only (1 - rho^2 on the upper half,
-// 1 - (2 - rho)^2 on the lower), so the integral is one-dimensional: int |cos|(rho) m(rho) d rho
-// with m(rho) the length of the cut u' + v' = rho through the rectangle. Both factors are
-// polynomial between the breakpoints (the horizon rho = 1 among them, so every piece lies on one
-// side), so 3-point Gauss-Legendre per piece is exact.
-OctahedralGrid::CosineWeightedArea cos_integral_quadrant_rect(double a, double b, double c,
-                                                              double d) {
-  double breaks[] = {a + c, a + d, b + c, b + d, 1.0};
-  std::sort(std::begin(breaks), std::end(breaks));
-  const double lo = a + c, hi = b + d;
-  auto m = [&](double rho) { return std::max(0.0, std::min(b, rho - c) - std::max(a, rho - d)); };
-  auto abs_cos = [](double rho) { return rho <= 1 ? 1 - rho * rho : 1 - (2 - rho) * (2 - rho); };
-  std::vector<double> x, w;
-  gauss_legendre(3, x, w);
-  OctahedralGrid::CosineWeightedArea out;
-  for (int k = 0; k + 1 < 5; ++k) {
-    const double p0 = std::clamp(breaks[k], lo, hi), p1 = std::clamp(breaks[k + 1], lo, hi);
-    if (!(p1 > p0)) continue;
-    const double mid = 0.5 * (p0 + p1), half = 0.5 * (p1 - p0);
-    double sum = 0;
-    for (int q = 0; q < 3; ++q)
-      sum += w[q] * half * abs_cos(mid + half * x[q]) * m(mid + half * x[q]);
-    (mid < 1 ? out.upper : out.lower) += kPi * sum;
-  }
-  return out;
-}
-
-}  // namespace
-
-std::vector<OctahedralGrid::CosineWeightedArea> OctahedralGrid::cosine_weighted_areas_by_side()
-    const {
-  std::vector<CosineWeightedArea> out(static_cast<size_t>(resolution) * resolution);
-  for (int iy = 0; iy < resolution; ++iy)
-    for (int ix = 0; ix < resolution; ++ix) {
-      // The bin in u', v', split at the axes so that each piece lies in one quadrant.
-      const double u0 = 2.0 * ix / resolution - 1, u1 = 2.0 * (ix + 1) / resolution - 1;
-      const double v0 = 2.0 * iy / resolution - 1, v1 = 2.0 * (iy + 1) / resolution - 1;
-      CosineWeightedArea& bin = out[static_cast<size_t>(iy) * resolution + ix];
-      for (auto [ua, ub] : {std::pair{u0, std::min(u1, 0.0)}, std::pair{std::max(u0, 0.0), u1}})
-        for (auto [va, vb] : {std::pair{v0, std::min(v1, 0.0)}, std::pair{std::max(v0, 0.0), v1}}) {
-          if (!(ub > ua) || !(vb > va)) continue;
-          // Reflect into the first quadrant.
-          const double a = std::min(std::abs(ua), std::abs(ub)),
-                       b = std::max(std::abs(ua), std::abs(ub));
-          const double c = std::min(std::abs(va), std::abs(vb)),
-                       d = std::max(std::abs(va), std::abs(vb));
-          const CosineWeightedArea piece = cos_integral_quadrant_rect(a, b, c, d);
-          bin.upper += piece.upper;
-          bin.lower += piece.lower;
-        }
-    }
-  return out;
-}
-
-std::vector<double> OctahedralGrid::cosine_weighted_areas() const {
-  const auto by_side = cosine_weighted_areas_by_side();
-  std::vector<double> out(by_side.size());
-  for (size_t k = 0; k < out.size(); ++k) out[k] = by_side[k].total();
-  return out;
-}
-
 std::vector<double> TabulatedBsdfTable::averages_from_weighted_sums(
     int resolution, const std::vector<double>& weighted_sums) {
-  const OctahedralGrid grid{resolution};
+  const DirectionGrid grid{resolution};
   const size_t cells = static_cast<size_t>(grid.bins());
   if (weighted_sums.size() != cells * cells)
     throw Error("", "weighted_sums",
@@ -260,7 +144,7 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
   }
   const int n_bins = table.bins();
   table.values.assign(static_cast<size_t>(n_bins) * n_bins * channels, 0.0f);
-  const double r = resolution;
+  const DirectionGrid grid = table.grid();
 
   // Rows (wi bins) in chunks, so progress is reported from this thread between chunks.
   const int chunk = std::max(1, n_bins / 64);
@@ -280,14 +164,11 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
       }
       std::fill(sum.begin(), sum.end(), 0.0);
       double weight_sum = 0;
-      const int xi = wi_bin % resolution, yi = wi_bin / resolution;
-      const int xo = wo_bin % resolution, yo = wo_bin / resolution;
       for (int s = 0; s < n; ++s) {
-        const Vec2 pi{(xi + (perm[0][s] + rng.uniform()) / n) / r,
-                      (yi + (perm[1][s] + rng.uniform()) / n) / r};
-        const Vec2 po{(xo + (perm[2][s] + rng.uniform()) / n) / r,
-                      (yo + (perm[3][s] + rng.uniform()) / n) / r};
-        const Vec3 wi = OctahedralGrid::to_direction(pi), wo = OctahedralGrid::to_direction(po);
+        const double ui = (perm[0][s] + rng.uniform()) / n, vi = (perm[1][s] + rng.uniform()) / n;
+        const double uo = (perm[2][s] + rng.uniform()) / n, vo = (perm[3][s] + rng.uniform()) / n;
+        const Vec3 wi = DirectionGrid::to_direction(grid.chart_point(wi_bin, ui, vi));
+        const Vec3 wo = DirectionGrid::to_direction(grid.chart_point(wo_bin, uo, vo));
         std::fill(value.begin(), value.end(), 0.0);
         f(wo, wi, value);
         const double w = std::abs(wi.z) * std::abs(wo.z);
@@ -317,24 +198,17 @@ TabulatedBsdfTable TabulatedBsdfTable::from_function(int resolution, int channel
 }
 
 TabulatedBsdfTable::DirectionalAlbedo TabulatedBsdfTable::directional_albedo(int wi_bin) const {
-  const OctahedralGrid g = grid();
+  const DirectionGrid g = grid();
   if (wi_bin < 0 || wi_bin >= g.bins())
     throw Error(
         "", "wi_bin",
         "must lie in [0, " + std::to_string(g.bins() - 1) + "], got " + std::to_string(wi_bin));
-  const auto d = g.cosine_weighted_areas_by_side();
-  const auto& di = d[static_cast<size_t>(wi_bin)];
+  const auto d = g.cosine_weighted_areas();
   DirectionalAlbedo out{std::vector<double>(channels, 0.0), std::vector<double>(channels, 0.0)};
   for (int wo = 0; wo < g.bins(); ++wo) {
-    const auto& d_o = d[static_cast<size_t>(wo)];
-    // The shares of D_i D_o with both directions on one side, and on opposite sides, over D_i.
-    const double same = (di.upper * d_o.upper + di.lower * d_o.lower) / di.total();
-    const double opposite = (di.upper * d_o.lower + di.lower * d_o.upper) / di.total();
-    for (int c = 0; c < channels; ++c) {
-      const double f = at(wi_bin, wo, c);
-      out.reflectance[c] += f * same;
-      out.transmittance[c] += f * opposite;
-    }
+    // No bin straddles the horizon: an exit is on the light's side or it is not.
+    auto& side = g.upper(wo) == g.upper(wi_bin) ? out.reflectance : out.transmittance;
+    for (int c = 0; c < channels; ++c) side[c] += at(wi_bin, wo, c) * d[static_cast<size_t>(wo)];
   }
   return out;
 }

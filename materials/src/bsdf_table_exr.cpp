@@ -84,9 +84,15 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
     };
 
     const int version = int_attr("weft_format_version");
-    if (version != kFormatVersion && version != 1)
+    if (version == 1 || version == 2)
       throw Error(file, "weft_format_version",
-                  "is " + std::to_string(version) + "; this program reads versions 1 and " +
+                  "is " + std::to_string(version) +
+                      ": an octahedral-grid table whose bins straddle the horizon; re-bake it with "
+                      "this version (format " +
+                      std::to_string(kFormatVersion) + ")");
+    if (version != kFormatVersion)
+      throw Error(file, "weft_format_version",
+                  "is " + std::to_string(version) + "; this program reads version " +
                       std::to_string(kFormatVersion));
     if (string_attr("parameterization") != kParameterization)
       throw Error(
@@ -154,20 +160,10 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
       if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
         table.metadata[name] = s->value();
     }
-    // The stored quantity: stated since version 2; in version 1 only fiber bakes said (in their
-    // "definition") that they hold cosine-weighted averages.
-    if (version >= 2) {
-      if (string_attr("cell_average") != kCellAverage)
-        throw Error(file, "cell_average",
-                    "is \"" + string_attr("cell_average") + "\"; this program reads \"" +
-                        kCellAverage + "\" cell averages");
-    } else {
-      const auto def = table.metadata.find("definition");
-      if (def == table.metadata.end() || def->second.find("cosine-weighted") == std::string::npos)
-        throw Error(file, "cell_average",
-                    "a version 1 table without a stated cell average holds plain solid-angle "
-                    "averages ('weft table bake' before format version 2): re-bake it");
-    }
+    if (string_attr("cell_average") != kCellAverage)
+      throw Error(file, "cell_average",
+                  "is \"" + string_attr("cell_average") + "\"; this program reads \"" +
+                      kCellAverage + "\" cell averages");
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {

@@ -1,5 +1,6 @@
 #include "weft/materials/tabulated_bsdf.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -11,16 +12,16 @@
 namespace weft {
 namespace {
 
-// Sub-samples per side for the mean |cos theta| of a cell.
-constexpr int kCosSubsamples = 8;
-
-// The 3 x 3 block of bins around 'bin' (across the octahedral fold where needed).
-std::array<int, 9> neighbourhood(const OctahedralGrid& grid, int bin) {
-  const int r = grid.resolution, x = bin % r, y = bin / r;
+// The 3 x 3 block of bins around 'bin' within its hemisphere (clamped at the horizon, like the
+// bilinear footprint, which never reaches across it).
+std::array<int, 9> neighbourhood(const DirectionGrid& grid, int bin) {
+  const int r = grid.resolution, hemi = grid.upper(bin) ? 0 : 1;
+  const int x = bin % r, y = (bin / r) % r;
   std::array<int, 9> out{};
   int k = 0;
   for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) out[k++] = grid.wrapped_bin(x + dx, y + dy);
+    for (int dx = -1; dx <= 1; ++dx)
+      out[k++] = (hemi * r + std::clamp(y + dy, 0, r - 1)) * r + std::clamp(x + dx, 0, r - 1);
   return out;
 }
 
@@ -30,7 +31,7 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
     const TabulatedBsdfTable& table) {
   table.validate("");
   auto data = std::make_shared<TabulatedBsdfData>();
-  const OctahedralGrid grid = table.grid();
+  const DirectionGrid grid = table.grid();
   const int n = grid.bins(), r = grid.resolution;
   const size_t cells = static_cast<size_t>(n) * static_cast<size_t>(n);
   data->grid = grid;
@@ -75,17 +76,9 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
       blur[at(wi, wo)] = static_cast<float>(s / 9);
     }
 
-  std::vector<double> cos_avg(n);
-  for (int b = 0; b < n; ++b) {
-    const int x = b % r, y = b / r;
-    double s = 0;
-    for (int i = 0; i < kCosSubsamples; ++i)
-      for (int j = 0; j < kCosSubsamples; ++j) {
-        const Vec2 p{(x + (i + 0.5) / kCosSubsamples) / r, (y + (j + 0.5) / kCosSubsamples) / r};
-        s += std::abs(OctahedralGrid::to_direction(p).z);
-      }
-    cos_avg[b] = s / (kCosSubsamples * kCosSubsamples);
-  }
+  // Mean |cos theta| over each cell.
+  std::vector<double> cos_avg = grid.cosine_weighted_areas();
+  for (double& c : cos_avg) c /= grid.bin_solid_angle();
 
   data->sampling.resize(n);
   parallel_for(static_cast<uint64_t>(n), 0, [&](uint64_t task) {
@@ -93,16 +86,16 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
     std::vector<double> w(n);
     for (int wi = 0; wi < n; ++wi)
       w[wi] = cos_avg[wi] * 0.5 * (static_cast<double>(mean[at(wi, wo)]) + blur[at(wi, wo)]);
-    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(r), static_cast<size_t>(r));
+    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(r), static_cast<size_t>(2 * r));
   });
   return data;
 }
 
 Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
   if (!data) return Rgb(0.0);  // a default-constructed value is black, never a crash
-  const OctahedralGrid& grid = data->grid;
-  const auto fo = grid.bilinear(OctahedralGrid::to_square(wo));
-  const auto fi = grid.bilinear(OctahedralGrid::to_square(wi));
+  const DirectionGrid& grid = data->grid;
+  const auto fo = grid.bilinear(DirectionGrid::to_chart(wo));
+  const auto fi = grid.bilinear(DirectionGrid::to_chart(wi));
   Rgb sum;
   for (int a = 0; a < 4; ++a) {
     if (fi.weight[a] == 0) continue;
@@ -116,21 +109,20 @@ Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
 
 double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
   if (!data) return 0;
-  const OctahedralGrid& grid = data->grid;
+  const DirectionGrid& grid = data->grid;
   const Distribution2D& dist = data->sampling[grid.bin_of(wo)];
   if (dist.integral() == 0) return 0;
   // The density is constant over wi's cell: evaluate it at the centre of the cell the grid
-  // assigns, so the cell is decided by OctahedralGrid alone.
-  const int cell = grid.bin_of(wi), r = grid.resolution;
-  const Vec2 centre{(cell % r + 0.5) / r, (cell / r + 0.5) / r};
-  return dist.pdf(centre) * kInv4Pi;  // area on the unit square = solid angle / (4 pi)
+  // assigns, so the cell is decided by DirectionGrid alone.
+  const Vec2 centre = grid.chart_point(grid.bin_of(wi), 0.5, 0.5);
+  return dist.pdf(centre) * kInv4Pi;  // area on the chart = solid angle / (4 pi)
 }
 
 std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double) const {
   if (!data) return std::nullopt;
   const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
   if (dist.integral() == 0) return std::nullopt;
-  const Vec3 wi = OctahedralGrid::to_direction(dist.sample(u).p);
+  const Vec3 wi = DirectionGrid::to_direction(dist.sample(u).p);
   const double p = pdf(wo, wi);
   if (!(p > 0)) return std::nullopt;
   return BsdfSample{wi, eval(wo, wi) * (std::abs(wi.z) / p), p, false};

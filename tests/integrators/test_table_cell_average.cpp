@@ -37,15 +37,15 @@ struct MonteCarloTable {
 // The baker's estimator: N direction pairs uniform over sphere x sphere, each adding
 // f |cos_i| |cos_o| (4 pi)^2 / N to its cell pair's sum; then the cell averages.
 MonteCarloTable monte_carlo_table(uint64_t n) {
-  const OctahedralGrid grid{kR};
+  const DirectionGrid grid{kR};
   const size_t cells = static_cast<size_t>(grid.bins());
   std::vector<double> sum(cells * cells, 0.0), sum2(cells * cells, 0.0), plain(cells * cells, 0.0);
   std::vector<double> count(cells * cells, 0.0);
   const double scale = 16 * kPi * kPi / static_cast<double>(n);
   Rng rng(11);
   for (uint64_t k = 0; k < n; ++k) {
-    const Vec3 wi = OctahedralGrid::to_direction({rng.uniform(), rng.uniform()});
-    const Vec3 wo = OctahedralGrid::to_direction({rng.uniform(), rng.uniform()});
+    const Vec3 wi = DirectionGrid::to_direction({rng.uniform(), rng.uniform()});
+    const Vec3 wo = DirectionGrid::to_direction({rng.uniform(), rng.uniform()});
     const size_t c = static_cast<size_t>(grid.bin_of(wi)) * cells + grid.bin_of(wo);
     const double f = f_of(wo, wi);
     const double x = f * std::abs(wi.z) * std::abs(wo.z) * scale;
@@ -109,7 +109,7 @@ TEST(TableCellAverage, StratifiedAndMonteCarloTablesHoldTheSameQuantity) {
   const StratifiedTable st = stratified_table();
   const TabulatedBsdfTable& a = st.table;
   const MonteCarloTable b = monte_carlo_table(uint64_t{1} << 23);
-  const size_t cells = static_cast<size_t>(kR * kR);
+  const size_t cells = static_cast<size_t>(DirectionGrid{kR}.bins());
   int compared = 0, outliers = 0, plain_differs = 0;
   for (size_t i = 0; i < cells; ++i)
     for (size_t o = 0; o < cells; ++o) {

@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/direction_grid.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
@@ -188,6 +189,29 @@ struct OctahedralSquareGrid {
         const Vec3 w = equal_area_square_to_sphere({(i + 0.5) / m, (j + 0.5) / m});
         out[(j / subdivisions) * n + i / subdivisions] += pdf(w) * area;
       }
+    return out;
+  }
+};
+
+// The tables' DirectionGrid at 'resolution' bins per hemisphere side, integrated by the midpoint
+// rule on 'subdivisions'^2 pieces per cell. A table of resolution R has a pdf constant on its own
+// cells: with resolution a multiple of R the integral is exact.
+struct DirectionGridBins {
+  int resolution = 8, subdivisions = 8;
+
+  int cells() const { return DirectionGrid{resolution}.bins(); }
+  int cell_of(const Vec3& w) const { return DirectionGrid{resolution}.bin_of(w); }
+  std::vector<double> integrate(const DirectionPdf& pdf) const {
+    const DirectionGrid g{resolution};
+    std::vector<double> out(cells(), 0.0);
+    const int m = subdivisions;
+    const double piece = g.bin_solid_angle() / (static_cast<double>(m) * m);
+    for (int b = 0; b < g.bins(); ++b)
+      for (int j = 0; j < m; ++j)
+        for (int i = 0; i < m; ++i)
+          out[b] +=
+              pdf(DirectionGrid::to_direction(g.chart_point(b, (i + 0.5) / m, (j + 0.5) / m))) *
+              piece;
     return out;
   }
 };

@@ -88,7 +88,7 @@ TEST(TableBsdf, LambertOneTablePassesTheWhiteFurnaceAwayFromTheEquator) {
 TEST(TableBsdf, EvalAtBinCentresReturnsTheTable) {
   const auto t = table_of(6, lumpy, 4);
   const Bsdf b = bsdf_of(t);
-  const OctahedralGrid g = t.grid();
+  const DirectionGrid g = t.grid();
   for (int wi = 0; wi < g.bins(); wi += 5)
     for (int wo = 0; wo < g.bins(); wo += 7) {
       const Rgb f = b.eval(g.bin_center(wo), g.bin_center(wi));
@@ -117,7 +117,7 @@ TEST(TableBsdf, SampleWeightAndPdfAreConsistent) {
       }
       // The pdf integrates to exactly 1: a piecewise-constant density on the table's own cells.
       double total = 0;
-      for (double c : OctahedralSquareGrid{1, 64}.integrate(bsdf_pdf(b, wo))) total += c;
+      for (double c : DirectionGridBins{8, 1}.integrate(bsdf_pdf(b, wo))) total += c;
       EXPECT_TRUE(total == 0 || std::abs(total - 1) < 1e-9) << total;
     }
   }
@@ -128,7 +128,7 @@ TEST(TableBsdf, PdfCoversWhereverInterpolationReaches) {
   // the pdf must be positive there too or that light could never be sampled.
   const auto t = table_of(8, sparse, 4);
   const Bsdf b = bsdf_of(t);
-  const OctahedralGrid g = t.grid();
+  const DirectionGrid g = t.grid();
   Rng rng(8);
   int reached_from_neighbours = 0;
   for (int i = 0; i < 200000; ++i) {

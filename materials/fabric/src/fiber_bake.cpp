@@ -73,7 +73,7 @@ double fiber_table_energy(const FiberBandTable& table) {
 FiberBandTable bake_fiber_band_direct(const FiberBandPhysics& fiber, const FiberBakeSettings& s,
                                       const ProgressCallback& progress) {
   validate(fiber, s);
-  const OctahedralGrid grid{s.resolution};
+  const DirectionGrid grid{s.resolution};
   const size_t cells = static_cast<size_t>(grid.bins());
   std::vector<double> total(cells * cells, 0.0);
   PhotonTally books;
@@ -137,7 +137,7 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberBandPhysics& fiber, const Fiber
       route.incident_psi_bins < 1 || route.cell_quadrature < 1)
     throw Error("", "bssrdf_grid", "grid sizes must be positive and u_bins even");
   const int R = s.resolution;
-  const OctahedralGrid table_grid{R};
+  const DirectionGrid table_grid{R};
   const size_t cells = static_cast<size_t>(table_grid.bins());
   const int nu = route.u_bins, ns = route.incident_s_bins, npsi = route.incident_psi_bins;
   BssrdfGrid grid;  // summed over the whole axis, surface reflection included
@@ -163,15 +163,14 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberBandPhysics& fiber, const Fiber
   for (int j = 0; j < nu; ++j)
     frames_aj.push_back(CylinderGeometry::cylinder_frame(kPi / 2 - (-kPi + j * du)));
   const int cq = route.cell_quadrature;
-  const double point_solid_angle = 4 * kPi / (static_cast<double>(R) * R) / (cq * cq);
+  const double point_solid_angle = table_grid.bin_solid_angle() / (cq * cq);
   std::vector<double> weighted(cells * cells, 0.0);
   parallel_for(cells, s.threads, [&](uint64_t i) {
-    const int ix = static_cast<int>(i % R), iy = static_cast<int>(i / R);
     double* row = &weighted[i * cells];
     for (int qa = 0; qa < cq; ++qa)
       for (int qb = 0; qb < cq; ++qb) {
-        const Vec3 omega = OctahedralGrid::to_direction(
-            {(ix + (qb + 0.5) / cq) / R, (iy + (qa + 0.5) / cq) / R});  // world = B's frame
+        const Vec3 omega = DirectionGrid::to_direction(table_grid.chart_point(
+            static_cast<int>(i), (qb + 0.5) / cq, (qa + 0.5) / cq));  // world = B's frame
         for (int j = 0; j < nu; ++j) {
           const Vec3 wa = frames_aj[j].to_local(omega);
           if (!(wa.z > 0)) continue;

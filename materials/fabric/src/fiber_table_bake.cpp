@@ -33,7 +33,7 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
   const FiberMedium medium = build_fiber_medium(spec, {}, medium_options);
 
   const int R = o.resolution;
-  const size_t cells = static_cast<size_t>(R) * R;
+  const size_t cells = static_cast<size_t>(DirectionGrid{R}.bins());
 
   // Per band: the physics, and running sums over passes.
   struct BandState {

@@ -7,10 +7,10 @@
 #include <cmath>
 
 #include "transport_test_util.h"
+#include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/sphere_mapping.h"
-#include "weft/materials/bsdf_table.h"
 #include "weft/materials/bsdfs.h"
 #include "weft/materials/fabric/fiber_bake.h"
 
@@ -44,36 +44,24 @@ FiberBandPhysics lambert_fiber(double rho) {
   return ph;
 }
 
-// Cosine-weighted area of the upper-hemisphere part of each bin (same midpoint rule).
-std::vector<double> upper_bin_areas(int resolution) {
-  const int q = 64;
-  std::vector<double> d(resolution * resolution, 0.0);
-  for (int iy = 0; iy < resolution; ++iy)
-    for (int ix = 0; ix < resolution; ++ix) {
-      double sum = 0;
-      for (int a = 0; a < q; ++a)
-        for (int b = 0; b < q; ++b)
-          sum += std::max(0.0, equal_area_square_to_sphere({(ix + (b + 0.5) / q) / resolution,
-                                                            (iy + (a + 0.5) / q) / resolution})
-                                   .z);
-      d[iy * resolution + ix] = 4 * kPi / (resolution * resolution) * sum / (q * q);
-    }
-  return d;
-}
-
-void expect_lambert_table(const FiberBandTable& t, double rho, double rel_tol_for_full_cells) {
-  const int R = t.resolution, cells = R * R;
-  const auto d = OctahedralGrid{R}.cosine_weighted_areas();
-  const auto up = upper_bin_areas(R);
+// rho / pi where light and view are above the point, else 0 (no bin straddles the horizon).
+// A cell pair (i, o) receives about N D_i D_o / pi^2 of the N photons' exits (the Lambert table's
+// energy is spread in proportion to D_i D_o), so its relative standard error is about
+// 1 / sqrt(that count): each cell must agree within z_max of them.
+void expect_lambert_table(const FiberBandTable& t, double rho, double z_max) {
+  const DirectionGrid g{t.resolution};
+  const auto d = g.cosine_weighted_areas();
+  const int cells = g.bins();
   for (int i = 0; i < cells; ++i)
     for (int o = 0; o < cells; ++o) {
-      const double expected = rho / kPi * up[i] * up[o] / (d[i] * d[o]);
       const double got = t.f[static_cast<size_t>(i) * cells + o];
-      if (up[i] == 0 || up[o] == 0) {
+      if (!g.upper(i) || !g.upper(o)) {
         ASSERT_EQ(got, 0.0) << i << " " << o;
-      } else if (up[i] == d[i] && up[o] == d[o]) {
-        ASSERT_NEAR(got, expected, rel_tol_for_full_cells * expected) << i << " " << o;
+        continue;
       }
+      const double count = static_cast<double>(t.photons) * d[i] * d[o] / (kPi * kPi);
+      const double z = (got / (rho / kPi) - 1) * std::sqrt(count);
+      EXPECT_LT(std::abs(z), z_max) << i << " " << o << ": " << got;
     }
 }
 
@@ -83,7 +71,7 @@ TEST(FiberBake, CosineWeightedBinAreasSumToTwoPi) {
   // integral of |cos theta| over the sphere = 2 pi; the per-bin integrals are exact.
   for (int r : {2, 4, 8}) {
     double sum = 0;
-    for (double v : OctahedralGrid{r}.cosine_weighted_areas()) sum += v;
+    for (double v : DirectionGrid{r}.cosine_weighted_areas()) sum += v;
     EXPECT_NEAR(sum, 2 * kPi, 1e-12) << r;
   }
 }
@@ -96,7 +84,7 @@ TEST(FiberBake, DirectRouteReproducesLambertSurface) {
   EXPECT_NEAR(t.exit_fraction, rho, 1e-12);  // every photon reflects weight rho exactly
   EXPECT_NEAR(fiber_table_energy(t), kPi * rho, 1e-9);
   // 16 x 16 cells; about 400000 * 0.6 exits over ~64 lit cell pairs -> ~2 % noise per cell.
-  expect_lambert_table(t, rho, 0.1);
+  expect_lambert_table(t, rho, 4.5);
 }
 
 TEST(FiberBake, BssrdfRouteReproducesLambertSurface) {
@@ -111,7 +99,7 @@ TEST(FiberBake, BssrdfRouteReproducesLambertSurface) {
   // default cq = 16), so the energy is pi * rho within 2e-3.
   EXPECT_EQ(grid.cell_quadrature, 16);
   EXPECT_NEAR(fiber_table_energy(t), kPi * rho, 2e-3 * kPi * rho);
-  expect_lambert_table(t, rho, 0.1);
+  expect_lambert_table(t, rho, 4.5);
 }
 
 TEST(FiberBake, BitIdenticalAtOneAndTwoThreads) {
@@ -155,19 +143,4 @@ TEST(FiberBake, RejectsBadSettings) {
   s.resolution = 4;
   s.photons = 0;
   EXPECT_THROW(bake_fiber_band_direct(ph, s, nullptr), Error);
-}
-
-TEST(FiberBake, CosineWeightedBinAreasMatchFineQuadrature) {
-  // Independent check of the exact per-bin integrals by a 400 x 400 midpoint rule.
-  const int R = 5, q = 400;  // odd R: the middle bins straddle the axes
-  const auto d = OctahedralGrid{R}.cosine_weighted_areas();
-  for (int iy = 0; iy < R; ++iy)
-    for (int ix = 0; ix < R; ++ix) {
-      double sum = 0;
-      for (int a = 0; a < q; ++a)
-        for (int b = 0; b < q; ++b)
-          sum += std::abs(
-              equal_area_square_to_sphere({(ix + (b + 0.5) / q) / R, (iy + (a + 0.5) / q) / R}).z);
-      EXPECT_NEAR(d[iy * R + ix], 4 * kPi / (R * R) * sum / (q * q), 2e-6) << ix << " " << iy;
-    }
 }

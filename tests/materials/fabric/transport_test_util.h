@@ -56,11 +56,4 @@ inline ::testing::AssertionResult within_sigma(const MeanEstimate& e, double ref
          << reference_error << ": " << dev / se << " sigma";
 }
 
-// Bin index of the mirror image of octahedral bin 'bin' (bsdf_table.h): flipping local x (the
-// fiber axis t) maps u -> 1 - u on the square, flipping y (the binormal b) maps v -> 1 - v.
-inline int mirror_bin(int bin, int resolution, bool flip_x) {
-  const int ix = bin % resolution, iy = bin / resolution;
-  return flip_x ? iy * resolution + (resolution - 1 - ix) : (resolution - 1 - iy) * resolution + ix;
-}
-
 }  // namespace weft::testing

@@ -2,18 +2,19 @@
 // The fiber_table and fabric_table materials: a TabulatedBsdfTable reduced to RGB and prepared for
 // sampling, shared immutable between every material that uses the same file.
 //
-// Evaluation: bilinear interpolation over the 4 nearest bin centres in the octahedral square,
-// separately for wo and for wi (16 table entries), wrapping across the square's folded edges
-// (OctahedralGrid::wrapped_bin). This makes f continuous over the sphere instead of faceted;
-// the cell averages themselves are what the table stores.
+// Evaluation: bilinear interpolation over the 4 nearest bin centres of the direction's own
+// hemisphere in the DirectionGrid chart, separately for wo and for wi (16 table entries), clamped
+// at the horizon. This makes f continuous within each hemisphere instead of faceted, and never
+// blends reflection with transmission; the cell averages themselves are what the table stores.
 //
-// Sampling: for the bin b holding wo, a Distribution2D over the R x R wi cells with weights
+// Sampling: for the bin b holding wo, a Distribution2D over the chart's R x 2R wi cells with
+// weights
 //   w(b, c) = cos_avg(c) * (m(b, c) + m3(b, c)) / 2,
 // where m is the channel mean of the table, m3 its mean over the 3 x 3 neighbourhoods of b and of
-// c (what bilinear eval can reach), and cos_avg(c) the mean |cos theta| over cell c. wi is uniform
-// (in solid angle) within the chosen cell. pdf(wo, wi) = p_square(wi | bin(wo)) / (4 pi), using
-// the same OctahedralGrid for both directions as sample does; the m3 term makes pdf > 0 wherever
-// the interpolated f > 0.
+// c within their hemispheres (what bilinear eval can reach), and cos_avg(c) the mean |cos theta|
+// over cell c. wi is uniform (in solid angle) within the chosen cell. pdf(wo, wi) =
+// p_chart(wi | bin(wo)) / (4 pi), using the same DirectionGrid for both directions as sample
+// does; the m3 term makes pdf > 0 wherever the interpolated f > 0.
 #include <memory>
 #include <optional>
 #include <string>
@@ -26,7 +27,7 @@
 namespace weft {
 
 struct TabulatedBsdfData {
-  OctahedralGrid grid;
+  DirectionGrid grid;
   std::string kind;                             // "fiber" | "fabric"
   std::map<std::string, std::string> metadata;  // from the table
   std::vector<float> rgb;                       // [wi_bin][wo_bin][3]

@@ -18,7 +18,7 @@
 //   v_range with v_bins = 1 sums over the whole axis, as the BRDF needs).
 // * Directions are in the local frame of their point (x = axis t, y = b = n x t, z = outward n),
 //   pointing away from the surface; w_in points towards the light.
-// * Exit directions are binned on the table's OctahedralGrid (bsdf_table.h) at
+// * Exit directions are binned on the tables' DirectionGrid (core/direction_grid.h) at
 //   direction_resolution, the one direction <-> bin mapping of the project.
 // * F_in is the power arriving at A, before the surface reflects part of it.
 #include <cstddef>
@@ -44,7 +44,7 @@ struct BssrdfGrid {
   bool keep_squares = false;
 
   void validate() const;  // weft::Error naming the field
-  OctahedralGrid directions() const { return {direction_resolution}; }
+  DirectionGrid directions() const { return {direction_resolution}; }
   size_t cells() const {
     return static_cast<size_t>(u_bins) * v_bins * static_cast<size_t>(directions().bins());
   }

@@ -13,7 +13,7 @@
 namespace weft {
 
 struct FiberBakeSettings {
-  int resolution = 8;    // R: R x R equal-area bins per direction (OctahedralGrid)
+  int resolution = 8;    // R: R x R equal-area bins per hemisphere and direction (DirectionGrid)
   uint64_t photons = 0;  // photons per band (callers say how many)
   uint64_t seed = 0;
   int threads = 0;  // 0 = all cores
