@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <fstream>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <sstream>
@@ -93,6 +94,8 @@ double check_length(const std::optional<double>& v, double fallback, const std::
 }
 
 struct Resolved {
+  std::string detail;
+  int repeats_x = 1, repeats_z = 1;
   Layout layout;
   detail::FiberSettings fibers;
   bool fiber_detail = false;
@@ -103,22 +106,28 @@ struct Resolved {
 
 Resolved resolve(const WeaveOptions& o) {
   Resolved r;
-  if (o.detail != "yarn" && o.detail != "fiber")
-    bad("detail", "must be yarn or fiber, got '" + o.detail + "'");
-  r.fiber_detail = o.detail == "fiber";
-  if (o.repeats_x < 1 || o.repeats_x > 1000 || o.repeats_z < 1 || o.repeats_z > 1000)
+  r.detail = o.detail.value_or("yarn");
+  if (r.detail != "yarn" && r.detail != "fiber")
+    bad("detail", "must be yarn or fiber, got '" + r.detail + "'");
+  r.fiber_detail = r.detail == "fiber";
+  r.repeats_x = o.repeats_x.value_or(1);
+  r.repeats_z = o.repeats_z.value_or(1);
+  if (r.repeats_x < 1 || r.repeats_x > 1000 || r.repeats_z < 1 || r.repeats_z > 1000)
     bad("repeats", "each count must lie in [1, 1000]");
-  if (o.segments_per_crossing < 2 || o.segments_per_crossing > 1024)
+  const int segments_per_crossing = o.segments_per_crossing.value_or(16);
+  const int sides = o.sides.value_or(16);
+  if (segments_per_crossing < 2 || segments_per_crossing > 1024)
     bad("segments-per-crossing", "must lie in [2, 1024]");
-  if (o.sides < 4 || o.sides > 1024) bad("sides", "must lie in [4, 1024]");
-
+  if (sides < 4 || sides > 1024) bad("sides", "must lie in [4, 1024]");
+  if (o.wif && o.pattern) bad("wif", "give either a pattern or a WIF draft, not both");
+  const bool from_wif = o.wif.has_value();
   std::vector<ThreadSize> warp, weft;
   const double warp_flat = kRedWarpThickness / kRedWarpWidth,
                weft_flat = kRedWeftThickness / kRedWeftWidth;
-  if (!o.wif.empty()) {
-    const WifDraft d = read_wif(o.wif);
+  if (from_wif) {
+    const WifDraft d = read_wif(*o.wif);
     r.repeat = d.interlacing();
-    r.source = o.wif;
+    r.source = *o.wif;
     // WIF sizes: a thread's thickness is its drawn width (clamped to its spacing so neighbours
     // do not overlap); its height follows the red-cotton flattening unless given.
     auto sizes = [&](const std::vector<WifThread>& threads, const std::string& dir,
@@ -142,8 +151,8 @@ Resolved resolve(const WeaveOptions& o) {
     sizes(d.weft, "weft", o.weft_spacing_mm, o.weft_width_mm, o.weft_thickness_mm, kRedWeftSpacing,
           kRedWeftWidth, weft_flat, weft, r.weft_rgb);
   } else {
-    r.repeat = parse_weave_pattern(o.pattern, "pattern");
-    r.source = o.pattern;
+    r.repeat = parse_weave_pattern(o.pattern.value_or("plain"), "pattern");
+    r.source = o.pattern.value_or("plain");
     ThreadSize w, f;
     w.spacing_mm = check_length(o.warp_spacing_mm, kRedWarpSpacing, "warp-spacing-mm", 0, 100);
     f.spacing_mm = check_length(o.weft_spacing_mm, kRedWeftSpacing, "weft-spacing-mm", 0, 100);
@@ -169,15 +178,15 @@ Resolved resolve(const WeaveOptions& o) {
                                ParamReader::fmt(weft[j].spacing_mm) +
                                " mm): neighbouring yarns would overlap");
   // A WIF draft's threads have no crimp data: balanced unless given.
-  double share = o.warp_crimp_share.value_or(o.wif.empty() ? kRedWarpCrimpShare : -1.0);
+  double share = o.warp_crimp_share.value_or(from_wif ? -1.0 : kRedWarpCrimpShare);
   if (!std::isfinite(share) || share > 1) bad("warp-crimp-share", "must be <= 1 (< 0: balanced)");
 
   // Sizes of the sample, estimated before anything is allocated.
-  const double nwarp = double(r.repeat.warps) * o.repeats_z,
-               nweft = double(r.repeat.wefts) * o.repeats_x;
-  const double segs = double(o.segments_per_crossing) * nwarp * nweft * 2;  // along all yarns
-  if (!r.fiber_detail && segs * o.sides * 2 > kMaxTriangles)
-    bad("repeats", "the sample would have " + ParamReader::fmt(segs * o.sides * 2) +
+  const double nwarp = double(r.repeat.warps) * r.repeats_z,
+               nweft = double(r.repeat.wefts) * r.repeats_x;
+  const double segs = double(segments_per_crossing) * nwarp * nweft * 2;  // along all yarns
+  if (!r.fiber_detail && segs * sides * 2 > kMaxTriangles)
+    bad("repeats", "the sample would have " + ParamReader::fmt(segs * sides * 2) +
                        " triangles (limit 5e7): fewer repeats, sides or segments");
 
   // Fiber settings.
@@ -219,11 +228,11 @@ Resolved resolve(const WeaveOptions& o) {
                              ? fs.fibers_per_yarn
                              : std::max(1.0, std::round(fs.packing * area /
                                                         (kPi * fs.radius_mm * fs.radius_mm)));
-        points += n * yarns_per_thread * (along * o.segments_per_crossing + 1);
+        points += n * yarns_per_thread * (along * segments_per_crossing + 1);
       }
     };
-    count(warp, o.repeats_z, nweft);
-    count(weft, o.repeats_x, nwarp);
+    count(warp, r.repeats_z, nweft);
+    count(weft, r.repeats_x, nwarp);
     if (points > kMaxCurvePoints)
       bad(fs.fibers_per_yarn > 0 ? "fibers-per-yarn" : "packing",
           "the sample would have " + ParamReader::fmt(points) +
@@ -232,8 +241,8 @@ Resolved resolve(const WeaveOptions& o) {
 
   // Layout of the tile.
   Layout& L = r.layout;
-  L.segments_per_crossing = o.segments_per_crossing;
-  L.sides = o.sides;
+  L.segments_per_crossing = segments_per_crossing;
+  L.sides = sides;
   L.tile.warps = static_cast<int>(nwarp);
   L.tile.wefts = static_cast<int>(nweft);
   L.tile.warp_over.resize(static_cast<size_t>(nwarp * nweft));
@@ -483,6 +492,7 @@ WeaveOptions red_cotton_weave_options() {
   WeaveOptions o;
   o.pattern = "plain";
   o.detail = "yarn";
+  o.repeats_x = o.repeats_z = 1;
   o.warp_spacing_mm = kRedWarpSpacing;
   o.weft_spacing_mm = kRedWeftSpacing;
   o.warp_width_mm = kRedWarpWidth;
@@ -490,6 +500,8 @@ WeaveOptions red_cotton_weave_options() {
   o.warp_thickness_mm = kRedWarpThickness;
   o.weft_thickness_mm = kRedWeftThickness;
   o.warp_crimp_share = kRedWarpCrimpShare;
+  o.segments_per_crossing = 16;
+  o.sides = 16;
   o.fiber_radius_um = kRedFiberRadiusUm;
   o.packing = kRedPacking;
   o.plies = 1;
@@ -497,17 +509,42 @@ WeaveOptions red_cotton_weave_options() {
   return o;
 }
 
+WeaveOptions overlay(WeaveOptions base, const WeaveOptions& g) {
+  auto take = [](auto& dst, const auto& src) {
+    if (src) dst = src;
+  };
+  if (g.pattern) base.wif.reset();
+  if (g.wif) base.pattern.reset();
+  if (g.fibers_per_yarn) base.packing.reset();
+  if (g.packing) base.fibers_per_yarn.reset();
+  if (g.twist_per_mm) base.twist_angle_deg.reset();
+  if (g.twist_angle_deg) base.twist_per_mm.reset();
+  take(base.pattern, g.pattern), take(base.wif, g.wif), take(base.detail, g.detail);
+  take(base.repeats_x, g.repeats_x), take(base.repeats_z, g.repeats_z);
+  take(base.warp_spacing_mm, g.warp_spacing_mm), take(base.weft_spacing_mm, g.weft_spacing_mm);
+  take(base.warp_width_mm, g.warp_width_mm), take(base.weft_width_mm, g.weft_width_mm);
+  take(base.warp_thickness_mm, g.warp_thickness_mm);
+  take(base.weft_thickness_mm, g.weft_thickness_mm);
+  take(base.warp_crimp_share, g.warp_crimp_share);
+  take(base.segments_per_crossing, g.segments_per_crossing), take(base.sides, g.sides);
+  take(base.fiber_radius_um, g.fiber_radius_um), take(base.fibers_per_yarn, g.fibers_per_yarn);
+  take(base.packing, g.packing), take(base.plies, g.plies);
+  take(base.twist_per_mm, g.twist_per_mm), take(base.twist_angle_deg, g.twist_angle_deg);
+  take(base.ply_twist_per_mm, g.ply_twist_per_mm);
+  return base;
+}
+
 WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& base_dir) {
   WeaveOptions o;
   const double big = 1e300;
   if (r.has("description")) r.string("description");
-  o.pattern = r.string("pattern", o.pattern);
+  if (r.has("pattern")) o.pattern = r.string("pattern");
   if (r.has("wif")) {
     const std::filesystem::path p = r.string("wif");
     o.wif = (p.is_absolute() ? p : base_dir / p).string();
     r.reject_unused("pattern", "a WIF draft gives the pattern");
   }
-  o.detail = r.choice("detail", o.detail, {"yarn", "fiber"});
+  if (r.has("detail")) o.detail = r.choice("detail", "yarn", {"yarn", "fiber"});
   if (r.has("repeats")) {
     const auto& a = r.at("repeats");
     if (!a.is_array() || a.size() != 2)
@@ -518,6 +555,9 @@ WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& bas
   auto num = [&](const char* key, std::optional<double>& v) {
     if (r.has(key)) v = r.number(key, -big, big);
   };
+  auto integer = [&](const char* key, std::optional<int>& v, int lo, int hi) {
+    if (r.has(key)) v = static_cast<int>(r.integer(key, lo, hi));
+  };
   num("warp-spacing-mm", o.warp_spacing_mm);
   num("weft-spacing-mm", o.weft_spacing_mm);
   num("warp-width-mm", o.warp_width_mm);
@@ -525,19 +565,30 @@ WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& bas
   num("warp-thickness-mm", o.warp_thickness_mm);
   num("weft-thickness-mm", o.weft_thickness_mm);
   num("warp-crimp-share", o.warp_crimp_share);
-  o.segments_per_crossing =
-      static_cast<int>(r.integer("segments-per-crossing", o.segments_per_crossing, 2, 1024));
-  o.sides = static_cast<int>(r.integer("sides", o.sides, 4, 1024));
+  integer("segments-per-crossing", o.segments_per_crossing, 2, 1024);
+  integer("sides", o.sides, 4, 1024);
   num("fiber-radius-um", o.fiber_radius_um);
-  if (r.has("fibers-per-yarn"))
-    o.fibers_per_yarn = static_cast<int>(r.integer("fibers-per-yarn", 1, 100000));
+  integer("fibers-per-yarn", o.fibers_per_yarn, 1, 100000);
   num("packing", o.packing);
-  if (r.has("plies")) o.plies = static_cast<int>(r.integer("plies", 1, 16));
+  integer("plies", o.plies, 1, 16);
   num("twist-per-mm", o.twist_per_mm);
   num("twist-angle-deg", o.twist_angle_deg);
   num("ply-twist-per-mm", o.ply_twist_per_mm);
   r.finish();
   return o;
+}
+
+WeaveOptions read_weave_options(const std::filesystem::path& json_file) {
+  std::ifstream in(json_file);
+  if (!in) throw Error(json_file.string(), "", "cannot open");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(json_file.string(), "", std::string("invalid JSON: ") + e.what());
+  }
+  ParamReader r(j, json_file.string(), "");  // keeps a reference to j
+  return read_weave_options(r, json_file.parent_path());
 }
 
 WovenSample make_woven_sample(const WeaveOptions& options) {
@@ -549,15 +600,15 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
   WovenSample out;
   WeaveSummary& s = out.summary;
   s.source = r.source;
-  s.detail = options.detail;
+  s.detail = r.detail;
   s.warps = r.repeat.warps;
   s.wefts = r.repeat.wefts;
-  s.repeats_x = options.repeats_x;
-  s.repeats_z = options.repeats_z;
+  s.repeats_x = r.repeats_x;
+  s.repeats_z = r.repeats_z;
   s.period_x_mm = L.period_x;
   s.period_z_mm = L.period_z;
-  s.repeat_x_mm = L.period_x / options.repeats_x;
-  s.repeat_z_mm = L.period_z / options.repeats_z;
+  s.repeat_x_mm = L.period_x / r.repeats_x;
+  s.repeat_z_mm = L.period_z / r.repeats_z;
   s.warp_crimp_share = L.warp_crimp_share;
   s.floating_warps = r.repeat.floating_warps();
   s.floating_wefts = r.repeat.floating_wefts();

@@ -179,6 +179,7 @@ TEST(Woven, CrossingYarnsDoNotInterpenetrate) {
   }
   WeaveOptions wif = defaults();
   wif.wif = (fs::path(WEFT_SOURCE_DIR) / "scenes/data/wif/54235-plain.wif").string();
+  wif.pattern.reset();
   wif.warp_spacing_mm.reset(), wif.weft_spacing_mm.reset(), wif.warp_width_mm.reset(),
       wif.weft_width_mm.reset(), wif.warp_thickness_mm.reset(), wif.weft_thickness_mm.reset(),
       wif.warp_crimp_share.reset();
@@ -614,6 +615,8 @@ TEST(Woven, BadParametersAreErrorsNamingTheField) {
   expect(o, "ply-twist-per-mm");  // needs plies
   o = defaults();
   o.wif = "/no/such/draft.wif";
+  expect(o, "wif");  // and a pattern
+  o.pattern.reset();
   EXPECT_NE(error_of(o).find("/no/such/draft.wif"), std::string::npos);
   // Absurd sizes are refused from an estimate, before anything is allocated.
   o = defaults();

@@ -47,21 +47,22 @@ class ParamReader;
 // ---------------------------------------------------------------------------------------------
 // Woven samples.
 
-// What the user chooses (CLI options, a sample description JSON). Sizes left unset come from a
-// WIF draft when there is one, else from the bundled red-cotton sample (kRedCotton*).
+// What the user chooses (CLI options, a sample description JSON): every field optional. Unset
+// fields take the bundled red-cotton sample's values (red_cotton_weave_options()), except the
+// thread sizes and crimp share of a WIF draft, which come from the draft (crimp: balanced).
 struct WeaveOptions {
-  std::string pattern = "plain";  // plain | twill:N/M | satin:N[/MOVE]; unused with a WIF draft
-  std::string wif;                // path of a WIF draft (its threads replace the pattern)
-  std::string detail = "yarn";    // yarn | fiber
-  int repeats_x = 1, repeats_z = 1;
+  std::optional<std::string> pattern;  // plain | twill:N/M | satin:N[/MOVE]; not with a WIF
+  std::optional<std::string> wif;      // path of a WIF draft (its threads replace the pattern)
+  std::optional<std::string> detail;   // yarn | fiber
+  std::optional<int> repeats_x, repeats_z;
   std::optional<double> warp_spacing_mm, weft_spacing_mm;  // centre to centre
   std::optional<double> warp_width_mm, weft_width_mm;
   std::optional<double> warp_thickness_mm, weft_thickness_mm;
   // Fraction of each crossing's total crimp height (t_warp + t_weft) / 2 that the warp carries;
   // negative: balanced (each yarn wraps half the other's thickness).
   std::optional<double> warp_crimp_share;
-  int segments_per_crossing = 16;  // along a yarn, per crossing (tubes and fiber polylines)
-  int sides = 16;                  // around a yarn tube
+  std::optional<int> segments_per_crossing;  // along a yarn, per crossing (tubes, polylines)
+  std::optional<int> sides;                  // around a yarn tube
   // Fiber detail.
   std::optional<double> fiber_radius_um;
   std::optional<int> fibers_per_yarn;  // per yarn section; unset: from the packing fraction
@@ -72,12 +73,16 @@ struct WeaveOptions {
   std::optional<double> ply_twist_per_mm;  // plies about the yarn axis (plies > 1), S < 0
 };
 
-// Reads a sample description (JSON object with WeaveOptions' keys, see
-// scenes/examples/red-cotton-weave.json); unknown keys are errors. Relative "wif" paths resolve
-// against 'base_dir'.
+// Reads a sample description (a JSON object whose keys are the `weft weave` option names without
+// the leading dashes, see scenes/examples/red-cotton-weave.json); unknown keys are errors.
+// Relative "wif" paths resolve against 'base_dir'. Only the keys present are set.
 WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& base_dir);
+WeaveOptions read_weave_options(const std::filesystem::path& json_file);
 // The bundled red-cotton sample's options, every value set (the defaults of `weft weave`).
 WeaveOptions red_cotton_weave_options();
+// 'base' with every field that 'given' sets replaced; setting one of a pair of alternatives
+// (pattern / wif, fibers-per-yarn / packing, twist-per-mm / twist-angle-deg) clears the other.
+WeaveOptions overlay(WeaveOptions base, const WeaveOptions& given);
 
 // Sizes of one thread, millimetres.
 struct ThreadSize {
