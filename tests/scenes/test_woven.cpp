@@ -627,3 +627,30 @@ TEST(Woven, BadParametersAreErrorsNamingTheField) {
   expect(o, "packing");
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
 }
+
+TEST(Woven, PositiveTwistIsAZTwistRightHandedHelix) {
+  // The default weft is straight (the warp takes all the crimp). A right-handed helix about +z,
+  // (r cos t, r sin t, c t) with c > 0, moves its top point towards -x as z grows: seen from
+  // above, the fibers on top lie like the middle stroke of a Z. Negative twist is S.
+  for (double twist : {1.0, -1.0}) {
+    WeaveOptions o = defaults();
+    o.detail = "fiber";
+    o.twist_per_mm = twist;
+    const WovenSample s = make_woven_sample(o);
+    const FiberCurves& f = s.fibers;
+    int checked = 0;
+    for (size_t c = 0; c < f.curve_count(); ++c) {
+      if (f.material(c) != "weft") continue;
+      for (uint32_t k = 1; k + 1 < f.curve_points[c]; ++k) {
+        const Vec3 p = f.point(f.curve_first[c] + k);
+        // Top of the yarn: higher than both neighbours (the fiber passes over the crown).
+        const Vec3 a = f.point(f.curve_first[c] + k - 1), b = f.point(f.curve_first[c] + k + 1);
+        if (!(p.y > a.y && p.y > b.y)) continue;
+        const double dxdz = (b.x - a.x) / (b.z - a.z);
+        EXPECT_LT(dxdz * twist, 0) << "curve " << c;
+        ++checked;
+      }
+    }
+    EXPECT_GT(checked, 0);
+  }
+}

@@ -22,6 +22,9 @@
 //   then the two yarns meet along their whole crossing: flattened against each other). The
 //   share of the crimp the warp takes is a parameter; the generator checks every crossing.
 // - Parallel neighbours never overlap: each yarn stays within its own spacing (w <= spacing).
+// - Each yarn is one tube closed around its section; it ends at the sample's sides, where its
+//   end ring is exactly the start ring of its periodic copy (so the tiled cloth is watertight;
+//   no end caps, which would be faces inside the cloth).
 // Fiber model: each yarn (or ply) is a bundle of round fibers on nested rings inside its section
 // (rings are the section eroded step by step, corners rounded), fibers evenly spaced along each
 // ring and carried around it by the twist (the idealised helical yarn, flattened); plies are
