@@ -132,8 +132,12 @@ GltfDocument build_gltf(const std::vector<TriangleMesh>* meshes, const FiberCurv
       for (int k = 0; k < 3; ++k) pos[3 * i + k] = f.points[4 * i + k];
       rad[i] = f.points[4 * i + 3];
     }
+    // One view each for all positions and all radii; accessors sharing a vertex view need its
+    // byteStride (glTF 2.0, 3.6.2.4).
     const size_t pv = w.view(pos.data(), pos.size() * 4, 34962);
     const size_t rv = w.view(rad.data(), rad.size() * 4, 34962);
+    w.views[pv]["byteStride"] = 12;
+    w.views[rv]["byteStride"] = 4;
     // Curves of one yarn are consecutive; one node and mesh per yarn.
     std::vector<nlohmann::json> yarn_prims(f.yarn_material.size(), nlohmann::json::array());
     for (size_t c = 0; c < f.curve_count(); ++c) {

@@ -501,6 +501,13 @@ TEST(Woven, GltfEncodingOfFibersAndYarns) {
       const auto pos = read_floats(prim["attributes"]["POSITION"]);
       const auto rad = read_floats(prim["attributes"]["_RADIUS"]);
       EXPECT_EQ(doc["accessors"][prim["attributes"]["_RADIUS"].get<size_t>()]["type"], "SCALAR");
+      // Accessors that share a vertex buffer view need its byteStride (glTF 2.0, 3.6.2.4).
+      auto stride = [&](const char* attr) {
+        const auto& a = doc["accessors"][prim["attributes"][attr].get<size_t>()];
+        return doc["bufferViews"][a["bufferView"].get<size_t>()].value("byteStride", 0);
+      };
+      EXPECT_EQ(stride("POSITION"), 12);
+      EXPECT_EQ(stride("_RADIUS"), 4);
       ASSERT_EQ(rad.size(), s.fibers.curve_points[curve]);
       ASSERT_EQ(pos.size(), 3 * rad.size());
       for (size_t k = 0; k < rad.size(); ++k) {
