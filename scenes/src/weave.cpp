@@ -43,10 +43,6 @@ double YarnPath::height_at(double s, double* slope) const {
   return h0 + (h1 - h0) * 0.5 * (1 - std::cos(kPi * u));
 }
 
-Vec3 YarnPath::point(double s, double l, double y) const {
-  return along() * s + across() * centre + Vec3{0, 1, 0} * (height_at(s) + y) + lateral() * l;
-}
-
 double YarnPath::max_slope() const {
   double m = 0;
   const size_t n = crossing.size();
@@ -84,12 +80,14 @@ constexpr double kMaxCurvePoints = 3e7;
   throw Error("", field, msg);
 }
 
+// 'where' names the source of a value that did not come from the options (a WIF thread).
 double check_length(const std::optional<double>& v, double fallback, const std::string& field,
-                    double lo, double hi) {
+                    double lo, double hi, const std::string& where = "") {
   const double x = v.value_or(fallback);
   if (!(std::isfinite(x) && x > lo && x <= hi))
     bad(field, "must be finite and in (" + ParamReader::fmt(lo) + ", " + ParamReader::fmt(hi) +
-                   "], got " + ParamReader::fmt(x));
+                   "], got " + ParamReader::fmt(x) +
+                   (v || where.empty() ? "" : " (" + where + ")"));
   return x;
 }
 
@@ -135,13 +133,14 @@ Resolved resolve(const WeaveOptions& o) {
                      const std::optional<double>& th, double def_sp, double def_w, double flat,
                      std::vector<ThreadSize>& out, std::vector<std::array<double, 3>>& rgb) {
       for (const WifThread& t : threads) {
+        const std::string where = *o.wif + ", " + dir + " thread " + std::to_string(out.size() + 1);
         ThreadSize s;
-        s.spacing_mm =
-            check_length(sp, t.spacing_mm > 0 ? t.spacing_mm : def_sp, dir + "-spacing-mm", 0, 100);
+        s.spacing_mm = check_length(sp, t.spacing_mm > 0 ? t.spacing_mm : def_sp,
+                                    dir + "-spacing-mm", 0, 100, where);
         const double drawn = t.thickness_mm > 0 ? std::min(t.thickness_mm, s.spacing_mm)
                                                 : std::min(def_w, s.spacing_mm);
-        s.width_mm = check_length(wd, drawn, dir + "-width-mm", 0, 100);
-        s.thickness_mm = check_length(th, s.width_mm * flat, dir + "-thickness-mm", 0, 100);
+        s.width_mm = check_length(wd, drawn, dir + "-width-mm", 0, 100, where);
+        s.thickness_mm = check_length(th, s.width_mm * flat, dir + "-thickness-mm", 0, 100, where);
         out.push_back(s);
         rgb.push_back(t.rgb);
       }

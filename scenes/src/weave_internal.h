@@ -31,8 +31,6 @@ struct YarnPath {
   Vec3 lateral() const { return warp ? Vec3{0, 0, 1} : Vec3{-1, 0, 0}; }
   // Centre height and its slope at along coordinate s (any s: periodic).
   double height_at(double s, double* slope = nullptr) const;
-  // Point at along coordinate s, lateral offset l and height offset y from the centre line.
-  Vec3 point(double s, double l, double y) const;
   // Largest |slope| of the centre line.
   double max_slope() const;
 };

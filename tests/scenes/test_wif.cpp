@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "weft/core/error.h"
+#include "weft/core/rng.h"
 #include "weft/scenes/weave.h"
 #include "weft/scenes/wif.h"
 
@@ -210,4 +211,43 @@ TEST(Wif, FloatingThreadsAreReported) {
   EXPECT_EQ(s.summary.floating_warps, std::vector<int>{3});
   EXPECT_TRUE(s.summary.floating_wefts.empty());
   fs::remove_all(dir);
+}
+
+TEST(Wif, MutatedDraftsAreErrorsOrDraftsNeverCrashes) {
+  // Deterministic mutations of a valid draft (characters replaced, lines dropped or repeated):
+  // each parses or throws weft::Error; anything else (another exception, a crash) fails.
+  const std::string alphabet = "0123456789=,;[]-. abcxyzTHREADSShaftsUnits\n";
+  Rng rng(7);
+  int parsed = 0, refused = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string text = kSmall;
+    const int edits = 1 + static_cast<int>(rng.uniform() * 4);
+    for (int e = 0; e < edits; ++e) {
+      const size_t pos = static_cast<size_t>(rng.uniform() * text.size());
+      const double kind = rng.uniform();
+      if (kind < 0.6) {
+        text[pos] = alphabet[static_cast<size_t>(rng.uniform() * alphabet.size())];
+      } else {
+        const size_t a = text.rfind('\n', pos), b = text.find('\n', pos);
+        const size_t from = a == std::string::npos ? 0 : a + 1;
+        const size_t to = b == std::string::npos ? text.size() : b + 1;
+        const std::string line = text.substr(from, to - from);
+        if (kind < 0.8)
+          text.erase(from, to - from);
+        else
+          text.insert(from, line);
+      }
+    }
+    try {
+      const WifDraft d = parse_wif(text, "mutant.wif");
+      const Interlacing m = d.interlacing();
+      EXPECT_EQ(m.warp_over.size(), d.warp.size() * d.weft.size());
+      ++parsed;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("mutant.wif"), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(parsed, 0);
+  EXPECT_GT(refused, 0);
 }
