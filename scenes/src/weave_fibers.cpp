@@ -539,12 +539,16 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
     for (size_t u = 0; u < cell.size(); ++u)
       for (size_t v = u + 1; v < cell.size(); ++v) {
         const Seg &a = segs[cell[u]], &b = segs[cell[v]];
-        if (a.curve == b.curve || along_joint(cell[u], cell[v]) || along_joint(cell[v], cell[u]))
-          continue;
-        // The periodic image of b nearest to a.
+        if (a.curve == b.curve) continue;
+        // The periodic image of b nearest to a; boxes grown by cutoff / 2 that miss each other
+        // hold no pair within the cutoff.
         const Vec3 ca = 0.5 * (a.a + a.b), cb = 0.5 * (b.a + b.b);
         const Vec3 shift{period_x * std::round((ca.x - cb.x) / period_x), 0,
                          period_z * std::round((ca.z - cb.z) / period_z)};
+        bool apart = false;
+        for (int i = 0; i < 3 && !apart; ++i)
+          apart = a.hi[i] < b.lo[i] + shift[i] || b.hi[i] + shift[i] < a.lo[i];
+        if (apart || along_joint(cell[u], cell[v]) || along_joint(cell[v], cell[u])) continue;
         best = std::min(best, segment_distance(a.a, a.b, b.a + shift, b.b + shift));
       }
   return best;

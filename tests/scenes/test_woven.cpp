@@ -271,20 +271,26 @@ TEST(Woven, SampleIsPeriodic) {
       EXPECT_NEAR(d.z, m == 0 ? 0 : qz, 1e-9);
     }
   }
-  // Fiber detail: the fibers' end points are their start points moved by the period.
-  WeaveOptions f = defaults();
-  f.detail = "fiber";
-  const WovenSample fs = make_woven_sample(f);
-  const FiberCurves& c = fs.fibers;
-  for (size_t k = 0; k < c.curve_count(); ++k) {
-    const bool warp = c.material(k) == "warp";
-    const Vec3 end =
-        c.point(c.curve_first[k] + c.curve_points[k] - 1) - Vec3{warp ? qx : 0, 0, warp ? 0 : qz};
-    double best = 1e300;
-    for (size_t j = 0; j < c.curve_count(); ++j)
-      if (c.curve_yarn[j] == c.curve_yarn[k])
-        best = std::min(best, length(c.point(c.curve_first[j]) - end));
-    EXPECT_LT(best, 1e-9) << "curve " << k;
+  // Fiber detail (singles, and two plies carried round by a ply twist): the fibers' end points
+  // are their start points moved by the period.
+  WeaveOptions singles = defaults(), plied = defaults();
+  singles.detail = plied.detail = "fiber";
+  plied.plies = 2;
+  plied.packing = 0.05;
+  plied.ply_twist_per_mm = -0.8;
+  for (const WeaveOptions& f : {singles, plied}) {
+    const WovenSample fs = make_woven_sample(f);
+    const FiberCurves& c = fs.fibers;
+    for (size_t k = 0; k < c.curve_count(); ++k) {
+      const bool warp = c.material(k) == "warp";
+      const Vec3 end =
+          c.point(c.curve_first[k] + c.curve_points[k] - 1) - Vec3{warp ? qx : 0, 0, warp ? 0 : qz};
+      double best = 1e300;
+      for (size_t j = 0; j < c.curve_count(); ++j)
+        if (c.curve_yarn[j] == c.curve_yarn[k])
+          best = std::min(best, length(c.point(c.curve_first[j]) - end));
+      EXPECT_LT(best, 1e-9) << "curve " << k << " plies " << *f.plies;
+    }
   }
 }
 
