@@ -1,49 +1,174 @@
-// weft weave: generate a woven patch (glTF) of yarn tubes.
+// weft weave: a woven sample (one periodic repeat, yarn or fiber detail) as glTF; the older
+// open-mesh patch when its options (--yarns, --yarn-radius-mm, ...) are given.
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "weft/core/error.h"
 #include "weft/scenes/weave.h"
 
 namespace weft::cli {
+namespace {
+
+// Parses "N" or "NxM" into repeats along x and z.
+void parse_repeats(const std::string& text, int& nx, int& nz) {
+  const auto x = text.find_first_of("xX");
+  try {
+    size_t used = 0;
+    if (x == std::string::npos) {
+      nx = nz = std::stoi(text, &used);
+      if (used != text.size()) throw std::invalid_argument(text);
+    } else {
+      nx = std::stoi(text.substr(0, x), &used);
+      if (used != x) throw std::invalid_argument(text);
+      nz = std::stoi(text.substr(x + 1), &used);
+      if (used != text.size() - x - 1) throw std::invalid_argument(text);
+    }
+  } catch (const std::exception&) {
+    throw Error("", "repeats", "expected N or NxM, got '" + text + "'");
+  }
+}
+
+// The open-mesh patch of earlier versions; its options cannot be mixed with the sample's.
+int run_legacy(const CLI::App& sub, WeaveParams p, const WeaveOptions& w, bool sides_given,
+               const std::string& output, bool json) {
+  for (const char* name : {"--sample", "--wif", "--detail", "--repeats", "--warp-spacing-mm",
+                           "--weft-spacing-mm", "--yarn-width-mm", "--yarn-thickness-mm",
+                           "--fibers-per-yarn", "--packing", "--segments-per-crossing"})
+    if (sub.get_option(name)->count())
+      throw Error("", std::string(name).substr(2),
+                  "cannot be combined with the legacy open-mesh options (--yarns, "
+                  "--yarn-radius-mm, --spacing-mm, --segments, --amplitude-mm)");
+  p.pattern = w.pattern.value_or("plain");
+  if (sides_given) p.sides = *w.sides;
+  const auto meshes = make_weave(p);
+  size_t tris = 0, verts = 0;
+  for (const auto& m : meshes) tris += m.triangle_count(), verts += m.vertex_count();
+  write_weave(output, p);
+  if (json)
+    std::cout << nlohmann::json({{"output", output},
+                                 {"detail", "legacy open mesh"},
+                                 {"triangles", tris},
+                                 {"vertices", verts}})
+                     .dump(2)
+              << "\n";
+  else
+    std::printf("%s: %zu triangles, %zu vertices (legacy open-mesh patch)\n", output.c_str(), tris,
+                verts);
+  return 0;
+}
+
+}  // namespace
 
 void add_weave_command(CLI::App& app, Commands& commands) {
   struct Options {
-    WeaveParams p;
-    std::string output;
+    WeaveOptions w;  // what the command line gives
+    std::string sample, repeats, output;
+    std::optional<double> yarn_width_mm, yarn_thickness_mm;
+    WeaveParams legacy;
     bool json = false;
   };
   auto o = std::make_shared<Options>();
-  auto* sub =
-      app.add_subcommand("weave", "Generate a woven patch of yarn tubes as glTF (y up, metres)");
-  sub->add_option("--pattern", o->p.pattern, "weave pattern (plain)")->capture_default_str();
-  sub->add_option("--yarns", o->p.yarns, "yarns per direction")->capture_default_str();
-  sub->add_option("--yarn-radius-mm", o->p.yarn_radius_mm, "yarn radius, mm")
-      ->capture_default_str();
-  sub->add_option("--spacing-mm", o->p.spacing_mm, "distance between parallel yarns, mm")
-      ->capture_default_str();
-  sub->add_option("--segments", o->p.segments, "segments along each yarn")->capture_default_str();
-  sub->add_option("--sides", o->p.sides, "segments around each yarn")->capture_default_str();
-  sub->add_option("--amplitude-mm", o->p.amplitude_mm,
-                  "centre-line amplitude, mm (default: the yarn radius)");
+  auto* sub = app.add_subcommand(
+      "weave",
+      "Generate a woven sample as glTF (metres, y up, warp along x, weft along z): one repeat of "
+      "a pattern or WIF draft, periodic in x and z, as yarn tubes or fiber curves. Defaults: the "
+      "bundled red-cotton poplin (scenes/examples/red-cotton-weave.json)");
+  sub->add_option("--sample", o->sample,
+                  "sample description JSON (keys: these options' names without the leading "
+                  "dashes); options given here override it");
+  sub->add_option("--pattern", o->w.pattern, "plain | twill:N/M | satin:N[/MOVE]");
+  sub->add_option("--wif", o->w.wif, "WIF weaving draft (replaces --pattern)");
+  sub->add_option("--detail", o->w.detail, "yarn (closed tubes) | fiber (round curves)");
+  sub->add_option("--repeats", o->repeats, "copies of the repeat, N or NxM (x by z)");
+  sub->add_option("--warp-spacing-mm", o->w.warp_spacing_mm, "warp centre-to-centre distance");
+  sub->add_option("--weft-spacing-mm", o->w.weft_spacing_mm, "weft centre-to-centre distance");
+  sub->add_option("--yarn-width-mm", o->yarn_width_mm, "width of warp and weft yarns");
+  sub->add_option("--yarn-thickness-mm", o->yarn_thickness_mm, "thickness of warp and weft yarns");
+  sub->add_option("--warp-width-mm", o->w.warp_width_mm, "warp yarn width");
+  sub->add_option("--weft-width-mm", o->w.weft_width_mm, "weft yarn width");
+  sub->add_option("--warp-thickness-mm", o->w.warp_thickness_mm, "warp yarn thickness");
+  sub->add_option("--weft-thickness-mm", o->w.weft_thickness_mm, "weft yarn thickness");
+  sub->add_option("--warp-crimp-share", o->w.warp_crimp_share,
+                  "share of the crimp height carried by the warp, [0, 1]; < 0: balanced");
+  sub->add_option("--segments-per-crossing", o->w.segments_per_crossing,
+                  "segments along a yarn per crossing");
+  sub->add_option("--fiber-radius-um", o->w.fiber_radius_um, "fiber radius, micrometres");
+  sub->add_option("--fibers-per-yarn", o->w.fibers_per_yarn, "fibers in a yarn section");
+  sub->add_option("--packing", o->w.packing, "fiber area / yarn section area (sets the count)");
+  sub->add_option("--plies", o->w.plies, "plies per yarn");
+  sub->add_option("--twist-per-mm", o->w.twist_per_mm, "fiber twist, turns per mm (Z > 0)");
+  sub->add_option("--twist-angle-deg", o->w.twist_angle_deg,
+                  "fiber twist as the outer fibers' helix angle, degrees");
+  sub->add_option("--ply-twist-per-mm", o->w.ply_twist_per_mm, "ply twist, turns per mm (S < 0)");
+  // Shared with the legacy patch: segments around each yarn tube.
+  auto* sides = sub->add_option("--sides", o->w.sides, "segments around each yarn tube");
+  // The legacy open-mesh patch.
+  auto* yarns = sub->add_option("--yarns", o->legacy.yarns, "legacy patch: yarns per direction");
+  auto* radius = sub->add_option("--yarn-radius-mm", o->legacy.yarn_radius_mm,
+                                 "legacy patch: circular yarn radius");
+  auto* spacing = sub->add_option("--spacing-mm", o->legacy.spacing_mm,
+                                  "legacy patch: distance between parallel yarns");
+  auto* segments =
+      sub->add_option("--segments", o->legacy.segments, "legacy patch: segments along a yarn");
+  auto* amplitude = sub->add_option("--amplitude-mm", o->legacy.amplitude_mm,
+                                    "legacy patch: centre-line amplitude (default: the radius)");
   sub->add_option("-o,--output", o->output, "output (.gltf with embedded buffer, or .glb)")
       ->required();
   sub->add_flag("--json", o->json, "print a JSON summary");
   commands.push_back(
-      {sub, [o] {
-         const auto meshes = make_weave(o->p);
-         size_t tris = 0, verts = 0;
-         for (const auto& m : meshes) tris += m.triangle_count(), verts += m.vertex_count();
-         write_weave(o->output, o->p);
-         if (o->json) {
-           std::cout << nlohmann::json(
-                            {{"output", o->output}, {"triangles", tris}, {"vertices", verts}})
-                            .dump(2)
-                     << "\n";
-         } else {
-           std::printf("%s: %zu triangles, %zu vertices\n", o->output.c_str(), tris, verts);
+      {sub, [o, sub, sides, yarns, radius, spacing, segments, amplitude] {
+         if (yarns->count() || radius->count() || spacing->count() || segments->count() ||
+             amplitude->count())
+           return run_legacy(*sub, o->legacy, o->w, sides->count() > 0, o->output, o->json);
+         // Unset options come from --sample, else from the bundled sample (or a WIF draft's sizes).
+         WeaveOptions given = o->w;
+         if (!o->repeats.empty()) {
+           int nx = 1, nz = 1;
+           parse_repeats(o->repeats, nx, nz);
+           given.repeats_x = nx, given.repeats_z = nz;
          }
+         if (o->yarn_width_mm) {
+           if (given.warp_width_mm || given.weft_width_mm)
+             throw Error("", "yarn-width-mm",
+                         "give it or --warp-width-mm/--weft-width-mm, not both");
+           given.warp_width_mm = given.weft_width_mm = o->yarn_width_mm;
+         }
+         if (o->yarn_thickness_mm) {
+           if (given.warp_thickness_mm || given.weft_thickness_mm)
+             throw Error("", "yarn-thickness-mm",
+                         "give it or --warp-thickness-mm/--weft-thickness-mm, not both");
+           given.warp_thickness_mm = given.weft_thickness_mm = o->yarn_thickness_mm;
+         }
+         auto one_of = [](bool a, bool b, const char* field, const char* what) {
+           if (a && b) throw Error("", field, std::string("give either ") + what + ", not both");
+         };
+         one_of(given.pattern.has_value(), given.wif.has_value(), "wif", "--pattern or --wif");
+         one_of(given.packing.has_value(), given.fibers_per_yarn.has_value(), "packing",
+                "--packing or --fibers-per-yarn");
+         one_of(given.twist_per_mm.has_value(), given.twist_angle_deg.has_value(),
+                "twist-angle-deg", "--twist-per-mm or --twist-angle-deg");
+         const WeaveOptions base =
+             o->sample.empty() ? WeaveOptions{} : read_weave_options(o->sample);
+         const WovenSample sample = make_woven_sample(overlay(base, given));
+         write_woven(o->output, sample);
+         const WeaveSummary& s = sample.summary;
+         if (o->json) {
+           std::cout << weave_summary_json(s, o->output);
+           return 0;
+         }
+         std::printf("%s: %s detail, %s; period %.4f x %.4f mm (x by z), y in [%.4f, %.4f] mm; ",
+                     o->output.c_str(), s.detail.c_str(), s.source.c_str(), s.period_x_mm,
+                     s.period_z_mm, s.y_min_mm, s.y_max_mm);
+         if (s.detail == "yarn")
+           std::printf("%zu triangles\n", s.triangles);
+         else
+           std::printf("%zu curves, %zu segments; closest fibers %.2f um apart\n", s.curves,
+                       s.curve_segments, s.min_fiber_distance_um);
+         if (!s.floating_warps.empty() || !s.floating_wefts.empty())
+           std::printf("note: %zu warp and %zu weft threads never interlace (floating threads)\n",
+                       s.floating_warps.size(), s.floating_wefts.size());
          return 0;
        }});
 }

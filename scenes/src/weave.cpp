@@ -1,21 +1,413 @@
+// The weave generator: options, yarn centre lines and lens sections, the crossing check, yarn
+// tubes, and the legacy open-mesh patch. Fibers: weave_fibers.cpp; glTF: weave_gltf.cpp.
 #include "weft/scenes/weave.h"
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
-#include <cstring>
 #include <fstream>
+#include <functional>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
-#include "weft/core/atomic_file.h"
+#include "weave_internal.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
+#include "weft/scenes/wif.h"
 
 namespace weft {
+namespace detail {
+
+double lens_half_thickness(double w, double t, double l) {
+  if (std::abs(l) >= 0.5 * w) return 0;
+  return 0.5 * t * std::cos(kPi * l / w);
+}
+
+double YarnPath::height_at(double s, double* slope) const {
+  const size_t n = crossing.size();
+  // Reduce s into [start, start + period).
+  double r = s - start;
+  r -= period * std::floor(r / period);
+  const double x = start + r;
+  const size_t k =
+      static_cast<size_t>(std::upper_bound(crossing.begin(), crossing.end(), x) - crossing.begin());
+  // The crossings around x: c0 <= x < c1, wrapping around the period.
+  const double c0 = k == 0 ? crossing[n - 1] - period : crossing[k - 1];
+  const double h0 = k == 0 ? height[n - 1] : height[k - 1];
+  const double c1 = k == n ? crossing[0] + period : crossing[k];
+  const double h1 = k == n ? height[0] : height[k];
+  const double u = (x - c0) / (c1 - c0);
+  // Half cosine from h0 to h1: zero slope at both crossings.
+  if (slope) *slope = (h1 - h0) * 0.5 * kPi / (c1 - c0) * std::sin(kPi * u);
+  return h0 + (h1 - h0) * 0.5 * (1 - std::cos(kPi * u));
+}
+
+double YarnPath::max_slope() const {
+  double m = 0;
+  const size_t n = crossing.size();
+  for (size_t k = 0; k < n; ++k) {
+    const double c1 = k + 1 == n ? crossing[0] + period : crossing[k + 1];
+    const double h1 = k + 1 == n ? height[0] : height[k + 1];
+    m = std::max(m, std::abs(h1 - height[k]) * 0.5 * kPi / (c1 - crossing[k]));
+  }
+  return m;
+}
+
+}  // namespace detail
+
+using detail::kMetresPerMm;
+using detail::Layout;
+using detail::YarnPath;
+
 namespace {
 
-constexpr double kMetresPerMm = 1e-3;
+// The bundled red-cotton sample (scenes/examples/red-cotton-weave.json; sources in
+// scenes/examples/README.md): a cotton poplin, warp Ne 50 at 120 ends/in, weft Ne 42 at 60
+// picks/in, lens sections of the Peirce yarn area, warp closed, weft straight.
+constexpr double kRedWarpSpacing = 0.2117, kRedWarpWidth = 0.2117, kRedWarpThickness = 0.0959;
+constexpr double kRedWeftSpacing = 0.4233, kRedWeftWidth = 0.2310, kRedWeftThickness = 0.1047;
+constexpr double kRedWarpCrimpShare = 1.0;
+constexpr double kRedFiberRadiusUm = 8.0;
+constexpr double kRedPacking = 0.25;
+constexpr double kRedTwistPerMm = 1.0;
 
-void check(const WeaveParams& p) {
-  auto bad = [](const std::string& field, const std::string& msg) { throw Error("", field, msg); };
+// Limits checked before anything is sized by them.
+constexpr double kMaxTriangles = 5e7;
+constexpr double kMaxCurvePoints = 3e7;
+
+[[noreturn]] void bad(const std::string& field, const std::string& msg) {
+  throw Error("", field, msg);
+}
+
+// 'where' names the source of a value that did not come from the options (a WIF thread).
+double check_length(const std::optional<double>& v, double fallback, const std::string& field,
+                    double lo, double hi, const std::string& where = "") {
+  const double x = v.value_or(fallback);
+  if (!(std::isfinite(x) && x > lo && x <= hi))
+    bad(field, "must be finite and in (" + ParamReader::fmt(lo) + ", " + ParamReader::fmt(hi) +
+                   "], got " + ParamReader::fmt(x) +
+                   (v || where.empty() ? "" : " (" + where + ")"));
+  return x;
+}
+
+struct Resolved {
+  std::string detail;
+  int repeats_x = 1, repeats_z = 1;
+  Layout layout;
+  detail::FiberSettings fibers;
+  bool fiber_detail = false;
+  std::string source;
+  std::vector<std::array<double, 3>> warp_rgb, weft_rgb;  // per repeat thread (WIF only)
+  Interlacing repeat;
+};
+
+Resolved resolve(const WeaveOptions& o) {
+  Resolved r;
+  r.detail = o.detail.value_or("yarn");
+  if (r.detail != "yarn" && r.detail != "fiber")
+    bad("detail", "must be yarn or fiber, got '" + r.detail + "'");
+  r.fiber_detail = r.detail == "fiber";
+  r.repeats_x = o.repeats_x.value_or(1);
+  r.repeats_z = o.repeats_z.value_or(1);
+  if (r.repeats_x < 1 || r.repeats_x > 1000 || r.repeats_z < 1 || r.repeats_z > 1000)
+    bad("repeats", "each count must lie in [1, 1000]");
+  const int segments_per_crossing = o.segments_per_crossing.value_or(16);
+  const int sides = o.sides.value_or(16);
+  if (segments_per_crossing < 2 || segments_per_crossing > 1024)
+    bad("segments-per-crossing", "must lie in [2, 1024]");
+  if (sides < 4 || sides > 1024) bad("sides", "must lie in [4, 1024]");
+  if (o.wif && o.pattern) bad("wif", "give either a pattern or a WIF draft, not both");
+  const bool from_wif = o.wif.has_value();
+  std::vector<ThreadSize> warp, weft;
+  const double warp_flat = kRedWarpThickness / kRedWarpWidth,
+               weft_flat = kRedWeftThickness / kRedWeftWidth;
+  if (from_wif) {
+    const WifDraft d = read_wif(*o.wif);
+    r.repeat = d.interlacing();
+    r.source = *o.wif;
+    // WIF sizes: a thread's thickness is its drawn width (clamped to its spacing so neighbours
+    // do not overlap); its height follows the red-cotton flattening unless given.
+    auto sizes = [&](const std::vector<WifThread>& threads, const std::string& dir,
+                     const std::optional<double>& sp, const std::optional<double>& wd,
+                     const std::optional<double>& th, double def_sp, double def_w, double flat,
+                     std::vector<ThreadSize>& out, std::vector<std::array<double, 3>>& rgb) {
+      for (const WifThread& t : threads) {
+        const std::string where = *o.wif + ", " + dir + " thread " + std::to_string(out.size() + 1);
+        ThreadSize s;
+        s.spacing_mm = check_length(sp, t.spacing_mm > 0 ? t.spacing_mm : def_sp,
+                                    dir + "-spacing-mm", 0, 100, where);
+        const double drawn = t.thickness_mm > 0 ? std::min(t.thickness_mm, s.spacing_mm)
+                                                : std::min(def_w, s.spacing_mm);
+        s.width_mm = check_length(wd, drawn, dir + "-width-mm", 0, 100, where);
+        s.thickness_mm = check_length(th, s.width_mm * flat, dir + "-thickness-mm", 0, 100, where);
+        out.push_back(s);
+        rgb.push_back(t.rgb);
+      }
+    };
+    sizes(d.warp, "warp", o.warp_spacing_mm, o.warp_width_mm, o.warp_thickness_mm, kRedWarpSpacing,
+          kRedWarpWidth, warp_flat, warp, r.warp_rgb);
+    sizes(d.weft, "weft", o.weft_spacing_mm, o.weft_width_mm, o.weft_thickness_mm, kRedWeftSpacing,
+          kRedWeftWidth, weft_flat, weft, r.weft_rgb);
+  } else {
+    r.repeat = parse_weave_pattern(o.pattern.value_or("plain"), "pattern");
+    r.source = o.pattern.value_or("plain");
+    ThreadSize w, f;
+    w.spacing_mm = check_length(o.warp_spacing_mm, kRedWarpSpacing, "warp-spacing-mm", 0, 100);
+    f.spacing_mm = check_length(o.weft_spacing_mm, kRedWeftSpacing, "weft-spacing-mm", 0, 100);
+    w.width_mm = check_length(o.warp_width_mm, kRedWarpWidth, "warp-width-mm", 0, 100);
+    f.width_mm = check_length(o.weft_width_mm, kRedWeftWidth, "weft-width-mm", 0, 100);
+    w.thickness_mm =
+        check_length(o.warp_thickness_mm, kRedWarpThickness, "warp-thickness-mm", 0, 100);
+    f.thickness_mm =
+        check_length(o.weft_thickness_mm, kRedWeftThickness, "weft-thickness-mm", 0, 100);
+    warp.assign(r.repeat.warps, w);
+    weft.assign(r.repeat.wefts, f);
+  }
+  for (size_t i = 0; i < warp.size(); ++i)
+    if (warp[i].width_mm > warp[i].spacing_mm * (1 + 1e-12))
+      bad("warp-width-mm", "warp " + std::to_string(i + 1) + " is wider (" +
+                               ParamReader::fmt(warp[i].width_mm) + " mm) than its spacing (" +
+                               ParamReader::fmt(warp[i].spacing_mm) +
+                               " mm): neighbouring yarns would overlap");
+  for (size_t j = 0; j < weft.size(); ++j)
+    if (weft[j].width_mm > weft[j].spacing_mm * (1 + 1e-12))
+      bad("weft-width-mm", "pick " + std::to_string(j + 1) + " is wider (" +
+                               ParamReader::fmt(weft[j].width_mm) + " mm) than its spacing (" +
+                               ParamReader::fmt(weft[j].spacing_mm) +
+                               " mm): neighbouring yarns would overlap");
+  // A WIF draft's threads have no crimp data: balanced unless given.
+  double share = o.warp_crimp_share.value_or(from_wif ? -1.0 : kRedWarpCrimpShare);
+  if (!std::isfinite(share) || share > 1) bad("warp-crimp-share", "must be <= 1 (< 0: balanced)");
+
+  // Sizes of the sample, estimated before anything is allocated.
+  const double nwarp = double(r.repeat.warps) * r.repeats_z,
+               nweft = double(r.repeat.wefts) * r.repeats_x;
+  const double segs = double(segments_per_crossing) * nwarp * nweft * 2;  // along all yarns
+  if (!r.fiber_detail && segs * sides * 2 > kMaxTriangles)
+    bad("repeats", "the sample would have " + ParamReader::fmt(segs * sides * 2) +
+                       " triangles (limit 5e7): fewer repeats, sides or segments");
+
+  // Fiber settings.
+  detail::FiberSettings& fs = r.fibers;
+  fs.radius_mm =
+      check_length(o.fiber_radius_um, kRedFiberRadiusUm, "fiber-radius-um", 0.01, 1000) * 1e-3;
+  fs.plies = o.plies.value_or(1);
+  if (fs.plies < 1 || fs.plies > 16) bad("plies", "must lie in [1, 16]");
+  fs.fibers_per_yarn = o.fibers_per_yarn.value_or(0);
+  if (o.fibers_per_yarn && (fs.fibers_per_yarn < 1 || fs.fibers_per_yarn > 100000))
+    bad("fibers-per-yarn", "must lie in [1, 100000]");
+  if (o.fibers_per_yarn && o.packing)
+    bad("packing", "give either --fibers-per-yarn or --packing, not both");
+  fs.packing = o.packing.value_or(kRedPacking);
+  if (!(std::isfinite(fs.packing) && fs.packing > 0 && fs.packing < 0.9069))
+    bad("packing", "must lie in (0, 0.9069) (0.9069: hexagonal packing of equal circles)");
+  if (o.twist_per_mm && o.twist_angle_deg)
+    bad("twist-angle-deg", "give either --twist-per-mm or --twist-angle-deg, not both");
+  fs.twist_per_mm = o.twist_per_mm.value_or(kRedTwistPerMm);
+  if (!(std::isfinite(fs.twist_per_mm) && std::abs(fs.twist_per_mm) <= 100))
+    bad("twist-per-mm", "must be finite and at most 100 turns per mm in magnitude");
+  if (o.twist_angle_deg) {
+    fs.twist_from_angle = true;
+    fs.twist_angle_deg = *o.twist_angle_deg;
+    if (!(std::isfinite(fs.twist_angle_deg) && std::abs(fs.twist_angle_deg) < 80))
+      bad("twist-angle-deg", "must lie in (-80, 80) degrees");
+  }
+  fs.ply_twist_per_mm = o.ply_twist_per_mm.value_or(0);
+  if (!(std::isfinite(fs.ply_twist_per_mm) && std::abs(fs.ply_twist_per_mm) <= 100))
+    bad("ply-twist-per-mm", "must be finite and at most 100 turns per mm in magnitude");
+  if (o.ply_twist_per_mm && fs.plies == 1) bad("ply-twist-per-mm", "needs --plies 2 or more");
+  if (r.fiber_detail) {
+    // Fibers per yarn from the packing unless given; estimate the points.
+    double points = 0;
+    auto count = [&](const std::vector<ThreadSize>& ts, double yarns_per_thread, double along) {
+      for (const ThreadSize& s : ts) {
+        const double area = 2 * s.width_mm * s.thickness_mm / kPi;  // lens
+        const double n = fs.fibers_per_yarn > 0
+                             ? fs.fibers_per_yarn
+                             : std::max(1.0, std::round(fs.packing * area /
+                                                        (kPi * fs.radius_mm * fs.radius_mm)));
+        points += n * yarns_per_thread * (along * segments_per_crossing + 1);
+      }
+    };
+    count(warp, r.repeats_z, nweft);
+    count(weft, r.repeats_x, nwarp);
+    if (points > kMaxCurvePoints)
+      bad(fs.fibers_per_yarn > 0 ? "fibers-per-yarn" : "packing",
+          "the sample would have " + ParamReader::fmt(points) +
+              " curve points (limit 3e7): fewer repeats, fibers or segments");
+  }
+
+  // Layout of the tile.
+  Layout& L = r.layout;
+  L.segments_per_crossing = segments_per_crossing;
+  L.sides = sides;
+  L.tile.warps = static_cast<int>(nwarp);
+  L.tile.wefts = static_cast<int>(nweft);
+  L.tile.warp_over.resize(static_cast<size_t>(nwarp * nweft));
+  for (int j = 0; j < L.tile.wefts; ++j)
+    for (int i = 0; i < L.tile.warps; ++i)
+      L.tile.warp_over[static_cast<size_t>(j) * L.tile.warps + i] =
+          r.repeat.over(i % r.repeat.warps, j % r.repeat.wefts);
+  std::vector<double> zc(L.tile.warps), xc(L.tile.wefts);
+  double acc = 0;
+  for (int i = 0; i < L.tile.warps; ++i) {
+    const double sp = warp[i % r.repeat.warps].spacing_mm;
+    zc[i] = acc + 0.5 * sp;
+    acc += sp;
+  }
+  L.period_z = acc;
+  acc = 0;
+  for (int j = 0; j < L.tile.wefts; ++j) {
+    const double sp = weft[j % r.repeat.wefts].spacing_mm;
+    xc[j] = acc + 0.5 * sp;
+    acc += sp;
+  }
+  L.period_x = acc;
+  for (double& z : zc) z -= 0.5 * L.period_z;
+  for (double& x : xc) x -= 0.5 * L.period_x;
+  const bool balanced = share < 0;
+  L.warp_crimp_share = share;
+  auto warp_height = [&](int i, int j) {
+    const ThreadSize &w = warp[i % r.repeat.warps], &f = weft[j % r.repeat.wefts];
+    return balanced ? 0.5 * f.thickness_mm : share * 0.5 * (w.thickness_mm + f.thickness_mm);
+  };
+  for (int i = 0; i < L.tile.warps; ++i) {
+    YarnPath y;
+    y.warp = true;
+    y.thread = i % r.repeat.warps;
+    y.centre = zc[i];
+    y.size = warp[y.thread];
+    y.start = -0.5 * L.period_x;
+    y.period = L.period_x;
+    y.crossing = xc;
+    for (int j = 0; j < L.tile.wefts; ++j)
+      y.height.push_back((L.tile.over(i, j) ? 1 : -1) * warp_height(i, j));
+    L.yarns.push_back(std::move(y));
+  }
+  for (int j = 0; j < L.tile.wefts; ++j) {
+    YarnPath y;
+    y.warp = false;
+    y.thread = j % r.repeat.wefts;
+    y.centre = xc[j];
+    y.size = weft[y.thread];
+    y.start = -0.5 * L.period_z;
+    y.period = L.period_z;
+    y.crossing = zc;
+    for (int i = 0; i < L.tile.warps; ++i) {
+      const ThreadSize &w = warp[i % r.repeat.warps], &f = weft[y.thread];
+      const double total = 0.5 * (w.thickness_mm + f.thickness_mm);
+      y.height.push_back((L.tile.over(i, j) ? -1 : 1) * (total - warp_height(i, j)));
+    }
+    L.yarns.push_back(std::move(y));
+  }
+  if (balanced) L.warp_crimp_share = -1;
+  return r;
+}
+
+// Every crossing of the repeat: the upper yarn's lower surface must not go below the lower
+// yarn's upper surface anywhere over the crossing (sampled densely; the model makes the
+// smallest separation zero at the centre). Error naming the share otherwise.
+void check_crossings(const Layout& L, int repeat_warps, int repeat_wefts) {
+  constexpr int kN = 24;
+  const int nw = L.tile.warps;
+  for (int i = 0; i < repeat_warps; ++i)
+    for (int j = 0; j < repeat_wefts; ++j) {
+      const YarnPath &w = L.yarns[i], &f = L.yarns[nw + j];
+      const bool warp_over = L.tile.over(i, j);
+      const double tol = 1e-9 * (w.size.thickness_mm + f.size.thickness_mm);
+      double worst = 1e300;
+      for (int a = 0; a <= kN; ++a)
+        for (int b = 0; b <= kN; ++b) {
+          const double dx = f.size.width_mm * (double(a) / kN - 0.5);
+          const double dz = w.size.width_mm * (double(b) / kN - 0.5);
+          const double x = f.centre + dx, z = w.centre + dz;
+          const double ew = detail::lens_half_thickness(w.size.width_mm, w.size.thickness_mm, dz);
+          const double ef = detail::lens_half_thickness(f.size.width_mm, f.size.thickness_mm, dx);
+          const double hw = w.height_at(x), hf = f.height_at(z);
+          const double sep = warp_over ? (hw - ew) - (hf + ef) : (hf - ef) - (hw + ew);
+          worst = std::min(worst, sep);
+        }
+      if (worst < -tol)
+        bad("warp-crimp-share",
+            "warp " + std::to_string(i + 1) + " and pick " + std::to_string(j + 1) +
+                " would interpenetrate by " + ParamReader::fmt(-worst * 1e3) +
+                " um at this crimp share (" + ParamReader::fmt(L.warp_crimp_share) +
+                "); move it towards the balanced value (-1), or make the crossing yarns narrower "
+                "than their spacing");
+    }
+}
+
+// One tube: rings k = 0..K along, vertices j = 0..M around (the seam repeats j = 0), triangles
+// (a, d, b), (b, d, c) with a = (k, j), d = (k, j + 1), b = (k + 1, j): front-facing outwards when
+// dP/dv x dP/du points out.
+struct TubeVertex {
+  Vec3 p, n, t;
+  double w = 1, u = 0, v = 0;
+};
+void append_tube(TriangleMesh& m, int K, int M,
+                 const std::function<TubeVertex(int k, int j)>& vertex) {
+  auto push3 = [](std::vector<float>& v, const Vec3& p) {
+    v.push_back(static_cast<float>(p.x));
+    v.push_back(static_cast<float>(p.y));
+    v.push_back(static_cast<float>(p.z));
+  };
+  const auto base = static_cast<uint32_t>(m.vertex_count());
+  for (int k = 0; k <= K; ++k)
+    for (int j = 0; j <= M; ++j) {
+      const TubeVertex v = vertex(k, j);
+      push3(m.positions, v.p);
+      push3(m.normals, v.n);
+      push3(m.tangents, v.t);
+      m.tangents.push_back(static_cast<float>(v.w));
+      m.uvs.push_back(static_cast<float>(v.u));
+      m.uvs.push_back(static_cast<float>(v.v));
+    }
+  for (int k = 0; k < K; ++k)
+    for (int j = 0; j < M; ++j) {
+      const uint32_t a = base + k * (M + 1) + j, b = a + (M + 1), c = b + 1, d = a + 1;
+      m.indices.insert(m.indices.end(), {a, d, b, b, d, c});
+    }
+}
+
+// A yarn of the woven sample as a closed lens tube. Angles run clockwise seen along the yarn
+// (phi = -2 pi (j + 1/2) / M) so that dP/dv x dP/du points outwards; no vertex sits on a lens
+// tip, so the polygon is inscribed in the (convex) lens.
+void append_yarn_tube(TriangleMesh& m, const YarnPath& y, int segments_per_crossing, int M) {
+  const int K = static_cast<int>(y.crossing.size()) * segments_per_crossing;
+  const double w = y.size.width_mm, t = y.size.thickness_mm;
+  const Vec3 up{0, 1, 0};
+  append_tube(m, K, M, [&](int k, int j) {
+    const double s = y.start + y.period * (k % K) / K;  // ring K repeats ring 0, shifted
+    const double shift = k == K ? y.period : 0;
+    double slope = 0;
+    const double h = y.height_at(s, &slope);
+    const double phi = -2 * kPi * ((j % M) + 0.5) / M;
+    const double c = std::cos(phi), sn = std::sin(phi), sg = sn < 0 ? -1.0 : 1.0;
+    const double l = 0.5 * w * c;
+    const double yo = 0.5 * t * sg * std::cos(0.5 * kPi * c);
+    // Derivatives in phi (for the normal) and s.
+    const double dl = -0.5 * w * sn;
+    const double dy = 0.5 * t * 0.5 * kPi * std::abs(sn) * std::sin(0.5 * kPi * c);
+    const Vec3 dp_ds = y.along() + up * slope;
+    const Vec3 dp_dphi = y.lateral() * dl + up * dy;
+    Vec3 n = normalize(cross(dp_dphi, dp_ds));
+    const Vec3 offset = y.lateral() * l + up * yo;
+    if (dot(n, offset) < 0) n = -n;  // outwards (the section is convex about the centre)
+    TubeVertex v;
+    v.p = (y.along() * (s + shift) + y.across() * y.centre + up * (h + yo) + y.lateral() * l) *
+          kMetresPerMm;
+    v.n = n;
+    v.t = normalize(dp_ds - n * dot(dp_ds, n));
+    // glTF: bitangent = cross(normal, tangent) * w points along dP/dv = -dP/dphi.
+    v.w = dot(cross(v.n, v.t), dp_dphi) <= 0 ? 1.0 : -1.0;
+    v.u = double(k) / K;
+    v.v = double(j) / M;
+    return v;
+  });
+}
+
+void check_legacy(const WeaveParams& p) {
   if (p.pattern != "plain") bad("pattern", "unknown pattern '" + p.pattern + "' (valid: plain)");
   if (p.yarns < 1 || p.yarns > 4096) bad("yarns", "must lie in [1, 4096]");
   if (!(std::isfinite(p.yarn_radius_mm) && p.yarn_radius_mm > 0 && p.yarn_radius_mm < 1e3))
@@ -30,158 +422,282 @@ void check(const WeaveParams& p) {
   if (tris > 2e9) bad("segments", "the patch would exceed 2e9 triangles");
 }
 
-void push3(std::vector<float>& v, const Vec3& p) {
-  v.push_back(static_cast<float>(p.x));
-  v.push_back(static_cast<float>(p.y));
-  v.push_back(static_cast<float>(p.z));
-}
-
-// Appends one tube around a sinusoidal centre line. 'along' is the yarn axis, 'across' the
-// in-plane offset axis of this yarn, 'offset' its position there; the centre line rises along y
-// as sign * A * cos(pi (s - s0) / S).
-void append_yarn(TriangleMesh& m, const WeaveParams& p, const Vec3& along, const Vec3& across,
-                 double offset, double sign) {
+// Legacy: a circular tube around a sinusoidal centre line; 'along' is the yarn axis, 'across'
+// the in-plane offset axis, 'offset' its position there; the centre rises as
+// sign * A * cos(pi (s - s0) / S).
+void append_legacy_yarn(TriangleMesh& m, const WeaveParams& p, const Vec3& along,
+                        const Vec3& across, double offset, double sign) {
   const double S = p.spacing_mm * kMetresPerMm, R = p.yarn_radius_mm * kMetresPerMm;
   const double A = (p.amplitude_mm < 0 ? p.yarn_radius_mm : p.amplitude_mm) * kMetresPerMm;
   const double L = p.yarns * S, s0 = -0.5 * (p.yarns - 1) * S;
   const Vec3 up{0, 1, 0};
-  // U is perpendicular to the plane of the centre line; V = T x U completes the frame.
-  const Vec3 U = cross(along, up);
-  const auto base = static_cast<uint32_t>(m.vertex_count());
+  const Vec3 U = cross(along, up);  // perpendicular to the centre line's plane
   const int K = p.segments, M = p.sides;
-  for (int k = 0; k <= K; ++k) {
+  append_tube(m, K, M, [&](int k, int j) {
     const double s = -0.5 * L + L * k / K;
     const double phase = kPi * (s - s0) / S;
     const Vec3 c = along * s + across * offset + up * (sign * A * std::cos(phase));
     const Vec3 T = normalize(along + up * (-sign * A * (kPi / S) * std::sin(phase)));
     const Vec3 V = cross(T, U);
-    for (int j = 0; j <= M; ++j) {
-      const double th = 2 * kPi * (j % M) / M;  // the seam repeats the first column exactly
-      const Vec3 r = U * std::cos(th) + V * std::sin(th);
-      push3(m.positions, c + r * R);
-      push3(m.normals, r);
-      push3(m.tangents, T);
-      // glTF: bitangent = cross(normal, tangent) * w; dP/dv points along -cross(r, T).
-      m.tangents.push_back(-1.0f);
-      m.uvs.push_back(static_cast<float>(static_cast<double>(k) / K));
-      m.uvs.push_back(static_cast<float>(static_cast<double>(j) / M));
-    }
-  }
-  for (int k = 0; k < K; ++k)
-    for (int j = 0; j < M; ++j) {
-      const uint32_t a = base + k * (M + 1) + j, b = a + (M + 1), c = b + 1, d = a + 1;
-      // (a, d, b) and (b, d, c) wind counter-clockwise seen from outside the tube.
-      m.indices.insert(m.indices.end(), {a, d, b, b, d, c});
-    }
+    const double th = 2 * kPi * (j % M) / M;  // the seam repeats the first column exactly
+    const Vec3 r = U * std::cos(th) + V * std::sin(th);
+    TubeVertex v;
+    v.p = c + r * R;
+    v.n = r;
+    v.t = T;
+    v.w = -1;  // glTF: bitangent = cross(normal, tangent) * w; dP/dv points along -cross(r, T)
+    v.u = static_cast<double>(k) / K;
+    v.v = static_cast<double>(j) / M;
+    return v;
+  });
 }
 
-std::string base64(const std::vector<uint8_t>& data) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  out.reserve((data.size() + 2) / 3 * 4);
-  for (size_t i = 0; i < data.size(); i += 3) {
-    const uint32_t n = (uint32_t(data[i]) << 16) |
-                       (i + 1 < data.size() ? uint32_t(data[i + 1]) << 8 : 0) |
-                       (i + 2 < data.size() ? uint32_t(data[i + 2]) : 0);
-    out += table[(n >> 18) & 63];
-    out += table[(n >> 12) & 63];
-    out += i + 1 < data.size() ? table[(n >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? table[n & 63] : '=';
-  }
-  return out;
-}
-
-// Builds the glTF JSON and its single binary buffer.
-std::pair<nlohmann::json, std::vector<uint8_t>> build_document(const WeaveParams& p) {
-  const auto meshes = make_weave(p);
-  nlohmann::json doc;
-  std::vector<uint8_t> bin;
-  doc["asset"] = {{"version", "2.0"}, {"generator", "weft weave"}};
-  doc["extras"] = {{"weft_weave",
-                    {{"pattern", p.pattern},
-                     {"yarns", p.yarns},
-                     {"yarn_radius_mm", p.yarn_radius_mm},
-                     {"spacing_mm", p.spacing_mm},
-                     {"segments", p.segments},
-                     {"sides", p.sides},
-                     {"amplitude_mm", p.amplitude_mm < 0 ? p.yarn_radius_mm : p.amplitude_mm},
-                     {"units", "metres"}}}};
-  doc["scene"] = 0;
-  doc["scenes"] = nlohmann::json::array({{{"name", "patch"}, {"nodes", {0}}}});
-  doc["nodes"] = nlohmann::json::array({{{"name", "patch"}, {"children", {1, 2}}},
-                                        {{"name", "warp"}, {"mesh", 0}},
-                                        {{"name", "weft"}, {"mesh", 1}}});
-  // Base colours only help other viewers; Weft binds its own materials by these names.
-  doc["materials"] = nlohmann::json::array(
-      {{{"name", "warp"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.6, 0.1, 0.1, 1.0}}}}},
-       {{"name", "weft"}, {"pbrMetallicRoughness", {{"baseColorFactor", {0.5, 0.5, 0.5, 1.0}}}}}});
-  auto views = nlohmann::json::array(), accessors = nlohmann::json::array(),
-       gmeshes = nlohmann::json::array();
-  auto add_view = [&](const void* data, size_t bytes, int target) {
-    while (bin.size() % 4) bin.push_back(0);
-    const size_t off = bin.size();
-    bin.resize(off + bytes);
-    if (bytes) std::memcpy(bin.data() + off, data, bytes);
-    views.push_back(
-        {{"buffer", 0}, {"byteOffset", off}, {"byteLength", bytes}, {"target", target}});
-    return views.size() - 1;
+nlohmann::json summary_object(const WeaveSummary& s) {
+  auto fibers = [](const std::vector<FiberLayoutInfo>& v) {
+    auto a = nlohmann::json::array();
+    for (const auto& f : v)
+      a.push_back({{"fibers_per_yarn", f.fibers},
+                   {"packing", f.packing},
+                   {"twist_per_mm", f.twist_per_mm},
+                   {"twist_angle_deg", f.twist_angle_deg}});
+    return a;
   };
-  auto add_floats = [&](const std::vector<float>& v, int comps, const char* type, bool minmax) {
-    nlohmann::json a = {{"bufferView", add_view(v.data(), v.size() * 4, 34962)},
-                        {"componentType", 5126},
-                        {"count", v.size() / comps},
-                        {"type", type}};
-    if (minmax) {
-      std::vector<double> lo(comps, 1e300), hi(comps, -1e300);
-      for (size_t i = 0; i < v.size(); ++i) {
-        lo[i % comps] = std::min(lo[i % comps], double(v[i]));
-        hi[i % comps] = std::max(hi[i % comps], double(v[i]));
-      }
-      a["min"] = lo;
-      a["max"] = hi;
-    }
-    accessors.push_back(a);
-    return accessors.size() - 1;
-  };
-  for (size_t mi = 0; mi < meshes.size(); ++mi) {
-    const auto& m = meshes[mi];
-    nlohmann::json attrs = {{"POSITION", add_floats(m.positions, 3, "VEC3", true)},
-                            {"NORMAL", add_floats(m.normals, 3, "VEC3", false)},
-                            {"TANGENT", add_floats(m.tangents, 4, "VEC4", false)},
-                            {"TEXCOORD_0", add_floats(m.uvs, 2, "VEC2", false)}};
-    size_t iv;
-    int ctype;
-    if (m.vertex_count() <= 65535) {
-      std::vector<uint16_t> idx(m.indices.begin(), m.indices.end());
-      iv = add_view(idx.data(), idx.size() * 2, 34963);
-      ctype = 5123;
-    } else {
-      iv = add_view(m.indices.data(), m.indices.size() * 4, 34963);
-      ctype = 5125;
-    }
-    accessors.push_back({{"bufferView", iv},
-                         {"componentType", ctype},
-                         {"count", m.indices.size()},
-                         {"type", "SCALAR"}});
-    gmeshes.push_back({{"name", m.material + "_yarns"},
-                       {"primitives",
-                        {{{"attributes", attrs},
-                          {"indices", accessors.size() - 1},
-                          {"material", mi},
-                          {"mode", 4}}}}});
+  nlohmann::json j = {
+      {"source", s.source},
+      {"detail", s.detail},
+      {"repeat_threads", {{"warps", s.warps}, {"wefts", s.wefts}}},
+      {"repeats", {{"x", s.repeats_x}, {"z", s.repeats_z}}},
+      {"repeat_mm", {{"x", s.repeat_x_mm}, {"z", s.repeat_z_mm}}},
+      {"period_mm", {{"x", s.period_x_mm}, {"z", s.period_z_mm}}},
+      {"thickness_mm", {{"y_min", s.y_min_mm}, {"y_max", s.y_max_mm}}},
+      {"warp_crimp_share", s.warp_crimp_share},
+      {"floating_threads", {{"warps", s.floating_warps}, {"wefts", s.floating_wefts}}},
+      {"triangles", s.triangles},
+      {"vertices", s.vertices},
+      {"curves", s.curves},
+      {"curve_segments", s.curve_segments},
+      {"curve_points", s.curve_points},
+      {"units", "metres in the glTF; mm and um here as named"}};
+  if (s.detail == "fiber") {
+    j["fibers"] = {{"warp", fibers(s.warp_fibers)}, {"weft", fibers(s.weft_fibers)}};
+    j["min_fiber_distance_um"] = s.min_fiber_distance_um;
   }
-  while (bin.size() % 4) bin.push_back(0);
-  doc["meshes"] = gmeshes;
-  doc["accessors"] = accessors;
-  doc["bufferViews"] = views;
-  doc["buffers"] = nlohmann::json::array({{{"byteLength", bin.size()}}});
-  return {doc, bin};
+  return j;
 }
 
 }  // namespace
 
+WeaveOptions red_cotton_weave_options() {
+  WeaveOptions o;
+  o.pattern = "plain";
+  o.detail = "yarn";
+  o.repeats_x = o.repeats_z = 1;
+  o.warp_spacing_mm = kRedWarpSpacing;
+  o.weft_spacing_mm = kRedWeftSpacing;
+  o.warp_width_mm = kRedWarpWidth;
+  o.weft_width_mm = kRedWeftWidth;
+  o.warp_thickness_mm = kRedWarpThickness;
+  o.weft_thickness_mm = kRedWeftThickness;
+  o.warp_crimp_share = kRedWarpCrimpShare;
+  o.segments_per_crossing = 16;
+  o.sides = 16;
+  o.fiber_radius_um = kRedFiberRadiusUm;
+  o.packing = kRedPacking;
+  o.plies = 1;
+  o.twist_per_mm = kRedTwistPerMm;
+  return o;
+}
+
+WeaveOptions overlay(WeaveOptions base, const WeaveOptions& g) {
+  auto take = [](auto& dst, const auto& src) {
+    if (src) dst = src;
+  };
+  if (g.pattern) base.wif.reset();
+  if (g.wif) base.pattern.reset();
+  if (g.fibers_per_yarn) base.packing.reset();
+  if (g.packing) base.fibers_per_yarn.reset();
+  if (g.twist_per_mm) base.twist_angle_deg.reset();
+  if (g.twist_angle_deg) base.twist_per_mm.reset();
+  take(base.pattern, g.pattern), take(base.wif, g.wif), take(base.detail, g.detail);
+  take(base.repeats_x, g.repeats_x), take(base.repeats_z, g.repeats_z);
+  take(base.warp_spacing_mm, g.warp_spacing_mm), take(base.weft_spacing_mm, g.weft_spacing_mm);
+  take(base.warp_width_mm, g.warp_width_mm), take(base.weft_width_mm, g.weft_width_mm);
+  take(base.warp_thickness_mm, g.warp_thickness_mm);
+  take(base.weft_thickness_mm, g.weft_thickness_mm);
+  take(base.warp_crimp_share, g.warp_crimp_share);
+  take(base.segments_per_crossing, g.segments_per_crossing), take(base.sides, g.sides);
+  take(base.fiber_radius_um, g.fiber_radius_um), take(base.fibers_per_yarn, g.fibers_per_yarn);
+  take(base.packing, g.packing), take(base.plies, g.plies);
+  take(base.twist_per_mm, g.twist_per_mm), take(base.twist_angle_deg, g.twist_angle_deg);
+  take(base.ply_twist_per_mm, g.ply_twist_per_mm);
+  return base;
+}
+
+WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& base_dir) {
+  WeaveOptions o;
+  const double big = 1e300;
+  if (r.has("description")) r.string("description");
+  if (r.has("pattern")) o.pattern = r.string("pattern");
+  if (r.has("wif")) {
+    const std::filesystem::path p = r.string("wif");
+    o.wif = (p.is_absolute() ? p : base_dir / p).string();
+    r.reject_unused("pattern", "a WIF draft gives the pattern");
+  }
+  if (r.has("detail")) o.detail = r.choice("detail", "yarn", {"yarn", "fiber"});
+  if (r.has("repeats")) {
+    const auto& a = r.at("repeats");
+    if (!a.is_array() || a.size() != 2)
+      throw Error(r.file(), r.field("repeats"), "must be [nx, nz]");
+    o.repeats_x = static_cast<int>(r.check_number(a[0], r.field("repeats") + "[0]", 1, 1000));
+    o.repeats_z = static_cast<int>(r.check_number(a[1], r.field("repeats") + "[1]", 1, 1000));
+  }
+  auto num = [&](const char* key, std::optional<double>& v) {
+    if (r.has(key)) v = r.number(key, -big, big);
+  };
+  auto integer = [&](const char* key, std::optional<int>& v, int lo, int hi) {
+    if (r.has(key)) v = static_cast<int>(r.integer(key, lo, hi));
+  };
+  num("warp-spacing-mm", o.warp_spacing_mm);
+  num("weft-spacing-mm", o.weft_spacing_mm);
+  num("warp-width-mm", o.warp_width_mm);
+  num("weft-width-mm", o.weft_width_mm);
+  num("warp-thickness-mm", o.warp_thickness_mm);
+  num("weft-thickness-mm", o.weft_thickness_mm);
+  num("warp-crimp-share", o.warp_crimp_share);
+  integer("segments-per-crossing", o.segments_per_crossing, 2, 1024);
+  integer("sides", o.sides, 4, 1024);
+  num("fiber-radius-um", o.fiber_radius_um);
+  integer("fibers-per-yarn", o.fibers_per_yarn, 1, 100000);
+  num("packing", o.packing);
+  integer("plies", o.plies, 1, 16);
+  num("twist-per-mm", o.twist_per_mm);
+  num("twist-angle-deg", o.twist_angle_deg);
+  num("ply-twist-per-mm", o.ply_twist_per_mm);
+  r.finish();
+  return o;
+}
+
+WeaveOptions read_weave_options(const std::filesystem::path& json_file) {
+  std::ifstream in(json_file);
+  if (!in) throw Error(json_file.string(), "", "cannot open");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(json_file.string(), "", std::string("invalid JSON: ") + e.what());
+  }
+  ParamReader r(j, json_file.string(), "");  // keeps a reference to j
+  return read_weave_options(r, json_file.parent_path());
+}
+
+WovenSample make_woven_sample(const WeaveOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  Resolved r = resolve(options);
+  const Layout& L = r.layout;
+  check_crossings(L, r.repeat.warps, r.repeat.wefts);
+
+  WovenSample out;
+  WeaveSummary& s = out.summary;
+  s.source = r.source;
+  s.detail = r.detail;
+  s.warps = r.repeat.warps;
+  s.wefts = r.repeat.wefts;
+  s.repeats_x = r.repeats_x;
+  s.repeats_z = r.repeats_z;
+  s.period_x_mm = L.period_x;
+  s.period_z_mm = L.period_z;
+  s.repeat_x_mm = L.period_x / r.repeats_x;
+  s.repeat_z_mm = L.period_z / r.repeats_z;
+  s.warp_crimp_share = L.warp_crimp_share;
+  s.floating_warps = r.repeat.floating_warps();
+  s.floating_wefts = r.repeat.floating_wefts();
+  if (!r.warp_rgb.empty()) {
+    for (int i = 0; i < L.tile.warps; ++i) out.yarn_rgb.push_back(r.warp_rgb[i % s.warps]);
+    for (int j = 0; j < L.tile.wefts; ++j) out.yarn_rgb.push_back(r.weft_rgb[j % s.wefts]);
+  }
+  double ylo = 1e300, yhi = -1e300;
+  if (!r.fiber_detail) {
+    TriangleMesh warp, weft;
+    warp.material = "warp";
+    warp.names = {"warp", "patch"};
+    weft.material = "weft";
+    weft.names = {"weft", "patch"};
+    for (const YarnPath& y : L.yarns)
+      append_yarn_tube(y.warp ? warp : weft, y, L.segments_per_crossing, L.sides);
+    for (const TriangleMesh* m : {&warp, &weft}) {
+      s.triangles += m->triangle_count();
+      s.vertices += m->vertex_count();
+      const Bounds3 b = m->bounds();
+      ylo = std::min(ylo, b.lo.y);
+      yhi = std::max(yhi, b.hi.y);
+    }
+    out.meshes.push_back(std::move(warp));
+    out.meshes.push_back(std::move(weft));
+  } else {
+    detail::build_fibers(L, r.fibers, out.fibers, s.warp_fibers, s.weft_fibers);
+    out.fibers.names = {"patch"};
+    const FiberCurves& f = out.fibers;
+    s.curves = f.curve_count();
+    s.curve_points = f.point_count();
+    s.curve_segments = f.segment_count();
+    for (size_t i = 0; i < f.point_count(); ++i) {
+      ylo = std::min(ylo, f.point(i).y - f.radius(i));
+      yhi = std::max(yhi, f.point(i).y + f.radius(i));
+    }
+    const double r_m = r.fibers.radius_mm * kMetresPerMm;
+    const double d =
+        min_fiber_distance(f, L.period_x * kMetresPerMm, L.period_z * kMetresPerMm, 4 * r_m);
+    s.min_fiber_distance_um = d * 1e6;
+    // The layout keeps 2r plus a margin; refuse anything that still comes closer.
+    if (d < 2 * r_m * (1 - 1e-2))
+      bad(options.fibers_per_yarn ? "fibers-per-yarn" : "packing",
+          "fibers would interpenetrate: closest centre lines " + ParamReader::fmt(d * 1e6) +
+              " um apart, less than twice the fiber radius; use fewer fibers, less twist or "
+              "more segments per crossing");
+  }
+  s.y_min_mm = ylo / kMetresPerMm;
+  s.y_max_mm = yhi / kMetresPerMm;
+  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return out;
+}
+
+std::string weave_summary_json(const WeaveSummary& summary, const std::string& output) {
+  nlohmann::json j = summary_object(summary);
+  j["output"] = output;
+  j["seconds"] = summary.seconds;
+  return j.dump(2) + "\n";
+}
+
+namespace {
+detail::GltfDocument woven_document(const WovenSample& sample) {
+  nlohmann::json extras = summary_object(sample.summary);
+  if (sample.summary.detail == "fiber")
+    extras["fiber_encoding"] =
+        "one LINE_STRIP primitive per fiber: POSITION (metres) and _RADIUS (SCALAR float, "
+        "metres, per point); one node and mesh per yarn";
+  extras["frame"] =
+      "y up (face side), warp along x, weft along z; periodic in x and z with period_mm";
+  return detail::build_gltf(sample.meshes.empty() ? nullptr : &sample.meshes,
+                            sample.meshes.empty() ? &sample.fibers : nullptr, extras,
+                            sample.yarn_rgb);
+}
+}  // namespace
+
+std::string woven_to_gltf(const WovenSample& sample) {
+  return detail::gltf_text(woven_document(sample));
+}
+std::vector<uint8_t> woven_to_glb(const WovenSample& sample) {
+  return detail::glb_bytes(woven_document(sample));
+}
+void write_woven(const std::filesystem::path& path, const WovenSample& sample) {
+  detail::write_gltf(path, woven_document(sample));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Legacy open-mesh patch.
+
 std::vector<TriangleMesh> make_weave(const WeaveParams& p) {
-  check(p);
+  check_legacy(p);
   const double S = p.spacing_mm * kMetresPerMm;
   const double first = -0.5 * (p.yarns - 1) * S;
   TriangleMesh warp, weft;
@@ -192,54 +708,39 @@ std::vector<TriangleMesh> make_weave(const WeaveParams& p) {
   // Warp j runs along x at z_j; weft i along z at x_i. At crossing (i, j) the warp centre is at
   // +A (-1)^(i+j) and the weft centre at -A (-1)^(i+j): they alternate over and under.
   for (int j = 0; j < p.yarns; ++j)
-    append_yarn(warp, p, {1, 0, 0}, {0, 0, 1}, first + j * S, (j % 2) ? -1.0 : 1.0);
+    append_legacy_yarn(warp, p, {1, 0, 0}, {0, 0, 1}, first + j * S, (j % 2) ? -1.0 : 1.0);
   for (int i = 0; i < p.yarns; ++i)
-    append_yarn(weft, p, {0, 0, 1}, {1, 0, 0}, first + i * S, (i % 2) ? 1.0 : -1.0);
+    append_legacy_yarn(weft, p, {0, 0, 1}, {1, 0, 0}, first + i * S, (i % 2) ? 1.0 : -1.0);
   return {std::move(warp), std::move(weft)};
 }
 
+namespace {
+detail::GltfDocument legacy_document(const WeaveParams& p) {
+  const auto meshes = make_weave(p);
+  const nlohmann::json extras = {
+      {"pattern", p.pattern},
+      {"yarns", p.yarns},
+      {"yarn_radius_mm", p.yarn_radius_mm},
+      {"spacing_mm", p.spacing_mm},
+      {"segments", p.segments},
+      {"sides", p.sides},
+      {"amplitude_mm", p.amplitude_mm < 0 ? p.yarn_radius_mm : p.amplitude_mm},
+      {"units", "metres"}};
+  return detail::build_gltf(&meshes, nullptr, extras, {});
+}
+}  // namespace
+
 std::string weave_to_gltf(const WeaveParams& p) {
-  auto [doc, bin] = build_document(p);
-  doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
-  return doc.dump(1) + "\n";
+  return detail::gltf_text(legacy_document(p));
 }
-
 std::vector<uint8_t> weave_to_glb(const WeaveParams& p) {
-  const auto [doc, bin] = build_document(p);
-  std::string json = doc.dump();
-  while (json.size() % 4) json += ' ';
-  std::vector<uint8_t> out;
-  auto u32 = [&](uint32_t v) {
-    for (int k = 0; k < 4; ++k) out.push_back(static_cast<uint8_t>(v >> (8 * k)));
-  };
-  u32(0x46546C67);  // "glTF"
-  u32(2);
-  u32(static_cast<uint32_t>(12 + 8 + json.size() + 8 + bin.size()));
-  u32(static_cast<uint32_t>(json.size()));
-  u32(0x4E4F534A);  // "JSON"
-  out.insert(out.end(), json.begin(), json.end());
-  u32(static_cast<uint32_t>(bin.size()));
-  u32(0x004E4942);  // "BIN\0"
-  out.insert(out.end(), bin.begin(), bin.end());
-  return out;
+  return detail::glb_bytes(legacy_document(p));
 }
-
 void write_weave(const std::filesystem::path& path, const WeaveParams& params) {
   const auto ext = path.extension().string();
   if (ext != ".gltf" && ext != ".glb")
     throw Error(path.string(), "", "output must end in .gltf or .glb");
-  if (ext == ".gltf") {
-    write_text_atomically(path, weave_to_gltf(params));
-    return;
-  }
-  const auto bytes = weave_to_glb(params);
-  write_atomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw Error(path.string(), "", "write failed");
-  });
+  detail::write_gltf(path, legacy_document(params));
 }
 
 }  // namespace weft

@@ -225,3 +225,47 @@ TEST(Cli, MieRangeErrorsNameTheField) {
     EXPECT_TRUE(r.out.empty()) << c.args;
   }
 }
+
+TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
+  const fs::path dir = temp_dir();
+  // Defaults (the bundled red-cotton poplin), fiber detail, JSON summary.
+  const CliRun fib =
+      run("weave --detail fiber --repeats 2x1 --json -o '" + (dir / "f.glb").string() + "'", dir);
+  ASSERT_EQ(fib.exit_code, 0) << fib.err;
+  const auto j = nlohmann::json::parse(fib.out);
+  EXPECT_EQ(j["detail"], "fiber");
+  EXPECT_GT(j["curves"].get<int>(), 0);
+  EXPECT_NEAR(j["period_mm"]["x"].get<double>(), 2 * 2 * 0.4233, 1e-9);  // 2 picks x 2 repeats
+  EXPECT_GE(j["min_fiber_distance_um"].get<double>(), 16 * 0.99);
+  EXPECT_TRUE(fs::exists(dir / "f.glb"));
+  // The legacy options still make the open patch.
+  const CliRun legacy =
+      run("weave --yarns 2 --segments 8 --sides 4 -o '" + (dir / "l.gltf").string() + "'", dir);
+  EXPECT_EQ(legacy.exit_code, 0) << legacy.err;
+  const CliRun mixed =
+      run("weave --yarns 2 --detail fiber -o '" + (dir / "m.gltf").string() + "'", dir);
+  EXPECT_EQ(mixed.exit_code, 2);
+  EXPECT_NE(mixed.err.find("detail"), std::string::npos) << mixed.err;
+  // A malformed draft: error naming file, section and key; non-zero exit; nothing written.
+  write(dir / "bad.wif",
+        "[WEAVING]\nShafts=2\nTreadles=2\n[WARP]\nThreads=2\n[WEFT]\nThreads=2\n"
+        "[THREADING]\n1=1\n2=3\n[TIEUP]\n1=1\n2=2\n[TREADLING]\n1=1\n2=2\n");
+  const CliRun bad =
+      run("weave --wif '" + (dir / "bad.wif").string() + "' -o '" + (dir / "b.glb").string() + "'",
+          dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_NE(bad.err.find("bad.wif"), std::string::npos) << bad.err;
+  EXPECT_NE(bad.err.find("[THREADING] 2"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "b.glb"));
+  // Sizes: a yarn wider than its spacing, absurd repeats.
+  const CliRun wide = run("weave --yarn-width-mm 0.5 -o '" + (dir / "w.glb").string() + "'", dir);
+  EXPECT_EQ(wide.exit_code, 2);
+  EXPECT_NE(wide.err.find("warp-width-mm"), std::string::npos) << wide.err;
+  const CliRun huge = run("weave --repeats 1000x1000 -o '" + (dir / "h.glb").string() + "'", dir);
+  EXPECT_EQ(huge.exit_code, 2);
+  EXPECT_NE(huge.err.find("repeats"), std::string::npos) << huge.err;
+  EXPECT_FALSE(fs::exists(dir / "w.glb"));
+  EXPECT_FALSE(fs::exists(dir / "h.glb"));
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+}

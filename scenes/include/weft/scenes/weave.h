@@ -1,17 +1,157 @@
 #pragma once
-// Plain-weave patch generator: warp yarns along x, weft yarns along z, the patch in the xz plane
-// with y up (glTF's convention). Each yarn is a tube of circular cross-section around a
-// sinusoidal over/under centre line; crossing yarns touch. Written as glTF with positions,
-// normals, TANGENTS along the yarn, UVs (u along the yarn, v around it) and two materials, "warp"
-// and "weft". Lengths in the parameters are millimetres; the glTF is in metres. Deterministic.
+// Woven samples: one repeat of a weave pattern (plain, twill, satin or a WIF draft) that tiles the
+// plane, at yarn detail (closed tubes, triangles) or fiber detail (round curves), written as glTF.
+//
+// Frame (glTF's, metres): the cloth lies in the xz plane with its face side towards +y. Warp
+// yarns run along x and sit side by side along z (warp i of the repeat at increasing z); weft
+// yarns (picks) run along z and sit side by side along x (pick j at increasing x). The sample
+// covers x in [-Px/2, Px/2] and z in [-Pz/2, Pz/2], Px = sum of the weft spacings times the
+// repeats along x, Pz = sum of the warp spacings times the repeats along z, centred on y = 0.
+// Everything is periodic with (Px, Pz): centre lines, cross-sections and fiber positions at x and
+// x + Px coincide (fibers as a set: a fiber that leaves through x = +Px/2 continues as the fiber
+// that enters at -Px/2 at the same point), so a renderer can wrap rays across the sides.
+//
+// Yarn model (all lengths in the vertical plane across the yarn, as in a micrograph of a cut):
+// - Cross-section: a lens of width w and thickness t, half-thickness (t/2) cos(pi l / w) at
+//   lateral offset l in [-w/2, w/2]: flattened, with pointed edges.
+// - Centre line: height +-a at each crossing (+ where the yarn is over), joined by half cosines
+//   (flat along floats): smooth, C1. With a_warp + a_weft = (t_warp + t_weft) / 2 crossing yarns
+//   touch at the crossing's centre; lens sections and cosine transitions keep them apart
+//   everywhere else when a_warp <= (t_weft / 2) R and a_weft <= (t_warp / 2) R, where R >= 1
+//   depends on how much narrower the crossing yarn is than its spacing (R = 1 when w = spacing,
+//   then the two yarns meet along their whole crossing: flattened against each other). The
+//   share of the crimp the warp takes is a parameter; the generator checks every crossing.
+// - Parallel neighbours never overlap: each yarn stays within its own spacing (w <= spacing).
+// - Each yarn is one tube closed around its section; it ends at the sample's sides, where its
+//   end ring is exactly the start ring of its periodic copy (so the tiled cloth is watertight;
+//   no end caps, which would be faces inside the cloth).
+// Fiber model: each yarn (or ply) is a bundle of round fibers on nested rings inside its section
+// (rings are the section eroded step by step, corners rounded), fibers evenly spaced along each
+// ring and carried around it by the twist (the idealised helical yarn, flattened); plies are
+// discs carried around the yarn by the ply twist, their fibers on circles turning with the
+// fiber twist. Ring and fiber spacings include the tilt of the fibers (crimp slope and twist) so
+// that fibers keep 2 x radius apart; the generator measures the minimum distance between fiber
+// segments of the whole sample, periodic copies included, and refuses a sample below it.
+#include <array>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "weft/scenes/curves.h"
 #include "weft/scenes/mesh.h"
+#include "weft/scenes/weave_pattern.h"
 
 namespace weft {
+
+class ParamReader;
+
+// ---------------------------------------------------------------------------------------------
+// Woven samples.
+
+// What the user chooses (CLI options, a sample description JSON): every field optional. Unset
+// fields take the bundled red-cotton sample's values (red_cotton_weave_options()), except the
+// thread sizes and crimp share of a WIF draft, which come from the draft (crimp: balanced).
+struct WeaveOptions {
+  std::optional<std::string> pattern;  // plain | twill:N/M | satin:N[/MOVE]; not with a WIF
+  std::optional<std::string> wif;      // path of a WIF draft (its threads replace the pattern)
+  std::optional<std::string> detail;   // yarn | fiber
+  std::optional<int> repeats_x, repeats_z;
+  std::optional<double> warp_spacing_mm, weft_spacing_mm;  // centre to centre
+  std::optional<double> warp_width_mm, weft_width_mm;
+  std::optional<double> warp_thickness_mm, weft_thickness_mm;
+  // Fraction of each crossing's total crimp height (t_warp + t_weft) / 2 that the warp carries;
+  // negative: balanced (each yarn wraps half the other's thickness).
+  std::optional<double> warp_crimp_share;
+  std::optional<int> segments_per_crossing;  // along a yarn, per crossing (tubes, polylines)
+  std::optional<int> sides;                  // around a yarn tube
+  // Fiber detail.
+  std::optional<double> fiber_radius_um;
+  std::optional<int> fibers_per_yarn;  // per yarn section; unset: from the packing fraction
+  std::optional<double> packing;       // fiber area / yarn section area
+  std::optional<int> plies;
+  std::optional<double> twist_per_mm;      // fibers about their ply (or yarn) axis, Z > 0
+  std::optional<double> twist_angle_deg;   // alternative: surface helix angle of the fibers
+  std::optional<double> ply_twist_per_mm;  // plies about the yarn axis (plies > 1), S < 0
+};
+
+// Reads a sample description (a JSON object whose keys are the `weft weave` option names without
+// the leading dashes, see scenes/examples/red-cotton-weave.json); unknown keys are errors.
+// Relative "wif" paths resolve against 'base_dir'. Only the keys present are set.
+WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& base_dir);
+WeaveOptions read_weave_options(const std::filesystem::path& json_file);
+// The bundled red-cotton sample's options, every value set (the defaults of `weft weave`).
+WeaveOptions red_cotton_weave_options();
+// 'base' with every field that 'given' sets replaced; setting one of a pair of alternatives
+// (pattern / wif, fibers-per-yarn / packing, twist-per-mm / twist-angle-deg) clears the other.
+WeaveOptions overlay(WeaveOptions base, const WeaveOptions& given);
+
+// Sizes of one thread, millimetres.
+struct ThreadSize {
+  double spacing_mm = 0, width_mm = 0, thickness_mm = 0;
+};
+
+struct FiberLayoutInfo {
+  int fibers = 0;              // per yarn section
+  double packing = 0;          // fiber area / section area
+  double twist_per_mm = 0;     // effective (rounded so the sample stays periodic), outer ring
+  double twist_angle_deg = 0;  // surface helix angle relative to the yarn axis
+};
+
+struct WeaveSummary {
+  std::string source;  // pattern or WIF file
+  std::string detail;
+  int warps = 0, wefts = 0;  // threads in one repeat
+  int repeats_x = 1, repeats_z = 1;
+  double repeat_x_mm = 0, repeat_z_mm = 0;  // one repeat
+  double period_x_mm = 0, period_z_mm = 0;  // the sample (repeats included): wrap here
+  double y_min_mm = 0, y_max_mm = 0;        // thickness range (surfaces, fibers with radius)
+  double warp_crimp_share = 0;
+  std::vector<int> floating_warps, floating_wefts;  // in the repeat, 0-based
+  size_t triangles = 0, vertices = 0;
+  size_t curves = 0, curve_segments = 0, curve_points = 0;
+  std::vector<FiberLayoutInfo> warp_fibers, weft_fibers;  // per distinct thread size
+  double min_fiber_distance_um = 0;                       // measured (fiber detail), centre lines
+  double seconds = 0;                                     // generation time
+};
+
+struct WovenSample {
+  std::vector<TriangleMesh> meshes;  // yarn detail: "warp" and "weft" (all yarns of each)
+  FiberCurves fibers;                // fiber detail
+  WeaveSummary summary;
+  // Per yarn of the sample (warps first, then wefts): its colour from a WIF draft, for extras.
+  std::vector<std::array<double, 3>> yarn_rgb;
+};
+
+// Checks everything (Error naming the field, before anything large is allocated) and builds the
+// sample. Deterministic: equal options give equal samples.
+WovenSample make_woven_sample(const WeaveOptions& options);
+
+// Minimum distance between centre-line segments of distinct fibers, periodic copies in x and z
+// included, looked for within 'cutoff_m' with a uniform grid (not all pairs). Returns cutoff_m
+// when no two segments come closer.
+double min_fiber_distance(const FiberCurves& fibers, double period_x_m, double period_z_m,
+                          double cutoff_m);
+
+// glTF 2.0 of the sample (metres). Yarn detail: meshes "warp_yarns"/"weft_yarns" (triangles with
+// POSITION, NORMAL, TANGENT along the yarn, TEXCOORD_0 with u along the yarn) under node "patch".
+// Fiber detail: one node and mesh per yarn ("warp_3", "weft_0", ...) under node "patch"; every
+// fiber is one primitive of mode LINE_STRIP (3) with POSITION (VEC3 float, metres) and the custom
+// attribute _RADIUS (SCALAR float, metres, one per point), material "warp" or "weft". A line
+// strip cannot hold several fibers without joining them, hence one primitive per fiber. The
+// document's extras.weft_weave holds the summary (periods, counts, parameters).
+std::string woven_to_gltf(const WovenSample& sample);
+std::vector<uint8_t> woven_to_glb(const WovenSample& sample);
+// .gltf (buffer embedded as base64) or .glb by extension, atomically.
+void write_woven(const std::filesystem::path& path, const WovenSample& sample);
+// The summary as JSON (what `weft weave --json` prints).
+std::string weave_summary_json(const WeaveSummary& summary, const std::string& output);
+
+// ---------------------------------------------------------------------------------------------
+// The open-mesh plain-weave patch of earlier versions (circular tubes around sinusoidal centre
+// lines, 'yarns' per direction, centred, not periodic): kept for the benchmarks and tests that
+// use it. Same frame and glTF layout as yarn detail above.
 
 struct WeaveParams {
   std::string pattern = "plain";

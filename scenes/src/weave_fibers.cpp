@@ -1,0 +1,557 @@
+// Fiber detail of the weave generator: fibers on nested rings inside each yarn's lens section
+// (or inside ply discs carried around the yarn), carried around the rings by the twist; and the
+// measurement of the closest approach of distinct fibers on a uniform grid.
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <optional>
+#include <tuple>
+
+#include "weave_internal.h"
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/params.h"
+
+namespace weft::detail {
+namespace {
+
+// Spacing margin over 2 x radius: covers the polyline's chords and second-order effects of the
+// tilt that the first-order spacing below leaves out; the final measurement checks the result.
+constexpr double kMargin = 0.05;
+constexpr int kLensVertices = 128;
+
+struct V2 {
+  double x = 0, y = 0;  // x: lateral offset l, y: height offset (mm), in the yarn's section
+};
+V2 operator+(V2 a, V2 b) {
+  return {a.x + b.x, a.y + b.y};
+}
+V2 operator-(V2 a, V2 b) {
+  return {a.x - b.x, a.y - b.y};
+}
+V2 operator*(V2 a, double s) {
+  return {a.x * s, a.y * s};
+}
+double dot2(V2 a, V2 b) {
+  return a.x * b.x + a.y * b.y;
+}
+double len2(V2 a) {
+  return std::sqrt(dot2(a, a));
+}
+using Poly = std::vector<V2>;  // convex, counter-clockwise
+
+double area(const Poly& p) {
+  double a = 0;
+  for (size_t i = 0; i < p.size(); ++i) {
+    const V2 &u = p[i], &v = p[(i + 1) % p.size()];
+    a += u.x * v.y - v.x * u.y;
+  }
+  return 0.5 * a;
+}
+
+// The lens polygon: vertices on the lens boundary (so inside the convex lens), tips included.
+Poly lens_polygon(double w, double t) {
+  Poly p;
+  for (int k = 0; k < kLensVertices; ++k) {
+    const double phi = 2 * kPi * k / kLensVertices;
+    const double c = std::cos(phi), s = std::sin(phi);
+    const double sg = s > 1e-12 ? 1 : (s < -1e-12 ? -1 : 0);
+    p.push_back({0.5 * w * c, 0.5 * t * sg * std::cos(0.5 * kPi * c)});
+  }
+  return p;
+}
+
+// Keeps the part of 'poly' where dot(n, p) >= c (Sutherland-Hodgman for one half-plane).
+Poly clip(const Poly& poly, V2 n, double c) {
+  Poly out;
+  for (size_t i = 0; i < poly.size(); ++i) {
+    const V2 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+    const double da = dot2(n, a) - c, db = dot2(n, b) - c;
+    if (da >= 0) out.push_back(a);
+    if ((da >= 0) != (db >= 0)) out.push_back(a + (b - a) * (da / (da - db)));
+  }
+  return out;
+}
+
+// The base polygon eroded by delta: the intersection of its edges' half-planes moved inwards.
+Poly erode(const Poly& base, double delta) {
+  Poly out = base;
+  for (size_t i = 0; i < base.size() && !out.empty(); ++i) {
+    const V2 e = base[(i + 1) % base.size()] - base[i];
+    const double l = len2(e);
+    if (l <= 0) continue;
+    const V2 n{-e.y / l, e.x / l};  // inward (left) normal of a counter-clockwise polygon
+    out = clip(out, n, dot2(n, base[i]) + delta);
+  }
+  return out;
+}
+
+// A closed curve parametrised by arc length.
+struct Ring {
+  std::vector<V2> pts;
+  std::vector<double> cum;  // arc length at each point; cum.back() = perimeter (closing edge)
+  double per = 0;
+  V2 at(double sigma) const {
+    if (pts.size() == 1 || per <= 0) return pts[0];
+    double r = sigma - per * std::floor(sigma / per);
+    const size_t i = std::min<size_t>(
+        pts.size() - 1,
+        static_cast<size_t>(std::upper_bound(cum.begin(), cum.end(), r) - cum.begin()) - 1);
+    const V2 a = pts[i], b = pts[(i + 1) % pts.size()];
+    const double seg = cum[i + 1] - cum[i];
+    return seg > 0 ? a + (b - a) * ((r - cum[i]) / seg) : a;
+  }
+};
+
+Ring make_ring(std::vector<V2> pts) {
+  Ring r;
+  // Drop repeated points.
+  for (const V2& p : pts)
+    if (r.pts.empty() || len2(p - r.pts.back()) > 1e-12) r.pts.push_back(p);
+  while (r.pts.size() > 1 && len2(r.pts.front() - r.pts.back()) <= 1e-12) r.pts.pop_back();
+  r.cum.push_back(0);
+  for (size_t i = 0; i < r.pts.size(); ++i)
+    r.cum.push_back(r.cum.back() +
+                    (r.pts.size() > 1 ? len2(r.pts[(i + 1) % r.pts.size()] - r.pts[i]) : 0));
+  r.per = r.cum.back();
+  return r;
+}
+
+// Boundary of (E dilated by rho): E's edges moved out by rho, joined by arcs at its vertices.
+Ring rounded(const Poly& e, double rho) {
+  if (rho <= 0) return make_ring(e);
+  std::vector<V2> pts;
+  const size_t n = e.size();
+  for (size_t i = 0; i < n; ++i) {
+    const V2 prev = e[i] - e[(i + n - 1) % n], next = e[(i + 1) % n] - e[i];
+    const double a0 = std::atan2(-prev.x, prev.y);  // outward normal of the incoming edge
+    double a1 = std::atan2(-next.x, next.y);
+    while (a1 < a0) a1 += 2 * kPi;
+    const int steps = std::max(1, static_cast<int>(std::ceil((a1 - a0) / (kPi / 18))));
+    for (int k = 0; k <= steps; ++k) {
+      const double a = a0 + (a1 - a0) * k / steps;
+      pts.push_back({e[i].x + rho * std::cos(a), e[i].y + rho * std::sin(a)});
+    }
+  }
+  return make_ring(pts);
+}
+
+// The ring at inset 'delta' of the section 'base' (boundary of the erosion by delta + rho dilated
+// by rho, rho as large as allowed up to rho_max), or a single point when only a sliver is left,
+// or nothing. Successive insets 'd' apart give rings at least d apart as long as rho <= d.
+std::optional<Ring> inset_ring(const Poly& base, double delta, double rho_max, double min_area) {
+  for (double rho : {rho_max, 0.5 * rho_max, 0.25 * rho_max, 0.0}) {
+    const Poly e = erode(base, delta + rho);
+    if (e.size() >= 3 && area(e) > min_area) return rounded(e, rho);
+  }
+  const Poly e = erode(base, delta);
+  if (e.empty()) return std::nullopt;
+  V2 c;
+  for (const V2& p : e) c = c + p;
+  return make_ring({c * (1.0 / e.size())});
+}
+
+// Smallest distance between any two of n points evenly spaced on the ring, over phases.
+double min_pair_distance(const Ring& r, int n) {
+  if (n < 2) return 1e300;
+  double best = 1e300;
+  std::vector<V2> p(n);
+  constexpr int kPhases = 16;
+  for (int ph = 0; ph < kPhases; ++ph) {
+    for (int i = 0; i < n; ++i) p[i] = r.at(r.per * (i + double(ph) / kPhases) / n);
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j) best = std::min(best, len2(p[i] - p[j]));
+  }
+  return best;
+}
+
+// Twist rounded so that the n fibers of a ring map onto each other after one period.
+double periodic_rate(double rate, double period, int n) {
+  return std::round(rate * period * n) / (period * n);
+}
+
+struct FiberRing {
+  Ring ring;
+  int n = 0;
+  double rate = 0;   // turns per mm (signed: > 0 is Z twist)
+  double phase = 0;  // fraction of the fiber spacing
+};
+
+// Rings of fibers in a convex section: nested insets 'ring_gap' apart starting at 'inset', each
+// with as many fibers as keep 'chord(u)' apart where u is the fibers' in-section speed.
+struct RingPlan {
+  std::vector<FiberRing> rings;
+  std::vector<int> capacity;
+  int total = 0;
+};
+
+struct Requirements {
+  double two_r = 0;   // 2 x radius x (1 + margin)
+  double slope = 0;   // largest crimp slope of the yarn
+  double rate = 0;    // fiber turns per mm about the section's own axis
+  double carry = 0;   // in-section speed added by a carrying motion (ply twist), mm per mm
+  double period = 0;  // along the yarn
+};
+
+RingPlan plan_rings(const Poly& section, double inset, const Requirements& q, double lambda,
+                    double min_area) {
+  RingPlan plan;
+  const double gap = lambda * q.two_r * std::sqrt(1 + q.slope * q.slope);
+  for (int k = 0; k < 64; ++k) {
+    const auto ring = inset_ring(section, inset + k * gap, gap, min_area);
+    if (!ring) break;
+    FiberRing fr;
+    fr.ring = *ring;
+    int best = 1;
+    if (fr.ring.per > 0) {
+      const int guess = static_cast<int>(fr.ring.per / (lambda * q.two_r)) + 1;
+      for (int n = guess; n >= 2; --n) {
+        const double rate = periodic_rate(q.rate, q.period, n);
+        const double u = std::abs(rate) * fr.ring.per + q.carry + q.slope;
+        if (min_pair_distance(fr.ring, n) >= lambda * q.two_r * std::sqrt(1 + u * u)) {
+          best = n;
+          break;
+        }
+      }
+    }
+    plan.capacity.push_back(best);
+    plan.total += best;
+    plan.rings.push_back(std::move(fr));
+  }
+  return plan;
+}
+
+bool ring_ok(const FiberRing& fr, int n, const Requirements& q, double lambda) {
+  if (n <= 1) return true;
+  const double rate = periodic_rate(q.rate, q.period, n);
+  const double u = std::abs(rate) * fr.ring.per + q.carry + q.slope;
+  return min_pair_distance(fr.ring, n) >= lambda * q.two_r * std::sqrt(1 + u * u);
+}
+
+// The spacing factor lambda >= 1 is raised as far as 'count' fibers still fit, so that fewer
+// fibers spread over the section instead of crowding its rim; then rings give up fibers until
+// exactly 'count' remain.
+std::vector<FiberRing> fit_rings(const Poly& section, double inset, const Requirements& q,
+                                 int count, double min_area, int* capacity_at_1) {
+  RingPlan best = plan_rings(section, inset, q, 1.0, min_area);
+  *capacity_at_1 = best.total;
+
+  if (best.total < count) return {};
+  double lo = 1, hi = 4;
+  for (int it = 0; it < 20; ++it) {
+    const double mid = 0.5 * (lo + hi);
+    RingPlan p = plan_rings(section, inset, q, mid, min_area);
+    if (p.total >= count) {
+      lo = mid;
+      best = std::move(p);
+    } else {
+      hi = mid;
+    }
+  }
+  std::vector<int> n = best.capacity;
+  int excess = best.total - count;
+  while (excess > 0) {
+    int pick = -1;
+    double densest = -1;
+    for (size_t k = 0; k < n.size(); ++k) {
+      if (n[k] == 0 || !(n[k] == 1 || ring_ok(best.rings[k], n[k] - 1, q, lo))) continue;
+      const double d = n[k] / std::max(best.rings[k].ring.per, 1e-9);
+      if (d > densest) densest = d, pick = static_cast<int>(k);
+    }
+    if (pick < 0) break;  // cannot happen: a ring can always drop to zero
+    --n[pick];
+    --excess;
+  }
+  std::vector<FiberRing> out;
+  for (size_t k = 0; k < n.size(); ++k) {
+    if (n[k] == 0) continue;
+    FiberRing fr = best.rings[k];
+    fr.n = n[k];
+    fr.rate = periodic_rate(q.rate, q.period, fr.n);
+    fr.phase = 0.5 * (k % 2);  // alternate rings start half a spacing apart
+    out.push_back(std::move(fr));
+  }
+  return out;
+}
+
+Poly circle_polygon(double radius) {
+  Poly p;
+  for (int k = 0; k < kLensVertices; ++k) {
+    const double a = 2 * kPi * k / kLensVertices;
+    p.push_back({radius * std::cos(a), radius * std::sin(a)});
+  }
+  return p;
+}
+
+// The fibers of one yarn section: where fiber f sits in the section at along coordinate s.
+struct Bundle {
+  std::vector<FiberRing> rings;  // single ply: in the section; plies: in a ply, about its centre
+  int plies = 1;
+  Ring ply_ring;
+  double ply_rate = 0;
+  int fibers = 0;  // in the whole section
+  FiberLayoutInfo info;
+
+  V2 offset(int f, double s) const {
+    const int per_ply = fibers / plies;
+    const int ply = f / per_ply;
+    int i = f % per_ply;
+    size_t k = 0;
+    while (i >= rings[k].n) i -= rings[k++].n;
+    const FiberRing& fr = rings[k];
+    // Z twist (rate > 0) turns right-handedly about the yarn's direction: clockwise in (l, y).
+    const double sigma = fr.ring.per * ((i + fr.phase) / fr.n - fr.rate * s);
+    V2 p = fr.ring.at(sigma);
+    if (plies > 1) {
+      const double ps = ply_ring.per * (double(ply) / plies - ply_rate * s);
+      p = p + ply_ring.at(ps);
+    }
+    return p;
+  }
+};
+
+Bundle make_bundle(double w, double t, double slope, double period, const FiberSettings& fs,
+                   const std::string& dir) {
+  Bundle b;
+  b.plies = fs.plies;
+  const double r = fs.radius_mm;
+  const double section_area = 2 * w * t / kPi;
+  const int count =
+      fs.fibers_per_yarn > 0
+          ? fs.fibers_per_yarn
+          : std::max(1, static_cast<int>(std::round(fs.packing * section_area / (kPi * r * r))));
+  const std::string field = fs.fibers_per_yarn > 0 ? "fibers-per-yarn" : "packing";
+  Requirements q;
+  q.two_r = 2 * r * (1 + kMargin);
+  q.slope = slope;
+  q.period = period;
+  const double inset = r * (1 + kMargin) * std::sqrt(1 + slope * slope);
+  const Poly lens = lens_polygon(w, t);
+  const double min_area = 1e-12 * w * t;
+  auto twist_rate = [&](double outer_perimeter) {
+    if (!fs.twist_from_angle) return fs.twist_per_mm;
+    return std::tan(deg_to_rad(fs.twist_angle_deg)) / std::max(outer_perimeter, 1e-9);
+  };
+  int capacity = 0;
+  if (fs.plies == 1) {
+    const auto outer = inset_ring(lens, inset, q.two_r, min_area);
+    q.rate = twist_rate(outer ? outer->per : 0);
+    b.rings = fit_rings(lens, inset, q, count, min_area, &capacity);
+    b.fibers = count;
+  } else {
+    // Largest ply radius for which 'plies' discs on a ring inset by their radius never overlap.
+    double lo = 0, hi = 0.5 * std::min(w, t);
+    std::optional<Ring> best_ring;
+    for (int it = 0; it < 30; ++it) {
+      const double rp = 0.5 * (lo + hi);
+      const auto ring = inset_ring(lens, rp, 0.5 * rp, min_area);
+      if (ring && ring->per > 0 && min_pair_distance(*ring, fs.plies) >= 2 * rp) {
+        lo = rp;
+        best_ring = ring;
+      } else {
+        hi = rp;
+      }
+    }
+    if (!best_ring || lo < r)
+      throw Error("", "plies",
+                  std::to_string(fs.plies) + " plies do not fit in a " + ParamReader::fmt(w) +
+                      " x " + ParamReader::fmt(t) + " mm yarn section (" + dir + ")");
+    b.ply_ring = *best_ring;
+    b.ply_rate = periodic_rate(fs.ply_twist_per_mm, period, fs.plies);
+    const int per_ply = std::max(1, static_cast<int>(std::round(double(count) / fs.plies)));
+    const Poly disc = circle_polygon(lo);
+    q.carry = std::abs(b.ply_rate) * b.ply_ring.per;
+    q.rate = twist_rate(2 * kPi * std::max(lo - inset, 0.0));
+    b.rings = fit_rings(disc, inset, q, per_ply, min_area, &capacity);
+    capacity *= fs.plies;
+    b.fibers = per_ply * fs.plies;
+  }
+  if (b.rings.empty())
+    throw Error("", field,
+                "at most " + std::to_string(capacity) + " fibers of radius " +
+                    ParamReader::fmt(r * 1e3) + " um fit in a " + ParamReader::fmt(w) + " x " +
+                    ParamReader::fmt(t) + " mm " + dir + " section (" + std::to_string(fs.plies) +
+                    " ply) at this twist and crimp without touching; " + std::to_string(count) +
+                    " asked");
+  b.info.fibers = b.fibers;
+  b.info.packing = b.fibers * kPi * r * r / section_area;
+  b.info.twist_per_mm = b.rings.front().rate;
+  const double outer_circumference = b.rings.front().ring.per;
+  b.info.twist_angle_deg = rad_to_deg(std::atan(b.info.twist_per_mm * outer_circumference));
+  return b;
+}
+
+}  // namespace
+
+void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& out,
+                  std::vector<FiberLayoutInfo>& warp_info,
+                  std::vector<FiberLayoutInfo>& weft_info) {
+  std::map<std::tuple<bool, double, double, double, double>, Bundle> bundles;
+  const Vec3 up{0, 1, 0};
+  const float radius_m = static_cast<float>(fs.radius_mm * kMetresPerMm);
+  for (size_t yi = 0; yi < layout.yarns.size(); ++yi) {
+    const YarnPath& y = layout.yarns[yi];
+    const auto key =
+        std::make_tuple(y.warp, y.size.width_mm, y.size.thickness_mm, y.max_slope(), y.period);
+    auto it = bundles.find(key);
+    if (it == bundles.end()) {
+      it = bundles
+               .emplace(key, make_bundle(y.size.width_mm, y.size.thickness_mm, y.max_slope(),
+                                         y.period, fs, y.warp ? "warp" : "weft"))
+               .first;
+      (y.warp ? warp_info : weft_info).push_back(it->second.info);
+    }
+    const Bundle& b = it->second;
+    out.yarn_material.push_back(y.warp ? "warp" : "weft");
+    const int K = static_cast<int>(y.crossing.size()) * layout.segments_per_crossing;
+    for (int f = 0; f < b.fibers; ++f) {
+      out.curve_first.push_back(static_cast<uint32_t>(out.point_count()));
+      out.curve_points.push_back(static_cast<uint32_t>(K + 1));
+      out.curve_yarn.push_back(static_cast<uint32_t>(yi));
+      for (int k = 0; k <= K; ++k) {
+        const double along = y.period * k / K;              // from the sample's start
+        const double s = y.start + y.period * (k % K) / K;  // crimp: exactly periodic
+        const V2 o = b.offset(f, along);
+        const Vec3 p = (y.along() * (y.start + along) + y.across() * y.centre +
+                        up * (y.height_at(s) + o.y) + y.lateral() * o.x) *
+                       kMetresPerMm;
+        out.points.insert(out.points.end(), {static_cast<float>(p.x), static_cast<float>(p.y),
+                                             static_cast<float>(p.z), radius_m});
+      }
+    }
+  }
+}
+
+}  // namespace weft::detail
+
+namespace weft {
+namespace {
+
+// Closest points of segments p0-p1 and q0-q1 (Ericson, Real-Time Collision Detection, 5.1.9).
+double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
+  const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
+  const double a = dot(d1, d1), e = dot(d2, d2), f = dot(d2, r);
+  double s = 0, t = 0;
+  if (a <= 1e-30 && e <= 1e-30) return length(r);
+  if (a <= 1e-30) {
+    t = std::clamp(f / e, 0.0, 1.0);
+  } else {
+    const double c = dot(d1, r);
+    if (e <= 1e-30) {
+      s = std::clamp(-c / a, 0.0, 1.0);
+    } else {
+      const double b = dot(d1, d2), den = a * e - b * b;
+      s = den > 0 ? std::clamp((b * f - c * e) / den, 0.0, 1.0) : 0.0;
+      t = (b * s + f) / e;
+      if (t < 0) {
+        t = 0;
+        s = std::clamp(-c / a, 0.0, 1.0);
+      } else if (t > 1) {
+        t = 1;
+        s = std::clamp((b - c) / a, 0.0, 1.0);
+      }
+    }
+  }
+  return length((p0 + d1 * s) - (q0 + d2 * t));
+}
+
+}  // namespace
+
+double min_fiber_distance(const FiberCurves& fibers, double period_x, double period_z,
+                          double cutoff) {
+  struct Seg {
+    Vec3 a, b, lo, hi;
+    uint32_t curve;
+  };
+  std::vector<Seg> segs;
+  segs.reserve(fibers.segment_count());
+  double ylo = 1e300, yhi = -1e300;
+  for (size_t c = 0; c < fibers.curve_count(); ++c)
+    for (uint32_t k = 0; k + 1 < fibers.curve_points[c]; ++k) {
+      const Vec3 a = fibers.point(fibers.curve_first[c] + k),
+                 b = fibers.point(fibers.curve_first[c] + k + 1);
+      Seg s{a, b, {}, {}, static_cast<uint32_t>(c)};
+      for (int i = 0; i < 3; ++i) {
+        s.lo[i] = std::min(a[i], b[i]) - 0.5 * cutoff;
+        s.hi[i] = std::max(a[i], b[i]) + 0.5 * cutoff;
+      }
+      ylo = std::min(ylo, s.lo.y);
+      yhi = std::max(yhi, s.hi.y);
+      segs.push_back(s);
+    }
+  if (segs.empty()) return cutoff;
+  // Cells at least 'cutoff' wide; x and z wrap with the period.
+  auto cells_along = [&](double extent) {
+    return std::clamp(static_cast<int>(extent / cutoff), 1, 512);
+  };
+  const int nx = cells_along(period_x), nz = cells_along(period_z),
+            ny = cells_along(std::max(yhi - ylo, cutoff));
+  const double cx = period_x / nx, cz = period_z / nz, cy = std::max(yhi - ylo, cutoff) / ny;
+  auto wrap = [](long i, int n) { return static_cast<int>(((i % n) + n) % n); };
+  std::vector<std::vector<uint32_t>> cells(static_cast<size_t>(nx) * ny * nz);
+  for (uint32_t i = 0; i < segs.size(); ++i) {
+    const Seg& s = segs[i];
+    const long x0 = std::lround(std::floor((s.lo.x + 0.5 * period_x) / cx)),
+               x1 = std::lround(std::floor((s.hi.x + 0.5 * period_x) / cx));
+    const long z0 = std::lround(std::floor((s.lo.z + 0.5 * period_z) / cz)),
+               z1 = std::lround(std::floor((s.hi.z + 0.5 * period_z) / cz));
+    const long y0 = std::lround(std::floor((s.lo.y - ylo) / cy)),
+               y1 = std::lround(std::floor((s.hi.y - ylo) / cy));
+    for (long x = x0; x <= std::min(x1, x0 + nx - 1); ++x)
+      for (long z = z0; z <= std::min(z1, z0 + nz - 1); ++z)
+        for (long yy = std::max(0L, y0); yy <= std::min<long>(y1, ny - 1); ++yy)
+          cells[(static_cast<size_t>(wrap(x, nx)) * ny + yy) * nz + wrap(z, nz)].push_back(i);
+  }
+  // A fiber that leaves through a side continues as the curve that starts at the same point
+  // on the opposite side: next[c] is that curve. Segments of such a joined pair within the cutoff
+  // of the joint are neighbours along one fiber, not two fibers.
+  const double joined = 1e-9;  // float storage of points a period apart
+  std::vector<int64_t> next(fibers.curve_count(), -1);
+  double min_segment = 1e300;
+  // A fiber continues within its own yarn: compare ends and starts yarn by yarn.
+  std::map<uint32_t, std::vector<uint32_t>> by_yarn;
+  for (size_t c = 0; c < fibers.curve_count(); ++c)
+    by_yarn[fibers.curve_yarn[c]].push_back(static_cast<uint32_t>(c));
+  for (const auto& [yarn, curves] : by_yarn)
+    for (uint32_t c : curves) {
+      const Vec3 end = fibers.point(fibers.curve_first[c] + fibers.curve_points[c] - 1);
+      for (uint32_t c2 : curves) {
+        Vec3 d = fibers.point(fibers.curve_first[c2]) - end;
+        d.x -= period_x * std::round(d.x / period_x);
+        d.z -= period_z * std::round(d.z / period_z);
+        if (length(d) < joined) next[c] = c2;
+      }
+    }
+  for (const Seg& s : segs) min_segment = std::min(min_segment, length(s.b - s.a));
+  const long near = static_cast<long>(std::ceil(cutoff / std::max(min_segment, 1e-15))) + 1;
+  // Index of each segment within its curve.
+  std::vector<uint32_t> index(segs.size());
+  for (size_t i = 1; i < segs.size(); ++i)
+    index[i] = segs[i].curve == segs[i - 1].curve ? index[i - 1] + 1 : 0;
+  auto along_joint = [&](uint32_t sa, uint32_t sb) {
+    const Seg &a = segs[sa], &b = segs[sb];
+    if (next[a.curve] != b.curve) return false;
+    const long from_end = static_cast<long>(fibers.curve_points[a.curve]) - 2 - index[sa];
+    return from_end + static_cast<long>(index[sb]) < near;
+  };
+  double best = cutoff;
+  for (const auto& cell : cells)
+    for (size_t u = 0; u < cell.size(); ++u)
+      for (size_t v = u + 1; v < cell.size(); ++v) {
+        const Seg &a = segs[cell[u]], &b = segs[cell[v]];
+        if (a.curve == b.curve) continue;
+        // The periodic image of b nearest to a; boxes grown by cutoff / 2 that miss each other
+        // hold no pair within the cutoff.
+        const Vec3 ca = 0.5 * (a.a + a.b), cb = 0.5 * (b.a + b.b);
+        const Vec3 shift{period_x * std::round((ca.x - cb.x) / period_x), 0,
+                         period_z * std::round((ca.z - cb.z) / period_z)};
+        bool apart = false;
+        for (int i = 0; i < 3 && !apart; ++i)
+          apart = a.hi[i] < b.lo[i] + shift[i] || b.hi[i] + shift[i] < a.lo[i];
+        if (apart || along_joint(cell[u], cell[v]) || along_joint(cell[v], cell[u])) continue;
+        best = std::min(best, segment_distance(a.a, a.b, b.a + shift, b.b + shift));
+      }
+  return best;
+}
+
+}  // namespace weft
