@@ -4,12 +4,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <initializer_list>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
+#include "weft/core/params.h"
 
 namespace weft {
 namespace detail {
@@ -26,54 +26,21 @@ namespace {
 
 using nlohmann::json;
 
-std::string join_path(const std::string& parent, const std::string& key) {
-  return parent.empty() ? key : parent + "." + key;
-}
-
-void check_keys(const json& j, const std::string& file, const std::string& path,
-                std::initializer_list<const char*> allowed) {
-  if (!j.is_object()) throw Error(file, path.empty() ? "(root)" : path, "must be a JSON object");
-  for (const auto& [key, value] : j.items()) {
-    bool ok = false;
-    for (const char* a : allowed) ok = ok || key == a;
-    if (!ok) {
-      std::string list;
-      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      throw Error(file, join_path(path, key), "unknown key (allowed here: " + list + ")");
-    }
-  }
-}
-
-const json& require(const json& j, const std::string& file, const std::string& path,
-                    const char* key) {
-  const auto it = j.find(key);
-  if (it == j.end()) throw Error(file, join_path(path, key), "missing");
-  return *it;
-}
-
-double number(const json& j, const std::string& file, const std::string& path) {
-  if (!j.is_number()) throw Error(file, path, "must be a number");
-  const double v = j.get<double>();
-  if (!std::isfinite(v)) throw Error(file, path, "must be finite");
-  return v;
-}
-
-std::string text(const json& j, const std::string& file, const std::string& path) {
-  if (!j.is_string()) throw Error(file, path, "must be a string");
-  return j.get<std::string>();
-}
-
 std::string fmt(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
+  return ParamReader::fmt(v);
 }
 
 // A number, 33 band values, or {"points": [[nm, value], ...]} linearly interpolated.
-Spectrum spectral(const json& j, const std::string& file, const std::string& path) {
+Spectrum spectral(ParamReader& parent, const std::string& key) {
+  const json& j = parent.at(key);
+  const std::string path = parent.field(key);
+  const std::string& file = parent.file();
   Spectrum s{};
+  auto number = [&](const json& v, const std::string& at) {
+    return parent.check_number(v, at, -1e300, 1e300);
+  };
   if (j.is_number()) {
-    s.fill(number(j, file, path));
+    s.fill(number(j, path));
     return s;
   }
   if (j.is_array()) {
@@ -81,13 +48,13 @@ Spectrum spectral(const json& j, const std::string& file, const std::string& pat
       throw Error(file, path,
                   "an array must hold 33 values (390..710 nm in 10 nm steps), got " +
                       std::to_string(j.size()));
-    for (int b = 0; b < kNumBands; ++b)
-      s[b] = number(j[b], file, path + "[" + std::to_string(b) + "]");
+    for (int b = 0; b < kNumBands; ++b) s[b] = number(j[b], path + "[" + std::to_string(b) + "]");
     return s;
   }
   if (j.is_object()) {
-    check_keys(j, file, path, {"points"});
-    const json& pts = require(j, file, path, "points");
+    ParamReader obj(j, file, path);
+    const json& pts = obj.at("points");
+    obj.finish();
     const std::string pp = path + ".points";
     if (!pts.is_array() || pts.size() < 2)
       throw Error(file, pp, "must be an array of at least two [wavelength_nm, value] pairs");
@@ -96,8 +63,8 @@ Spectrum spectral(const json& j, const std::string& file, const std::string& pat
       const std::string ip = pp + "[" + std::to_string(i) + "]";
       if (!pts[i].is_array() || pts[i].size() != 2)
         throw Error(file, ip, "must be a [wavelength_nm, value] pair");
-      wl.push_back(number(pts[i][0], file, ip + "[0]"));
-      val.push_back(number(pts[i][1], file, ip + "[1]"));
+      wl.push_back(number(pts[i][0], ip + "[0]"));
+      val.push_back(number(pts[i][1], ip + "[1]"));
       if (i > 0 && !(wl[i] > wl[i - 1]))
         throw Error(file, ip, "wavelengths must increase strictly");
     }
@@ -118,40 +85,27 @@ Spectrum spectral(const json& j, const std::string& file, const std::string& pat
   throw Error(file, path, "must be a number, an array of 33 band values or {\"points\": ...}");
 }
 
-void require_range(const Spectrum& s, const std::string& file, const std::string& path, double lo,
+void require_range(const Spectrum& s, const ParamReader& p, const std::string& key, double lo,
                    bool lo_open, const char* what) {
   for (int b = 0; b < kNumBands; ++b) {
     const bool bad = lo_open ? !(s[b] > lo) : !(s[b] >= lo);
     if (bad)
-      throw Error(file, path,
+      throw Error(p.file(), p.field(key),
                   std::string(what) + " at " + fmt(band_wavelength_nm(b)) + " nm is " + fmt(s[b]));
   }
 }
 
-SizeDistribution parse_size(const json& j, const std::string& file, const std::string& path) {
-  if (!j.is_object()) throw Error(file, path, "must be a JSON object");
-  const std::string kind =
-      text(require(j, file, path, "distribution"), file, join_path(path, "distribution"));
+SizeDistribution parse_size(ParamReader p) {
+  const std::string kind = p.choice("distribution", "", {"monodisperse", "lognormal"});
   SizeDistribution d;
   if (kind == "monodisperse") {
-    check_keys(j, file, path, {"distribution", "radius_um"});
-    d = SizeDistribution::monodisperse(
-        number(require(j, file, path, "radius_um"), file, join_path(path, "radius_um")));
-    if (!(d.radius_um > 0)) throw Error(file, join_path(path, "radius_um"), "must be > 0");
-  } else if (kind == "lognormal") {
-    check_keys(j, file, path, {"distribution", "median_radius_um", "sigma"});
-    d = SizeDistribution::lognormal(
-        number(require(j, file, path, "median_radius_um"), file,
-               join_path(path, "median_radius_um")),
-        number(require(j, file, path, "sigma"), file, join_path(path, "sigma")));
-    if (!(d.radius_um > 0)) throw Error(file, join_path(path, "median_radius_um"), "must be > 0");
-    if (!(d.sigma > 0) || d.sigma > kMaxLognormalSigma)
-      throw Error(file, join_path(path, "sigma"),
-                  "must lie in (0, " + fmt(kMaxLognormalSigma) + "] (standard deviation of ln r)");
+    d = SizeDistribution::monodisperse(p.number("radius_um", 1e-300, 1e300));
   } else {
-    throw Error(file, join_path(path, "distribution"),
-                "unknown distribution '" + kind + "' (monodisperse, lognormal)");
+    const double median = p.number("median_radius_um", 1e-300, 1e300);
+    const double sigma = p.number("sigma", 1e-300, kMaxLognormalSigma);
+    d = SizeDistribution::lognormal(median, sigma);
   }
+  p.finish();
   return d;
 }
 
@@ -168,73 +122,55 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
   } catch (const json::exception& e) {
     throw Error(file, "", std::string("invalid JSON: ") + e.what());
   }
-  check_keys(root, file, "", {"name", "fiber_radius_um", "roughness", "host", "species", "notes"});
+  ParamReader p(root, file, "");
   FiberSpec spec;
-  spec.name = text(require(root, file, "", "name"), file, "name");
-  if (spec.name.empty()) throw Error(file, "name", "must not be empty");
-  if (const auto it = root.find("notes"); it != root.end()) text(*it, file, "notes");
+  spec.name = p.string("name");
+  if (p.has("notes")) {
+    if (!p.at("notes").is_string()) throw Error(file, "notes", "must be a string");
+  }
+  spec.fiber_radius_um = p.number("fiber_radius_um", 1e-300, 1e300);
 
-  spec.fiber_radius_um =
-      number(require(root, file, "", "fiber_radius_um"), file, "fiber_radius_um");
-  if (!(spec.fiber_radius_um > 0)) throw Error(file, "fiber_radius_um", "must be > 0");
+  ParamReader rough = p.object("roughness");
+  spec.roughness_distribution = rough.choice("distribution", "", {"beckmann", "ggx"}) == "ggx"
+                                    ? MicrofacetModel::kGgx
+                                    : MicrofacetModel::kBeckmann;
+  spec.roughness_alpha = rough.number("alpha", 1e-300, 1.0);
+  rough.finish();
 
-  const json& rough = require(root, file, "", "roughness");
-  check_keys(rough, file, "roughness", {"distribution", "alpha"});
-  const std::string dist =
-      text(require(rough, file, "roughness", "distribution"), file, "roughness.distribution");
-  if (dist == "beckmann")
-    spec.roughness_distribution = MicrofacetModel::kBeckmann;
-  else if (dist == "ggx")
-    spec.roughness_distribution = MicrofacetModel::kGgx;
-  else
-    throw Error(file, "roughness.distribution", "unknown '" + dist + "' (beckmann, ggx)");
-  spec.roughness_alpha =
-      number(require(rough, file, "roughness", "alpha"), file, "roughness.alpha");
-  if (!(spec.roughness_alpha > 0) || spec.roughness_alpha > 1)
-    throw Error(file, "roughness.alpha", "must lie in (0, 1]");
-
-  const json& host = require(root, file, "", "host");
-  check_keys(host, file, "host", {"n", "absorption_per_um", "absorption_per_mm"});
-  spec.host_n = spectral(require(host, file, "host", "n"), file, "host.n");
-  require_range(spec.host_n, file, "host.n", 0.0, true, "refractive index");
-  const bool per_um = host.contains("absorption_per_um"),
-             per_mm = host.contains("absorption_per_mm");
+  ParamReader host = p.object("host");
+  spec.host_n = spectral(host, "n");
+  require_range(spec.host_n, host, "n", 0.0, true, "refractive index");
+  const bool per_um = host.has("absorption_per_um"), per_mm = host.has("absorption_per_mm");
   if (per_um && per_mm)
     throw Error(file, "host", "give absorption_per_um or absorption_per_mm, not both");
   if (per_um) {
-    spec.host_absorption_per_um =
-        spectral(host.at("absorption_per_um"), file, "host.absorption_per_um");
-    require_range(spec.host_absorption_per_um, file, "host.absorption_per_um", 0.0, false,
-                  "absorption");
+    spec.host_absorption_per_um = spectral(host, "absorption_per_um");
+    require_range(spec.host_absorption_per_um, host, "absorption_per_um", 0.0, false, "absorption");
   } else if (per_mm) {
-    const Spectrum mm = spectral(host.at("absorption_per_mm"), file, "host.absorption_per_mm");
-    require_range(mm, file, "host.absorption_per_mm", 0.0, false, "absorption");
+    const Spectrum mm = spectral(host, "absorption_per_mm");
+    require_range(mm, host, "absorption_per_mm", 0.0, false, "absorption");
     for (int b = 0; b < kNumBands; ++b) spec.host_absorption_per_um[b] = mm[b] * 1e-3;
   }
+  host.finish();
 
-  const json& species = require(root, file, "", "species");
+  const json& species = p.at("species");
   if (!species.is_array()) throw Error(file, "species", "must be an array");
   double total_fraction = 0;
   for (size_t i = 0; i < species.size(); ++i) {
-    const std::string p = "species[" + std::to_string(i) + "]";
-    const json& s = species[i];
-    check_keys(s, file, p, {"name", "n", "k", "volume_fraction", "size"});
+    ParamReader s(species[i], file, "species[" + std::to_string(i) + "]");
     ParticleSpecies sp;
-    sp.name = text(require(s, file, p, "name"), file, p + ".name");
-    sp.n = spectral(require(s, file, p, "n"), file, p + ".n");
-    require_range(sp.n, file, p + ".n", 0.0, true, "refractive index");
-    sp.k = spectral(require(s, file, p, "k"), file, p + ".k");
-    require_range(sp.k, file, p + ".k", 0.0, false, "extinction coefficient k");
-    sp.volume_fraction =
-        number(require(s, file, p, "volume_fraction"), file, p + ".volume_fraction");
-    if (sp.volume_fraction < 0 || sp.volume_fraction > kMaxVolumeFraction)
-      throw Error(
-          file, p + ".volume_fraction",
-          "must lie in [0, " + fmt(kMaxVolumeFraction) + "], got " + fmt(sp.volume_fraction));
-    sp.size = parse_size(require(s, file, p, "size"), file, p + ".size");
+    sp.name = s.string("name");
+    sp.n = spectral(s, "n");
+    require_range(sp.n, s, "n", 0.0, true, "refractive index");
+    sp.k = spectral(s, "k");
+    require_range(sp.k, s, "k", 0.0, false, "extinction coefficient k");
+    sp.volume_fraction = s.number("volume_fraction", 0.0, kMaxVolumeFraction);
+    sp.size = parse_size(s.object("size"));
+    s.finish();
     total_fraction += sp.volume_fraction;
     spec.species.push_back(std::move(sp));
   }
+  p.finish();
   if (total_fraction > kMaxVolumeFraction)
     throw Error(
         file, "species",
