@@ -34,6 +34,13 @@ std::vector<double> TabulatedBsdfTable::averages_from_weighted_sums(
   return out;
 }
 
+void TabulatedBsdfTable::interpolate(const Vec3& wo, const Vec3& wi, std::span<double> out) const {
+  std::fill(out.begin(), out.end(), 0.0);
+  for_each_interpolated_cell(grid(), wo, wi, [&](int i, int o, double w) {
+    for (int c = 0; c < channels; ++c) out[c] += w * static_cast<double>(at(i, o, c));
+  });
+}
+
 std::string TabulatedBsdfTable::checksum() const {
   uint64_t h = kFnv1a64Basis;
   for (const float v : values) {

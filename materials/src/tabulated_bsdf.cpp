@@ -93,17 +93,9 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
 
 Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
   if (!data) return Rgb(0.0);  // a default-constructed value is black, never a crash
-  const DirectionGrid& grid = data->grid;
-  const auto fo = grid.bilinear(DirectionGrid::to_chart(wo));
-  const auto fi = grid.bilinear(DirectionGrid::to_chart(wi));
   Rgb sum;
-  for (int a = 0; a < 4; ++a) {
-    if (fi.weight[a] == 0) continue;
-    for (int b = 0; b < 4; ++b) {
-      const double w = fi.weight[a] * fo.weight[b];
-      if (w != 0) sum += data->lookup(fi.bin[a], fo.bin[b]) * w;
-    }
-  }
+  for_each_interpolated_cell(data->grid, wo, wi,
+                             [&](int i, int o, double w) { sum += data->lookup(i, o) * w; });
   return sum * scale;
 }
 

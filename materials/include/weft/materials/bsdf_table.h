@@ -39,6 +39,23 @@
 
 namespace weft {
 
+// The interpolation of a table between its cells, shared by every reader: bilinear in each
+// direction within its own hemisphere (DirectionGrid::bilinear), so f(wo, wi) blends up to 16 cell
+// pairs. Calls add(wi_bin, wo_bin, weight) for each pair of non-zero weight.
+template <class Add>
+void for_each_interpolated_cell(const DirectionGrid& grid, const Vec3& wo, const Vec3& wi,
+                                Add&& add) {
+  const auto fo = grid.bilinear(DirectionGrid::to_chart(wo));
+  const auto fi = grid.bilinear(DirectionGrid::to_chart(wi));
+  for (int a = 0; a < 4; ++a) {
+    if (fi.weight[a] == 0) continue;
+    for (int b = 0; b < 4; ++b) {
+      const double w = fi.weight[a] * fo.weight[b];
+      if (w != 0) add(fi.bin[a], fo.bin[b], w);
+    }
+  }
+}
+
 // f(wo, wi) -> one value per channel (written into 'values'); must be thread-safe.
 using TableFunction = std::function<void(const Vec3& wo, const Vec3& wi, std::span<double> values)>;
 
@@ -104,6 +121,10 @@ struct TabulatedBsdfTable {
   // is [wi_bin][wo_bin] for one channel; returns the cell averages in the same order.
   static std::vector<double> averages_from_weighted_sums(int resolution,
                                                          const std::vector<double>& weighted_sums);
+
+  // f(wo, wi) per channel, interpolated like the table material does (for_each_interpolated_cell);
+  // 'out' holds 'channels' values.
+  void interpolate(const Vec3& wo, const Vec3& wi, std::span<double> out) const;
 
   // Writes the OpenEXR file atomically (a complete file or none). Throws weft::Error.
   void write_exr(const std::filesystem::path& path) const;
