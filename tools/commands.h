@@ -14,6 +14,7 @@ void add_table_command(CLI::App& app, Commands& commands);
 void add_render_command(CLI::App& app, Commands& commands);
 void add_sweep_command(CLI::App& app, Commands& commands);
 void add_weave_command(CLI::App& app, Commands& commands);
+void add_compare_command(CLI::App& app, Commands& commands);
 
 // The subcommands of "bench" (cmd_bench.cpp makes the group).
 void add_bench_bake_command(CLI::App& bench, Commands& commands);

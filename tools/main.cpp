@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   weft::cli::add_render_command(app, commands);
   weft::cli::add_sweep_command(app, commands);
   weft::cli::add_weave_command(app, commands);
+  weft::cli::add_compare_command(app, commands);
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,90 @@
+// weft compare: how far apart two BSDF tables are (relative RMS and largest relative difference,
+// overall, in reflection and in transmission) and their in-plane curves.
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "plot_util.h"
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
+#include "weft/materials/table_compare.h"
+
+namespace weft::cli {
+namespace {
+
+struct CompareCliOptions {
+  std::string a, b, plot, csv;
+  bool json = false;
+  CompareOptions compare;
+};
+
+nlohmann::json to_json(const TableDifference& d) {
+  return {{"rel_rms", d.rel_rms}, {"max_rel", d.max_rel}, {"cells", d.cells}};
+}
+
+int run_compare(const CompareCliOptions& o) {
+  for (const auto& out : {o.plot, o.csv})
+    if (!out.empty()) {
+      const auto dir = std::filesystem::absolute(out).parent_path();
+      if (!std::filesystem::is_directory(dir))
+        throw Error(out, "", "output directory does not exist");
+    }
+  const auto a = TabulatedBsdfTable::read_exr(o.a);
+  const auto b = TabulatedBsdfTable::read_exr(o.b);
+  const TableComparison c = compare_tables(a, b, o.compare);
+  const std::string curves = in_plane_csv(c, a.channel_names());
+  if (!o.csv.empty()) write_text_atomically(o.csv, curves);
+  if (!o.plot.empty()) {
+    const auto tmp = std::filesystem::temp_directory_path() / "weft-compare-curves.csv";
+    write_text_atomically(tmp, curves);
+    run_plot_script("plot_compare.py",
+                    {tmp.string(), o.plot, std::filesystem::path(o.a).filename().string(),
+                     std::filesystem::path(o.b).filename().string()},
+                    o.plot);
+    std::filesystem::remove(tmp);
+  }
+  if (o.json) {
+    std::cout << nlohmann::json{{"a", o.a},
+                                {"b", o.b},
+                                {"overall", to_json(c.overall)},
+                                {"reflection", to_json(c.reflection)},
+                                {"transmission", to_json(c.transmission)},
+                                {"in_plane_rel_rms", c.in_plane_rel_rms},
+                                {"significant", o.compare.significant}}
+                     .dump(2)
+              << "\n";
+  } else {
+    std::printf("%s vs %s (reference %s)\n", o.b.c_str(), o.a.c_str(), o.a.c_str());
+    for (const auto& [name, d] :
+         {std::pair{"overall", c.overall}, std::pair{"reflection", c.reflection},
+          std::pair{"transmission", c.transmission}})
+      std::printf("  %-13s rel_rms %.4f  max_rel %.4f  (%zu cell pairs)\n", name, d.rel_rms,
+                  d.max_rel, d.cells);
+    std::printf("  in-plane      rel_rms %.4f\n", c.in_plane_rel_rms);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_compare_command(CLI::App& app, Commands& commands) {
+  auto o = std::make_shared<CompareCliOptions>();
+  auto* sub = app.add_subcommand(
+      "compare",
+      "Compare two BSDF tables (.exr): relative RMS and largest relative difference "
+      "of B against the reference A, overall, in reflection and in transmission");
+  sub->add_option("a", o->a, "reference table (.exr)")->required();
+  sub->add_option("b", o->b, "table to compare (.exr)")->required();
+  sub->add_flag("--json", o->json, "print JSON with stable keys");
+  sub->add_option("--plot", o->plot, "in-plane curves as a plot (.png or .svg)");
+  sub->add_option("--csv", o->csv, "in-plane curves as CSV");
+  sub->add_option("--significant", o->compare.significant,
+                  "max_rel counts cells at least this fraction of A's mean value")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
+  commands.push_back({sub, [o] { return run_compare(*o); }});
+}
+
+}  // namespace weft::cli
