@@ -1,9 +1,6 @@
 #pragma once
-// Deterministic parallel photon batches. Photons are split into fixed-size tasks; task k draws
-// from Rng(seed, k) and fills its own tally; tallies are merged into the result in task order. So
-// the result has the same bits at any thread count. Tasks run in waves; between waves the progress
-// callback is called on the calling thread and may cancel: the tasks done so far are kept, and
-// the status says how many photons they hold.
+// Photon batches: per-photon statistics of the energy books, and photon tasks on the project's
+// one deterministic batch runner (core/task_batch.h).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,6 +11,7 @@
 #include "weft/core/parallel.h"
 #include "weft/core/progress.h"
 #include "weft/core/rng.h"
+#include "weft/core/task_batch.h"
 #include "weft/materials/fabric/transport.h"
 
 namespace weft {
@@ -99,6 +97,7 @@ struct PhotonStats {
   }
 };
 
+// A batch of photons for the one batch runner (core/task_batch.h), named in photons.
 struct PhotonBatchOptions {
   uint64_t photons = 0;
   uint64_t seed = 0;
@@ -107,9 +106,16 @@ struct PhotonBatchOptions {
   uint64_t tasks_per_wave = 0;       // 0: 8 per thread; lower it when tallies are large
   ProgressCallback progress;         // may be empty
 
-  void validate() const {
-    if (photons_per_task == 0) throw Error("", "photons_per_task", "must be >= 1");
-    if (threads < 0) throw Error("", "threads", "must be >= 0");
+  TaskBatch batch() const {
+    TaskBatch b;
+    b.items = photons;
+    b.seed = seed;
+    b.threads = threads;
+    b.items_per_task = photons_per_task;
+    b.tasks_per_wave = tasks_per_wave;
+    b.progress = progress;
+    b.stage = "photons";
+    return b;
   }
 };
 
@@ -119,44 +125,13 @@ struct PhotonBatchStatus {
   bool cancelled = false;
 };
 
-// The one photon task runner. Runs run(task, first_photon, count, rng, tally) for every task, each
-// on a default-constructed TaskTally, and hands the tallies to merge(tally) in task order, so the
-// merged result has the same bits at any thread count. Exceptions from run propagate.
+// Photon tasks on the one batch runner: run(task, first_photon, count, rng, tally), tallies merged
+// in task order.
 template <class TaskTally, class Run, class Merge>
 PhotonBatchStatus run_photon_tasks(const PhotonBatchOptions& options, Run&& run, Merge&& merge) {
-  options.validate();
-  const uint64_t per_task = options.photons_per_task;
-  const uint64_t tasks = options.photons / per_task + (options.photons % per_task != 0 ? 1 : 0);
-  const int threads = options.threads > 0 ? options.threads : hardware_threads();
-  const uint64_t wave =
-      options.tasks_per_wave > 0 ? options.tasks_per_wave : 8 * static_cast<uint64_t>(threads);
-  PhotonBatchStatus status;
-  // A first report before any work starts the front end's clock and allows an early stop.
-  if (options.progress && !options.progress(ProgressUpdate{"photons", 0, options.photons})) {
-    status.cancelled = tasks > 0;
-    return status;
-  }
-  std::vector<TaskTally> tallies;
-  for (uint64_t start = 0; start < tasks; start += wave) {
-    const uint64_t n = std::min(wave, tasks - start);
-    tallies.assign(n, TaskTally{});
-    parallel_for(n, threads, [&](uint64_t i) {
-      const uint64_t task = start + i;
-      const uint64_t first = task * per_task;
-      const uint64_t count = std::min(per_task, options.photons - first);
-      Rng rng(options.seed, task);
-      run(task, first, count, rng, tallies[i]);
-    });
-    for (uint64_t i = 0; i < n; ++i) merge(tallies[i]);
-    status.tasks_done = start + n;
-    status.photons_done = std::min(options.photons, status.tasks_done * per_task);
-    if (options.progress &&
-        !options.progress(ProgressUpdate{"photons", status.photons_done, options.photons})) {
-      status.cancelled = status.tasks_done < tasks;
-      break;
-    }
-  }
-  return status;
+  if (options.photons_per_task == 0) throw Error("", "photons_per_task", "must be >= 1");
+  const TaskBatchStatus s = run_batch<TaskTally>(options.batch(), run, merge);
+  return {s.items_done, s.tasks_done, s.cancelled};
 }
 
 }  // namespace weft
