@@ -1,0 +1,58 @@
+#pragma once
+// The ray-traced fabric BSDF, the reference the summations (materials/fabric/fabric_summation.h)
+// are measured against: a virtual gonioreflectometer on one repeat of a woven sample with periodic
+// boundaries. For every incident bin a parallel beam (directions spread over the bin) falls on the
+// tile from above or from below; each light particle is followed through the sample with the fiber
+// table at every hit until it leaves the cloth's slab, and its exit direction is binned: the
+// exits of all particles, reflected and transmitted, are the fabric table (cosine-weighted cell
+// averages, materials/bsdf_table.h).
+//
+// The fiber table is the BSDF of a whole fiber (docs/fiber-bsdf.md): the radiance leaving a point
+// B for light entering anywhere on the fiber. A renderer shades a fiber point with it and lets
+// light from behind B pass through B's own fiber. Traced forwards, a particle whose line meets a
+// fiber therefore lights both points where that line crosses the fiber's surface: where it enters
+// (B') and where it would leave (B''); it is re-emitted from one of them (chosen in proportion to
+// the table's albedo there, weighted to stay unbiased) into a direction drawn from the table's cell
+// averages at that point. The cloth is periodic: the geometry is the repeat and its eight
+// neighbours, and a particle crossing a side of the repeat re-enters through the opposite side.
+//
+// Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
+// is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
+#include <cstdint>
+
+#include "weft/core/progress.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/scenes/weave.h"
+
+namespace weft {
+
+struct FabricRaytraceOptions {
+  int resolution = 8;                  // of the fabric table (DirectionGrid R)
+  uint64_t particles_per_bin = 20000;  // per incident bin
+  uint64_t seed = 1;
+  int threads = 0;                   // 0 = all cores; results do not depend on it
+  int max_scatterings = 1000;        // beyond it a particle's weight is booked as lost
+  double roulette_threshold = 0.05;  // Russian roulette below this weight (mean over channels)
+
+  void validate() const;  // weft::Error naming the field
+};
+
+struct FabricRaytraceResult {
+  TabulatedBsdfTable table;  // kind "fabric", the fiber table's channels
+  // Energy books, as fractions of the power that fell on the cloth (mean over channels): exited +
+  // absorbed + lost + roulette_net = 1 to rounding. absorbed is what the fibers' tables keep
+  // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
+  double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
+  uint64_t particles = 0, scatterings = 0, wraps = 0;
+  // Standard error of the table relative to its values, weighted like weft compare's rel_rms
+  // (by D_i D_o): what two independent runs would differ by, over sqrt(2).
+  double relative_noise = 0;
+  bool cancelled = false;
+};
+
+FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
+                                           const TabulatedBsdfTable& fiber,
+                                           const FabricRaytraceOptions& options,
+                                           const ProgressCallback& progress = no_progress());
+
+}  // namespace weft

@@ -1,0 +1,379 @@
+#include "weft/integrators/fabric_raytrace.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "weft/core/direction_grid.h"
+#include "weft/core/distribution.h"
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/task_batch.h"
+#include "weft/scenes/description.h"
+#include "weft/scenes/render_scene.h"
+
+namespace weft {
+namespace {
+
+constexpr double kMetresPerMm = 1e-3;
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+Vec3 cloth_to_world(const Vec3& c) {
+  return {c.x, c.z, -c.y};
+}
+Vec3 world_to_cloth(const Vec3& w) {
+  return {w.x, -w.z, w.y};
+}
+
+// The fiber table as the particle tracer draws from it: per light bin i the albedo of each
+// channel, A_c[i] = sum_o f_c[i][o] D_o, and a distribution over exit cells o with weights
+// mean_c f_c[i][o] D_o; within a cell, directions are drawn in proportion to |cos theta|.
+struct FiberSampler {
+  const TabulatedBsdfTable* table = nullptr;
+  DirectionGrid grid;
+  std::vector<double> areas, max_cos;
+  std::vector<double> albedo;       // [i * channels + c]
+  std::vector<double> mean_albedo;  // [i]
+  std::vector<Distribution1D> rows;
+
+  explicit FiberSampler(const TabulatedBsdfTable& t) : table(&t), grid(t.grid()) {
+    const int bins = grid.bins(), nc = t.channels;
+    areas = grid.cosine_weighted_areas();
+    max_cos.resize(bins);
+    for (int b = 0; b < bins; ++b) {
+      // A bound of |cos theta| over the cell (for rejection): its largest value on a lattice that
+      // includes the edges, a little enlarged; the pole's cell reaches 1.
+      double m = 0;
+      for (int i = 0; i <= 16; ++i)
+        for (int j = 0; j <= 16; ++j)
+          m = std::max(
+              m, std::abs(DirectionGrid::to_direction(grid.chart_point(b, i / 16.0, j / 16.0)).z));
+      max_cos[b] = std::min(1.0, 1.02 * m + 1e-6);
+    }
+    albedo.assign(static_cast<size_t>(bins) * nc, 0.0);
+    mean_albedo.assign(bins, 0.0);
+    rows.resize(bins);
+    std::vector<double> w(bins);
+    for (int i = 0; i < bins; ++i) {
+      for (int o = 0; o < bins; ++o) {
+        double mean = 0;
+        for (int c = 0; c < nc; ++c) {
+          const double f = t.at(i, o, c);
+          albedo[static_cast<size_t>(i) * nc + c] += f * areas[o];
+          mean += f;
+        }
+        w[o] = mean / nc * areas[o];
+        mean_albedo[i] += w[o];
+      }
+      rows[i] = Distribution1D(w);
+    }
+  }
+
+  // A direction in cell b with density proportional to |cos theta| (rejection against the bound).
+  Vec3 cosine_direction_in(int b, Rng& rng) const {
+    for (int tries = 0; tries < 1000; ++tries) {
+      const Vec3 d = DirectionGrid::to_direction(grid.chart_point(b, rng.uniform(), rng.uniform()));
+      if (rng.uniform() * max_cos[b] <= std::abs(d.z)) return d;
+    }
+    return grid.bin_center(b);  // a cell of vanishing cosine mass: never drawn in practice
+  }
+};
+
+// Where a particle's line meets a fiber: the point and its local frame (x = axis, z = outward).
+struct FiberPoint {
+  SurfaceHit hit;
+  Vec3 wi_local;  // towards where the light came from
+  int bin = 0;
+};
+
+struct ExitRecord {
+  uint64_t cell;   // incident bin * bins + exit bin
+  uint32_t first;  // index of its channel weights in the task's weight list
+};
+
+struct TaskTally {
+  std::vector<ExitRecord> exits;
+  std::vector<double> weights;  // channels per exit
+  double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
+  uint64_t particles = 0, scatterings = 0, wraps = 0;
+};
+
+// Where the line through 'h' along 'along' crosses the surface again, leaving the material it
+// entered at h (the next hit whose normal faces along the line), within a few hits.
+bool find_crossing(const RenderScene& scene, const SurfaceHit& h, const Vec3& along,
+                   SurfaceHit* out) {
+  SurfaceHit cur = h;
+  for (int k = 0; k < 4; ++k) {
+    if (!scene.intersect({cur.spawn_origin(along), along, 1e300}, out)) return false;
+    if (dot(along, out->shading.n) > 0) return true;
+    cur = *out;
+  }
+  return false;
+}
+
+// The repeat and its eight neighbours, for a renderer that only asks for geometry: copy k of the
+// sample's mesh m is mesh 9 m + k.
+SceneDescription tiled_geometry(const WovenSample& sample, double px, double pz) {
+  if (sample.meshes.empty())
+    throw Error(
+        "", "detail",
+        "the ray-traced estimator needs the sample's geometry (yarn tubes); this sample has "
+        "none");
+  SceneDescription d;
+  d.source = "woven sample";
+  for (const auto& mesh : sample.meshes)
+    for (int i = -1; i <= 1; ++i)
+      for (int k = -1; k <= 1; ++k) {
+        TriangleMesh m = mesh;
+        for (size_t v = 0; v < m.vertex_count(); ++v) {
+          m.positions[3 * v] += static_cast<float>(i * px);
+          m.positions[3 * v + 2] += static_cast<float>(k * pz);
+        }
+        d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+      }
+  MaterialBinding any;
+  any.type = "lambert";
+  any.field = "fabric estimator";
+  d.default_material = any;
+  return d;
+}
+
+}  // namespace
+
+void FabricRaytraceOptions::validate() const {
+  if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
+    throw Error("", "resolution",
+                "must lie in [1, " + std::to_string(TabulatedBsdfTable::kMaxResolution) + "]");
+  if (particles_per_bin < 1 || particles_per_bin > (uint64_t{1} << 36))
+    throw Error("", "samples", "particles per incident bin must lie in [1, 2^36]");
+  if (max_scatterings < 1) throw Error("", "max_scatterings", "must be >= 1");
+  if (!(roulette_threshold > 0 && roulette_threshold < 1))
+    throw Error("", "roulette_threshold", "must lie in (0, 1)");
+  if (threads < 0) throw Error("", "threads", "must be >= 0");
+}
+
+FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
+                                           const TabulatedBsdfTable& fiber,
+                                           const FabricRaytraceOptions& o,
+                                           const ProgressCallback& progress) {
+  o.validate();
+  fiber.validate("");
+  if (fiber.kind != "fiber") throw Error("", "fiber", "expected a fiber table, got " + fiber.kind);
+  const double px = sample.summary.period_x_mm * kMetresPerMm;
+  const double pz = sample.summary.period_z_mm * kMetresPerMm;
+  const double y0 = sample.summary.y_min_mm * kMetresPerMm;
+  const double y1 = sample.summary.y_max_mm * kMetresPerMm;
+  if (!(px > 0 && pz > 0 && y1 > y0))
+    throw Error("", "sample", "the woven sample has no period or no thickness");
+  const double x0 = -0.5 * px, z0 = -0.5 * pz;
+  const RenderScene scene(tiled_geometry(sample, px, pz));
+  const FiberSampler fs(fiber);
+  const int nc = fiber.channels;
+  const DirectionGrid grid{o.resolution};
+  const int bins = grid.bins();
+  const auto areas = grid.cosine_weighted_areas();
+  const uint64_t per_bin = o.particles_per_bin;
+
+  std::vector<double> sum(static_cast<size_t>(bins) * bins * nc, 0.0);
+  std::vector<double> sum2(static_cast<size_t>(bins) * bins, 0.0);
+  FabricRaytraceResult result;
+  double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
+
+  TaskBatch batch;
+  batch.items = per_bin * static_cast<uint64_t>(bins);
+  batch.seed = o.seed;
+  batch.threads = o.threads;
+  batch.items_per_task = std::min<uint64_t>(per_bin, 2048);
+  batch.progress = progress;
+  batch.stage = "particles";
+
+  const TaskBatchStatus status = run_batch<TaskTally>(
+      batch,
+      [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, TaskTally& tally) {
+        std::vector<double> w(nc);
+        for (uint64_t k = first; k < first + count; ++k) {
+          const int a = static_cast<int>(k / per_bin);
+          // The light: a direction of bin a (uniform in solid angle), flux per unit area
+          // proportional to |cos theta_i|; entering the slab through the face it faces.
+          const Vec3 wi_cloth =
+              DirectionGrid::to_direction(grid.chart_point(a, rng.uniform(), rng.uniform()));
+          const double w0 = std::abs(wi_cloth.z);
+          Vec3 d = -cloth_to_world(wi_cloth);
+          Vec3 p{x0 + px * rng.uniform(), wi_cloth.z > 0 ? y1 : y0, z0 + pz * rng.uniform()};
+          std::fill(w.begin(), w.end(), w0);
+          tally.launched += w0;
+          ++tally.particles;
+          int events = 0;
+          while (true) {
+            double mean_w = 0;
+            for (double x : w) mean_w += x;
+            mean_w /= nc;
+            // Distances to the repeat's sides and to the slab's faces.
+            double t_side = kInfinity;
+            int side = -1;
+            const double lo[2] = {x0, z0}, hi[2] = {x0 + px, z0 + pz};
+            const double pc[2] = {p.x, p.z}, dc[2] = {d.x, d.z};
+            for (int ax = 0; ax < 2; ++ax) {
+              if (dc[ax] > 0 && (hi[ax] - pc[ax]) / dc[ax] < t_side)
+                t_side = (hi[ax] - pc[ax]) / dc[ax], side = 2 * ax + 1;
+              if (dc[ax] < 0 && (lo[ax] - pc[ax]) / dc[ax] < t_side)
+                t_side = (lo[ax] - pc[ax]) / dc[ax], side = 2 * ax;
+            }
+            t_side = std::max(0.0, t_side);
+            const double t_slab = d.y > 0   ? (y1 - p.y) / d.y
+                                  : d.y < 0 ? (y0 - p.y) / d.y
+                                            : kInfinity;
+            SurfaceHit h;
+            if (!scene.intersect({p, d, std::min(t_side, t_slab)}, &h)) {
+              if (t_slab <= t_side) {  // left the cloth: binned by its direction
+                const int exit_bin = grid.bin_of(world_to_cloth(d));
+                tally.exits.push_back({static_cast<uint64_t>(a) * bins + exit_bin,
+                                       static_cast<uint32_t>(tally.weights.size())});
+                tally.weights.insert(tally.weights.end(), w.begin(), w.end());
+                tally.exited += mean_w;
+                break;
+              }
+              // Through a side of the repeat: in again through the opposite one.
+              p += t_side * d;
+              if (side == 0) p.x += px;
+              if (side == 1) p.x -= px;
+              if (side == 2) p.z += pz;
+              if (side == 3) p.z -= pz;
+              if (++tally.wraps, ++events > 100 * o.max_scatterings) {
+                tally.lost += mean_w;
+                break;
+              }
+              continue;
+            }
+            // The line meets a fiber (here: a yarn tube) at B' and would leave it at B''. Tubes
+            // that press on each other share surfaces, so a particle may find itself inside one:
+            // then this hit is B'' and B' lies behind it.
+            FiberPoint pts[2];
+            int n_pts = 0;
+            const bool from_outside = dot(d, h.shading.n) < 0;
+            pts[n_pts++].hit = h;
+            const Vec3 along = from_outside ? d : -d;
+            SurfaceHit other;
+            if (find_crossing(scene, h, along, &other)) pts[n_pts++].hit = other;
+            double a_sum = 0, a_pt[2] = {0, 0};
+            for (int q = 0; q < n_pts; ++q) {
+              pts[q].wi_local = pts[q].hit.shading.to_local(-d);
+              pts[q].bin = fs.grid.bin_of(pts[q].wi_local);
+              a_pt[q] = fs.mean_albedo[pts[q].bin];
+              a_sum += a_pt[q];
+            }
+            if (!(a_sum > 0)) {  // the fiber absorbs all
+              tally.absorbed += mean_w;
+              break;
+            }
+            const int q = n_pts == 2 && rng.uniform() * a_sum >= a_pt[0] ? 1 : 0;
+            const FiberPoint& pt = pts[q];
+            double pmf = 0;
+            const int ob = static_cast<int>(fs.rows[pt.bin].sample_discrete(rng.uniform(), &pmf));
+            const Vec3 wo_local = fs.cosine_direction_in(ob, rng);
+            double fmean = 0;
+            for (int c = 0; c < nc; ++c) fmean += fiber.at(pt.bin, ob, c);
+            fmean /= nc;
+            // w_c f_c D_o / (P_q pmf) = w_c (f_c / mean f) (A' + A'').
+            double before = 0, after = 0;
+            for (int c = 0; c < nc; ++c) {
+              before += w[c];
+              w[c] *= fiber.at(pt.bin, ob, c) / fmean * a_sum;
+              after += w[c];
+            }
+            tally.absorbed += (before - after) / nc;
+            d = normalize(pt.hit.shading.to_world(wo_local));
+            p = pt.hit.spawn_origin(d);
+            ++tally.scatterings;
+            if (++events >= o.max_scatterings) {
+              double m = 0;
+              for (double x : w) m += x;
+              tally.lost += m / nc;
+              break;
+            }
+            mean_w = 0;
+            for (double x : w) mean_w += x;
+            mean_w /= nc;
+            if (mean_w < o.roulette_threshold) {
+              const double survive = mean_w / o.roulette_threshold;
+              if (rng.uniform() < survive) {
+                for (double& x : w) x /= survive;
+                tally.roulette_net -= mean_w / survive - mean_w;
+              } else {
+                tally.roulette_net += mean_w;
+                break;
+              }
+            }
+          }
+        }
+      },
+      [&](const TaskTally& t) {
+        for (const auto& e : t.exits) {
+          double m = 0;
+          for (int c = 0; c < nc; ++c) {
+            sum[e.cell * nc + c] += t.weights[e.first + c];
+            m += t.weights[e.first + c];
+          }
+          m /= nc;
+          sum2[e.cell] += m * m;
+        }
+        launched += t.launched;
+        exited += t.exited;
+        lost += t.lost;
+        roulette_net += t.roulette_net;
+        absorbed += t.absorbed;
+        result.particles += t.particles;
+        result.scatterings += t.scatterings;
+        result.wraps += t.wraps;
+      });
+
+  result.cancelled = status.cancelled;
+  TabulatedBsdfTable& table = result.table;
+  table.resolution = o.resolution;
+  table.channels = nc;
+  table.kind = "fabric";
+  table.values.assign(static_cast<size_t>(bins) * bins * nc, 0.0f);
+  const double n = static_cast<double>(per_bin);
+  const double omega = grid.bin_solid_angle();
+  double noise2 = 0, signal2 = 0;
+  for (int a = 0; a < bins; ++a)
+    for (int b = 0; b < bins; ++b) {
+      const size_t cell = static_cast<size_t>(a) * bins + b;
+      const double scale = omega / (n * areas[a] * areas[b]);
+      double mean = 0;
+      for (int c = 0; c < nc; ++c) {
+        const double f = sum[cell * nc + c] * scale;
+        table.values[cell * nc + c] = static_cast<float>(f);
+        mean += f;
+      }
+      mean /= nc;
+      // Per particle the cell receives one exit or none: the sample variance of the mean weight.
+      double m1 = 0;
+      for (int c = 0; c < nc; ++c) m1 += sum[cell * nc + c];
+      m1 /= nc * n;
+      const double var = std::max(0.0, sum2[cell] / n - m1 * m1) / n;
+      const double se = std::sqrt(var) * omega / (areas[a] * areas[b]);
+      noise2 += se * se * areas[a] * areas[b];
+      signal2 += mean * mean * areas[a] * areas[b];
+    }
+  result.relative_noise = signal2 > 0 ? std::sqrt(noise2 / signal2) : 0.0;
+  if (launched > 0) {
+    result.exited = exited / launched;
+    result.lost = lost / launched;
+    result.roulette_net = roulette_net / launched;
+    result.absorbed = absorbed / launched;
+  }
+  table.metadata = {{"method", "raytrace"},
+                    {"fiber_checksum", fiber.checksum()},
+                    {"particles_per_bin", std::to_string(per_bin)},
+                    {"seed", std::to_string(o.seed)},
+                    {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
+  for (const char* key : {"spec_hash", "spec_name"})
+    if (const auto it = fiber.metadata.find(key); it != fiber.metadata.end())
+      table.metadata[std::string("fiber_") + key] = it->second;
+  return result;
+}
+
+}  // namespace weft
