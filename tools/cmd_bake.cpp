@@ -14,6 +14,7 @@ namespace weft::cli {
 void add_bake_command(CLI::App& app, Commands& commands) {
   auto* bake = app.add_subcommand("bake", "Bake BSDF tables from physical specs");
   bake->require_subcommand(1);
+  add_bake_fabric_command(*bake, commands);
 
   struct Options {
     std::string spec;

@@ -142,6 +142,27 @@ SceneDescription tiled_geometry(const WovenSample& sample, double px, double pz)
 
 }  // namespace
 
+std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_above,
+                                         int rays_per_side) {
+  if (rays_per_side < 1 || rays_per_side > 4096)
+    throw Error("", "rays_per_side", "must lie in [1, 4096]");
+  const double px = sample.summary.period_x_mm * kMetresPerMm;
+  const double pz = sample.summary.period_z_mm * kMetresPerMm;
+  const double y0 = sample.summary.y_min_mm * kMetresPerMm;
+  const double y1 = sample.summary.y_max_mm * kMetresPerMm;
+  const RenderScene scene(tiled_geometry(sample, px, pz));
+  std::vector<Vec3> out;
+  for (int i = 0; i < rays_per_side; ++i)
+    for (int k = 0; k < rays_per_side; ++k) {
+      const Vec3 p{-0.5 * px + px * (i + 0.5) / rays_per_side, from_above ? y1 + 1e-6 : y0 - 1e-6,
+                   -0.5 * pz + pz * (k + 0.5) / rays_per_side};
+      SurfaceHit h;
+      if (scene.intersect({p, {0, from_above ? -1.0 : 1.0, 0}, 1e300}, &h))
+        out.push_back(world_to_cloth(h.shading.s));
+    }
+  return out;
+}
+
 void FabricRaytraceOptions::validate() const {
   if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
     throw Error("", "resolution",

@@ -19,6 +19,7 @@
 // Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
 #include <cstdint>
+#include <vector>
 
 #include "weft/core/progress.h"
 #include "weft/materials/bsdf_table.h"
@@ -49,6 +50,13 @@ struct FabricRaytraceResult {
   double relative_noise = 0;
   bool cancelled = false;
 };
+
+// The fiber directions seen at the cloth's surface, for the summations: the unit tangents (cloth
+// frame) at the first hits of a rays_per_side x rays_per_side grid of rays along the normal over
+// one repeat, from above (views on the cloth's face) or from below. Each stands for an equal share
+// of the cloth's area.
+std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_above,
+                                         int rays_per_side = 64);
 
 FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                                            const TabulatedBsdfTable& fiber,

@@ -1,0 +1,157 @@
+// weft bake fabric: a fiber table (file, or a spec baked on demand) and a woven sample -> a fabric
+// BSDF table, by the paper's summation, our visible-layer summation or the ray-traced reference.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "commands.h"
+#include "weft/core/error.h"
+#include "weft/integrators/fabric_raytrace.h"
+#include "weft/materials/fabric/bake_cache.h"
+#include "weft/materials/fabric/fabric_summation.h"
+#include "weft/scenes/weave.h"
+
+namespace weft::cli {
+namespace {
+
+struct BakeFabricOptions {
+  std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
+  std::string detail = "yarn";
+  int resolution = 8, threads = 0;
+  uint64_t samples = 0, seed = 1;
+  bool json = false, quiet = false;
+};
+
+// The fiber table: a table file, or a fiber spec or preset baked once into ./.weft-cache (RGB).
+TabulatedBsdfTable fiber_table(const std::string& fiber, const ProgressCallback& progress) {
+  std::error_code ec;
+  if (std::filesystem::path(fiber).extension() == ".exr" ||
+      (std::filesystem::is_regular_file(fiber, ec) && fiber.size() > 4 &&
+       fiber.compare(fiber.size() - 4, 4, ".exr") == 0))
+    return TabulatedBsdfTable::read_exr(fiber);
+  FiberTableBakeOptions o;
+  o.spectral = false;
+  return TabulatedBsdfTable::read_exr(
+      cached_fiber_table(".weft-cache", load_fiber_spec(fiber), o, progress));
+}
+
+WovenSample woven_sample(const BakeFabricOptions& o) {
+  WeaveOptions given;
+  if (!o.pattern.empty()) given.pattern = o.pattern;
+  if (!o.wif.empty()) given.wif = o.wif;
+  if (!o.pattern.empty() && !o.wif.empty())
+    throw Error("", "wif", "give either --pattern or --wif, not both");
+  given.detail = o.detail;
+  const WeaveOptions base = o.weave.empty() ? WeaveOptions{} : read_weave_options(o.weave);
+  return make_woven_sample(overlay(base, given));
+}
+
+std::vector<FiberOrientation> orientations(const std::vector<Vec3>& tangents) {
+  std::vector<FiberOrientation> out;
+  for (const Vec3& t : tangents) out.push_back({t, 1.0});
+  return out;
+}
+
+int run(const BakeFabricOptions& o) {
+  if (std::filesystem::path(o.output).extension() != ".exr")
+    throw Error(o.output, "", "the fabric table must be written to a .exr file");
+  const auto dir = std::filesystem::absolute(o.output).parent_path();
+  if (!std::filesystem::is_directory(dir))
+    throw Error(o.output, "", "output directory does not exist");
+  const auto progress = progress_bar(o.quiet);
+  const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
+  const WovenSample sample = woven_sample(o);
+  const auto t0 = std::chrono::steady_clock::now();
+  TabulatedBsdfTable table;
+  nlohmann::json extra;
+  if (o.method == "raytrace") {
+    FabricRaytraceOptions r;
+    r.resolution = o.resolution;
+    if (o.samples) r.particles_per_bin = o.samples;
+    r.seed = o.seed;
+    r.threads = o.threads;
+    const FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, r, progress);
+    if (res.cancelled) {
+      std::fprintf(stderr, "\nweft: bake cancelled; nothing was written\n");
+      return 130;
+    }
+    table = res.table;
+    extra = {{"particles", res.particles}, {"scatterings", res.scatterings},
+             {"exited", res.exited},       {"absorbed", res.absorbed},
+             {"lost", res.lost},           {"relative_noise", res.relative_noise}};
+  } else {
+    FabricSummationOptions s;
+    s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
+    s.resolution = o.resolution;
+    if (o.samples) s.samples_per_cell = static_cast<int>(o.samples);
+    s.seed = o.seed;
+    s.threads = o.threads;
+    if (s.method == FabricSummation::kVisible) {
+      s.top = orientations(visible_fiber_tangents(sample, true));
+      s.bottom = orientations(visible_fiber_tangents(sample, false));
+    }
+    table = sum_fabric_table(fiber, s, progress);
+  }
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  table.metadata["sample"] = sample.summary.source + " (" + sample.summary.detail + ")";
+  table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
+  table.write_exr(o.output);
+  const DirectionGrid g = table.grid();
+  const auto normal = table.directional_albedo(g.bin_of({0, 0, 1}));
+  nlohmann::json j = {{"output", o.output},
+                      {"method", o.method},
+                      {"resolution", o.resolution},
+                      {"seconds", seconds},
+                      {"sample", table.metadata["sample"]},
+                      {"reflectance_normal_incidence", normal.reflectance},
+                      {"transmittance_normal_incidence", normal.transmittance}};
+  if (extra.is_object()) j.update(extra);
+  if (o.json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::printf(
+        "%s: %s, R = %d, %.2f s; at normal incidence R = %.4f, T = %.4f (mean of channels)\n",
+        o.output.c_str(), o.method.c_str(), o.resolution, seconds,
+        (normal.reflectance.front() + normal.reflectance.back()) / 2,
+        (normal.transmittance.front() + normal.transmittance.back()) / 2);
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
+  auto o = std::make_shared<BakeFabricOptions>();
+  auto* sub =
+      bake.add_subcommand("fabric",
+                          "Fabric BSDF table from a fiber table and a woven sample (summation, "
+                          "summation-visible or the ray-traced reference)");
+  sub->add_option("--fiber", o->fiber, "fiber table (.exr), or a fiber spec or preset to bake")
+      ->capture_default_str();
+  sub->add_option("--method", o->method, "summation | summation-visible | raytrace")
+      ->check(CLI::IsMember({"summation", "summation-visible", "raytrace"}))
+      ->capture_default_str();
+  sub->add_option("--weave", o->weave, "woven sample options (.json; default: the bundled poplin)");
+  sub->add_option("--pattern", o->pattern, "weave pattern: plain, twill:N/M, satin:N");
+  sub->add_option("--wif", o->wif, "WIF weaving draft");
+  sub->add_option("--detail", o->detail, "sample detail for the ray tracer: yarn or fiber")
+      ->check(CLI::IsMember({"yarn", "fiber"}))
+      ->capture_default_str();
+  sub->add_option("-R,--resolution", o->resolution, "fabric table bins per hemisphere side")
+      ->check(CLI::Range(1, TabulatedBsdfTable::kMaxResolution))
+      ->capture_default_str();
+  sub->add_option(
+      "--samples", o->samples,
+      "summations: direction pairs per cell pair; raytrace: particles per incident bin");
+  sub->add_option("--seed", o->seed, "random seed")->capture_default_str();
+  sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
+  sub->add_option("-o,--output", o->output, "output fabric table (.exr)")->required();
+  sub->add_flag("--json", o->json, "print a JSON summary");
+  sub->add_flag("--quiet", o->quiet, "no progress bar");
+  commands.push_back({sub, [o] { return run(*o); }});
+}
+
+}  // namespace weft::cli
