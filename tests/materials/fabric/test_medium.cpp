@@ -5,8 +5,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <numbers>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "weft/core/error.h"
 #include "weft/materials/fabric/fiber_spec.h"
@@ -139,4 +142,42 @@ TEST(FiberMedium, SameBitsAtAnyThreadCount) {
   EXPECT_THROW(build_fiber_medium(s, bad), Error);
   // Cancellation through the progress callback.
   EXPECT_THROW(build_fiber_medium(s, {}, one, [](const ProgressUpdate&) { return false; }), Error);
+}
+
+TEST(Medium, PresetsDocMatchesTheMedium) {
+  // docs/presets.md tabulates what each preset produces at single wavelengths: the numbers users
+  // read must be the ones the code computes (to the digits printed).
+  std::ifstream doc(std::string(WEFT_SOURCE_DIR) + "/docs/presets.md");
+  ASSERT_TRUE(doc) << "docs/presets.md";
+  std::string line;
+  int rows = 0;
+  while (std::getline(doc, line)) {
+    // | preset | nm | mu_s | mu_a | albedo | g |, single-wavelength rows only.
+    std::vector<std::string> cells;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, '|')) {
+      const auto b = cell.find_first_not_of(' '), e = cell.find_last_not_of(' ');
+      cells.push_back(b == std::string::npos ? "" : cell.substr(b, e - b + 1));
+    }
+    if (cells.size() < 7) continue;
+    const std::string preset = cells[1];
+    if (preset != "red-cotton" && preset != "white-cotton" && preset != "polyester-delustered")
+      continue;
+    if (cells[2].find_first_not_of("0123456789") != std::string::npos) continue;  // a range
+    const double nm = std::stod(cells[2]);
+    const MediumBand mb = compute_medium_band(load_fiber_spec(preset),
+                                              static_cast<int>(std::lround((nm - 390) / 10)));
+    const double values[4] = {mb.mu_s_per_um, mb.mu_a_per_um, mb.albedo, mb.g};
+    for (int k = 0; k < 4; ++k) {
+      const std::string& text = cells[3 + k];
+      const auto dot = text.find('.');
+      const double last_digit =
+          dot == std::string::npos ? 1 : std::pow(10.0, -static_cast<int>(text.size() - dot - 1));
+      EXPECT_NEAR(std::stod(text), values[k], 0.51 * last_digit)
+          << preset << " " << nm << " col " << k;
+    }
+    ++rows;
+  }
+  EXPECT_GE(rows, 6);
 }
