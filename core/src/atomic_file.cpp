@@ -1,5 +1,9 @@
 #include "weft/core/atomic_file.h"
 
+#include <unistd.h>
+
+#include <atomic>
+#include <cstdint>
 #include <fstream>
 #include <system_error>
 
@@ -12,8 +16,12 @@ void write_atomically(const std::filesystem::path& path,
   namespace fs = std::filesystem;
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
   if (!fs::is_directory(parent)) throw Error(path.string(), "", "output directory does not exist");
-  // Keep the extension last: writers such as OpenImageIO choose the format by it.
-  fs::path tmp = parent / (".tmp-" + path.stem().string() + "-partial" + path.extension().string());
+  // A name of its own per process and call, so that writers of one path never share a temporary;
+  // the extension last: writers such as OpenImageIO choose the format by it.
+  static std::atomic<uint64_t> calls{0};
+  const fs::path tmp =
+      parent / (".tmp-" + path.stem().string() + "-" + std::to_string(::getpid()) + "-" +
+                std::to_string(calls.fetch_add(1)) + "-partial" + path.extension().string());
   try {
     write(tmp);
   } catch (...) {

@@ -1,5 +1,10 @@
 #include "weft/materials/fabric/bake_cache.h"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <system_error>
 
 #include "weft/core/error.h"
@@ -17,18 +22,61 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
   return dir / ("fiber-" + fiber_spec_hash_hex(spec) + "-" + hex64(fnv1a64(key)) + ".exr");
 }
 
+namespace {
+
+// An entry is usable when it reads back whole (the table format checks sizes and a checksum).
+bool usable(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::exists(file, ec)) return false;
+  try {
+    TabulatedBsdfTable::read_exr(file);
+    return true;
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+// An exclusive lock on 'path' (created if missing), released when the holder closes it or dies:
+// processes that need the same entry wait here while one of them bakes it.
+class FileLock {
+ public:
+  explicit FileLock(const std::filesystem::path& path) {
+    fd_ = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (fd_ < 0) throw Error(path.string(), "", "cannot open the bake-cache lock");
+    while (::flock(fd_, LOCK_EX) != 0) {
+      if (errno != EINTR) {
+        ::close(fd_);
+        throw Error(path.string(), "", "cannot lock the bake cache");
+      }
+    }
+  }
+  ~FileLock() { ::close(fd_); }
+  FileLock(const FileLock&) = delete;
+  FileLock& operator=(const FileLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
+}  // namespace
+
 std::filesystem::path cached_fiber_table(const std::filesystem::path& dir, const FiberSpec& spec,
                                          const FiberTableBakeOptions& options,
-                                         const ProgressCallback& progress) {
+                                         const ProgressCallback& progress, bool* baked) {
+  if (baked) *baked = false;
   const std::filesystem::path file = fiber_table_cache_file(dir, spec, options);
+  if (usable(file)) return file;
   std::error_code ec;
-  if (std::filesystem::exists(file, ec)) return file;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error(dir.string(), "", "cannot create the bake cache folder: " + ec.message());
+  const FileLock lock(std::filesystem::path(file).concat(".lock"));
+  // Another process may have baked it while this one waited; a damaged entry is baked again.
+  if (usable(file)) return file;
   FiberTableBakeResult r = bake_fiber_table(spec, options, progress);
   if (r.cancelled) throw Error(file.string(), "", "bake interrupted; nothing was cached");
   r.table.metadata["cache_key"] = file.stem().string();
   r.table.write_exr(file);
+  if (baked) *baked = true;
   return file;
 }
 

@@ -2,6 +2,8 @@
 // furnace, the agreement of the direct and the paper's BSSRDF route, the fiber's symmetries,
 // reproducibility, extremes and table sampling. Definitions: docs/fiber-bsdf.md.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -377,4 +379,71 @@ TEST(FiberTableBake, SpecBakedForASceneInARelativeFolderLoadsItsOwnCache) {
         << e.what();
   }
   fs::remove_all(rel.parent_path());
+}
+
+namespace {
+
+// Runs cached_fiber_table in 'n' processes started together; returns how many baked, and whether
+// every one succeeded.
+std::pair<int, bool> bake_in_processes(int n, const std::filesystem::path& dir) {
+  FiberTableBakeOptions o;
+  o.resolution = 2;
+  o.photons_per_band = 2000;
+  o.spectral = false;
+  o.threads = 1;
+  const FiberSpec spec = load_fiber_spec("white-cotton");
+  std::vector<pid_t> children;
+  for (int i = 0; i < n; ++i) {
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      int code = 2;
+      try {
+        bool baked = false;
+        const auto file = cached_fiber_table(dir, spec, o, no_progress(), &baked);
+        TabulatedBsdfTable::read_exr(file);  // whole, whoever wrote it
+        code = baked ? 1 : 0;
+      } catch (...) {
+      }
+      ::_exit(code);
+    }
+    children.push_back(pid);
+  }
+  int baked = 0;
+  bool ok = true;
+  for (pid_t pid : children) {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    if (!WIFEXITED(status) || WEXITSTATUS(status) > 1) ok = false;
+    baked += WIFEXITED(status) && WEXITSTATUS(status) == 1;
+  }
+  return {baked, ok};
+}
+
+}  // namespace
+
+TEST(FiberTableBake, ConcurrentProcessesBakeACacheEntryOnce) {
+  // Two and four processes that need the same table at once: one bakes, the others wait for it
+  // and reuse it (no failed rename, no second bake), and a truncated entry is baked again.
+  namespace fs = std::filesystem;
+  for (int n : {2, 4}) {
+    const fs::path dir = fs::temp_directory_path() / ("weft-cache-race-" + std::to_string(n));
+    fs::remove_all(dir);
+    const auto [baked, ok] = bake_in_processes(n, dir);
+    EXPECT_TRUE(ok) << n << " processes";
+    EXPECT_EQ(baked, 1) << n << " processes";
+    // Exactly one entry (and its lock), no temporaries left behind.
+    int tables = 0;
+    for (const auto& e : fs::directory_iterator(dir)) {
+      EXPECT_NE(e.path().filename().string().rfind(".tmp-", 0), 0u) << e.path();
+      tables += e.path().extension() == ".exr";
+    }
+    EXPECT_EQ(tables, 1);
+  }
+  // Damage the entry: the next process bakes it again instead of failing.
+  const fs::path dir = fs::temp_directory_path() / "weft-cache-race-2";
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().extension() == ".exr") fs::resize_file(e.path(), fs::file_size(e.path()) / 2);
+  const auto [baked, ok] = bake_in_processes(1, dir);
+  EXPECT_TRUE(ok);
+  EXPECT_EQ(baked, 1);
 }

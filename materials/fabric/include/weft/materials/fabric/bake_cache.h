@@ -16,11 +16,15 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
                                              const FiberSpec& spec,
                                              const FiberTableBakeOptions& options);
 
-// The table for (spec, options) in 'dir': read from the cache when present, else baked (progress
-// through 'progress') and written atomically. Error when interrupted (nothing is written).
+// The table for (spec, options) in 'dir': read from the cache when present and whole, else baked
+// (progress through 'progress') and written atomically; a damaged entry is baked again. Safe when
+// several processes need the same entry at once: one bakes (under an exclusive lock on the
+// entry's ".lock" file, which the system releases if the process dies), the others wait and reuse
+// its result. 'baked' (may be null) says whether this call baked. Error when interrupted (nothing
+// is written).
 std::filesystem::path cached_fiber_table(const std::filesystem::path& dir, const FiberSpec& spec,
                                          const FiberTableBakeOptions& options,
-                                         const ProgressCallback& progress);
+                                         const ProgressCallback& progress, bool* baked = nullptr);
 
 // The material registry's FiberTableResolver: reads "spec" (a spec file relative to the scene's
 // folder, or a preset name) and the optional bake settings "resolution", "photons", "seed"
