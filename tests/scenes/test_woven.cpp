@@ -4,7 +4,6 @@
 // (vertical rays through the triangles, segment distances), not on the generator's formulas.
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -634,11 +633,9 @@ TEST(Woven, BadParametersAreErrorsNamingTheField) {
   // Absurd sizes are refused from an estimate, before anything is allocated.
   o = defaults();
   o.repeats_x = o.repeats_z = 1000;
-  const auto t0 = std::chrono::steady_clock::now();
   expect(o, "repeats");
   o.detail = "fiber";
   expect(o, "packing");
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1.0);
 }
 
 TEST(Woven, PositiveTwistIsAZTwistRightHandedHelix) {
