@@ -333,8 +333,10 @@ TEST(FiberTableBake, FiberTableMaterialBakesASpecOnDemandOnce) {
   EXPECT_EQ(a.eval(wo, wi), b.eval(wo, wi));
   // Another photon count is another table.
   make_bsdf("fiber_table", {{"spec", "white-cotton"}, {"resolution", 4}, {"photons", 300}}, ctx);
-  EXPECT_EQ(std::distance(fs::directory_iterator(dir / ".weft-cache"), fs::directory_iterator{}),
-            2);
+  int tables = 0;
+  for (const auto& e : fs::directory_iterator(dir / ".weft-cache"))
+    tables += e.path().extension() == ".exr";
+  EXPECT_EQ(tables, 2);
   // Bad parameters name the field.
   for (const auto& [bad, field] : std::vector<std::pair<nlohmann::json, std::string>>{
            {{{"spec", "white-cotton"}, {"file", "x.exr"}}, "spec"},
