@@ -63,12 +63,13 @@ struct FiberBandPhysics {
 FiberBandPhysics smooth_fiber_physics(const TransportMedium& medium, double radius,
                                       double n_outside, TransportOptions options = {});
 
-// Directional albedo of a Cook-Torrance lobe at cos theta, tabulated in cos theta and
-// interpolated linearly; computed by a deterministic stratified quadrature of the sample weights.
+// Directional albedo of a Cook-Torrance lobe at cos theta, tabulated at nodes uniform in
+// sqrt(cos theta) (dense at grazing angles) and interpolated linearly; computed by a
+// deterministic stratified quadrature of the sample weights.
 class SurfaceAlbedoTable {
  public:
   SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes = 129,
-                     int samples_per_side = 48);
+                     int samples_per_side = 64);
   double operator()(double cos_theta) const;
 
  private:
