@@ -6,6 +6,7 @@
 
 #include <filesystem>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/integrators/gonio.h"
 #include "weft/integrators/render_settings.h"
@@ -33,16 +34,7 @@ SceneDescription with(const std::string& section, const json& value) {
   return parse_scene_description(j, ".", "scene.json");
 }
 
-// The message of the Error that reading the settings throws ("" when none).
-template <class Read>
-std::string error_of(Read read) {
-  try {
-    read();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using weft::testing::error_of;
 
 std::string render_error(const json& render) {
   return error_of([&] { render_settings_from(with("render", render)); });

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/gltf.h"
@@ -90,13 +91,8 @@ TEST(Weave, RoundTripAndOverUnderSeenByRays) {
 }
 
 TEST(Weave, BadParametersAreErrors) {
-  auto error_of = [](WeaveParams p) -> std::string {
-    try {
-      make_weave(p);
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "";
+  auto error_of = [](const WeaveParams& p) {
+    return weft::testing::error_of([&] { make_weave(p); });
   };
   WeaveParams p;
   p.spacing_mm = 0.15;

@@ -11,6 +11,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 #include "weft/scenes/gltf.h"
@@ -91,12 +92,7 @@ double worst_overlap(const WovenSample& s, int n) {
 }
 
 std::string error_of(const WeaveOptions& o) {
-  try {
-    make_woven_sample(o);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of([&] { make_woven_sample(o); });
 }
 
 // Minimum distance between segments of distinct curves by brute force over all pairs and the
