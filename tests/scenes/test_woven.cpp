@@ -11,6 +11,7 @@
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "mesh_checks.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
@@ -454,22 +455,11 @@ TEST(Woven, YarnTubesHaveOutwardNormalsAndTangentsAlongTheYarn) {
   for (int mi = 0; mi < 2; ++mi) {
     const TriangleMesh& m = s.meshes[mi];
     const Vec3 axis = mi == 0 ? Vec3{1, 0, 0} : Vec3{0, 0, 1};
-    for (size_t v = 0; v < m.vertex_count(); ++v) {
-      const Vec3 n{m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
-      const Vec3 t{m.tangents[4 * v], m.tangents[4 * v + 1], m.tangents[4 * v + 2]};
-      EXPECT_NEAR(length(n), 1, 1e-6);
-      EXPECT_NEAR(dot(n, t), 0, 1e-6);
+    weft::testing::expect_consistent_frames(m, [&](size_t v, const Vec3& t) {
       EXPECT_GT(std::abs(dot(t, axis)), 0.7);  // crimp slope at most about 37 degrees
       EXPECT_GE(m.uvs[2 * v], 0.0f);
       EXPECT_LE(m.uvs[2 * v], 1.0f);
-    }
-    for (size_t t = 0; t < m.triangle_count(); ++t) {
-      const uint32_t i0 = m.indices[3 * t];
-      const Vec3 p0 = m.position(i0);
-      const Vec3 ng =
-          cross(m.position(m.indices[3 * t + 1]) - p0, m.position(m.indices[3 * t + 2]) - p0);
-      EXPECT_GT(dot(ng, Vec3{m.normals[3 * i0], m.normals[3 * i0 + 1], m.normals[3 * i0 + 2]}), 0);
-    }
+    });
   }
 }
 
