@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -566,54 +567,43 @@ TEST(Woven, BundledSampleDescriptionIsTheDefault) {
 }
 
 TEST(Woven, BadParametersAreErrorsNamingTheField) {
-  auto expect = [](WeaveOptions o, const std::string& field) {
+  auto expect = [](const WeaveOptions& o, const std::string& field) {
     const std::string e = error_of(o);
     EXPECT_NE(e.find("field '" + field + "'"), std::string::npos) << field << ": " << e;
   };
+  // Each case changes the defaults once; its error must name the field.
+  using Change = std::function<void(WeaveOptions&)>;
+  const std::pair<std::string, Change> cases[] = {
+      // Wider than its spacing 0.2117.
+      {"warp-width-mm", [](WeaveOptions& o) { o.warp_width_mm = 0.3; }},
+      {"weft-spacing-mm", [](WeaveOptions& o) { o.weft_spacing_mm = -1; }},
+      {"warp-thickness-mm", [](WeaveOptions& o) { o.warp_thickness_mm = NAN; }},
+      {"detail", [](WeaveOptions& o) { o.detail = "cloud"; }},
+      {"repeats", [](WeaveOptions& o) { o.repeats_x = 0; }},
+      {"pattern", [](WeaveOptions& o) { o.pattern = "satin:6"; }},
+      // All crimp in the weft, whose crossing warps fill their spacing.
+      {"warp-crimp-share", [](WeaveOptions& o) { o.warp_crimp_share = 0; }},
+      {"sides", [](WeaveOptions& o) { o.sides = 2; }},
+      {"fiber-radius-um", [](WeaveOptions& o) { o.fiber_radius_um = 0; }},
+      {"packing", [](WeaveOptions& o) { o.fibers_per_yarn = 10; }},            // both given
+      {"twist-angle-deg", [](WeaveOptions& o) { o.twist_angle_deg = 20; }},    // both given
+      {"ply-twist-per-mm", [](WeaveOptions& o) { o.ply_twist_per_mm = -1; }},  // needs plies
+      {"wif", [](WeaveOptions& o) { o.wif = "/no/such/draft.wif"; }},          // and a pattern
+  };
+  for (const auto& [field, change] : cases) {
+    WeaveOptions o = defaults();
+    change(o);
+    expect(o, field);
+  }
+  // More fibers than fit: the error says how many do.
   WeaveOptions o = defaults();
-  o.warp_width_mm = 0.3;  // wider than its spacing 0.2117
-  expect(o, "warp-width-mm");
-  o = defaults();
-  o.weft_spacing_mm = -1;
-  expect(o, "weft-spacing-mm");
-  o = defaults();
-  o.warp_thickness_mm = NAN;
-  expect(o, "warp-thickness-mm");
-  o = defaults();
-  o.detail = "cloud";
-  expect(o, "detail");
-  o = defaults();
-  o.repeats_x = 0;
-  expect(o, "repeats");
-  o = defaults();
-  o.pattern = "satin:6";
-  expect(o, "pattern");
-  o = defaults();
-  o.warp_crimp_share = 0;  // all crimp in the weft, whose crossing warps fill their spacing
-  expect(o, "warp-crimp-share");
-  o = defaults();
-  o.sides = 2;
-  expect(o, "sides");
-  o = defaults();
-  o.fiber_radius_um = 0;
-  expect(o, "fiber-radius-um");
-  o = defaults();
   o.detail = "fiber";
-  o.packing = 0.6;  // more fibers than fit
+  o.packing = 0.6;
   expect(o, "packing");
   EXPECT_NE(error_of(o).find("at most"), std::string::npos);
-  o = defaults();
-  o.fibers_per_yarn = 10;
-  expect(o, "packing");  // both given
-  o = defaults();
-  o.twist_angle_deg = 20;
-  expect(o, "twist-angle-deg");  // both given
-  o = defaults();
-  o.ply_twist_per_mm = -1;
-  expect(o, "ply-twist-per-mm");  // needs plies
+  // A missing draft is named.
   o = defaults();
   o.wif = "/no/such/draft.wif";
-  expect(o, "wif");  // and a pattern
   o.pattern.reset();
   EXPECT_NE(error_of(o).find("/no/such/draft.wif"), std::string::npos);
   // Absurd sizes are refused from an estimate, before anything is allocated.
