@@ -48,10 +48,15 @@ void write(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
 }
 
-// A refused input: exit code 2 and an error that mentions 'part'.
-void expect_refused(const CliRun& r, const std::string& part) {
+// Runs 'args' with '-o output' and expects a refusal: exit code 2, an error that mentions 'part',
+// and nothing at 'output'. Returns the run for more checks of its message.
+CliRun expect_refused(const std::string& args, const fs::path& output, const std::string& part,
+                      const fs::path& dir) {
+  const CliRun r = run(args + " -o '" + output.string() + "'", dir);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(output));
+  return r;
 }
 
 // Outputs are written atomically: no temporary (".tmp-*") may be left in 'dir'.
@@ -115,25 +120,19 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
       {"truncated", good.substr(0, good.size() / 2), ""},
   };
   for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
     const fs::path spec = dir / (c.name + ".json");
     write(spec, c.text);
-    const fs::path out = dir / (c.name + ".exr");
-    const CliRun r = run(
-        "bake fiber '" + spec.string() + "' --photons 10 --quiet -o '" + out.string() + "'", dir);
-    EXPECT_EQ(r.exit_code, 2) << c.name << ": " << r.err;
-    EXPECT_NE(r.err.find(spec.filename().string()), std::string::npos) << c.name << ": " << r.err;
+    const CliRun r = expect_refused("bake fiber '" + spec.string() + "' --photons 10 --quiet",
+                                    dir / (c.name + ".exr"), spec.filename().string(), dir);
     if (!c.expect_in_error.empty()) {
-      EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << c.name << ": " << r.err;
+      EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << r.err;
     }
-    EXPECT_FALSE(fs::exists(out)) << c.name;
   }
   // A missing file is named, and the presets are listed.
-  const CliRun missing =
-      run("bake fiber '" + (dir / "nope.json").string() + "' -o '" + (dir / "x.exr").string() + "'",
-          dir);
-  expect_refused(missing, "nope.json");
+  const CliRun missing = expect_refused("bake fiber '" + (dir / "nope.json").string() + "'",
+                                        dir / "x.exr", "nope.json", dir);
   EXPECT_NE(missing.err.find("red-cotton"), std::string::npos) << missing.err;
-  EXPECT_FALSE(fs::exists(dir / "x.exr"));
   // Leftover temporaries would be half-written outputs.
   expect_no_temporaries(dir);
 }
@@ -247,25 +246,16 @@ TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
   const CliRun legacy =
       run("weave --yarns 2 --segments 8 --sides 4 -o '" + (dir / "l.gltf").string() + "'", dir);
   EXPECT_EQ(legacy.exit_code, 0) << legacy.err;
-  const CliRun mixed =
-      run("weave --yarns 2 --detail fiber -o '" + (dir / "m.gltf").string() + "'", dir);
-  expect_refused(mixed, "detail");
+  expect_refused("weave --yarns 2 --detail fiber", dir / "m.gltf", "detail", dir);
   // A malformed draft: error naming file, section and key; non-zero exit; nothing written.
   write(dir / "bad.wif",
         "[WEAVING]\nShafts=2\nTreadles=2\n[WARP]\nThreads=2\n[WEFT]\nThreads=2\n"
         "[THREADING]\n1=1\n2=3\n[TIEUP]\n1=1\n2=2\n[TREADLING]\n1=1\n2=2\n");
-  const CliRun bad =
-      run("weave --wif '" + (dir / "bad.wif").string() + "' -o '" + (dir / "b.glb").string() + "'",
-          dir);
-  expect_refused(bad, "bad.wif");
+  const CliRun bad = expect_refused("weave --wif '" + (dir / "bad.wif").string() + "'",
+                                    dir / "b.glb", "bad.wif", dir);
   EXPECT_NE(bad.err.find("[THREADING] 2"), std::string::npos) << bad.err;
-  EXPECT_FALSE(fs::exists(dir / "b.glb"));
   // Sizes: a yarn wider than its spacing, absurd repeats.
-  const CliRun wide = run("weave --yarn-width-mm 0.5 -o '" + (dir / "w.glb").string() + "'", dir);
-  expect_refused(wide, "warp-width-mm");
-  const CliRun huge = run("weave --repeats 1000x1000 -o '" + (dir / "h.glb").string() + "'", dir);
-  expect_refused(huge, "repeats");
-  EXPECT_FALSE(fs::exists(dir / "w.glb"));
-  EXPECT_FALSE(fs::exists(dir / "h.glb"));
+  expect_refused("weave --yarn-width-mm 0.5", dir / "w.glb", "warp-width-mm", dir);
+  expect_refused("weave --repeats 1000x1000", dir / "h.glb", "repeats", dir);
   expect_no_temporaries(dir);
 }
