@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "weft/core/error.h"
+#include "weft/integrators/path_tracer.h"
+#include "weft/scenes/description.h"
 
 namespace weft::cli {
 namespace {
@@ -67,6 +69,23 @@ ProgressCallback progress_bar(bool quiet) {
     }
     return !g_interrupted.load();
   };
+}
+
+SceneDescription load_scene_reporting_warnings(const std::string& path) {
+  SceneDescription desc = load_scene_description(path);
+  for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
+  return desc;
+}
+
+int report_render_outcome(const RenderOutcome& r, const std::string& what) {
+  if (r.cancelled) {
+    std::fprintf(stderr, "\nweft: %s cancelled; nothing was written\n", what.c_str());
+    return 130;
+  }
+  if (r.nonfinite_samples)
+    std::fprintf(stderr, "weft: warning: %llu non-finite samples were dropped\n",
+                 static_cast<unsigned long long>(r.nonfinite_samples));
+  return 0;
 }
 
 std::optional<double> finite_number(const std::string& text) {

@@ -9,6 +9,11 @@
 
 #include "weft/core/progress.h"
 
+namespace weft {
+struct RenderOutcome;
+struct SceneDescription;
+}  // namespace weft
+
 namespace weft::cli {
 
 // A subcommand: its CLI11 app and what to run when it was chosen. run() returns the exit code.
@@ -24,6 +29,13 @@ ProgressCallback progress_bar(bool quiet);
 // Installs the SIGINT handler used by progress_bar (idempotent).
 void install_interrupt_handler();
 bool interrupted();
+
+// The scene description at 'path', its warnings printed on stderr (commands that render it).
+SceneDescription load_scene_reporting_warnings(const std::string& path);
+// The end of a render on stderr, alike for every command that renders: a cancelled run says that
+// 'what' wrote nothing and gives exit code 130; dropped non-finite samples are a warning.
+// Returns the exit code to stop with, or 0 to go on to the outputs.
+int report_render_outcome(const RenderOutcome& r, const std::string& what);
 
 // The finite number that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
 std::optional<double> finite_number(const std::string& text);

@@ -44,8 +44,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
       {sub, [o, seed] {
          if (!o->mask.empty() && o->mask_object.empty())
            throw Error("", "--mask-object", "is required with --mask");
-         const SceneDescription desc = load_scene_description(o->scene);
-         for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
+         const SceneDescription desc = load_scene_reporting_warnings(o->scene);
          RenderJob job;
          job.exr = o->output;
          if (!o->preview.empty()) job.png = o->preview;
@@ -63,13 +62,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
              render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());
          const double sec =
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-         if (r.cancelled) {
-           std::fprintf(stderr, "\nweft: render cancelled; nothing was written\n");
-           return 130;
-         }
-         if (r.nonfinite_samples)
-           std::fprintf(stderr, "weft: warning: %llu non-finite samples were dropped\n",
-                        static_cast<unsigned long long>(r.nonfinite_samples));
+         if (const int code = report_render_outcome(r, "render")) return code;
          if (o->json) {
            nlohmann::json j = {{"output", o->output},
                                {"width", job.settings.width},

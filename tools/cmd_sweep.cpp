@@ -59,8 +59,7 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--json", o->json, "also print the rows as JSON on stdout");
   commands.push_back(
       {sub, [o, lz, la, va, irr, seed] {
-         const SceneDescription desc = load_scene_description(o->scene);
-         for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
+         const SceneDescription desc = load_scene_reporting_warnings(o->scene);
          GonioSettings g = gonio_settings_from(desc);
          if (lz->count())
            g.light_zenith_deg = o->light_zenith;
@@ -90,13 +89,7 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          if (!parent.empty() && !std::filesystem::is_directory(parent))
            throw Error(o->output, "", "output directory does not exist");
          const GonioResult r = run_gonio(desc, g, progress_bar(o->quiet), fiber_table_resolver());
-         if (r.cancelled) {
-           std::fprintf(stderr, "\nweft: sweep cancelled; nothing was written\n");
-           return 130;
-         }
-         if (r.nonfinite_samples)
-           std::fprintf(stderr, "weft: warning: %llu non-finite samples were dropped\n",
-                        static_cast<unsigned long long>(r.nonfinite_samples));
+         if (const int code = report_render_outcome(r, "sweep")) return code;
          write_text_atomically(o->output, gonio_csv(r));
          if (o->json) {
            nlohmann::json rows = nlohmann::json::array();

@@ -82,14 +82,17 @@ void add_weave_command(CLI::App& app, Commands& commands) {
   sub->add_option("--wif", o->w.wif, "WIF weaving draft (replaces --pattern)");
   sub->add_option("--detail", o->w.detail, "yarn (closed tubes) | fiber (round curves)");
   sub->add_option("--repeats", o->repeats, "copies of the repeat, N or NxM (x by z)");
-  sub->add_option("--warp-spacing-mm", o->w.warp_spacing_mm, "warp centre-to-centre distance");
-  sub->add_option("--weft-spacing-mm", o->w.weft_spacing_mm, "weft centre-to-centre distance");
+  // Thread sizes come per direction: --warp-<size>-mm and --weft-<size>-mm.
+  auto add_sizes = [&](const std::string& size, const std::string& what,
+                       std::optional<double>& warp, std::optional<double>& weft) {
+    sub->add_option("--warp-" + size + "-mm", warp, "warp " + what);
+    sub->add_option("--weft-" + size + "-mm", weft, "weft " + what);
+  };
+  add_sizes("spacing", "centre-to-centre distance", o->w.warp_spacing_mm, o->w.weft_spacing_mm);
   sub->add_option("--yarn-width-mm", o->yarn_width_mm, "width of warp and weft yarns");
   sub->add_option("--yarn-thickness-mm", o->yarn_thickness_mm, "thickness of warp and weft yarns");
-  sub->add_option("--warp-width-mm", o->w.warp_width_mm, "warp yarn width");
-  sub->add_option("--weft-width-mm", o->w.weft_width_mm, "weft yarn width");
-  sub->add_option("--warp-thickness-mm", o->w.warp_thickness_mm, "warp yarn thickness");
-  sub->add_option("--weft-thickness-mm", o->w.weft_thickness_mm, "weft yarn thickness");
+  add_sizes("width", "yarn width", o->w.warp_width_mm, o->w.weft_width_mm);
+  add_sizes("thickness", "yarn thickness", o->w.warp_thickness_mm, o->w.weft_thickness_mm);
   sub->add_option("--warp-crimp-share", o->w.warp_crimp_share,
                   "share of the crimp height carried by the warp, [0, 1]; < 0: balanced");
   sub->add_option("--segments-per-crossing", o->w.segments_per_crossing,
@@ -129,18 +132,17 @@ void add_weave_command(CLI::App& app, Commands& commands) {
            parse_repeats(o->repeats, nx, nz);
            given.repeats_x = nx, given.repeats_z = nz;
          }
-         if (o->yarn_width_mm) {
-           if (given.warp_width_mm || given.weft_width_mm)
-             throw Error("", "yarn-width-mm",
-                         "give it or --warp-width-mm/--weft-width-mm, not both");
-           given.warp_width_mm = given.weft_width_mm = o->yarn_width_mm;
-         }
-         if (o->yarn_thickness_mm) {
-           if (given.warp_thickness_mm || given.weft_thickness_mm)
-             throw Error("", "yarn-thickness-mm",
-                         "give it or --warp-thickness-mm/--weft-thickness-mm, not both");
-           given.warp_thickness_mm = given.weft_thickness_mm = o->yarn_thickness_mm;
-         }
+         // --yarn-<size>-mm sets both directions' size, instead of either of its own options.
+         auto both = [](const std::optional<double>& yarn, const std::string& size,
+                        std::optional<double>& warp, std::optional<double>& weft) {
+           if (!yarn) return;
+           if (warp || weft)
+             throw Error("", "yarn-" + size + "-mm",
+                         "give it or --warp-" + size + "-mm/--weft-" + size + "-mm, not both");
+           warp = weft = yarn;
+         };
+         both(o->yarn_width_mm, "width", given.warp_width_mm, given.weft_width_mm);
+         both(o->yarn_thickness_mm, "thickness", given.warp_thickness_mm, given.weft_thickness_mm);
          auto one_of = [](bool a, bool b, const char* field, const char* what) {
            if (a && b) throw Error("", field, std::string("give either ") + what + ", not both");
          };

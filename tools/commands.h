@@ -4,22 +4,18 @@
 
 namespace weft::cli {
 
-void add_slab_command(CLI::App& app, Commands& commands);
-void add_spectrum_command(CLI::App& app, Commands& commands);
-void add_bake_command(CLI::App& app, Commands& commands);
-void add_bench_command(CLI::App& app, Commands& commands);
-void add_mie_command(CLI::App& app, Commands& commands);
-void add_medium_command(CLI::App& app, Commands& commands);
-void add_table_command(CLI::App& app, Commands& commands);
-void add_render_command(CLI::App& app, Commands& commands);
-void add_sweep_command(CLI::App& app, Commands& commands);
-void add_weave_command(CLI::App& app, Commands& commands);
-void add_compare_command(CLI::App& app, Commands& commands);
+// What each cmd_*.cpp provides: adds its subcommand (and its runner) under 'parent'. One
+// signature for all, so main.cpp can hold them in a list.
+using AddCommand = void(CLI::App& parent, Commands& commands);
+
+AddCommand add_slab_command, add_spectrum_command, add_bake_command, add_bench_command,
+    add_mie_command, add_medium_command, add_table_command, add_render_command, add_sweep_command,
+    add_weave_command, add_compare_command;
+
 // The "fabric" subcommand of the "bake" group (cmd_bake_fabric.cpp).
-void add_bake_fabric_command(CLI::App& bake, Commands& commands);
+AddCommand add_bake_fabric_command;
 
 // The subcommands of "bench" (cmd_bench.cpp makes the group).
-void add_bench_bake_command(CLI::App& bench, Commands& commands);
-void add_bench_render_command(CLI::App& bench, Commands& commands);
+AddCommand add_bench_bake_command, add_bench_render_command;
 
 }  // namespace weft::cli

@@ -11,17 +11,14 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", WEFT_VERSION);
   app.require_subcommand(1);
   weft::cli::Commands commands;
-  weft::cli::add_slab_command(app, commands);
-  weft::cli::add_spectrum_command(app, commands);
-  weft::cli::add_bake_command(app, commands);
-  weft::cli::add_bench_command(app, commands);
-  weft::cli::add_mie_command(app, commands);
-  weft::cli::add_medium_command(app, commands);
-  weft::cli::add_table_command(app, commands);
-  weft::cli::add_render_command(app, commands);
-  weft::cli::add_sweep_command(app, commands);
-  weft::cli::add_weave_command(app, commands);
-  weft::cli::add_compare_command(app, commands);
+  // In the order `weft --help` lists them.
+  namespace cli = weft::cli;
+  for (cli::AddCommand* add :
+       {cli::add_slab_command, cli::add_spectrum_command, cli::add_bake_command,
+        cli::add_bench_command, cli::add_mie_command, cli::add_medium_command,
+        cli::add_table_command, cli::add_render_command, cli::add_sweep_command,
+        cli::add_weave_command, cli::add_compare_command})
+    add(app, commands);
 
   try {
     app.parse(argc, argv);

@@ -66,40 +66,36 @@ std::vector<Ray> diffuse_rays(const SceneDescription& desc, size_t n, uint64_t s
   return rays;
 }
 
-double embree_rate(const RenderScene& scene, const std::vector<Ray>& rays, int threads) {
-  const uint64_t chunk = 4096, chunks = (rays.size() + chunk - 1) / chunk;
+// Queries per second of 'threads' threads answering query(i) for i in [0, n), in chunks of 4096.
+// The answers (0 or 1 each) are summed so the work stays observable; 0 if that sum is impossible.
+template <class Query>
+double query_rate(size_t n, int threads, Query query) {
+  const uint64_t chunk = 4096, chunks = (n + chunk - 1) / chunk;
   std::vector<uint64_t> hits(chunks, 0);
   const auto t0 = Clock::now();
   parallel_for(chunks, threads, [&](uint64_t c) {
     uint64_t h = 0;
-    const size_t end = std::min<size_t>(rays.size(), (c + 1) * chunk);
-    for (size_t i = c * chunk; i < end; ++i)
-      h += std::isfinite(embree_hit_distance(scene, to_embree(rays[i], false)));
-    hits[c] = h;  // keeps the work observable
-  });
-  const double s = seconds_since(t0);
-  uint64_t total = 0;
-  for (auto h : hits) total += h;
-  return total <= rays.size() ? rays.size() / s : 0;
-}
-
-double replay_rate(const RenderScene& scene, const std::vector<EmbreeRay>& log, int threads) {
-  const uint64_t chunk = 4096, chunks = (log.size() + chunk - 1) / chunk;
-  std::vector<uint64_t> hits(chunks, 0);
-  const auto t0 = Clock::now();
-  parallel_for(chunks, threads, [&](uint64_t c) {
-    uint64_t h = 0;
-    const size_t end = std::min<size_t>(log.size(), (c + 1) * chunk);
-    for (size_t i = c * chunk; i < end; ++i) {
-      const EmbreeRay& r = log[i];
-      h += r.shadow ? embree_occluded(scene, r) : std::isfinite(embree_hit_distance(scene, r));
-    }
+    const size_t end = std::min<size_t>(n, (c + 1) * chunk);
+    for (size_t i = c * chunk; i < end; ++i) h += query(i);
     hits[c] = h;
   });
   const double s = seconds_since(t0);
   uint64_t total = 0;
   for (auto h : hits) total += h;
-  return total <= log.size() ? log.size() / s : 0;
+  return total <= n ? n / s : 0;
+}
+
+double embree_rate(const RenderScene& scene, const std::vector<Ray>& rays, int threads) {
+  return query_rate(rays.size(), threads, [&](size_t i) {
+    return std::isfinite(embree_hit_distance(scene, to_embree(rays[i], false)));
+  });
+}
+
+double replay_rate(const RenderScene& scene, const std::vector<EmbreeRay>& log, int threads) {
+  return query_rate(log.size(), threads, [&](size_t i) {
+    const EmbreeRay& r = log[i];
+    return r.shadow ? embree_occluded(scene, r) : std::isfinite(embree_hit_distance(scene, r));
+  });
 }
 
 // Seconds for a fixed amount of floating-point work split into tasks, on 'threads' threads.
@@ -140,15 +136,24 @@ EmbreeRay to_embree(const Ray& ray, bool shadow) {
           shadow};
 }
 
+namespace {
+// The ray of either bare query: r from tnear 0 to its tmax, seen by every geometry.
+RTCRay rtc_ray(const EmbreeRay& r) {
+  RTCRay ray;
+  ray.org_x = r.org[0], ray.org_y = r.org[1], ray.org_z = r.org[2];
+  ray.dir_x = r.dir[0], ray.dir_y = r.dir[1], ray.dir_z = r.dir[2];
+  ray.tnear = 0.0f;
+  ray.tfar = r.tmax;
+  ray.mask = 0xFFFFFFFFu;
+  ray.time = 0.0f;
+  ray.flags = 0;
+  return ray;
+}
+}  // namespace
+
 double embree_hit_distance(const RenderScene& scene, const EmbreeRay& r) {
   RTCRayHit rh;
-  rh.ray.org_x = r.org[0], rh.ray.org_y = r.org[1], rh.ray.org_z = r.org[2];
-  rh.ray.dir_x = r.dir[0], rh.ray.dir_y = r.dir[1], rh.ray.dir_z = r.dir[2];
-  rh.ray.tnear = 0.0f;
-  rh.ray.tfar = r.tmax;
-  rh.ray.mask = 0xFFFFFFFFu;
-  rh.ray.time = 0.0f;
-  rh.ray.flags = 0;
+  rh.ray = rtc_ray(r);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   RTCIntersectContext ctx;
@@ -158,14 +163,7 @@ double embree_hit_distance(const RenderScene& scene, const EmbreeRay& r) {
 }
 
 bool embree_occluded(const RenderScene& scene, const EmbreeRay& r) {
-  RTCRay ray;
-  ray.org_x = r.org[0], ray.org_y = r.org[1], ray.org_z = r.org[2];
-  ray.dir_x = r.dir[0], ray.dir_y = r.dir[1], ray.dir_z = r.dir[2];
-  ray.tnear = 0.0f;
-  ray.tfar = r.tmax;
-  ray.mask = 0xFFFFFFFFu;
-  ray.time = 0.0f;
-  ray.flags = 0;
+  RTCRay ray = rtc_ray(r);
   RTCIntersectContext ctx;
   rtcInitIntersectContext(&ctx);
   rtcOccluded1(scene.embree_scene(), &ctx, &ray);

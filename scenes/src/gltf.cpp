@@ -306,30 +306,41 @@ void load_primitive(const Ctx& c, const tinygltf::Primitive& prim, const Affine&
   auto mesh = std::make_shared<TriangleMesh>();
   mesh->material = material_key(c, prim.material, field + ".material");
   mesh->names = names;
+  // Vertex v of a packed attribute ('stride' values per vertex) and of the mesh's float arrays.
+  auto vertex = [](const std::vector<double>& a, int stride, size_t v) {
+    return Vec3{a[stride * v], a[stride * v + 1], a[stride * v + 2]};
+  };
+  auto store = [](std::vector<float>& a, int stride, size_t v, const Vec3& x) {
+    for (int k = 0; k < 3; ++k) a[stride * v + k] = static_cast<float>(x[k]);
+  };
+  // A direction through the linear part of 'm', normalized; 'len' is its length before (a zero
+  // direction stays zero).
+  auto unit = [](const Affine& m, const Vec3& d, double& len) {
+    const Vec3 x = m.vector(d);
+    len = length(x);
+    return len > 0 ? x / len : x;
+  };
   mesh->positions.resize(3 * nv);
   for (size_t v = 0; v < nv; ++v) {
-    const Vec3 p = world.point({pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]});
+    const Vec3 p = world.point(vertex(pos, 3, v));
     if (!is_finite(p) || std::abs(p.x) > 1e30 || std::abs(p.y) > 1e30 || std::abs(p.z) > 1e30)
       fail(c, af + "POSITION", "position out of range after transform");
-    for (int k = 0; k < 3; ++k) mesh->positions[3 * v + k] = static_cast<float>(p[k]);
+    store(mesh->positions, 3, v, p);
   }
   if (!nrm.empty()) {
     mesh->normals.resize(3 * nv);
     for (size_t v = 0; v < nv; ++v) {
-      Vec3 n = nm.vector({nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]});
-      const double len = length(n);
+      double len = 0;
+      const Vec3 n = unit(nm, vertex(nrm, 3, v), len);
       if (!(len > 0)) fail(c, af + "NORMAL", "zero normal at vertex " + std::to_string(v));
-      n = n / len;
-      for (int k = 0; k < 3; ++k) mesh->normals[3 * v + k] = static_cast<float>(n[k]);
+      store(mesh->normals, 3, v, n);
     }
   }
   if (!tan.empty()) {
     mesh->tangents.resize(4 * nv);
     for (size_t v = 0; v < nv; ++v) {
-      Vec3 t = world.vector({tan[4 * v], tan[4 * v + 1], tan[4 * v + 2]});
-      const double len = length(t);
-      if (len > 0) t = t / len;
-      for (int k = 0; k < 3; ++k) mesh->tangents[4 * v + k] = static_cast<float>(t[k]);
+      double len = 0;
+      store(mesh->tangents, 4, v, unit(world, vertex(tan, 4, v), len));
       // A mirroring transform flips the handedness of the tangent frame.
       mesh->tangents[4 * v + 3] =
           static_cast<float>((tan[4 * v + 3] < 0 ? -1.0 : 1.0) * (det < 0 ? -1 : 1));

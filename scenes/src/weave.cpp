@@ -164,18 +164,18 @@ Resolved resolve(const WeaveOptions& o) {
     warp.assign(r.repeat.warps, w);
     weft.assign(r.repeat.wefts, f);
   }
-  for (size_t i = 0; i < warp.size(); ++i)
-    if (warp[i].width_mm > warp[i].spacing_mm * (1 + 1e-12))
-      bad("warp-width-mm", "warp " + std::to_string(i + 1) + " is wider (" +
-                               ParamReader::fmt(warp[i].width_mm) + " mm) than its spacing (" +
-                               ParamReader::fmt(warp[i].spacing_mm) +
-                               " mm): neighbouring yarns would overlap");
-  for (size_t j = 0; j < weft.size(); ++j)
-    if (weft[j].width_mm > weft[j].spacing_mm * (1 + 1e-12))
-      bad("weft-width-mm", "pick " + std::to_string(j + 1) + " is wider (" +
-                               ParamReader::fmt(weft[j].width_mm) + " mm) than its spacing (" +
-                               ParamReader::fmt(weft[j].spacing_mm) +
-                               " mm): neighbouring yarns would overlap");
+  // A yarn wider than its spacing would overlap its neighbours; the same check each way.
+  auto check_widths = [](const std::vector<ThreadSize>& threads, const std::string& field,
+                         const std::string& thread_name) {
+    for (size_t k = 0; k < threads.size(); ++k)
+      if (threads[k].width_mm > threads[k].spacing_mm * (1 + 1e-12))
+        bad(field, thread_name + " " + std::to_string(k + 1) + " is wider (" +
+                       ParamReader::fmt(threads[k].width_mm) + " mm) than its spacing (" +
+                       ParamReader::fmt(threads[k].spacing_mm) +
+                       " mm): neighbouring yarns would overlap");
+  };
+  check_widths(warp, "warp-width-mm", "warp");
+  check_widths(weft, "weft-width-mm", "pick");
   // A WIF draft's threads have no crimp data: balanced unless given.
   double share = o.warp_crimp_share.value_or(from_wif ? -1.0 : kRedWarpCrimpShare);
   if (!std::isfinite(share) || share > 1) bad("warp-crimp-share", "must be <= 1 (< 0: balanced)");
@@ -249,57 +249,54 @@ Resolved resolve(const WeaveOptions& o) {
     for (int i = 0; i < L.tile.warps; ++i)
       L.tile.warp_over[static_cast<size_t>(j) * L.tile.warps + i] =
           r.repeat.over(i % r.repeat.warps, j % r.repeat.wefts);
-  std::vector<double> zc(L.tile.warps), xc(L.tile.wefts);
-  double acc = 0;
-  for (int i = 0; i < L.tile.warps; ++i) {
-    const double sp = warp[i % r.repeat.warps].spacing_mm;
-    zc[i] = acc + 0.5 * sp;
-    acc += sp;
-  }
-  L.period_z = acc;
-  acc = 0;
-  for (int j = 0; j < L.tile.wefts; ++j) {
-    const double sp = weft[j % r.repeat.wefts].spacing_mm;
-    xc[j] = acc + 0.5 * sp;
-    acc += sp;
-  }
-  L.period_x = acc;
-  for (double& z : zc) z -= 0.5 * L.period_z;
-  for (double& x : xc) x -= 0.5 * L.period_x;
+  // Centres of 'count' threads cycling through the repeat's sizes, laid side by side and centred
+  // on zero; 'period' is their total spacing. Warps lie along z, picks along x.
+  auto centres = [](const std::vector<ThreadSize>& sizes, int repeat, int count, double& period) {
+    std::vector<double> c(count);
+    double acc = 0;
+    for (int k = 0; k < count; ++k) {
+      const double sp = sizes[k % repeat].spacing_mm;
+      c[k] = acc + 0.5 * sp;
+      acc += sp;
+    }
+    period = acc;
+    for (double& v : c) v -= 0.5 * period;
+    return c;
+  };
+  const std::vector<double> zc = centres(warp, r.repeat.warps, L.tile.warps, L.period_z);
+  const std::vector<double> xc = centres(weft, r.repeat.wefts, L.tile.wefts, L.period_x);
   const bool balanced = share < 0;
   L.warp_crimp_share = share;
   auto warp_height = [&](int i, int j) {
     const ThreadSize &w = warp[i % r.repeat.warps], &f = weft[j % r.repeat.wefts];
     return balanced ? 0.5 * f.thickness_mm : share * 0.5 * (w.thickness_mm + f.thickness_mm);
   };
-  for (int i = 0; i < L.tile.warps; ++i) {
-    YarnPath y;
-    y.warp = true;
-    y.thread = i % r.repeat.warps;
-    y.centre = zc[i];
-    y.size = warp[y.thread];
-    y.start = -0.5 * L.period_x;
-    y.period = L.period_x;
-    y.crossing = xc;
-    for (int j = 0; j < L.tile.wefts; ++j)
-      y.height.push_back((L.tile.over(i, j) ? 1 : -1) * warp_height(i, j));
-    L.yarns.push_back(std::move(y));
-  }
-  for (int j = 0; j < L.tile.wefts; ++j) {
-    YarnPath y;
-    y.warp = false;
-    y.thread = j % r.repeat.wefts;
-    y.centre = xc[j];
-    y.size = weft[y.thread];
-    y.start = -0.5 * L.period_z;
-    y.period = L.period_z;
-    y.crossing = zc;
-    for (int i = 0; i < L.tile.warps; ++i) {
-      const ThreadSize &w = warp[i % r.repeat.warps], &f = weft[y.thread];
-      const double total = 0.5 * (w.thickness_mm + f.thickness_mm);
-      y.height.push_back((L.tile.over(i, j) ? -1 : 1) * (total - warp_height(i, j)));
+  // Signed centre height of warp i (of_warp) or pick j where they cross: the warp carries
+  // warp_height, the pick the rest of the crossing's crimp height, on the other side.
+  auto crossing_height = [&](bool of_warp, int i, int j) {
+    if (of_warp) return (L.tile.over(i, j) ? 1 : -1) * warp_height(i, j);
+    const ThreadSize &w = warp[i % r.repeat.warps], &f = weft[j % r.repeat.wefts];
+    const double total = 0.5 * (w.thickness_mm + f.thickness_mm);
+    return (L.tile.over(i, j) ? -1 : 1) * (total - warp_height(i, j));
+  };
+  // One yarn per thread of the tile, both directions alike: a warp runs along x past the picks'
+  // centres, a pick along z past the warps'. Warps first (Layout::yarns' order).
+  for (const bool is_warp : {true, false}) {
+    const int count = is_warp ? L.tile.warps : L.tile.wefts;
+    const int crossings = is_warp ? L.tile.wefts : L.tile.warps;
+    for (int k = 0; k < count; ++k) {
+      YarnPath y;
+      y.warp = is_warp;
+      y.thread = k % (is_warp ? r.repeat.warps : r.repeat.wefts);
+      y.centre = (is_warp ? zc : xc)[k];
+      y.size = (is_warp ? warp : weft)[y.thread];
+      y.period = is_warp ? L.period_x : L.period_z;
+      y.start = -0.5 * y.period;
+      y.crossing = is_warp ? xc : zc;
+      for (int c = 0; c < crossings; ++c)
+        y.height.push_back(is_warp ? crossing_height(true, k, c) : crossing_height(false, c, k));
+      L.yarns.push_back(std::move(y));
     }
-    L.yarns.push_back(std::move(y));
   }
   if (balanced) L.warp_crimp_share = -1;
   return r;

@@ -41,13 +41,9 @@ std::vector<int> Interlacing::floating_warps() const {
 }
 
 std::vector<int> Interlacing::floating_wefts() const {
-  std::vector<int> out;
-  for (int j = 0; j < wefts; ++j) {
-    bool any_over = false, any_under = false;
-    for (int i = 0; i < warps; ++i) (over(i, j) ? any_over : any_under) = true;
-    if (!(any_over && any_under)) out.push_back(j);
-  }
-  return out;
+  // Pick j is warp j of the transpose, whose crossings are this one's, each side swapped: all on
+  // one side there exactly when all on one side here.
+  return transposed().floating_warps();
 }
 
 Interlacing Interlacing::transposed() const {

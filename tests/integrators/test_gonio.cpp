@@ -10,7 +10,7 @@
 #include "weft/core/error.h"
 #include "weft/integrators/gonio.h"
 #include "weft/scenes/description.h"
-#include "weft/scenes/weave.h"
+#include "woven_patch.h"
 
 using namespace weft;
 
@@ -112,12 +112,7 @@ TEST(Gonio, ViewDirectionSignConvention) {
 TEST(Gonio, WovenPatchErrorsAreCalibrated) {
   // Noisy case: inter-reflections in a woven patch. Two independent seeds must agree within their
   // reported standard errors, and quadrupling spp must halve the error.
-  WeaveParams p;
-  p.yarns = 4, p.segments = 32, p.sides = 6;
-  SceneDescription d;
-  d.source = "woven";
-  for (auto& m : make_weave(p))
-    d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+  SceneDescription d = weft::testing::woven_patch();
   d.default_material =
       MaterialBinding{"lambert", {{"reflectance", 0.9}}, std::nullopt, std::nullopt, "default"};
   GonioSettings g;

@@ -13,7 +13,7 @@
 #include "weft/integrators/path_tracer.h"
 #include "weft/integrators/render_job.h"
 #include "weft/scenes/render_scene.h"
-#include "weft/scenes/weave.h"
+#include "woven_patch.h"
 
 using namespace weft;
 namespace fs = std::filesystem;
@@ -22,12 +22,7 @@ namespace {
 // A small woven patch (lambert warp and weft) under a parallel light and an environment (which
 // adds MIS paths), seen by an orthographic camera from 20 degrees.
 SceneDescription woven() {
-  WeaveParams p;
-  p.yarns = 4, p.segments = 32, p.sides = 6;
-  SceneDescription d;
-  d.source = "woven";
-  for (auto& m : make_weave(p))
-    d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+  SceneDescription d = weft::testing::woven_patch();
   d.materials["warp"] = {"lambert", {{"reflectance", {0.6, 0.15, 0.1}}}, {}, {}, "materials.warp"};
   d.materials["weft"] = {"lambert", {{"reflectance", 0.5}}, {}, {}, "materials.weft"};
   d.lights.directional.push_back({d.frame.direction(deg_to_rad(30), 0), Rgb(1.0)});

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/integrators/gonio.h"
 #include "weft/integrators/render_settings.h"
@@ -33,16 +34,7 @@ SceneDescription with(const std::string& section, const json& value) {
   return parse_scene_description(j, ".", "scene.json");
 }
 
-// The message of the Error that reading the settings throws ("" when none).
-template <class Read>
-std::string error_of(Read read) {
-  try {
-    read();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
+using weft::testing::error_of;
 
 std::string render_error(const json& render) {
   return error_of([&] { render_settings_from(with("render", render)); });
@@ -55,17 +47,22 @@ bool contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
 }
 
+// The settings a "render" section sets, compared one by one so that a failure names the key.
+void expect_render_keys(const RenderSettings& r, const RenderSettings& want) {
+  EXPECT_EQ(r.width, want.width);
+  EXPECT_EQ(r.height, want.height);
+  EXPECT_EQ(r.spp, want.spp);
+  EXPECT_EQ(r.max_depth, want.max_depth);
+  EXPECT_EQ(r.rr_depth, want.rr_depth);
+  EXPECT_EQ(r.seed, want.seed);
+}
+
 }  // namespace
 
 TEST(Settings, AbsentSectionsGiveTheDefaults) {
   const SceneDescription d = parse_scene_description(quad_scene(), ".", "scene.json");
-  const RenderSettings r = render_settings_from(d), def;
-  EXPECT_EQ(r.width, def.width);
-  EXPECT_EQ(r.height, def.height);
-  EXPECT_EQ(r.spp, def.spp);
-  EXPECT_EQ(r.max_depth, def.max_depth);
-  EXPECT_EQ(r.rr_depth, def.rr_depth);
-  EXPECT_EQ(r.seed, def.seed);
+  const RenderSettings def;
+  expect_render_keys(render_settings_from(d), def);
   const GonioSettings g = gonio_settings_from(d), gdef;
   EXPECT_EQ(g.sample, gdef.sample);
   EXPECT_EQ(g.width, gdef.width);
@@ -81,13 +78,9 @@ TEST(Settings, AbsentSectionsGiveTheDefaults) {
 
 TEST(Settings, BundledExampleSections) {
   const SceneDescription d = load_scene_description(kExamples / "lambert-plane.json");
-  const RenderSettings r = render_settings_from(d);
-  EXPECT_EQ(r.width, 128);
-  EXPECT_EQ(r.height, 128);
-  EXPECT_EQ(r.spp, 16);
-  EXPECT_EQ(r.max_depth, 8);
-  EXPECT_EQ(r.rr_depth, RenderSettings{}.rr_depth);  // not given
-  EXPECT_EQ(r.seed, 1u);
+  // rr_depth is not given: the default.
+  expect_render_keys(render_settings_from(d),
+                     {.width = 128, .height = 128, .spp = 16, .max_depth = 8, .seed = 1});
   const GonioSettings g = gonio_settings_from(d);
   EXPECT_EQ(g.sample, "plane");
   EXPECT_EQ(g.light_zenith_deg, 30);
@@ -111,12 +104,12 @@ TEST(Settings, EveryRenderKey) {
                                            {"max_depth", 2},
                                            {"rr_depth", 1},
                                            {"seed", 18446744073709551615ull}}));
-  EXPECT_EQ(r.width, 7);
-  EXPECT_EQ(r.height, 5);
-  EXPECT_EQ(r.spp, 3);
-  EXPECT_EQ(r.max_depth, 2);
-  EXPECT_EQ(r.rr_depth, 1);
-  EXPECT_EQ(r.seed, 18446744073709551615ull);
+  expect_render_keys(r, {.width = 7,
+                         .height = 5,
+                         .spp = 3,
+                         .max_depth = 2,
+                         .rr_depth = 1,
+                         .seed = 18446744073709551615ull});
 }
 
 TEST(Settings, EverySweepKey) {

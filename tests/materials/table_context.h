@@ -3,7 +3,9 @@
 // every material by name.
 #include <filesystem>
 #include <memory>
+#include <utility>
 
+#include "test_util.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
@@ -23,6 +25,11 @@ inline MaterialContext context_with_tables(const std::filesystem::path& dir,
   ctx.base_dir = dir;
   ctx.cache = std::make_shared<TableCache>();
   return ctx;
+}
+
+// The same in the running test's fresh folder (fresh_test_dir), which is then ctx.base_dir.
+inline MaterialContext context_with_tables(TabulatedBsdfTable table) {
+  return context_with_tables(fresh_test_dir(), std::move(table));
 }
 
 }  // namespace weft::testing

@@ -13,7 +13,6 @@
 
 using namespace weft;
 using namespace weft::testing;
-namespace fs = std::filesystem;
 using json = nlohmann::json;
 
 namespace {
@@ -25,16 +24,14 @@ struct Material {
 };
 
 std::vector<Material> all_materials() {
-  const fs::path dir = fresh_test_dir();
   const auto fiber = ClassicFiberBsdf::create(Rgb(0.6, 0.3, 0.2), {MicrofacetModel::kGgx, 0.3});
-  const MaterialContext ctx =
-      context_with_tables(dir, TabulatedBsdfTable::from_function(
-                                   8, 3,
-                                   [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-                                     const Rgb f = wo.z * wi.z > 0 ? fiber.eval(wo, wi) : Rgb(0.05);
-                                     v[0] = f.r, v[1] = f.g, v[2] = f.b;
-                                   },
-                                   4, 3));
+  const MaterialContext ctx = context_with_tables(TabulatedBsdfTable::from_function(
+      8, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const Rgb f = wo.z * wi.z > 0 ? fiber.eval(wo, wi) : Rgb(0.05);
+        v[0] = f.r, v[1] = f.g, v[2] = f.b;
+      },
+      4, 3));
   return {
       {"lambert", make_bsdf("lambert", {{"reflectance", 0.9}}, ctx), false},
       {"cook_torrance", make_bsdf("cook_torrance", {{"alpha", 0.2}}, ctx), false},

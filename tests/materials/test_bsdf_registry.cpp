@@ -18,19 +18,18 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Fixture {
-  fs::path dir;
-  MaterialContext ctx;
-  Fixture() {
-    dir = weft::testing::fresh_test_dir();
-    auto f = [](const Vec3&, const Vec3& wi, std::span<double> v) {
-      v[0] = v[1] = v[2] = 0.1 + 0.1 * wi.z * wi.z;
-    };
-    ctx = weft::testing::context_with_tables(dir, TabulatedBsdfTable::from_function(4, 3, f, 1));
-    ctx.source_file = "scene.json";
-    ctx.field_prefix = "materials.seat";
-  }
-};
+// Materials as a scene's binding "materials.seat" in scene.json sees them, with a fiber and a
+// fabric table in the test's folder (ctx.base_dir).
+MaterialContext seat_context() {
+  auto f = [](const Vec3&, const Vec3& wi, std::span<double> v) {
+    v[0] = v[1] = v[2] = 0.1 + 0.1 * wi.z * wi.z;
+  };
+  MaterialContext ctx =
+      weft::testing::context_with_tables(TabulatedBsdfTable::from_function(4, 3, f, 1));
+  ctx.source_file = "scene.json";
+  ctx.field_prefix = "materials.seat";
+  return ctx;
+}
 
 std::string error_of(const std::string& type, const json& params, const MaterialContext& ctx) {
   return weft::testing::error_of([&] { make_bsdf(type, params, ctx); });
@@ -51,7 +50,7 @@ void expect_error(const std::string& type, const json& params, const MaterialCon
 }  // namespace
 
 TEST(Registry, EveryNameConstructsFromValidParameters) {
-  Fixture fx;
+  const MaterialContext ctx = seat_context();
   const std::pair<std::string, json> valid[] = {
       {"lambert", {{"reflectance", {0.8, 0.2, 0.1}}}},
       {"cook_torrance", {{"distribution", "ggx"}, {"alpha", 0.2}, {"ior", 1.557}, {"tint", 0.9}}},
@@ -63,7 +62,7 @@ TEST(Registry, EveryNameConstructsFromValidParameters) {
   std::vector<std::string> names;
   for (const auto& [type, params] : valid) {
     names.push_back(type);
-    const Bsdf b = make_bsdf(type, params, fx.ctx);
+    const Bsdf b = make_bsdf(type, params, ctx);
     const Vec3 wo{0.3, 0.1, std::sqrt(1 - 0.1)}, wi{-0.2, 0.3, std::sqrt(1 - 0.13)};
     EXPECT_GT(b.eval(wo, wi).max_component(), 0.0) << type;
     EXPECT_TRUE(b.sample(wo, {0.3, 0.6}, 0.4).has_value()) << type;
@@ -72,28 +71,28 @@ TEST(Registry, EveryNameConstructsFromValidParameters) {
   EXPECT_EQ(names, material_names()) << "every registered name is exercised here";
   // Defaults work too (an empty object).
   for (const std::string t : {"lambert", "cook_torrance", "classic_fiber"})
-    EXPECT_NO_THROW(make_bsdf(t, json::object(), fx.ctx)) << t;
+    EXPECT_NO_THROW(make_bsdf(t, json::object(), ctx)) << t;
 }
 
 TEST(Registry, ParametersReachTheMaterial) {
-  Fixture fx;
-  const Bsdf ct = make_bsdf("cook_torrance", {{"distribution", "ggx"}, {"roughness", 0.5}}, fx.ctx);
+  const MaterialContext ctx = seat_context();
+  const Bsdf ct = make_bsdf("cook_torrance", {{"distribution", "ggx"}, {"roughness", 0.5}}, ctx);
   const auto& c = std::get<CookTorranceBsdf>(ct.variant());
   EXPECT_EQ(c.distribution.model, MicrofacetModel::kGgx);
   EXPECT_DOUBLE_EQ(c.distribution.alpha, 0.25);  // alpha = roughness^2
   EXPECT_DOUBLE_EQ(c.ior, kCottonIor);
   const Bsdf t =
-      make_bsdf("fiber_table", {{"file", "tables/fiber.exr"}, {"tint", 0.5}, {"scale", 2}}, fx.ctx);
+      make_bsdf("fiber_table", {{"file", "tables/fiber.exr"}, {"tint", 0.5}, {"scale", 2}}, ctx);
   EXPECT_EQ(std::get<TabulatedBsdf>(t.variant()).scale, Rgb(1.0));
   // Two materials on one file share one table.
-  const Bsdf t2 = make_bsdf("fiber_table", {{"file", "./tables/../tables/fiber.exr"}}, fx.ctx);
+  const Bsdf t2 = make_bsdf("fiber_table", {{"file", "./tables/../tables/fiber.exr"}}, ctx);
   EXPECT_EQ(std::get<TabulatedBsdf>(t.variant()).data.get(),
             std::get<TabulatedBsdf>(t2.variant()).data.get());
 }
 
 TEST(Registry, UnknownTypeListsTheValidNames) {
-  Fixture fx;
-  const std::string msg = error_of("velvet", json::object(), fx.ctx);
+  const MaterialContext ctx = seat_context();
+  const std::string msg = error_of("velvet", json::object(), ctx);
   EXPECT_NE(msg.find("velvet"), std::string::npos) << msg;
   EXPECT_NE(msg.find("materials.seat.type"), std::string::npos) << msg;
   for (const auto& n : material_names())
@@ -101,43 +100,43 @@ TEST(Registry, UnknownTypeListsTheValidNames) {
 }
 
 TEST(Registry, BadParametersAreNamed) {
-  Fixture fx;
+  const MaterialContext ctx = seat_context();
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  expect_error("lambert", {{"reflectanse", 0.5}}, fx.ctx, "reflectanse", "unknown key");
-  expect_error("lambert", {{"reflectance", 1.5}}, fx.ctx, "reflectance");
-  expect_error("lambert", {{"reflectance", {0.5, 0.5}}}, fx.ctx, "reflectance");
-  expect_error("cook_torrance", {{"alpha", nan}}, fx.ctx, "alpha");
-  expect_error("cook_torrance", {{"alpha", 0.0}}, fx.ctx, "alpha");
-  expect_error("cook_torrance", {{"alpha", 2.0}}, fx.ctx, "alpha");
-  expect_error("cook_torrance", {{"alpha", "rough"}}, fx.ctx, "alpha");
-  expect_error("cook_torrance", {{"alpha", 0.2}, {"roughness", 0.4}}, fx.ctx, "roughness");
-  expect_error("cook_torrance", {{"distribution", "phong"}}, fx.ctx, "distribution", "ggx");
-  expect_error("cook_torrance", {{"ior", 0.5}}, fx.ctx, "ior");
-  expect_error("cook_torrance", {{"ior", nan}}, fx.ctx, "ior");
-  expect_error("cook_torrance", {{"tint", {0.5, nan, 0.5}}}, fx.ctx, "tint[1]");
-  expect_error("classic_fiber", {{"reflectance", -0.1}}, fx.ctx, "reflectance");
-  expect_error("classic_fiber", {{"tint", 0.5}}, fx.ctx, "tint", "unknown key");
-  expect_error("fiber_table", json::object(), fx.ctx, "file", "required");
-  expect_error("fiber_table", {{"file", 3}}, fx.ctx, "file");
-  expect_error("fiber_table", {{"file", "tables/none.exr"}}, fx.ctx, "file", "none.exr");
-  expect_error("fiber_table", {{"file", "tables/fabric.exr"}}, fx.ctx, "file", "fabric table");
-  expect_error("fabric_table", {{"file", "tables/fiber.exr"}}, fx.ctx, "file", "fiber table");
-  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", -1}}, fx.ctx, "scale");
-  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", nan}}, fx.ctx, "scale");
-  expect_error("measured_nbrdf", {{"name", "blue-fabric"}}, fx.ctx, "name", "merl-white-fabric");
-  expect_error("measured_nbrdf", json::object(), fx.ctx, "name", "exactly one");
-  expect_error("measured_nbrdf", {{"file", "nbrdf.txt"}}, fx.ctx, "file", "nbrdf.txt");
-  expect_error("measured_nbrdf", {{"name", "merl-red-fabric"}, {"file", "x"}}, fx.ctx, "name");
+  expect_error("lambert", {{"reflectanse", 0.5}}, ctx, "reflectanse", "unknown key");
+  expect_error("lambert", {{"reflectance", 1.5}}, ctx, "reflectance");
+  expect_error("lambert", {{"reflectance", {0.5, 0.5}}}, ctx, "reflectance");
+  expect_error("cook_torrance", {{"alpha", nan}}, ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", 0.0}}, ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", 2.0}}, ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", "rough"}}, ctx, "alpha");
+  expect_error("cook_torrance", {{"alpha", 0.2}, {"roughness", 0.4}}, ctx, "roughness");
+  expect_error("cook_torrance", {{"distribution", "phong"}}, ctx, "distribution", "ggx");
+  expect_error("cook_torrance", {{"ior", 0.5}}, ctx, "ior");
+  expect_error("cook_torrance", {{"ior", nan}}, ctx, "ior");
+  expect_error("cook_torrance", {{"tint", {0.5, nan, 0.5}}}, ctx, "tint[1]");
+  expect_error("classic_fiber", {{"reflectance", -0.1}}, ctx, "reflectance");
+  expect_error("classic_fiber", {{"tint", 0.5}}, ctx, "tint", "unknown key");
+  expect_error("fiber_table", json::object(), ctx, "file", "required");
+  expect_error("fiber_table", {{"file", 3}}, ctx, "file");
+  expect_error("fiber_table", {{"file", "tables/none.exr"}}, ctx, "file", "none.exr");
+  expect_error("fiber_table", {{"file", "tables/fabric.exr"}}, ctx, "file", "fabric table");
+  expect_error("fabric_table", {{"file", "tables/fiber.exr"}}, ctx, "file", "fiber table");
+  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", -1}}, ctx, "scale");
+  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", nan}}, ctx, "scale");
+  expect_error("measured_nbrdf", {{"name", "blue-fabric"}}, ctx, "name", "merl-white-fabric");
+  expect_error("measured_nbrdf", json::object(), ctx, "name", "exactly one");
+  expect_error("measured_nbrdf", {{"file", "nbrdf.txt"}}, ctx, "file", "nbrdf.txt");
+  expect_error("measured_nbrdf", {{"name", "merl-red-fabric"}, {"file", "x"}}, ctx, "name");
   // Parameters must be an object.
-  const std::string msg = error_of("lambert", json::array({1, 2}), fx.ctx);
+  const std::string msg = error_of("lambert", json::array({1, 2}), ctx);
   EXPECT_NE(msg.find("JSON object"), std::string::npos) << msg;
 }
 
 TEST(Registry, MeasuredByFileResolvesAgainstBaseDir) {
-  Fixture fx;
-  fs::copy_file(find_measured_nbrdf("merl-white-fabric"), fx.dir / "w.txt");
-  const Bsdf by_file = make_bsdf("measured_nbrdf", {{"file", "w.txt"}}, fx.ctx);
-  const Bsdf by_name = make_bsdf("measured_nbrdf", {{"name", "merl-white-fabric"}}, fx.ctx);
+  const MaterialContext ctx = seat_context();
+  fs::copy_file(find_measured_nbrdf("merl-white-fabric"), ctx.base_dir / "w.txt");
+  const Bsdf by_file = make_bsdf("measured_nbrdf", {{"file", "w.txt"}}, ctx);
+  const Bsdf by_name = make_bsdf("measured_nbrdf", {{"name", "merl-white-fabric"}}, ctx);
   const Vec3 wo{0, 0, 1}, wi{0.6, 0, 0.8};
   EXPECT_EQ(by_file.eval(wo, wi), by_name.eval(wo, wi));
 }

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/scenes/description.h"
@@ -27,22 +28,13 @@ json plane_scene() {
 }
 
 std::string parse_error(const json& j) {
-  try {
-    parse_scene_description(j, kExamples, "scene.json");
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of([&] { parse_scene_description(j, kExamples, "scene.json"); });
 }
 
 // Builds the RenderScene too (material parameters are checked by the registry there).
 std::string build_error(const json& j) {
-  try {
-    RenderScene(parse_scene_description(j, kExamples, "scene.json"));
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of(
+      [&] { RenderScene(parse_scene_description(j, kExamples, "scene.json")); });
 }
 
 bool contains(const std::string& s, const std::string& part) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/scenes/gltf.h"
 #include "weft/scenes/weave.h"
@@ -33,12 +34,7 @@ void expect_near(const Vec3& a, const Vec3& b, double tol) {
 
 // Error message of loading 'file', or "" when it loads.
 std::string load_error(const std::string& file) {
-  try {
-    load_gltf(kData / file);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of([&] { load_gltf(kData / file); });
 }
 }  // namespace
 

@@ -12,7 +12,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
+#include "test_util.h"
 #include "weft/core/math.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
@@ -64,6 +66,15 @@ SceneDescription lamp_scene() {
 const Light& only_light(const RenderScene& scene) {
   EXPECT_EQ(scene.lights().size(), 1u);
   return scene.lights().front();
+}
+
+// The samples' mean is 'expected' within four standard errors, and that error is below
+// 'max_std_error' (so the check has the power to fail).
+void expect_mean(const std::vector<double>& samples, double expected, double max_std_error) {
+  const weft::testing::SampleMean e = weft::testing::sample_mean(static_cast<int>(samples.size()),
+                                                                 [&](int i) { return samples[i]; });
+  EXPECT_LT(e.std_error, max_std_error);
+  EXPECT_NEAR(e.mean, expected, 4 * e.std_error);
 }
 
 }  // namespace
@@ -122,7 +133,7 @@ TEST(LightInterface, EnvironmentSampleAgreesWithPdfAndEval) {
   EXPECT_EQ(light.eval(LightHit::on_surface({0, 1, 0}, 0, 0, {0, -1, 0}, 1)), Rgb(0.0));
   EXPECT_EQ(light.pdf(LightHit::on_surface({0, 1, 0}, 0, 0, {0, -1, 0}, 1)), 0.0);
   const int n = 200000;
-  double sum = 0, sum2 = 0;
+  std::vector<double> samples;
   for (int i = 0; i < n; ++i) {
     Rng rng(3, uint64_t(i));
     const auto s = light.sample({1, 2, 3}, rng);
@@ -132,13 +143,9 @@ TEST(LightInterface, EnvironmentSampleAgreesWithPdfAndEval) {
     const LightHit hit = LightHit::escaped_along(s->wi);
     ASSERT_EQ(light.pdf(hit), s->pdf);
     ASSERT_EQ(light.eval(hit), s->L);
-    const double v = std::max(0.0, s->wi.y) / s->pdf;
-    sum += v;
-    sum2 += v * v;
+    samples.push_back(std::max(0.0, s->wi.y) / s->pdf);
   }
-  const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / (n - 1));
-  EXPECT_LT(se, 0.01 * kPi);
-  EXPECT_NEAR(mean, kPi, 4 * se);
+  expect_mean(samples, kPi, 0.01 * kPi);
 }
 
 TEST(LightInterface, AreaLightSampleAgreesWithPdfEvalAndTheSolidAngle) {
@@ -149,7 +156,7 @@ TEST(LightInterface, AreaLightSampleAgreesWithPdfEvalAndTheSolidAngle) {
   const Vec3 p{0, 0, 0};
   EXPECT_EQ(draws_of([&](Rng& r) { light.sample(p, r); }), 3);
   const int n = 100000;
-  double sum = 0, sum2 = 0;
+  std::vector<double> samples;
   for (int i = 0; i < n; ++i) {
     Rng rng(5, uint64_t(i));
     const auto s = light.sample(p, rng);
@@ -165,14 +172,11 @@ TEST(LightInterface, AreaLightSampleAgreesWithPdfEvalAndTheSolidAngle) {
     const LightHit at = LightHit::on_surface(s->wi, hit.mesh, hit.prim, hit.ng, hit.t);
     ASSERT_NEAR(light.pdf(at), s->pdf, 1e-5 * s->pdf);
     ASSERT_EQ(light.eval(at), s->L);
-    sum += 1 / s->pdf;
-    sum2 += 1 / (s->pdf * s->pdf);
+    samples.push_back(1 / s->pdf);
   }
   const double a = 0.5, b = 1.0, c = 1.0;
   const double omega = 4 * std::asin(a * b / std::sqrt((a * a + c * c) * (b * b + c * c)));
-  const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / (n - 1));
-  EXPECT_LT(se, 0.01 * omega);
-  EXPECT_NEAR(mean, omega, 4 * se);
+  expect_mean(samples, omega, 0.01 * omega);
 }
 
 TEST(LightInterface, AreaLightPdfIntegratesToOne) {
@@ -182,7 +186,7 @@ TEST(LightInterface, AreaLightPdfIntegratesToOne) {
   const Light environment = EnvironmentLight{Rgb(1.0)};  // a uniform sphere sampler
   const Vec3 p{0.2, 0.1, -0.3};
   const int n = 400000;
-  double sum = 0, sum2 = 0;
+  std::vector<double> samples;
   for (int i = 0; i < n; ++i) {
     Rng rng(9, uint64_t(i));
     const Vec3 dir = environment.sample(p, rng)->wi;
@@ -190,12 +194,9 @@ TEST(LightInterface, AreaLightPdfIntegratesToOne) {
     double v = 0;
     if (scene.intersect({p, dir}, &hit))
       v = light.pdf(LightHit::on_surface(dir, hit.mesh, hit.prim, hit.ng, hit.t)) * 4 * kPi;
-    sum += v;
-    sum2 += v * v;
+    samples.push_back(v);
   }
-  const double mean = sum / n, se = std::sqrt((sum2 / n - mean * mean) / (n - 1));
-  EXPECT_LT(se, 0.02);
-  EXPECT_NEAR(mean, 1.0, 4 * se);
+  expect_mean(samples, 1.0, 0.02);
 }
 
 TEST(LightInterface, AreaLightPicksTrianglesByPowerAndRespectsSides) {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <filesystem>
 
+#include "mesh_checks.h"
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/gltf.h"
@@ -35,21 +37,10 @@ TEST(Weave, NormalsOutwardTangentsAlongTheYarn) {
   for (int mi = 0; mi < 2; ++mi) {
     const TriangleMesh& m = meshes[mi];
     const Vec3 axis = mi == 0 ? Vec3{1, 0, 0} : Vec3{0, 0, 1};
-    for (size_t v = 0; v < m.vertex_count(); ++v) {
-      const Vec3 n{m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
-      const Vec3 t{m.tangents[4 * v], m.tangents[4 * v + 1], m.tangents[4 * v + 2]};
-      EXPECT_NEAR(length(n), 1, 1e-6);
-      EXPECT_NEAR(dot(n, t), 0, 1e-6);
+    weft::testing::expect_consistent_frames(m, [&](size_t, const Vec3& t) {
       // Centre-line slope is at most A pi / S = 0.1 pi / 0.5: the tangent stays near the axis.
       EXPECT_GT(dot(t, axis), std::cos(std::atan(0.1 * M_PI / 0.5)) - 1e-6);
-    }
-    for (size_t t = 0; t < m.triangle_count(); ++t) {
-      const uint32_t i0 = m.indices[3 * t];
-      const Vec3 p0 = m.position(i0);
-      const Vec3 ng =
-          cross(m.position(m.indices[3 * t + 1]) - p0, m.position(m.indices[3 * t + 2]) - p0);
-      EXPECT_GT(dot(ng, Vec3{m.normals[3 * i0], m.normals[3 * i0 + 1], m.normals[3 * i0 + 2]}), 0);
-    }
+    });
   }
 }
 
@@ -90,13 +81,8 @@ TEST(Weave, RoundTripAndOverUnderSeenByRays) {
 }
 
 TEST(Weave, BadParametersAreErrors) {
-  auto error_of = [](WeaveParams p) -> std::string {
-    try {
-      make_weave(p);
-    } catch (const Error& e) {
-      return e.what();
-    }
-    return "";
+  auto error_of = [](const WeaveParams& p) {
+    return weft::testing::error_of([&] { make_weave(p); });
   };
   WeaveParams p;
   p.spacing_mm = 0.15;

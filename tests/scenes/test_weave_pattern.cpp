@@ -5,6 +5,7 @@
 
 #include <numeric>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/scenes/weave_pattern.h"
 
@@ -12,12 +13,7 @@ using namespace weft;
 
 namespace {
 std::string error_of(const std::string& spec) {
-  try {
-    parse_weave_pattern(spec);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of([&] { parse_weave_pattern(spec); });
 }
 }  // namespace
 

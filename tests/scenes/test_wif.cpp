@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/rng.h"
 #include "weft/scenes/weave.h"
@@ -61,12 +62,7 @@ std::string replace(std::string text, const std::string& from, const std::string
 }
 
 std::string error_of(const std::string& text) {
-  try {
-    parse_wif(text, "draft.wif");
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of([&] { parse_wif(text, "draft.wif"); });
 }
 
 }  // namespace

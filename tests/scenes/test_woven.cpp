@@ -8,9 +8,12 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "mesh_checks.h"
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 #include "weft/scenes/gltf.h"
@@ -91,12 +94,7 @@ double worst_overlap(const WovenSample& s, int n) {
 }
 
 std::string error_of(const WeaveOptions& o) {
-  try {
-    make_woven_sample(o);
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
+  return weft::testing::error_of([&] { make_woven_sample(o); });
 }
 
 // Minimum distance between segments of distinct curves by brute force over all pairs and the
@@ -458,22 +456,11 @@ TEST(Woven, YarnTubesHaveOutwardNormalsAndTangentsAlongTheYarn) {
   for (int mi = 0; mi < 2; ++mi) {
     const TriangleMesh& m = s.meshes[mi];
     const Vec3 axis = mi == 0 ? Vec3{1, 0, 0} : Vec3{0, 0, 1};
-    for (size_t v = 0; v < m.vertex_count(); ++v) {
-      const Vec3 n{m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
-      const Vec3 t{m.tangents[4 * v], m.tangents[4 * v + 1], m.tangents[4 * v + 2]};
-      EXPECT_NEAR(length(n), 1, 1e-6);
-      EXPECT_NEAR(dot(n, t), 0, 1e-6);
+    weft::testing::expect_consistent_frames(m, [&](size_t v, const Vec3& t) {
       EXPECT_GT(std::abs(dot(t, axis)), 0.7);  // crimp slope at most about 37 degrees
       EXPECT_GE(m.uvs[2 * v], 0.0f);
       EXPECT_LE(m.uvs[2 * v], 1.0f);
-    }
-    for (size_t t = 0; t < m.triangle_count(); ++t) {
-      const uint32_t i0 = m.indices[3 * t];
-      const Vec3 p0 = m.position(i0);
-      const Vec3 ng =
-          cross(m.position(m.indices[3 * t + 1]) - p0, m.position(m.indices[3 * t + 2]) - p0);
-      EXPECT_GT(dot(ng, Vec3{m.normals[3 * i0], m.normals[3 * i0 + 1], m.normals[3 * i0 + 2]}), 0);
-    }
+    });
   }
 }
 
@@ -580,54 +567,43 @@ TEST(Woven, BundledSampleDescriptionIsTheDefault) {
 }
 
 TEST(Woven, BadParametersAreErrorsNamingTheField) {
-  auto expect = [](WeaveOptions o, const std::string& field) {
+  auto expect = [](const WeaveOptions& o, const std::string& field) {
     const std::string e = error_of(o);
     EXPECT_NE(e.find("field '" + field + "'"), std::string::npos) << field << ": " << e;
   };
+  // Each case changes the defaults once; its error must name the field.
+  using Change = std::function<void(WeaveOptions&)>;
+  const std::pair<std::string, Change> cases[] = {
+      // Wider than its spacing 0.2117.
+      {"warp-width-mm", [](WeaveOptions& o) { o.warp_width_mm = 0.3; }},
+      {"weft-spacing-mm", [](WeaveOptions& o) { o.weft_spacing_mm = -1; }},
+      {"warp-thickness-mm", [](WeaveOptions& o) { o.warp_thickness_mm = NAN; }},
+      {"detail", [](WeaveOptions& o) { o.detail = "cloud"; }},
+      {"repeats", [](WeaveOptions& o) { o.repeats_x = 0; }},
+      {"pattern", [](WeaveOptions& o) { o.pattern = "satin:6"; }},
+      // All crimp in the weft, whose crossing warps fill their spacing.
+      {"warp-crimp-share", [](WeaveOptions& o) { o.warp_crimp_share = 0; }},
+      {"sides", [](WeaveOptions& o) { o.sides = 2; }},
+      {"fiber-radius-um", [](WeaveOptions& o) { o.fiber_radius_um = 0; }},
+      {"packing", [](WeaveOptions& o) { o.fibers_per_yarn = 10; }},            // both given
+      {"twist-angle-deg", [](WeaveOptions& o) { o.twist_angle_deg = 20; }},    // both given
+      {"ply-twist-per-mm", [](WeaveOptions& o) { o.ply_twist_per_mm = -1; }},  // needs plies
+      {"wif", [](WeaveOptions& o) { o.wif = "/no/such/draft.wif"; }},          // and a pattern
+  };
+  for (const auto& [field, change] : cases) {
+    WeaveOptions o = defaults();
+    change(o);
+    expect(o, field);
+  }
+  // More fibers than fit: the error says how many do.
   WeaveOptions o = defaults();
-  o.warp_width_mm = 0.3;  // wider than its spacing 0.2117
-  expect(o, "warp-width-mm");
-  o = defaults();
-  o.weft_spacing_mm = -1;
-  expect(o, "weft-spacing-mm");
-  o = defaults();
-  o.warp_thickness_mm = NAN;
-  expect(o, "warp-thickness-mm");
-  o = defaults();
-  o.detail = "cloud";
-  expect(o, "detail");
-  o = defaults();
-  o.repeats_x = 0;
-  expect(o, "repeats");
-  o = defaults();
-  o.pattern = "satin:6";
-  expect(o, "pattern");
-  o = defaults();
-  o.warp_crimp_share = 0;  // all crimp in the weft, whose crossing warps fill their spacing
-  expect(o, "warp-crimp-share");
-  o = defaults();
-  o.sides = 2;
-  expect(o, "sides");
-  o = defaults();
-  o.fiber_radius_um = 0;
-  expect(o, "fiber-radius-um");
-  o = defaults();
   o.detail = "fiber";
-  o.packing = 0.6;  // more fibers than fit
+  o.packing = 0.6;
   expect(o, "packing");
   EXPECT_NE(error_of(o).find("at most"), std::string::npos);
-  o = defaults();
-  o.fibers_per_yarn = 10;
-  expect(o, "packing");  // both given
-  o = defaults();
-  o.twist_angle_deg = 20;
-  expect(o, "twist-angle-deg");  // both given
-  o = defaults();
-  o.ply_twist_per_mm = -1;
-  expect(o, "ply-twist-per-mm");  // needs plies
+  // A missing draft is named.
   o = defaults();
   o.wif = "/no/such/draft.wif";
-  expect(o, "wif");  // and a pattern
   o.pattern.reset();
   EXPECT_NE(error_of(o).find("/no/such/draft.wif"), std::string::npos);
   // Absurd sizes are refused from an estimate, before anything is allocated.

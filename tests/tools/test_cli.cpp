@@ -11,9 +11,13 @@
 #include <sstream>
 #include <string>
 
+#include "test_util.h"
 #include "weft/materials/bsdf_table.h"
 
 namespace fs = std::filesystem;
+// Each test works in its own folder under the build folder, not in the shared temporary folder,
+// where another build's tests running at the same time would use the same names.
+using weft::testing::fresh_test_dir;
 
 namespace {
 
@@ -21,14 +25,6 @@ struct CliRun {
   int exit_code = -1;
   std::string out, err;
 };
-
-fs::path temp_dir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  fs::path dir = fs::temp_directory_path() / (std::string("weft-cli-") + info->name());
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p);
@@ -52,6 +48,23 @@ void write(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
 }
 
+// Runs 'args' with '-o output' and expects a refusal: exit code 2, an error that mentions 'part',
+// and nothing at 'output'. Returns the run for more checks of its message.
+CliRun expect_refused(const std::string& args, const fs::path& output, const std::string& part,
+                      const fs::path& dir) {
+  const CliRun r = run(args + " -o '" + output.string() + "'", dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(output));
+  return r;
+}
+
+// Outputs are written atomically: no temporary (".tmp-*") may be left in 'dir'.
+void expect_no_temporaries(const fs::path& dir) {
+  for (const auto& e : fs::directory_iterator(dir))
+    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+}
+
 const char* kGoodSpec = R"({"name": "cli-test", "fiber_radius_um": 6,
   "roughness": {"distribution": "beckmann", "alpha": 0.3},
   "host": {"n": 1.557},
@@ -61,7 +74,7 @@ const char* kGoodSpec = R"({"name": "cli-test", "fiber_radius_um": 6,
 }  // namespace
 
 TEST(Cli, BakeFiberWritesTableAndJsonSummary) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = fresh_test_dir();
   const fs::path out = dir / "fiber.exr";
   const CliRun r =
       run("bake fiber red-cotton --photons 60 --resolution 2 --passes 2 --json --quiet -o '" +
@@ -86,7 +99,7 @@ TEST(Cli, BakeFiberWritesTableAndJsonSummary) {
 }
 
 TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = fresh_test_dir();
   struct Case {
     std::string name, text, expect_in_error;
   };
@@ -107,33 +120,25 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
       {"truncated", good.substr(0, good.size() / 2), ""},
   };
   for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
     const fs::path spec = dir / (c.name + ".json");
     write(spec, c.text);
-    const fs::path out = dir / (c.name + ".exr");
-    const CliRun r = run(
-        "bake fiber '" + spec.string() + "' --photons 10 --quiet -o '" + out.string() + "'", dir);
-    EXPECT_EQ(r.exit_code, 2) << c.name << ": " << r.err;
-    EXPECT_NE(r.err.find(spec.filename().string()), std::string::npos) << c.name << ": " << r.err;
+    const CliRun r = expect_refused("bake fiber '" + spec.string() + "' --photons 10 --quiet",
+                                    dir / (c.name + ".exr"), spec.filename().string(), dir);
     if (!c.expect_in_error.empty()) {
-      EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << c.name << ": " << r.err;
+      EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << r.err;
     }
-    EXPECT_FALSE(fs::exists(out)) << c.name;
   }
   // A missing file is named, and the presets are listed.
-  const CliRun missing =
-      run("bake fiber '" + (dir / "nope.json").string() + "' -o '" + (dir / "x.exr").string() + "'",
-          dir);
-  EXPECT_EQ(missing.exit_code, 2);
-  EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
+  const CliRun missing = expect_refused("bake fiber '" + (dir / "nope.json").string() + "'",
+                                        dir / "x.exr", "nope.json", dir);
   EXPECT_NE(missing.err.find("red-cotton"), std::string::npos) << missing.err;
-  EXPECT_FALSE(fs::exists(dir / "x.exr"));
   // Leftover temporaries would be half-written outputs.
-  for (const auto& e : fs::directory_iterator(dir))
-    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+  expect_no_temporaries(dir);
 }
 
 TEST(Cli, BadNumbersOnTheCommandLineAreRejected) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = fresh_test_dir();
   EXPECT_NE(run("bake fiber red-cotton --resolution 1 -o '" + (dir / "a.exr").string() + "'", dir)
                 .exit_code,
             0);
@@ -158,7 +163,7 @@ TEST(Cli, InterruptedBakeLeavesACompleteTableOrNone) {
   // SIGINT after 2 s into a long bake of many short passes: the program stops at a task
   // boundary and writes the finished passes (exit 130, metadata "interrupted"), or, if not even
   // one pass finished, writes nothing (exit 2). Never a partial file.
-  const fs::path dir = temp_dir();
+  const fs::path dir = fresh_test_dir();
   const fs::path out = dir / "fiber.exr";
   const CliRun r = run(
       "bake fiber white-cotton --photons 100000000 --passes 100000 --resolution 2 --quiet -o '" +
@@ -172,14 +177,13 @@ TEST(Cli, InterruptedBakeLeavesACompleteTableOrNone) {
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_FALSE(fs::exists(out));
   }
-  for (const auto& e : fs::directory_iterator(dir))
-    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+  expect_no_temporaries(dir);
 }
 
 TEST(Cli, TableInfoReportsTheAlbedoForLightFromTheNormal) {
   // A Lambert table of reflectance 0.5: light from the normal is reflected, nothing transmitted.
   // The figures are the library's (TabulatedBsdfTable::directional_albedo), printed per channel.
-  const fs::path dir = temp_dir();
+  const fs::path dir = fresh_test_dir();
   const fs::path table = dir / "lambert.exr";
   const CliRun bake =
       run("table bake lambert --params '{\"reflectance\": 0.5}' -R 8 --spp 4 "
@@ -205,7 +209,7 @@ TEST(Cli, TableInfoReportsTheAlbedoForLightFromTheNormal) {
 TEST(Cli, MieRangeErrorsNameTheField) {
   // Ranges are checked by the Mie library (mie.h), whose errors name the field; the command only
   // parses its options.
-  const fs::path dir = temp_dir();
+  const fs::path dir = fresh_test_dir();
   struct Case {
     std::string args, field;
   };
@@ -227,7 +231,7 @@ TEST(Cli, MieRangeErrorsNameTheField) {
 }
 
 TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
-  const fs::path dir = temp_dir();
+  const fs::path dir = fresh_test_dir();
   // Defaults (the bundled red-cotton poplin), fiber detail, JSON summary.
   const CliRun fib =
       run("weave --detail fiber --repeats 2x1 --json -o '" + (dir / "f.glb").string() + "'", dir);
@@ -242,30 +246,16 @@ TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
   const CliRun legacy =
       run("weave --yarns 2 --segments 8 --sides 4 -o '" + (dir / "l.gltf").string() + "'", dir);
   EXPECT_EQ(legacy.exit_code, 0) << legacy.err;
-  const CliRun mixed =
-      run("weave --yarns 2 --detail fiber -o '" + (dir / "m.gltf").string() + "'", dir);
-  EXPECT_EQ(mixed.exit_code, 2);
-  EXPECT_NE(mixed.err.find("detail"), std::string::npos) << mixed.err;
+  expect_refused("weave --yarns 2 --detail fiber", dir / "m.gltf", "detail", dir);
   // A malformed draft: error naming file, section and key; non-zero exit; nothing written.
   write(dir / "bad.wif",
         "[WEAVING]\nShafts=2\nTreadles=2\n[WARP]\nThreads=2\n[WEFT]\nThreads=2\n"
         "[THREADING]\n1=1\n2=3\n[TIEUP]\n1=1\n2=2\n[TREADLING]\n1=1\n2=2\n");
-  const CliRun bad =
-      run("weave --wif '" + (dir / "bad.wif").string() + "' -o '" + (dir / "b.glb").string() + "'",
-          dir);
-  EXPECT_EQ(bad.exit_code, 2);
-  EXPECT_NE(bad.err.find("bad.wif"), std::string::npos) << bad.err;
+  const CliRun bad = expect_refused("weave --wif '" + (dir / "bad.wif").string() + "'",
+                                    dir / "b.glb", "bad.wif", dir);
   EXPECT_NE(bad.err.find("[THREADING] 2"), std::string::npos) << bad.err;
-  EXPECT_FALSE(fs::exists(dir / "b.glb"));
   // Sizes: a yarn wider than its spacing, absurd repeats.
-  const CliRun wide = run("weave --yarn-width-mm 0.5 -o '" + (dir / "w.glb").string() + "'", dir);
-  EXPECT_EQ(wide.exit_code, 2);
-  EXPECT_NE(wide.err.find("warp-width-mm"), std::string::npos) << wide.err;
-  const CliRun huge = run("weave --repeats 1000x1000 -o '" + (dir / "h.glb").string() + "'", dir);
-  EXPECT_EQ(huge.exit_code, 2);
-  EXPECT_NE(huge.err.find("repeats"), std::string::npos) << huge.err;
-  EXPECT_FALSE(fs::exists(dir / "w.glb"));
-  EXPECT_FALSE(fs::exists(dir / "h.glb"));
-  for (const auto& e : fs::directory_iterator(dir))
-    EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+  expect_refused("weave --yarn-width-mm 0.5", dir / "w.glb", "warp-width-mm", dir);
+  expect_refused("weave --repeats 1000x1000", dir / "h.glb", "repeats", dir);
+  expect_no_temporaries(dir);
 }

@@ -68,15 +68,13 @@ struct GonioRow {
   std::optional<Rgb> beta_norm;
 };
 
-struct GonioResult {
+// Rays and dropped samples of every view's render together; cancelled: the rows are partial.
+struct GonioResult : RenderOutcome {
   std::vector<GonioRow> rows;
   double light_zenith_deg = 0, light_azimuth_deg = 0;
   Rgb l_white;                       // E cos(theta_i) / pi
   std::optional<Rgb> beta_normal;    // beta at normal incidence and view (when normalizing)
   std::optional<Rgb> normalization;  // the factor applied to every beta
-  RayCounts rays;
-  uint64_t nonfinite_samples = 0;
-  bool cancelled = false;
 };
 
 // 'fiber_tables' makes the fiber tables that materials name by spec (null: such materials are an

@@ -29,11 +29,16 @@ struct RayCounts {
   }
 };
 
-struct RenderResult {
-  Image image;  // mean radiance per pixel, linear RGB
+// How a run of the renderer went, whatever it was run for (an image, a render job, a sweep of
+// views): what every caller reports the same way.
+struct RenderOutcome {
   RayCounts rays;
   uint64_t nonfinite_samples = 0;  // dropped (counted, never hidden)
   bool cancelled = false;          // the progress callback asked to stop; results are partial
+};
+
+struct RenderResult : RenderOutcome {
+  Image image;  // mean radiance per pixel, linear RGB
 };
 
 // After every camera sample: its pixel (row-major), the mesh its camera ray hit first (-1: none)

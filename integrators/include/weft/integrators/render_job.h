@@ -20,11 +20,7 @@ struct RenderJob {
   RenderSettings settings;
 };
 
-struct RenderJobResult {
-  RayCounts rays;
-  uint64_t nonfinite_samples = 0;
-  bool cancelled = false;
-};
+using RenderJobResult = RenderOutcome;  // a cancelled job wrote nothing
 
 // 'fiber_tables' makes the fiber tables that materials name by spec (null: such materials are an
 // error).
