@@ -95,8 +95,8 @@ void BM_FiberBeamBatch(benchmark::State& state) {
   s.medium = cotton_medium();
   s.radius = kRadiusUm;
   s.direction = kBeam;
-  PhotonBatchOptions b;
-  b.photons = 1u << 18;
+  TaskBatch b;
+  b.items = 1u << 18;
   b.seed = 1;
   b.threads = static_cast<int>(state.range(0));
   for (auto _ : state) benchmark::DoNotOptimize(simulate_cylinder_beam(s, b));
@@ -107,9 +107,9 @@ BENCHMARK(BM_FiberBeamBatch)->Arg(1)->Arg(2)->UseRealTime()->Unit(benchmark::kMi
 void BM_FiberBssrdfBatch(benchmark::State& state) {
   const FiberBandPhysics fiber = smooth_fiber_physics(cotton_medium(), kRadiusUm, 1.0);
   const BssrdfIncidence incidence = BssrdfIncidence::from(normalize(Vec3{0.3, 0.1, 1}));
-  PhotonBatchOptions b;
-  b.photons = 1u << 20;
-  b.photons_per_task = 16384;
+  TaskBatch b;
+  b.items = 1u << 20;
+  b.items_per_task = 16384;
   b.seed = 1;
   b.threads = static_cast<int>(state.range(0));
   for (auto _ : state) benchmark::DoNotOptimize(simulate_bssrdf(fiber, table_grid(), incidence, b));

@@ -72,11 +72,11 @@ SlabSetup make_setup(const SlabOptions& o) {
 
 int run_slab(const SlabOptions& o) {
   const SlabSetup setup = make_setup(o);
-  PhotonBatchOptions batch;
-  batch.photons = static_cast<uint64_t>(o.photons);
+  TaskBatch batch;
+  batch.items = static_cast<uint64_t>(o.photons);
   batch.seed = o.seed;
   batch.threads = o.threads;
-  batch.photons_per_task = static_cast<uint64_t>(o.photons_per_task);
+  batch.items_per_task = static_cast<uint64_t>(o.photons_per_task);
   batch.progress = progress_bar(o.quiet);
   const SlabResult r = simulate_slab(setup, batch);
 
@@ -97,7 +97,7 @@ int run_slab(const SlabOptions& o) {
     }
     j["energy_imbalance"] = r.energy_imbalance;
     j["photons"] = r.photons;
-    j["photons_requested"] = batch.photons;
+    j["photons_requested"] = batch.items;
     j["scatterings"] = r.scatterings;
     j["internal_reflections"] = r.reflections;
     j["cancelled"] = r.cancelled;
@@ -119,7 +119,7 @@ int run_slab(const SlabOptions& o) {
       std::printf("%-9s %12.6f %12.6f\n", key, e.mean, e.std_error);
     std::printf("photons %llu of %llu, scatterings %llu%s\n",
                 static_cast<unsigned long long>(r.photons),
-                static_cast<unsigned long long>(batch.photons),
+                static_cast<unsigned long long>(batch.items),
                 static_cast<unsigned long long>(r.scatterings), r.cancelled ? " (cancelled)" : "");
   }
   if (r.cancelled) {

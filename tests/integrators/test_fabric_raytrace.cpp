@@ -43,6 +43,18 @@ WovenSample flat_sheet() {
   return s;
 }
 
+FabricRaytraceOptions options(int resolution, uint64_t particles_per_bin) {
+  FabricRaytraceOptions o;
+  o.resolution = resolution;
+  o.particles_per_bin = particles_per_bin;
+  return o;
+}
+
+// A lossless-shaped "fiber": every point sends a fraction of the light to its outer hemisphere.
+TabulatedBsdfTable uniform_fiber(int resolution, double f) {
+  return fiber_table(resolution, [f](const Vec3& wo, const Vec3&) { return wo.z > 0 ? f : 0.0; });
+}
+
 WovenSample default_yarn_sample() {
   WeaveOptions o;
   o.detail = "yarn";
@@ -58,9 +70,7 @@ TEST(FabricRaytrace, FlatLambertSheetIsLambertian) {
   const double rho = 0.6;
   const auto fiber = fiber_table(
       4, [&](const Vec3& wo, const Vec3& wi) { return wo.z > 0 && wi.z > 0 ? rho / kPi : 0.0; });
-  FabricRaytraceOptions o;
-  o.resolution = 3;
-  o.particles_per_bin = 20000;
+  FabricRaytraceOptions o = options(3, 20000);
   const auto r = raytrace_fabric_table(flat_sheet(), fiber, o);
   ASSERT_FALSE(r.cancelled);
   const DirectionGrid g = r.table.grid();
@@ -88,11 +98,8 @@ TEST(FabricRaytrace, PeriodicRepeatLeaksNoEnergy) {
   // line through a yarn crosses its surface twice, so each scattering keeps the weight, and all
   // the light leaves the cloth, through its faces, wrapping across the repeat's sides as often as
   // it must. Exited = 1 up to the particles the scattering cap stops.
-  const auto fiber =
-      fiber_table(4, [](const Vec3& wo, const Vec3&) { return wo.z > 0 ? 0.5 * kInvPi : 0.0; });
-  FabricRaytraceOptions o;
-  o.resolution = 2;
-  o.particles_per_bin = 2000;
+  const auto fiber = uniform_fiber(4, 0.5 * kInvPi);
+  FabricRaytraceOptions o = options(2, 2000);
   const auto r = raytrace_fabric_table(default_yarn_sample(), fiber, o);
   EXPECT_GT(r.wraps, 0u);
   EXPECT_NEAR(r.exited + r.absorbed + r.lost + r.roulette_net, 1.0, 1e-9);
@@ -110,9 +117,7 @@ TEST(FabricRaytrace, NoiseEstimateMatchesTheSpreadOfIndependentRuns) {
   const auto fiber = fiber_table(4, [](const Vec3& wo, const Vec3& wi) {
     return wo.z > 0 ? (0.3 + 0.2 * std::max(0.0, wi.z)) * kInvPi : 0.0;
   });
-  FabricRaytraceOptions o;
-  o.resolution = 3;
-  o.particles_per_bin = 4000;
+  FabricRaytraceOptions o = options(3, 4000);
   const auto a = raytrace_fabric_table(default_yarn_sample(), fiber, o);
   o.seed = 2;
   const auto b = raytrace_fabric_table(default_yarn_sample(), fiber, o);
@@ -124,11 +129,8 @@ TEST(FabricRaytrace, NoiseEstimateMatchesTheSpreadOfIndependentRuns) {
 }
 
 TEST(FabricRaytrace, BitIdenticalAtOneAndTwoThreads) {
-  const auto fiber =
-      fiber_table(3, [](const Vec3& wo, const Vec3&) { return wo.z > 0 ? 0.4 * kInvPi : 0.0; });
-  FabricRaytraceOptions o;
-  o.resolution = 2;
-  o.particles_per_bin = 500;
+  const auto fiber = uniform_fiber(3, 0.4 * kInvPi);
+  FabricRaytraceOptions o = options(2, 500);
   o.threads = 1;
   const auto a = raytrace_fabric_table(default_yarn_sample(), fiber, o);
   o.threads = 2;

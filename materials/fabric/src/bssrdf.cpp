@@ -111,7 +111,7 @@ MeanEstimate BssrdfResult::value(int bin, int iu, int iv, int direction_bin) con
 }
 
 BssrdfResult simulate_bssrdf(const FiberBandPhysics& fiber, const BssrdfGrid& grid,
-                             const BssrdfIncidence& incidence, const PhotonBatchOptions& batch) {
+                             const BssrdfIncidence& incidence, const TaskBatch& batch) {
   fiber.validate();
   grid.validate();
   incidence.validate();
@@ -135,8 +135,8 @@ BssrdfResult simulate_bssrdf(const FiberBandPhysics& fiber, const BssrdfGrid& gr
   r.flux_in.assign(static_cast<size_t>(bins), 0.0);
   r.photons_in.assign(static_cast<size_t>(bins), 0);
 
-  const PhotonBatchStatus status = run_photon_tasks<BssrdfTaskTally>(
-      batch,
+  const TaskBatchStatus status = run_batch<BssrdfTaskTally>(
+      photon_batch(batch),
       [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, BssrdfTaskTally& tally) {
         tally.exits.reserve(2 * count);
         tally.flux_in.assign(static_cast<size_t>(bins), 0.0);

@@ -25,13 +25,11 @@ void validate(const FiberBandPhysics& fiber, const FiberBakeSettings& s) {
   if (s.photons_per_task == 0) throw Error("", "photons_per_task", "must be positive");
 }
 
-PhotonBatchOptions batch_of(const FiberBakeSettings& s, const ProgressCallback& progress) {
-  return {.photons = s.photons,
-          .seed = s.seed,
-          .threads = s.threads,
-          .photons_per_task = s.photons_per_task,
-          .tasks_per_wave = 0,
-          .progress = progress};
+TaskBatch batch_of(const FiberBakeSettings& s, const ProgressCallback& progress) {
+  TaskBatch b = photon_batch({});
+  b.items = s.photons, b.seed = s.seed, b.threads = s.threads;
+  b.items_per_task = s.photons_per_task, b.progress = progress;
+  return b;
 }
 
 // The table from the sums of f |cos_i| |cos_o| per cell pair, and the books' fractions.
@@ -81,7 +79,7 @@ FiberBandTable bake_fiber_band_direct(const FiberBandPhysics& fiber, const Fiber
   const int ffs = s.far_field_s_bins, ffp = s.far_field_psi_bins;
   std::vector<double> far_total(far_field ? static_cast<size_t>(ffs) * ffs * ffp : 0, 0.0);
 
-  const PhotonBatchStatus status = run_photon_tasks<DirectTally>(
+  const TaskBatchStatus status = run_batch<DirectTally>(
       batch_of(s, progress),
       [&](uint64_t, uint64_t, uint64_t count, Rng& rng, DirectTally& tally) {
         tally.exits.reserve(2 * count);

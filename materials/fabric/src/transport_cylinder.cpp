@@ -26,14 +26,13 @@ void CylinderBeamSetup::validate() const {
     throw Error("", "direction", "a beam along the cylinder axis never enters it");
 }
 
-CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup,
-                                          const PhotonBatchOptions& batch) {
+CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup, const TaskBatch& batch) {
   setup.validate();
   const CylinderTransport transport(CylinderGeometry(setup.radius, setup.n_outside), setup.medium,
                                     setup.options);
   PhotonStats total;
-  const PhotonBatchStatus status = run_photon_tasks<PhotonStats>(
-      batch,
+  const TaskBatchStatus status = run_batch<PhotonStats>(
+      photon_batch(batch),
       [&](uint64_t, uint64_t, uint64_t count, Rng& rng, PhotonStats& tally) {
         NullRecorder none;
         for (uint64_t i = 0; i < count; ++i) {

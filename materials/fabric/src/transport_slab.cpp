@@ -45,15 +45,15 @@ void SlabSetup::validate() const {
                 "a semi-infinite slab needs mu_a + mu_s > 0 (light would travel without end)");
 }
 
-SlabResult simulate_slab(const SlabSetup& setup, const PhotonBatchOptions& batch) {
+SlabResult simulate_slab(const SlabSetup& setup, const TaskBatch& batch) {
   setup.validate();
   const SlabTransport transport(SlabGeometry(setup.thickness, setup.n_above, setup.n_below),
                                 setup.medium, setup.options);
   const Vec3 direction{std::sin(setup.incidence_rad), 0, -std::cos(setup.incidence_rad)};
 
   SlabTally total;
-  const PhotonBatchStatus status = run_photon_tasks<SlabTally>(
-      batch,
+  const TaskBatchStatus status = run_batch<SlabTally>(
+      photon_batch(batch),
       [&](uint64_t, uint64_t, uint64_t count, Rng& rng, SlabTally& tally) {
         for (uint64_t i = 0; i < count; ++i) {
           PhotonTally photon;

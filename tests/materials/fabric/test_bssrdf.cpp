@@ -33,7 +33,7 @@ BssrdfGrid grid() {
   return g;
 }
 
-PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
+TaskBatch batch(uint64_t photons, uint64_t seed, int threads = 2) {
   return weft::testing::batch_options(photons, seed, threads, 4096);
 }
 

@@ -40,6 +40,16 @@ TabulatedBsdfTable uniform_fiber(int resolution) {
   return t;
 }
 
+// The visible-layer method at a table resolution, samples per cell and points per circumference.
+FabricSummationOptions visible(int resolution, int samples_per_cell, int circumference_samples) {
+  FabricSummationOptions o;
+  o.method = FabricSummation::kVisible;
+  o.resolution = resolution;
+  o.samples_per_cell = samples_per_cell;
+  o.circumference_samples = circumference_samples;
+  return o;
+}
+
 }  // namespace
 
 TEST(FabricSummation, PaperSumOfALambertianFiberIsALambertianFabric) {
@@ -79,11 +89,7 @@ TEST(FabricSummation, VisibleLayerConservesEnergyAndTransmitsThroughTheUnderside
   // With in-plane fibers the layer returns at most what it receives (single scattering, masking
   // only removes light): directional albedo <= 1 for light from above; and the uniform fiber sends
   // light out of the layer's underside, which the paper's sum cannot.
-  FabricSummationOptions o;
-  o.method = FabricSummation::kVisible;
-  o.resolution = 4;
-  o.samples_per_cell = 2;
-  o.circumference_samples = 32;
+  FabricSummationOptions o = visible(4, 2, 32);
   const auto fab = sum_fabric_table(uniform_fiber(8), o);
   const DirectionGrid g = fab.grid();
   for (int i = 0; i < g.bins(); ++i) {
@@ -126,11 +132,7 @@ TEST(FabricSummation, TurningTheFibersTurnsTheTable) {
 }
 
 TEST(FabricSummation, BitIdenticalAtOneAndTwoThreads) {
-  FabricSummationOptions o;
-  o.method = FabricSummation::kVisible;
-  o.resolution = 3;
-  o.samples_per_cell = 2;
-  o.circumference_samples = 16;
+  FabricSummationOptions o = visible(3, 2, 16);
   o.threads = 1;
   const auto a = sum_fabric_table(uniform_fiber(4), o);
   o.threads = 2;

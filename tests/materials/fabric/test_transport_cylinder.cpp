@@ -23,7 +23,7 @@ CylinderBeamSetup beam(const TransportMedium& m, double radius, double n_out, co
   return {.medium = m, .radius = radius, .n_outside = n_out, .direction = dir, .options = {}};
 }
 
-PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
+TaskBatch batch(uint64_t photons, uint64_t seed, int threads = 2) {
   return weft::testing::batch_options(photons, seed, threads, 1024);
 }
 

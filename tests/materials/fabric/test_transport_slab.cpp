@@ -27,7 +27,7 @@ SlabSetup make_slab(double mua, double mus, double g, double n, double thickness
   return s;
 }
 
-PhotonBatchOptions batch(uint64_t photons, uint64_t seed, int threads = 2) {
+TaskBatch batch(uint64_t photons, uint64_t seed, int threads = 2) {
   return weft::testing::batch_options(photons, seed, threads, 2048);
 }
 
@@ -246,7 +246,7 @@ TEST(TransportSlab, SameBitsAtOneAndTwoThreads) {
 // Cancellation keeps whole tasks: the result equals a run of exactly the photons done.
 TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
-  PhotonBatchOptions b = batch(200000, 22, 2);
+  TaskBatch b = batch(200000, 22, 2);
   b.tasks_per_wave = 3;
   int calls = 0;
   b.progress = [&](const ProgressUpdate& u) {
@@ -256,7 +256,7 @@ TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   const SlabResult cut = simulate_slab(s, b);
   EXPECT_TRUE(cut.cancelled);
   EXPECT_EQ(cut.photons, 6u * 2048u);
-  PhotonBatchOptions whole = batch(cut.photons, 22, 1);
+  TaskBatch whole = batch(cut.photons, 22, 1);
   const SlabResult ref = simulate_slab(s, whole);
   EXPECT_FALSE(ref.cancelled);
   EXPECT_EQ(cut.rd.mean, ref.rd.mean);
@@ -327,7 +327,7 @@ TEST(TransportSlab, BadInputIsRejectedWithTheFieldNamed) {
   s = make_slab(1, 1, 0, 1, 1);
   s.options.roulette_survival = 0;
   EXPECT_NE(message_of(s).find("roulette_survival"), std::string::npos);
-  PhotonBatchOptions b = batch(10, 1);
-  b.photons_per_task = 0;
+  TaskBatch b = batch(10, 1);
+  b.items_per_task = 0;
   EXPECT_THROW(simulate_slab(make_slab(1, 1, 0, 1, 1), b), Error);
 }

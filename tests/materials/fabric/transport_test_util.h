@@ -12,13 +12,13 @@
 namespace weft::testing {
 
 // Batch options for a test run of 'photons' photons in tasks of 'photons_per_task'.
-inline PhotonBatchOptions batch_options(uint64_t photons, uint64_t seed, int threads,
-                                        uint64_t photons_per_task) {
-  PhotonBatchOptions b;
-  b.photons = photons;
+inline TaskBatch batch_options(uint64_t photons, uint64_t seed, int threads,
+                               uint64_t photons_per_task) {
+  TaskBatch b;
+  b.items = photons;
   b.seed = seed;
   b.threads = threads;
-  b.photons_per_task = photons_per_task;
+  b.items_per_task = photons_per_task;
   return b;
 }
 

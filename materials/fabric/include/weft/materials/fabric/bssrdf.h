@@ -94,13 +94,13 @@ struct BssrdfResult {
 
  private:
   friend BssrdfResult simulate_bssrdf(const FiberBandPhysics&, const BssrdfGrid&,
-                                      const BssrdfIncidence&, const PhotonBatchOptions&);
+                                      const BssrdfIncidence&, const TaskBatch&);
   std::vector<double> direction_areas_;  // D_out per direction bin
 };
 
-// Traces batch.photons photons into A. Tasks keep compact lists of (cell, weight) exits, merged in
+// Traces batch.items photons into A. Tasks keep compact lists of (cell, weight) exits, merged in
 // task order, so the result has the same bits at any thread count.
 BssrdfResult simulate_bssrdf(const FiberBandPhysics& fiber, const BssrdfGrid& grid,
-                             const BssrdfIncidence& incidence, const PhotonBatchOptions& batch);
+                             const BssrdfIncidence& incidence, const TaskBatch& batch);
 
 }  // namespace weft

@@ -1,6 +1,6 @@
 #pragma once
-// Photon batches: per-photon statistics of the energy books, and photon tasks on the project's
-// one deterministic batch runner (core/task_batch.h).
+// Per-photon statistics of the energy books. Photons run as tasks on the project's one
+// deterministic batch runner (core/task_batch.h, TaskBatch: items are photons).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -97,41 +97,10 @@ struct PhotonStats {
   }
 };
 
-// A batch of photons for the one batch runner (core/task_batch.h), named in photons.
-struct PhotonBatchOptions {
-  uint64_t photons = 0;
-  uint64_t seed = 0;
-  int threads = 0;                   // 0: all hardware threads
-  uint64_t photons_per_task = 4096;  // fixes the random streams: change it, change the bits
-  uint64_t tasks_per_wave = 0;       // 0: 8 per thread; lower it when tallies are large
-  ProgressCallback progress;         // may be empty
-
-  TaskBatch batch() const {
-    TaskBatch b;
-    b.items = photons;
-    b.seed = seed;
-    b.threads = threads;
-    b.items_per_task = photons_per_task;
-    b.tasks_per_wave = tasks_per_wave;
-    b.progress = progress;
-    b.stage = "photons";
-    return b;
-  }
-};
-
-struct PhotonBatchStatus {
-  uint64_t photons_done = 0;
-  uint64_t tasks_done = 0;
-  bool cancelled = false;
-};
-
-// Photon tasks on the one batch runner: run(task, first_photon, count, rng, tally), tallies merged
-// in task order.
-template <class TaskTally, class Run, class Merge>
-PhotonBatchStatus run_photon_tasks(const PhotonBatchOptions& options, Run&& run, Merge&& merge) {
-  if (options.photons_per_task == 0) throw Error("", "photons_per_task", "must be >= 1");
-  const TaskBatchStatus s = run_batch<TaskTally>(options.batch(), run, merge);
-  return {s.items_done, s.tasks_done, s.cancelled};
+// A batch whose items are photons: progress reports the stage "photons".
+inline TaskBatch photon_batch(TaskBatch b) {
+  b.stage = "photons";
+  return b;
 }
 
 }  // namespace weft

@@ -30,7 +30,6 @@ struct CylinderBeamResult : PhotonFractions {
   bool cancelled = false;
 };
 
-CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup,
-                                          const PhotonBatchOptions& batch);
+CylinderBeamResult simulate_cylinder_beam(const CylinderBeamSetup& setup, const TaskBatch& batch);
 
 }  // namespace weft

@@ -31,6 +31,6 @@ struct SlabResult : PhotonFractions {
   bool cancelled = false;
 };
 
-SlabResult simulate_slab(const SlabSetup& setup, const PhotonBatchOptions& batch);
+SlabResult simulate_slab(const SlabSetup& setup, const TaskBatch& batch);
 
 }  // namespace weft
