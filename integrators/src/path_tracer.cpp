@@ -64,13 +64,13 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       for (const Light& light : scene.lights()) add_found_light(light, escaped);
       break;
     }
-    if (depth == 0 && first_mesh) *first_mesh = hit.mesh;
+    if (depth == 0 && first_mesh) *first_mesh = hit.shape;
     const Vec3 wo_world = -ray.d;
-    if (const Light* light = scene.surface_light(hit.mesh))
-      add_found_light(*light, LightHit::on_surface(ray.d, hit.mesh, hit.prim, hit.ng, hit.t));
+    if (const Light* light = scene.surface_light(hit.shape))
+      add_found_light(*light, LightHit::on_surface(ray.d, hit.shape, hit.prim, hit.ng, hit.t));
     if (depth >= settings.max_depth) break;
 
-    const Bsdf& bsdf = scene.bsdf(hit.mesh);
+    const Bsdf& bsdf = scene.bsdf(hit);
     const Frame& frame = hit.shading;
     const Vec3 wo = frame.to_local(wo_world);
     // Shading normals differ from the facets: a direction the BSDF treats as reflection may lie

@@ -36,8 +36,8 @@ struct RenderResult {
   bool cancelled = false;          // the progress callback asked to stop; results are partial
 };
 
-// After every camera sample: its pixel (row-major), the mesh its camera ray hit first (-1: none)
-// and its radiance (0 for a dropped non-finite sample).
+// After every camera sample: its pixel (row-major), the shape (SurfaceHit::shape) its camera ray
+// hit first (-1: none) and its radiance (0 for a dropped non-finite sample).
 using SampleObserver = std::function<void(uint64_t pixel, int64_t first_mesh, const Rgb& radiance)>;
 // Every ray handed to the scene: camera and bounce rays (shadow = false) and shadow rays (shadow =
 // true, ending at ray.tmax).
@@ -57,7 +57,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
                     const ProgressCallback& progress = no_progress(),
                     const RenderObservers& observers = {});
 
-// Radiance arriving along 'ray' (one path sample). 'first_mesh' receives the mesh the ray hits
+// Radiance arriving along 'ray' (one path sample). 'first_mesh' receives the shape the ray hits
 // first (-1 for none); 'on_ray' sees every ray traced. Exposed for tests of the estimator itself.
 Rgb trace_path(const RenderScene& scene, const Ray& ray, const RenderSettings& settings, Rng& rng,
                RayCounts& rays, int64_t* first_mesh = nullptr, const RayObserver* on_ray = nullptr);
