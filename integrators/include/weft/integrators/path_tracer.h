@@ -7,6 +7,13 @@
 // decides); transmission continues through the surface. Every random number of a camera sample
 // comes from Rng(seed, pixel index, sample index) and tiles write disjoint pixels, so images are
 // bit-identical at any thread count.
+//
+// Fibers (round curves or tubes) are shaded with their fiber BSDF as hair renderers shade a fiber
+// with its BCSDF: a fiber table is the BSDF of the whole fiber (docs/fiber-bsdf.md), so a point B
+// of a fiber is shaded without occlusion by its own fiber: the shadow rays of next-event
+// estimation and the continuation ray that leave B ignore B's fiber (RenderScene's ignore_fiber),
+// and light from behind B, through its own fiber, is the table's to account for. Every other
+// fiber occludes and inter-reflects as any surface does. Triangles of meshes are unaffected.
 #include <cstdint>
 #include <functional>
 #include <vector>
