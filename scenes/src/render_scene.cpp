@@ -256,8 +256,8 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     geo->triangles += mesh->triangle_count();
   }
 
-  // Fibers: geometry IDs meshes.size() + k, one per curve set, each with the filter that ignores
-  // the query's fiber.
+  // Fibers: one Embree geometry per curve set, with the filter that ignores the query's fiber.
+  // Tubes take the shape's ID in the scene; round curves ID k in the instanced curve scene.
   geo->fiber_geometry = options.fiber_geometry.value_or(desc.fiber_geometry);
   const bool tubes = geo->fiber_geometry.type == FiberGeometry::Type::tubes;
   if (!desc.curves.empty() &&
@@ -333,11 +333,15 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
       allocated = vb && ib && fb;
       if (allocated) {
         const auto scale = static_cast<float>(geo->curve_scale);
+        bool in_range = true;
         for (size_t i = 0; i < curves->points.size(); ++i) {
           vb[i] = curves->points[i] * scale;  // exact: a power of two
-          if (!(std::abs(vb[i]) < 1e37f))
-            throw Error(desc.source, "curves[" + std::to_string(k) + "]",
-                        "fiber coordinates too large for their radii");
+          in_range = in_range && std::abs(vb[i]) < 1e37f;
+        }
+        if (!in_range) {
+          rtcReleaseGeometry(g);
+          throw Error(desc.source, "curves[" + std::to_string(k) + "]",
+                      "fiber coordinates too large for their radii");
         }
         std::memcpy(ib, rec.segments.first_point.data(), nseg * sizeof(uint32_t));
         for (size_t s = 0; s < nseg; ++s) {
