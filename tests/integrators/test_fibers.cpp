@@ -26,7 +26,7 @@
 #include "test_util.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
-#include "weft/integrators/masked_render.h"
+#include "weft/integrators/fiber_scattering.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/fabric/fiber_bake.h"
@@ -48,8 +48,7 @@ constexpr double kRadius = 8e-6;  // metres, as the weave generator's cotton
 // A unit direction by its axial cosine s and azimuth psi about the fiber axis x, psi measured
 // from y towards z (the baker's world frame: psi = atan2(z, y), docs/fiber-bsdf.md).
 Vec3 fiber_direction(double s, double psi) {
-  const double c = std::sqrt(std::max(0.0, 1 - s * s));
-  return {s, c * std::cos(psi), c * std::sin(psi)};
+  return weft::fiber_direction({1, 0, 0}, {0, 1, 0}, s, psi);
 }
 
 // One straight fiber along x through the origin, 200 radii long (8 segments), material "fiber".
@@ -70,49 +69,16 @@ SceneDescription one_fiber(const MaterialBinding& material, const char* geometry
   return d;
 }
 
-struct Estimate {
-  double value = 0, se = 0;
-};
+using Estimate = FiberScatteringEstimate;
 
-// F(w_i, w_o) per unit length in fiber radii, rendered: the fiber of one_fiber() under a parallel
-// light of irradiance E from w_i, an orthographic film of 16 x 2.5 radii facing w_o, its width
-// along the fiber's projection. The film sees the fiber length l = 16 R / sqrt(1 - s_o^2) (the
-// fiber is uniform along its axis, so l is exact for any film width); F = sum L A_px / (E l R).
-// The standard error comes from each pixel's sample variance.
+// F(w_i, w_o) of the fiber of one_fiber() (fiber_scattering.h: a film of 16 x 2.5 radii).
 Estimate render_f(const RenderScene& scene, const Vec3& wi, const Vec3& wo, uint64_t seed,
-                  int spp = 16, int threads = 0) {
-  const double e = 2.0;  // W/m^2: F must not depend on it
-  Lights lights;
-  lights.directional.push_back({wi, Rgb(e)});
-  const RenderScene lit = scene.with_lights(lights);
-  Camera cam;
-  cam.type = Camera::Type::orthographic;
-  cam.forward = -wo;
-  const Vec3 axis{1, 0, 0};
-  cam.right = normalize(axis - wo * dot(axis, wo));
-  cam.up = cross(cam.right, cam.forward);
-  cam.position = wo * (300 * kRadius);  // beyond the fiber's ends: the film never cuts it
-  cam.half_width = 8 * kRadius;
-  cam.half_height = 1.25 * kRadius;
-  RenderSettings s;
-  s.width = 32;
-  s.height = 8;
-  s.spp = spp;
-  s.max_depth = 1;  // one fiber alone: nothing to bounce from
-  s.seed = seed;
-  s.threads = threads;
-  const MaskedRender m =
-      render_masked(lit, cam, s, std::vector<uint8_t>(scene.shape_count(), 1));  // all fibers
-  double sum = 0, var = 0;
-  for (size_t p = 0; p < m.coverage.size(); ++p) {
-    const double mean = m.sum[3 * p + 1], second = m.sum_sq[3 * p + 1];  // green
-    sum += mean;
-    var += std::max(0.0, second - mean * mean) / (spp - 1);
-  }
-  const double pixel_area = (2 * cam.half_width / s.width) * (2 * cam.half_height / s.height);
-  const double length = 2 * cam.half_width / std::sqrt(1 - wo.x * wo.x);
-  const double scale = pixel_area / (e * length * kRadius);
-  return {sum * scale, std::sqrt(var) * scale};
+                  int spp = 16) {
+  FiberScatteringSetup f;
+  f.radius = kRadius;
+  f.spp = spp;
+  f.seed = seed;
+  return render_fiber_scattering(scene, f, wi, wo);
 }
 
 MaterialBinding table_binding(const fs::path& file) {
@@ -172,8 +138,8 @@ TEST(Fibers, LambertFiberRendersTheClosedForm) {
                             ((kPi - a) * std::cos(a) + std::sin(a));
     const Estimate f = render_f(scene, fiber_direction(c.s_i, psi_i),
                                 fiber_direction(c.s_o, psi_i + deg_to_rad(c.dpsi_deg)), 3, 256);
-    EXPECT_LT(f.se, 0.01 * expected);
-    EXPECT_NEAR(f.value, expected, 4 * f.se);
+    EXPECT_LT(f.std_error, 0.01 * expected);
+    EXPECT_NEAR(f.value, expected, 4 * f.std_error);
   }
 }
 
@@ -300,7 +266,7 @@ TEST(Fibers, LightFromBehindReachesAFiberThroughItselfButNotThroughAnother) {
     const Vec3 wi{0, -1, 0}, wo{0, 1, 0};
     const Estimate alone = render_f(scene_with(std::nullopt), wi, wo, 5, 64);
     if (std::string(geometry) == "curves")
-      EXPECT_NEAR(alone.value, 0.25, 4 * alone.se);
+      EXPECT_NEAR(alone.value, 0.25, 4 * alone.std_error);
     else  // an octagon: its flat facets shade differently (bench/ measures by how much)
       EXPECT_GT(alone.value, 0.0);
     const Estimate shadowed = render_f(scene_with(Vec3{0, -3 * kRadius, 0}), wi, wo, 5, 64);
