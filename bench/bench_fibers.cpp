@@ -2,7 +2,7 @@
 // benchmark per representation on the red-cotton patch at fiber detail. Counters: rays per second
 // of RenderScene::intersect on rays leaving fibers (own fiber ignored) and of the path tracer,
 // build seconds, and the one-fiber render's error against the Lambertian fiber's closed form
-// (mean and largest relative error, and the renders' relative noise).
+// (of the total scattered light and relative L2, and the renders' own noise).
 #include <benchmark/benchmark.h>
 
 #include <vector>
@@ -24,8 +24,8 @@ void BM_FiberGeometry(benchmark::State& state, size_t index) {
   state.counters["build_s"] = r.build_s;
   state.counters["triangles"] = double(r.triangles);
   state.counters["segments"] = double(r.curve_segments);
-  state.counters["one_fiber_mean_err"] = r.one_fiber_mean_error;
-  state.counters["one_fiber_max_err"] = r.one_fiber_max_error;
+  state.counters["one_fiber_total_err"] = r.one_fiber_total_error;
+  state.counters["one_fiber_rms_err"] = r.one_fiber_rms_error;
   state.counters["one_fiber_noise"] = r.one_fiber_noise;
 }
 

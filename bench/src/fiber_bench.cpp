@@ -57,7 +57,9 @@ std::vector<FiberRay> fiber_rays(const FiberCurves& c, size_t n, uint64_t seed) 
 }
 
 SceneDescription patch_scene(const FiberBenchOptions& o) {
-  WeaveOptions w = overlay(red_cotton_weave_options(), o.weave);
+  WeaveOptions base = red_cotton_weave_options();
+  base.repeats_x = base.repeats_z = 4;
+  WeaveOptions w = overlay(base, o.weave);
   w.detail = "fiber";
   const WovenSample sample = make_woven_sample(w);
   SceneDescription d;
@@ -158,7 +160,7 @@ std::vector<FiberBenchRow> bench_fibers(const FiberBenchOptions& o) {
     }
     // The one-fiber render against the closed form.
     const RenderScene fiber(one, so);
-    double sum = 0, worst = 0;
+    double sum_r = 0, sum_e = 0, sq_diff = 0, sq_e = 0, sq_se = 0;
     int n = 0;
     for (double s_i : {-0.5, 0.0, 0.3})
       for (double s_o : {-0.4, 0.0, 0.6})
@@ -174,14 +176,14 @@ std::vector<FiberBenchRow> bench_fibers(const FiberBenchOptions& o) {
           const Vec3 x{1, 0, 0}, y{0, 1, 0};
           const auto e = render_fiber_scattering(fiber, f, fiber_direction(x, y, s_i, psi),
                                                  fiber_direction(x, y, s_o, psi + a));
-          const double err = e.value / exact - 1;
-          sum += err;
-          worst = std::max(worst, std::abs(err));
-          r.one_fiber_noise = std::max(r.one_fiber_noise, e.std_error / exact);
+          sum_r += e.value, sum_e += exact;
+          sq_diff += (e.value - exact) * (e.value - exact), sq_e += exact * exact;
+          sq_se += e.std_error * e.std_error;
           ++n;
         }
-    r.one_fiber_mean_error = sum / n;
-    r.one_fiber_max_error = worst;
+    r.one_fiber_total_error = sum_r / sum_e - 1;
+    r.one_fiber_rms_error = std::sqrt(sq_diff / sq_e);
+    r.one_fiber_noise = std::sqrt(sq_se / sq_e);
     rows.push_back(r);
   }
   return rows;

@@ -15,6 +15,7 @@
 //  * Own-fiber exclusion: light from behind a fiber reaches its far side through the fiber, but
 //    not through another fiber.
 //  * Bit-identical renders of a fiber scene at 1 and 2 threads (curves and tubes).
+//  * The gonioreflectometer's sample and white reference cover fibers.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -24,9 +25,11 @@
 #include <optional>
 
 #include "test_util.h"
+#include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
 #include "weft/integrators/fiber_scattering.h"
+#include "weft/integrators/gonio.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/fabric/fiber_bake.h"
@@ -370,4 +373,32 @@ TEST(Fibers, FiberScenesAreBitIdenticalAtOneAndTwoThreads) {
     for (float v : a.image.rgb) sum += v;
     EXPECT_GT(sum, 0);
   }
+}
+
+TEST(Fibers, GonioreflectometerMeasuresAFiberPatch) {
+  // The sweep's sample, framing and white reference (a material override) cover curve sets like
+  // meshes. Direct light only: a patch of grey Lambertian fibers (rho = 0.4) measures exactly
+  // 0.4 times its white reference, the same scene with every fiber white.
+  MaterialBinding grey;
+  grey.type = "lambert";
+  grey.params = {{"reflectance", 0.4}};
+  grey.field = "materials.fiber";
+  const SceneDescription d = fiber_patch(grey, "curves", 0, false);
+  GonioSettings g;
+  g.sample = "patch";
+  g.light_zenith_deg = 30;
+  g.view_zenith_deg = {-40, 0, 40};
+  g.width = g.height = 24;
+  g.spp = 4;
+  g.max_depth = 1;
+  const GonioResult r = run_gonio(d, g);
+  ASSERT_EQ(r.rows.size(), 3u);
+  for (const auto& row : r.rows) {
+    EXPECT_GT(row.footprint_px, 0.3 * g.width * g.height);  // the film frames the fibers
+    ASSERT_TRUE(row.white.has_value());
+    EXPECT_GT(row.white->g, 0.1);
+    EXPECT_NEAR(row.beta.g, 0.4 * row.white->g, 1e-6 * row.white->g);
+  }
+  g.sample = "nothing";
+  EXPECT_THROW(run_gonio(d, g), Error);
 }

@@ -35,9 +35,11 @@ struct FiberBenchRow {
   double rays_per_s = 0;       // intersect(), own fiber ignored, 'threads' threads
   double hit_fraction = 0;     // of those rays (the same rays for every representation)
   double path_rays_per_s = 0;  // every ray of the path tracer on the patch
-  // One Lambertian fiber: F rendered / closed form - 1, over a fixed set of direction pairs.
-  double one_fiber_mean_error = 0, one_fiber_max_error = 0;
-  double one_fiber_noise = 0;  // the renders' relative standard error (largest)
+  // One Lambertian fiber over a fixed set of direction pairs (36: light and view at axial cosines
+  // -0.5..0.6, azimuth differences 0..140 deg), rendered F_r against the closed form F_e:
+  // total: sum F_r / sum F_e - 1 (the light scattered, all pairs together); rms: the relative L2
+  // error sqrt(sum (F_r - F_e)^2 / sum F_e^2); noise: the renders' own, in the rms's units.
+  double one_fiber_total_error = 0, one_fiber_rms_error = 0, one_fiber_noise = 0;
 };
 
 std::vector<FiberBenchRow> bench_fibers(const FiberBenchOptions& options);
