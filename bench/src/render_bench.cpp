@@ -13,6 +13,7 @@
 #include "weft/core/rng.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/materials/bsdfs.h"
+#include "weft/scenes/embree_context.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
@@ -156,17 +157,15 @@ double embree_hit_distance(const RenderScene& scene, const EmbreeRay& r) {
   rh.ray = rtc_ray(r);
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  rtcIntersect1(scene.embree_scene(), &ctx, &rh);
+  FiberQueryContext ctx;  // the fibers' filter functions read it
+  rtcIntersect1(scene.embree_scene(), &ctx.embree, &rh);
   return rh.hit.geomID == RTC_INVALID_GEOMETRY_ID ? INFINITY : rh.ray.tfar;
 }
 
 bool embree_occluded(const RenderScene& scene, const EmbreeRay& r) {
   RTCRay ray = rtc_ray(r);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  rtcOccluded1(scene.embree_scene(), &ctx, &ray);
+  FiberQueryContext ctx;
+  rtcOccluded1(scene.embree_scene(), &ctx.embree, &ray);
   return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 

@@ -152,7 +152,7 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   std::optional<RenderScene> white_scene;
   if (g.white_check) {
     RenderSceneOptions opt;
-    opt.override_meshes = sel;
+    opt.override_shapes = sel;
     MaterialBinding white;
     white.type = "lambert";
     white.params = {{"reflectance", 1.0}};

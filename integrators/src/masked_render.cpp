@@ -7,8 +7,8 @@ namespace weft {
 MaskedRender render_masked(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
                            const std::vector<uint8_t>& mask_meshes,
                            const ProgressCallback& progress) {
-  if (mask_meshes.size() != scene.mesh_count())
-    throw Error("", "render", "mask does not match the mesh count");
+  if (mask_meshes.size() != scene.shape_count())
+    throw Error("", "render", "mask does not match the shape count");
   MaskedRender out;
   // render() rejects a bad size; until then, allocate nothing for it.
   const size_t npx = s.width > 0 && s.height > 0 ? size_t(s.width) * s.height : 0;

@@ -26,10 +26,10 @@ bool finite(const Rgb& c) {
 
 Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings,
                Rng& rng, RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
-  auto occluded = [&](const Vec3& o, const Vec3& d, double tmax) {
+  auto occluded = [&](const Vec3& o, const Vec3& d, double tmax, int64_t ignore_fiber) {
     ++rays.shadow;
     if (on_ray) (*on_ray)({o, d, tmax}, true);
-    return scene.occluded(o, d, tmax);
+    return scene.occluded(o, d, tmax, ignore_fiber);
   };
   const bool use_mis = settings.sampling == LightSampling::mis;
   const bool nee_area = settings.sampling != LightSampling::bsdf_only;
@@ -38,12 +38,14 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
   bool specular = true;  // camera rays and delta bounces are not covered by next-event estimation
   double prev_pdf = 0;
   if (first_mesh) *first_mesh = -1;
+  // Rays that leave a fiber pass through it (its own fiber never occludes a point of it).
+  int64_t ignore_fiber = kNoFiber;
   // Shadow ray from just off the surface (on the target's side) to just short of the target.
   auto occluded_between = [&](const SurfaceHit& h, const Vec3& target) {
     const Vec3 o = h.spawn_origin(target - h.p);
     const Vec3 to = target - o;
     const double d = length(to);
-    return d > 0 && occluded(o, to / d, d * (1 - 1e-5));
+    return d > 0 && occluded(o, to / d, d * (1 - 1e-5), h.fiber);
   };
   // Radiance from a light that the last BSDF sample found, weighted against next-event estimation
   // of the same light.
@@ -58,27 +60,28 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
   for (int depth = 0;; ++depth) {
     SurfaceHit hit;
     if (on_ray) (*on_ray)(ray, false);
-    const bool found = scene.intersect(ray, &hit);
+    const bool found = scene.intersect(ray, &hit, ignore_fiber);
     if (!found) {
       const LightHit escaped = LightHit::escaped_along(ray.d);
       for (const Light& light : scene.lights()) add_found_light(light, escaped);
       break;
     }
-    if (depth == 0 && first_mesh) *first_mesh = hit.mesh;
+    if (depth == 0 && first_mesh) *first_mesh = hit.shape;
     const Vec3 wo_world = -ray.d;
-    if (const Light* light = scene.surface_light(hit.mesh))
-      add_found_light(*light, LightHit::on_surface(ray.d, hit.mesh, hit.prim, hit.ng, hit.t));
+    if (const Light* light = scene.surface_light(hit.shape))
+      add_found_light(*light, LightHit::on_surface(ray.d, hit.shape, hit.prim, hit.ng, hit.t));
     if (depth >= settings.max_depth) break;
 
-    const Bsdf& bsdf = scene.bsdf(hit.mesh);
+    const Bsdf& bsdf = scene.bsdf(hit);
     const Frame& frame = hit.shading;
     const Vec3 wo = frame.to_local(wo_world);
     // Shading normals differ from the facets: a direction the BSDF treats as reflection may lie
     // behind the facet (or the reverse for transmission). Such directions would leak light
-    // through the surface, so they carry none (Veach 1997, section 5.3).
+    // through the surface, so they carry none (Veach 1997, section 5.3). A fiber has no such
+    // surface to leak through: it is shaded as a whole, light from any side of B included.
     const double wo_ng = dot(wo_world, hit.ng);
     auto consistent = [&](const Vec3& wi_world, const Vec3& wi_local) {
-      return (wo_ng * dot(wi_world, hit.ng) > 0) == (wo.z * wi_local.z > 0);
+      return hit.on_fiber() || (wo_ng * dot(wi_world, hit.ng) > 0) == (wo.z * wi_local.z > 0);
     };
 
     // Next-event estimation: one sample of every light; area lights and the environment weighted
@@ -93,8 +96,9 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       const Rgb f = bsdf.eval(wo, wi);
       if (f.is_black()) continue;
       const double w = delta || !use_mis ? 1.0 : power_heuristic(ls->pdf, bsdf.pdf(wo, wi));
-      const bool blocked = ls->at_infinity ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300)
-                                           : occluded_between(hit, ls->p_light);
+      const bool blocked = ls->at_infinity
+                               ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300, hit.fiber)
+                               : occluded_between(hit, ls->p_light);
       if (!blocked) L += beta * f * ls->L * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
     }
 
@@ -109,6 +113,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
     specular = bs->is_delta;
     prev_pdf = bs->pdf;
     ray = {hit.spawn_origin(wi), wi};
+    ignore_fiber = hit.fiber;
     ++rays.bounce;
     if (depth + 1 >= settings.rr_depth) {
       const double q = std::min(0.95, beta.max_component());

@@ -126,6 +126,18 @@ Camera parse_camera(ParamReader f, const SceneDescription& d,
   return cam;
 }
 
+FiberGeometry parse_fiber_geometry(ParamReader f) {
+  FiberGeometry g;
+  const std::string type = f.choice("type", "curves", {"curves", "tubes"});
+  if (type == "tubes") {
+    g.type = FiberGeometry::Type::tubes;
+    g.tube_sides = static_cast<int>(f.integer("sides", g.tube_sides, FiberGeometry::kMinTubeSides,
+                                              FiberGeometry::kMaxTubeSides));
+  }
+  f.finish();
+  return g;
+}
+
 void parse_object(ParamReader f, SceneDescription& d) {
   const std::string type = f.string("type");
   TriangleMesh m;
@@ -151,9 +163,27 @@ void parse_object(ParamReader f, SceneDescription& d) {
     m = detail::make_sphere(c, r, sub, inward);
     // Flat facets (no vertex normals) make shading and geometry agree exactly (furnace tests).
     if (!f.boolean("smooth", true)) m.normals.clear();
+  } else if (type == "fiber") {
+    FiberCurves c;
+    const Vec3 from = f.vec3("from"), to = f.vec3("to");
+    if (!(length(to - from) > 0)) throw Error(f.file(), f.field("to"), "equals 'from'");
+    const double r = f.number("radius", 1e-30, 1e30);
+    const int segments = static_cast<int>(f.integer("segments", 1, 1, 1 << 20));
+    for (int k = 0; k <= segments; ++k) {
+      const Vec3 p = from + (to - from) * (double(k) / segments);
+      c.points.insert(c.points.end(), {float(p.x), float(p.y), float(p.z), float(r)});
+    }
+    c.curve_first = {0};
+    c.curve_points = {static_cast<uint32_t>(segments + 1)};
+    c.curve_yarn = {0};
+    c.yarn_material = {f.string("material")};
+    if (f.has("name")) c.names = {f.string("name")};
+    f.finish();
+    d.curves.push_back(std::make_shared<const FiberCurves>(std::move(c)));
+    return;
   } else {
     throw Error(f.file(), f.field("type"),
-                "unknown object type '" + type + "' (valid: quad, sphere)");
+                "unknown object type '" + type + "' (valid: quad, sphere, fiber)");
   }
   m.material = f.string("material");
   if (f.has("name")) m.names = {f.string("name")};
@@ -173,21 +203,28 @@ Bounds3 SceneDescription::object_bounds(const std::string& object) const {
   Bounds3 b;
   for (size_t i = 0; i < meshes.size(); ++i)
     if (sel[i]) b.expand(meshes[i]->bounds());
+  for (size_t k = 0; k < curves.size(); ++k)
+    if (sel[meshes.size() + k]) b.expand(curves[k]->bounds());
   if (b.empty()) throw Error(source, "", "object '" + object + "' has no vertices");
   return b;
 }
 
 std::vector<uint8_t> SceneDescription::select_object(const std::string& object) const {
-  std::vector<uint8_t> sel(meshes.size(), 0);
+  std::vector<uint8_t> sel(shape_count(), 0);
   bool any = false;
   for (size_t i = 0; i < meshes.size(); ++i)
     if (object.empty() || meshes[i]->has_name(object)) sel[i] = 1, any = true;
+  for (size_t k = 0; k < curves.size(); ++k)
+    if (object.empty() || curves[k]->has_name(object)) sel[meshes.size() + k] = 1, any = true;
   if (!any) {
     std::string known;
     std::set<std::string> seen;
-    for (const auto& m : meshes)
-      for (const auto& n : m->names)
+    auto add = [&](const std::vector<std::string>& names) {
+      for (const auto& n : names)
         if (seen.insert(n).second) known += (known.empty() ? "" : ", ") + n;
+    };
+    for (const auto& m : meshes) add(m->names);
+    for (const auto& c : curves) add(c->names);
     throw Error(
         source, "",
         "no object named '" + object + "' (known: " + (known.empty() ? "none" : known) + ")");
@@ -236,6 +273,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
         throw Error(source, field, "glTF file not found: " + path.string());
       GltfContent content = load_gltf(path);
       for (auto& m : content.meshes) d.meshes.push_back(std::move(m));
+      for (auto& c : content.curves) d.curves.push_back(std::move(c));
       for (const auto& [key, info] : content.materials) d.gltf_materials[key] = info;
       for (auto& c : content.cameras) gltf_cameras.push_back(std::move(c));
       d.lights.directional.insert(d.lights.directional.end(), content.lights.directional.begin(),
@@ -266,6 +304,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
       parse_light(ParamReader(ls[i], source, "lights[" + std::to_string(i) + "]"), d.frame,
                   d.lights);
   }
+  if (f.has("fiber_geometry")) d.fiber_geometry = parse_fiber_geometry(f.object("fiber_geometry"));
   if (f.has("render")) d.render = f.at("render");
   if (f.has("sweep")) d.sweep = f.at("sweep");
   if (f.has("camera"))
@@ -274,13 +313,20 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     d.camera = gltf_cameras.front().camera;
   f.finish();
 
-  if (d.meshes.empty()) throw Error(source, "gltf", "the scene has no geometry");
-  // Every mesh needs a material: fail now rather than at render time.
+  if (d.meshes.empty() && d.curves.empty())
+    throw Error(source, "gltf", "the scene has no geometry");
+  // Every mesh and fiber needs a material: fail now rather than at render time.
   for (const auto& m : d.meshes) d.binding_for(m->material);
+  for (const auto& c : d.curves) {
+    c->validate(source, "curves");
+    for (const auto& key : c->yarn_material) d.binding_for(key);
+  }
   for (const auto& [key, b] : d.materials)
     if (!d.gltf_materials.count(key)) {
       bool used = false;
       for (const auto& m : d.meshes) used = used || m->material == key;
+      for (const auto& c : d.curves)
+        for (const auto& y : c->yarn_material) used = used || y == key;
       if (!used)
         d.warnings.push_back(source + ": materials." + key + ": no mesh uses this material");
     }

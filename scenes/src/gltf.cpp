@@ -5,6 +5,7 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -247,10 +248,101 @@ std::string material_key(const Ctx& c, int material, const std::string& field) {
   return name.empty() ? "material_" + std::to_string(material) : name;
 }
 
+// The uniform scale of a transform's linear part; Error naming the node when it scales unevenly
+// (a round fiber would turn elliptic) or is singular.
+double uniform_scale(const Ctx& c, const Affine& world, const std::string& node_field) {
+  Vec3 col[3];
+  for (int k = 0; k < 3; ++k) col[k] = {world.m[0][k], world.m[1][k], world.m[2][k]};
+  const double l0 = length(col[0]), l1 = length(col[1]), l2 = length(col[2]);
+  const double s = (l0 + l1 + l2) / 3;
+  const double tol = 1e-6 * s;
+  if (!(s > 0) || !std::isfinite(s))
+    fail(c, node_field, "node transform of fiber curves is singular");
+  if (std::abs(l0 - s) > tol || std::abs(l1 - s) > tol || std::abs(l2 - s) > tol ||
+      std::abs(dot(col[0], col[1])) > tol * s || std::abs(dot(col[0], col[2])) > tol * s ||
+      std::abs(dot(col[1], col[2])) > tol * s)
+    fail(c, node_field,
+         "fiber curves (LINE_STRIP with _RADIUS) need a uniform scale: a non-uniform one would "
+         "make the round fibers elliptic");
+  return s;
+}
+
+// Curve point totals are stored in 32 bits and handed to Embree as its vertex count.
+constexpr size_t kMaxCurvePoints = size_t(1) << 31;
+
+// A LINE_STRIP with _RADIUS: one fiber, appended to 'curves' (the mesh instance's fibers).
+void load_curve(const Ctx& c, const tinygltf::Primitive& prim, const Affine& world,
+                const std::string& field, const std::string& node_field, FiberCurves& curves) {
+  auto attr = [&](const char* name) {
+    const auto it = prim.attributes.find(name);
+    return it == prim.attributes.end() ? -2 : it->second;
+  };
+  const std::string af = field + ".attributes.";
+  if (attr("POSITION") == -2) fail(c, af + "POSITION", "is required");
+  const double scale = uniform_scale(c, world, node_field);
+  // Sizes first: nothing is allocated for counts the buffers cannot hold or Embree cannot index.
+  const AccessorView pv = accessor_view(c, attr("POSITION"), af + "POSITION");
+  const AccessorView rv = accessor_view(c, attr("_RADIUS"), af + "_RADIUS");
+  if (rv.count != pv.count)
+    fail(c, af + "_RADIUS",
+         "count " + std::to_string(rv.count) + " differs from POSITION's " +
+             std::to_string(pv.count));
+  if (rv.components != 1) fail(c, af + "_RADIUS", "must be SCALAR (one radius per point)");
+  if (rv.component_type != TINYGLTF_COMPONENT_TYPE_FLOAT)
+    fail(c, af + "_RADIUS", "must be float (metres)");
+  size_t strip = pv.count;
+  if (prim.indices >= 0) strip = accessor_view(c, prim.indices, field + ".indices").count;
+  if (strip < 2) fail(c, field, "a fiber (LINE_STRIP) needs at least 2 points");
+  if (strip > kMaxCurvePoints - curves.point_count())
+    fail(c, field, "too many fiber points (at most 2^31 per mesh)");
+  const auto pos = read_attribute(c, attr("POSITION"), 3, false, af + "POSITION");
+  const auto rad = read_attribute(c, attr("_RADIUS"), 1, false, af + "_RADIUS");
+  const size_t nv = rad.size();
+  std::vector<uint32_t> idx;
+  if (prim.indices >= 0) {
+    idx = read_indices(c, prim.indices, field + ".indices");
+    for (size_t i = 0; i < idx.size(); ++i)
+      if (idx[i] >= nv)
+        fail(c, field + ".indices",
+             "index " + std::to_string(idx[i]) + " at " + std::to_string(i) +
+                 " exceeds the vertex count " + std::to_string(nv));
+  }
+  const std::string key = material_key(c, prim.material, field + ".material");
+  auto yarn = std::find(curves.yarn_material.begin(), curves.yarn_material.end(), key);
+  if (yarn == curves.yarn_material.end())
+    yarn = curves.yarn_material.insert(curves.yarn_material.end(), key);
+  curves.curve_first.push_back(static_cast<uint32_t>(curves.point_count()));
+  curves.curve_points.push_back(static_cast<uint32_t>(strip));
+  curves.curve_yarn.push_back(static_cast<uint32_t>(yarn - curves.yarn_material.begin()));
+  curves.points.reserve(curves.points.size() + 4 * strip);
+  for (size_t k = 0; k < strip; ++k) {
+    const size_t v = idx.empty() ? k : idx[k];
+    if (!(rad[v] > 0))
+      fail(c, af + "_RADIUS", "radius at element " + std::to_string(v) + " must be > 0");
+    const Vec3 p = world.point({pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]});
+    const double r = rad[v] * scale;
+    if (!is_finite(p) || std::abs(p.x) > 1e30 || std::abs(p.y) > 1e30 || std::abs(p.z) > 1e30)
+      fail(c, af + "POSITION", "position out of range after transform");
+    if (!(r > 0 && r < 1e30))
+      fail(c, af + "_RADIUS",
+           "radius out of range after transform at element " + std::to_string(v));
+    curves.points.insert(curves.points.end(),
+                         {float(p.x), float(p.y), float(p.z), static_cast<float>(r)});
+  }
+}
+
 void load_primitive(const Ctx& c, const tinygltf::Primitive& prim, const Affine& world,
-                    const std::vector<std::string>& names, const std::string& field) {
+                    const std::vector<std::string>& names, const std::string& field,
+                    const std::string& node_field, FiberCurves& curves) {
   if (prim.mode >= 0 && prim.mode <= 3) {
-    c.out->warnings.push_back(c.file + ": " + field + ": points/lines carry no area; skipped");
+    const bool radius = prim.attributes.count("_RADIUS") > 0;
+    if (radius && prim.mode == TINYGLTF_MODE_LINE_STRIP) {
+      load_curve(c, prim, world, field, node_field, curves);
+      return;
+    }
+    c.out->warnings.push_back(c.file + ": " + field +
+                              (radius ? ": fibers must be LINE_STRIP primitives (mode 3); skipped"
+                                      : ": points/lines carry no area; skipped"));
     return;
   }
   if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
@@ -453,10 +545,15 @@ void visit(const Ctx& c, int index, const Affine& parent, std::vector<std::strin
     const auto& mesh = m.meshes[node.mesh];
     auto mesh_names = names;
     if (!mesh.name.empty()) mesh_names.push_back(mesh.name);
+    FiberCurves curves;  // the instance's fibers: one FiberCurves, one object
+    curves.names = mesh_names;
     for (size_t p = 0; p < mesh.primitives.size(); ++p)
       load_primitive(
           c, mesh.primitives[p], world, mesh_names,
-          "meshes[" + std::to_string(node.mesh) + "].primitives[" + std::to_string(p) + "]");
+          "meshes[" + std::to_string(node.mesh) + "].primitives[" + std::to_string(p) + "]", field,
+          curves);
+    if (curves.curve_count() > 0)
+      c.out->curves.push_back(std::make_shared<const FiberCurves>(std::move(curves)));
   }
   load_camera(c, node, world, field);
   load_light(c, node, world, field);

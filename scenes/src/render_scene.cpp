@@ -2,6 +2,7 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -9,6 +10,7 @@
 
 #include "weft/core/error.h"
 #include "weft/materials/registry.h"
+#include "weft/scenes/embree_context.h"
 
 namespace weft {
 
@@ -16,6 +18,17 @@ namespace {
 struct EmbreeErrors {
   std::mutex mutex;
   std::string message;
+};
+
+// A curve set: one Embree geometry (round linear curves, or the tubes' triangles), whose filter
+// functions get this record as their user pointer.
+struct CurveRecord {
+  std::shared_ptr<const FiberCurves> curves;
+  FiberSegmentIndex segments;
+  std::vector<uint32_t> yarn_bsdf;          // per yarn of 'curves'
+  int64_t first_fiber = 0;                  // scene-wide id of curve 0
+  std::shared_ptr<const FiberTubes> tubes;  // set when the fibers are tubes
+  std::vector<uint32_t> prim_curve;         // per Embree primitive (segment or triangle): curve
 };
 }  // namespace
 
@@ -28,14 +41,23 @@ struct RenderScene::Geometry {
   EmbreeErrors errors;  // outlives the device, which reports into it
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
+  // Round curves live in their own scene, scaled by curve_scale (a power of two, so exactly) and
+  // instanced into 'scene' at 1 / curve_scale: Embree's round-curve intersector has absolute
+  // tolerances (float epsilon on squared lengths) that fail for fibers of micrometres in metres.
+  RTCScene curve_scene = nullptr;
+  double curve_scale = 1;
   std::vector<MeshRecord> meshes;
+  std::vector<CurveRecord> curve_sets;  // reserved once: Embree holds pointers to its elements
   std::vector<Bsdf> bsdfs;
   AreaLight area_light;  // the emissive triangles
   Bounds3 bounds;
-  size_t triangles = 0;
+  size_t triangles = 0, curve_segments = 0;
+  int64_t fibers = 0;
+  FiberGeometry fiber_geometry;
 
   ~Geometry() {
     if (scene) rtcReleaseScene(scene);
+    if (curve_scene) rtcReleaseScene(curve_scene);
     if (device) rtcReleaseDevice(device);
   }
 };
@@ -72,6 +94,92 @@ RTCRayHit embree_ray(const Ray& ray) {
   return rh;
 }
 
+// Embree calls this for every candidate hit on a fiber geometry (intersect and occluded): a hit on
+// the fiber the query ignores is rejected, and Embree goes on looking behind it.
+void ignore_fiber_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* ctx = reinterpret_cast<const FiberQueryContext*>(args->context);
+  const auto* rec = static_cast<const CurveRecord*>(args->geometryUserPtr);
+  const int64_t local = ctx->ignore_fiber - rec->first_fiber;
+  if (local < 0 || local >= static_cast<int64_t>(rec->curves->curve_count())) return;
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    if (rec->prim_curve[RTCHitN_primID(args->hit, args->N, i)] == static_cast<uint32_t>(local))
+      args->valid[i] = 0;
+  }
+}
+
+FiberSegment segment_of(const CurveRecord& rec, uint32_t segment) {
+  const FiberCurves& c = *rec.curves;
+  const uint32_t i = rec.segments.first_point[segment];
+  return {c.point(i), c.point(i + 1), c.radius(i), c.radius(i + 1)};
+}
+
+// Fills the hit on triangle 'prim' of 'm' at barycentrics (b1, b2).
+void triangle_hit(const TriangleMesh& m, uint32_t prim, double b1, double b2, const Ray& ray,
+                  SurfaceHit* hit) {
+  const uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1],
+                 i2 = m.indices[3 * prim + 2];
+  const double b0 = 1 - b1 - b2;
+  const Vec3 p0 = vertex(m, i0), p1 = vertex(m, i1), p2 = vertex(m, i2);
+  hit->p = b0 * p0 + b1 * p1 + b2 * p2;
+  Vec3 ng = cross(p1 - p0, p2 - p0);
+  const double ng_len = length(ng);
+  ng = ng_len > 0 ? ng / ng_len : -ray.d;
+  hit->ng = ng;
+  hit->prim = prim;
+  auto attr3 = [&](const std::vector<float>& a, int stride) {
+    return b0 * Vec3{a[stride * i0], a[stride * i0 + 1], a[stride * i0 + 2]} +
+           b1 * Vec3{a[stride * i1], a[stride * i1 + 1], a[stride * i1 + 2]} +
+           b2 * Vec3{a[stride * i2], a[stride * i2 + 1], a[stride * i2 + 2]};
+  };
+  Vec3 ns = ng;
+  if (!m.normals.empty()) {
+    const Vec3 n = attr3(m.normals, 3);
+    const double len = length(n);
+    if (len > 1e-12) ns = n / len;
+  }
+  const Vec3 tangent = m.tangents.empty() ? Vec3{} : attr3(m.tangents, 4);
+  hit->shading = Frame::from_normal_tangent(ns, tangent);
+  if (!m.uvs.empty()) {
+    hit->uv = {b0 * m.uvs[2 * i0] + b1 * m.uvs[2 * i1] + b2 * m.uvs[2 * i2],
+               b0 * m.uvs[2 * i0 + 1] + b1 * m.uvs[2 * i1 + 1] + b2 * m.uvs[2 * i2 + 1]};
+  } else {
+    hit->uv = {b1, b2};
+  }
+  // Float intersection error grows with the coordinates' magnitude: offset relative to it.
+  double mag = 0;
+  for (const Vec3& p : {p0, p1, p2})
+    mag = std::max({mag, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  hit->offset = 2e-6 * mag + 1e-30;  // ~30 float ulps of the largest coordinate
+}
+
+// Fills the hit on a round curve segment from Embree's distance: the point is put back onto the
+// fiber's surface (radially from the axis point closest to the ray's point), in double precision.
+void curve_hit(const FiberSegment& s, double t, const Ray& ray, SurfaceHit* hit) {
+  const Vec3 q = ray.o + ray.d * t;
+  const double u = s.closest_u(q);
+  const Vec3 c = s.axis_point(u);
+  const Vec3 axis = s.p1 - s.p0;
+  const double axis_len = length(axis);
+  Vec3 n = q - c;
+  double len = length(n);
+  if (!(len > 0)) {  // on the axis (never for a hit from outside): face the ray
+    n = -ray.d - (axis_len > 0 ? axis * (dot(-ray.d, axis) / (axis_len * axis_len)) : Vec3{});
+    len = length(n);
+    n = len > 0 ? n / len : -ray.d;
+  } else {
+    n = n / len;
+  }
+  hit->p = c + n * s.radius_at(u);
+  hit->ng = n;
+  // The fiber frame: tangent along the segment (orthogonalised against n on the end spheres).
+  hit->shading = Frame::from_normal_tangent(n, axis_len > 0 ? axis / axis_len : Vec3{});
+  hit->uv = {u, 0};
+  const Vec3& p = hit->p;
+  const double mag = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
+  hit->offset = 2e-6 * mag + 1e-30;
+}
+
 }  // namespace
 
 RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions& options) {
@@ -84,8 +192,8 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   rtcSetSceneFlags(geo->scene, RTC_SCENE_FLAG_ROBUST);  // watertight: no leaks along shared edges
   rtcSetSceneBuildQuality(geo->scene, RTC_BUILD_QUALITY_HIGH);
 
-  if (!options.override_meshes.empty() && options.override_meshes.size() != desc.meshes.size())
-    throw Error(desc.source, "", "override mask does not match the mesh count");
+  if (!options.override_shapes.empty() && options.override_shapes.size() != desc.shape_count())
+    throw Error(desc.source, "", "override mask does not match the shape count");
   // One BSDF per binding, created once and shared by every mesh that uses it.
   std::map<const MaterialBinding*, uint32_t> bsdf_of;
   const auto cache = options.table_cache ? options.table_cache : std::make_shared<TableCache>();
@@ -104,15 +212,17 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     bsdf_of[&b] = id;
     return id;
   };
+  auto overridden = [&](size_t shape) {
+    const bool o = !options.override_shapes.empty() && options.override_shapes[shape];
+    if (o && !options.override_binding) throw Error(desc.source, "", "override without a binding");
+    return o;
+  };
 
   std::vector<AreaLight::Emission> emission;
   for (size_t i = 0; i < desc.meshes.size(); ++i) {
     const auto& mesh = desc.meshes[i];
-    const bool overridden = !options.override_meshes.empty() && options.override_meshes[i];
-    if (overridden && !options.override_binding)
-      throw Error(desc.source, "", "override without a binding");
     const MaterialBinding& b =
-        overridden ? *options.override_binding : desc.binding_for(mesh->material);
+        overridden(i) ? *options.override_binding : desc.binding_for(mesh->material);
     Geometry::MeshRecord rec;
     rec.mesh = mesh;
     rec.bsdf = bsdf_index(b);
@@ -145,6 +255,131 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     rtcReleaseGeometry(g);
     geo->triangles += mesh->triangle_count();
   }
+
+  // Fibers: one Embree geometry per curve set, with the filter that ignores the query's fiber.
+  // Tubes take the shape's ID in the scene; round curves ID k in the instanced curve scene.
+  geo->fiber_geometry = options.fiber_geometry.value_or(desc.fiber_geometry);
+  const bool tubes = geo->fiber_geometry.type == FiberGeometry::Type::tubes;
+  if (!desc.curves.empty() &&
+      rtcGetDeviceProperty(geo->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0)
+    throw Error(desc.source, "curves",
+                "this Embree is built without filter functions, which fibers need");
+  for (size_t k = 0; k < desc.curves.size(); ++k)
+    desc.curves[k]->validate(desc.source, "curves[" + std::to_string(k) + "]");
+  geo->curve_sets.reserve(desc.curves.size());
+  if (!tubes && !desc.curves.empty()) {
+    // The scale that makes the mean fiber radius about 1.
+    double sum = 0;
+    size_t n = 0;
+    for (const auto& c : desc.curves)
+      for (size_t i = 0; i < c->point_count(); ++i) sum += c->radius(i), ++n;
+    if (n > 0) geo->curve_scale = std::ldexp(1.0, std::clamp(-std::ilogb(sum / n), -100, 100));
+    geo->curve_scene = rtcNewScene(geo->device);
+    rtcSetSceneFlags(geo->curve_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(geo->curve_scene, RTC_BUILD_QUALITY_HIGH);
+  }
+  for (size_t k = 0; k < desc.curves.size(); ++k) {
+    const size_t shape = desc.meshes.size() + k;
+    const auto& curves = desc.curves[k];
+    CurveRecord& rec = geo->curve_sets.emplace_back();
+    rec.curves = curves;
+    rec.segments = index_segments(*curves);
+    rec.first_fiber = geo->fibers;
+    geo->fibers += static_cast<int64_t>(curves->curve_count());
+    for (const std::string& key : curves->yarn_material) {
+      const MaterialBinding& b =
+          overridden(shape) ? *options.override_binding : desc.binding_for(key);
+      if (b.emission && !b.emission->is_black())
+        throw Error(desc.source, b.field.empty() ? "materials" : b.field + ".emission",
+                    "fibers do not emit light: bind emission to meshes only");
+      rec.yarn_bsdf.push_back(bsdf_index(b));
+    }
+    geo->bounds.expand(curves->bounds());
+    if (curves->curve_count() == 0) continue;
+
+    RTCGeometry g = nullptr;
+    bool allocated = true;
+    if (tubes) {
+      auto t =
+          std::make_shared<FiberTubes>(make_fiber_tubes(*curves, geo->fiber_geometry.tube_sides));
+      rec.prim_curve.resize(t->triangle_segment.size());
+      for (size_t i = 0; i < t->triangle_segment.size(); ++i)
+        rec.prim_curve[i] = rec.segments.curve[t->triangle_segment[i]];
+      const TriangleMesh& m = t->mesh;
+      g = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertex_count()));
+      auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), m.triangle_count()));
+      allocated = vb && ib;
+      if (allocated) {
+        std::memcpy(vb, m.positions.data(), m.positions.size() * sizeof(float));
+        std::memcpy(ib, m.indices.data(), m.indices.size() * sizeof(uint32_t));
+      }
+      geo->triangles += m.triangle_count();
+      rec.tubes = std::move(t);
+    } else {
+      rec.prim_curve = rec.segments.curve;
+      const size_t nseg = rec.segments.first_point.size();
+      g = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
+                                                             RTC_FORMAT_FLOAT4, 4 * sizeof(float),
+                                                             curves->point_count()));
+      auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(uint32_t), nseg));
+      // Neighbour flags: a fiber's inner joints attach, only its two ends are closed by spheres.
+      auto* fb = static_cast<uint8_t*>(
+          rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR, 1, nseg));
+      allocated = vb && ib && fb;
+      if (allocated) {
+        const auto scale = static_cast<float>(geo->curve_scale);
+        bool in_range = true;
+        for (size_t i = 0; i < curves->points.size(); ++i) {
+          vb[i] = curves->points[i] * scale;  // exact: a power of two
+          in_range = in_range && std::abs(vb[i]) < 1e37f;
+        }
+        if (!in_range) {
+          rtcReleaseGeometry(g);
+          throw Error(desc.source, "curves[" + std::to_string(k) + "]",
+                      "fiber coordinates too large for their radii");
+        }
+        std::memcpy(ib, rec.segments.first_point.data(), nseg * sizeof(uint32_t));
+        for (size_t s = 0; s < nseg; ++s) {
+          const uint32_t c = rec.segments.curve[s], first = curves->curve_first[c];
+          const uint32_t last = first + curves->curve_points[c] - 2;  // its last segment's start
+          const uint32_t at = rec.segments.first_point[s];
+          fb[s] = static_cast<uint8_t>((at > first ? RTC_CURVE_FLAG_NEIGHBOR_LEFT : 0) |
+                                       (at < last ? RTC_CURVE_FLAG_NEIGHBOR_RIGHT : 0));
+        }
+      }
+      geo->curve_segments += nseg;
+    }
+    if (!allocated) {
+      rtcReleaseGeometry(g);
+      throw Error(desc.source, "", "Embree could not allocate buffers: " + errors.message);
+    }
+    rtcSetGeometryUserData(g, &rec);
+    rtcSetGeometryIntersectFilterFunction(g, ignore_fiber_filter);
+    rtcSetGeometryOccludedFilterFunction(g, ignore_fiber_filter);
+    rtcCommitGeometry(g);
+    // Tubes: shape IDs in the scene; round curves: set k in the curve scene.
+    if (tubes)
+      rtcAttachGeometryByID(geo->scene, g, static_cast<unsigned>(shape));
+    else
+      rtcAttachGeometryByID(geo->curve_scene, g, static_cast<unsigned>(k));
+    rtcReleaseGeometry(g);
+  }
+  if (geo->curve_scene) {
+    rtcCommitScene(geo->curve_scene);
+    RTCGeometry inst = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, geo->curve_scene);
+    const auto inv = static_cast<float>(1 / geo->curve_scale);
+    const float xfm[12] = {inv, 0, 0, 0, inv, 0, 0, 0, inv, 0, 0, 0};  // 3 x 4, column-major
+    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    rtcCommitGeometry(inst);
+    rtcAttachGeometryByID(geo->scene, inst, static_cast<unsigned>(desc.shape_count()));
+    rtcReleaseGeometry(inst);
+  }
   rtcCommitScene(geo->scene);
   if (!errors.message.empty()) throw Error(desc.source, "", errors.message);
   geo->area_light = AreaLight(desc.meshes, emission);
@@ -154,8 +389,10 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   set_lights(desc.lights);
 }
 
-const Light* RenderScene::surface_light(uint32_t mesh) const {
-  return surface_light_ >= 0 && geo_->meshes[mesh].emits ? &lights_[surface_light_] : nullptr;
+const Light* RenderScene::surface_light(uint32_t shape) const {
+  return surface_light_ >= 0 && shape < geo_->meshes.size() && geo_->meshes[shape].emits
+             ? &lights_[surface_light_]
+             : nullptr;
 }
 
 void RenderScene::set_lights(const Lights& lights) {
@@ -170,52 +407,33 @@ void RenderScene::set_lights(const Lights& lights) {
   if (!lights.environment.is_black()) lights_.push_back(EnvironmentLight{lights.environment});
 }
 
-bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit) const {
+bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fiber) const {
   RTCRayHit rh = embree_ray(ray);
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
-  rtcIntersect1(geo_->scene, &ctx, &rh);
+  FiberQueryContext ctx(ignore_fiber);
+  rtcIntersect1(geo_->scene, &ctx.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-
-  const auto& rec = geo_->meshes[rh.hit.geomID];
-  const TriangleMesh& m = *rec.mesh;
-  const uint32_t prim = rh.hit.primID;
-  const uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1],
-                 i2 = m.indices[3 * prim + 2];
-  const double b1 = rh.hit.u, b2 = rh.hit.v, b0 = 1 - b1 - b2;
-  const Vec3 p0 = vertex(m, i0), p1 = vertex(m, i1), p2 = vertex(m, i2);
   hit->t = rh.ray.tfar;
-  hit->p = b0 * p0 + b1 * p1 + b2 * p2;
-  Vec3 ng = cross(p1 - p0, p2 - p0);
-  const double ng_len = length(ng);
-  ng = ng_len > 0 ? ng / ng_len : -ray.d;
-  hit->ng = ng;
-  hit->mesh = rh.hit.geomID;
-  hit->prim = prim;
-  auto attr3 = [&](const std::vector<float>& a, int stride) {
-    return b0 * Vec3{a[stride * i0], a[stride * i0 + 1], a[stride * i0 + 2]} +
-           b1 * Vec3{a[stride * i1], a[stride * i1 + 1], a[stride * i1 + 2]} +
-           b2 * Vec3{a[stride * i2], a[stride * i2 + 1], a[stride * i2 + 2]};
-  };
-  Vec3 ns = ng;
-  if (!m.normals.empty()) {
-    const Vec3 n = attr3(m.normals, 3);
-    const double len = length(n);
-    if (len > 1e-12) ns = n / len;
+  hit->shape = rh.hit.geomID;
+  if (rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID && rh.hit.geomID < geo_->meshes.size()) {
+    triangle_hit(*geo_->meshes[rh.hit.geomID].mesh, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit);
+    hit->fiber = kNoFiber;
+    hit->segment = 0;
+    return true;
   }
-  const Vec3 tangent = m.tangents.empty() ? Vec3{} : attr3(m.tangents, 4);
-  hit->shading = Frame::from_normal_tangent(ns, tangent);
-  if (!m.uvs.empty()) {
-    hit->uv = {b0 * m.uvs[2 * i0] + b1 * m.uvs[2 * i1] + b2 * m.uvs[2 * i2],
-               b0 * m.uvs[2 * i0 + 1] + b1 * m.uvs[2 * i1 + 1] + b2 * m.uvs[2 * i2 + 1]};
+  // Round curves are hit inside the curve scene's instance, where geomID is the curve set.
+  const bool instanced = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID;
+  const size_t set = instanced ? rh.hit.geomID : rh.hit.geomID - geo_->meshes.size();
+  hit->shape = static_cast<uint32_t>(geo_->meshes.size() + set);
+  const CurveRecord& rec = geo_->curve_sets[set];
+  if (rec.tubes) {
+    triangle_hit(rec.tubes->mesh, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit);
+    hit->segment = rec.tubes->triangle_segment[rh.hit.primID];
   } else {
-    hit->uv = {b1, b2};
+    hit->segment = rh.hit.primID;
+    curve_hit(segment_of(rec, hit->segment), hit->t, ray, hit);
+    hit->prim = hit->segment;
   }
-  // Float intersection error grows with the coordinates' magnitude: offset relative to it.
-  double mag = 0;
-  for (const Vec3& p : {p0, p1, p2})
-    mag = std::max({mag, std::abs(p.x), std::abs(p.y), std::abs(p.z)});
-  hit->offset = 2e-6 * mag + 1e-30;  // ~30 float ulps of the largest coordinate
+  hit->fiber = rec.first_fiber + rec.segments.curve[hit->segment];
   return true;
 }
 
@@ -223,9 +441,9 @@ RTCSceneTy* RenderScene::embree_scene() const {
   return geo_->scene;
 }
 
-bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax) const {
-  RTCIntersectContext ctx;
-  rtcInitIntersectContext(&ctx);
+bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax,
+                           int64_t ignore_fiber) const {
+  FiberQueryContext ctx(ignore_fiber);
   RTCRay r;
   r.org_x = static_cast<float>(origin.x);
   r.org_y = static_cast<float>(origin.y);
@@ -238,12 +456,59 @@ bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax) con
   r.mask = 0xFFFFFFFFu;
   r.time = 0.0f;
   r.flags = 0;
-  rtcOccluded1(geo_->scene, &ctx, &r);
+  rtcOccluded1(geo_->scene, &ctx.embree, &r);
   return r.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 
-const Bsdf& RenderScene::bsdf(uint32_t mesh) const {
-  return geo_->bsdfs[geo_->meshes[mesh].bsdf];
+const Bsdf& RenderScene::bsdf(const SurfaceHit& hit) const {
+  if (!hit.on_fiber()) return geo_->bsdfs[geo_->meshes[hit.shape].bsdf];
+  const CurveRecord& rec = geo_->curve_sets[hit.shape - geo_->meshes.size()];
+  const auto curve = static_cast<size_t>(hit.fiber - rec.first_fiber);
+  return geo_->bsdfs[rec.yarn_bsdf[rec.curves->curve_yarn[curve]]];
+}
+
+size_t RenderScene::fiber_count() const {
+  return static_cast<size_t>(geo_->fibers);
+}
+
+RenderScene::FiberRef RenderScene::fiber_ref(int64_t fiber) const {
+  if (fiber < 0 || fiber >= geo_->fibers)
+    throw Error("", "fiber",
+                "fiber id " + std::to_string(fiber) + " out of range (" +
+                    std::to_string(geo_->fibers) + " fibers)");
+  // The last curve set whose first fiber is <= fiber (sets with no curves are skipped over).
+  const auto& sets = geo_->curve_sets;
+  const auto it =
+      std::upper_bound(sets.begin(), sets.end(), fiber,
+                       [](int64_t f, const CurveRecord& r) { return f < r.first_fiber; });
+  auto k = static_cast<size_t>(it - sets.begin()) - 1;
+  while (sets[k].curves->curve_count() == 0) --k;  // an empty set shares its successor's start
+  FiberRef r;
+  r.curve_set = static_cast<uint32_t>(k);
+  r.shape = static_cast<uint32_t>(geo_->meshes.size() + k);
+  r.curve = static_cast<uint32_t>(fiber - sets[k].first_fiber);
+  return r;
+}
+
+FiberSegment RenderScene::fiber_segment(const SurfaceHit& hit) const {
+  if (!hit.on_fiber() || hit.shape < geo_->meshes.size())
+    throw Error("", "hit", "not a hit on a fiber");
+  return segment_of(geo_->curve_sets[hit.shape - geo_->meshes.size()], hit.segment);
+}
+
+std::vector<FiberSegment> RenderScene::fiber_segments(int64_t fiber) const {
+  const FiberRef r = fiber_ref(fiber);
+  const FiberCurves& c = *geo_->curve_sets[r.curve_set].curves;
+  std::vector<FiberSegment> out;
+  const uint32_t first = c.curve_first[r.curve];
+  for (uint32_t k = 0; k + 1 < c.curve_points[r.curve]; ++k)
+    out.push_back(
+        {c.point(first + k), c.point(first + k + 1), c.radius(first + k), c.radius(first + k + 1)});
+  return out;
+}
+
+FiberGeometry RenderScene::fiber_geometry() const {
+  return geo_->fiber_geometry;
 }
 
 RenderScene RenderScene::with_lights(const Lights& lights) const {
@@ -256,8 +521,14 @@ RenderScene RenderScene::with_lights(const Lights& lights) const {
 size_t RenderScene::mesh_count() const {
   return geo_->meshes.size();
 }
+size_t RenderScene::shape_count() const {
+  return geo_->meshes.size() + geo_->curve_sets.size();
+}
 size_t RenderScene::triangle_count() const {
   return geo_->triangles;
+}
+size_t RenderScene::curve_segment_count() const {
+  return geo_->curve_segments;
 }
 Bounds3 RenderScene::bounds() const {
   return geo_->bounds;

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "weft/bench/bake_bench.h"
+#include "weft/bench/fiber_bench.h"
 #include "weft/bench/render_bench.h"
 #include "weft/core/error.h"
 #include "weft/core/rng.h"
@@ -92,4 +93,30 @@ TEST(RenderBench, BareEmbreeFindsTheRenderersHits) {
     ASSERT_TRUE(embree_occluded(scene, to_embree(longer, true)));
   }
   EXPECT_GT(hits, 100);
+}
+
+TEST(FiberBench, BothRepresentationsOfTheSameFibersAreMeasured) {
+  FiberBenchOptions o;
+  o.rays = 2048;
+  o.weave.repeats_x = o.weave.repeats_z = 1;
+  o.render.width = o.render.height = 16;
+  o.render.spp = 1;
+  o.accuracy_spp = 8;
+  o.geometries = {{FiberGeometry::Type::curves, 8}, {FiberGeometry::Type::tubes, 6}};
+  const auto rows = bench_fibers(o);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0].geometry, "curves");
+  EXPECT_EQ(rows[1].geometry, "tubes:6");
+  EXPECT_EQ(rows[0].fibers, rows[1].fibers);
+  EXPECT_EQ(rows[0].triangles, 0u);
+  EXPECT_EQ(rows[1].curve_segments, 0u);
+  EXPECT_EQ(rows[1].triangles, 2 * 6 * rows[0].curve_segments);
+  for (const auto& r : rows) {
+    EXPECT_GT(r.rays_per_s, 0);
+    EXPECT_GT(r.path_rays_per_s, 0);
+    EXPECT_GT(r.hit_fraction, 0.1);  // rays leaving a fiber inside a yarn mostly meet another
+  }
+  // Round curves render the Lambertian fiber's closed form within the renders' noise.
+  EXPECT_LT(std::abs(rows[0].one_fiber_total_error), 4 * rows[0].one_fiber_noise);
+  EXPECT_LT(rows[0].one_fiber_rms_error, 4 * rows[0].one_fiber_noise);
 }

@@ -169,7 +169,7 @@ TEST(LightInterface, AreaLightSampleAgreesWithPdfEvalAndTheSolidAngle) {
     ASSERT_TRUE(scene.intersect({p, s->wi}, &hit));
     const double dist = length(s->p_light - p);
     ASSERT_NEAR(hit.t, dist, 1e-5 * dist);
-    const LightHit at = LightHit::on_surface(s->wi, hit.mesh, hit.prim, hit.ng, hit.t);
+    const LightHit at = LightHit::on_surface(s->wi, hit.shape, hit.prim, hit.ng, hit.t);
     ASSERT_NEAR(light.pdf(at), s->pdf, 1e-5 * s->pdf);
     ASSERT_EQ(light.eval(at), s->L);
     samples.push_back(1 / s->pdf);
@@ -193,7 +193,7 @@ TEST(LightInterface, AreaLightPdfIntegratesToOne) {
     SurfaceHit hit;
     double v = 0;
     if (scene.intersect({p, dir}, &hit))
-      v = light.pdf(LightHit::on_surface(dir, hit.mesh, hit.prim, hit.ng, hit.t)) * 4 * kPi;
+      v = light.pdf(LightHit::on_surface(dir, hit.shape, hit.prim, hit.ng, hit.t)) * 4 * kPi;
     samples.push_back(v);
   }
   expect_mean(samples, 1.0, 0.02);
@@ -231,8 +231,8 @@ TEST(LightInterface, AreaLightPicksTrianglesByPowerAndRespectsSides) {
   EXPECT_EQ(arrived_on_a, 0);
   SurfaceHit hit;
   ASSERT_TRUE(scene.intersect({{0, 3, 0}, {0, -1, 0}}, &hit));
-  ASSERT_EQ(hit.mesh, 0u);
-  EXPECT_EQ(light.eval(LightHit::on_surface({0, -1, 0}, hit.mesh, hit.prim, hit.ng, hit.t)),
+  ASSERT_EQ(hit.shape, 0u);
+  EXPECT_EQ(light.eval(LightHit::on_surface({0, -1, 0}, hit.shape, hit.prim, hit.ng, hit.t)),
             Rgb(0.0));
   EXPECT_EQ(light.eval(LightHit::escaped_along({0, 1, 0})), Rgb(0.0));
 }

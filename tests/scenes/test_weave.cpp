@@ -70,9 +70,9 @@ TEST(Weave, RoundTripAndOverUnderSeenByRays) {
     for (int j = 0; j < 4; ++j) {
       SurfaceHit hit;
       ASSERT_TRUE(scene.intersect({{first + i * S, 0.01, first + j * S}, {0, -1, 0}}, &hit));
-      EXPECT_EQ(hit.mesh, (i + j) % 2 == 0 ? 0u : 1u) << i << "," << j;
+      EXPECT_EQ(hit.shape, (i + j) % 2 == 0 ? 0u : 1u) << i << "," << j;
       // Shading tangent follows the yarn: x for warp, z for weft.
-      const Vec3 axis = hit.mesh == 0 ? Vec3{1, 0, 0} : Vec3{0, 0, 1};
+      const Vec3 axis = hit.shape == 0 ? Vec3{1, 0, 0} : Vec3{0, 0, 1};
       EXPECT_GT(std::abs(dot(hit.shading.s, axis)), 0.99);
       // The top of the upper yarn: centre at +A, radius R above it (A = R = 0.1 mm).
       EXPECT_NEAR(hit.p.y, 0.2e-3, 0.2e-3 * (1 - std::cos(M_PI / 12)) + 1e-9);

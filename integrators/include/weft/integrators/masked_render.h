@@ -1,7 +1,8 @@
 #pragma once
 // A render that also measures an object mask: per pixel, how many camera samples first hit one of
-// a set of meshes, and the moments of their radiance. The gonioreflectometer's measurement
-// (gonio.h) and the coverage image of `weft render --mask` (render_job.h) are made of this.
+// a set of shapes (meshes and fiber curve sets), and the moments of their radiance. The
+// gonioreflectometer's measurement (gonio.h) and the coverage image of `weft render --mask`
+// (render_job.h) are made of this.
 #include <cstdint>
 #include <vector>
 
@@ -17,7 +18,7 @@ struct MaskedRender {
   std::vector<double> sum, sum_sq;
 };
 
-// 'mask_meshes' holds one flag per mesh of the scene (e.g. SceneDescription::select_object).
+// 'mask_meshes' holds one flag per shape of the scene (SceneDescription::select_object).
 MaskedRender render_masked(const RenderScene& scene, const Camera& camera,
                            const RenderSettings& settings, const std::vector<uint8_t>& mask_meshes,
                            const ProgressCallback& progress = no_progress());

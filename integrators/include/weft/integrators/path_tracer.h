@@ -7,6 +7,13 @@
 // decides); transmission continues through the surface. Every random number of a camera sample
 // comes from Rng(seed, pixel index, sample index) and tiles write disjoint pixels, so images are
 // bit-identical at any thread count.
+//
+// Fibers (round curves or tubes) are shaded with their fiber BSDF as hair renderers shade a fiber
+// with its BCSDF: a fiber table is the BSDF of the whole fiber (docs/fiber-bsdf.md), so a point B
+// of a fiber is shaded without occlusion by its own fiber: the shadow rays of next-event
+// estimation and the continuation ray that leave B ignore B's fiber (RenderScene's ignore_fiber),
+// and light from behind B, through its own fiber, is the table's to account for. Every other
+// fiber occludes and inter-reflects as any surface does. Triangles of meshes are unaffected.
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -41,8 +48,8 @@ struct RenderResult : RenderOutcome {
   Image image;  // mean radiance per pixel, linear RGB
 };
 
-// After every camera sample: its pixel (row-major), the mesh its camera ray hit first (-1: none)
-// and its radiance (0 for a dropped non-finite sample).
+// After every camera sample: its pixel (row-major), the shape (SurfaceHit::shape) its camera ray
+// hit first (-1: none) and its radiance (0 for a dropped non-finite sample).
 using SampleObserver = std::function<void(uint64_t pixel, int64_t first_mesh, const Rgb& radiance)>;
 // Every ray handed to the scene: camera and bounce rays (shadow = false) and shadow rays (shadow =
 // true, ending at ray.tmax).
@@ -62,7 +69,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
                     const ProgressCallback& progress = no_progress(),
                     const RenderObservers& observers = {});
 
-// Radiance arriving along 'ray' (one path sample). 'first_mesh' receives the mesh the ray hits
+// Radiance arriving along 'ray' (one path sample). 'first_mesh' receives the shape the ray hits
 // first (-1 for none); 'on_ray' sees every ray traced. Exposed for tests of the estimator itself.
 Rgb trace_path(const RenderScene& scene, const Ray& ray, const RenderSettings& settings, Rng& rng,
                RayCounts& rays, int64_t* first_mesh = nullptr, const RayObserver* on_ray = nullptr);

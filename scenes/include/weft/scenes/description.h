@@ -11,7 +11,10 @@
 //     {"type": "quad", "name": N, "material": KEY, "center": [3], "normal": [3], "tangent": [3],
 //      "size": [w, h]} |
 //     {"type": "sphere", "name": N, "material": KEY, "center": [3], "radius": r,
-//      "subdivisions": k, "inward": false, "smooth": true} ],
+//      "subdivisions": k, "inward": false, "smooth": true} |
+//     {"type": "fiber", "name": N, "material": KEY, "from": [3], "to": [3], "radius": r,
+//      "segments": 1} ],                                  // a straight fiber (metres)
+//   "fiber_geometry": {"type": "curves"} | {"type": "tubes", "sides": 8},  // curves.h
 //   "materials": { KEY: {"type": T, "params": {...}, "emission": c, "double_sided": b} },
 //   "default_material": {"type": T, "params": {...}},      // for keys with no binding
 //   "frame": {"normal": [0,1,0], "tangent": [1,0,0]},      // zenith/azimuth reference (glTF Y up)
@@ -29,6 +32,9 @@
 //   "render": {...},                                       // weft/integrators/render_settings.h
 //   "sweep": {...}                                         // weft/integrators/gonio.h
 // }
+// Shapes: the meshes (glTF triangles, inline quads and spheres) followed by the fiber curve sets
+// (glTF LINE_STRIP + _RADIUS, inline fibers); a shape index is a mesh index or meshes.size() plus a
+// curve set's index. Objects select shapes by name, materials bind meshes and fibers alike.
 // A colour c is a number or [r, g, b]. Unknown keys, wrong types, out-of-range values and missing
 // files are weft::Error naming the file and the field.
 #include <filesystem>
@@ -41,6 +47,7 @@
 
 #include "weft/core/spectrum.h"
 #include "weft/scenes/camera.h"
+#include "weft/scenes/curves.h"
 #include "weft/scenes/gltf.h"
 #include "weft/scenes/lights.h"
 #include "weft/scenes/mesh.h"
@@ -70,6 +77,8 @@ struct SceneDescription {
   std::string source;  // the description file, for error messages
   std::filesystem::path base_dir = ".";
   std::vector<std::shared_ptr<const TriangleMesh>> meshes;
+  std::vector<std::shared_ptr<const FiberCurves>> curves;  // shapes meshes.size() + k
+  FiberGeometry fiber_geometry;                            // how RenderScene builds the curves
   std::map<std::string, GltfMaterialInfo> gltf_materials;  // emissive info by binding key
   std::map<std::string, MaterialBinding> materials;        // bindings by key
   std::optional<MaterialBinding> default_material;
@@ -81,11 +90,13 @@ struct SceneDescription {
   std::optional<nlohmann::json> render, sweep;
   std::vector<std::string> warnings;
 
-  // Bounding box of the meshes selected by 'object' (every mesh when empty); Error when none.
+  size_t shape_count() const { return meshes.size() + curves.size(); }
+  // Bounding box of the shapes selected by 'object' (every shape when empty); Error when none.
   Bounds3 object_bounds(const std::string& object) const;
-  // Per-mesh flags of the meshes selected by 'object'; Error listing known names when none.
+  // Per-shape flags of the shapes selected by 'object'; Error listing known names when none.
   std::vector<uint8_t> select_object(const std::string& object) const;
-  // The binding for a mesh's material key (default_material where unbound); Error when neither.
+  // The binding for a material key of a mesh or fiber (default_material where unbound); Error when
+  // neither.
   const MaterialBinding& binding_for(const std::string& key) const;
 };
 

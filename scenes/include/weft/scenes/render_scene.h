@@ -1,9 +1,10 @@
 #pragma once
 // The immutable, renderable form of a SceneDescription: an Embree 3 scene committed once, one BSDF
 // per material binding (created once through the material registry), and its lights (lights.h):
-// the description's, plus the emissive triangles as one area light. Copies share the geometry;
-// with_lights() swaps the description's lights without rebuilding anything. Thread-safe for
-// concurrent queries.
+// the description's, plus the emissive triangles as one area light. Fibers (the description's
+// curve sets) become Embree round linear curves or triangle tubes (FiberGeometry). Copies share
+// the geometry; with_lights() swaps the description's lights without rebuilding anything.
+// Thread-safe for concurrent queries.
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -16,6 +17,7 @@
 #include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
 #include "weft/scenes/camera.h"
+#include "weft/scenes/curves.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/lights.h"
 #include "weft/scenes/mesh.h"
@@ -24,16 +26,27 @@ struct RTCSceneTy;  // Embree's scene (RTCScene is a pointer to it)
 
 namespace weft {
 
+// Fiber ids are scene-wide: the curves of the description's curve sets numbered in order (set 0's
+// curves first). kNoFiber: a triangle of a mesh, or "ignore nothing" in queries.
+inline constexpr int64_t kNoFiber = -1;
+
 struct SurfaceHit {
   double t = 0;
-  Vec3 p;         // position (barycentric interpolation, double precision)
-  Vec3 ng;        // unit geometric normal, front side = counter-clockwise winding
-  Frame shading;  // shading normal (z) and tangent (x) from the mesh; not flipped
-  Vec2 uv;
-  uint32_t mesh = 0;  // index into the description's meshes
-  uint32_t prim = 0;  // triangle index
+  Vec3 p;  // position (double precision): barycentric on triangles, on the fiber's surface
+  // Unit geometric normal: triangles' front side = counter-clockwise winding; on a round fiber the
+  // radial direction from the segment's axis (outward).
+  Vec3 ng;
+  // Shading frame, not flipped: the mesh's normal (z) and tangent (x); on a fiber (round or tube)
+  // the fiber frame: x = unit tangent along the segment, z = outward normal, y = z x x.
+  Frame shading;
+  Vec2 uv;  // triangles: texture coordinates (or barycentrics); fibers: (u along segment, 0)
+  uint32_t shape = 0;        // the description's shape: mesh index, or meshes.size() + curve set
+  uint32_t prim = 0;         // triangle index (tubes too), or the segment index of a round curve
+  int64_t fiber = kNoFiber;  // scene-wide fiber id; kNoFiber for mesh triangles
+  uint32_t segment = 0;      // fibers: segment index within the curve set (index_segments order)
   double offset = 0;  // distance to move ray origins off the surface (scales with coordinates)
 
+  bool on_fiber() const { return fiber != kNoFiber; }
   // Origin for a ray leaving the surface in direction d: offset along ng to d's side, so rays
   // continue through the surface for transmission and do not re-hit it.
   Vec3 spawn_origin(const Vec3& d) const { return p + ng * (dot(d, ng) > 0 ? offset : -offset); }
@@ -41,8 +54,11 @@ struct SurfaceHit {
 
 struct RenderSceneOptions {
   // Material keys replaced by another binding (e.g. the white reference of the gonioreflectometer).
-  std::vector<uint8_t> override_meshes;  // per mesh; empty = none
+  std::vector<uint8_t>
+      override_shapes;  // per shape (SceneDescription::select_object); empty = none
   std::optional<MaterialBinding> override_binding;
+  // How fibers are represented; unset: the description's fiber_geometry.
+  std::optional<FiberGeometry> fiber_geometry;
   // Tables (fiber/fabric BSDFs, measured networks) are loaded once into this cache and shared
   // between bindings and between scenes that pass the same cache; null: one cache per scene.
   std::shared_ptr<TableCache> table_cache;
@@ -56,25 +72,46 @@ class RenderScene {
  public:
   explicit RenderScene(const SceneDescription& desc, const RenderSceneOptions& options = {});
 
-  bool intersect(const Ray& ray, SurfaceHit* hit) const;
-  bool occluded(const Vec3& origin, const Vec3& dir, double tmax) const;
+  // The closest hit along the ray, ignoring every primitive of fiber 'ignore_fiber' (kNoFiber:
+  // ignore nothing). A fiber is shaded as a whole (docs/fiber-bsdf.md): rays leaving a point of a
+  // fiber pass through that fiber and meet every other one. Embree filter functions on the fiber
+  // geometries do the ignoring; meshes have none, so triangle-only scenes pay nothing for it.
+  bool intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fiber = kNoFiber) const;
+  // Whether anything but fiber 'ignore_fiber' lies along origin + t dir, 0 < t < tmax.
+  bool occluded(const Vec3& origin, const Vec3& dir, double tmax,
+                int64_t ignore_fiber = kNoFiber) const;
   // The committed Embree scene, for measurements against bare Embree queries (bench/); rendering
-  // goes through intersect and occluded.
+  // goes through intersect and occluded. Queries on it must pass a FiberQueryContext
+  // (embree_context.h) when the scene has fibers: their filter functions read it.
   RTCSceneTy* embree_scene() const;
 
-  const Bsdf& bsdf(uint32_t mesh) const;
+  // The BSDF of a hit's material (per mesh, or per fiber of a curve set).
+  const Bsdf& bsdf(const SurfaceHit& hit) const;
 
-  // Every light, in the order their contributions are summed: parallel, point and spot (in the
-  // description's order), the emissive surfaces, the environment. Lights that cannot contribute
-  // (no emissive triangle, a black environment) are left out.
+  // Fibers, for instruments that trace against them (the fabric estimator): how many, the segment
+  // a fiber hit lies on (its axis end points and radii: where a line through the fiber leaves it,
+  // curves.h cylinder_exit_distance), and every segment of one fiber, in order along it.
+  size_t fiber_count() const;
+  FiberSegment fiber_segment(const SurfaceHit& hit) const;  // Error unless hit.on_fiber()
+  std::vector<FiberSegment> fiber_segments(int64_t fiber) const;
+  // The curve set and the curve within it of a fiber id; Error when out of range.
+  struct FiberRef {
+    uint32_t shape = 0;  // meshes.size() + curve set
+    uint32_t curve_set = 0, curve = 0;
+  };
+  FiberRef fiber_ref(int64_t fiber) const;
+  FiberGeometry fiber_geometry() const;
+
   const std::vector<Light>& lights() const { return lights_; }
-  // The light a mesh's surface belongs to; null when the mesh does not emit.
-  const Light* surface_light(uint32_t mesh) const;
+  // The light a shape's surface belongs to; null when it does not emit (fibers never do).
+  const Light* surface_light(uint32_t shape) const;
   // The same scene lit by 'lights' instead of the description's (emissive surfaces still emit).
   RenderScene with_lights(const Lights& lights) const;
 
   size_t mesh_count() const;
-  size_t triangle_count() const;
+  size_t shape_count() const;          // meshes, then curve sets (SurfaceHit::shape)
+  size_t triangle_count() const;       // meshes' triangles and the fibers' tube triangles
+  size_t curve_segment_count() const;  // round curve segments (0 when fibers are tubes)
   Bounds3 bounds() const;
 
  private:
