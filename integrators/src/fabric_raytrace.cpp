@@ -113,31 +113,84 @@ bool find_crossing(const RenderScene& scene, const SurfaceHit& h, const Vec3& al
   return false;
 }
 
-// The repeat and its eight neighbours, for a renderer that only asks for geometry: copy k of the
-// sample's mesh m is mesh 9 m + k.
+// The repeat and its eight neighbours, for a renderer that only asks for geometry. Copy
+// (i, k), shifted by (i Px, k Pz) with i, k in {-1, 0, 1}, is copy number 3 (i + 1) + (k + 1):
+// copy q of the sample's mesh m is mesh 9 m + q; at fiber detail copy q is curve set q, and fiber
+// c of the sample in it is fiber id q * curves + c (RenderScene numbers fibers set by set).
+int copy_index(int i, int k) {
+  return 3 * (i + 1) + (k + 1);
+}
+
 SceneDescription tiled_geometry(const WovenSample& sample, double px, double pz) {
-  if (sample.meshes.empty())
-    throw Error(
-        "", "detail",
-        "the ray-traced estimator needs the sample's geometry (yarn tubes); this sample has "
-        "none");
   SceneDescription d;
   d.source = "woven sample";
-  for (const auto& mesh : sample.meshes)
-    for (int i = -1; i <= 1; ++i)
-      for (int k = -1; k <= 1; ++k) {
-        TriangleMesh m = mesh;
-        for (size_t v = 0; v < m.vertex_count(); ++v) {
-          m.positions[3 * v] += static_cast<float>(i * px);
-          m.positions[3 * v + 2] += static_cast<float>(k * pz);
+  const bool fibers = sample.fibers.curve_count() > 0;
+  if (!fibers && sample.meshes.empty())
+    throw Error("", "detail",
+                "the ray-traced estimator needs the sample's geometry (fibers or yarn tubes); "
+                "this sample has none");
+  for (int i = -1; i <= 1; ++i)
+    for (int k = -1; k <= 1; ++k) {
+      const float dx = static_cast<float>(i * px), dz = static_cast<float>(k * pz);
+      if (fibers) {
+        FiberCurves c = sample.fibers;
+        for (size_t v = 0; v < c.point_count(); ++v) {
+          c.points[4 * v] += dx;
+          c.points[4 * v + 2] += dz;
         }
-        d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+        d.curves.push_back(std::make_shared<const FiberCurves>(std::move(c)));
       }
+    }
+  if (!fibers)
+    for (const auto& mesh : sample.meshes)
+      for (int i = -1; i <= 1; ++i)
+        for (int k = -1; k <= 1; ++k) {
+          TriangleMesh m = mesh;
+          for (size_t v = 0; v < m.vertex_count(); ++v) {
+            m.positions[3 * v] += static_cast<float>(i * px);
+            m.positions[3 * v + 2] += static_cast<float>(k * pz);
+          }
+          d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+        }
   MaterialBinding any;
   any.type = "lambert";
   any.field = "fabric estimator";
   d.default_material = any;
   return d;
+}
+
+// The fiber a particle ignores after it moved by one period through side 'side' (0: -x, 1: +x,
+// 2: -z, 3: +z; the particle re-enters through the opposite side): the same fiber in the copy that
+// now lies where it was, or none when that copy is not part of the tiling.
+int64_t fiber_after_wrap(int64_t fiber, int side, int64_t curves) {
+  if (fiber == kNoFiber) return kNoFiber;
+  const int64_t q = fiber / curves, c = fiber % curves;
+  int i = static_cast<int>(q / 3) - 1, k = static_cast<int>(q % 3) - 1;
+  // Through -x the particle moves by +Px: what was at copy i is now at copy i + 1, relative to it.
+  i += side == 0 ? 1 : side == 1 ? -1 : 0;
+  k += side == 2 ? 1 : side == 3 ? -1 : 0;
+  if (i < -1 || i > 1 || k < -1 || k > 1) return kNoFiber;
+  return copy_index(i, k) * curves + c;
+}
+
+// Where the line through B' (a hit on a round fiber) along d leaves the fiber's cylinder: B'' with
+// the fiber frame there (x along the axis, z outward). False when the line only grazes it.
+bool fiber_exit_point(const RenderScene& scene, const SurfaceHit& entry, const Vec3& d,
+                      SurfaceHit* out) {
+  const FiberSegment seg = scene.fiber_segment(entry);
+  const std::optional<double> t = cylinder_exit_distance(seg, entry.p, d);
+  if (!t || *t <= 0) return false;
+  *out = entry;
+  out->p = entry.p + d * *t;
+  out->t = entry.t + *t;
+  const Vec3 axis = seg.tangent();
+  const Vec3 radial = out->p - seg.axis_point(seg.closest_u(out->p));
+  const Vec3 n = radial - axis * dot(radial, axis);
+  const double len = length(n);
+  if (!(len > 0)) return false;
+  out->ng = n / len;
+  out->shading = Frame(axis, cross(out->ng, axis), out->ng);
+  return true;
 }
 
 }  // namespace
@@ -190,6 +243,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
     throw Error("", "sample", "the woven sample has no period or no thickness");
   const double x0 = -0.5 * px, z0 = -0.5 * pz;
   const RenderScene scene(tiled_geometry(sample, px, pz));
+  const auto curves = static_cast<int64_t>(sample.fibers.curve_count());
   const FiberSampler fs(fiber);
   const int nc = fiber.channels;
   const DirectionGrid grid{o.resolution};
@@ -227,6 +281,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
           tally.launched += w0;
           ++tally.particles;
           int events = 0;
+          int64_t ignore = kNoFiber;  // the fiber the particle last left (fiber detail)
           while (true) {
             double mean_w = 0;
             for (double x : w) mean_w += x;
@@ -247,7 +302,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                                   : d.y < 0 ? (y0 - p.y) / d.y
                                             : kInfinity;
             SurfaceHit h;
-            if (!scene.intersect({p, d, std::min(t_side, t_slab)}, &h)) {
+            if (!scene.intersect({p, d, std::min(t_side, t_slab)}, &h, ignore)) {
               if (t_slab <= t_side) {  // left the cloth: binned by its direction
                 const int exit_bin = grid.bin_of(world_to_cloth(d));
                 tally.exits.push_back({static_cast<uint64_t>(a) * bins + exit_bin,
@@ -262,22 +317,28 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               if (side == 1) p.x -= px;
               if (side == 2) p.z += pz;
               if (side == 3) p.z -= pz;
+              ignore = fiber_after_wrap(ignore, side, curves);
               if (++tally.wraps, ++events > 100 * o.max_scatterings) {
                 tally.lost += mean_w;
                 break;
               }
               continue;
             }
-            // The line meets a fiber (here: a yarn tube) at B' and would leave it at B''. Tubes
-            // that press on each other share surfaces, so a particle may find itself inside one:
-            // then this hit is B'' and B' lies behind it.
+            // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is
+            // where the line leaves its cylinder. Yarn tubes that press on each other share
+            // surfaces, so a particle may find itself inside one: then this hit is B'' and B' lies
+            // behind it (for round fibers, apart by 2 radii, that happens only where a fiber's end
+            // cap meets its continuation in the next repeat; the hit is then taken alone).
             FiberPoint pts[2];
             int n_pts = 0;
-            const bool from_outside = dot(d, h.shading.n) < 0;
+            const bool from_outside = dot(d, h.ng) < 0;
             pts[n_pts++].hit = h;
-            const Vec3 along = from_outside ? d : -d;
             SurfaceHit other;
-            if (find_crossing(scene, h, along, &other)) pts[n_pts++].hit = other;
+            if (h.on_fiber()) {
+              if (from_outside && fiber_exit_point(scene, h, d, &other)) pts[n_pts++].hit = other;
+            } else if (find_crossing(scene, h, from_outside ? d : -d, &other)) {
+              pts[n_pts++].hit = other;
+            }
             double a_sum = 0, a_pt[2] = {0, 0};
             for (int q = 0; q < n_pts; ++q) {
               pts[q].wi_local = pts[q].hit.shading.to_local(-d);
@@ -307,6 +368,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
             tally.absorbed += (before - after) / nc;
             d = normalize(pt.hit.shading.to_world(wo_local));
             p = pt.hit.spawn_origin(d);
+            ignore = pt.hit.fiber;  // light leaves a fiber through the fiber itself
             ++tally.scatterings;
             if (++events >= o.max_scatterings) {
               double m = 0;
