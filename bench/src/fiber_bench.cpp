@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "weft/bench/render_bench.h"
 #include "weft/core/distribution.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
@@ -67,15 +68,7 @@ SceneDescription patch_scene(const FiberBenchOptions& o) {
   auto curves = std::make_shared<FiberCurves>(sample.fibers);
   curves->names = {"patch"};
   d.curves.push_back(curves);
-  MaterialBinding warp, weft;
-  warp.type = weft.type = "lambert";
-  warp.params = {{"reflectance", {0.6, 0.15, 0.1}}};
-  weft.params = {{"reflectance", 0.5}};
-  warp.field = "materials.warp";
-  weft.field = "materials.weft";
-  d.materials["warp"] = warp;
-  d.materials["weft"] = weft;
-  d.lights.directional.push_back({d.frame.direction(deg_to_rad(30), 0), Rgb(1.0)});
+  add_bench_materials_and_sun(d);
   d.lights.environment = Rgb(0.2);
   d.camera = frame_box_orthographic(d.object_bounds("patch"),
                                     d.frame.direction(deg_to_rad(20), kPi), d.frame.normal);

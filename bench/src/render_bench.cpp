@@ -169,11 +169,7 @@ bool embree_occluded(const RenderScene& scene, const EmbreeRay& r) {
   return ray.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 
-SceneDescription weave_bench_scene(const WeaveParams& params) {
-  SceneDescription d;
-  d.source = "weave bench scene";
-  for (auto& m : make_weave(params))
-    d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+void add_bench_materials_and_sun(SceneDescription& d) {
   MaterialBinding warp, weft;
   warp.type = weft.type = "lambert";
   warp.params = {{"reflectance", {0.6, 0.15, 0.1}}};
@@ -183,6 +179,14 @@ SceneDescription weave_bench_scene(const WeaveParams& params) {
   d.materials["warp"] = warp;
   d.materials["weft"] = weft;
   d.lights.directional.push_back({d.frame.direction(deg_to_rad(30), 0), Rgb(1.0)});
+}
+
+SceneDescription weave_bench_scene(const WeaveParams& params) {
+  SceneDescription d;
+  d.source = "weave bench scene";
+  for (auto& m : make_weave(params))
+    d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+  add_bench_materials_and_sun(d);
   d.camera = frame_box_orthographic(d.object_bounds(""), d.frame.direction(deg_to_rad(20), kPi),
                                     d.frame.normal);
   return d;

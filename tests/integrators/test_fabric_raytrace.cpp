@@ -55,9 +55,10 @@ TabulatedBsdfTable uniform_fiber(int resolution, double f) {
   return fiber_table(resolution, [f](const Vec3& wo, const Vec3&) { return wo.z > 0 ? f : 0.0; });
 }
 
-WovenSample default_yarn_sample() {
+// The bundled red-cotton sample at yarn or fiber detail.
+WovenSample default_sample(const char* detail = "yarn") {
   WeaveOptions o;
-  o.detail = "yarn";
+  o.detail = detail;
   return make_woven_sample(overlay(red_cotton_weave_options(), o));
 }
 
@@ -100,7 +101,7 @@ TEST(FabricRaytrace, PeriodicRepeatLeaksNoEnergy) {
   // it must. Exited = 1 up to the particles the scattering cap stops.
   const auto fiber = uniform_fiber(4, 0.5 * kInvPi);
   FabricRaytraceOptions o = options(2, 2000);
-  const auto r = raytrace_fabric_table(default_yarn_sample(), fiber, o);
+  const auto r = raytrace_fabric_table(default_sample(), fiber, o);
   EXPECT_GT(r.wraps, 0u);
   EXPECT_NEAR(r.exited + r.absorbed + r.lost + r.roulette_net, 1.0, 1e-9);
   EXPECT_LT(r.lost, 0.01);
@@ -118,9 +119,9 @@ TEST(FabricRaytrace, NoiseEstimateMatchesTheSpreadOfIndependentRuns) {
     return wo.z > 0 ? (0.3 + 0.2 * std::max(0.0, wi.z)) * kInvPi : 0.0;
   });
   FabricRaytraceOptions o = options(3, 4000);
-  const auto a = raytrace_fabric_table(default_yarn_sample(), fiber, o);
+  const auto a = raytrace_fabric_table(default_sample(), fiber, o);
   o.seed = 2;
-  const auto b = raytrace_fabric_table(default_yarn_sample(), fiber, o);
+  const auto b = raytrace_fabric_table(default_sample(), fiber, o);
   const double measured = compare_tables(a.table, b.table).overall.rel_rms;
   const double stated =
       std::sqrt(0.5 * (a.relative_noise * a.relative_noise + b.relative_noise * b.relative_noise)) *
@@ -132,20 +133,12 @@ TEST(FabricRaytrace, BitIdenticalAtOneAndTwoThreads) {
   const auto fiber = uniform_fiber(3, 0.4 * kInvPi);
   FabricRaytraceOptions o = options(2, 500);
   o.threads = 1;
-  const auto a = raytrace_fabric_table(default_yarn_sample(), fiber, o);
+  const auto a = raytrace_fabric_table(default_sample(), fiber, o);
   o.threads = 2;
-  const auto b = raytrace_fabric_table(default_yarn_sample(), fiber, o);
+  const auto b = raytrace_fabric_table(default_sample(), fiber, o);
   EXPECT_EQ(a.table.values, b.table.values);
   EXPECT_EQ(a.exited, b.exited);
 }
-
-namespace {
-WovenSample default_fiber_sample() {
-  WeaveOptions o;
-  o.detail = "fiber";
-  return make_woven_sample(overlay(red_cotton_weave_options(), o));
-}
-}  // namespace
 
 TEST(FabricRaytrace, FiberLevelSampleLeaksNoEnergy) {
   // The lossless whole-fiber table of PeriodicRepeatLeaksNoEnergy on the fiber-level sample: a
@@ -155,7 +148,7 @@ TEST(FabricRaytrace, FiberLevelSampleLeaksNoEnergy) {
   // fiber (one crossing) or meets a fiber's end cap at the repeat's side.
   const auto fiber = uniform_fiber(4, 0.5 * kInvPi);
   FabricRaytraceOptions o = options(2, 2000);
-  const auto r = raytrace_fabric_table(default_fiber_sample(), fiber, o);
+  const auto r = raytrace_fabric_table(default_sample("fiber"), fiber, o);
   EXPECT_GT(r.wraps, 0u);
   EXPECT_GT(r.scatterings, r.particles);  // light meets several fibers on its way
   EXPECT_NEAR(r.exited + r.absorbed + r.lost + r.roulette_net, 1.0, 1e-9);
@@ -167,9 +160,9 @@ TEST(FabricRaytrace, FiberLevelBitIdenticalAtOneAndTwoThreads) {
   const auto fiber = uniform_fiber(3, 0.4 * kInvPi);
   FabricRaytraceOptions o = options(2, 300);
   o.threads = 1;
-  const auto a = raytrace_fabric_table(default_fiber_sample(), fiber, o);
+  const auto a = raytrace_fabric_table(default_sample("fiber"), fiber, o);
   o.threads = 2;
-  const auto b = raytrace_fabric_table(default_fiber_sample(), fiber, o);
+  const auto b = raytrace_fabric_table(default_sample("fiber"), fiber, o);
   EXPECT_EQ(a.table.values, b.table.values);
   EXPECT_EQ(a.exited, b.exited);
   EXPECT_EQ(a.scatterings, b.scatterings);

@@ -13,6 +13,7 @@
 
 #include "test_util.h"
 #include "weft/core/error.h"
+#include "weft/core/hash.h"
 #include "weft/core/math.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/gltf.h"
@@ -25,21 +26,6 @@ using nlohmann::json;
 using weft::testing::error_of;
 
 namespace {
-
-std::string base64(const std::vector<uint8_t>& data) {
-  static const char* table = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  for (size_t i = 0; i < data.size(); i += 3) {
-    const uint32_t n = (uint32_t(data[i]) << 16) |
-                       (i + 1 < data.size() ? uint32_t(data[i + 1]) << 8 : 0) |
-                       (i + 2 < data.size() ? uint32_t(data[i + 2]) : 0);
-    out += table[(n >> 18) & 63];
-    out += table[(n >> 12) & 63];
-    out += i + 1 < data.size() ? table[(n >> 6) & 63] : '=';
-    out += i + 2 < data.size() ? table[n & 63] : '=';
-  }
-  return out;
-}
 
 // A glTF document with one node "fiber_node" holding mesh "fiber_mesh": one LINE_STRIP primitive
 // through 'points' (x, y, z) with radii 'radii', material "wool". Accessors: 0 POSITION,

@@ -59,6 +59,9 @@ struct RenderBenchResult {
 // A woven patch in memory (lambert warp and weft, a parallel light at 30 degrees, orthographic
 // camera framing the patch from 20 degrees).
 SceneDescription weave_bench_scene(const WeaveParams& params);
+// The benchmarks' lighting and yarn materials: Lambertian "warp" (red) and "weft" (grey), a
+// directional light at 30 degrees from the normal.
+void add_bench_materials_and_sun(SceneDescription& d);
 
 RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::string& name,
                                      const RenderBenchOptions& options);

@@ -4,6 +4,7 @@
 // table checksums, bake-cache keys) so that equal inputs give equal names.
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <string>
 #include <string_view>
 
@@ -26,5 +27,7 @@ inline uint64_t fnv1a64(std::string_view text, uint64_t h = kFnv1a64Basis) {
 
 // 16 lower-case hex digits.
 std::string hex64(uint64_t value);
+// Bytes as base64 (RFC 4648, padded): glTF data URIs.
+std::string base64(std::span<const uint8_t> data);
 
 }  // namespace weft
