@@ -4,6 +4,7 @@
 #include <system_error>
 
 #include "weft/core/error.h"
+#include "weft/core/install_paths.h"
 
 #ifndef WEFT_TOOLS_DIR
 #define WEFT_TOOLS_DIR ""
@@ -27,18 +28,10 @@ std::string quoted(const std::string& s) {
 }
 
 std::filesystem::path find_script(const std::string& script) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  std::vector<fs::path> candidates;
-  if (std::string(WEFT_TOOLS_DIR).size()) candidates.push_back(fs::path(WEFT_TOOLS_DIR) / script);
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(exe.parent_path() / ".." / "share" / "weft" / "tools" / script);
   std::string tried;
-  for (const auto& c : candidates) {
-    if (fs::is_regular_file(c, ec)) return c;
-    tried += (tried.empty() ? "" : ", ") + c.string();
-  }
-  throw Error(script, "", "plot script not found (tried: " + tried + ")");
+  const auto path = find_installed_file(WEFT_TOOLS_DIR, "tools", script, &tried);
+  if (path.empty()) throw Error(script, "", "plot script not found (tried: " + tried + ")");
+  return path;
 }
 
 }  // namespace

@@ -60,14 +60,8 @@ std::vector<FiberRay> fiber_rays(const FiberCurves& c, size_t n, uint64_t seed) 
 SceneDescription patch_scene(const FiberBenchOptions& o) {
   WeaveOptions base = red_cotton_weave_options();
   base.repeats_x = base.repeats_z = 4;
-  WeaveOptions w = overlay(base, o.weave);
-  w.detail = "fiber";
-  const WovenSample sample = make_woven_sample(w);
-  SceneDescription d;
-  d.source = "fiber bench patch";
-  auto curves = std::make_shared<FiberCurves>(sample.fibers);
-  curves->names = {"patch"};
-  d.curves.push_back(curves);
+  SceneDescription d =
+      fiber_patch_description(overlay(base, o.weave), "fiber bench patch", "patch");
   add_bench_materials_and_sun(d);
   d.lights.environment = Rgb(0.2);
   d.camera = frame_box_orthographic(d.object_bounds("patch"),

@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "weft/core/error.h"
+#include "weft/core/install_paths.h"
 #include "weft/core/math.h"
 
 #ifndef WEFT_DATA_DIR
@@ -120,18 +121,12 @@ std::filesystem::path find_measured_nbrdf(const std::string& name) {
     valid += (valid.empty() ? "" : ", ") + n;
   }
   if (!known) throw Error("unknown measured material '" + name + "' (valid: " + valid + ")");
-  const fs::path rel = fs::path("measured") / name / "nbrdf_weights.txt";
-  std::vector<fs::path> candidates;
-  if (std::string(WEFT_DATA_DIR).size()) candidates.push_back(fs::path(WEFT_DATA_DIR) / rel);
-  std::error_code ec;
-  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(exe.parent_path() / ".." / "share" / "weft" / "materials" / rel);
   std::string tried;
-  for (const auto& c : candidates) {
-    if (fs::is_regular_file(c, ec)) return c;
-    tried += (tried.empty() ? "" : ", ") + c.string();
-  }
-  throw Error("data for measured material '" + name + "' not found (tried: " + tried + ")");
+  const fs::path path = find_installed_file(
+      WEFT_DATA_DIR, "materials", fs::path("measured") / name / "nbrdf_weights.txt", &tried);
+  if (path.empty())
+    throw Error("data for measured material '" + name + "' not found (tried: " + tried + ")");
+  return path;
 }
 
 Rgb MeasuredNbrdfBsdf::eval(const Vec3& wo, const Vec3& wi) const {

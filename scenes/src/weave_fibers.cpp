@@ -11,6 +11,7 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/params.h"
+#include "weft/scenes/description.h"
 
 namespace weft::detail {
 namespace {
@@ -552,6 +553,17 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
         best = std::min(best, segment_distance(a.a, a.b, b.a + shift, b.b + shift));
       }
   return best;
+}
+
+SceneDescription fiber_patch_description(WeaveOptions options, const std::string& source,
+                                         const std::string& object) {
+  options.detail = "fiber";
+  SceneDescription d;
+  d.source = source;
+  auto curves = std::make_shared<FiberCurves>(make_woven_sample(options).fibers);
+  curves->names = {object};
+  d.curves.push_back(std::move(curves));
+  return d;
 }
 
 }  // namespace weft

@@ -286,14 +286,7 @@ namespace {
 // a parallel light.
 SceneDescription fiber_patch(const MaterialBinding& material, const char* geometry,
                              double environment, bool sun) {
-  WeaveOptions o = red_cotton_weave_options();
-  o.detail = "fiber";
-  const WovenSample sample = make_woven_sample(o);
-  SceneDescription d;
-  d.source = "fiber patch";
-  auto curves = std::make_shared<FiberCurves>(sample.fibers);
-  curves->names = {"patch"};
-  d.curves.push_back(curves);
+  SceneDescription d = fiber_patch_description(red_cotton_weave_options(), "fiber patch", "patch");
   d.materials["warp"] = d.materials["weft"] = material;
   d.fiber_geometry.type =
       std::string(geometry) == "tubes" ? FiberGeometry::Type::tubes : FiberGeometry::Type::curves;

@@ -46,6 +46,7 @@
 namespace weft {
 
 class ParamReader;
+struct SceneDescription;
 
 // ---------------------------------------------------------------------------------------------
 // Woven samples.
@@ -147,6 +148,11 @@ std::vector<uint8_t> woven_to_glb(const WovenSample& sample);
 void write_woven(const std::filesystem::path& path, const WovenSample& sample);
 // The summary as JSON (what `weft weave --json` prints).
 std::string weave_summary_json(const WeaveSummary& summary, const std::string& output);
+// A scene description holding the fiber-detail sample of 'options' (detail forced to fiber) as
+// one curve set named 'object' (materials "warp" and "weft" left to the caller), for tests and
+// benchmarks that render a fiber patch.
+SceneDescription fiber_patch_description(WeaveOptions options, const std::string& source,
+                                         const std::string& object);
 
 // ---------------------------------------------------------------------------------------------
 // The open-mesh plain-weave patch of earlier versions (circular tubes around sinusoidal centre
