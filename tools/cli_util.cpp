@@ -74,6 +74,10 @@ ProgressCallback progress_bar(bool quiet) {
 SceneDescription load_scene_reporting_warnings(const std::string& path) {
   SceneDescription desc = load_scene_description(path);
   for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
+  // What the lights are, in the renderer's units (glTF photometric values were converted).
+  for (const auto& n : desc.notes) std::fprintf(stderr, "weft: %s\n", n.c_str());
+  for (const auto& l : describe_lights(desc.lights))
+    std::fprintf(stderr, "weft: light: %s\n", l.c_str());
   return desc;
 }
 

@@ -1,8 +1,10 @@
 #include "weft/scenes/camera.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "weft/core/error.h"
+#include "weft/core/math.h"
 
 namespace weft {
 
@@ -14,7 +16,52 @@ Ray Camera::generate_ray(double fx, double fy, double aspect) const {
   return {position, normalize(forward + right * (sx * th * aspect) + up * (sy * th))};
 }
 
+namespace {
+
+bool within(const Vec3& v, double bound) {
+  return is_finite(v) && std::abs(v.x) <= bound && std::abs(v.y) <= bound && std::abs(v.z) <= bound;
+}
+
+std::string format_vec(const Vec3& v) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", v.x, v.y, v.z);
+  return buf;
+}
+
+std::string format_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+}  // namespace
+
+void Camera::validate(const std::string& file, const std::string& field) const {
+  if (!within(position, kMaxCameraCoordinate_m))
+    throw Error(file, field,
+                "camera position " + format_vec(position) + " is not finite or beyond " +
+                    format_number(kMaxCameraCoordinate_m) + " m");
+  const double tol = 1e-6;
+  for (const Vec3* v : {&right, &up, &forward})
+    if (!is_finite(*v) || std::abs(length(*v) - 1) > tol)
+      throw Error(file, field, "camera basis is not finite and unit length");
+  if (std::abs(dot(right, up)) > tol || std::abs(dot(right, forward)) > tol ||
+      std::abs(dot(up, forward)) > tol)
+    throw Error(file, field, "camera basis is not orthogonal");
+  if (type == Type::perspective && !(yfov_rad > 0 && yfov_rad < kPi))
+    throw Error(file, field, "perspective field of view must lie in (0, pi)");
+  if (type == Type::orthographic && !(half_width > 0 && half_height > 0 &&
+                                      half_width <= 1e30 && half_height <= 1e30))
+    throw Error(file, field, "orthographic film extents must be finite and positive");
+}
+
 Camera Camera::look_at(Type type, const Vec3& position, const Vec3& target, const Vec3& up_hint) {
+  if (!within(position, kMaxCameraCoordinate_m))
+    throw Error("", "camera",
+                "camera position " + format_vec(position) + " is not finite or beyond " +
+                    format_number(kMaxCameraCoordinate_m) + " m");
+  if (!within(target, 1e300) || !within(up_hint, 1e300))
+    throw Error("", "camera", "look_at and up must be finite");
   Camera c;
   c.type = type;
   c.position = position;

@@ -281,6 +281,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
       d.lights.points.insert(d.lights.points.end(), content.lights.points.begin(),
                              content.lights.points.end());
       for (auto& w : content.warnings) d.warnings.push_back(std::move(w));
+      for (auto& n : content.notes) d.notes.push_back(std::move(n));
     }
   }
   if (f.has("objects")) {

@@ -8,7 +8,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <functional>
 
 #include "weft/core/error.h"
@@ -66,10 +68,24 @@ struct Ctx {
   throw Error(c.file, field, msg);
 }
 
+// Largest |coordinate| (metres) of a vertex or light after the node transforms; farther points
+// cannot be traced in Embree's single precision (camera.h states why).
+constexpr double kMaxCoordinate_m = kMaxCameraCoordinate_m;
+
 bool finite_all(const std::vector<double>& v) {
   for (double x : v)
     if (!std::isfinite(x)) return false;
   return true;
+}
+
+std::string format_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", x);
+  return buf;
+}
+
+std::string format_rgb(const Rgb& c) {
+  return "(" + format_number(c.r) + ", " + format_number(c.g) + ", " + format_number(c.b) + ")";
 }
 
 Affine local_transform(const Ctx& c, const tinygltf::Node& node, const std::string& field) {
@@ -113,13 +129,47 @@ Affine local_transform(const Ctx& c, const tinygltf::Node& node, const std::stri
   return a;
 }
 
-// Where the bytes of accessor 'index' are, after checking every index and range.
+// Where the bytes of accessor 'index' are, after checking every index and range. A sparse
+// accessor (glTF 2.0 section 3.6.2.3) is materialised into 'owned': its base elements (zeros
+// without a bufferView), then the substituted ones.
 struct AccessorView {
   const unsigned char* data = nullptr;
   size_t count = 0, stride = 0;
   int component_type = 0, components = 0;
   bool normalized = false;
+  std::shared_ptr<std::vector<unsigned char>> owned;
 };
+
+// A sparse accessor without a bufferView holds no bytes in the file, so nothing bounds its count
+// but this: 2^24 elements (a 16.7-million-vertex attribute, 400 MB as VEC3 doubles).
+constexpr size_t kMaxZeroInitialisedElements = size_t(1) << 24;
+
+// Checks that 'count' elements of 'elem' bytes at 'stride' from byte 'offset' of bufferView
+// 'view_index' lie inside it and its buffer; returns their first byte.
+const unsigned char* view_bytes(const Ctx& c, int view_index, size_t offset, size_t count,
+                                size_t stride, size_t elem, const std::string& field) {
+  const auto& m = c.model;
+  if (view_index < 0 || static_cast<size_t>(view_index) >= m.bufferViews.size())
+    fail(c, field + ".bufferView", "index " + std::to_string(view_index) + " out of range");
+  const auto& view = m.bufferViews[view_index];
+  const std::string vf = "bufferViews[" + std::to_string(view_index) + "]";
+  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= m.buffers.size())
+    fail(c, vf + ".buffer", "index " + std::to_string(view.buffer) + " out of range");
+  const auto& buffer = m.buffers[view.buffer];
+  if (view.byteOffset > buffer.data.size() ||
+      view.byteLength > buffer.data.size() - view.byteOffset)
+    fail(c, vf,
+         "byte range exceeds buffer " + std::to_string(view.buffer) + " (" +
+             std::to_string(buffer.data.size()) + " bytes)");
+  if (offset > view.byteLength) fail(c, field + ".byteOffset", "exceeds its bufferView");
+  // Compared by division, not by multiplying: the count is the file's and may be absurd.
+  const size_t avail = view.byteLength - offset;
+  if (count > 0 && (elem > avail || (count - 1) > (avail - elem) / stride))
+    fail(c, field,
+         "count " + std::to_string(count) + " needs more bytes than " + vf + " holds (" +
+             std::to_string(view.byteLength) + ")");
+  return buffer.data.data() + view.byteOffset + offset;
+}
 
 AccessorView accessor_view(const Ctx& c, int index, const std::string& field) {
   const auto& m = c.model;
@@ -129,38 +179,78 @@ AccessorView accessor_view(const Ctx& c, int index, const std::string& field) {
              std::to_string(m.accessors.size()) + " accessors)");
   const auto& acc = m.accessors[index];
   const std::string af = "accessors[" + std::to_string(index) + "]";
-  if (acc.sparse.isSparse) fail(c, af, "sparse accessors are not supported");
-  if (acc.bufferView < 0 || static_cast<size_t>(acc.bufferView) >= m.bufferViews.size())
-    fail(c, af + ".bufferView", "index " + std::to_string(acc.bufferView) + " out of range");
-  const auto& view = m.bufferViews[acc.bufferView];
-  const std::string vf = "bufferViews[" + std::to_string(acc.bufferView) + "]";
-  if (view.buffer < 0 || static_cast<size_t>(view.buffer) >= m.buffers.size())
-    fail(c, vf + ".buffer", "index " + std::to_string(view.buffer) + " out of range");
-  const auto& buffer = m.buffers[view.buffer];
   const int csize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(acc.componentType));
   const int ncomp = tinygltf::GetNumComponentsInType(static_cast<uint32_t>(acc.type));
   if (csize <= 0 || ncomp <= 0) fail(c, af, "unknown componentType or type");
-  const int stride = acc.ByteStride(view);
-  if (stride <= 0) fail(c, vf + ".byteStride", "invalid");
   const size_t elem = static_cast<size_t>(csize) * ncomp;
-  if (static_cast<size_t>(stride) < elem) fail(c, vf + ".byteStride", "smaller than an element");
-  if (view.byteOffset > buffer.data.size() ||
-      view.byteLength > buffer.data.size() - view.byteOffset)
-    fail(c, vf,
-         "byte range exceeds buffer " + std::to_string(view.buffer) + " (" +
-             std::to_string(buffer.data.size()) + " bytes)");
-  if (acc.byteOffset > view.byteLength) fail(c, af + ".byteOffset", "exceeds its bufferView");
-  if (acc.count > 0) {
-    const size_t need = acc.byteOffset + (acc.count - 1) * static_cast<size_t>(stride) + elem;
-    if (acc.count > (size_t(1) << 40) || need > view.byteLength)
-      fail(c, af, "byte range exceeds its bufferView");
+  AccessorView out{nullptr, acc.count, elem, acc.componentType, ncomp, acc.normalized, nullptr};
+  if (acc.bufferView >= 0 || !acc.sparse.isSparse) {
+    if (acc.bufferView < 0 || static_cast<size_t>(acc.bufferView) >= m.bufferViews.size())
+      fail(c, af + ".bufferView", "index " + std::to_string(acc.bufferView) + " out of range");
+    const auto& view = m.bufferViews[acc.bufferView];
+    const int stride = acc.ByteStride(view);
+    const std::string vf = "bufferViews[" + std::to_string(acc.bufferView) + "]";
+    if (stride <= 0) fail(c, vf + ".byteStride", "invalid");
+    if (static_cast<size_t>(stride) < elem) fail(c, vf + ".byteStride", "smaller than an element");
+    out.stride = static_cast<size_t>(stride);
+    out.data = view_bytes(c, acc.bufferView, acc.byteOffset, acc.count, out.stride, elem, af);
+  } else if (acc.count > kMaxZeroInitialisedElements) {
+    fail(c, af + ".count",
+         std::to_string(acc.count) + " elements without a bufferView (at most " +
+             std::to_string(kMaxZeroInitialisedElements) + ")");
   }
-  return {buffer.data.data() + view.byteOffset + acc.byteOffset,
-          acc.count,
-          static_cast<size_t>(stride),
-          acc.componentType,
-          ncomp,
-          acc.normalized};
+  if (!acc.sparse.isSparse) return out;
+
+  // Sparse: copy the base elements tightly packed, then overwrite the listed ones. Every size is
+  // checked against the buffers above and below before anything is allocated.
+  const std::string sf = af + ".sparse";
+  const auto& sp = acc.sparse;
+  if (sp.count < 1 || static_cast<size_t>(sp.count) > acc.count)
+    fail(c, sf + ".count",
+         "must lie in [1, accessor count " + std::to_string(acc.count) + "], got " +
+             std::to_string(sp.count));
+  const int isize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(sp.indices.componentType));
+  if (sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+      sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+      sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
+    fail(c, sf + ".indices.componentType", "must be unsigned byte, short or int");
+  if (sp.indices.byteOffset < 0 || sp.values.byteOffset < 0)
+    fail(c, sf, "byteOffset must be >= 0");
+  const size_t n = static_cast<size_t>(sp.count);
+  const unsigned char* ip = view_bytes(c, sp.indices.bufferView, sp.indices.byteOffset, n, isize,
+                                       isize, sf + ".indices");
+  const unsigned char* vp =
+      view_bytes(c, sp.values.bufferView, sp.values.byteOffset, n, elem, elem, sf + ".values");
+  auto owned = std::make_shared<std::vector<unsigned char>>(acc.count * elem, 0);
+  if (out.data)
+    for (size_t i = 0; i < acc.count; ++i)
+      std::memcpy(owned->data() + i * elem, out.data + i * out.stride, elem);
+  uint64_t previous = 0;
+  for (size_t k = 0; k < n; ++k) {
+    uint64_t target = 0;
+    if (isize == 1) {
+      target = ip[k];
+    } else if (isize == 2) {
+      uint16_t v;
+      std::memcpy(&v, ip + 2 * k, 2);
+      target = v;
+    } else {
+      uint32_t v;
+      std::memcpy(&v, ip + 4 * k, 4);
+      target = v;
+    }
+    // The specification requires strictly increasing indices.
+    if (target >= acc.count || (k > 0 && target <= previous))
+      fail(c, sf + ".indices",
+           "index " + std::to_string(target) + " at " + std::to_string(k) +
+               " is out of range or not strictly increasing");
+    previous = target;
+    std::memcpy(owned->data() + target * elem, vp + k * elem, elem);
+  }
+  out.data = owned->data();
+  out.stride = elem;
+  out.owned = std::move(owned);
+  return out;
 }
 
 double read_component(const unsigned char* p, int type, bool normalized) {
@@ -321,9 +411,10 @@ void load_curve(const Ctx& c, const tinygltf::Primitive& prim, const Affine& wor
       fail(c, af + "_RADIUS", "radius at element " + std::to_string(v) + " must be > 0");
     const Vec3 p = world.point({pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]});
     const double r = rad[v] * scale;
-    if (!is_finite(p) || std::abs(p.x) > 1e30 || std::abs(p.y) > 1e30 || std::abs(p.z) > 1e30)
+    if (!is_finite(p) || std::abs(p.x) > kMaxCoordinate_m || std::abs(p.y) > kMaxCoordinate_m ||
+        std::abs(p.z) > kMaxCoordinate_m)
       fail(c, af + "POSITION", "position out of range after transform");
-    if (!(r > 0 && r < 1e30))
+    if (!(r > 0 && r < kMaxCoordinate_m))
       fail(c, af + "_RADIUS",
            "radius out of range after transform at element " + std::to_string(v));
     curves.points.insert(curves.points.end(),
@@ -415,7 +506,8 @@ void load_primitive(const Ctx& c, const tinygltf::Primitive& prim, const Affine&
   mesh->positions.resize(3 * nv);
   for (size_t v = 0; v < nv; ++v) {
     const Vec3 p = world.point(vertex(pos, 3, v));
-    if (!is_finite(p) || std::abs(p.x) > 1e30 || std::abs(p.y) > 1e30 || std::abs(p.z) > 1e30)
+    if (!is_finite(p) || std::abs(p.x) > kMaxCoordinate_m || std::abs(p.y) > kMaxCoordinate_m ||
+        std::abs(p.z) > kMaxCoordinate_m)
       fail(c, af + "POSITION", "position out of range after transform");
     store(mesh->positions, 3, v, p);
   }
@@ -476,12 +568,22 @@ void load_light(const Ctx& c, const tinygltf::Node& node, const Affine& world,
   // Lights shine along their local -z.
   const Vec3 axis = world.vector({0, 0, -1});
   if (!(length(axis) > 0)) fail(c, field, "light transform is singular");
+  // KHR_lights_punctual intensities are photometric; Weft's lights are radiometric (lights.h).
+  const Rgb radiometric = color / kLuminousEfficacy_lm_per_W;
+  const std::string what = lf + (l.name.empty() ? "" : " '" + l.name + "'") + " (" + l.type + ")";
   if (l.type == "directional") {
-    c.out->lights.directional.push_back({-normalize(axis), color});
+    c.out->lights.directional.push_back({-normalize(axis), radiometric});
+    c.out->notes.push_back(c.file + ": " + what + ": " + format_number(l.intensity) +
+                           " lux -> irradiance " + format_rgb(radiometric) + " W/m^2");
   } else if (l.type == "point" || l.type == "spot") {
     PointLight p;
     p.position = world.point({0, 0, 0});
-    p.intensity = color;
+    if (!is_finite(p.position) || std::abs(p.position.x) > kMaxCoordinate_m ||
+        std::abs(p.position.y) > kMaxCoordinate_m || std::abs(p.position.z) > kMaxCoordinate_m)
+      fail(c, field, "light position out of range after transform");
+    p.intensity = radiometric;
+    c.out->notes.push_back(c.file + ": " + what + ": " + format_number(l.intensity) +
+                           " cd -> radiant intensity " + format_rgb(radiometric) + " W/sr");
     if (l.type == "spot") {
       const double inner = l.spot.innerConeAngle, outer = l.spot.outerConeAngle;
       if (!(inner >= 0 && inner < outer && outer <= kPi / 2))
@@ -506,9 +608,15 @@ void load_camera(const Ctx& c, const tinygltf::Node& node, const Affine& world,
   Camera cam;
   // glTF cameras look along local -z with +y up.
   const Vec3 f = world.vector({0, 0, -1}), u = world.vector({0, 1, 0});
-  if (!(length(cross(f, u)) > 0)) fail(c, field, "camera transform is singular");
-  cam = Camera::look_at(Camera::Type::perspective, world.point({0, 0, 0}),
-                        world.point({0, 0, 0}) + f, u);
+  if (!(length(cross(f, u)) > 0) || !is_finite(f) || !is_finite(u))
+    fail(c, field, "camera transform is singular or not finite");
+  try {
+    // The look-at point one unit ahead: f may be huge or tiny after scaling.
+    cam = Camera::look_at(Camera::Type::perspective, world.point({0, 0, 0}),
+                          world.point({0, 0, 0}) + normalize(f), u);
+  } catch (const Error& e) {
+    fail(c, field, std::string("camera: ") + e.what());
+  }
   if (gc.type == "perspective") {
     if (!(gc.perspective.yfov > 0 && gc.perspective.yfov < kPi))
       fail(c, cf + ".perspective.yfov", "must lie in (0, pi)");
@@ -525,25 +633,66 @@ void load_camera(const Ctx& c, const tinygltf::Node& node, const Affine& world,
   } else {
     fail(c, cf + ".type", "unknown camera type '" + gc.type + "'");
   }
+  cam.validate(c.file, field);
   c.out->cameras.push_back({node.name.empty() ? gc.name : node.name, cam});
 }
 
-void visit(const Ctx& c, int index, const Affine& parent, std::vector<std::string> names,
-           std::vector<uint8_t>& on_path) {
+// The node graph checked before any traversal: child indices in range, at most one parent per node
+// (glTF 2.0 section 3.5.3: the hierarchy is a set of disjoint trees), no cycles. Returns every
+// node's parent (-1 for roots). Iterative throughout: a chain 10^4 nodes deep is legal glTF.
+std::vector<int> node_parents(const Ctx& c) {
+  const auto& nodes = c.model.nodes;
+  std::vector<int> parent(nodes.size(), -1);
+  for (size_t i = 0; i < nodes.size(); ++i)
+    for (size_t k = 0; k < nodes[i].children.size(); ++k) {
+      const int ch = nodes[i].children[k];
+      const std::string field = "nodes[" + std::to_string(i) + "].children[" + std::to_string(k) + "]";
+      if (ch < 0 || static_cast<size_t>(ch) >= nodes.size())
+        fail(c, field,
+             "node index " + std::to_string(ch) + " out of range (" +
+                 std::to_string(nodes.size()) + " nodes)");
+      if (parent[ch] >= 0 || static_cast<size_t>(ch) == i)
+        fail(c, field,
+             "nodes[" + std::to_string(ch) + "] has several parents (nodes[" +
+                 std::to_string(static_cast<size_t>(ch) == i ? static_cast<int>(i) : parent[ch]) +
+                 "] and nodes[" + std::to_string(i) +
+                 "]): glTF node hierarchies must be trees; instance a mesh by giving it to several "
+                 "nodes instead");
+      parent[ch] = static_cast<int>(i);
+    }
+  // With one parent each, a cycle is a loop of parent links that never reaches a root.
+  std::vector<uint8_t> state(nodes.size(), 0);  // 0 unknown, 1 on the current walk, 2 reaches a root
+  for (size_t start = 0; start < nodes.size(); ++start) {
+    int n = static_cast<int>(start);
+    while (n >= 0 && state[n] == 0) state[n] = 1, n = parent[n];
+    if (n >= 0 && state[n] == 1) {
+      std::string loop = "nodes[" + std::to_string(n) + "]";
+      for (int m = parent[n]; m != n; m = parent[m]) loop += " -> nodes[" + std::to_string(m) + "]";
+      fail(c, "nodes[" + std::to_string(n) + "].children",
+           "node hierarchy has a cycle (child to parent: " + loop + ")");
+    }
+    for (n = static_cast<int>(start); n >= 0 && state[n] == 1; n = parent[n]) state[n] = 2;
+  }
+  return parent;
+}
+
+// Names of a node's objects: its own name first, then its ancestors' (nearest first).
+std::vector<std::string> node_names(const Ctx& c, const std::vector<int>& parent, int index) {
+  std::vector<std::string> names;
+  for (int n = index; n >= 0; n = parent[n])
+    if (!c.model.nodes[n].name.empty()) names.push_back(c.model.nodes[n].name);
+  return names;
+}
+
+void load_node(const Ctx& c, const std::vector<int>& parent, int index, const Affine& world) {
   const auto& m = c.model;
   const std::string field = "nodes[" + std::to_string(index) + "]";
-  if (index < 0 || static_cast<size_t>(index) >= m.nodes.size())
-    fail(c, field, "node index out of range (" + std::to_string(m.nodes.size()) + " nodes)");
-  if (on_path[index]) fail(c, field, "node hierarchy has a cycle");
-  on_path[index] = 1;
   const auto& node = m.nodes[index];
-  const Affine world = parent * local_transform(c, node, field);
-  if (!node.name.empty()) names.insert(names.begin(), node.name);  // own name first
   if (node.mesh >= 0) {
     if (static_cast<size_t>(node.mesh) >= m.meshes.size())
       fail(c, field + ".mesh", "mesh index " + std::to_string(node.mesh) + " out of range");
     const auto& mesh = m.meshes[node.mesh];
-    auto mesh_names = names;
+    auto mesh_names = node_names(c, parent, index);
     if (!mesh.name.empty()) mesh_names.push_back(mesh.name);
     FiberCurves curves;  // the instance's fibers: one FiberCurves, one object
     curves.names = mesh_names;
@@ -557,13 +706,97 @@ void visit(const Ctx& c, int index, const Affine& parent, std::vector<std::strin
   }
   load_camera(c, node, world, field);
   load_light(c, node, world, field);
-  for (int child : node.children) visit(c, child, world, names, on_path);
-  on_path[index] = 0;
+}
+
+// Depth-first over the trees below 'roots', parents before children, children in order (the order
+// meshes, cameras and lights come out in), with an explicit stack instead of recursion.
+void load_nodes(const Ctx& c, const std::vector<int>& roots) {
+  const auto& nodes = c.model.nodes;
+  const std::vector<int> parent = node_parents(c);
+  std::vector<uint8_t> seen(nodes.size(), 0);
+  std::vector<std::pair<int, Affine>> stack;  // node and its parent's world transform
+  for (auto r = roots.rbegin(); r != roots.rend(); ++r) stack.push_back({*r, Affine{}});
+  while (!stack.empty()) {
+    const auto [index, parent_world] = stack.back();
+    stack.pop_back();
+    const std::string field = "nodes[" + std::to_string(index) + "]";
+    if (seen[index]) fail(c, field, "is reached twice from the scene's root nodes");
+    seen[index] = 1;
+    const Affine world = parent_world * local_transform(c, nodes[index], field);
+    load_node(c, parent, index, world);
+    const auto& ch = nodes[index].children;
+    for (auto k = ch.rbegin(); k != ch.rend(); ++k) stack.push_back({*k, world});
+  }
 }
 
 bool ignore_images(tinygltf::Image*, const int, std::string*, std::string*, int, int,
                    const unsigned char*, int, void*) {
   return true;  // Weft binds its own materials; textures are not used.
+}
+
+// One warning per kind of content that Weft reads past, so that nobody expects it in the image.
+void ignored_content_warnings(const Ctx& c) {
+  const auto& m = c.model;
+  auto warn = [&](const std::string& what) { c.out->warnings.push_back(c.file + ": " + what); };
+  size_t shaded = 0;  // materials with more than a name, an emissive colour and doubleSided
+  for (const auto& mat : m.materials) {
+    const auto& pbr = mat.pbrMetallicRoughness;
+    const bool plain_base = pbr.baseColorTexture.index < 0 &&
+                            pbr.metallicRoughnessTexture.index < 0 &&
+                            mat.normalTexture.index < 0 && mat.occlusionTexture.index < 0 &&
+                            mat.emissiveTexture.index < 0;
+    bool other_ext = false;
+    for (const auto& [name, value] : mat.extensions)
+      other_ext = other_ext || name != "KHR_materials_emissive_strength";
+    if (!plain_base || other_ext) ++shaded;
+  }
+  if (shaded > 0)
+    warn(std::to_string(shaded) +
+         " glTF material(s) use textures or material extensions, which are ignored: Weft binds "
+         "its own materials by glTF material name (the description's 'materials'); only the "
+         "emissive colour and doubleSided are read");
+  if (!m.textures.empty() || !m.images.empty())
+    warn(std::to_string(m.textures.size()) + " texture(s) and " + std::to_string(m.images.size()) +
+         " image(s) are ignored (images are not loaded)");
+  size_t morphs = 0;
+  for (const auto& mesh : m.meshes)
+    for (const auto& prim : mesh.primitives) morphs += prim.targets.empty() ? 0 : 1;
+  if (morphs > 0)
+    warn(std::to_string(morphs) +
+         " primitive(s) have morph targets, which are ignored: the base shape is rendered");
+  size_t skinned = 0;
+  for (const auto& node : m.nodes) skinned += node.skin >= 0 ? 1 : 0;
+  if (!m.skins.empty() || skinned > 0)
+    warn(std::to_string(m.skins.size()) +
+         " skin(s) are ignored: skinned meshes are rendered unposed, under their node transform");
+  if (!m.animations.empty())
+    warn(std::to_string(m.animations.size()) +
+         " animation(s) are ignored: nodes are rendered with the transforms written in the file");
+}
+
+// Extensions a file may require: those Weft reads, and those whose content Weft ignores anyway
+// (material and texture extensions: Weft binds its own materials by name).
+bool extension_usable(const std::string& name) {
+  if (name == "KHR_lights_punctual" || name == "KHR_materials_emissive_strength") return true;
+  return name.rfind("KHR_materials_", 0) == 0 || name == "KHR_texture_transform" ||
+         name == "KHR_texture_basisu" || name == "EXT_texture_webp" || name == "MSFT_texture_dds";
+}
+
+// GLB (binary glTF) is recognised by its magic, whatever the file's extension; a version other
+// than 2 is glTF 1.0's binary container, which tinygltf would misread.
+bool is_glb(const std::string& file) {
+  std::ifstream in(file, std::ios::binary);
+  unsigned char head[8] = {};
+  if (!in.read(reinterpret_cast<char*>(head), 8)) return false;
+  if (std::memcmp(head, "glTF", 4) != 0) return false;
+  uint32_t version = 0;
+  std::memcpy(&version, head + 4, 4);
+  if (version != 2)
+    throw Error(file, "GLB header version",
+                "GLB version " + std::to_string(version) +
+                    " is not supported: Weft reads glTF 2.0 (GLB version 2); re-export the "
+                    "model as glTF 2.0");
+  return true;
 }
 
 }  // namespace
@@ -576,11 +809,14 @@ GltfContent load_gltf(const std::filesystem::path& path) {
   loader.SetImageLoader(ignore_images, nullptr);
   tinygltf::Model model;
   std::string err, warn;
-  const bool binary = path.extension() == ".glb" || path.extension() == ".GLB";
+  const bool binary = is_glb(file);
   bool ok = false;
   try {
     ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, file)
                 : loader.LoadASCIIFromFile(&model, &err, &warn, file);
+  } catch (const std::bad_alloc&) {
+    throw Error(file, "",
+                "malformed glTF: a size or count in the file is too large to allocate");
   } catch (const std::exception& e) {
     throw Error(file, "", std::string("malformed glTF: ") + e.what());
   }
@@ -588,6 +824,18 @@ GltfContent load_gltf(const std::filesystem::path& path) {
     while (!err.empty() && (err.back() == '\n' || err.back() == ' ')) err.pop_back();
     throw Error(file, "", "malformed glTF: " + (err.empty() ? std::string("unknown error") : err));
   }
+  if (model.asset.version.rfind("2.", 0) != 0)
+    throw Error(file, "asset.version",
+                "'" + model.asset.version + "' is not supported: Weft reads glTF 2.0");
+  std::string unsupported;
+  for (const auto& e : model.extensionsRequired)
+    if (!extension_usable(e)) unsupported += (unsupported.empty() ? "" : ", ") + e;
+  if (!unsupported.empty())
+    throw Error(file, "extensionsRequired",
+                "unsupported extension(s) " + unsupported +
+                    " (Weft reads KHR_lights_punctual and KHR_materials_emissive_strength and "
+                    "ignores material and texture extensions); export without them, e.g. "
+                    "without mesh compression");
   GltfContent out;
   const Ctx c{model, file, &out};
   for (size_t i = 0; i < model.materials.size(); ++i) {
@@ -614,9 +862,16 @@ GltfContent load_gltf(const std::filesystem::path& path) {
   }
   std::vector<int> roots;
   if (!model.scenes.empty()) {
-    const int s = model.defaultScene >= 0 ? model.defaultScene : 0;
-    if (static_cast<size_t>(s) >= model.scenes.size()) fail(c, "scene", "scene index out of range");
-    roots = model.scenes[s].nodes;
+    const int sc = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (static_cast<size_t>(sc) >= model.scenes.size())
+      fail(c, "scene", "scene index out of range");
+    roots = model.scenes[sc].nodes;
+    const std::string sf = "scenes[" + std::to_string(sc) + "].nodes";
+    for (size_t k = 0; k < roots.size(); ++k)
+      if (roots[k] < 0 || static_cast<size_t>(roots[k]) >= model.nodes.size())
+        fail(c, sf + "[" + std::to_string(k) + "]",
+             "node index " + std::to_string(roots[k]) + " out of range (" +
+                 std::to_string(model.nodes.size()) + " nodes)");
   } else {
     // No scene: every node that is nobody's child is a root.
     std::vector<uint8_t> is_child(model.nodes.size(), 0);
@@ -626,8 +881,8 @@ GltfContent load_gltf(const std::filesystem::path& path) {
     for (size_t i = 0; i < model.nodes.size(); ++i)
       if (!is_child[i]) roots.push_back(static_cast<int>(i));
   }
-  std::vector<uint8_t> on_path(model.nodes.size(), 0);
-  for (int r : roots) visit(c, r, Affine{}, {}, on_path);
+  load_nodes(c, roots);
+  ignored_content_warnings(c);
   for (auto& w : warn)
     if (w == '\n') w = ' ';
   if (!warn.empty()) out.warnings.push_back(file + ": " + warn);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "weft/core/distribution.h"
 #include "weft/core/math.h"
@@ -173,6 +174,26 @@ double AreaLight::pdf(const LightHit& hit) const {
 Rgb AreaLight::eval(const LightHit& hit) const {
   if (hit.escaped || !emits(hit.mesh)) return Rgb(0.0);
   return data_->emitted(hit.mesh, hit.ng, -hit.dir);
+}
+
+std::vector<std::string> describe_lights(const Lights& lights) {
+  auto num = [](double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.6g", x);
+    return std::string(buf);
+  };
+  auto vec = [&](const Vec3& v) { return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")"; };
+  auto rgb = [&](const Rgb& c) { return "(" + num(c.r) + ", " + num(c.g) + ", " + num(c.b) + ")"; };
+  std::vector<std::string> out;
+  for (const auto& d : lights.directional)
+    out.push_back("parallel towards " + vec(d.to_light) + ": irradiance " + rgb(d.irradiance) +
+                  " W/m^2");
+  for (const auto& p : lights.points)
+    out.push_back(std::string(p.is_spot() ? "spot" : "point") + " at " + vec(p.position) +
+                  ": intensity " + rgb(p.intensity) + " W/sr");
+  if (!lights.environment.is_black())
+    out.push_back("environment: radiance " + rgb(lights.environment) + " W m^-2 sr^-1");
+  return out;
 }
 
 }  // namespace weft

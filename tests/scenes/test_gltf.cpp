@@ -4,10 +4,14 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
 
 #include "test_util.h"
 #include "weft/core/error.h"
+#include "weft/core/hash.h"
 #include "weft/scenes/gltf.h"
 #include "weft/scenes/weave.h"
 
@@ -30,6 +34,35 @@ void expect_near(const Vec3& a, const Vec3& b, double tol) {
   EXPECT_NEAR(a.x, b.x, tol);
   EXPECT_NEAR(a.y, b.y, tol);
   EXPECT_NEAR(a.z, b.z, tol);
+}
+
+// A glTF document (as JSON) holding one triangle, vertices (0,0,0), (1,0,0), (0,1,0), as accessor 0
+// (POSITION) of mesh 0 in an embedded buffer; no nodes. Tests add nodes and scenes.
+nlohmann::json triangle_doc() {
+  const float p[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::vector<uint8_t> bytes(sizeof p);
+  std::memcpy(bytes.data(), p, sizeof p);
+  return {{"asset", {{"version", "2.0"}}},
+          {"buffers",
+           {{{"byteLength", bytes.size()},
+             {"uri", "data:application/octet-stream;base64," + base64(bytes)}}}},
+          {"bufferViews", {{{"buffer", 0}, {"byteOffset", 0}, {"byteLength", bytes.size()}}}},
+          {"accessors",
+           {{{"bufferView", 0},
+             {"componentType", 5126},
+             {"count", 3},
+             {"type", "VEC3"},
+             {"min", {0, 0, 0}},
+             {"max", {1, 1, 0}}}}},
+          {"meshes", {{{"name", "tri"}, {"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
+          {"nodes", nlohmann::json::array()}};
+}
+
+std::filesystem::path write_doc(const std::filesystem::path& dir, const std::string& name,
+                                const nlohmann::json& doc) {
+  const auto path = dir / name;
+  std::ofstream(path) << doc.dump();
+  return path;
 }
 
 // Error message of loading 'file', or "" when it loads.
@@ -123,10 +156,11 @@ TEST(Gltf, CameraLightsAndEmission) {
   // The directional light is rotated -90 deg about x: it shines down, so the light is up.
   ASSERT_EQ(c.lights.directional.size(), 1u);
   expect_near(c.lights.directional[0].to_light, {0, 1, 0}, 1e-9);
-  EXPECT_EQ(c.lights.directional[0].irradiance, Rgb(3.0));
+  // 3 lux and (2, 1, 1) cd in the file, divided by 683 lm/W (gltf.h).
+  EXPECT_EQ(c.lights.directional[0].irradiance, Rgb(3.0 / 683));
   ASSERT_EQ(c.lights.points.size(), 1u);
   expect_near(c.lights.points[0].position, {10, 3, 0}, 1e-9);
-  EXPECT_EQ(c.lights.points[0].intensity, Rgb(2.0, 1.0, 1.0));
+  EXPECT_EQ(c.lights.points[0].intensity, Rgb(2.0 / 683, 1.0 / 683, 1.0 / 683));
   EXPECT_FALSE(c.lights.points[0].is_spot());
   // emissiveFactor (1, 0.5, 0.25) x emissiveStrength 4.
   ASSERT_TRUE(c.materials.count("glow"));
@@ -171,4 +205,242 @@ TEST(Gltf, MalformedFilesAreErrorsNamingTheFile) {
   EXPECT_NE(index.find("exceeds the vertex count"), std::string::npos) << index;
   const std::string absent = load_error("no_such_file.gltf");
   EXPECT_NE(absent.find("no_such_file.gltf"), std::string::npos) << absent;
+}
+
+TEST(Gltf, DeepNodeChainLoadsWithoutRecursion) {
+  // 10^4 nodes, each the only child of the previous one, the mesh at the bottom; each node moves
+  // by (0.001, 0, 0), so the triangle ends at x + 10 (the sum of 10^4 translations).
+  const auto dir = weft::testing::fresh_test_dir();
+  nlohmann::json doc = triangle_doc();
+  const int n = 10000;
+  for (int i = 0; i < n; ++i) {
+    nlohmann::json node = {{"translation", {0.001, 0, 0}}};
+    if (i + 1 < n) node["children"] = {i + 1};
+    if (i + 1 == n) node["mesh"] = 0, node["name"] = "bottom";
+    doc["nodes"].push_back(node);
+  }
+  doc["scenes"] = {{{"nodes", {0}}}};
+  const GltfContent c = load_gltf(write_doc(dir, "chain.gltf", doc));
+  ASSERT_EQ(c.meshes.size(), 1u);
+  EXPECT_NEAR(c.meshes[0]->bounds().lo.x, 10.0, 1e-6);
+  EXPECT_EQ(c.meshes[0]->names.front(), "bottom");
+}
+
+TEST(Gltf, NodeWithSeveralParentsIsAnErrorNamingTheNodes) {
+  // The instanced DAG of issue 10: 6 levels of 20 nodes, each node listing all 20 of the next
+  // level as children (20^6 paths: it hung). glTF requires trees (glTF 2.0, section 3.5.3).
+  const auto dir = weft::testing::fresh_test_dir();
+  nlohmann::json doc = triangle_doc();
+  const int levels = 6, width = 20;
+  // Node 0 is the root; level k holds nodes 1 + (k-1)*width ... k*width.
+  doc["nodes"].push_back({{"children", nlohmann::json::array()}});
+  for (int k = 1; k <= levels; ++k)
+    for (int i = 0; i < width; ++i) doc["nodes"].push_back({{"mesh", 0}});
+  for (int i = 0; i < width; ++i) doc["nodes"][0]["children"].push_back(1 + i);
+  for (int k = 1; k < levels; ++k)
+    for (int i = 0; i < width; ++i)
+      for (int j = 0; j < width; ++j)
+        doc["nodes"][1 + (k - 1) * width + i]["children"].push_back(1 + k * width + j);
+  doc["scenes"] = {{{"nodes", {0}}}};
+  const std::string e =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "dag.gltf", doc)); });
+  EXPECT_NE(e.find("dag.gltf"), std::string::npos) << e;
+  EXPECT_NE(e.find("nodes[21] has several parents (nodes[1] and nodes[2])"), std::string::npos)
+      << e;
+}
+
+TEST(Gltf, NodeCycleIsAnErrorNamingTheNodes) {
+  const auto dir = weft::testing::fresh_test_dir();
+  nlohmann::json doc = triangle_doc();
+  doc["nodes"] = {{{"mesh", 0}},
+                  {{"children", {2}}},
+                  {{"children", {3}}},
+                  {{"children", {1}}, {"mesh", 0}}};
+  doc["scenes"] = {{{"nodes", {0}}}};
+  const std::string e =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "cycle.gltf", doc)); });
+  EXPECT_NE(e.find("cycle.gltf"), std::string::npos) << e;
+  EXPECT_NE(e.find("cycle"), std::string::npos) << e;
+  EXPECT_NE(e.find("nodes[1] -> nodes[3] -> nodes[2]"), std::string::npos) << e;
+  // A node that is its own child.
+  doc["nodes"] = {{{"mesh", 0}, {"children", {0}}}};
+  const std::string self =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "self.gltf", doc)); });
+  EXPECT_NE(self.find("nodes[0].children[0]"), std::string::npos) << self;
+}
+
+TEST(Gltf, AbsurdCameraTransformIsAClearError) {
+  const auto dir = weft::testing::fresh_test_dir();
+  nlohmann::json doc = triangle_doc();
+  doc["cameras"] = {{{"type", "perspective"}, {"perspective", {{"yfov", 0.8}, {"znear", 0.1}}}}};
+  doc["nodes"] = {{{"mesh", 0}}, {{"camera", 0}, {"translation", {1e30, 0, 5}}}};
+  doc["scenes"] = {{{"nodes", {0, 1}}}};
+  const std::string far =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "far.gltf", doc)); });
+  EXPECT_NE(far.find("far.gltf"), std::string::npos) << far;
+  EXPECT_NE(far.find("nodes[1]"), std::string::npos) << far;
+  EXPECT_NE(far.find("camera position"), std::string::npos) << far;
+  // A scale of 1e300 on each of two nested nodes overflows to infinity.
+  doc["nodes"] = {{{"mesh", 0}},
+                  {{"children", {2}}, {"scale", {1e300, 1e300, 1e300}}},
+                  {{"camera", 0}, {"scale", {1e300, 1e300, 1e300}}}};
+  const std::string inf =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "inf.gltf", doc)); });
+  EXPECT_NE(inf.find("nodes[2]"), std::string::npos) << inf;
+  // The same camera 10 m away loads.
+  doc["nodes"] = {{{"mesh", 0}}, {{"camera", 0}, {"translation", {0, 0, 10}}}};
+  EXPECT_EQ(load_gltf(write_doc(dir, "near.gltf", doc)).cameras.size(), 1u);
+}
+
+TEST(Gltf, RequiredExtensionsThatWeftCannotReadAreNamed) {
+  // Draco-compressed primitives have accessors without bufferViews; the error must say Draco, not
+  // "invalid bufferView".
+  const auto dir = weft::testing::fresh_test_dir();
+  nlohmann::json doc = triangle_doc();
+  doc["nodes"] = {{{"mesh", 0}}};
+  doc["scenes"] = {{{"nodes", {0}}}};
+  doc["accessors"][0].erase("bufferView");
+  doc["meshes"][0]["primitives"][0]["extensions"] = {
+      {"KHR_draco_mesh_compression", {{"bufferView", 0}, {"attributes", {{"POSITION", 0}}}}}};
+  doc["extensionsUsed"] = {"KHR_draco_mesh_compression", "KHR_lights_punctual"};
+  doc["extensionsRequired"] = {"KHR_draco_mesh_compression", "KHR_lights_punctual"};
+  const std::string e =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "draco.gltf", doc)); });
+  EXPECT_NE(e.find("draco.gltf"), std::string::npos) << e;
+  EXPECT_NE(e.find("extensionsRequired"), std::string::npos) << e;
+  EXPECT_NE(e.find("KHR_draco_mesh_compression"), std::string::npos) << e;
+  EXPECT_EQ(e.find("KHR_lights_punctual,"), std::string::npos) << e;  // that one is supported
+}
+
+TEST(Gltf, SparseAccessorSubstitutesItsValues) {
+  // sparse.gltf: a quad's four vertices at y = 0, of which the sparse part moves vertices 1 and 3
+  // to y = 2 and y = 3 (make_data.py).
+  const GltfContent c = load_gltf(kData / "sparse.gltf");
+  ASSERT_EQ(c.meshes.size(), 1u);
+  const TriangleMesh& m = *c.meshes[0];
+  ASSERT_EQ(m.vertex_count(), 4u);
+  expect_near(m.position(0), {0, 0, 0}, 0);
+  expect_near(m.position(1), {1, 2, 0}, 0);
+  expect_near(m.position(2), {1, 0, 1}, 0);
+  expect_near(m.position(3), {0, 3, 1}, 0);
+  // A sparse accessor without a bufferView starts from zeros.
+  const GltfContent z = load_gltf(kData / "sparse_zeros.gltf");
+  ASSERT_EQ(z.meshes.size(), 1u);
+  expect_near(z.meshes[0]->position(0), {0, 0, 0}, 0);
+  expect_near(z.meshes[0]->position(1), {1, 2, 0}, 0);
+  expect_near(z.meshes[0]->position(2), {0, 0, 0}, 0);
+  expect_near(z.meshes[0]->position(3), {0, 3, 1}, 0);
+}
+
+TEST(Gltf, SparseIndicesOutOfOrderAndAbsurdCountsAreErrors) {
+  const auto dir = weft::testing::fresh_test_dir();
+  nlohmann::json doc = triangle_doc();
+  doc["nodes"] = {{{"mesh", 0}}};
+  doc["scenes"] = {{{"nodes", {0}}}};
+  // A count that would need 4e18 bytes: refused before anything is allocated.
+  doc["accessors"][0]["count"] = 333333333333333333ull;
+  const std::string big =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "big.gltf", doc)); });
+  EXPECT_NE(big.find("accessors[0]"), std::string::npos) << big;
+  EXPECT_NE(big.find("needs more bytes than bufferViews[0] holds"), std::string::npos) << big;
+  // The same count without a bufferView (sparse over zeros) has no bytes to bound it.
+  doc["accessors"][0].erase("bufferView");
+  doc["accessors"][0]["sparse"] = {
+      {"count", 1},
+      {"indices", {{"bufferView", 0}, {"componentType", 5125}}},
+      {"values", {{"bufferView", 0}}}};
+  const std::string zeros =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "zeros.gltf", doc)); });
+  EXPECT_NE(zeros.find("accessors[0].count"), std::string::npos) << zeros;
+  // Sparse indices must increase: bytes 0..3 of the buffer read as uint32 index 0, twice.
+  doc["accessors"][0]["count"] = 3;
+  doc["accessors"][0]["sparse"]["count"] = 2;
+  doc["bufferViews"].push_back({{"buffer", 0}, {"byteOffset", 0}, {"byteLength", 8}});
+  doc["accessors"][0]["sparse"]["indices"]["bufferView"] = 1;
+  const std::string order =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "order.gltf", doc)); });
+  EXPECT_NE(order.find("accessors[0].sparse.indices"), std::string::npos) << order;
+  EXPECT_NE(order.find("not strictly increasing"), std::string::npos) << order;
+}
+
+TEST(Gltf, GlbVersionOneAndGltfOneAreRefused) {
+  const auto dir = weft::testing::fresh_test_dir();
+  // A GLB header of version 1 (glTF 1.0's binary container): magic, version, length, then a JSON
+  // chunk that would otherwise parse.
+  const std::string json = R"({"asset":{"version":"2.0"}})";
+  std::string bytes = "glTF";
+  auto u32 = [&](uint32_t v) { bytes.append(reinterpret_cast<const char*>(&v), 4); };
+  u32(1);
+  u32(static_cast<uint32_t>(20 + json.size()));
+  u32(static_cast<uint32_t>(json.size()));
+  u32(0x4E4F534A);
+  bytes += json;
+  std::ofstream(dir / "v1.glb", std::ios::binary) << bytes;
+  const std::string e = weft::testing::error_of([&] { load_gltf(dir / "v1.glb"); });
+  EXPECT_NE(e.find("v1.glb"), std::string::npos) << e;
+  EXPECT_NE(e.find("GLB version 1 is not supported"), std::string::npos) << e;
+  nlohmann::json doc = triangle_doc();
+  doc["asset"]["version"] = "1.0";
+  const std::string v1 =
+      weft::testing::error_of([&] { load_gltf(write_doc(dir, "v1.gltf", doc)); });
+  EXPECT_NE(v1.find("asset.version"), std::string::npos) << v1;
+}
+
+TEST(Gltf, IgnoredContentIsOneWarningPerKind) {
+  const auto dir = weft::testing::fresh_test_dir();
+  nlohmann::json doc = triangle_doc();
+  doc["nodes"] = {{{"mesh", 0}, {"skin", 0}}, {{"mesh", 0}, {"skin", 0}}};
+  doc["scenes"] = {{{"nodes", {0, 1}}}};
+  doc["materials"] = {{{"name", "a"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+                      {{"name", "b"}, {"normalTexture", {{"index", 0}}}}};
+  doc["meshes"][0]["primitives"][0]["material"] = 0;
+  doc["textures"] = {{{"source", 0}}};
+  doc["images"] = {{{"uri", "missing.png"}}};
+  doc["meshes"][0]["primitives"][0]["targets"] = {{{"POSITION", 0}}, {{"POSITION", 0}}};
+  doc["skins"] = {{{"joints", {0}}}};
+  doc["animations"] = {{{"channels", nlohmann::json::array()}, {"samplers", nlohmann::json::array()}}};
+  const GltfContent c = load_gltf(write_doc(dir, "ignored.gltf", doc));
+  EXPECT_EQ(c.meshes.size(), 2u);
+  auto count = [&](const std::string& what) {
+    int n = 0;
+    for (const auto& w : c.warnings) n += w.find(what) != std::string::npos ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(count("2 glTF material(s)"), 1);
+  EXPECT_EQ(count("texture(s)"), 1);
+  EXPECT_EQ(count("morph targets"), 1);
+  EXPECT_EQ(count("skin(s)"), 1);
+  EXPECT_EQ(count("animation(s)"), 1);
+  // A file without any of these (the materials only named and coloured) warns about none.
+  EXPECT_TRUE(load_gltf(kData / "cube_tangents.gltf").warnings.empty());
+}
+
+TEST(Gltf, PhotometricLightsAreConvertedAndDescribed) {
+  // blender_sun.gltf: a Blender-style export (make_data.py) with a sun of 1000 lux; the cube's
+  // point light is 2 cd in red. Both divided by 683 lm/W (gltf.h).
+  const GltfContent c = load_gltf(kData / "blender_sun.gltf");
+  ASSERT_EQ(c.lights.directional.size(), 1u);
+  EXPECT_DOUBLE_EQ(c.lights.directional[0].irradiance.r, 1000.0 / 683);
+  ASSERT_EQ(c.notes.size(), 1u);
+  EXPECT_NE(c.notes[0].find("'Sun' (directional): 1000 lux -> irradiance (1.46413, 1.46413, "
+                            "1.46413) W/m^2"),
+            std::string::npos)
+      << c.notes[0];
+  const GltfContent cube = load_gltf(kData / "cube_tangents.gltf");
+  ASSERT_EQ(cube.notes.size(), 2u);
+  EXPECT_NE(cube.notes[1].find("'bulb' (point): 2 cd -> radiant intensity (0.00292826, "
+                               "0.00146413, 0.00146413) W/sr"),
+            std::string::npos)
+      << cube.notes[1];
+  Lights all = cube.lights;
+  all.environment = Rgb(0.5);
+  const auto lines = describe_lights(all);
+  ASSERT_EQ(lines.size(), 3u);
+  // (The direction carries the rounding of the light's rotation.)
+  EXPECT_EQ(lines[0].find("parallel towards ("), 0u) << lines[0];
+  EXPECT_NE(lines[0].find("): irradiance (0.00439239, 0.00439239, 0.00439239) W/m^2"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_EQ(lines[1], "point at (10, 3, 0): intensity (0.00292826, 0.00146413, 0.00146413) W/sr");
+  EXPECT_EQ(lines[2], "environment: radiance (0.5, 0.5, 0.5) W m^-2 sr^-1");
 }

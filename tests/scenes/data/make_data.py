@@ -13,8 +13,14 @@ Each file is built from first principles here so its expected contents are known
   missing_buffer.gltf  references a .bin file that does not exist
   bad_accessor.gltf    a primitive whose POSITION accessor index is out of range
   bad_index.gltf       an index that exceeds the vertex count
+  sparse.gltf          a quad whose POSITION accessor is sparse: vertices 1 and 3 moved to y = 2
+                       and y = 3 (glTF 2.0 section 3.6.2.3)
+  sparse_zeros.gltf    the same sparse accessor without a bufferView: the other vertices are zero
+  blender_sun.gltf     laid out as Blender's glTF exporter writes a scene (Y up, a 2 m "Plane"
+                       with a Principled "Material", a "Camera" 2 m above looking down, a "Sun" of
+                       1000 lux shining 30 degrees off the vertical, KHR_lights_punctual)
 """
-import base64, json, struct
+import base64, json, math, struct
 
 def pack(fmt, values):
     return b"".join(struct.pack("<" + fmt, *v) if isinstance(v, (list, tuple)) else struct.pack("<" + fmt, v)
@@ -147,3 +153,57 @@ d = quad_doc()
 d.indices([0, 1, 7])
 d.d["meshes"][0]["primitives"][0]["indices"] = len(d.d["accessors"]) - 1
 d.finish("bad_index.gltf")
+
+def sparse_doc(zeros):
+    d = Doc()
+    base = [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]]
+    pos = d.floats(base, "VEC3")
+    acc = d.d["accessors"][pos]
+    if zeros:
+        del acc["bufferView"]
+    idx_view = d.view(pack("H", [1, 3]), None)
+    val_view = d.view(pack("fff", [[1, 2, 0], [0, 3, 1]]), None)
+    for v in (idx_view, val_view):
+        del d.d["bufferViews"][v]["target"]
+    acc["sparse"] = {"count": 2, "indices": {"bufferView": idx_view, "componentType": 5123},
+                     "values": {"bufferView": val_view}}
+    acc["min"], acc["max"] = [0, 0, 0], [1, 3, 1]
+    d.d["materials"] = [{"name": "quad_mat"}]
+    d.d["meshes"] = [{"name": "sparse_mesh", "primitives": [
+        {"attributes": {"POSITION": pos}, "indices": d.indices([0, 1, 2, 0, 2, 3]), "material": 0}]}]
+    d.d["nodes"] = [{"name": "quad", "mesh": 0}]
+    d.d["scenes"][0]["nodes"] = [0]
+    return d
+
+sparse_doc(False).finish("sparse.gltf")
+sparse_doc(True).finish("sparse_zeros.gltf")
+
+def blender_doc():
+    d = Doc()
+    d.d["asset"] = {"generator": "Khronos glTF Blender I/O v4.2.70", "version": "2.0"}
+    # Blender's default plane (2 m) after the exporter's +Y-up conversion: normal +y.
+    P = [[-1, 0, 1], [1, 0, 1], [-1, 0, -1], [1, 0, -1]]
+    attrs = {"POSITION": d.floats(P, "VEC3"), "NORMAL": d.floats([[0, 1, 0]] * 4, "VEC3"),
+             "TEXCOORD_0": d.floats([[0, 0], [1, 0], [0, 1], [1, 1]], "VEC2")}
+    d.d["materials"] = [{"name": "Material", "doubleSided": True, "pbrMetallicRoughness": {
+        "baseColorFactor": [0.8, 0.8, 0.8, 1.0], "metallicFactor": 0, "roughnessFactor": 0.5}}]
+    d.d["meshes"] = [{"name": "Plane", "primitives": [
+        {"attributes": attrs, "indices": d.indices([0, 1, 3, 0, 3, 2]), "material": 0}]}]
+    s = 0.5 ** 0.5
+    # The sun's -z axis turned by -60 degrees about x: it shines along (0, -0.866, -0.5).
+    h = math.radians(-60) / 2
+    d.d["nodes"] = [
+        {"name": "Plane", "mesh": 0},
+        {"name": "Camera", "camera": 0, "translation": [0, 2, 0], "rotation": [-s, 0, 0, s]},
+        {"name": "Sun", "rotation": [math.sin(h), 0, 0, math.cos(h)], "translation": [0, 5, 0],
+         "extensions": {"KHR_lights_punctual": {"light": 0}}}]
+    d.d["cameras"] = [{"name": "Camera", "type": "perspective",
+                       "perspective": {"aspectRatio": 1.0, "yfov": 0.6, "znear": 0.1, "zfar": 100}}]
+    d.d["extensionsUsed"] = ["KHR_lights_punctual"]
+    d.d["extensions"] = {"KHR_lights_punctual": {"lights": [
+        {"name": "Sun", "type": "directional", "color": [1, 1, 1], "intensity": 1000}]}}
+    d.d["scenes"][0]["nodes"] = [0, 1, 2]
+    d.d["scenes"][0]["name"] = "Scene"
+    return d
+
+blender_doc().finish("blender_sun.gltf")

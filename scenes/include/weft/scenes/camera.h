@@ -1,9 +1,16 @@
 #pragma once
 // Cameras: perspective and orthographic, as an orthonormal basis and a film extent.
+#include <string>
+
 #include "weft/core/vec.h"
 #include "weft/scenes/mesh.h"
 
 namespace weft {
+
+// Largest |coordinate| (metres) of a camera position. Embree traces in single precision and
+// refuses ray origins beyond about 1.8e18; far below that, at 1e15 m (6.7 astronomical units) a
+// float's spacing is 6.7e7 m, so nothing a camera there sees can be resolved anyway.
+inline constexpr double kMaxCameraCoordinate_m = 1e15;
 
 struct Ray {
   Vec3 o, d;  // origin, unit direction
@@ -22,6 +29,11 @@ struct Camera {
   // Ray through film point (fx, fy) in [0,1]^2, fx to the right, fy downwards. 'aspect' is the
   // image width / height (perspective only; an orthographic film is given by its half extents).
   Ray generate_ray(double fx, double fy, double aspect) const;
+
+  // Error naming 'file' and 'field' unless the position is finite and within
+  // kMaxCameraCoordinate_m, the basis finite and orthonormal, and the field of view (perspective)
+  // or film (orthographic) finite and non-empty.
+  void validate(const std::string& file, const std::string& field) const;
 
   // Camera with basis from a viewing direction and an up hint (Gram-Schmidt).
   static Camera look_at(Type type, const Vec3& position, const Vec3& target, const Vec3& up_hint);

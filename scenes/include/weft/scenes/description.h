@@ -89,6 +89,7 @@ struct SceneDescription {
   // errors naming 'source' and the section.
   std::optional<nlohmann::json> render, sweep;
   std::vector<std::string> warnings;
+  std::vector<std::string> notes;  // for the render log (gltf.h: how glTF lights were converted)
 
   size_t shape_count() const { return meshes.size() + curves.size(); }
   // Bounding box of the shapes selected by 'object' (every shape when empty); Error when none.

@@ -29,6 +29,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <string>
 #include <variant>
 #include <vector>
 
@@ -173,5 +174,9 @@ struct Lights {
   std::vector<PointLight> points;
   Rgb environment{0.0};  // constant radiance arriving from every direction (environments add up)
 };
+
+// One line per light for a render log: its kind, where it is, and its radiometric value with the
+// unit (W/m^2 irradiance, W/sr intensity, W m^-2 sr^-1 radiance).
+std::vector<std::string> describe_lights(const Lights& lights);
 
 }  // namespace weft
