@@ -166,8 +166,8 @@ const unsigned char* view_bytes(const Ctx& c, int view_index, size_t offset, siz
   const size_t avail = view.byteLength - offset;
   if (count > 0 && (elem > avail || (count - 1) > (avail - elem) / stride))
     fail(c, field,
-         "count " + std::to_string(count) + " needs more bytes than " + vf + " holds (" +
-             std::to_string(view.byteLength) + ")");
+         "count " + std::to_string(count) + ": byte range exceeds its bufferView (" + vf + ", " +
+             std::to_string(view.byteLength) + " bytes)");
   return buffer.data.data() + view.byteOffset + offset;
 }
 
