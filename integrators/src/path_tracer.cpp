@@ -92,13 +92,33 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       const std::optional<LightSample> ls = light.sample(hit.p, rng);
       if (!ls) continue;
       const Vec3 wi = frame.to_local(ls->wi);
-      if (!consistent(ls->wi, wi)) continue;
+      // Shadow terminator (Hanika 2021, render_scene.h SurfaceHit::lift_front): on a low-poly
+      // mesh with vertex normals, the shading normal sees lights that the flat facet has behind
+      // it, or that a neighbouring facet hides, and Veach's rule (consistent) then blackens whole
+      // facets along the terminator. For reflection, the shadow ray starts instead on the smooth
+      // surface the vertex normals describe, above the facet, and decides alone: light that the
+      // facet really hides still meets it there, so nothing leaks through.
+      const Vec3 lift = wo_ng >= 0 ? hit.lift_front : hit.lift_back;
+      const bool lifted = !hit.on_fiber() && wo.z * wi.z > 0 && !(lift == Vec3{});
+      if (!lifted && !consistent(ls->wi, wi)) continue;
       const Rgb f = bsdf.eval(wo, wi);
       if (f.is_black()) continue;
       const double w = delta || !use_mis ? 1.0 : power_heuristic(ls->pdf, bsdf.pdf(wo, wi));
-      const bool blocked = ls->at_infinity
-                               ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300, hit.fiber)
-                               : occluded_between(hit, ls->p_light);
+      bool blocked;
+      if (lifted) {
+        // Off the lifted point on the viewer's side of the facet.
+        const Vec3 o = hit.p + lift + hit.ng * (wo_ng >= 0 ? hit.offset : -hit.offset);
+        if (ls->at_infinity) {
+          blocked = occluded(o, ls->wi, 1e300, hit.fiber);
+        } else {
+          const Vec3 to = ls->p_light - o;
+          const double d = length(to);
+          blocked = !(d > 0) || occluded(o, to / d, d * (1 - 1e-5), hit.fiber);
+        }
+      } else {
+        blocked = ls->at_infinity ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300, hit.fiber)
+                                  : occluded_between(hit, ls->p_light);
+      }
       if (!blocked) L += beta * f * ls->L * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
     }
 

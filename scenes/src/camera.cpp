@@ -50,8 +50,8 @@ void Camera::validate(const std::string& file, const std::string& field) const {
     throw Error(file, field, "camera basis is not orthogonal");
   if (type == Type::perspective && !(yfov_rad > 0 && yfov_rad < kPi))
     throw Error(file, field, "perspective field of view must lie in (0, pi)");
-  if (type == Type::orthographic && !(half_width > 0 && half_height > 0 &&
-                                      half_width <= 1e30 && half_height <= 1e30))
+  if (type == Type::orthographic &&
+      !(half_width > 0 && half_height > 0 && half_width <= 1e30 && half_height <= 1e30))
     throw Error(file, field, "orthographic film extents must be finite and positive");
 }
 

@@ -209,16 +209,16 @@ AccessorView accessor_view(const Ctx& c, int index, const std::string& field) {
     fail(c, sf + ".count",
          "must lie in [1, accessor count " + std::to_string(acc.count) + "], got " +
              std::to_string(sp.count));
-  const int isize = tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(sp.indices.componentType));
+  const int isize =
+      tinygltf::GetComponentSizeInBytes(static_cast<uint32_t>(sp.indices.componentType));
   if (sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
       sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
       sp.indices.componentType != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)
     fail(c, sf + ".indices.componentType", "must be unsigned byte, short or int");
-  if (sp.indices.byteOffset < 0 || sp.values.byteOffset < 0)
-    fail(c, sf, "byteOffset must be >= 0");
+  if (sp.indices.byteOffset < 0 || sp.values.byteOffset < 0) fail(c, sf, "byteOffset must be >= 0");
   const size_t n = static_cast<size_t>(sp.count);
-  const unsigned char* ip = view_bytes(c, sp.indices.bufferView, sp.indices.byteOffset, n, isize,
-                                       isize, sf + ".indices");
+  const unsigned char* ip =
+      view_bytes(c, sp.indices.bufferView, sp.indices.byteOffset, n, isize, isize, sf + ".indices");
   const unsigned char* vp =
       view_bytes(c, sp.values.bufferView, sp.values.byteOffset, n, elem, elem, sf + ".values");
   auto owned = std::make_shared<std::vector<unsigned char>>(acc.count * elem, 0);
@@ -646,11 +646,12 @@ std::vector<int> node_parents(const Ctx& c) {
   for (size_t i = 0; i < nodes.size(); ++i)
     for (size_t k = 0; k < nodes[i].children.size(); ++k) {
       const int ch = nodes[i].children[k];
-      const std::string field = "nodes[" + std::to_string(i) + "].children[" + std::to_string(k) + "]";
+      const std::string field =
+          "nodes[" + std::to_string(i) + "].children[" + std::to_string(k) + "]";
       if (ch < 0 || static_cast<size_t>(ch) >= nodes.size())
         fail(c, field,
-             "node index " + std::to_string(ch) + " out of range (" +
-                 std::to_string(nodes.size()) + " nodes)");
+             "node index " + std::to_string(ch) + " out of range (" + std::to_string(nodes.size()) +
+                 " nodes)");
       if (parent[ch] >= 0 || static_cast<size_t>(ch) == i)
         fail(c, field,
              "nodes[" + std::to_string(ch) + "] has several parents (nodes[" +
@@ -661,7 +662,8 @@ std::vector<int> node_parents(const Ctx& c) {
       parent[ch] = static_cast<int>(i);
     }
   // With one parent each, a cycle is a loop of parent links that never reaches a root.
-  std::vector<uint8_t> state(nodes.size(), 0);  // 0 unknown, 1 on the current walk, 2 reaches a root
+  std::vector<uint8_t> state(nodes.size(),
+                             0);  // 0 unknown, 1 on the current walk, 2 reaches a root
   for (size_t start = 0; start < nodes.size(); ++start) {
     int n = static_cast<int>(start);
     while (n >= 0 && state[n] == 0) state[n] = 1, n = parent[n];
@@ -742,9 +744,8 @@ void ignored_content_warnings(const Ctx& c) {
   for (const auto& mat : m.materials) {
     const auto& pbr = mat.pbrMetallicRoughness;
     const bool plain_base = pbr.baseColorTexture.index < 0 &&
-                            pbr.metallicRoughnessTexture.index < 0 &&
-                            mat.normalTexture.index < 0 && mat.occlusionTexture.index < 0 &&
-                            mat.emissiveTexture.index < 0;
+                            pbr.metallicRoughnessTexture.index < 0 && mat.normalTexture.index < 0 &&
+                            mat.occlusionTexture.index < 0 && mat.emissiveTexture.index < 0;
     bool other_ext = false;
     for (const auto& [name, value] : mat.extensions)
       other_ext = other_ext || name != "KHR_materials_emissive_strength";
@@ -815,8 +816,7 @@ GltfContent load_gltf(const std::filesystem::path& path) {
     ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, file)
                 : loader.LoadASCIIFromFile(&model, &err, &warn, file);
   } catch (const std::bad_alloc&) {
-    throw Error(file, "",
-                "malformed glTF: a size or count in the file is too large to allocate");
+    throw Error(file, "", "malformed glTF: a size or count in the file is too large to allocate");
   } catch (const std::exception& e) {
     throw Error(file, "", std::string("malformed glTF: ") + e.what());
   }

@@ -182,7 +182,9 @@ std::vector<std::string> describe_lights(const Lights& lights) {
     std::snprintf(buf, sizeof buf, "%.6g", x);
     return std::string(buf);
   };
-  auto vec = [&](const Vec3& v) { return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")"; };
+  auto vec = [&](const Vec3& v) {
+    return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")";
+  };
   auto rgb = [&](const Rgb& c) { return "(" + num(c.r) + ", " + num(c.g) + ", " + num(c.b) + ")"; };
   std::vector<std::string> out;
   for (const auto& d : lights.directional)

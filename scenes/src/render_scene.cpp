@@ -133,10 +133,25 @@ void triangle_hit(const TriangleMesh& m, uint32_t prim, double b1, double b2, co
            b2 * Vec3{a[stride * i2], a[stride * i2 + 1], a[stride * i2 + 2]};
   };
   Vec3 ns = ng;
+  hit->lift_front = hit->lift_back = Vec3{};
   if (!m.normals.empty()) {
     const Vec3 n = attr3(m.normals, 3);
     const double len = length(n);
     if (len > 1e-12) ns = n / len;
+    // Shadow-terminator lift (SurfaceHit::lift_front): the corners' tangent planes, each side.
+    const uint32_t corner[3] = {i0, i1, i2};
+    const Vec3 pc[3] = {p0, p1, p2};
+    const double bc[3] = {b0, b1, b2};
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = corner[k];
+      const Vec3 nk{m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
+      const double nlen = length(nk);
+      if (!(nlen > 1e-12)) continue;
+      const Vec3 nu = nk / nlen;
+      const double d = dot(hit->p - pc[k], nu);
+      hit->lift_front -= nu * (bc[k] * std::min(0.0, d));
+      hit->lift_back -= nu * (bc[k] * std::max(0.0, d));
+    }
   }
   const Vec3 tangent = m.tangents.empty() ? Vec3{} : attr3(m.tangents, 4);
   hit->shading = Frame::from_normal_tangent(ns, tangent);

@@ -252,10 +252,8 @@ TEST(Gltf, NodeWithSeveralParentsIsAnErrorNamingTheNodes) {
 TEST(Gltf, NodeCycleIsAnErrorNamingTheNodes) {
   const auto dir = weft::testing::fresh_test_dir();
   nlohmann::json doc = triangle_doc();
-  doc["nodes"] = {{{"mesh", 0}},
-                  {{"children", {2}}},
-                  {{"children", {3}}},
-                  {{"children", {1}}, {"mesh", 0}}};
+  doc["nodes"] = {
+      {{"mesh", 0}}, {{"children", {2}}}, {{"children", {3}}}, {{"children", {1}}, {"mesh", 0}}};
   doc["scenes"] = {{{"nodes", {0}}}};
   const std::string e =
       weft::testing::error_of([&] { load_gltf(write_doc(dir, "cycle.gltf", doc)); });
@@ -347,10 +345,9 @@ TEST(Gltf, SparseIndicesOutOfOrderAndAbsurdCountsAreErrors) {
       << big;
   // The same count without a bufferView (sparse over zeros) has no bytes to bound it.
   doc["accessors"][0].erase("bufferView");
-  doc["accessors"][0]["sparse"] = {
-      {"count", 1},
-      {"indices", {{"bufferView", 0}, {"componentType", 5125}}},
-      {"values", {{"bufferView", 0}}}};
+  doc["accessors"][0]["sparse"] = {{"count", 1},
+                                   {"indices", {{"bufferView", 0}, {"componentType", 5125}}},
+                                   {"values", {{"bufferView", 0}}}};
   const std::string zeros =
       weft::testing::error_of([&] { load_gltf(write_doc(dir, "zeros.gltf", doc)); });
   EXPECT_NE(zeros.find("accessors[0].count"), std::string::npos) << zeros;
@@ -393,14 +390,16 @@ TEST(Gltf, IgnoredContentIsOneWarningPerKind) {
   nlohmann::json doc = triangle_doc();
   doc["nodes"] = {{{"mesh", 0}, {"skin", 0}}, {{"mesh", 0}, {"skin", 0}}};
   doc["scenes"] = {{{"nodes", {0, 1}}}};
-  doc["materials"] = {{{"name", "a"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
-                      {{"name", "b"}, {"normalTexture", {{"index", 0}}}}};
+  doc["materials"] = {
+      {{"name", "a"}, {"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}},
+      {{"name", "b"}, {"normalTexture", {{"index", 0}}}}};
   doc["meshes"][0]["primitives"][0]["material"] = 0;
   doc["textures"] = {{{"source", 0}}};
   doc["images"] = {{{"uri", "missing.png"}}};
   doc["meshes"][0]["primitives"][0]["targets"] = {{{"POSITION", 0}}, {{"POSITION", 0}}};
   doc["skins"] = {{{"joints", {0}}}};
-  doc["animations"] = {{{"channels", nlohmann::json::array()}, {"samplers", nlohmann::json::array()}}};
+  doc["animations"] = {
+      {{"channels", nlohmann::json::array()}, {"samplers", nlohmann::json::array()}}};
   const GltfContent c = load_gltf(write_doc(dir, "ignored.gltf", doc));
   EXPECT_EQ(c.meshes.size(), 2u);
   auto count = [&](const std::string& what) {

@@ -45,6 +45,12 @@ struct SurfaceHit {
   int64_t fiber = kNoFiber;  // scene-wide fiber id; kNoFiber for mesh triangles
   uint32_t segment = 0;      // fibers: segment index within the curve set (index_segments order)
   double offset = 0;  // distance to move ray origins off the surface (scales with coordinates)
+  // Triangles with vertex normals: from p to the smooth surface those normals describe, on the
+  // front (normals') side and on the back side (Hanika 2021, "Hacking the shadow terminator",
+  // Ray Tracing Gems II ch. 4: p projected onto each corner's tangent plane where it lies below
+  // it, the projections blended by the barycentrics). Zero on flat or concave parts, on meshes
+  // without normals and on fibers. The path tracer starts shadow rays there (path_tracer.cpp).
+  Vec3 lift_front, lift_back;
 
   bool on_fiber() const { return fiber != kNoFiber; }
   // Origin for a ray leaving the surface in direction d: offset along ng to d's side, so rays
