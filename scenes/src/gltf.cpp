@@ -567,7 +567,8 @@ void load_light(const Ctx& c, const tinygltf::Node& node, const Affine& world,
   const Rgb color = light_color(c, l, lf);
   // Lights shine along their local -z.
   const Vec3 axis = world.vector({0, 0, -1});
-  if (!(length(axis) > 0)) fail(c, field, "light transform is singular");
+  if (!(length(axis) > 0) || !is_finite(axis))
+    fail(c, field, "light transform is singular or not finite");
   // KHR_lights_punctual intensities are photometric; Weft's lights are radiometric (lights.h).
   const Rgb radiometric = color / kLuminousEfficacy_lm_per_W;
   const std::string what = lf + (l.name.empty() ? "" : " '" + l.name + "'") + " (" + l.type + ")";
