@@ -12,6 +12,7 @@
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
+#include "weft/scenes/description.h"
 #include "weft/scenes/gltf.h"
 #include "weft/scenes/weave.h"
 
@@ -288,6 +289,21 @@ TEST(Gltf, AbsurdCameraTransformIsAClearError) {
   // The same camera 10 m away loads.
   doc["nodes"] = {{{"mesh", 0}}, {{"camera", 0}, {"translation", {0, 0, 10}}}};
   EXPECT_EQ(load_gltf(write_doc(dir, "near.gltf", doc)).cameras.size(), 1u);
+}
+
+TEST(Gltf, DescriptionCameraAt1e30IsAClearError) {
+  // The scene description's own cameras pass the same check (Camera::look_at).
+  const nlohmann::json j = {
+      {"objects",
+       {{{"type", "quad"}, {"material", "m"}, {"center", {0, 0, 0}}, {"normal", {0, 1, 0}}}}},
+      {"materials", {{"m", {{"type", "lambert"}}}}},
+      {"camera", {{"type", "perspective"}, {"position", {1e30, 1, 0}}, {"look_at", {0, 0, 0}}}}};
+  const std::string e =
+      weft::testing::error_of([&] { parse_scene_description(j, ".", "far.json"); });
+  EXPECT_NE(e.find("far.json"), std::string::npos) << e;
+  EXPECT_NE(e.find("camera position (1e+30, 1, 0) is not finite or beyond 1e+15 m"),
+            std::string::npos)
+      << e;
 }
 
 TEST(Gltf, RequiredExtensionsThatWeftCannotReadAreNamed) {
