@@ -100,10 +100,14 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       // facet really hides still meets it there, so nothing leaks through.
       const Vec3 lift = wo_ng >= 0 ? hit.lift_front : hit.lift_back;
       const bool lifted = !hit.on_fiber() && wo.z * wi.z > 0 && !(lift == Vec3{});
-      if (!lifted && !consistent(ls->wi, wi)) continue;
+      const bool agrees = consistent(ls->wi, wi);
+      if (!lifted && !agrees) continue;
       const Rgb f = bsdf.eval(wo, wi);
       if (f.is_black()) continue;
-      const double w = delta || !use_mis ? 1.0 : power_heuristic(ls->pdf, bsdf.pdf(wo, wi));
+      // BSDF sampling stops at directions the facet disagrees on, so there this is the only
+      // strategy and takes the whole weight.
+      const double w =
+          delta || !use_mis || !agrees ? 1.0 : power_heuristic(ls->pdf, bsdf.pdf(wo, wi));
       bool blocked;
       if (lifted) {
         // Off the lifted point on the viewer's side of the facet.
