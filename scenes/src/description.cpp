@@ -266,12 +266,17 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     } else {
       throw Error(source, "gltf", "must be a file name or a list of them");
     }
+    // KHR_lights_punctual's units (gltf.h): photometric unless the exporter wrote watts.
+    const GltfLightUnits light_units =
+        f.choice("gltf_light_units", "photometric", {"photometric", "radiometric"}) == "photometric"
+            ? GltfLightUnits::photometric
+            : GltfLightUnits::radiometric;
     for (const auto& [file, field] : files) {
       const auto path = base_dir / file;
       std::error_code ec;
       if (!std::filesystem::is_regular_file(path, ec))
         throw Error(source, field, "glTF file not found: " + path.string());
-      GltfContent content = load_gltf(path);
+      GltfContent content = load_gltf(path, light_units);
       for (auto& m : content.meshes) d.meshes.push_back(std::move(m));
       for (auto& c : content.curves) d.curves.push_back(std::move(c));
       for (const auto& [key, info] : content.materials) d.gltf_materials[key] = info;

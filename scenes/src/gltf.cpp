@@ -62,6 +62,7 @@ struct Ctx {
   const tinygltf::Model& model;
   std::string file;
   GltfContent* out;
+  GltfLightUnits light_units = GltfLightUnits::photometric;
 };
 
 [[noreturn]] void fail(const Ctx& c, const std::string& field, const std::string& msg) {
@@ -570,12 +571,14 @@ void load_light(const Ctx& c, const tinygltf::Node& node, const Affine& world,
   if (!(length(axis) > 0) || !is_finite(axis))
     fail(c, field, "light transform is singular or not finite");
   // KHR_lights_punctual intensities are photometric; Weft's lights are radiometric (lights.h).
-  const Rgb radiometric = color / kLuminousEfficacy_lm_per_W;
+  const bool photometric = c.light_units == GltfLightUnits::photometric;
+  const Rgb radiometric = photometric ? color / kLuminousEfficacy_lm_per_W : color;
   const std::string what = lf + (l.name.empty() ? "" : " '" + l.name + "'") + " (" + l.type + ")";
   if (l.type == "directional") {
     c.out->lights.directional.push_back({-normalize(axis), radiometric});
     c.out->notes.push_back(c.file + ": " + what + ": " + format_number(l.intensity) +
-                           " lux -> irradiance " + format_rgb(radiometric) + " W/m^2");
+                           (photometric ? " lux" : " (radiometric)") + " -> irradiance " +
+                           format_rgb(radiometric) + " W/m^2");
   } else if (l.type == "point" || l.type == "spot") {
     PointLight p;
     p.position = world.point({0, 0, 0});
@@ -584,7 +587,8 @@ void load_light(const Ctx& c, const tinygltf::Node& node, const Affine& world,
       fail(c, field, "light position out of range after transform");
     p.intensity = radiometric;
     c.out->notes.push_back(c.file + ": " + what + ": " + format_number(l.intensity) +
-                           " cd -> radiant intensity " + format_rgb(radiometric) + " W/sr");
+                           (photometric ? " cd" : " (radiometric)") + " -> radiant intensity " +
+                           format_rgb(radiometric) + " W/sr");
     if (l.type == "spot") {
       const double inner = l.spot.innerConeAngle, outer = l.spot.outerConeAngle;
       if (!(inner >= 0 && inner < outer && outer <= kPi / 2))
@@ -803,7 +807,7 @@ bool is_glb(const std::string& file) {
 
 }  // namespace
 
-GltfContent load_gltf(const std::filesystem::path& path) {
+GltfContent load_gltf(const std::filesystem::path& path, GltfLightUnits light_units) {
   const std::string file = path.string();
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw Error(file, "", "glTF file not found");
@@ -838,7 +842,7 @@ GltfContent load_gltf(const std::filesystem::path& path) {
                     "ignores material and texture extensions); export without them, e.g. "
                     "without mesh compression");
   GltfContent out;
-  const Ctx c{model, file, &out};
+  const Ctx c{model, file, &out, light_units};
   for (size_t i = 0; i < model.materials.size(); ++i) {
     const auto& mat = model.materials[i];
     const std::string mf = "materials[" + std::to_string(i) + "]";

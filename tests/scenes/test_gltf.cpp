@@ -461,3 +461,23 @@ TEST(Gltf, PhotometricLightsAreConvertedAndDescribed) {
   EXPECT_EQ(lines[1], "point at (10, 3, 0): intensity (0.00292826, 0.00146413, 0.00146413) W/sr");
   EXPECT_EQ(lines[2], "environment: radiance (0.5, 0.5, 0.5) W m^-2 sr^-1");
 }
+
+TEST(Gltf, DescriptionCanSayTheGltfLightsAreRadiometric) {
+  // For exporters that write watts (Blender's "Unitless" mode): no division by 683.
+  nlohmann::json j = {{"gltf", "blender_sun.gltf"}, {"default_material", {{"type", "lambert"}}}};
+  const SceneDescription photometric = parse_scene_description(j, kData, "s.json");
+  ASSERT_EQ(photometric.lights.directional.size(), 1u);
+  EXPECT_DOUBLE_EQ(photometric.lights.directional[0].irradiance.g, 1000.0 / 683);
+  j["gltf_light_units"] = "radiometric";
+  const SceneDescription radiometric = parse_scene_description(j, kData, "s.json");
+  ASSERT_EQ(radiometric.lights.directional.size(), 1u);
+  EXPECT_DOUBLE_EQ(radiometric.lights.directional[0].irradiance.g, 1000.0);
+  ASSERT_EQ(radiometric.notes.size(), 1u);
+  EXPECT_NE(radiometric.notes[0].find("1000 (radiometric) -> irradiance (1000, 1000, 1000) W/m^2"),
+            std::string::npos)
+      << radiometric.notes[0];
+  j["gltf_light_units"] = "lumens";
+  const std::string e =
+      weft::testing::error_of([&] { parse_scene_description(j, kData, "s.json"); });
+  EXPECT_NE(e.find("gltf_light_units"), std::string::npos) << e;
+}

@@ -7,6 +7,7 @@
 //
 // {
 //   "gltf": "plane.gltf" | ["a.gltf", "b.glb"],
+//   "gltf_light_units": "photometric" | "radiometric",  // KHR_lights_punctual values (gltf.h)
 //   "objects": [ inline primitives, for tests:
 //     {"type": "quad", "name": N, "material": KEY, "center": [3], "normal": [3], "tangent": [3],
 //      "size": [w, h]} |

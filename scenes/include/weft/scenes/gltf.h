@@ -55,6 +55,12 @@ struct GltfContent {
   std::vector<std::string> notes;
 };
 
-GltfContent load_gltf(const std::filesystem::path& path);
+// How KHR_lights_punctual intensities are read: photometric (lux, candela; the specification's
+// units, divided by kLuminousEfficacy_lm_per_W), or radiometric already (W/m^2, W/sr: exporters
+// that write raw watts, e.g. Blender's "Unitless" lighting mode).
+enum class GltfLightUnits { photometric, radiometric };
+
+GltfContent load_gltf(const std::filesystem::path& path,
+                      GltfLightUnits light_units = GltfLightUnits::photometric);
 
 }  // namespace weft
