@@ -137,11 +137,24 @@ nlohmann::json read_image_metadata(const std::filesystem::path& path) {
     } else if (t.basetype == OIIO::TypeDesc::FLOAT || t.basetype == OIIO::TypeDesc::INT ||
                t.basetype == OIIO::TypeDesc::DOUBLE || t.basetype == OIIO::TypeDesc::UINT) {
       const int n = static_cast<int>(t.numelements() * t.aggregate);
+      // The raw values: ParamValue's converting getters do not index into matrices.
+      auto element = [&](int i) -> nlohmann::json {
+        switch (t.basetype) {
+          case OIIO::TypeDesc::INT:
+            return static_cast<const int32_t*>(a.data())[i];
+          case OIIO::TypeDesc::UINT:
+            return static_cast<const uint32_t*>(a.data())[i];
+          case OIIO::TypeDesc::DOUBLE:
+            return static_cast<const double*>(a.data())[i];
+          default:
+            return static_cast<const float*>(a.data())[i];
+        }
+      };
       if (n == 1) {
-        j[a.name().string()] = a.get_float();
+        j[a.name().string()] = element(0);
       } else {
         nlohmann::json arr = nlohmann::json::array();
-        for (int i = 0; i < n; ++i) arr.push_back(a.get_float_indexed(i));
+        for (int i = 0; i < n; ++i) arr.push_back(element(i));
         j[a.name().string()] = arr;
       }
     }

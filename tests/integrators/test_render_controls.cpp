@@ -181,7 +181,12 @@ TEST(RenderControls, ExrIsTheSameBytesOnEveryRunAndCarriesMetadata) {
   const fs::path dir = fresh_test_dir();
   SceneDescription d = woven();
   d.source = "/somewhere/woven.json";
-  d.camera = Camera::look_at(Camera::Type::perspective, {0.3, 2.0, 1.5}, {0, 0, 0}, {0, 1, 0});
+  // A perspective view of the patch from above and aside, at about twice its size.
+  const Bounds3 box = d.object_bounds("");
+  const Vec3 centre = (box.lo + box.hi) * 0.5;
+  const double size = length(box.hi - box.lo);
+  d.camera = Camera::look_at(Camera::Type::perspective, centre + Vec3{0.3, 2.0, 1.5} * size, centre,
+                             {0, 1, 0});
   d.camera->yfov_rad = deg_to_rad(35);
   RenderJob job;
   job.settings = small(2);
@@ -216,15 +221,15 @@ TEST(RenderControls, ExrIsTheSameBytesOnEveryRunAndCarriesMetadata) {
   const double aspect = 45.0 / 37.0;
   for (const auto& [fx, fy] : {std::pair{0.5, 0.5}, {0.1, 0.8}, {0.95, 0.05}}) {
     const Ray ray = d.camera->generate_ray(fx, fy, aspect);
-    const Vec3 p = ray.o + ray.d * 2.5;
+    const Vec3 p = ray.o + ray.d * (2.5 * size);
     const double v[4] = {p.x, p.y, p.z, 1};
     double h[4] = {0, 0, 0, 0}, c[4] = {0, 0, 0, 0};
     for (int j = 0; j < 4; ++j)
       for (int i = 0; i < 4; ++i) h[j] += v[i] * ndc[4 * i + j], c[j] += v[i] * cam[4 * i + j];
     EXPECT_NEAR(h[0] / h[3], fx, 1e-5);
     EXPECT_NEAR(h[1] / h[3], fy, 1e-5);
-    EXPECT_NEAR(c[2], 2.5 * dot(ray.d, d.camera->forward), 1e-5);
-    EXPECT_NEAR(c[0], dot(p - d.camera->position, d.camera->right), 1e-5);
+    EXPECT_NEAR(c[2], 2.5 * size * dot(ray.d, d.camera->forward), 1e-5 * size);
+    EXPECT_NEAR(c[0], dot(p - d.camera->position, d.camera->right), 1e-5 * size);
   }
 }
 
@@ -290,4 +295,32 @@ TEST(RenderControls, OutputsThatClashAreRefusedBeforeRendering) {
   EXPECT_NE(error_of([&] { render_to_files(d, job); }).find("crop"), std::string::npos);
   EXPECT_FALSE(fs::exists(dir / "out.exr"));
   EXPECT_FALSE(fs::exists(dir / "mask.exr"));
+}
+
+TEST(RenderControls, RenderSectionTakesCropAndTimeLimit) {
+  auto with_render = [](const nlohmann::json& render) {
+    const nlohmann::json j = {
+        {"objects",
+         {{{"type", "quad"}, {"material", "m"}, {"center", {0, 0, 0}}, {"normal", {0, 1, 0}}}}},
+        {"materials", {{"m", {{"type", "lambert"}}}}},
+        {"render", render}};
+    return render_settings_from(parse_scene_description(j, ".", "scene.json"));
+  };
+  const RenderSettings s =
+      with_render({{"width", 64}, {"height", 32}, {"crop", {1, 9, 2, 30}}, {"time_limit_s", 5}});
+  ASSERT_TRUE(s.crop.has_value());
+  EXPECT_EQ(*s.crop, (PixelWindow{1, 9, 2, 30}));
+  EXPECT_EQ(s.time_limit_s, 5);
+  EXPECT_FALSE(with_render({{"spp", 4}}).crop.has_value());
+  for (const nlohmann::json& bad : {nlohmann::json{1, 9, 2}, nlohmann::json{1, 9, 2, 40},
+                                    nlohmann::json{1.5, 9, 2, 20}, nlohmann::json{9, 1, 2, 20}}) {
+    const std::string e = error_of([&] {
+      with_render({{"width", 64}, {"height", 32}, {"crop", bad}});
+    });
+    EXPECT_NE(e.find("scene.json: field 'render.crop"), std::string::npos) << e;
+  }
+  EXPECT_NE(error_of([&] {
+              with_render({{"time_limit_s", -1}});
+            }).find("render.time_limit_s"),
+            std::string::npos);
 }

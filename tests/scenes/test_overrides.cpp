@@ -9,6 +9,7 @@
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/scenes/description.h"
+#include "weft/scenes/render_scene.h"
 
 using namespace weft;
 using nlohmann::json;
@@ -71,7 +72,9 @@ TEST(Overrides, ANewLastKeyIsCheckedByTheParserLikeAKeyInTheFile) {
   EXPECT_EQ(j["render"]["seed"], 9);
   EXPECT_EQ(j["sweep"]["spp"], 2);
   j = overridden({{"materials.Material.001.params.reflectanse", "0.3"}});
-  const std::string e = error_of([&] { parse_scene_description(j, ".", "scene.json"); });
+  // Material parameters are read when the render scene is built.
+  const std::string e =
+      error_of([&] { RenderScene scene(parse_scene_description(j, ".", "scene.json")); });
   EXPECT_NE(e.find("scene.json"), std::string::npos) << e;
   EXPECT_NE(e.find("materials.Material.001.params.reflectanse"), std::string::npos) << e;
 }

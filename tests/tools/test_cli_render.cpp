@@ -51,9 +51,10 @@ bool contains(const std::string& s, const std::string& part) {
 }
 
 // The bundled Lambert plane, small and quick.
-std::string plane(const fs::path& out, const std::string& more = "") {
+std::string plane(const fs::path& out, const std::string& more = "", int spp = 2) {
   return "render '" + (kExamples / "lambert-plane.json").string() +
-         "' --width 24 --height 20 --spp 2 --quiet -o '" + out.string() + "' " + more;
+         "' --width 24 --height 20 --spp " + std::to_string(spp) + " --quiet -o '" + out.string() +
+         "' " + more;
 }
 
 // The bundled plane's glTF with two cameras above it looking down: node 1 holds an unnamed
@@ -203,7 +204,7 @@ TEST(CliRender, ExposureScalesThePreviewOnly) {
 
 TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
   const fs::path dir = fresh_test_dir();
-  const CliRun r = run(plane(dir / "out.exr", "--spp 64 --time-limit 1e-9 --json"), dir);
+  const CliRun r = run(plane(dir / "out.exr", "--time-limit 1e-9 --json", 64), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out).at("spp_done"), 1);
   const nlohmann::json m = weft::read_image_metadata(dir / "out.exr");
@@ -211,7 +212,7 @@ TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
   EXPECT_EQ(m.at("weft:spp_requested"), 64);
   EXPECT_TRUE(m.contains("weft:time_limit_s"));
   // One pass is a render of 1 sample per pixel.
-  ASSERT_EQ(run(plane(dir / "one.exr", "--spp 1"), dir).exit_code, 0);
+  ASSERT_EQ(run(plane(dir / "one.exr", "", 1), dir).exit_code, 0);
   EXPECT_EQ(weft::read_image(dir / "out.exr").rgb, weft::read_image(dir / "one.exr").rgb);
 }
 
