@@ -58,8 +58,9 @@ struct RenderResult : RenderOutcome {
   Image albedo, normal;
 };
 
-// After every camera sample: its pixel (row-major), the shape (SurfaceHit::shape) its camera ray
-// hit first (-1: none) and its radiance (0 for a dropped non-finite sample).
+// After every camera sample: its pixel (row-major on the whole film, a crop window too), the shape
+// (SurfaceHit::shape) its camera ray hit first (-1: none) and its radiance (0 for a dropped
+// non-finite sample).
 using SampleObserver = std::function<void(uint64_t pixel, int64_t first_mesh, const Rgb& radiance)>;
 // Every ray handed to the scene: camera and bounce rays (shadow = false) and shadow rays (shadow =
 // true, ending at ray.tmax).
