@@ -1,5 +1,7 @@
 #include "cli_util.h"
 
+#include <unistd.h>
+
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -19,16 +21,6 @@ extern "C" void on_sigint(int) {
   g_interrupted.store(true);
 }
 
-std::string format_duration(double seconds) {
-  if (!std::isfinite(seconds) || seconds < 0) return "--:--";
-  const long s = std::lround(seconds);
-  char buf[32];
-  if (s >= 3600)
-    std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", s / 3600, (s / 60) % 60, s % 60);
-  else
-    std::snprintf(buf, sizeof buf, "%02ld:%02ld", s / 60, s % 60);
-  return buf;
-}
 }  // namespace
 
 void install_interrupt_handler() {
@@ -47,23 +39,27 @@ ProgressCallback progress_bar(bool quiet) {
     std::string stage;
   };
   auto state = std::make_shared<State>();
-  return [state, quiet](const ProgressUpdate& u) {
+  // A terminal gets one line redrawn in place; a log file or pipe gets plain lines, fewer of them,
+  // so that a batch job's log is readable rather than one line of carriage returns.
+  const bool terminal = isatty(fileno(stderr)) != 0;
+  const auto period = terminal ? std::chrono::milliseconds(200) : std::chrono::milliseconds(10000);
+  return [state, quiet, terminal, period](const ProgressUpdate& u) {
     if (!quiet) {
       const auto now = Clock::now();
       if (u.stage != state->stage) {
         state->stage = std::string(u.stage);
         state->start = now;
+        state->last_draw = now;  // the first line comes one period into the stage
       }
       const bool finished = u.total > 0 && u.done >= u.total;
-      if (finished || now - state->last_draw > std::chrono::milliseconds(200)) {
+      if (finished || now - state->last_draw > period) {
         state->last_draw = now;
         const double elapsed = std::chrono::duration<double>(now - state->start).count();
-        const double rate = elapsed > 0 ? static_cast<double>(u.done) / elapsed : 0;
-        const double frac = u.total > 0 ? static_cast<double>(u.done) / u.total : 0;
-        const double eta = rate > 0 && u.total > 0 ? (u.total - u.done) / rate : NAN;
-        std::fprintf(stderr, "\r%-10s %5.1f%%  %10.4g/s  ETA %s   ", state->stage.c_str(),
-                     100 * frac, rate, format_duration(eta).c_str());
-        if (finished) std::fprintf(stderr, "\n");
+        const std::string line = format_progress_line(u, elapsed);
+        if (terminal)
+          std::fprintf(stderr, "\r%-70s%s", line.c_str(), finished ? "\n" : "");
+        else
+          std::fprintf(stderr, "%s\n", line.c_str());
         std::fflush(stderr);
       }
     }
@@ -72,7 +68,12 @@ ProgressCallback progress_bar(bool quiet) {
 }
 
 SceneDescription load_scene_reporting_warnings(const std::string& path) {
-  SceneDescription desc = load_scene_description(path);
+  return load_scene_reporting_warnings(path, {});
+}
+
+SceneDescription load_scene_reporting_warnings(const std::string& path,
+                                               const std::vector<SceneOverride>& overrides) {
+  SceneDescription desc = load_scene_description(path, overrides);
   for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
   // What the lights are, in the renderer's units (glTF photometric values were converted).
   for (const auto& n : desc.notes) std::fprintf(stderr, "weft: %s\n", n.c_str());

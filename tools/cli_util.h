@@ -12,6 +12,7 @@
 namespace weft {
 struct RenderOutcome;
 struct SceneDescription;
+struct SceneOverride;
 }  // namespace weft
 
 namespace weft::cli {
@@ -23,7 +24,9 @@ struct Command {
 };
 using Commands = std::vector<Command>;
 
-// A progress bar on stderr (percent, rate, ETA), silent when quiet. It returns false once the user
+// Progress on stderr (format_progress_line: percent, rate with its unit, ETA), silent when quiet:
+// on a terminal one line redrawn in place, elsewhere (a log, a pipe) a plain line every 10 s and
+// at the end of each stage. It returns false once the user
 // pressed Ctrl-C, so the library stops at the next task boundary and keeps what it has.
 ProgressCallback progress_bar(bool quiet);
 // Installs the SIGINT handler used by progress_bar (idempotent).
@@ -32,6 +35,9 @@ bool interrupted();
 
 // The scene description at 'path', its warnings printed on stderr (commands that render it).
 SceneDescription load_scene_reporting_warnings(const std::string& path);
+// Same with "-D key=value" overrides applied to the description (description.h).
+SceneDescription load_scene_reporting_warnings(const std::string& path,
+                                               const std::vector<SceneOverride>& overrides);
 // The end of a render on stderr, alike for every command that renders: a cancelled run says that
 // 'what' wrote nothing and gives exit code 130; dropped non-finite samples are a warning.
 // Returns the exit code to stop with, or 0 to go on to the outputs.

@@ -177,8 +177,6 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   rs.rr_depth = g.rr_depth;
   rs.seed = g.seed;
   rs.threads = g.threads;
-  const uint64_t tiles_per = uint64_t((g.width + rs.tile_size - 1) / rs.tile_size) *
-                             ((g.height + rs.tile_size - 1) / rs.tile_size);
   uint64_t renders_done = 0;
 
   GonioResult res;
@@ -194,9 +192,9 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
     // Film "up" follows the sample normal except near normal view.
     const Vec3 up_hint = std::abs(zen) > 5 ? desc.frame.normal : desc.frame.tangent;
     const Camera cam = frame_box_orthographic(box, towards_viewer, up_hint);
-    const uint64_t base = renders_done * tiles_per;
+    // Every view is the same number of samples (u.total) long.
     const MaskedRender r = render_masked(scene, cam, rs, sel, [&](const ProgressUpdate& u) {
-      return progress({"sweep", base + u.done, renders * tiles_per});
+      return progress({"sweep", renders_done * u.total + u.done, renders * u.total, u.unit});
     });
     ++renders_done;
     res.rays += r.render.rays;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <mutex>
 
@@ -153,54 +154,135 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   if (s.width < 1 || s.height < 1 || s.spp < 1 || s.tile_size < 1 || s.max_depth < 0 ||
       s.rr_depth < 0)
     throw Error("", "render", "width, height, spp and tile size must be positive");
+  if (!(s.time_limit_s >= 0) || !std::isfinite(s.time_limit_s))
+    throw Error("", "render.time_limit_s", "must be a finite number of seconds >= 0");
+  const PixelWindow win = s.crop.value_or(PixelWindow{0, s.width, 0, s.height});
+  check_crop(win, s.width, s.height, "", "render.crop");
   RenderResult out;
-  out.image = Image(s.width, s.height);
+  const int ww = win.width(), wh = win.height();
+  const size_t npx = size_t(ww) * wh;
+  auto film_image = [&] {
+    Image im(ww, wh);
+    im.x0 = win.x0, im.y0 = win.y0, im.film_width = s.width, im.film_height = s.height;
+    return im;
+  };
+  out.image = film_image();
+  const bool aov = s.aov_albedo || s.aov_normal;
+  if (s.aov_albedo) out.albedo = film_image();
+  if (s.aov_normal) out.normal = film_image();
   const RayObserver* on_ray = observers.on_ray ? &observers.on_ray : nullptr;
-  const int tx = (s.width + s.tile_size - 1) / s.tile_size,
-            ty = (s.height + s.tile_size - 1) / s.tile_size;
+  const int tx = (ww + s.tile_size - 1) / s.tile_size, ty = (wh + s.tile_size - 1) / s.tile_size;
   const uint64_t tiles = uint64_t(tx) * ty;
   std::vector<RayCounts> tile_rays(tiles);
   std::vector<uint64_t> tile_nonfinite(tiles, 0);
   std::atomic<bool> cancel{false};
   std::atomic<uint64_t> done{0};
+  const uint64_t total = uint64_t(npx) * s.spp;
   std::mutex progress_mutex;
   const double aspect = double(s.width) / s.height;
-  const double inv_spp = 1.0 / s.spp;
 
-  parallel_for(tiles, s.threads, [&](uint64_t tile) {
-    if (cancel.load(std::memory_order_relaxed)) return;
-    const int x0 = int(tile % tx) * s.tile_size, y0 = int(tile / tx) * s.tile_size;
-    const int x1 = std::min(x0 + s.tile_size, s.width), y1 = std::min(y0 + s.tile_size, s.height);
-    RayCounts rays;
-    for (int y = y0; y < y1; ++y) {
-      // A cancelled render is discarded anyway: stop within a row, not a whole tile.
-      if (cancel.load(std::memory_order_relaxed)) return;
-      for (int x = x0; x < x1; ++x) {
-        const uint64_t pixel = uint64_t(y) * s.width + x;
-        double sum[3] = {0, 0, 0};
-        for (int k = 0; k < s.spp; ++k) {
-          Rng rng(s.seed, pixel, uint64_t(k));
-          const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
-          const Ray ray = camera.generate_ray(fx, fy, aspect);
-          ++rays.camera;
-          int64_t first = -1;
-          Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray);
-          if (!finite(L)) {
-            ++tile_nonfinite[tile];
-            L = Rgb(0.0);
-          }
-          sum[0] += L.r, sum[1] += L.g, sum[2] += L.b;
-          if (observers.on_sample) observers.on_sample(pixel, first, L);
+  // Per-pixel sums of radiance, albedo and normal, in sample order.
+  struct Sums {
+    double L[3] = {0, 0, 0}, albedo[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+  };
+  // Samples [k0, k1) of film pixel (x, y), added to 'acc'.
+  auto sample_pixel = [&](int x, int y, int k0, int k1, Sums& acc, RayCounts& rays,
+                          uint64_t& nonfinite) {
+    const uint64_t pixel = uint64_t(y) * s.width + x;
+    for (int k = k0; k < k1; ++k) {
+      Rng rng(s.seed, pixel, uint64_t(k));
+      const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
+      const Ray ray = camera.generate_ray(fx, fy, aspect);
+      ++rays.camera;
+      int64_t first = -1;
+      Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray);
+      if (!finite(L)) {
+        ++nonfinite;
+        L = Rgb(0.0);
+      }
+      acc.L[0] += L.r, acc.L[1] += L.g, acc.L[2] += L.b;
+      if (observers.on_sample) observers.on_sample(pixel, first, L);
+      if (aov) {
+        // Its own stream (the sample index with the top bit set, never a render sample), so
+        // asking for passes leaves the image's bits alone.
+        Rng aov_rng(s.seed, pixel, uint64_t(k) | (uint64_t(1) << 63));
+        SurfaceHit hit;
+        if (!scene.intersect(ray, &hit, kNoFiber)) continue;
+        const Vec3 wo_world = -ray.d;
+        if (s.aov_normal) {
+          const Vec3 n = dot(hit.shading.n, wo_world) < 0 ? -hit.shading.n : hit.shading.n;
+          acc.normal[0] += n.x, acc.normal[1] += n.y, acc.normal[2] += n.z;
         }
-        for (int i = 0; i < 3; ++i)
-          out.image.rgb[3 * pixel + i] = static_cast<float>(sum[i] * inv_spp);
+        if (s.aov_albedo) {
+          const Vec3 wo = hit.shading.to_local(wo_world);
+          const double u_lobe = aov_rng.uniform();
+          const Vec2 u{aov_rng.uniform(), aov_rng.uniform()};
+          const auto bs = scene.bsdf(hit).sample(wo, u, u_lobe);
+          if (bs && finite(bs->weight))
+            acc.albedo[0] += bs->weight.r, acc.albedo[1] += bs->weight.g,
+                acc.albedo[2] += bs->weight.b;
+        }
       }
     }
-    tile_rays[tile] = rays;
-    const uint64_t d = done.fetch_add(1) + 1;
-    std::lock_guard lock(progress_mutex);
-    if (!cancel.load() && !progress({"render", d, tiles})) cancel.store(true);
-  });
+  };
+  auto store = [&](size_t i, const Sums& acc, double inv_n) {
+    for (int c = 0; c < 3; ++c) {
+      out.image.rgb[3 * i + c] = static_cast<float>(acc.L[c] * inv_n);
+      if (s.aov_albedo) out.albedo.rgb[3 * i + c] = static_cast<float>(acc.albedo[c] * inv_n);
+      if (s.aov_normal) out.normal.rgb[3 * i + c] = static_cast<float>(acc.normal[c] * inv_n);
+    }
+  };
+  // Samples [k0, k1) of every pixel of the window, tile by tile; 'sums' holds the running sums
+  // when the render goes in several passes (null: one pass, stored as it ends).
+  auto pass = [&](int k0, int k1, std::vector<Sums>* sums) {
+    parallel_for(tiles, s.threads, [&](uint64_t tile) {
+      if (cancel.load(std::memory_order_relaxed)) return;
+      const int x0 = int(tile % tx) * s.tile_size, y0 = int(tile / tx) * s.tile_size;
+      const int x1 = std::min(x0 + s.tile_size, ww), y1 = std::min(y0 + s.tile_size, wh);
+      RayCounts rays;
+      for (int y = y0; y < y1; ++y) {
+        // A cancelled render is discarded anyway: stop within a row, not a whole tile.
+        if (cancel.load(std::memory_order_relaxed)) return;
+        for (int x = x0; x < x1; ++x) {
+          const size_t i = size_t(y) * ww + x;
+          if (sums) {
+            sample_pixel(win.x0 + x, win.y0 + y, k0, k1, (*sums)[i], rays, tile_nonfinite[tile]);
+          } else {
+            Sums acc;
+            sample_pixel(win.x0 + x, win.y0 + y, k0, k1, acc, rays, tile_nonfinite[tile]);
+            store(i, acc, 1.0 / s.spp);
+          }
+        }
+      }
+      tile_rays[tile] += rays;
+      const uint64_t d = done.fetch_add(uint64_t(x1 - x0) * (y1 - y0) * (k1 - k0)) +
+                         uint64_t(x1 - x0) * (y1 - y0) * (k1 - k0);
+      std::lock_guard lock(progress_mutex);
+      if (!cancel.load() && !progress({"render", d, total, "samples"})) cancel.store(true);
+    });
+  };
+
+  if (s.time_limit_s == 0) {
+    pass(0, s.spp, nullptr);
+    out.spp_done = s.spp;
+  } else {
+    // One sample per pixel a pass, so that the image is always a whole number of samples per
+    // pixel; the sums are kept between passes (72 bytes a pixel).
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<Sums> sums(npx);
+    int n = 0;
+    while (n < s.spp && !cancel.load()) {
+      pass(n, n + 1, &sums);
+      if (cancel.load()) break;
+      ++n;
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (elapsed >= s.time_limit_s) break;
+    }
+    out.spp_done = n;
+    if (n > 0)
+      for (size_t i = 0; i < npx; ++i) store(i, sums[i], 1.0 / n);
+  }
   for (uint64_t t = 0; t < tiles; ++t) {
     out.rays += tile_rays[t];
     out.nonfinite_samples += tile_nonfinite[t];

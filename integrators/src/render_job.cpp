@@ -1,5 +1,9 @@
 #include "weft/integrators/render_job.h"
 
+#include <cmath>
+#include <utility>
+#include <vector>
+
 #include "weft/core/error.h"
 #include "weft/integrators/image.h"
 #include "weft/integrators/masked_render.h"
@@ -16,16 +20,53 @@ void check_output(const std::filesystem::path& p, const std::string& ext, const 
     throw Error(p.string(), what, "output directory does not exist");
 }
 
+// The file a path names, for comparing outputs with each other and with inputs.
+std::filesystem::path identity(const std::filesystem::path& p) {
+  std::error_code ec;
+  const auto c = std::filesystem::weakly_canonical(p, ec);
+  return ec ? p.lexically_normal() : c;
+}
+
 }  // namespace
+
+void check_render_outputs(const SceneDescription& desc, const RenderJob& job) {
+  std::vector<std::pair<std::filesystem::path, std::string>> outputs = {{job.exr, "output"}};
+  check_output(job.exr, ".exr", "output");
+  if (job.png) check_output(*job.png, ".png", "preview"), outputs.push_back({*job.png, "preview"});
+  if (job.mask) check_output(*job.mask, ".exr", "mask"), outputs.push_back({*job.mask, "mask"});
+  if (job.albedo)
+    check_output(*job.albedo, ".exr", "albedo"), outputs.push_back({*job.albedo, "albedo"});
+  if (job.normal)
+    check_output(*job.normal, ".exr", "normal"), outputs.push_back({*job.normal, "normal"});
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    const auto id = identity(outputs[i].first);
+    if (!desc.source.empty() && id == identity(desc.source))
+      throw Error(outputs[i].first.string(), outputs[i].second,
+                  "is the scene description being rendered");
+    for (size_t k = 0; k < i; ++k)
+      if (id == identity(outputs[k].first))
+        throw Error(outputs[i].first.string(), outputs[i].second,
+                    "is also the " + outputs[k].second + " file");
+  }
+}
 
 RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& job,
                                 const ProgressCallback& progress,
                                 const FiberTableResolver& fiber_tables) {
   // Everything that can be checked is checked before the (long) render.
-  check_output(job.exr, ".exr", "output");
-  if (job.png) check_output(*job.png, ".png", "preview");
-  if (job.mask) check_output(*job.mask, ".exr", "mask");
+  check_render_outputs(desc, job);
   if (!desc.camera) throw Error(desc.source, "camera", "no camera: add 'camera' or a glTF camera");
+  if (job.mask && (job.settings.crop || job.settings.time_limit_s > 0))
+    throw Error(job.mask->string(), "mask",
+                "a coverage mask is of the whole film and every sample: not with a crop window or "
+                "a time limit");
+  if (!(job.preview_exposure > 0) || !std::isfinite(job.preview_exposure))
+    throw Error("", "exposure", "must give a finite positive scale");
+  RenderSettings settings = job.settings;
+  settings.aov_albedo = settings.aov_albedo || job.albedo.has_value();
+  settings.aov_normal = settings.aov_normal || job.normal.has_value();
+  check_crop(settings.crop.value_or(PixelWindow{0, settings.width, 0, settings.height}),
+             settings.width, settings.height, desc.source, "render.crop");
   const std::vector<uint8_t> mask =
       job.mask ? desc.select_object(job.mask_object) : std::vector<uint8_t>();
   RenderSceneOptions scene_options;
@@ -35,20 +76,37 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   RenderResult r;
   std::vector<float> coverage;
   if (job.mask) {
-    MaskedRender m = render_masked(scene, *desc.camera, job.settings, mask, progress);
+    MaskedRender m = render_masked(scene, *desc.camera, settings, mask, progress);
     r = std::move(m.render);
     coverage = std::move(m.coverage);
   } else {
-    r = render(scene, *desc.camera, job.settings, progress);
+    r = render(scene, *desc.camera, settings, progress);
   }
   RenderJobResult out;
   out.rays = r.rays;
   out.nonfinite_samples = r.nonfinite_samples;
   out.cancelled = r.cancelled;
+  out.spp_done = r.spp_done;
   if (r.cancelled) return out;  // nothing half-finished reaches the disk
-  write_exr(job.exr, r.image);
-  if (job.png) write_png_preview(*job.png, r.image);
-  if (job.mask) write_mask_exr(*job.mask, job.settings.width, job.settings.height, coverage);
+  RenderMetadata meta;
+  meta.scene = std::filesystem::path(desc.source).filename().string();
+  meta.camera_name = job.camera_name;
+  meta.seed = settings.seed;
+  meta.spp = r.spp_done;
+  meta.spp_requested = settings.spp;
+  meta.time_limit_s = settings.time_limit_s;
+  meta.camera = *desc.camera;
+  write_exr(job.exr, r.image, &meta);
+  if (job.png) write_png_preview(*job.png, r.image, job.preview_exposure);
+  if (job.mask) write_mask_exr(*job.mask, settings.width, settings.height, coverage);
+  if (job.albedo) {
+    meta.pass = "albedo";
+    write_exr(*job.albedo, r.albedo, &meta);
+  }
+  if (job.normal) {
+    meta.pass = "normal (world space, towards the camera)";
+    write_exr(*job.normal, r.normal, &meta);
+  }
   return out;
 }
 

@@ -317,6 +317,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     d.camera = parse_camera(f.object("camera"), d, gltf_cameras);
   else if (!gltf_cameras.empty())
     d.camera = gltf_cameras.front().camera;
+  d.gltf_cameras = std::move(gltf_cameras);
   f.finish();
 
   if (d.meshes.empty() && d.curves.empty())
@@ -339,7 +340,198 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
   return d;
 }
 
-SceneDescription load_scene_description(const std::filesystem::path& path) {
+namespace {
+
+// One step of an override's key: a name (possibly joined with the next ones by '.') or an index.
+struct KeyToken {
+  std::string name;
+  bool index = false;
+  size_t i = 0;
+};
+
+std::vector<KeyToken> tokenize_key(const std::string& key, const std::string& source) {
+  auto bad = [&](const std::string& why) { throw Error(source, "-D " + key, why); };
+  std::vector<KeyToken> out;
+  size_t p = 0;
+  while (p < key.size()) {
+    if (key[p] == '[') {
+      const size_t close = key.find(']', p);
+      if (close == std::string::npos || close == p + 1) bad("'[' without an index and ']'");
+      const std::string digits = key.substr(p + 1, close - p - 1);
+      if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9)
+        bad("'[" + digits + "]' is not an index");
+      out.push_back({digits, true, std::stoul(digits)});
+      p = close + 1;
+      if (p < key.size() && key[p] == '.') {
+        ++p;
+        if (p == key.size()) bad("ends in '.'");
+      } else if (p < key.size() && key[p] != '[') {
+        bad("expected '.' or '[' after ']'");
+      }
+      continue;
+    }
+    const size_t end = key.find_first_of(".[", p);
+    const std::string name = key.substr(p, end == std::string::npos ? end : end - p);
+    if (name.empty()) bad("has an empty name");
+    out.push_back({name});
+    p = end == std::string::npos ? key.size() : end;
+    if (p < key.size() && key[p] == '.') {
+      ++p;
+      if (p == key.size()) bad("ends in '.'");
+    }
+  }
+  if (out.empty()) bad("is empty");
+  return out;
+}
+
+const char* kind_of(const nlohmann::json& v) {
+  if (v.is_number()) return "a number";
+  if (v.is_boolean()) return "true or false";
+  if (v.is_string()) return "text";
+  if (v.is_array()) return "a list";
+  if (v.is_object()) return "an object";
+  return "null";
+}
+
+bool numeric_list(const nlohmann::json& v) {
+  if (!v.is_array() || v.empty()) return false;
+  for (const auto& e : v)
+    if (!e.is_number()) return false;
+  return true;
+}
+
+void apply_override(nlohmann::json& root, const SceneOverride& o, const std::string& source) {
+  const std::string field = "-D " + o.key;
+  const std::vector<KeyToken> tokens = tokenize_key(o.key, source);
+  nlohmann::json* node = &root;
+  std::string where;  // the path walked so far, as errors print it
+  size_t t = 0;
+  while (true) {
+    const bool at_root = node == &root;
+    if (node->is_array()) {
+      const KeyToken& tok = tokens[t];
+      const bool digits = !tok.name.empty() && !tok.index &&
+                          tok.name.find_first_not_of("0123456789") == std::string::npos &&
+                          tok.name.size() <= 9;
+      if (!tok.index && !digits)
+        throw Error(
+            source, field,
+            "addresses nothing: '" + where + "' is a list; give an index, as " + where + "[0]");
+      const size_t i = tok.index ? tok.i : std::stoul(tok.name);
+      if (i >= node->size())
+        throw Error(
+            source, field,
+            "addresses nothing: '" + where + "' has " + std::to_string(node->size()) +
+                (node->size() == 1 ? " entry" : " entries") +
+                (node->empty() ? std::string()
+                               : " (indices 0 to " + std::to_string(node->size() - 1) + ")"));
+      where.append("[").append(std::to_string(i)).append("]");
+      node = &(*node)[i];
+      ++t;
+    } else if (node->is_object()) {
+      if (tokens[t].index)
+        throw Error(source, field,
+                    "addresses nothing: '" +
+                        (where.empty() ? std::string("the description") : where) +
+                        "' is an object, not a list");
+      // The longest run of names joined by '.' that is a key of this object.
+      size_t run = 0;
+      while (t + run < tokens.size() && !tokens[t + run].index) ++run;
+      size_t used = 0;
+      std::string name;
+      for (size_t k = run; k >= 1; --k) {
+        std::string joined = tokens[t].name;
+        for (size_t m = 1; m < k; ++m) joined += "." + tokens[t + m].name;
+        if (node->contains(joined)) {
+          used = k, name = joined;
+          break;
+        }
+      }
+      if (used == 0) {
+        name = tokens[t].name;
+        if (t + 1 == tokens.size()) {
+          // A new last name: the parser checks it like any key in the file.
+          (*node)[name] = nlohmann::json::parse(o.value, nullptr, false).is_discarded()
+                              ? nlohmann::json(o.value)
+                              : nlohmann::json::parse(o.value);
+          return;
+        }
+        if (at_root) {
+          (*node)[name] = nlohmann::json::object();
+          used = 1;
+        } else {
+          std::string known;
+          for (const auto& [k, v] : node->items()) known += (known.empty() ? "" : ", ") + k;
+          throw Error(source, field,
+                      "addresses nothing: '" + where + "' has no '" + name +
+                          "' (it has: " + (known.empty() ? "nothing" : known) + ")");
+        }
+      }
+      where += (where.empty() ? "" : ".") + name;
+      node = &(*node)[name];
+      t += used;
+    } else {
+      throw Error(source, field,
+                  "addresses nothing: '" + where + "' is " + kind_of(*node) + ", not an object");
+    }
+    if (t == tokens.size()) break;
+  }
+  // Replace an existing value by one of the same kind.
+  nlohmann::json value;
+  if (node->is_string()) {
+    value = o.value;
+  } else {
+    value = nlohmann::json::parse(o.value, nullptr, false);
+    if (value.is_discarded()) value = o.value;
+  }
+  const bool same = std::string(kind_of(value)) == kind_of(*node) ||
+                    (node->is_number() && numeric_list(value)) ||
+                    (numeric_list(*node) && value.is_number());
+  if (!same)
+    throw Error(source, field,
+                "'" + where + "' is " + kind_of(*node) + " in the description, but '" + o.value +
+                    "' is " + kind_of(value));
+  *node = std::move(value);
+}
+
+}  // namespace
+
+SceneOverride parse_scene_override(const std::string& text) {
+  const size_t eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error("", "-D", "'" + text + "' is not key=value (e.g. -D render.spp=64)");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+void apply_scene_overrides(nlohmann::json& j, const std::vector<SceneOverride>& overrides,
+                           const std::string& source) {
+  if (!j.is_object()) throw Error(source, "", "the scene description must be a JSON object");
+  for (const auto& o : overrides) apply_override(j, o, source);
+}
+
+NamedCamera select_camera(const SceneDescription& d, const std::string& which) {
+  auto listing = [&] {
+    if (d.gltf_cameras.empty()) return std::string("the scene has no glTF cameras");
+    std::string s = "glTF cameras: ";
+    for (size_t i = 0; i < d.gltf_cameras.size(); ++i)
+      s += (i ? ", " : "") + std::to_string(i) + " " +
+           (d.gltf_cameras[i].name.empty() ? std::string("(unnamed)")
+                                           : "'" + d.gltf_cameras[i].name + "'");
+    return s;
+  };
+  if (!which.empty() && which.size() <= 9 &&
+      which.find_first_not_of("0123456789") == std::string::npos) {
+    const size_t i = std::stoul(which);
+    if (i < d.gltf_cameras.size()) return d.gltf_cameras[i];
+    throw Error(d.source, "--camera", "no camera with index " + which + " (" + listing() + ")");
+  }
+  for (const auto& c : d.gltf_cameras)
+    if (c.name == which) return c;
+  throw Error(d.source, "--camera", "no camera named '" + which + "' (" + listing() + ")");
+}
+
+SceneDescription load_scene_description(const std::filesystem::path& path,
+                                        const std::vector<SceneOverride>& overrides) {
   const std::string source = path.string();
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(source, "", "cannot open scene description");
@@ -351,6 +543,7 @@ SceneDescription load_scene_description(const std::filesystem::path& path) {
   } catch (const nlohmann::json::parse_error& e) {
     throw Error(source, "", std::string("invalid JSON: ") + e.what());
   }
+  apply_scene_overrides(j, overrides, source);
   const auto base = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   return parse_scene_description(j, base, source);
 }

@@ -6,7 +6,9 @@
 // bounces; shading in the mesh's tangent frame; two-sided (the BSDF sees wo below its normal and
 // decides); transmission continues through the surface. Every random number of a camera sample
 // comes from Rng(seed, pixel index, sample index) and tiles write disjoint pixels, so images are
-// bit-identical at any thread count.
+// bit-identical at any thread count. The pixel index is that of the whole film, so a crop window
+// holds the same bits as the same window of the whole render; a render cut short by its time
+// limit after n whole passes holds the same bits as a render of n samples per pixel.
 //
 // Fibers (round curves or tubes) are shaded with their fiber BSDF as hair renderers shade a fiber
 // with its BCSDF: a fiber table is the BSDF of the whole fiber (docs/fiber-bsdf.md), so a point B
@@ -45,11 +47,20 @@ struct RenderOutcome {
 };
 
 struct RenderResult : RenderOutcome {
-  Image image;  // mean radiance per pixel, linear RGB
+  Image image;  // mean radiance per pixel, linear RGB (the crop window's pixels when cropped)
+  // Samples per pixel in 'image': settings.spp, or fewer whole passes when the time limit ended
+  // the render.
+  int spp_done = 0;
+  // The first surface each camera sample hits, averaged like 'image' (empty unless asked for):
+  // its directional albedo for the direction to the camera (one BSDF sample per camera sample:
+  // the sampled weight f cos / pdf, whose mean is the albedo), and its shading normal in world
+  // space turned towards the camera. A camera ray that hits nothing adds zero to both.
+  Image albedo, normal;
 };
 
-// After every camera sample: its pixel (row-major), the shape (SurfaceHit::shape) its camera ray
-// hit first (-1: none) and its radiance (0 for a dropped non-finite sample).
+// After every camera sample: its pixel (row-major on the whole film, a crop window too), the shape
+// (SurfaceHit::shape) its camera ray hit first (-1: none) and its radiance (0 for a dropped
+// non-finite sample).
 using SampleObserver = std::function<void(uint64_t pixel, int64_t first_mesh, const Rgb& radiance)>;
 // Every ray handed to the scene: camera and bounce rays (shadow = false) and shadow rays (shadow =
 // true, ending at ray.tmax).

@@ -1,11 +1,14 @@
 #pragma once
 // What the path tracer is told, and the scene description's "render" section that sets it:
 //
-//   "render": {"width": 256, "height": 256, "spp": 16, "max_depth": 16, "rr_depth": 3, "seed": 0}
+//   "render": {"width": 256, "height": 256, "spp": 16, "max_depth": 16, "rr_depth": 3, "seed": 0,
+//              "crop": [x0, x1, y0, y1], "time_limit_s": 60}
 //
 // Every key is optional; the defaults are RenderSettings{}, the renderer's one set of defaults
 // (the command line and the benchmarks start from it too).
 #include <cstdint>
+#include <optional>
+#include <string>
 
 #include "weft/scenes/description.h"
 
@@ -14,6 +17,15 @@ namespace weft {
 // Which strategies estimate light from area lights and the environment (delta lights always use
 // next-event estimation). The single-strategy modes exist to test MIS against each of its parts.
 enum class LightSampling { mis, lights_only, bsdf_only };
+
+// A window of the film in pixels, x0 <= x < x1 and y0 <= y < y1 (pbrt-v4's "pixelbounds"): its
+// pixels are those of the whole film's render, bit for bit.
+struct PixelWindow {
+  int x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+  bool operator==(const PixelWindow&) const = default;
+};
 
 struct RenderSettings {
   int width = 256, height = 256;
@@ -24,10 +36,21 @@ struct RenderSettings {
   int threads = 0;  // 0 = all cores
   int tile_size = 16;
   LightSampling sampling = LightSampling::mis;
+  std::optional<PixelWindow> crop;  // render only this window of the width x height film
+  // Seconds after which the render stops at the end of a whole pass (one sample per pixel of the
+  // window); the image is then the mean of the passes done (RenderResult::spp_done). 0: no limit.
+  double time_limit_s = 0;
+  // Extra passes of the first surface each camera sample sees (RenderResult::albedo, normal).
+  bool aov_albedo = false, aov_normal = false;
 };
 
 // RenderSettings{} with the description's "render" section applied. Unknown keys and bad values
 // are weft::Error naming the description's file and the key's path ("render.spp").
 RenderSettings render_settings_from(const SceneDescription& desc);
+
+// Error naming 'file' and 'field' unless the window lies on the width x height film and is not
+// empty.
+void check_crop(const PixelWindow& window, int width, int height, const std::string& file,
+                const std::string& field);
 
 }  // namespace weft

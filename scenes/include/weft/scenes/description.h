@@ -85,6 +85,9 @@ struct SceneDescription {
   std::optional<MaterialBinding> default_material;
   Lights lights;
   std::optional<Camera> camera;
+  // Every glTF camera, file by file in the order of "gltf", each file's in its node order
+  // (unnamed ones have an empty name): what --camera selects from (select_camera).
+  std::vector<NamedCamera> gltf_cameras;
   AngleFrame frame;
   // The "render" and "sweep" sections as written (absent: nullopt), read by the integrators with
   // errors naming 'source' and the section.
@@ -102,7 +105,33 @@ struct SceneDescription {
   const MaterialBinding& binding_for(const std::string& key) const;
 };
 
-SceneDescription load_scene_description(const std::filesystem::path& path);
+// A "-D key=value" override of a value in a description (docs/scenes.md, "Overrides"). The key is
+// the value's JSON path as errors print it: names joined by '.', array elements as [i] (or .i),
+// e.g. "materials.seat.params.reflectance", "lights[0].irradiance", "render.spp". A name may
+// itself hold dots (glTF material names such as "Material.001"): the longest name that exists
+// is taken.
+struct SceneOverride {
+  std::string key, value;
+};
+// "key=value" split at the first '='; Error naming the option when there is no '=' or no key.
+SceneOverride parse_scene_override(const std::string& text);
+// Sets each value in the description's JSON 'j', in order. Everything up to the last name must
+// exist (a top-level section such as "render" is made when absent); the last name may be new in
+// an existing object, and the parser then checks it as if it were written in the file. The value
+// is JSON (0.5, [1, 0, 0], true, "text") or else text; an existing string takes the text as
+// written. Replacing a value by one of another kind (a number by text, an object by a number) is
+// an error; a number and a list of numbers stand for each other (colours). Errors name 'source'
+// and "-D KEY".
+void apply_scene_overrides(nlohmann::json& j, const std::vector<SceneOverride>& overrides,
+                           const std::string& source);
+
+SceneDescription load_scene_description(const std::filesystem::path& path,
+                                        const std::vector<SceneOverride>& overrides = {});
+
+// The camera a user picks with --camera: a glTF camera by name (node name, else camera name) or by
+// index in SceneDescription::gltf_cameras ("0", "1", ...; a name of digits only is taken as an
+// index). Error naming 'source' and --camera that lists the cameras there are.
+NamedCamera select_camera(const SceneDescription& desc, const std::string& which);
 // Same from parsed JSON; relative paths resolve against base_dir, errors name 'source'.
 SceneDescription parse_scene_description(const nlohmann::json& j,
                                          const std::filesystem::path& base_dir,

@@ -1,0 +1,263 @@
+// weft render's controls as a user meets them (issue 9): -D overrides, --camera, --crop,
+// --exposure, --time-limit, --aov, EXR metadata and bit-identical files, progress in a log.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+
+#include "test_util.h"
+#include "weft/core/spectrum.h"
+#include "weft/integrators/image.h"
+
+namespace fs = std::filesystem;
+using weft::testing::fresh_test_dir;
+
+namespace {
+
+const fs::path kExamples = fs::path(WEFT_SOURCE_DIR) / "scenes/examples";
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Runs weft with stdout and stderr in files (so stderr is not a terminal).
+CliRun run(const std::string& args, const fs::path& dir) {
+  const std::string cmd = "'" + std::string(WEFT_EXE) + "' " + args + " >'" +
+                          (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(dir / "stdout");
+  r.err = slurp(dir / "stderr");
+  return r;
+}
+
+bool contains(const std::string& s, const std::string& part) {
+  return s.find(part) != std::string::npos;
+}
+
+// The bundled Lambert plane, small and quick.
+std::string plane(const fs::path& out, const std::string& more = "", int spp = 2) {
+  return "render '" + (kExamples / "lambert-plane.json").string() +
+         "' --width 24 --height 20 --spp " + std::to_string(spp) + " --quiet -o '" + out.string() +
+         "' " + more;
+}
+
+// The bundled plane's glTF with two cameras above it looking down: node 1 holds an unnamed
+// perspective camera, node 2 an orthographic one named "top". A description binds the plane.
+fs::path scene_with_cameras(const fs::path& dir) {
+  nlohmann::json g = nlohmann::json::parse(slurp(kExamples / "lambert-plane.gltf"));
+  // Buffers are embedded (data URIs) or beside the file: copy whatever the plane refers to.
+  for (auto& b : g["buffers"])
+    if (b.contains("uri") && b["uri"].get<std::string>().rfind("data:", 0) != 0)
+      fs::copy_file(kExamples / b["uri"].get<std::string>(), dir / b["uri"].get<std::string>(),
+                    fs::copy_options::overwrite_existing);
+  const double s = std::sqrt(0.5);  // -90 degrees about x: the camera's -z points down
+  g["cameras"] = {
+      {{"type", "perspective"}, {"perspective", {{"yfov", 0.6}, {"znear", 0.01}}}},
+      {{"type", "orthographic"},
+       {"orthographic", {{"xmag", 0.3}, {"ymag", 0.3}, {"znear", 0.01}, {"zfar", 10}}}}};
+  g["nodes"].push_back({{"camera", 0}, {"translation", {0, 2, 0}}, {"rotation", {-s, 0, 0, s}}});
+  g["nodes"].push_back(
+      {{"name", "top"}, {"camera", 1}, {"translation", {0, 2, 0}}, {"rotation", {-s, 0, 0, s}}});
+  g["scenes"][0]["nodes"] = {0, 1, 2};
+  std::ofstream(dir / "cams.gltf") << g.dump();
+  const nlohmann::json d = {
+      {"gltf", "cams.gltf"},
+      {"materials", {{"plane", {{"type", "lambert"}, {"params", {{"reflectance", 0.5}}}}}}},
+      {"lights", {{{"type", "parallel"}, {"irradiance", 1}, {"zenith_deg", 30}}}},
+      {"render", {{"width", 16}, {"height", 16}, {"spp", 2}}}};
+  std::ofstream(dir / "cams.json") << d.dump(2);
+  return dir / "cams.json";
+}
+
+}  // namespace
+
+TEST(CliRender, DefineOverridesAMaterialParameter) {
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(run(plane(dir / "half.exr"), dir).exit_code, 0);
+  const CliRun r =
+      run(plane(dir / "quarter.exr", "-D materials.plane.params.reflectance=0.25"), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  // Direct light on a lone Lambert plane is reflectance / pi x E cos: halving the reflectance
+  // halves every pixel exactly (a power of two).
+  const weft::Image half = weft::read_image(dir / "half.exr"),
+                    quarter = weft::read_image(dir / "quarter.exr");
+  ASSERT_EQ(half.rgb.size(), quarter.rgb.size());
+  double lit = 0;
+  for (size_t i = 0; i < half.rgb.size(); ++i) {
+    ASSERT_EQ(quarter.rgb[i], half.rgb[i] * 0.5f) << i;
+    lit += half.rgb[i];
+  }
+  EXPECT_GT(lit, 0);
+  // render.spp reaches the render settings (--spp not given).
+  const CliRun s = run("render '" + (kExamples / "lambert-plane.json").string() +
+                           "' --width 8 --height 8 -D render.spp=3 --quiet --json -o '" +
+                           (dir / "spp.exr").string() + "'",
+                       dir);
+  ASSERT_EQ(s.exit_code, 0) << s.err;
+  EXPECT_EQ(nlohmann::json::parse(s.out).at("spp"), 3);
+}
+
+TEST(CliRender, DefineErrorsNameTheKeyAndTheFileAndWriteNothing) {
+  const fs::path dir = fresh_test_dir();
+  for (const auto& [define, part] :
+       {std::pair<std::string, std::string>{"materials.cloth.params.reflectance=0.5",
+                                            "has no 'cloth'"},
+        {"render.spp=many", "is a number in the description, but 'many' is text"},
+        {"lights[3].irradiance=2", "has 1 entry (indices 0 to 0)"},
+        {"render.spp", "is not key=value"}}) {
+    const CliRun r = run(plane(dir / "out.exr", "-D " + define), dir);
+    EXPECT_EQ(r.exit_code, 2) << define;
+    EXPECT_TRUE(contains(r.err, part)) << r.err;
+    if (define.find('=') != std::string::npos) {
+      EXPECT_TRUE(contains(r.err, "lambert-plane.json")) << r.err;
+      EXPECT_TRUE(contains(r.err, "-D " + define.substr(0, define.find('=')))) << r.err;
+    }
+    EXPECT_FALSE(fs::exists(dir / "out.exr"));
+  }
+}
+
+TEST(CliRender, CameraByNameOrIndexAndTheErrorListsThem) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path scene = scene_with_cameras(dir);
+  auto render_with = [&](const std::string& camera, const fs::path& out) {
+    return run(
+        "render '" + scene.string() + "' --quiet --camera " + camera + " -o '" + out.string() + "'",
+        dir);
+  };
+  CliRun r = render_with("0", dir / "persp.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  r = render_with("top", dir / "top.exr");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(weft::read_image_metadata(dir / "top.exr").at("weft:camera"), "top");
+  // The orthographic camera sees 0.6 m of the 1 m plane: every pixel is lit plane. The
+  // perspective one (yfov 0.6 rad from 2 m: 1.25 m) sees past the plane's edges.
+  const weft::Image top = weft::read_image(dir / "top.exr"),
+                    persp = weft::read_image(dir / "persp.exr");
+  EXPECT_GT(*std::min_element(top.rgb.begin(), top.rgb.end()), 0.0f);
+  EXPECT_EQ(*std::min_element(persp.rgb.begin(), persp.rgb.end()), 0.0f);
+  r = render_with("2", dir / "none.exr");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.err, "cams.json")) << r.err;
+  EXPECT_TRUE(contains(r.err, "no camera with index 2")) << r.err;
+  EXPECT_TRUE(contains(r.err, "0 (unnamed), 1 'top'")) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "none.exr"));
+  r = render_with("side", dir / "none.exr");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_TRUE(contains(r.err, "no camera named 'side'")) << r.err;
+}
+
+TEST(CliRender, CropIsTheSameWindowOfTheWholeRender) {
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(run(plane(dir / "full.exr"), dir).exit_code, 0);
+  const CliRun r = run(plane(dir / "crop.exr", "--crop 3,17,2,11"), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const weft::Image full = weft::read_image(dir / "full.exr"),
+                    crop = weft::read_image(dir / "crop.exr");
+  ASSERT_EQ(crop.width, 14);
+  ASSERT_EQ(crop.height, 9);
+  EXPECT_EQ(crop.x0, 3);
+  EXPECT_EQ(crop.y0, 2);
+  EXPECT_EQ(crop.film_width, 24);
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 14; ++x) ASSERT_EQ(crop.at(x, y).g, full.at(3 + x, 2 + y).g);
+  for (const std::string bad : {"3,17,2", "3,30,2,11", "5,3,2,11", "a,b,c,d", "1.5,3,2,11"}) {
+    const CliRun b = run(plane(dir / "bad.exr", "--crop " + bad), dir);
+    EXPECT_EQ(b.exit_code, 2) << bad;
+    EXPECT_TRUE(contains(b.err, "--crop")) << b.err;
+    EXPECT_FALSE(fs::exists(dir / "bad.exr"));
+  }
+}
+
+TEST(CliRender, ExposureScalesThePreviewOnly) {
+  const fs::path dir = fresh_test_dir();
+  const CliRun r = run(
+      plane(dir / "out.exr", "--exposure 1 --preview '" + (dir / "out.png").string() + "'"), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  ASSERT_EQ(run(plane(dir / "plain.exr"), dir).exit_code, 0);
+  const weft::Image exr = weft::read_image(dir / "out.exr"),
+                    png = weft::read_image(dir / "out.png");
+  EXPECT_EQ(exr.rgb, weft::read_image(dir / "plain.exr").rgb);  // the EXR is unchanged
+  ASSERT_EQ(png.rgb.size(), exr.rgb.size());
+  // +1 EV doubles the linear value, then clips to [0, 1] and encodes sRGB (8 bits).
+  for (size_t i = 0; i < exr.rgb.size(); ++i) {
+    const double expect =
+        std::lround(255 * weft::linear_to_srgb_gamma(std::min(1.0, 2.0 * exr.rgb[i]))) / 255.0;
+    ASSERT_NEAR(png.rgb[i], expect, 1e-6) << i;
+  }
+}
+
+TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
+  const fs::path dir = fresh_test_dir();
+  const CliRun r = run(plane(dir / "out.exr", "--time-limit 1e-9 --json", 64), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out).at("spp_done"), 1);
+  const nlohmann::json m = weft::read_image_metadata(dir / "out.exr");
+  EXPECT_EQ(m.at("weft:spp"), 1);
+  EXPECT_EQ(m.at("weft:spp_requested"), 64);
+  EXPECT_TRUE(m.contains("weft:time_limit_s"));
+  // One pass is a render of 1 sample per pixel.
+  ASSERT_EQ(run(plane(dir / "one.exr", "", 1), dir).exit_code, 0);
+  EXPECT_EQ(weft::read_image(dir / "out.exr").rgb, weft::read_image(dir / "one.exr").rgb);
+}
+
+TEST(CliRender, AovPassesAreFilesBesideTheImage) {
+  const fs::path dir = fresh_test_dir();
+  const CliRun r = run(plane(dir / "out.exr", "--aov albedo,normal"), dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const weft::Image albedo = weft::read_image(dir / "out.albedo.exr");
+  const weft::Image normal = weft::read_image(dir / "out.normal.exr");
+  // The plane (reflectance 0.5, normal +y) fills the bundled camera's view.
+  EXPECT_NEAR(albedo.at(12, 10).r, 0.5, 1e-6);
+  EXPECT_NEAR(normal.at(12, 10).g, 1.0, 1e-6);
+  const CliRun bad = run(plane(dir / "bad.exr", "--aov albedo,depth"), dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_TRUE(contains(bad.err, "unknown pass 'depth' (valid: albedo, normal)")) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad.exr"));
+}
+
+TEST(CliRender, ExrIsBitIdenticalAcrossRuns) {
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(run(plane(dir / "a.exr"), dir).exit_code, 0);
+  ASSERT_EQ(run(plane(dir / "b.exr", "--threads 1"), dir).exit_code, 0);
+  const std::string a = slurp(dir / "a.exr"), b = slurp(dir / "b.exr");
+  ASSERT_GT(a.size(), 500u);
+  EXPECT_TRUE(a == b) << "the two renders' files differ";
+  const nlohmann::json m = weft::read_image_metadata(dir / "a.exr");
+  EXPECT_EQ(m.at("weft:scene"), "lambert-plane.json");
+  EXPECT_EQ(m.at("weft:seed"), "1");  // the bundled scene's render.seed
+  EXPECT_EQ(m.at("weft:spp"), 2);
+  EXPECT_TRUE(m.contains("worldToCamera"));
+  EXPECT_TRUE(m.contains("worldToNDC"));
+  EXPECT_TRUE(m.contains("chromaticities"));
+}
+
+TEST(CliRender, ProgressInALogIsPlainLinesWithUnits) {
+  const fs::path dir = fresh_test_dir();
+  const CliRun r =
+      run("render '" + (kExamples / "lambert-plane.json").string() +
+              "' --width 24 --height 20 --spp 2 -o '" + (dir / "out.exr").string() + "'",
+          dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
+  EXPECT_TRUE(contains(r.err, "render  100.0%")) << r.err;
+  EXPECT_TRUE(contains(r.err, "samples/s")) << r.err;
+  EXPECT_TRUE(contains(r.err, "ETA 00:00")) << r.err;
+  EXPECT_TRUE(contains(r.err, "rays/s")) << r.err;  // the summary
+  EXPECT_TRUE(contains(r.err, "2 of 2 samples per pixel")) << r.err;
+}
