@@ -5,6 +5,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 
@@ -98,6 +99,31 @@ std::optional<double> finite_number(const std::string& text) {
   }
   if (used != text.size() || !std::isfinite(v)) return std::nullopt;
   return v;
+}
+
+void validate_output_paths(const std::vector<std::string>& outputs,
+                           const std::vector<std::string>& inputs) {
+  namespace fs = std::filesystem;
+  auto canonical = [](const std::string& p) {
+    std::error_code ec;
+    const fs::path c = fs::weakly_canonical(fs::absolute(p), ec);
+    return ec ? fs::absolute(p).lexically_normal() : c;
+  };
+  std::vector<std::pair<fs::path, std::string>> seen;
+  for (const auto& in : inputs) {
+    std::error_code ec;
+    if (!in.empty() && fs::exists(in, ec)) seen.emplace_back(canonical(in), "input " + in);
+  }
+  for (const auto& out : outputs) {
+    if (out.empty()) continue;
+    const fs::path c = canonical(out);
+    if (!fs::is_directory(c.parent_path()))
+      throw Error(out, "", "output directory does not exist");
+    if (fs::is_directory(c)) throw Error(out, "", "is a directory, not a file");
+    for (const auto& [p, what] : seen)
+      if (p == c) throw Error(out, "", "is also the " + what + ": refusing to overwrite it");
+    seen.emplace_back(c, "output " + out);
+  }
 }
 
 std::vector<double> parse_range(const std::string& text, const std::string& option_name) {
