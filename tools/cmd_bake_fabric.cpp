@@ -63,6 +63,7 @@ int run(const BakeFabricOptions& o) {
   const auto dir = std::filesystem::absolute(o.output).parent_path();
   if (!std::filesystem::is_directory(dir))
     throw Error(o.output, "", "output directory does not exist");
+  validate_output_paths({o.output}, {o.fiber, o.weave, o.wif});
   const auto progress = progress_bar(o.quiet);
   const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
   const WovenSample sample = woven_sample(o);

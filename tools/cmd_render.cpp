@@ -44,6 +44,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
       {sub, [o, seed] {
          if (!o->mask.empty() && o->mask_object.empty())
            throw Error("", "--mask-object", "is required with --mask");
+         validate_output_paths({o->output, o->preview, o->mask}, {o->scene});
          const SceneDescription desc = load_scene_reporting_warnings(o->scene);
          RenderJob job;
          job.exr = o->output;

@@ -121,7 +121,8 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
 }
 
 int merge_fabric_bake(const JobPart& all, const std::string& output, bool json) {
-  const TabulatedBsdfTable t = assemble(all, all.job.at("resolution").get<int>());
+  TabulatedBsdfTable t = assemble(all, all.job.at("resolution").get<int>());
+  t.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;  // as bake fabric writes
   t.write_exr(output);
   if (json)
     std::cout << nlohmann::json({{"output", output}, {"parts_merged", true}}).dump(2) << "\n";
