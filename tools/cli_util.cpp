@@ -117,8 +117,7 @@ void validate_output_paths(const std::vector<std::string>& outputs,
   for (const auto& out : outputs) {
     if (out.empty()) continue;
     const fs::path c = canonical(out);
-    if (!fs::is_directory(c.parent_path()))
-      throw Error(out, "", "output directory does not exist");
+    if (!fs::is_directory(c.parent_path())) throw Error(out, "", "output directory does not exist");
     if (fs::is_directory(c)) throw Error(out, "", "is a directory, not a file");
     for (const auto& [p, what] : seen)
       if (p == c) throw Error(out, "", "is also the " + what + ": refusing to overwrite it");

@@ -1,11 +1,11 @@
 // weft bake fiber: a fiber spec (file or preset) -> fiber BSDF table (.exr) + JSON summary.
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
-#include <cstdio>
 #include <iostream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
@@ -22,53 +22,53 @@ namespace {
 int report_fiber_bake(const FiberTableBakeResult& r, const FiberSpec& spec,
                       const FiberTableBakeOptions& o, const std::string& output, double seconds,
                       bool json) {
-   nlohmann::json bands = nlohmann::json::array();
-   for (const auto& b : r.bands)
-     bands.push_back({{"wavelength_nm", b.wavelength_nm},
-                      {"mu_s_per_um", b.mu_s_per_um},
-                      {"mu_a_per_um", b.mu_a_per_um},
-                      {"g", b.g},
-                      {"photons", b.photons},
-                      {"surface_reflected", b.surface_fraction},
-                      {"albedo", b.exit_fraction},
-                      {"absorbed", b.absorbed_fraction},
-                      {"lost", b.lost_fraction},
-                      {"roulette_net", b.roulette_net},
-                      {"surface_sampling_excess", b.surface_sampling_excess},
-                      {"energy_balance", b.energy_balance},
-                      {"table_energy", b.energy_table}});
-   nlohmann::json j = {{"output", output},
-                       {"spec", spec.name},
-                       {"spec_hash", fiber_spec_hash_hex(spec)},
-                       {"resolution", o.resolution},
-                       {"bands", o.spectral ? "spectral" : "rgb"},
-                       {"route", o.route == FiberBakeRoute::kDirect ? "direct" : "bssrdf"},
-                       {"photons", r.photons},
-                       {"scattering_events", r.scattering_events},
-                       {"seconds", seconds},
-                       {"events_per_s", seconds > 0 ? r.scattering_events / seconds : 0.0},
-                       {"photons_per_s", seconds > 0 ? r.photons / seconds : 0.0},
-                       {"interrupted", r.cancelled},
-                       {"rgb_negative_clipped", r.rgb_negative_clipped},
-                       {"per_band", bands}};
-   if (json) {
-     std::cout << j.dump(2) << "\n";
-   } else {
-     std::printf("baked %s (%s) -> %s\n", spec.name.c_str(),
-                 fiber_spec_hash_hex(spec).c_str(), output.c_str());
-     std::printf("%llu photons, %llu scattering events in %.1f s (%.3g events/s)%s\n",
-                 static_cast<unsigned long long>(r.photons),
-                 static_cast<unsigned long long>(r.scattering_events), seconds,
-                 seconds > 0 ? r.scattering_events / seconds : 0.0,
-                 r.cancelled ? "  [interrupted: table holds the finished passes]" : "");
-     std::printf("  nm    mu_s/um   mu_a/um    g     surface  albedo  absorbed  balance\n");
-     for (const auto& b : r.bands)
-       std::printf("  %3.0f  %8.4f  %8.5f  %5.3f  %6.4f  %6.4f  %6.4f  %6.4f\n",
-                   b.wavelength_nm, b.mu_s_per_um, b.mu_a_per_um, b.g, b.surface_fraction,
-                   b.exit_fraction, b.absorbed_fraction, b.energy_balance);
-   }
-   if (r.cancelled) std::fprintf(stderr, "weft: interrupted; wrote the finished passes\n");
-   return r.cancelled ? 130 : 0;
+  nlohmann::json bands = nlohmann::json::array();
+  for (const auto& b : r.bands)
+    bands.push_back({{"wavelength_nm", b.wavelength_nm},
+                     {"mu_s_per_um", b.mu_s_per_um},
+                     {"mu_a_per_um", b.mu_a_per_um},
+                     {"g", b.g},
+                     {"photons", b.photons},
+                     {"surface_reflected", b.surface_fraction},
+                     {"albedo", b.exit_fraction},
+                     {"absorbed", b.absorbed_fraction},
+                     {"lost", b.lost_fraction},
+                     {"roulette_net", b.roulette_net},
+                     {"surface_sampling_excess", b.surface_sampling_excess},
+                     {"energy_balance", b.energy_balance},
+                     {"table_energy", b.energy_table}});
+  nlohmann::json j = {{"output", output},
+                      {"spec", spec.name},
+                      {"spec_hash", fiber_spec_hash_hex(spec)},
+                      {"resolution", o.resolution},
+                      {"bands", o.spectral ? "spectral" : "rgb"},
+                      {"route", o.route == FiberBakeRoute::kDirect ? "direct" : "bssrdf"},
+                      {"photons", r.photons},
+                      {"scattering_events", r.scattering_events},
+                      {"seconds", seconds},
+                      {"events_per_s", seconds > 0 ? r.scattering_events / seconds : 0.0},
+                      {"photons_per_s", seconds > 0 ? r.photons / seconds : 0.0},
+                      {"interrupted", r.cancelled},
+                      {"rgb_negative_clipped", r.rgb_negative_clipped},
+                      {"per_band", bands}};
+  if (json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::printf("baked %s (%s) -> %s\n", spec.name.c_str(), fiber_spec_hash_hex(spec).c_str(),
+                output.c_str());
+    std::printf("%llu photons, %llu scattering events in %.1f s (%.3g events/s)%s\n",
+                static_cast<unsigned long long>(r.photons),
+                static_cast<unsigned long long>(r.scattering_events), seconds,
+                seconds > 0 ? r.scattering_events / seconds : 0.0,
+                r.cancelled ? "  [interrupted: table holds the finished passes]" : "");
+    std::printf("  nm    mu_s/um   mu_a/um    g     surface  albedo  absorbed  balance\n");
+    for (const auto& b : r.bands)
+      std::printf("  %3.0f  %8.4f  %8.5f  %5.3f  %6.4f  %6.4f  %6.4f  %6.4f\n", b.wavelength_nm,
+                  b.mu_s_per_um, b.mu_a_per_um, b.g, b.surface_fraction, b.exit_fraction,
+                  b.absorbed_fraction, b.energy_balance);
+  }
+  if (r.cancelled) std::fprintf(stderr, "weft: interrupted; wrote the finished passes\n");
+  return r.cancelled ? 130 : 0;
 }
 
 // What fixes a fiber bake's bits: a shard's identity (job_part.h).
@@ -275,8 +275,8 @@ void add_bake_command(CLI::App& app, Commands& commands) {
            std::filesystem::remove(checkpoint_path(opt->output));
            std::printf("bands %llu..%llu of %s (shard %u/%u) -> %s in %.1f s\n",
                        static_cast<unsigned long long>(range.first),
-                       static_cast<unsigned long long>(range.last), spec.name.c_str(),
-                       shard.index, shard.count, opt->output.c_str(), seconds);
+                       static_cast<unsigned long long>(range.last), spec.name.c_str(), shard.index,
+                       shard.count, opt->output.c_str(), seconds);
            return 0;
          }
          FiberTableBakeResult r = finish_fiber_table(spec, o, traced.bands, traced.cancelled);

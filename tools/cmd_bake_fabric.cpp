@@ -79,8 +79,8 @@ int run(const BakeFabricOptions& o) {
     FabricRaytraceResult res;
     if (!o.shard.empty() || o.resume) {
       int code = 0;
-      auto pieces = raytrace_fabric_in_pieces(sample, fiber, r, o.output, o.shard, o.resume,
-                                              progress, &code);
+      auto pieces =
+          raytrace_fabric_in_pieces(sample, fiber, r, o.output, o.shard, o.resume, progress, &code);
       if (!pieces) return code;
       res = std::move(*pieces);
     } else {

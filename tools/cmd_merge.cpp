@@ -23,18 +23,16 @@ void add_merge_command(CLI::App& app, Commands& commands) {
   sub->add_option("parts", o->parts, "part files, one per shard, in any order")->required();
   sub->add_option("-o,--output", o->output, "output (.exr table or .csv sweep)")->required();
   sub->add_flag("--json", o->json, "print the command's summary as JSON");
-  commands.push_back({sub, [o] {
-                        validate_output_paths({o->output}, o->parts);
-                        const JobPart all = merge_job_parts(
-                            std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
-                        if (all.command == "bake fiber")
-                          return merge_fiber_bake(all, o->output, o->json);
-                        if (all.command == "bake fabric")
-                          return merge_fabric_bake(all, o->output, o->json);
-                        if (all.command == "sweep") return merge_sweep(all, o->output, o->json);
-                        throw Error(o->parts.front(), "command",
-                                    "unknown command '" + all.command + "'");
-                      }});
+  commands.push_back(
+      {sub, [o] {
+         validate_output_paths({o->output}, o->parts);
+         const JobPart all =
+             merge_job_parts(std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
+         if (all.command == "bake fiber") return merge_fiber_bake(all, o->output, o->json);
+         if (all.command == "bake fabric") return merge_fabric_bake(all, o->output, o->json);
+         if (all.command == "sweep") return merge_sweep(all, o->output, o->json);
+         throw Error(o->parts.front(), "command", "unknown command '" + all.command + "'");
+       }});
 }
 
 }  // namespace weft::cli

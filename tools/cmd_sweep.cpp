@@ -4,8 +4,8 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <sstream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 
 #include "commands.h"
 #include "job_part.h"
@@ -44,10 +44,9 @@ JobPart sweep_job(const std::string& scene, const GonioSettings& g, Shard shard)
            {"light_azimuth_deg", g.light_azimuth_deg},
            {"irradiance", rgb_json(g.irradiance)},
            {"view_zenith_deg", g.view_zenith_deg},
-           {"view_azimuth_deg", g.view_azimuth_deg ? nlohmann::json(*g.view_azimuth_deg)
-                                                   : nlohmann::json(nullptr)},
-           {"normalize_to",
-            g.normalize_to ? rgb_json(*g.normalize_to) : nlohmann::json(nullptr)},
+           {"view_azimuth_deg",
+            g.view_azimuth_deg ? nlohmann::json(*g.view_azimuth_deg) : nlohmann::json(nullptr)},
+           {"normalize_to", g.normalize_to ? rgb_json(*g.normalize_to) : nlohmann::json(nullptr)},
            {"white_check", g.white_check},
            {"width", g.width},
            {"height", g.height},
@@ -75,11 +74,23 @@ GonioSettings sweep_settings(const nlohmann::json& j) {
 void encode_sweep_units(const GonioResult& r, JobPart& p) {
   for (const auto& row : r.rows) {
     const Rgb w = row.white.value_or(Rgb(0.0));
-    p.units[row.view] = {row.view_zenith_deg, row.view_azimuth_deg, row.sum.r,  row.sum.g,
-                         row.sum.b,           row.footprint_px,     row.beta.r, row.beta.g,
-                         row.beta.b,          row.beta_err_rgb.r,   row.beta_err_rgb.g,
-                         row.beta_err_rgb.b,  row.beta_err,         row.white ? 1.0 : 0.0,
-                         w.r,                 w.g,                  w.b};
+    p.units[row.view] = {row.view_zenith_deg,
+                         row.view_azimuth_deg,
+                         row.sum.r,
+                         row.sum.g,
+                         row.sum.b,
+                         row.footprint_px,
+                         row.beta.r,
+                         row.beta.g,
+                         row.beta.b,
+                         row.beta_err_rgb.r,
+                         row.beta_err_rgb.g,
+                         row.beta_err_rgb.b,
+                         row.beta_err,
+                         row.white ? 1.0 : 0.0,
+                         w.r,
+                         w.g,
+                         w.b};
   }
   if (r.beta_normal && p.units_total > 0) {
     const uint64_t ref = p.units_total - 1;

@@ -2,13 +2,14 @@
 // raytrace --shard K/N`) written as a part, checkpoints of finished bins (`--resume`), and the
 // merge of the parts. Each incident bin's row of the table depends only on (seed, bin): a piece
 // holds the rows a whole run computes, bit for bit.
+#include "fabric_parts.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 
-#include "fabric_parts.h"
 #include "weft/core/error.h"
 
 namespace weft::cli {

@@ -53,10 +53,14 @@ uint64_t as_u64(double d) {
 void write_job_part(const std::filesystem::path& path, const JobPart& p) {
   nlohmann::json units = nlohmann::json::array(), sizes = nlohmann::json::array();
   for (const auto& [u, v] : p.units) units.push_back(u), sizes.push_back(v.size());
-  const nlohmann::json header = {{"command", p.command},         {"job", p.job},
-                                 {"units_total", p.units_total}, {"shard", p.shard.index},
-                                 {"shards", p.shard.count},      {"checkpoint", p.checkpoint},
-                                 {"extra", p.extra},             {"units", units},
+  const nlohmann::json header = {{"command", p.command},
+                                 {"job", p.job},
+                                 {"units_total", p.units_total},
+                                 {"shard", p.shard.index},
+                                 {"shards", p.shard.count},
+                                 {"checkpoint", p.checkpoint},
+                                 {"extra", p.extra},
+                                 {"units", units},
                                  {"unit_doubles", sizes}};
   write_atomically(path, [&](const std::filesystem::path& tmp) {
     std::ofstream out(tmp, std::ios::binary);
@@ -78,7 +82,8 @@ JobPart read_job_part(const std::filesystem::path& path) {
   if (ec) throw Error(file, "", "cannot read its size");
   std::string magic;
   std::getline(in, magic);
-  if (magic != kMagic) throw Error(file, "", "not a weft part or checkpoint (no '" + std::string(kMagic) + "' line)");
+  if (magic != kMagic)
+    throw Error(file, "", "not a weft part or checkpoint (no '" + std::string(kMagic) + "' line)");
   std::string line;
   line.reserve(4096);
   char c;
@@ -104,7 +109,8 @@ JobPart read_job_part(const std::filesystem::path& path) {
     uint64_t doubles = 0;
     for (size_t i = 0; i < units.size(); ++i) {
       if (units[i] >= p.units_total) throw Error(file, "units", "a unit beyond units_total");
-      if (sizes[i] > size / sizeof(double)) throw Error(file, "unit_doubles", "larger than the file");
+      if (sizes[i] > size / sizeof(double))
+        throw Error(file, "unit_doubles", "larger than the file");
       doubles += sizes[i];
     }
     const uint64_t payload_at = static_cast<uint64_t>(in.tellg());
@@ -186,8 +192,8 @@ JobPart merge_job_parts(const std::vector<std::filesystem::path>& paths) {
   for (uint32_t k = 0; k < all.shard.count; ++k)
     if (!shards_seen.count(k) && shard_units(all.units_total, {k, all.shard.count}).last >
                                      shard_units(all.units_total, {k, all.shard.count}).first)
-      missing += (missing.empty() ? "" : ", ") + std::to_string(k) + "/" +
-                 std::to_string(all.shard.count);
+      missing +=
+          (missing.empty() ? "" : ", ") + std::to_string(k) + "/" + std::to_string(all.shard.count);
   if (!missing.empty()) throw Error("", "parts", "incomplete: missing shard " + missing);
   return all;
 }

@@ -260,7 +260,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
 
   const uint64_t first_item = per_bin * static_cast<uint64_t>(o.first_bin);
-  const uint64_t last_item = per_bin * static_cast<uint64_t>(o.bin_count ? o.first_bin + o.bin_count : bins);
+  const uint64_t last_item =
+      per_bin * static_cast<uint64_t>(o.bin_count ? o.first_bin + o.bin_count : bins);
   TaskBatch batch;
   batch.items = per_bin * static_cast<uint64_t>(bins);
   batch.seed = o.seed;

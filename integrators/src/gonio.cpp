@@ -135,7 +135,8 @@ void normalize_gonio(GonioResult& res, const GonioSettings& g) {
     for (const auto& row : res.rows)
       if (row.view_zenith_deg == 0) res.beta_normal = row.beta;
   }
-  if (!res.beta_normal) throw Error("", "normalize_to", "the normal-incidence reference is missing");
+  if (!res.beta_normal)
+    throw Error("", "normalize_to", "the normal-incidence reference is missing");
   res.normalization = divide(*g.normalize_to, *res.beta_normal);
   for (auto& row : res.rows) row.beta_norm = row.beta * *res.normalization;
 }
@@ -271,16 +272,14 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   }
 
   if (need_normal_render && wanted[views]) {
-    {
-      const RenderScene normal_scene = sample_scene.with_lights(light_set(0, 0));
-      const Rgb l_white00 = g.irradiance * kInvPi;
-      const auto s = render_view(normal_scene, 0, 0, l_white00);
-      if (!s) {
-        res.cancelled = true;
-        return res;
-      }
-      res.beta_normal = s->second;
+    const RenderScene normal_scene = sample_scene.with_lights(light_set(0, 0));
+    const Rgb l_white00 = g.irradiance * kInvPi;
+    const auto s = render_view(normal_scene, 0, 0, l_white00);
+    if (!s) {
+      res.cancelled = true;
+      return res;
     }
+    res.beta_normal = s->second;
     if (on_unit) on_unit(res);
   }
   if (!g.units) normalize_gonio(res, g);

@@ -81,8 +81,8 @@ void expect_shards_merge_to(const std::vector<std::string>& args, const fs::path
   for (int k = 0; k < 4; ++k) {
     const fs::path part = dir / ("part-" + std::to_string(k) + ".part");
     ASSERT_EQ(run_weft(args + std::vector<std::string>{"--shard", std::to_string(k) + "/4", "-o",
-                                                   part.string()},
-                   dir),
+                                                       part.string()},
+                       dir),
               0)
         << slurp(dir / "stderr");
     merge.push_back(part.string());
@@ -97,8 +97,8 @@ void expect_shards_merge_to(const std::vector<std::string>& args, const fs::path
   EXPECT_TRUE(a == b) << reference << " and " << merged << " differ";
 }
 
-const std::vector<std::string> kFiberBake = split(
-    "bake fiber red-cotton --photons 3000 --resolution 3 --passes 4 --quiet --threads 2");
+const std::vector<std::string> kFiberBake =
+    split("bake fiber red-cotton --photons 3000 --resolution 3 --passes 4 --quiet --threads 2");
 const std::string kScene = std::string(WEFT_SOURCE_DIR) + "/scenes/examples/woven-patch.json";
 const std::vector<std::string> kSweep =
     split("sweep " + kScene + " --spp 2 --resolution 12 --quiet --threads 2");
@@ -119,13 +119,13 @@ TEST(Shards, FiberBakeOfFourShardsMergesToTheOneProcessBytes) {
 TEST(Shards, RaytracedFabricOfFourShardsMergesToTheOneProcessBytes) {
   const fs::path dir = fresh_test_dir();
   const fs::path fiber = dir / "fiber.exr";
-  ASSERT_EQ(run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()},
-                 dir),
-            0);
+  ASSERT_EQ(
+      run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()}, dir),
+      0);
   // 2100 particles per bin: the batch runner's tasks of 2048 straddle incident bins, so a
   // shard's first and last task hold particles of its neighbours' bins.
-  const auto args = split("bake fabric --method raytrace -R 2 --samples 2100 --quiet --fiber " +
-                          fiber.string());
+  const auto args =
+      split("bake fabric --method raytrace -R 2 --samples 2100 --quiet --fiber " + fiber.string());
   const fs::path one = dir / "one.exr";
   ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
       << slurp(dir / "stderr");
@@ -148,11 +148,12 @@ TEST(Shards, MergeRefusesMissingDuplicateAndForeignParts) {
   const fs::path dir = fresh_test_dir();
   auto part = [&](const std::string& name, const std::string& shard, const std::string& seed) {
     const fs::path p = dir / name;
-    EXPECT_EQ(run_weft(split("bake fiber red-cotton --photons 200 --resolution 2 --passes 1 --quiet "
-                         "--seed " +
-                         seed + " --shard " + shard + " -o " + p.string()),
-                   dir),
-              0);
+    EXPECT_EQ(
+        run_weft(split("bake fiber red-cotton --photons 200 --resolution 2 --passes 1 --quiet "
+                       "--seed " +
+                       seed + " --shard " + shard + " -o " + p.string()),
+                 dir),
+        0);
     return p.string();
   };
   const std::string p0 = part("p0", "0/3", "1"), p1 = part("p1", "1/3", "1"),
@@ -160,8 +161,8 @@ TEST(Shards, MergeRefusesMissingDuplicateAndForeignParts) {
   const fs::path out = dir / "out.exr";
   auto refused = [&](const std::vector<std::string>& parts, const std::string& says) {
     EXPECT_EQ(run_weft(std::vector<std::string>{"merge"} + parts +
-                       std::vector<std::string>{"-o", out.string()},
-                   dir),
+                           std::vector<std::string>{"-o", out.string()},
+                       dir),
               2);
     const std::string err = slurp(dir / "stderr");
     EXPECT_NE(err.find(says), std::string::npos) << err;
@@ -188,8 +189,8 @@ void kill_and_resume(const std::vector<std::string>& args, const std::string& ex
   ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
       << slurp(dir / "stderr");
   const int max_delay_ms = static_cast<int>(
-      1.2 * std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
-                .count());
+      1.2 *
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   std::mt19937 rng(20261201);
   int killed = 0, finished_first = 0, from_checkpoint = 0;
   for (int t = 0; t < trials; ++t) {
@@ -232,9 +233,9 @@ TEST(Resume, SweepKilledAtRandomMomentsResumesToTheSameBytes) {
 TEST(Resume, ShardOfARaytracedFabricKilledAtRandomMomentsResumesToTheSameBytes) {
   const fs::path dir = fresh_test_dir();
   const fs::path fiber = dir / "fiber.exr";
-  ASSERT_EQ(run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()},
-                 dir),
-            0);
+  ASSERT_EQ(
+      run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()}, dir),
+      0);
   kill_and_resume(split("bake fabric --method raytrace -R 3 --samples 3000 --quiet --shard 1/2 "
                         "--threads 2 --fiber " +
                         fiber.string()),

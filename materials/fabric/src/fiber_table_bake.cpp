@@ -121,12 +121,11 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
 }
 
 FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
-                                        const std::vector<FiberBandState>& states,
-                                        bool cancelled) {
+                                        const std::vector<FiberBandState>& states, bool cancelled) {
   validate(o);
   if (states.size() != static_cast<size_t>(kNumBands))
-    throw Error("", "bands", "a table needs the states of all " + std::to_string(kNumBands) +
-                                 " bands");
+    throw Error("", "bands",
+                "a table needs the states of all " + std::to_string(kNumBands) + " bands");
   const int R = o.resolution;
   const size_t cells = static_cast<size_t>(DirectionGrid{R}.bins());
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
