@@ -11,17 +11,50 @@
 
 namespace weft {
 
-void write_atomically(const std::filesystem::path& path,
-                      const std::function<void(const std::filesystem::path&)>& write) {
+namespace {
+std::filesystem::path temporary_sibling(const std::filesystem::path& path) {
   namespace fs = std::filesystem;
   const fs::path parent = path.has_parent_path() ? path.parent_path() : fs::path(".");
   if (!fs::is_directory(parent)) throw Error(path.string(), "", "output directory does not exist");
   // A name of its own per process and call, so that writers of one path never share a temporary;
   // the extension last: writers such as OpenImageIO choose the format by it.
   static std::atomic<uint64_t> calls{0};
-  const fs::path tmp =
-      parent / (".tmp-" + path.stem().string() + "-" + std::to_string(::getpid()) + "-" +
-                std::to_string(calls.fetch_add(1)) + "-partial" + path.extension().string());
+  return parent / (".tmp-" + path.stem().string() + "-" + std::to_string(::getpid()) + "-" +
+                   std::to_string(calls.fetch_add(1)) + "-partial" + path.extension().string());
+}
+}  // namespace
+
+void write_all_atomically(
+    const std::vector<std::pair<std::filesystem::path, FileWriter>>& outputs) {
+  namespace fs = std::filesystem;
+  std::vector<fs::path> tmps;
+  auto remove_all = [&] {
+    std::error_code ec;
+    for (const auto& t : tmps) fs::remove(t, ec);
+  };
+  try {
+    for (const auto& [path, write] : outputs) {
+      tmps.push_back(temporary_sibling(path));
+      write(tmps.back());
+    }
+  } catch (...) {
+    remove_all();
+    throw;
+  }
+  for (size_t i = 0; i < outputs.size(); ++i) {
+    std::error_code ec;
+    fs::rename(tmps[i], outputs[i].first, ec);
+    if (ec) {
+      remove_all();
+      throw Error(outputs[i].first.string(), "", "cannot move the finished output into place");
+    }
+  }
+}
+
+void write_atomically(const std::filesystem::path& path,
+                      const std::function<void(const std::filesystem::path&)>& write) {
+  namespace fs = std::filesystem;
+  const fs::path tmp = temporary_sibling(path);
   try {
     write(tmp);
   } catch (...) {

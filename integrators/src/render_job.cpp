@@ -1,5 +1,6 @@
 #include "weft/integrators/render_job.h"
 
+#include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/integrators/image.h"
 #include "weft/integrators/masked_render.h"
@@ -46,9 +47,17 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   out.nonfinite_samples = r.nonfinite_samples;
   out.cancelled = r.cancelled;
   if (r.cancelled) return out;  // nothing half-finished reaches the disk
-  write_exr(job.exr, r.image);
-  if (job.png) write_png_preview(*job.png, r.image);
-  if (job.mask) write_mask_exr(*job.mask, job.settings.width, job.settings.height, coverage);
+  // All or none: a preview that cannot be written leaves no EXR behind.
+  std::vector<std::pair<std::filesystem::path, FileWriter>> files{
+      {job.exr, [&](const std::filesystem::path& p) { write_exr(p, r.image); }}};
+  if (job.png)
+    files.emplace_back(*job.png,
+                       [&](const std::filesystem::path& p) { write_png_preview(p, r.image); });
+  if (job.mask)
+    files.emplace_back(*job.mask, [&](const std::filesystem::path& p) {
+      write_mask_exr(p, job.settings.width, job.settings.height, coverage);
+    });
+  write_all_atomically(files);
   return out;
 }
 
