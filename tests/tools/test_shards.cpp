@@ -200,10 +200,18 @@ void kill_and_resume(const std::vector<std::string>& args, const std::string& ex
     for (int k = 0; k < 3; ++k) {
       if (fs::exists(checkpoint)) ++from_checkpoint;
       const pid_t pid = spawn(run, dir);
-      std::this_thread::sleep_for(
-          std::chrono::milliseconds(std::uniform_int_distribution<int>(0, max_delay_ms)(rng)));
+      int status = 0;
+      bool reaped = false;
+      // The second kill of a trial waits for a checkpoint first, so that some runs continue
+      // from one however fast or loaded the machine; the others die at any moment.
+      if (k == 1)
+        while (!fs::exists(checkpoint) && !(reaped = waitpid(pid, &status, WNOHANG) == pid))
+          std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      std::this_thread::sleep_for(std::chrono::milliseconds(
+          std::uniform_int_distribution<int>(0, k == 1 ? max_delay_ms / 4 : max_delay_ms)(rng)));
       kill(pid, SIGKILL);
-      const int code = wait_exit(pid);
+      if (!reaped) waitpid(pid, &status, 0);
+      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
       if (code == 128 + SIGKILL) ++killed;
       if (code == 0) ++finished_first;
       EXPECT_TRUE(code == 0 || code == 128 + SIGKILL) << code << ": " << slurp(dir / "stderr");
