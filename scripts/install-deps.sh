@@ -5,7 +5,8 @@ set -euo pipefail
 packages=(build-essential cmake ninja-build pkg-config
   libembree-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libtinygltf-dev nlohmann-json3-dev libtbb-dev libcli11-dev
-  libgtest-dev libbenchmark-dev python3-matplotlib python3-numpy)
+  libgtest-dev libbenchmark-dev python3-matplotlib python3-numpy
+  slurm-wlm munge)  # slurm-wlm, munge: the single-node Slurm of tests/tools/slurm_test.sh
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -7,9 +7,11 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 
+#include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
@@ -103,6 +105,14 @@ std::optional<double> finite_number(const std::string& text) {
   }
   if (used != text.size() || !std::isfinite(v)) return std::nullopt;
   return v;
+}
+
+void validate_output_paths(const std::vector<std::string>& outputs,
+                           const std::vector<std::string>& inputs) {
+  std::vector<NamedPath> out, in;
+  for (const auto& p : outputs) out.push_back({p, "output"});
+  for (const auto& p : inputs) in.push_back({p, "input"});
+  check_output_paths(out, in);
 }
 
 std::vector<double> parse_range(const std::string& text, const std::string& option_name) {

@@ -46,6 +46,13 @@ int report_render_outcome(const RenderOutcome& r, const std::string& what);
 // The finite number that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
 std::optional<double> finite_number(const std::string& text);
 
+// Checks a command's output paths before any work: each names a file in an existing directory,
+// no two name the same file and none names one of the inputs (compared by canonical path, so
+// "./x" and "x" or a symbolic link are the same file). Inputs that are not files (a preset name)
+// are ignored. weft::Error naming the output otherwise.
+void validate_output_paths(const std::vector<std::string>& outputs,
+                           const std::vector<std::string>& inputs);
+
 // Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers.
 std::vector<double> parse_range(const std::string& text, const std::string& option_name);
 

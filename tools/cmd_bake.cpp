@@ -1,15 +1,159 @@
 // weft bake fiber: a fiber spec (file or preset) -> fiber BSDF table (.exr) + JSON summary.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "job_part.h"
 #include "weft/core/error.h"
 #include "weft/materials/fabric/fiber_spec.h"
 #include "weft/materials/fabric/fiber_table_bake.h"
 
 namespace weft::cli {
+
+namespace {
+
+// The summary of a bake (or of a merge of its shards) on stdout.
+int report_fiber_bake(const FiberTableBakeResult& r, const FiberSpec& spec,
+                      const FiberTableBakeOptions& o, const std::string& output, double seconds,
+                      bool json) {
+  nlohmann::json bands = nlohmann::json::array();
+  for (const auto& b : r.bands)
+    bands.push_back({{"wavelength_nm", b.wavelength_nm},
+                     {"mu_s_per_um", b.mu_s_per_um},
+                     {"mu_a_per_um", b.mu_a_per_um},
+                     {"g", b.g},
+                     {"photons", b.photons},
+                     {"surface_reflected", b.surface_fraction},
+                     {"albedo", b.exit_fraction},
+                     {"absorbed", b.absorbed_fraction},
+                     {"lost", b.lost_fraction},
+                     {"roulette_net", b.roulette_net},
+                     {"surface_sampling_excess", b.surface_sampling_excess},
+                     {"energy_balance", b.energy_balance},
+                     {"table_energy", b.energy_table}});
+  nlohmann::json j = {{"output", output},
+                      {"spec", spec.name},
+                      {"spec_hash", fiber_spec_hash_hex(spec)},
+                      {"resolution", o.resolution},
+                      {"bands", o.spectral ? "spectral" : "rgb"},
+                      {"route", o.route == FiberBakeRoute::kDirect ? "direct" : "bssrdf"},
+                      {"photons", r.photons},
+                      {"scattering_events", r.scattering_events},
+                      {"seconds", seconds},
+                      {"events_per_s", seconds > 0 ? r.scattering_events / seconds : 0.0},
+                      {"photons_per_s", seconds > 0 ? r.photons / seconds : 0.0},
+                      {"interrupted", r.cancelled},
+                      {"rgb_negative_clipped", r.rgb_negative_clipped},
+                      {"per_band", bands}};
+  if (json) {
+    std::cout << j.dump(2) << "\n";
+  } else {
+    std::printf("baked %s (%s) -> %s\n", spec.name.c_str(), fiber_spec_hash_hex(spec).c_str(),
+                output.c_str());
+    std::printf("%llu photons, %llu scattering events in %.1f s (%.3g events/s)%s\n",
+                static_cast<unsigned long long>(r.photons),
+                static_cast<unsigned long long>(r.scattering_events), seconds,
+                seconds > 0 ? r.scattering_events / seconds : 0.0,
+                r.cancelled ? "  [interrupted: table holds the finished passes]" : "");
+    std::printf("  nm    mu_s/um   mu_a/um    g     surface  albedo  absorbed  balance\n");
+    for (const auto& b : r.bands)
+      std::printf("  %3.0f  %8.4f  %8.5f  %5.3f  %6.4f  %6.4f  %6.4f  %6.4f\n", b.wavelength_nm,
+                  b.mu_s_per_um, b.mu_a_per_um, b.g, b.surface_fraction, b.exit_fraction,
+                  b.absorbed_fraction, b.energy_balance);
+  }
+  if (r.cancelled) std::fprintf(stderr, "weft: interrupted; wrote the finished passes\n");
+  return r.cancelled ? 130 : 0;
+}
+
+// What fixes a fiber bake's bits: a shard's identity (job_part.h).
+JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
+                       const FiberTableBakeOptions& o, Shard shard) {
+  JobPart p;
+  p.command = "bake fiber";
+  p.job = {{"spec_hash", fiber_spec_hash_hex(spec)},
+           {"spec_name", spec.name},
+           {"resolution", o.resolution},
+           {"photons_per_band", o.photons_per_band},
+           {"seed", o.seed},
+           {"spectral", o.spectral},
+           {"route", o.route == FiberBakeRoute::kDirect ? "direct" : "bssrdf"},
+           {"max_events_per_photon", o.max_events_per_photon},
+           {"passes", o.passes},
+           {"program_version", WEFT_VERSION}};
+  p.units_total = kNumBands;
+  p.shard = shard;
+  // The spec as given (a merge makes the table's metadata from it; its hash is checked).
+  std::error_code ec;
+  const bool file = std::filesystem::is_regular_file(spec_arg, ec);
+  std::string text;
+  if (file) {
+    std::ifstream in(spec_arg, std::ios::binary);
+    text.assign(std::istreambuf_iterator<char>(in), {});
+  } else {
+    text = fiber_preset_json(spec_arg);
+  }
+  p.extra = {{"spec", text}, {"spec_file", spec_arg}};
+  return p;
+}
+
+constexpr size_t kBandHeader = 13;  // doubles before the weighted sums
+
+std::vector<double> encode_fiber_band(const FiberBandState& s) {
+  std::vector<double> v;
+  v.reserve(kBandHeader + s.weighted_sum.size());
+  push_u64(v, s.passes_done);
+  push_u64(v, s.photons);
+  push_u64(v, s.events);
+  for (double x : {s.mu_s_per_um, s.mu_a_per_um, s.g, s.surface, s.exit, s.absorbed, s.roulette,
+                   s.lost, s.excess, s.energy})
+    v.push_back(x);
+  v.insert(v.end(), s.weighted_sum.begin(), s.weighted_sum.end());
+  return v;
+}
+
+FiberBandState decode_fiber_band(const std::vector<double>& v) {
+  if (v.size() < kBandHeader) throw Error("", "units", "a band's record is too short");
+  FiberBandState s;
+  s.passes_done = as_u64(v[0]), s.photons = as_u64(v[1]), s.events = as_u64(v[2]);
+  s.mu_s_per_um = v[3], s.mu_a_per_um = v[4], s.g = v[5], s.surface = v[6], s.exit = v[7];
+  s.absorbed = v[8], s.roulette = v[9], s.lost = v[10], s.excess = v[11], s.energy = v[12];
+  s.weighted_sum.assign(v.begin() + kBandHeader, v.end());
+  return s;
+}
+
+}  // namespace
+
+int merge_fiber_bake(const JobPart& all, const std::string& output, bool json) {
+  const FiberSpec spec = parse_fiber_spec(all.extra.at("spec").get<std::string>(),
+                                          all.extra.at("spec_file").get<std::string>());
+  if (fiber_spec_hash_hex(spec) != all.job.at("spec_hash").get<std::string>())
+    throw Error("", "spec", "the parts' spec does not match their spec hash");
+  FiberTableBakeOptions o;
+  o.resolution = all.job.at("resolution").get<int>();
+  o.photons_per_band = all.job.at("photons_per_band").get<uint64_t>();
+  o.seed = all.job.at("seed").get<uint64_t>();
+  o.spectral = all.job.at("spectral").get<bool>();
+  o.route = all.job.at("route") == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
+  o.max_events_per_photon = all.job.at("max_events_per_photon").get<uint64_t>();
+  o.passes = all.job.at("passes").get<uint64_t>();
+  const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
+  std::vector<FiberBandState> states;
+  for (const auto& [band, v] : all.units) {
+    states.push_back(decode_fiber_band(v));
+    if (states.back().passes_done != passes)
+      throw Error("", "units", "band " + std::to_string(band) + " is unfinished");
+  }
+  FiberTableBakeResult r = finish_fiber_table(spec, o, states, false);
+  r.table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
+  r.table.write_exr(output);
+  return report_fiber_bake(r, spec, o, output, 0, json);
+}
 
 void add_bake_command(CLI::App& app, Commands& commands) {
   auto* bake = app.add_subcommand("bake", "Bake BSDF tables from physical specs");
@@ -26,6 +170,8 @@ void add_bake_command(CLI::App& app, Commands& commands) {
     uint64_t seed = FiberTableBakeOptions{}.seed;
     uint64_t passes = FiberTableBakeOptions{}.passes;
     int threads = 0;
+    std::string shard;
+    bool resume = false;
     bool json = false;
     bool quiet = false;
   };
@@ -63,12 +209,18 @@ void add_bake_command(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 20));
   fiber->add_option("--threads", opt->threads, "threads (0 = all cores)")
       ->check(CLI::Range(0, 1024));
+  fiber->add_option("--shard", opt->shard,
+                    "K/N: trace only shard K of N (bands) into a part file for `weft merge`");
+  fiber->add_flag("--resume", opt->resume,
+                  "checkpoint every finished pass beside the output and continue from a "
+                  "checkpoint an earlier run of this bake left there");
   fiber->add_flag("--json", opt->json, "print the summary as JSON");
   fiber->add_flag("--quiet", opt->quiet, "no progress bar");
 
   commands.push_back(
       {fiber, [opt] {
          const FiberSpec spec = load_fiber_spec(opt->spec);
+         validate_output_paths({opt->output}, {opt->spec});
          FiberTableBakeOptions o;
          o.resolution = opt->resolution;
          o.photons_per_band = opt->photons;
@@ -77,60 +229,61 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          o.spectral = opt->bands == "spectral";
          o.route = opt->route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
          o.passes = opt->passes;
+         const Shard shard = opt->shard.empty() ? Shard{} : parse_shard(opt->shard, "--shard");
+         const JobPart job = fiber_bake_job(opt->spec, spec, o, shard);
+         const UnitRange range = shard_units(kNumBands, shard);
+         FiberBandWork work;
+         work.first_band = static_cast<int>(range.first);
+         work.last_band = static_cast<int>(range.last);
+         if (const auto cp = load_checkpoint(opt->output, job, opt->resume)) {
+           for (const auto& [band, v] : cp->units) work.start.push_back(decode_fiber_band(v));
+           if (work.start.size() != range.last - range.first)
+             throw Error(checkpoint_path(opt->output).string(), "units",
+                         "does not hold every band of the shard");
+         }
+         if (opt->resume)
+           work.on_pass = [&](const std::vector<FiberBandState>& states) {
+             JobPart cp = job;
+             cp.checkpoint = true;
+             for (size_t i = 0; i < states.size(); ++i)
+               cp.units[range.first + i] = encode_fiber_band(states[i]);
+             write_job_part(checkpoint_path(opt->output), cp);
+           };
          const auto start = std::chrono::steady_clock::now();
-         FiberTableBakeResult r = bake_fiber_table(spec, o, progress_bar(opt->quiet));
+         FiberBandsResult traced;
+         if (range.last > range.first) {
+           try {
+             traced = trace_fiber_bands(spec, o, work, progress_bar(opt->quiet));
+           } catch (const Error&) {
+             if (!interrupted()) throw;
+             std::fprintf(stderr, "\nweft: interrupted before any photon; nothing was written\n");
+             return 130;
+           }
+         }
          const double seconds =
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+         if (!shard.whole()) {
+           if (traced.cancelled) {
+             std::fprintf(stderr, "\nweft: interrupted; no part written%s\n",
+                          opt->resume ? " (--resume continues from the last finished pass)" : "");
+             return 130;
+           }
+           JobPart part = job;
+           for (size_t i = 0; i < traced.bands.size(); ++i)
+             part.units[range.first + i] = encode_fiber_band(traced.bands[i]);
+           write_job_part(opt->output, part);
+           std::filesystem::remove(checkpoint_path(opt->output));
+           std::printf("bands %llu..%llu of %s (shard %u/%u) -> %s in %.1f s\n",
+                       static_cast<unsigned long long>(range.first),
+                       static_cast<unsigned long long>(range.last), spec.name.c_str(), shard.index,
+                       shard.count, opt->output.c_str(), seconds);
+           return 0;
+         }
+         FiberTableBakeResult r = finish_fiber_table(spec, o, traced.bands, traced.cancelled);
          r.table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
          r.table.write_exr(opt->output);
-
-         nlohmann::json bands = nlohmann::json::array();
-         for (const auto& b : r.bands)
-           bands.push_back({{"wavelength_nm", b.wavelength_nm},
-                            {"mu_s_per_um", b.mu_s_per_um},
-                            {"mu_a_per_um", b.mu_a_per_um},
-                            {"g", b.g},
-                            {"photons", b.photons},
-                            {"surface_reflected", b.surface_fraction},
-                            {"albedo", b.exit_fraction},
-                            {"absorbed", b.absorbed_fraction},
-                            {"lost", b.lost_fraction},
-                            {"roulette_net", b.roulette_net},
-                            {"surface_sampling_excess", b.surface_sampling_excess},
-                            {"energy_balance", b.energy_balance},
-                            {"table_energy", b.energy_table}});
-         nlohmann::json j = {{"output", opt->output},
-                             {"spec", spec.name},
-                             {"spec_hash", fiber_spec_hash_hex(spec)},
-                             {"resolution", opt->resolution},
-                             {"bands", opt->bands},
-                             {"route", opt->route},
-                             {"photons", r.photons},
-                             {"scattering_events", r.scattering_events},
-                             {"seconds", seconds},
-                             {"events_per_s", seconds > 0 ? r.scattering_events / seconds : 0.0},
-                             {"photons_per_s", seconds > 0 ? r.photons / seconds : 0.0},
-                             {"interrupted", r.cancelled},
-                             {"rgb_negative_clipped", r.rgb_negative_clipped},
-                             {"per_band", bands}};
-         if (opt->json) {
-           std::cout << j.dump(2) << "\n";
-         } else {
-           std::printf("baked %s (%s) -> %s\n", spec.name.c_str(),
-                       fiber_spec_hash_hex(spec).c_str(), opt->output.c_str());
-           std::printf("%llu photons, %llu scattering events in %.1f s (%.3g events/s)%s\n",
-                       static_cast<unsigned long long>(r.photons),
-                       static_cast<unsigned long long>(r.scattering_events), seconds,
-                       seconds > 0 ? r.scattering_events / seconds : 0.0,
-                       r.cancelled ? "  [interrupted: table holds the finished passes]" : "");
-           std::printf("  nm    mu_s/um   mu_a/um    g     surface  albedo  absorbed  balance\n");
-           for (const auto& b : r.bands)
-             std::printf("  %3.0f  %8.4f  %8.5f  %5.3f  %6.4f  %6.4f  %6.4f  %6.4f\n",
-                         b.wavelength_nm, b.mu_s_per_um, b.mu_a_per_um, b.g, b.surface_fraction,
-                         b.exit_fraction, b.absorbed_fraction, b.energy_balance);
-         }
-         if (r.cancelled) std::fprintf(stderr, "weft: interrupted; wrote the finished passes\n");
-         return r.cancelled ? 130 : 0;
+         if (!r.cancelled) std::filesystem::remove(checkpoint_path(opt->output));
+         return report_fiber_bake(r, spec, o, opt->output, seconds, opt->json);
        }});
 }
 

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "fabric_parts.h"
 #include "weft/core/error.h"
 #include "weft/integrators/fabric_raytrace.h"
 #include "weft/materials/fabric/bake_cache.h"
@@ -18,10 +19,10 @@ namespace {
 
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
-  std::string detail = "yarn";
+  std::string detail = "yarn", shard;
   int resolution = 8, threads = 0;
   uint64_t samples = 0, seed = 1;
-  bool json = false, quiet = false;
+  bool json = false, quiet = false, resume = false;
 };
 
 // The fiber table: a table file, or a fiber spec or preset baked once into ./.weft-cache (RGB).
@@ -55,11 +56,14 @@ std::vector<FiberOrientation> orientations(const std::vector<Vec3>& tangents) {
 }
 
 int run(const BakeFabricOptions& o) {
-  if (std::filesystem::path(o.output).extension() != ".exr")
+  if ((!o.shard.empty() || o.resume) && o.method != "raytrace")
+    throw Error("", "--shard", "--shard and --resume need --method raytrace");
+  if (std::filesystem::path(o.output).extension() != ".exr" && o.shard.empty())
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
   const auto dir = std::filesystem::absolute(o.output).parent_path();
   if (!std::filesystem::is_directory(dir))
     throw Error(o.output, "", "output directory does not exist");
+  validate_output_paths({o.output}, {o.fiber, o.weave, o.wif});
   const auto progress = progress_bar(o.quiet);
   const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
   const WovenSample sample = woven_sample(o);
@@ -72,7 +76,16 @@ int run(const BakeFabricOptions& o) {
     if (o.samples) r.particles_per_bin = o.samples;
     r.seed = o.seed;
     r.threads = o.threads;
-    const FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, r, progress);
+    FabricRaytraceResult res;
+    if (!o.shard.empty() || o.resume) {
+      int code = 0;
+      auto pieces =
+          raytrace_fabric_in_pieces(sample, fiber, r, o.output, o.shard, o.resume, progress, &code);
+      if (!pieces) return code;
+      res = std::move(*pieces);
+    } else {
+      res = raytrace_fabric_table(sample, fiber, r, progress);
+    }
     if (res.cancelled) {
       std::fprintf(stderr, "\nweft: bake cancelled; nothing was written\n");
       return 130;
@@ -149,6 +162,12 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   sub->add_option("--seed", o->seed, "random seed")->capture_default_str();
   sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
   sub->add_option("-o,--output", o->output, "output fabric table (.exr)")->required();
+  sub->add_option("--shard", o->shard,
+                  "raytrace: K/N, trace only shard K of N (incident bins) into a part file for "
+                  "`weft merge`");
+  sub->add_flag("--resume", o->resume,
+                "raytrace: checkpoint finished incident bins beside the output and continue "
+                "from a checkpoint an earlier run left there");
   sub->add_flag("--json", o->json, "print a JSON summary");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
   commands.push_back({sub, [o] { return run(*o); }});

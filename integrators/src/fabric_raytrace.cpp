@@ -226,6 +226,9 @@ void FabricRaytraceOptions::validate() const {
   if (!(roulette_threshold > 0 && roulette_threshold < 1))
     throw Error("", "roulette_threshold", "must lie in (0, 1)");
   if (threads < 0) throw Error("", "threads", "must be >= 0");
+  const int bins = DirectionGrid{resolution}.bins();
+  if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
+    throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
 }
 
 FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
@@ -256,6 +259,9 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   FabricRaytraceResult result;
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
 
+  const uint64_t first_item = per_bin * static_cast<uint64_t>(o.first_bin);
+  const uint64_t last_item =
+      per_bin * static_cast<uint64_t>(o.bin_count ? o.first_bin + o.bin_count : bins);
   TaskBatch batch;
   batch.items = per_bin * static_cast<uint64_t>(bins);
   batch.seed = o.seed;
@@ -266,10 +272,13 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
 
   const TaskBatchStatus status = run_batch<TaskTally>(
       batch,
-      [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, TaskTally& tally) {
+      [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, TaskTally& task_tally) {
+        if (first + count <= first_item || first >= last_item) return;
         std::vector<double> w(nc);
+        TaskTally outside;  // a task's particles of bins not asked for: traced, not tallied
         for (uint64_t k = first; k < first + count; ++k) {
           const int a = static_cast<int>(k / per_bin);
+          TaskTally& tally = k >= first_item && k < last_item ? task_tally : outside;
           // The light: a direction of bin a (uniform in solid angle), flux per unit area
           // proportional to |cos theta_i|; entering the slab through the face it faces.
           const Vec3 wi_cloth =

@@ -117,8 +117,33 @@ Vec3 gonio_view_direction(const AngleFrame& frame, double view_zenith_deg,
   return frame.direction(deg_to_rad(std::abs(view_zenith_deg)), deg_to_rad(azimuth));
 }
 
+namespace {
+bool needs_normal_render(const GonioSettings& g) {
+  return g.normalize_to &&
+         !(g.light_zenith_deg == 0 && std::find(g.view_zenith_deg.begin(), g.view_zenith_deg.end(),
+                                                0.0) != g.view_zenith_deg.end());
+}
+}  // namespace
+
+size_t gonio_unit_count(const GonioSettings& g) {
+  return g.view_zenith_deg.size() + (needs_normal_render(g) ? 1 : 0);
+}
+
+void normalize_gonio(GonioResult& res, const GonioSettings& g) {
+  if (!g.normalize_to) return;
+  if (!needs_normal_render(g)) {
+    for (const auto& row : res.rows)
+      if (row.view_zenith_deg == 0) res.beta_normal = row.beta;
+  }
+  if (!res.beta_normal)
+    throw Error("", "normalize_to", "the normal-incidence reference is missing");
+  res.normalization = divide(*g.normalize_to, *res.beta_normal);
+  for (auto& row : res.rows) row.beta_norm = row.beta * *res.normalization;
+}
+
 GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
-                      const ProgressCallback& progress, const FiberTableResolver& fiber_tables) {
+                      const ProgressCallback& progress, const FiberTableResolver& fiber_tables,
+                      const std::function<void(const GonioResult&)>& on_unit) {
   const std::string src = desc.source;
   if (!(g.light_zenith_deg >= 0 && g.light_zenith_deg < 90))
     throw Error(src, "light_zenith_deg", "must lie in [0, 90)");
@@ -163,12 +188,18 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   }
 
   // Normalization needs beta at normal incidence and view; reuse a row when the sweep has it.
-  const bool need_normal_render =
-      g.normalize_to &&
-      !(g.light_zenith_deg == 0 && std::find(g.view_zenith_deg.begin(), g.view_zenith_deg.end(),
-                                             0.0) != g.view_zenith_deg.end());
+  const size_t views = g.view_zenith_deg.size();
+  const bool need_normal_render = needs_normal_render(g);
+  std::vector<bool> wanted(gonio_unit_count(g), !g.units.has_value());
+  if (g.units)
+    for (size_t u : *g.units) {
+      if (u >= wanted.size()) throw Error(src, "units", "a unit beyond the sweep's");
+      wanted[u] = true;
+    }
   const int per_view = g.white_check ? 2 : 1;
-  const uint64_t renders = g.view_zenith_deg.size() * per_view + (need_normal_render ? 1 : 0);
+  uint64_t renders = 0;
+  for (size_t u = 0; u < wanted.size(); ++u)
+    if (wanted[u]) renders += u < views ? per_view : 1;
   RenderSettings rs;
   rs.width = g.width;
   rs.height = g.height;
@@ -204,8 +235,11 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
     return std::make_pair(m, divide(m.mean, l_white));
   };
 
-  for (double zen : g.view_zenith_deg) {
+  for (size_t v = 0; v < views; ++v) {
+    if (!wanted[v]) continue;
+    const double zen = g.view_zenith_deg[v];
     GonioRow row;
+    row.view = v;
     row.view_zenith_deg = zen;
     row.view_azimuth_deg = phi_v;
     const auto s = render_view(sample_scene, zen, phi_v, res.l_white);
@@ -232,27 +266,21 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
       row.white = w->second;
     }
     res.rows.push_back(row);
+    if (on_unit) on_unit(res);
   }
 
-  if (g.normalize_to) {
-    Rgb beta00;
-    if (need_normal_render) {
-      const RenderScene normal_scene = sample_scene.with_lights(light_set(0, 0));
-      const Rgb l_white00 = g.irradiance * kInvPi;
-      const auto s = render_view(normal_scene, 0, 0, l_white00);
-      if (!s) {
-        res.cancelled = true;
-        return res;
-      }
-      beta00 = s->second;
-    } else {
-      for (const auto& row : res.rows)
-        if (row.view_zenith_deg == 0) beta00 = row.beta;
+  if (need_normal_render && wanted[views]) {
+    const RenderScene normal_scene = sample_scene.with_lights(light_set(0, 0));
+    const Rgb l_white00 = g.irradiance * kInvPi;
+    const auto s = render_view(normal_scene, 0, 0, l_white00);
+    if (!s) {
+      res.cancelled = true;
+      return res;
     }
-    res.beta_normal = beta00;
-    res.normalization = divide(*g.normalize_to, beta00);
-    for (auto& row : res.rows) row.beta_norm = row.beta * *res.normalization;
+    res.beta_normal = s->second;
+    if (on_unit) on_unit(res);
   }
+  if (!g.units) normalize_gonio(res, g);
   return res;
 }
 

@@ -4,6 +4,7 @@
 #include <utility>
 #include <vector>
 
+#include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/integrators/image.h"
 #include "weft/integrators/masked_render.h"
@@ -20,17 +21,10 @@ void check_output(const std::filesystem::path& p, const std::string& ext, const 
     throw Error(p.string(), what, "output directory does not exist");
 }
 
-// The file a path names, for comparing outputs with each other and with inputs.
-std::filesystem::path identity(const std::filesystem::path& p) {
-  std::error_code ec;
-  const auto c = std::filesystem::weakly_canonical(p, ec);
-  return ec ? p.lexically_normal() : c;
-}
-
 }  // namespace
 
 void check_render_outputs(const SceneDescription& desc, const RenderJob& job) {
-  std::vector<std::pair<std::filesystem::path, std::string>> outputs = {{job.exr, "output"}};
+  std::vector<NamedPath> outputs = {{job.exr, "output"}};
   check_output(job.exr, ".exr", "output");
   if (job.png) check_output(*job.png, ".png", "preview"), outputs.push_back({*job.png, "preview"});
   if (job.mask) check_output(*job.mask, ".exr", "mask"), outputs.push_back({*job.mask, "mask"});
@@ -38,16 +32,7 @@ void check_render_outputs(const SceneDescription& desc, const RenderJob& job) {
     check_output(*job.albedo, ".exr", "albedo"), outputs.push_back({*job.albedo, "albedo"});
   if (job.normal)
     check_output(*job.normal, ".exr", "normal"), outputs.push_back({*job.normal, "normal"});
-  for (size_t i = 0; i < outputs.size(); ++i) {
-    const auto id = identity(outputs[i].first);
-    if (!desc.source.empty() && id == identity(desc.source))
-      throw Error(outputs[i].first.string(), outputs[i].second,
-                  "is the scene description being rendered");
-    for (size_t k = 0; k < i; ++k)
-      if (id == identity(outputs[k].first))
-        throw Error(outputs[i].first.string(), outputs[i].second,
-                    "is also the " + outputs[k].second + " file");
-  }
+  check_output_paths(outputs, {{desc.source, "scene description"}});
 }
 
 RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& job,
@@ -96,17 +81,27 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   meta.spp_requested = settings.spp;
   meta.time_limit_s = settings.time_limit_s;
   meta.camera = *desc.camera;
-  write_exr(job.exr, r.image, &meta);
-  if (job.png) write_png_preview(*job.png, r.image, job.preview_exposure);
-  if (job.mask) write_mask_exr(*job.mask, settings.width, settings.height, coverage);
-  if (job.albedo) {
-    meta.pass = "albedo";
-    write_exr(*job.albedo, r.albedo, &meta);
-  }
-  if (job.normal) {
-    meta.pass = "normal (world space, towards the camera)";
-    write_exr(*job.normal, r.normal, &meta);
-  }
+  RenderMetadata albedo_meta = meta, normal_meta = meta;
+  albedo_meta.pass = "albedo";
+  normal_meta.pass = "normal (world space, towards the camera)";
+  // All or none: a preview or pass that cannot be written leaves no EXR behind.
+  std::vector<std::pair<std::filesystem::path, FileWriter>> files{
+      {job.exr, [&](const std::filesystem::path& p) { write_exr(p, r.image, &meta); }}};
+  if (job.png)
+    files.emplace_back(*job.png, [&](const std::filesystem::path& p) {
+      write_png_preview(p, r.image, job.preview_exposure);
+    });
+  if (job.mask)
+    files.emplace_back(*job.mask, [&](const std::filesystem::path& p) {
+      write_mask_exr(p, settings.width, settings.height, coverage);
+    });
+  if (job.albedo)
+    files.emplace_back(*job.albedo,
+                       [&](const std::filesystem::path& p) { write_exr(p, r.albedo, &albedo_meta); });
+  if (job.normal)
+    files.emplace_back(*job.normal,
+                       [&](const std::filesystem::path& p) { write_exr(p, r.normal, &normal_meta); });
+  write_all_atomically(files);
   return out;
 }
 

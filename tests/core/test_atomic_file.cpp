@@ -103,3 +103,23 @@ TEST(AtomicFile, MissingDirectoryIsAnErrorNamingThePath) {
   EXPECT_NE(error_of([&] { write_text_atomically(out, "x"); }), "");
   EXPECT_TRUE(entries(dir).empty());
 }
+
+// Several outputs (a render's EXR, preview and mask): a failing second writer leaves neither the
+// first output nor any temporary, and an old file at the first path untouched.
+TEST(AtomicFile, SeveralOutputsAreWrittenAllOrNone) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path a = dir / "image.exr", b = dir / "preview.png";
+  std::ofstream(a) << "old";
+  auto text = [](const std::string& s) {
+    return [s](const fs::path& tmp) { std::ofstream(tmp) << s; };
+  };
+  EXPECT_THROW(write_all_atomically({{a, text("new")},
+                                     {b, [](const fs::path&) { throw std::runtime_error("x"); }}}),
+               std::runtime_error);
+  EXPECT_EQ(slurp(a), "old");
+  EXPECT_EQ(entries(dir), std::vector<std::string>{"image.exr"});
+  write_all_atomically({{a, text("new")}, {b, text("png")}});
+  EXPECT_EQ(slurp(a), "new");
+  EXPECT_EQ(slurp(b), "png");
+  EXPECT_EQ((entries(dir)), (std::vector<std::string>{"image.exr", "preview.png"}));
+}

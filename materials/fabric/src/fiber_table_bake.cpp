@@ -25,48 +25,58 @@ void validate(const FiberTableBakeOptions& o) {
 
 }  // namespace
 
-FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
-                                      const ProgressCallback& progress) {
+FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOptions& o,
+                                   const FiberBandWork& work, const ProgressCallback& progress) {
   validate(o);
+  if (work.first_band < 0 || work.last_band > kNumBands || work.first_band >= work.last_band)
+    throw Error("", "bands", "band range must lie in [0, " + std::to_string(kNumBands) + ")");
+  const int nb = work.last_band - work.first_band;
+  if (!work.start.empty() && work.start.size() != static_cast<size_t>(nb))
+    throw Error("", "bands", "a resumed bake needs one state per band");
+  std::vector<int> band_ids;
+  for (int b = work.first_band; b < work.last_band; ++b) band_ids.push_back(b);
   MediumOptions medium_options;
   medium_options.threads = o.threads;
-  const FiberMedium medium = build_fiber_medium(spec, {}, medium_options);
+  const FiberMedium medium = build_fiber_medium(spec, band_ids, medium_options, progress);
 
   const int R = o.resolution;
   const size_t cells = static_cast<size_t>(DirectionGrid{R}.bins());
-
-  // Per band: the physics, and running sums over passes.
-  struct BandState {
-    FiberBandPhysics physics;
-    std::vector<double> weighted_sum;  // photon-weighted sum of per-pass cell sums
-    double surface = 0, exit = 0, absorbed = 0, roulette = 0, lost = 0, excess = 0, energy = 0;
-    uint64_t photons = 0, events = 0;
-  };
-  std::vector<BandState> states(kNumBands);
-  std::map<double, std::shared_ptr<const SurfaceAlbedoTable>> albedo_by_ior;
-  for (int band = 0; band < kNumBands; ++band) {
-    auto& albedo = albedo_by_ior[medium.bands[band].host_n];
-    if (!albedo)
-      albedo = std::make_shared<const SurfaceAlbedoTable>(
-          spec.roughness_distribution, spec.roughness_alpha, medium.bands[band].host_n);
-    states[band].physics =
-        fiber_band_physics(spec, medium.bands[band], o.max_events_per_photon, albedo);
-    states[band].weighted_sum.assign(cells * cells, 0.0);
-  }
-
   // Photons are traced in passes over all bands, so an interrupted bake still has every band,
   // each with the photons of the passes it finished (the table records how many).
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
-  const uint64_t total_units = o.photons_per_band * kNumBands;
+  FiberBandsResult result;
+  result.passes = passes;
+  std::vector<FiberBandState>& states = result.bands;
+  states = work.start.empty() ? std::vector<FiberBandState>(nb) : work.start;
+  std::vector<FiberBandPhysics> physics(nb);
+  std::map<double, std::shared_ptr<const SurfaceAlbedoTable>> albedo_by_ior;
+  for (int i = 0; i < nb; ++i) {
+    const MediumBand& mb = medium.bands[i];
+    auto& albedo = albedo_by_ior[mb.host_n];
+    if (!albedo)
+      albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
+                                                          spec.roughness_alpha, mb.host_n);
+    physics[i] = fiber_band_physics(spec, mb, o.max_events_per_photon, albedo);
+    FiberBandState& st = states[i];
+    st.mu_s_per_um = mb.mu_s_per_um, st.mu_a_per_um = mb.mu_a_per_um, st.g = mb.g;
+    if (work.start.empty()) st.weighted_sum.assign(cells * cells, 0.0);
+    if (st.weighted_sum.size() != cells * cells || st.passes_done > passes)
+      throw Error("", "bands", "a resumed state does not fit this bake's resolution or passes");
+  }
+
+  const uint64_t total_units = o.photons_per_band * static_cast<uint64_t>(nb);
   uint64_t units_done = 0;
+  for (const auto& st : states) units_done += st.photons;
   bool stop_requested = false;
-  FiberTableBakeResult result;
-  for (uint64_t pass = 0; pass < passes && !result.cancelled; ++pass) {
+  uint64_t first_pass = passes;
+  for (const auto& st : states) first_pass = std::min(first_pass, st.passes_done);
+  for (uint64_t pass = first_pass; pass < passes && !result.cancelled; ++pass) {
     const uint64_t first = o.photons_per_band * pass / passes;
     const uint64_t count = o.photons_per_band * (pass + 1) / passes - first;
-    for (int band = 0; band < kNumBands && !result.cancelled; ++band) {
-      BandState& st = states[band];
-      const FiberBandPhysics& ph = st.physics;
+    for (int i = 0; i < nb && !result.cancelled; ++i) {
+      FiberBandState& st = states[i];
+      if (st.passes_done > pass) continue;
+      const int band = work.first_band + i;
       FiberBakeSettings settings;
       settings.resolution = R;
       settings.photons = count;
@@ -81,8 +91,8 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       };
       const FiberBandTable t =
           o.route == FiberBakeRoute::kDirect
-              ? bake_fiber_band_direct(ph, settings, band_progress)
-              : bake_fiber_band_bssrdf(ph, settings, BssrdfRouteSettings{}, band_progress);
+              ? bake_fiber_band_direct(physics[i], settings, band_progress)
+              : bake_fiber_band_bssrdf(physics[i], settings, BssrdfRouteSettings{}, band_progress);
       const double n = static_cast<double>(t.photons);
       for (size_t k = 0; k < st.weighted_sum.size(); ++k)
         st.weighted_sum[k] += t.weighted_sum[k] * n;
@@ -96,22 +106,44 @@ FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBak
       st.photons += t.photons;
       st.events += t.scattering_events;
       units_done += t.photons;
-      result.photons += t.photons;
-      result.scattering_events += t.scattering_events;
       result.cancelled = t.cancelled || stop_requested;
+      if (!result.cancelled) st.passes_done = pass + 1;
     }
+    if (!result.cancelled && work.on_pass) work.on_pass(states);
   }
+  return result;
+}
 
+FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
+                                      const ProgressCallback& progress) {
+  const FiberBandsResult r = trace_fiber_bands(spec, o, FiberBandWork{}, progress);
+  return finish_fiber_table(spec, o, r.bands, r.cancelled);
+}
+
+FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
+                                        const std::vector<FiberBandState>& states, bool cancelled) {
+  validate(o);
+  if (states.size() != static_cast<size_t>(kNumBands))
+    throw Error("", "bands",
+                "a table needs the states of all " + std::to_string(kNumBands) + " bands");
+  const int R = o.resolution;
+  const size_t cells = static_cast<size_t>(DirectionGrid{R}.bins());
+  const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
+  FiberTableBakeResult result;
+  result.cancelled = cancelled;
   std::vector<std::vector<double>> band_f(kNumBands);
   for (int band = 0; band < kNumBands; ++band) {
-    BandState& st = states[band];
-    const MediumBand& mb = medium.bands[band];
+    const FiberBandState& st = states[band];
+    if (st.weighted_sum.size() != cells * cells)
+      throw Error("", "bands", "band " + std::to_string(band) + " has another resolution");
+    result.photons += st.photons;
+    result.scattering_events += st.events;
     FiberBandSummary s;
     s.band = band;
     s.wavelength_nm = band_wavelength_nm(band);
-    s.mu_s_per_um = mb.mu_s_per_um;
-    s.mu_a_per_um = mb.mu_a_per_um;
-    s.g = mb.g;
+    s.mu_s_per_um = st.mu_s_per_um;
+    s.mu_a_per_um = st.mu_a_per_um;
+    s.g = st.g;
     s.photons = st.photons;
     s.scattering_events = st.events;
     if (st.photons > 0) {

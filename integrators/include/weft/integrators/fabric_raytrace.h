@@ -34,6 +34,9 @@ struct FabricRaytraceOptions {
   int threads = 0;                   // 0 = all cores; results do not depend on it
   int max_scatterings = 1000;        // beyond it a particle's weight is booked as lost
   double roulette_threshold = 0.05;  // Russian roulette below this weight (mean over channels)
+  // Trace only incident bins [first_bin, first_bin + bin_count) (0: all), for a table split over
+  // processes: their rows have the bits of a whole run's, the other rows are zero.
+  int first_bin = 0, bin_count = 0;
 
   void validate() const;  // weft::Error naming the field
 };

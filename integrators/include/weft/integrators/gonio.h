@@ -22,6 +22,7 @@
 //             "normalize_to": c, "white_check": true, "width": 64, "height": 64, "spp": 16}
 //
 // and its "render" section the path tracer's max_depth, rr_depth and seed.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -48,7 +49,15 @@ struct GonioSettings {
   int max_depth = RenderSettings{}.max_depth, rr_depth = RenderSettings{}.rr_depth;
   uint64_t seed = RenderSettings{}.seed;
   int threads = RenderSettings{}.threads;
+  // A sweep split over processes or resumed renders some of its units (gonio_unit_count): unit v
+  // < views is view v, the last one, when there is one, the normal-incidence reference that the
+  // normalization needs when no row gives it. Empty: every unit, then the normalization.
+  std::optional<std::vector<size_t>> units;
 };
+
+// Units of a sweep: its views, plus one for the normal-incidence reference when normalizing and
+// no row is at normal incidence and view.
+size_t gonio_unit_count(const GonioSettings& settings);
 
 // GonioSettings{} with the description's "sweep" section and the path tracer's settings of its
 // "render" section applied. Unknown keys and bad values are weft::Error naming the description's
@@ -59,6 +68,7 @@ GonioSettings gonio_settings_from(const SceneDescription& desc);
 Vec3 gonio_view_direction(const AngleFrame& frame, double view_zenith_deg, double view_azimuth_deg);
 
 struct GonioRow {
+  size_t view = 0;  // index into view_zenith_deg
   double view_zenith_deg = 0, view_azimuth_deg = 0;
   Rgb sum;                  // sum over pixels of the radiance of samples hitting the sample
   double footprint_px = 0;  // pixels covered by the sample (sum of coverage)
@@ -79,9 +89,16 @@ struct GonioResult : RenderOutcome {
 
 // 'fiber_tables' makes the fiber tables that materials name by spec (null: such materials are an
 // error).
+// 'on_unit' is called after every unit rendered, with the result so far (a checkpoint).
 GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& settings,
                       const ProgressCallback& progress = no_progress(),
-                      const FiberTableResolver& fiber_tables = {});
+                      const FiberTableResolver& fiber_tables = {},
+                      const std::function<void(const GonioResult&)>& on_unit = {});
+
+// The normalization of a sweep whose rows (every view, in order) and beta_normal (when it took
+// the reference unit) are there: sets normalization and every row's beta_norm. Does nothing
+// without settings.normalize_to.
+void normalize_gonio(GonioResult& result, const GonioSettings& settings);
 
 // One row per view: view_zenith_deg, view_azimuth_deg, light_zenith_deg, light_azimuth_deg,
 // sum_r, sum_g, sum_b, footprint_px, beta_r, beta_g, beta_b, beta_err, beta_err_r, beta_err_g,

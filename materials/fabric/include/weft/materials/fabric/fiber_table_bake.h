@@ -3,6 +3,7 @@
 // cylinder -> cosine-weighted cell averages (docs/fiber-bsdf.md) plus the Cook-Torrance surface
 // lobe, for every band, stored as a spectral (33 bands) or RGB table.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -62,5 +63,40 @@ struct FiberTableBakeResult {
 
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
                                       const ProgressCallback& progress = no_progress());
+
+// The pieces of bake_fiber_table, for bakes split over processes (shards of bands) or resumed
+// from a checkpoint. A band's running sums after some passes: continuing from them gives the same
+// bits as a bake that never stopped, and the table depends on nothing else.
+struct FiberBandState {
+  double mu_s_per_um = 0, mu_a_per_um = 0, g = 0;  // the medium's band (for the summary)
+  std::vector<double> weighted_sum;  // photon-weighted sum over passes of the cell sums
+  double surface = 0, exit = 0, absorbed = 0, roulette = 0, lost = 0, excess = 0, energy = 0;
+  uint64_t photons = 0, events = 0;
+  uint64_t passes_done = 0;
+};
+
+struct FiberBandWork {
+  int first_band = 0, last_band = kNumBands;  // the bands to trace: [first, last)
+  // Where to continue from: one state per band of the range (empty: from the start).
+  std::vector<FiberBandState> start;
+  // Called after every pass finished by all bands of the range (a checkpoint).
+  std::function<void(const std::vector<FiberBandState>&)> on_pass;
+};
+
+struct FiberBandsResult {
+  std::vector<FiberBandState> bands;  // one per band of the range
+  uint64_t passes = 0;                // passes of a finished bake (options.passes, clamped)
+  bool cancelled = false;
+};
+
+// Photon transport for a range of bands over every pass (Mie medium first: Ctrl-C is honoured
+// there too, as a weft::Error "cancelled" when nothing was traced yet).
+FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOptions& options,
+                                   const FiberBandWork& work,
+                                   const ProgressCallback& progress = no_progress());
+
+// The table and summary from the states of all kNumBands bands.
+FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
+                                        const std::vector<FiberBandState>& bands, bool cancelled);
 
 }  // namespace weft

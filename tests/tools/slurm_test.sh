@@ -1,0 +1,113 @@
+#!/usr/bin/env bash
+# The Slurm path end to end on a real single-node Slurm: munge key, a minimal slurm.conf with one
+# node of nproc CPUs, munged, slurmctld and slurmd started here (as root, on private ports and
+# sockets, in a temporary folder), then `weft slurm --shards 4` for a fiber bake and a sweep
+# (sbatch --array and a dependent merge job), each merged output compared byte for byte with the
+# one-process run; the daemons are stopped at the end. Installs nothing (scripts/install-deps.sh
+# installs slurm-wlm and munge); exits 77 (skipped, with the reason) only where the scheduler
+# cannot start: not root, no slurm-wlm or munge, or the daemons do not come up.
+# Usage: slurm_test.sh WEFT_EXE SOURCE_DIR
+set -uo pipefail
+weft=$(readlink -f "$1")
+src=$(readlink -f "$2")
+skip() { echo "slurm_test: SKIPPED: $*"; exit 77; }
+[ "$(id -u)" -eq 0 ] || skip "needs root to start munged, slurmctld and slurmd"
+for b in munged slurmctld slurmd sbatch squeue sinfo; do
+  command -v "$b" >/dev/null || skip "$b not found (scripts/install-deps.sh installs slurm-wlm and munge)"
+done
+
+T=$(mktemp -d /tmp/weft-slurm.XXXXXX)
+chmod 755 "$T"
+pids=()
+cleanup() {
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null; done
+  [ "${KEEP:-0}" = 1 ] || rm -rf "$T"
+}
+trap cleanup EXIT
+
+# munge: its own key, socket and folders.
+mkdir -p "$T/munge" "$T/state" "$T/spool" "$T/out"
+chmod 700 "$T/munge"
+dd if=/dev/urandom of="$T/munge/munge.key" bs=1024 count=1 status=none
+chmod 400 "$T/munge/munge.key"
+munged --foreground --force --key-file="$T/munge/munge.key" --socket="$T/munge/socket" \
+  --pid-file="$T/munge/pid" --log-file="$T/munge/log" --seed-file="$T/munge/seed" \
+  >"$T/munged.out" 2>&1 &
+pids+=($!)
+
+host=$(hostname -s)
+cpus=$(nproc)
+port=$((20000 + RANDOM % 20000))
+cat > "$T/slurm.conf" <<CONF
+ClusterName=weft-test
+SlurmctldHost=$host(127.0.0.1)
+SlurmctldPort=$port
+SlurmdPort=$((port + 1))
+SlurmUser=root
+SlurmdUser=root
+AuthType=auth/munge
+CredType=cred/munge
+AuthInfo=socket=$T/munge/socket
+StateSaveLocation=$T/state
+SlurmdSpoolDir=$T/spool
+SlurmctldPidFile=$T/slurmctld.pid
+SlurmdPidFile=$T/slurmd.pid
+SlurmctldLogFile=$T/slurmctld.log
+SlurmdLogFile=$T/slurmd.log
+ProctrackType=proctrack/linuxproc
+TaskPlugin=task/none
+SwitchType=switch/none
+MpiDefault=none
+SelectType=select/cons_tres
+SelectTypeParameters=CR_CPU
+SchedulerType=sched/builtin
+ReturnToService=2
+JobCompType=jobcomp/none
+AccountingStorageType=accounting_storage/none
+JobAcctGatherType=jobacct_gather/none
+SlurmctldTimeout=10
+SlurmdTimeout=10
+MinJobAge=30
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
+PartitionName=weft Nodes=$host Default=YES MaxTime=INFINITE State=UP
+CONF
+export SLURM_CONF=$T/slurm.conf
+for i in $(seq 50); do [ -S "$T/munge/socket" ] && break; sleep 0.1; done
+[ -S "$T/munge/socket" ] || skip "munged did not start: $(cat "$T/munge/log" 2>/dev/null)"
+slurmctld -D -i -f "$SLURM_CONF" >"$T/slurmctld.out" 2>&1 &
+pids+=($!)
+slurmd -D -f "$SLURM_CONF" -N "$host" >"$T/slurmd.out" 2>&1 &
+pids+=($!)
+up=0
+for i in $(seq 100); do
+  state=$(sinfo -h -o %t 2>/dev/null | head -1)
+  [ "$state" = idle ] && up=1 && break
+  sleep 0.2
+done
+[ $up = 1 ] || skip "slurmctld/slurmd did not come up (state '$state'): $(tail -3 "$T/slurmctld.log" "$T/slurmd.log" 2>/dev/null)"
+echo "slurm_test: single-node Slurm up ($cpus CPUs) after $i polls"
+
+fail=0
+# Submits through weft slurm, waits for the merge job, compares with the one-process run.
+check() {
+  local name=$1 out=$2
+  shift 2
+  "$weft" slurm --shards 4 "$@" -o "$T/out/$out" || { echo "FAIL $name: weft slurm"; fail=1; return; }
+  for i in $(seq 600); do
+    [ -z "$(squeue -h 2>/dev/null)" ] && break
+    sleep 0.1
+  done
+  "$weft" "$@" -o "$T/out/one-$out" >/dev/null || { echo "FAIL $name: one-process run"; fail=1; return; }
+  if [ -f "$T/out/$out" ] && cmp -s "$T/out/$out" "$T/out/one-$out"; then
+    echo "slurm_test: $name: 4 shards through sbatch --array + merge == one process (bytes)"
+  else
+    echo "FAIL $name: merged output missing or different"
+    tail -5 "$T/out/$out.slurm/"*.log 2>/dev/null
+    fail=1
+  fi
+}
+cd "$T"
+check "bake fiber" fiber.exr bake fiber red-cotton --photons 400 --resolution 2 --passes 2 --quiet
+check "sweep" sweep.csv sweep "$src/scenes/examples/woven-patch.json" --spp 1 --resolution 8 --quiet
+exit $fail

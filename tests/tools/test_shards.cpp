@@ -1,0 +1,281 @@
+// Long jobs split and survived: shards merged by `weft merge` give the bytes of the one-process
+// run (bake fiber, bake fabric --method raytrace, sweep); merge refuses parts of other jobs,
+// duplicates and missing shards (naming them); runs killed with SIGKILL at random moments and
+// resumed with --resume end with the bytes of an uninterrupted run; outputs never overwrite
+// inputs or each other.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "test_util.h"
+
+namespace fs = std::filesystem;
+using weft::testing::fresh_test_dir;
+
+namespace {
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> split(const std::string& args) {
+  std::vector<std::string> out;
+  std::istringstream in(args);
+  std::string a;
+  while (in >> a) out.push_back(a);
+  return out;
+}
+
+// Starts weft with 'args' (no shell; stdout and stderr to files in 'dir').
+pid_t spawn(const std::vector<std::string>& args, const fs::path& dir) {
+  const pid_t pid = fork();
+  if (pid == 0) {
+    const std::string out = (dir / "stdout").string(), err = (dir / "stderr").string();
+    if (!std::freopen(out.c_str(), "w", stdout) || !std::freopen(err.c_str(), "w", stderr))
+      _exit(126);
+    std::vector<char*> argv;
+    std::string exe = WEFT_EXE;
+    argv.push_back(exe.data());
+    std::vector<std::string> copy = args;
+    for (auto& a : copy) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    execv(WEFT_EXE, argv.data());
+    _exit(127);
+  }
+  return pid;
+}
+
+int wait_exit(pid_t pid) {
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+int run_weft(const std::vector<std::string>& args, const fs::path& dir) {
+  return wait_exit(spawn(args, dir));
+}
+
+std::vector<std::string> operator+(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// Runs 'args' as 4 shards, merges them and expects the bytes of 'reference'.
+void expect_shards_merge_to(const std::vector<std::string>& args, const fs::path& reference,
+                            const fs::path& dir, const std::string& ext) {
+  std::vector<std::string> merge = {"merge"};
+  for (int k = 0; k < 4; ++k) {
+    const fs::path part = dir / ("part-" + std::to_string(k) + ".part");
+    ASSERT_EQ(run_weft(args + std::vector<std::string>{"--shard", std::to_string(k) + "/4", "-o",
+                                                       part.string()},
+                       dir),
+              0)
+        << slurp(dir / "stderr");
+    merge.push_back(part.string());
+  }
+  // Any order of the parts.
+  std::swap(merge[1], merge[3]);
+  const fs::path merged = dir / ("merged" + ext);
+  ASSERT_EQ(run_weft(merge + std::vector<std::string>{"-o", merged.string()}, dir), 0)
+      << slurp(dir / "stderr");
+  const std::string a = slurp(reference), b = slurp(merged);
+  EXPECT_GT(a.size(), 0u);
+  EXPECT_TRUE(a == b) << reference << " and " << merged << " differ";
+}
+
+const std::vector<std::string> kFiberBake =
+    split("bake fiber red-cotton --photons 3000 --resolution 3 --passes 4 --quiet --threads 2");
+const std::string kScene = std::string(WEFT_SOURCE_DIR) + "/scenes/examples/woven-patch.json";
+const std::vector<std::string> kSweep =
+    split("sweep " + kScene + " --spp 2 --resolution 12 --quiet --threads 2");
+
+}  // namespace
+
+TEST(Shards, FiberBakeOfFourShardsMergesToTheOneProcessBytes) {
+  const fs::path dir = fresh_test_dir();
+  for (const char* bands : {"spectral", "rgb"}) {
+    const auto args = kFiberBake + std::vector<std::string>{"--bands", bands};
+    const fs::path one = dir / (std::string("one-") + bands + ".exr");
+    ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
+        << slurp(dir / "stderr");
+    expect_shards_merge_to(args, one, dir, ".exr");
+  }
+}
+
+TEST(Shards, RaytracedFabricOfFourShardsMergesToTheOneProcessBytes) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = dir / "fiber.exr";
+  ASSERT_EQ(
+      run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()}, dir),
+      0);
+  // 2100 particles per bin: the batch runner's tasks of 2048 straddle incident bins, so a
+  // shard's first and last task hold particles of its neighbours' bins.
+  const auto args =
+      split("bake fabric --method raytrace -R 2 --samples 2100 --quiet --fiber " + fiber.string());
+  const fs::path one = dir / "one.exr";
+  ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
+      << slurp(dir / "stderr");
+  expect_shards_merge_to(args, one, dir, ".exr");
+}
+
+TEST(Shards, SweepOfFourShardsMergesToTheOneProcessBytes) {
+  const fs::path dir = fresh_test_dir();
+  // The scene normalizes (to beta at normal incidence): the reference render is a unit too.
+  for (const char* light : {"30", "0"}) {
+    const auto args = kSweep + std::vector<std::string>{"--light-zenith-deg", light};
+    const fs::path one = dir / (std::string("one-") + light + ".csv");
+    ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
+        << slurp(dir / "stderr");
+    expect_shards_merge_to(args, one, dir, ".csv");
+  }
+}
+
+TEST(Shards, MergeRefusesMissingDuplicateAndForeignParts) {
+  const fs::path dir = fresh_test_dir();
+  auto part = [&](const std::string& name, const std::string& shard, const std::string& seed) {
+    const fs::path p = dir / name;
+    EXPECT_EQ(
+        run_weft(split("bake fiber red-cotton --photons 200 --resolution 2 --passes 1 --quiet "
+                       "--seed " +
+                       seed + " --shard " + shard + " -o " + p.string()),
+                 dir),
+        0);
+    return p.string();
+  };
+  const std::string p0 = part("p0", "0/3", "1"), p1 = part("p1", "1/3", "1"),
+                    p2 = part("p2", "2/3", "1"), other = part("other", "2/3", "2");
+  const fs::path out = dir / "out.exr";
+  auto refused = [&](const std::vector<std::string>& parts, const std::string& says) {
+    EXPECT_EQ(run_weft(std::vector<std::string>{"merge"} + parts +
+                           std::vector<std::string>{"-o", out.string()},
+                       dir),
+              2);
+    const std::string err = slurp(dir / "stderr");
+    EXPECT_NE(err.find(says), std::string::npos) << err;
+    EXPECT_FALSE(fs::exists(out));
+  };
+  refused({p0, p2}, "missing shard 1/3");
+  refused({p0, p1, p1, p2}, "given twice");
+  refused({p0, p1, other}, "belongs to another job");
+  refused({p0, p1, p2, dir / "stdout"}, "not a weft part");
+  // A truncated part is named, not read past its end.
+  const std::string bytes = slurp(p2);
+  std::ofstream(dir / "cut", std::ios::binary) << bytes.substr(0, bytes.size() - 8);
+  refused({p0, p1, (dir / "cut").string()}, "truncated");
+  EXPECT_EQ(run_weft({"merge", p2, p0, p1, "-o", out.string()}, dir), 0) << slurp(dir / "stderr");
+}
+
+// SIGKILL at random moments (seeded: the same moments every run), each run continuing from the
+// checkpoint the killed one left, then a last run to the end: the bytes of an uninterrupted run.
+// Delays are uniform over [0, 1.2 x] the uninterrupted run's time, however loaded the machine.
+void kill_and_resume(const std::vector<std::string>& args, const std::string& ext, int trials,
+                     const fs::path& dir = fresh_test_dir()) {
+  const fs::path one = dir / ("one" + ext);
+  const auto t0 = std::chrono::steady_clock::now();
+  ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
+      << slurp(dir / "stderr");
+  const int max_delay_ms = static_cast<int>(
+      1.2 *
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  std::mt19937 rng(20261201);
+  int killed = 0, finished_first = 0, from_checkpoint = 0;
+  for (int t = 0; t < trials; ++t) {
+    const fs::path out = dir / ("resumed-" + std::to_string(t) + ext);
+    const auto run = args + std::vector<std::string>{"--resume", "-o", out.string()};
+    const fs::path checkpoint = dir / ("." + out.filename().string() + ".weft-checkpoint");
+    for (int k = 0; k < 3; ++k) {
+      if (fs::exists(checkpoint)) ++from_checkpoint;
+      const pid_t pid = spawn(run, dir);
+      int status = 0;
+      bool reaped = false;
+      // The second kill of a trial waits for a checkpoint first, so that some runs continue
+      // from one however fast or loaded the machine; the others die at any moment.
+      if (k == 1)
+        while (!fs::exists(checkpoint) && !(reaped = waitpid(pid, &status, WNOHANG) == pid))
+          std::this_thread::sleep_for(std::chrono::milliseconds(2));
+      std::this_thread::sleep_for(std::chrono::milliseconds(
+          std::uniform_int_distribution<int>(0, k == 1 ? max_delay_ms / 4 : max_delay_ms)(rng)));
+      kill(pid, SIGKILL);
+      if (!reaped) waitpid(pid, &status, 0);
+      const int code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      if (code == 128 + SIGKILL) ++killed;
+      if (code == 0) ++finished_first;
+      EXPECT_TRUE(code == 0 || code == 128 + SIGKILL) << code << ": " << slurp(dir / "stderr");
+    }
+    if (fs::exists(checkpoint)) ++from_checkpoint;
+    ASSERT_EQ(run_weft(run, dir), 0) << slurp(dir / "stderr");
+    EXPECT_TRUE(slurp(one) == slurp(out)) << "trial " << t << ": " << out << " differs";
+    EXPECT_FALSE(fs::exists(checkpoint));
+  }
+  std::printf(
+      "kill/resume: %d trials, %d runs killed, %d finished before their kill, %d runs started "
+      "from a checkpoint\n",
+      trials, killed, finished_first, from_checkpoint);
+  EXPECT_GT(from_checkpoint, 0);  // resuming was exercised, not only starting afresh
+}
+
+TEST(Resume, FiberBakeKilledAtRandomMomentsResumesToTheSameBytes) {
+  kill_and_resume(split("bake fiber red-cotton --photons 6000 --resolution 3 --passes 12 "
+                        "--quiet --threads 2"),
+                  ".exr", 6);
+}
+
+TEST(Resume, SweepKilledAtRandomMomentsResumesToTheSameBytes) {
+  // Views heavy enough that a run's time is mostly rendering, not loading the scene.
+  kill_and_resume(split("sweep " + kScene +
+                        " --spp 16 --resolution 24 --quiet --threads 2 --light-zenith-deg 0"),
+                  ".csv", 6);
+}
+
+TEST(Resume, ShardOfARaytracedFabricKilledAtRandomMomentsResumesToTheSameBytes) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = dir / "fiber.exr";
+  ASSERT_EQ(
+      run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()}, dir),
+      0);
+  kill_and_resume(split("bake fabric --method raytrace -R 3 --samples 3000 --quiet --shard 1/2 "
+                        "--threads 2 --fiber " +
+                        fiber.string()),
+                  ".part", 4, dir);
+}
+
+TEST(Outputs, NeverOverwriteInputsOrEachOther) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path scene = dir / "s.json", spec = dir / "spec.json";
+  fs::copy_file(kScene, scene);
+  fs::copy_file(fs::path(kScene).parent_path() / "woven-patch.gltf", dir / "woven-patch.gltf");
+  std::ofstream(spec) << R"({"name": "t", "fiber_radius_um": 6,
+    "roughness": {"distribution": "beckmann", "alpha": 0.3}, "host": {"n": 1.557},
+    "species": []})";
+  const std::string scene_bytes = slurp(scene), spec_bytes = slurp(spec);
+  auto refused = [&](const std::string& args) {
+    EXPECT_EQ(run_weft(split(args), dir), 2) << args;
+    EXPECT_NE(slurp(dir / "stderr").find("refusing to overwrite"), std::string::npos)
+        << slurp(dir / "stderr");
+  };
+  refused("sweep " + scene.string() + " --spp 1 --resolution 4 -o " + scene.string());
+  // The same file by another spelling.
+  refused("sweep " + scene.string() + " --spp 1 --resolution 4 -o " +
+          (dir / "." / "s.json").string());
+  refused("bake fiber " + spec.string() + " --photons 10 --resolution 2 -o " + spec.string());
+  const fs::path x = dir / "x.exr";
+  refused("render " + scene.string() + " --spp 1 --width 4 --height 4 -o " + x.string() +
+          " --mask " + x.string() + " --mask-object patch");
+  EXPECT_FALSE(fs::exists(x));
+  EXPECT_EQ(slurp(scene), scene_bytes);
+  EXPECT_EQ(slurp(spec), spec_bytes);
+}

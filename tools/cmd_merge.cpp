@@ -1,0 +1,38 @@
+// weft merge: the parts of a sharded bake or sweep (`--shard K/N`) -> the output the unsharded run
+// writes, bit for bit. The parts must be of one job, disjoint and together complete.
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "job_part.h"
+#include "weft/core/error.h"
+
+namespace weft::cli {
+
+void add_merge_command(CLI::App& app, Commands& commands) {
+  struct Options {
+    std::vector<std::string> parts;
+    std::string output;
+    bool json = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* sub = app.add_subcommand(
+      "merge",
+      "Merge the parts of a sharded `bake fiber`, `bake fabric --method raytrace` or `sweep` "
+      "(--shard K/N) into the output of the unsharded run, bit for bit");
+  sub->add_option("parts", o->parts, "part files, one per shard, in any order")->required();
+  sub->add_option("-o,--output", o->output, "output (.exr table or .csv sweep)")->required();
+  sub->add_flag("--json", o->json, "print the command's summary as JSON");
+  commands.push_back(
+      {sub, [o] {
+         validate_output_paths({o->output}, o->parts);
+         const JobPart all =
+             merge_job_parts(std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
+         if (all.command == "bake fiber") return merge_fiber_bake(all, o->output, o->json);
+         if (all.command == "bake fabric") return merge_fabric_bake(all, o->output, o->json);
+         if (all.command == "sweep") return merge_sweep(all, o->output, o->json);
+         throw Error(o->parts.front(), "command", "unknown command '" + all.command + "'");
+       }});
+}
+
+}  // namespace weft::cli

@@ -1,0 +1,153 @@
+// weft slurm: a bake or sweep as a Slurm job array of N shards (`--shard K/N`) plus a merge job
+// that runs after all of them succeeded (`--dependency=afterok`). Writes the two batch scripts
+// beside the output and submits them with sbatch, or prints them (--dry-run) for users who submit
+// themselves. Shards run with --resume: a shard requeued after a node failure continues from its
+// checkpoint.
+#include <unistd.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "commands.h"
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
+
+namespace weft::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string shell_quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+// Runs 'command', returns its stdout and exit status.
+std::pair<std::string, int> run_capture(const std::string& command) {
+  std::string out;
+  FILE* pipe = ::popen(command.c_str(), "r");
+  if (!pipe) return {"", -1};
+  std::array<char, 256> buf{};
+  while (std::fgets(buf.data(), buf.size(), pipe)) out += buf.data();
+  const int status = ::pclose(pipe);
+  return {out, status};
+}
+
+std::string self_path() {
+  std::error_code ec;
+  const fs::path p = fs::read_symlink("/proc/self/exe", ec);
+  return ec ? std::string("weft") : p.string();
+}
+
+}  // namespace
+
+void add_slurm_command(CLI::App& app, Commands& commands) {
+  struct Options {
+    int shards = 0;
+    std::string partition, time, account;
+    int cpus = 0;
+    bool dry_run = false;
+  };
+  auto o = std::make_shared<Options>();
+  auto* sub = app.add_subcommand(
+      "slurm",
+      "Run `weft bake fiber|fabric ...` or `weft sweep ...` as a Slurm job array of --shards "
+      "shards and a merge job after them (scripts in OUTPUT.slurm/)");
+  sub->add_option("--shards", o->shards, "number of shards (array tasks)")
+      ->required()
+      ->check(CLI::Range(1, 10000));
+  sub->add_option("--partition", o->partition, "Slurm partition (sbatch --partition)");
+  sub->add_option("--time", o->time, "time limit per shard (sbatch --time, e.g. 1:00:00)");
+  sub->add_option("--account", o->account, "Slurm account (sbatch --account)");
+  sub->add_option("--cpus-per-task", o->cpus, "CPUs per shard (sbatch --cpus-per-task)")
+      ->check(CLI::Range(1, 4096));
+  sub->add_flag("--dry-run", o->dry_run,
+                "print the scripts and the sbatch commands; submit nothing");
+  sub->allow_extras();
+  sub->footer(
+      "Example: weft slurm --shards 8 --partition cpu bake fiber spec.json -o fiber.exr "
+      "--photons 1000000");
+  commands.push_back(
+      {sub, [o, sub] {
+         std::vector<std::string> args = sub->remaining();
+         if (args.size() < 2 ||
+             !((args[0] == "bake" && (args[1] == "fiber" || args[1] == "fabric")) ||
+               args[0] == "sweep"))
+           throw Error("", "command",
+                       "expected `bake fiber ...`, `bake fabric ...` or `sweep ...`");
+         std::string output;
+         size_t output_at = 0;
+         for (size_t i = 0; i < args.size(); ++i) {
+           if (args[i] == "--shard" || args[i].rfind("--shard=", 0) == 0 || args[i] == "--resume")
+             throw Error("", args[i], "is set by weft slurm for each shard");
+           if ((args[i] == "-o" || args[i] == "--output") && i + 1 < args.size())
+             output = args[i + 1], output_at = i + 1;
+         }
+         if (output.empty()) throw Error("", "--output", "the command needs -o OUTPUT");
+         const fs::path out_abs = fs::absolute(output);
+         validate_output_paths({out_abs.string()}, {});
+         const fs::path dir = out_abs.string() + ".slurm";
+         const std::string weft = self_path();
+         const std::string name = "weft-" + out_abs.filename().string();
+         const int n = o->shards;
+
+         auto directives = [&](const std::string& job_name, const std::string& log) {
+           std::string s = "#!/bin/bash\n#SBATCH --job-name=" + job_name +
+                           "\n#SBATCH --output=" + (dir / log).string() + "\n";
+           if (!o->partition.empty()) s += "#SBATCH --partition=" + o->partition + "\n";
+           if (!o->time.empty()) s += "#SBATCH --time=" + o->time + "\n";
+           if (!o->account.empty()) s += "#SBATCH --account=" + o->account + "\n";
+           if (o->cpus) s += "#SBATCH --cpus-per-task=" + std::to_string(o->cpus) + "\n";
+           return s;
+         };
+         std::string array = directives(name, "shard-%a.log");
+         array += "#SBATCH --array=0-" + std::to_string(n - 1) +
+                  "\n#SBATCH --requeue\nset -eu\ncd " + shell_quote(fs::current_path().string()) +
+                  "\nexec " + shell_quote(weft);
+         for (size_t i = 0; i < args.size(); ++i)
+           array += " " + (i == output_at ? shell_quote((dir / "part-").string()) +
+                                                "\"$SLURM_ARRAY_TASK_ID\".part"
+                                          : shell_quote(args[i]));
+         array += " --shard \"$SLURM_ARRAY_TASK_ID/" + std::to_string(n) + "\" --resume --quiet\n";
+         std::string merge = directives(name + "-merge", "merge.log");
+         merge += "set -eu\ncd " + shell_quote(fs::current_path().string()) + "\nexec " +
+                  shell_quote(weft) + " merge";
+         for (int k = 0; k < n; ++k)
+           merge += " " + shell_quote((dir / ("part-" + std::to_string(k) + ".part")).string());
+         merge += " -o " + shell_quote(out_abs.string()) + "\n";
+
+         const fs::path array_sh = dir / "array.sh", merge_sh = dir / "merge.sh";
+         if (o->dry_run) {
+           std::printf(
+               "# %s\n%s\n# %s\n%s\n# submit with:\n#   jobid=$(sbatch --parsable %s)\n"
+               "#   sbatch --dependency=afterok:${jobid%%%%;*} %s\n",
+               array_sh.c_str(), array.c_str(), merge_sh.c_str(), merge.c_str(),
+               shell_quote(array_sh.string()).c_str(), shell_quote(merge_sh.string()).c_str());
+           return 0;
+         }
+         fs::create_directories(dir);
+         write_text_atomically(array_sh, array);
+         write_text_atomically(merge_sh, merge);
+         const auto [id_text, status] =
+             run_capture("sbatch --parsable " + shell_quote(array_sh.string()));
+         const std::string id = id_text.substr(0, id_text.find_first_of(";\n"));
+         if (status != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
+           throw Error(array_sh.string(), "sbatch", "submission failed: " + id_text);
+         const auto [mid_text, mstatus] = run_capture(
+             "sbatch --parsable --dependency=afterok:" + id + " " + shell_quote(merge_sh.string()));
+         const std::string mid = mid_text.substr(0, mid_text.find_first_of(";\n"));
+         if (mstatus != 0 || mid.empty())
+           throw Error(merge_sh.string(), "sbatch", "submission failed: " + mid_text);
+         std::printf("submitted array job %s (%d shards) and merge job %s -> %s\n", id.c_str(), n,
+                     mid.c_str(), out_abs.c_str());
+         return 0;
+       }});
+}
+
+}  // namespace weft::cli
