@@ -333,8 +333,8 @@ VerifySettings verify_settings(VerifyQuality q) {
       break;
     case VerifyQuality::kDefault:
       s.resolution = 8;
-      s.fiber_photons_per_band = 100000;
-      s.particles_per_bin = 32000;
+      s.fiber_photons_per_band = 200000;  // FiberTableBakeOptions{}'s
+      s.particles_per_bin = 64000;
       s.batches = 4;
       s.summation_samples = 8;
       break;

@@ -210,12 +210,9 @@ TEST(VerifyReportFiles, AllOrNone) {
 }
 
 TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
-  WeaveOptions w = red_cotton_weave_options();
+  WeaveOptions w;
   w.detail = "fiber";
-  w.repeats_x = 1;
-  w.repeats_z = 1;
-  w.fibers_per_yarn = 7;
-  const WovenSample sample = make_woven_sample(w);
+  const WovenSample sample = make_woven_sample(overlay(red_cotton_weave_options(), w));
   VerifySettings s = verify_settings(VerifyQuality::kDraft);
   s.resolution = 2;
   s.particles_per_bin = 200;
