@@ -52,9 +52,7 @@ int run(const VerifyCliOptions& o) {
   if (!o.wif.empty()) given.wif = o.wif;
   given.detail = "fiber";  // the fiber-level reference
   const WeaveOptions base = o.weave.empty() ? WeaveOptions{} : read_weave_options(o.weave);
-  const auto out_parent = std::filesystem::absolute(o.output).parent_path();
-  if (!std::filesystem::is_directory(out_parent))
-    throw Error(o.output, "-o", "the output's parent directory does not exist");
+  check_verify_output(o.output);
 
   const auto progress = progress_bar(o.quiet);
   VerifyInputs in;

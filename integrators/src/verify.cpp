@@ -775,8 +775,7 @@ std::string verify_index_html(const VerifyReport& r,
   return h.str();
 }
 
-void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
-                         const std::function<void(const std::filesystem::path&)>& draw) {
+void check_verify_output(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
   const fs::path target = fs::absolute(dir);
@@ -795,12 +794,22 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
                     "refusing to replace it");
     }
   }
+}
+
+void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
+                         const std::function<void(const std::filesystem::path&)>& draw) {
+  namespace fs = std::filesystem;
+  check_verify_output(dir);
+  std::error_code ec;
+  const fs::path target = fs::absolute(dir);
+  const fs::path parent = target.parent_path();
   static std::atomic<uint64_t> calls{0};
   const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(calls.fetch_add(1));
   const fs::path staging = parent / (".tmp-" + target.filename().string() + "-" + tag + "-partial");
   const fs::path old = parent / (".tmp-" + target.filename().string() + "-" + tag + "-old");
   try {
-    fs::create_directory(staging);
+    if (!fs::create_directory(staging, ec) || ec)
+      throw Error(dir.string(), "-o", "cannot create a staging folder beside it");
     write_text_atomically(staging / "inplane.csv", verify_inplane_csv(report));
     write_text_atomically(staging / "metrics.json", verify_metrics_json(report));
     draw(staging);
@@ -817,8 +826,12 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
     }
     write_text_atomically(staging / "index.html", verify_index_html(report, images));
     // The earlier report (if any) is moved aside, the new one moved in, the old one removed.
-    if (fs::exists(target, ec)) fs::rename(target, old);
-    fs::rename(staging, target);
+    if (fs::exists(target, ec)) {
+      fs::rename(target, old, ec);
+      if (ec) throw Error(dir.string(), "-o", "cannot move the earlier report aside");
+    }
+    fs::rename(staging, target, ec);
+    if (ec) throw Error(dir.string(), "-o", "cannot move the finished report into place");
   } catch (...) {
     fs::remove_all(staging, ec);
     if (fs::exists(old, ec) && !fs::exists(target, ec)) fs::rename(old, target, ec);

@@ -30,10 +30,14 @@ std::string slurp(const fs::path& p) {
 }
 
 VerifyRun run_weft(const std::string& args, const fs::path& dir) {
-  // PATH without /usr/bin's python3 first: the plots must not depend on it.
-  const std::string cmd = "PATH=/nonexistent:$PATH '" + std::string(WEFT_EXE) + "' " + args +
-                          " >'" + (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() +
-                          "'";
+  // A python3 that fails, first on PATH: the plots must not depend on which python3 that finds.
+  const fs::path bin = dir / "fakebin";
+  fs::create_directories(bin);
+  std::ofstream(bin / "python3") << "#!/bin/sh\nexit 1\n";
+  fs::permissions(bin / "python3", fs::perms::owner_all);
+  const std::string cmd = "PATH='" + bin.string() + "':$PATH '" + std::string(WEFT_EXE) + "' " +
+                          args + " >'" + (dir / "stdout").string() + "' 2>'" +
+                          (dir / "stderr").string() + "'";
   const int status = std::system(cmd.c_str());
   VerifyRun r;
   r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -91,4 +95,12 @@ TEST(CliVerify, DraftWritesTheWholeReport) {
   EXPECT_NE(html.find("real fabric (paper, Table 1)"), std::string::npos);
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+  // A second run into a folder that holds something else is refused, and the folder kept.
+  const fs::path other = dir / "other";
+  fs::create_directories(other);
+  std::ofstream(other / "notes.txt") << "mine";
+  const VerifyRun r2 = run_weft("verify --quiet --quality draft -o '" + other.string() + "'", dir);
+  EXPECT_EQ(r2.exit_code, 2);
+  EXPECT_NE(r2.err.find("refusing"), std::string::npos) << r2.err;
+  EXPECT_TRUE(fs::exists(other / "notes.txt"));
 }

@@ -199,6 +199,8 @@ std::string verify_index_html(const VerifyReport& report,
 // PNGs, then the staging folder replaces DIR. DIR must not exist, be empty, or hold an earlier
 // report (its metrics.json has "report": "weft verify"); anything else is refused (weft::Error
 // naming DIR) and left alone.
+// The check write_verify_report makes first, for callers to make before the work.
+void check_verify_output(const std::filesystem::path& dir);
 void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
                          const std::function<void(const std::filesystem::path& staging)>& draw);
 
