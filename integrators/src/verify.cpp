@@ -157,9 +157,10 @@ MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
       throw Error(file, where + " theta_o_deg", "must lie in (-90, 90)");
     for (size_t k = 2; k < 5; ++k)
       if (v[k] < 0) throw Error(file, where + " " + needed[k], "a radiance coefficient is >= 0");
-    // The table's theta_o is negative on the mirror side; the paper's view angle positive.
+    // The table's theta_o is negative on the mirror side, the paper's view positive (0.0 - x:
+    // no negative zero).
     auto& curve = rows[v[0]];
-    if (!curve.emplace(-v[1], Rgb(v[2], v[3], v[4])).second)
+    if (!curve.emplace(0.0 - v[1], Rgb(v[2], v[3], v[4])).second)
       throw Error(file, where, "duplicate row for this (theta_i_deg, theta_o_deg)");
   }
   if (rows.empty()) throw Error(file, "", "no data rows");
