@@ -441,12 +441,21 @@ void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& nor
   MetricsAccumulator abs_all, norm_all;
   for (size_t i = 0; i < meas.curves.size(); ++i) {
     MetricsAccumulator a, n;
+    std::array<MetricsAccumulator, 3> ac, nc;
     const auto& c = meas.curves[i];
     for (size_t v = 0; v < c.view_deg.size(); ++v)
       for (int k = 0; k < 3; ++k) {
-        a.add(channel(m.beta[i][v], k), channel(c.beta[v], k));
-        n.add(channel(m.beta[i][v], k) * channel(m.normalization, k), channel(c.beta[v], k));
+        ac[k].add(channel(m.beta[i][v], k), channel(c.beta[v], k));
+        nc[k].add(channel(m.beta[i][v], k) * channel(m.normalization, k), channel(c.beta[v], k));
       }
+    auto& acm = m.absolute_channel.emplace_back();
+    auto& ncm = m.normalized_channel.emplace_back();
+    for (int k = 0; k < 3; ++k) {
+      a.add(ac[k]);
+      n.add(nc[k]);
+      acm[k] = ac[k].result();
+      ncm[k] = nc[k].result();
+    }
     m.absolute.push_back(a.result());
     m.normalized.push_back(n.result());
     abs_all.add(a);
@@ -639,10 +648,18 @@ std::string verify_metrics_json(const VerifyReport& r) {
   nlohmann::json models = nlohmann::json::object();
   for (const auto& m : r.models) {
     nlohmann::json per = nlohmann::json::array();
-    for (size_t i = 0; i < r.measured.curves.size(); ++i)
+    for (size_t i = 0; i < r.measured.curves.size(); ++i) {
+      nlohmann::json channels = nlohmann::json::object();
+      if (i < m.absolute_channel.size())
+        for (int k = 0; k < 3; ++k)
+          channels[std::string(1, "RGB"[k])] = {
+              {"absolute", metrics_json(m.absolute_channel[i][k])},
+              {"normalized", metrics_json(m.normalized_channel[i][k])}};
       per.push_back({{"theta_i_deg", r.measured.curves[i].theta_i_deg},
                      {"absolute", metrics_json(m.absolute[i])},
-                     {"normalized", metrics_json(m.normalized[i])}});
+                     {"normalized", metrics_json(m.normalized[i])},
+                     {"channels", channels}});
+    }
     models[m.key] = {{"label", m.label},
                      {"normalization_factor", rgb_json(m.normalization)},
                      {"absolute", metrics_json(m.absolute_overall)},

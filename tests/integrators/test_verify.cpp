@@ -238,6 +238,14 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
     EXPECT_NEAR(r.classic_reflectance.r, 0.6, 2e-3);
     EXPECT_NEAR(r.classic_reflectance.b, 0.6, 2e-3);
     ASSERT_GE(r.colours.size(), 2u);
+    // Per curve (incidence, channel): their points add up to the incidence's.
+    for (const auto& mc : r.models)
+      for (size_t i = 0; i < m.curves.size(); ++i) {
+        size_t points = 0;
+        for (const auto& c : mc.normalized_channel[i]) points += c.points + c.excluded;
+        EXPECT_EQ(points, mc.normalized[i].points + mc.normalized[i].excluded);
+        EXPECT_EQ(points, 3u * m.curves[i].view_deg.size());
+      }
     EXPECT_EQ(r.colours[0].name, "computed fabric, reflection");
     r.seconds.clear();
     r.settings.threads = 0;

@@ -166,6 +166,8 @@ struct ModelCurves {
   Rgb normalization{1.0};                        // paper's, per channel
   // [incidence] then overall ("all" last): absolute and normalized metrics, channels together.
   std::vector<CurveMetrics> absolute, normalized;
+  // [incidence][channel]: each curve (one incidence, one channel) on its own.
+  std::vector<std::array<CurveMetrics, 3>> absolute_channel, normalized_channel;
   CurveMetrics absolute_overall, normalized_overall;
 };
 
