@@ -14,6 +14,7 @@ AddCommand add_slab_command, add_spectrum_command, add_bake_command, add_bench_c
 
 // The "fabric" subcommand of the "bake" group (cmd_bake_fabric.cpp).
 AddCommand add_bake_fabric_command;
+AddCommand add_verify_command;  // cmd_verify.cpp
 
 // The subcommands of "bench" (cmd_bench.cpp makes the group).
 AddCommand add_bench_bake_command, add_bench_render_command;

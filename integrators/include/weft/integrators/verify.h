@@ -1,0 +1,209 @@
+#pragma once
+// weft verify (docs/verify.md): the paper's verification (Voloboy et al. 2010, section 4) in one
+// call. For every incidence angle of a measured in-plane table, the radiance coefficient
+// beta = pi f in the plane of incidence of
+//   * the computed fabric: fabric tables of the woven sample made from the fiber table, by the
+//     fiber-level ray trace (integrators/fabric_raytrace.h) and by the paper's summation (made by
+//     the caller: the summation lives in the fiber physics, which this library does not link);
+//   * the classic baseline: a Lambert + Cook-Torrance fiber (materials/classic_fiber.h) whose
+//     diffuse colour is the fiber's volume albedo, tabulated as a fiber table and ray-traced on the
+//     same sample, so the two differ only in the fiber's BSDF;
+//   * the measurement;
+// and the metrics that compare them (absolute and with the paper's normalization), the fabric's
+// colour in reflection and transmission (paper's Table 1), and the report files.
+//
+// Why the tables and not the gonioreflectometer sweep: a fabric table is the cloth's BSDF, the
+// quantity a gonioreflectometer on an infinite sample measures, so beta at any (incidence, view)
+// is pi times the table's value; one table serves every incidence, where the sweep renders one
+// image per view and incidence (9 x 35 renders for the bundled measurement) and adds the edges of
+// a finite patch. The table's resolution limits the angular detail (a bin spans about
+// 180 / (2 R) degrees), which the quality levels trade against time.
+//
+// In-plane directions (cloth frame, z = normal): light at zenith theta_i and azimuth phi,
+// w_i = (sin theta_i cos phi, sin theta_i sin phi, cos theta_i); a view zenith v > 0 lies on the
+// mirror side (the paper's Fig. 7), w_o = (-sin v cos phi, -sin v sin phi, cos v). The measured
+// tables are of isotropic fits, so the computed values are averaged over 'azimuths' planes
+// phi = 360 k / azimuths.
+#include <array>
+#include <cstdint>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/core/spectrum.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/materials/microfacet.h"
+#include "weft/scenes/weave.h"
+
+namespace weft {
+
+// ---- The measurement -------------------------------------------------------------------------
+
+// One incidence of a measured in-plane table; views in the paper's sign (> 0 on the mirror side).
+struct MeasuredCurve {
+  double theta_i_deg = 0;
+  std::vector<double> view_deg;
+  std::vector<Rgb> beta;
+};
+
+struct MeasuredInplane {
+  std::string file;
+  std::vector<MeasuredCurve> curves;  // by increasing theta_i
+};
+
+// Reads a table in the format of materials/data/measured/*/inplane.csv: optional comment lines
+// starting with '#' or '"#', a header naming at least theta_i_deg, theta_o_deg, nbrdf_beta_R,
+// nbrdf_beta_G, nbrdf_beta_B, and one row per (theta_i, theta_o) with theta_o < 0 on the mirror
+// side (that table's convention; flipped here). weft::Error naming the file and the column (or
+// line) on a missing file or column, a non-number, a negative or non-finite beta, an angle out of
+// range, or a duplicate row.
+MeasuredInplane read_measured_inplane(const std::filesystem::path& path);
+
+// The bundled MERL red fabric (materials/data/measured/merl-red-fabric/inplane.csv), found in the
+// source tree or the installed tree; weft::Error listing the places tried.
+std::filesystem::path bundled_measured_inplane();
+
+// ---- Evaluating a table in the plane of incidence ---------------------------------------------
+
+// beta = pi f of an RGB table (3 channels), averaged over 'azimuths' planes of incidence, for
+// each view of 'views_deg' (paper's sign).
+std::vector<Rgb> inplane_beta(const TabulatedBsdfTable& rgb_table, double theta_i_deg,
+                              const std::vector<double>& views_deg, int azimuths);
+
+// A spectral table (33 bands) as linear sRGB under D65 (core/spectrum.h bands_to_linear_srgb);
+// negative components (out of gamut) are set to 0 and counted in 'clip'. A 3-channel table is
+// returned as it is.
+TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& table, GamutClip* clip = nullptr);
+
+// ---- Metrics ---------------------------------------------------------------------------------
+
+// model vs measurement over points where both are positive: RMS of ln(model / measured) and of
+// (model - measured) / measured. Points where either is <= 0 are not in the RMS and are counted
+// in 'excluded' (a log ratio is undefined there).
+struct CurveMetrics {
+  double rms_log = 0, rms_rel = 0;
+  size_t points = 0, excluded = 0;
+};
+
+// Accumulates squared errors of points; 'result' gives the RMS over what was added.
+struct MetricsAccumulator {
+  double sum_log2 = 0, sum_rel2 = 0;
+  size_t points = 0, excluded = 0;
+  void add(double model, double measured);
+  void add(const MetricsAccumulator& other);
+  CurveMetrics result() const;
+};
+
+// The paper's normalization, per channel: the factor that makes the model's beta at normal
+// incidence and normal view equal the measured one. weft::Error when the model's value is not
+// positive there (no factor exists).
+Rgb paper_normalization(const Rgb& model_at_normal, const Rgb& measured_at_normal,
+                        const std::string& model_name);
+
+// ---- Colour (paper's Table 1) ----------------------------------------------------------------
+
+struct ColourEntry {
+  std::string name;
+  std::optional<Spectrum> spectrum;  // absent for entries given as RGB or HSV
+  Rgb linear_srgb;                   // D65, unclipped (negative = out of gamut)
+  Hsv hsv;                           // of the linear sRGB with negative components set to 0
+  std::string note;
+};
+
+// The colour of a reflectance or transmittance spectrum under D65 through CIE 1931.
+ColourEntry colour_of_spectrum(const std::string& name, const Spectrum& spectrum,
+                               const std::string& note);
+
+// Reflectance and transmittance spectra of a spectral fabric table (33 bands) at normal
+// incidence (the directional albedo of the wi bin containing the normal, materials/bsdf_table.h).
+struct FabricSpectra {
+  Spectrum reflectance{}, transmittance{};
+};
+FabricSpectra normal_incidence_spectra(const TabulatedBsdfTable& spectral_table);
+
+// ---- The whole verification ------------------------------------------------------------------
+
+enum class VerifyQuality { kDraft, kDefault, kPublication };
+VerifyQuality parse_verify_quality(const std::string& name);  // weft::Error naming "--quality"
+std::string quality_name(VerifyQuality q);
+
+// What a quality level sets. One place for the figures (docs/verify.md gives their times).
+struct VerifySettings {
+  VerifyQuality quality = VerifyQuality::kDefault;
+  int resolution = 8;                   // of the fiber and fabric tables
+  uint64_t fiber_photons_per_band = 0;  // the fiber bake
+  uint64_t particles_per_bin = 0;       // ray trace, all batches together
+  int batches = 4;                      // independent ray traces (the error bars)
+  int summation_samples = 8;            // direction pairs per cell pair (summation, classic)
+  int azimuths = 24;                    // planes of incidence averaged
+  uint64_t seed = 1;
+  int threads = 0;  // 0 = all cores; results do not depend on it
+};
+VerifySettings verify_settings(VerifyQuality quality);
+
+// What the caller brings: the fiber physics' results (this library does not link them).
+struct VerifyInputs {
+  TabulatedBsdfTable fiber;  // fiber table (spectral for the colour table, or RGB)
+  // The fiber's volume albedo per band (albedo minus the surface part): the classic model's
+  // diffuse colour.
+  Spectrum volume_albedo{};
+  MicrofacetDistribution classic_distribution;  // the fiber's surface roughness
+  double classic_ior = 1.5;
+  std::optional<TabulatedBsdfTable> summation;  // the paper's summation table (any channels)
+  std::string fiber_name, sample_name;
+  std::map<std::string, double> seconds;  // timings of the caller's steps (fiber bake, ...)
+};
+
+// One model's curves: per measured incidence, beta at every measured view, and its standard
+// error (zero where the model is deterministic).
+struct ModelCurves {
+  std::string key, label;
+  std::vector<std::vector<Rgb>> beta, beta_err;  // [incidence][view]
+  Rgb normalization{1.0};                        // paper's, per channel
+  // [incidence] then overall ("all" last): absolute and normalized metrics, channels together.
+  std::vector<CurveMetrics> absolute, normalized;
+  // [incidence][channel]: each curve (one incidence, one channel) on its own.
+  std::vector<std::array<CurveMetrics, 3>> absolute_channel, normalized_channel;
+  CurveMetrics absolute_overall, normalized_overall;
+};
+
+struct VerifyReport {
+  VerifySettings settings;
+  MeasuredInplane measured;
+  std::vector<ModelCurves> models;  // "computed_raytrace", "computed_summation"?, "classic"
+  std::vector<ColourEntry> colours;
+  Rgb classic_reflectance;  // the classic model's diffuse colour (linear sRGB, clipped to [0,1])
+  GamutClip classic_clip;   // what making it a reflectance removed
+  std::map<std::string, double> seconds;
+  std::string fiber_name, sample_name;
+  size_t fabric_table_gamut_clipped = 0;  // components of the computed table set to 0
+  double raytrace_relative_noise = 0;     // of the combined computed table (fabric_raytrace.h)
+  bool cancelled = false;
+};
+
+VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& inputs,
+                        const MeasuredInplane& measured, const VerifySettings& settings,
+                        const ProgressCallback& progress = no_progress());
+
+// The report's files, as text: the long-form curves CSV and metrics JSON (stable keys,
+// docs/verify.md), and the offline HTML page embedding the given images (file name -> bytes).
+std::string verify_inplane_csv(const VerifyReport& report);
+std::string verify_metrics_json(const VerifyReport& report);
+std::string verify_index_html(const VerifyReport& report,
+                              const std::vector<std::pair<std::string, std::string>>& images);
+
+// Writes DIR whole or not at all: inplane.csv and metrics.json into a staging folder beside DIR,
+// then draw(staging) (the plots: PNG and SVG files it writes there), then index.html embedding the
+// PNGs, then the staging folder replaces DIR. DIR must not exist, be empty, or hold an earlier
+// report (its metrics.json has "report": "weft verify"); anything else is refused (weft::Error
+// naming DIR) and left alone.
+// The check write_verify_report makes first, for callers to make before the work.
+void check_verify_output(const std::filesystem::path& dir);
+void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
+                         const std::function<void(const std::filesystem::path& staging)>& draw);
+
+}  // namespace weft

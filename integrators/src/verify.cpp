@@ -1,0 +1,861 @@
+#include "weft/integrators/verify.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <system_error>
+
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
+#include "weft/core/hash.h"
+#include "weft/core/install_paths.h"
+#include "weft/integrators/fabric_raytrace.h"
+#include "weft/materials/classic_fiber.h"
+
+#ifndef WEFT_DATA_DIR
+#define WEFT_DATA_DIR ""
+#endif
+
+namespace weft {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kDeg = kPi / 180.0;
+
+std::vector<std::string> split_csv(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : line) {
+    if (c == ',') {
+      out.push_back(cur);
+      cur.clear();
+    } else if (c != '\r') {
+      cur.push_back(c);
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+double parse_number(const std::string& text, const std::string& file, const std::string& field) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (const std::exception&) {
+    used = 0;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v))
+    throw Error(file, field, "'" + text + "' is not a finite number");
+  return v;
+}
+
+double channel(const Rgb& c, int k) {
+  return k == 0 ? c.r : (k == 1 ? c.g : c.b);
+}
+
+nlohmann::json metrics_json(const CurveMetrics& m) {
+  return {{"rms_log", m.rms_log},
+          {"rms_rel", m.rms_rel},
+          {"points", m.points},
+          {"excluded", m.excluded}};
+}
+
+nlohmann::json rgb_json(const Rgb& c) {
+  return nlohmann::json::array({c.r, c.g, c.b});
+}
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// Batch k of a model's ray trace: its own stream, from the run's seed (core/hash.h).
+uint64_t batch_seed(uint64_t seed, const std::string& model, int k) {
+  return fnv1a64(model + ":" + std::to_string(seed) + ":" + std::to_string(k));
+}
+
+std::string html_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o.push_back(c);
+    }
+  }
+  return o;
+}
+
+std::string fmt(double v, int digits = 3) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
+}  // namespace
+
+// ---- Measurement ---------------------------------------------------------------------------
+
+MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::ifstream in(path);
+  if (!in) throw Error(file, "", "cannot open the measured in-plane table");
+  std::string line;
+  std::vector<std::string> header;
+  size_t line_no = 0;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line[0] == '#' || line.rfind("\"#", 0) == 0) continue;
+    header = split_csv(line);
+    break;
+  }
+  if (header.empty()) throw Error(file, "", "no header line (empty table)");
+  const std::vector<std::string> needed = {"theta_i_deg", "theta_o_deg", "nbrdf_beta_R",
+                                           "nbrdf_beta_G", "nbrdf_beta_B"};
+  std::array<size_t, 5> col{};
+  for (size_t k = 0; k < needed.size(); ++k) {
+    const auto it = std::find(header.begin(), header.end(), needed[k]);
+    if (it == header.end()) throw Error(file, needed[k], "missing column");
+    col[k] = static_cast<size_t>(it - header.begin());
+  }
+  std::map<double, std::map<double, Rgb>> rows;  // theta_i -> view (paper's sign) -> beta
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line == "\r") continue;
+    const auto f = split_csv(line);
+    const std::string where = "line " + std::to_string(line_no);
+    if (f.size() != header.size())
+      throw Error(file, where,
+                  std::to_string(f.size()) + " fields where the header has " +
+                      std::to_string(header.size()));
+    std::array<double, 5> v{};
+    for (size_t k = 0; k < 5; ++k) v[k] = parse_number(f[col[k]], file, where + " " + needed[k]);
+    if (v[0] < 0 || v[0] >= 90) throw Error(file, where + " theta_i_deg", "must lie in [0, 90)");
+    if (v[1] <= -90 || v[1] >= 90)
+      throw Error(file, where + " theta_o_deg", "must lie in (-90, 90)");
+    for (size_t k = 2; k < 5; ++k)
+      if (v[k] < 0) throw Error(file, where + " " + needed[k], "a radiance coefficient is >= 0");
+    // The table's theta_o is negative on the mirror side, the paper's view positive (0.0 - x:
+    // no negative zero).
+    auto& curve = rows[v[0]];
+    if (!curve.emplace(0.0 - v[1], Rgb(v[2], v[3], v[4])).second)
+      throw Error(file, where, "duplicate row for this (theta_i_deg, theta_o_deg)");
+  }
+  if (rows.empty()) throw Error(file, "", "no data rows");
+  MeasuredInplane m;
+  m.file = file;
+  for (const auto& [ti, views] : rows) {
+    MeasuredCurve c;
+    c.theta_i_deg = ti;
+    for (const auto& [v, b] : views) {
+      c.view_deg.push_back(v);
+      c.beta.push_back(b);
+    }
+    m.curves.push_back(std::move(c));
+  }
+  return m;
+}
+
+std::filesystem::path bundled_measured_inplane() {
+  std::string tried;
+  const auto p = find_installed_file(WEFT_DATA_DIR, "materials",
+                                     "measured/merl-red-fabric/inplane.csv", &tried);
+  if (p.empty())
+    throw Error("merl-red-fabric/inplane.csv", "--measured",
+                "the bundled measurement is not found (tried: " + tried + ")");
+  return p;
+}
+
+// ---- Tables in the plane of incidence ---------------------------------------------------------
+
+std::vector<Rgb> inplane_beta(const TabulatedBsdfTable& t, double theta_i_deg,
+                              const std::vector<double>& views_deg, int azimuths) {
+  if (t.channels != 3) throw Error("", "channels", "inplane_beta needs an RGB table");
+  if (azimuths < 1) throw Error("", "azimuths", "must be >= 1");
+  std::vector<Rgb> out(views_deg.size());
+  std::array<double, 3> f{};
+  const double ti = theta_i_deg * kDeg;
+  for (size_t k = 0; k < views_deg.size(); ++k) {
+    const double v = views_deg[k] * kDeg;
+    Rgb sum;
+    for (int a = 0; a < azimuths; ++a) {
+      const double phi = 2 * kPi * a / azimuths;
+      const Vec3 wi{std::sin(ti) * std::cos(phi), std::sin(ti) * std::sin(phi), std::cos(ti)};
+      const Vec3 wo{-std::sin(v) * std::cos(phi), -std::sin(v) * std::sin(phi), std::cos(v)};
+      t.interpolate(wo, wi, f);
+      sum += Rgb(f[0], f[1], f[2]);
+    }
+    out[k] = sum * (kPi / azimuths);
+  }
+  return out;
+}
+
+TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& t, GamutClip* clip) {
+  if (t.channels == 3) return t;
+  if (t.channels != kNumBands) throw Error("", "channels", "neither RGB nor 33 bands");
+  TabulatedBsdfTable o;
+  o.resolution = t.resolution;
+  o.channels = 3;
+  o.kind = t.kind;
+  o.metadata = t.metadata;
+  const size_t cells = t.values.size() / kNumBands;
+  o.values.resize(cells * 3);
+  GamutClip local;
+  for (size_t c = 0; c < cells; ++c) {
+    const float* v = &t.values[c * kNumBands];
+    Rgb rgb = bands_to_linear_srgb([v](int b) { return v[b]; });
+    (clip ? *clip : local).clip(rgb);
+    o.values[c * 3] = static_cast<float>(rgb.r);
+    o.values[c * 3 + 1] = static_cast<float>(rgb.g);
+    o.values[c * 3 + 2] = static_cast<float>(rgb.b);
+  }
+  return o;
+}
+
+// ---- Metrics ----------------------------------------------------------------------------------
+
+void MetricsAccumulator::add(double model, double measured) {
+  if (!(model > 0) || !(measured > 0)) {
+    ++excluded;
+    return;
+  }
+  const double l = std::log(model / measured), r = (model - measured) / measured;
+  sum_log2 += l * l;
+  sum_rel2 += r * r;
+  ++points;
+}
+
+void MetricsAccumulator::add(const MetricsAccumulator& o) {
+  sum_log2 += o.sum_log2;
+  sum_rel2 += o.sum_rel2;
+  points += o.points;
+  excluded += o.excluded;
+}
+
+CurveMetrics MetricsAccumulator::result() const {
+  CurveMetrics m;
+  m.points = points;
+  m.excluded = excluded;
+  if (points) {
+    m.rms_log = std::sqrt(sum_log2 / static_cast<double>(points));
+    m.rms_rel = std::sqrt(sum_rel2 / static_cast<double>(points));
+  } else {
+    m.rms_log = m.rms_rel = std::numeric_limits<double>::quiet_NaN();
+  }
+  return m;
+}
+
+Rgb paper_normalization(const Rgb& model, const Rgb& measured, const std::string& name) {
+  Rgb f;
+  for (int k = 0; k < 3; ++k) {
+    if (!(channel(model, k) > 0))
+      throw Error(name, "normalization",
+                  "the model's beta at normal incidence and view is not positive in channel " +
+                      std::to_string(k) + ": no normalization factor exists");
+    (k == 0 ? f.r : k == 1 ? f.g : f.b) = channel(measured, k) / channel(model, k);
+  }
+  return f;
+}
+
+// ---- Colour -----------------------------------------------------------------------------------
+
+ColourEntry colour_of_spectrum(const std::string& name, const Spectrum& s,
+                               const std::string& note) {
+  ColourEntry e;
+  e.name = name;
+  e.spectrum = s;
+  e.note = note;
+  e.linear_srgb = xyz_to_linear_srgb(reflectance_to_xyz_d65(s));
+  Rgb c = e.linear_srgb;
+  GamutClip().clip(c);
+  e.hsv = rgb_to_hsv(c);
+  return e;
+}
+
+FabricSpectra normal_incidence_spectra(const TabulatedBsdfTable& t) {
+  if (t.channels != kNumBands)
+    throw Error("", "channels", "the colour table needs a spectral (33-band) fabric table");
+  const auto a = t.directional_albedo(t.grid().bin_of({0, 0, 1}));
+  FabricSpectra s;
+  for (int b = 0; b < kNumBands; ++b) {
+    s.reflectance[b] = a.reflectance[b];
+    s.transmittance[b] = a.transmittance[b];
+  }
+  return s;
+}
+
+// ---- Settings ---------------------------------------------------------------------------------
+
+VerifyQuality parse_verify_quality(const std::string& name) {
+  if (name == "draft") return VerifyQuality::kDraft;
+  if (name == "default") return VerifyQuality::kDefault;
+  if (name == "publication") return VerifyQuality::kPublication;
+  throw Error("", "--quality", "'" + name + "' is not draft, default or publication");
+}
+
+std::string quality_name(VerifyQuality q) {
+  return q == VerifyQuality::kDraft     ? "draft"
+         : q == VerifyQuality::kDefault ? "default"
+                                        : "publication";
+}
+
+VerifySettings verify_settings(VerifyQuality q) {
+  VerifySettings s;
+  s.quality = q;
+  switch (q) {
+    case VerifyQuality::kDraft:
+      s.resolution = 6;
+      s.fiber_photons_per_band = 20000;
+      s.particles_per_bin = 4000;
+      s.batches = 2;
+      s.summation_samples = 4;
+      break;
+    case VerifyQuality::kDefault:
+      s.resolution = 8;
+      s.fiber_photons_per_band = 200000;  // FiberTableBakeOptions{}'s
+      s.particles_per_bin = 64000;
+      s.batches = 4;
+      s.summation_samples = 8;
+      break;
+    case VerifyQuality::kPublication:
+      s.resolution = 12;
+      s.fiber_photons_per_band = 1000000;
+      s.particles_per_bin = 256000;
+      s.batches = 8;
+      s.summation_samples = 16;
+      break;
+  }
+  return s;
+}
+
+// ---- The run ----------------------------------------------------------------------------------
+
+namespace {
+
+// Ray-traced fabric table of 'fiber' in 'batches' independent runs: the curves of their mean and
+// the standard error of that mean from their spread (what the error bars show).
+struct TracedCurves {
+  std::vector<std::vector<Rgb>> beta, err;
+  TabulatedBsdfTable mean;  // the fiber table's channels
+  double relative_noise = 0;
+  bool cancelled = false;
+};
+
+TracedCurves trace_curves(const WovenSample& sample, const TabulatedBsdfTable& fiber,
+                          const MeasuredInplane& measured, const VerifySettings& s,
+                          const std::string& model, const ProgressCallback& progress) {
+  TracedCurves out;
+  const size_t n_inc = measured.curves.size();
+  std::vector<std::vector<std::vector<Rgb>>> per_batch;  // [batch][incidence][view]
+  std::vector<double> sum;
+  double noise2 = 0;
+  for (int k = 0; k < s.batches; ++k) {
+    FabricRaytraceOptions o;
+    o.resolution = s.resolution;
+    o.particles_per_bin = s.particles_per_bin / static_cast<uint64_t>(s.batches);
+    o.seed = batch_seed(s.seed, model, k);
+    o.threads = s.threads;
+    const FabricRaytraceResult r = raytrace_fabric_table(sample, fiber, o, progress);
+    if (r.cancelled) {
+      out.cancelled = true;
+      return out;
+    }
+    noise2 += r.relative_noise * r.relative_noise;
+    if (sum.empty()) {
+      sum.assign(r.table.values.size(), 0.0);
+      out.mean = r.table;
+    }
+    for (size_t i = 0; i < sum.size(); ++i) sum[i] += r.table.values[i];
+    const TabulatedBsdfTable rgb = table_to_rgb(r.table);
+    auto& curves = per_batch.emplace_back();
+    for (const auto& c : measured.curves)
+      curves.push_back(inplane_beta(rgb, c.theta_i_deg, c.view_deg, s.azimuths));
+  }
+  for (size_t i = 0; i < sum.size(); ++i)
+    out.mean.values[i] = static_cast<float>(sum[i] / s.batches);
+  // Each batch's noise is sqrt(batches) times the mean's.
+  out.relative_noise = std::sqrt(noise2 / s.batches) / std::sqrt(double(s.batches));
+  out.beta.resize(n_inc);
+  out.err.resize(n_inc);
+  const double kb = s.batches;
+  for (size_t i = 0; i < n_inc; ++i) {
+    const size_t nv = measured.curves[i].view_deg.size();
+    out.beta[i].assign(nv, Rgb());
+    out.err[i].assign(nv, Rgb());
+    for (size_t v = 0; v < nv; ++v) {
+      Rgb m, m2;
+      for (const auto& b : per_batch) {
+        m += b[i][v];
+        m2 += b[i][v] * b[i][v];
+      }
+      m = m / kb;
+      Rgb var = m2 / kb + m * m * -1.0;  // population variance of the batches
+      Rgb err;
+      for (int c = 0; c < 3; ++c) {
+        const double sd2 = std::max(0.0, channel(var, c)) * kb / std::max(1.0, kb - 1);
+        (c == 0 ? err.r : c == 1 ? err.g : err.b) = std::sqrt(sd2 / kb);
+      }
+      out.beta[i][v] = m;
+      out.err[i][v] = err;
+    }
+  }
+  return out;
+}
+
+ModelCurves model_curves(std::string key, std::string label, std::vector<std::vector<Rgb>> beta,
+                         std::vector<std::vector<Rgb>> err) {
+  ModelCurves m;
+  m.key = std::move(key);
+  m.label = std::move(label);
+  m.beta = std::move(beta);
+  m.beta_err = std::move(err);
+  return m;
+}
+
+void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& normal_curve,
+           size_t normal_view) {
+  const Rgb model0 = m.beta[&normal_curve - meas.curves.data()][normal_view];
+  m.normalization = paper_normalization(model0, normal_curve.beta[normal_view], m.label);
+  MetricsAccumulator abs_all, norm_all;
+  for (size_t i = 0; i < meas.curves.size(); ++i) {
+    MetricsAccumulator a, n;
+    std::array<MetricsAccumulator, 3> ac, nc;
+    const auto& c = meas.curves[i];
+    for (size_t v = 0; v < c.view_deg.size(); ++v)
+      for (int k = 0; k < 3; ++k) {
+        ac[k].add(channel(m.beta[i][v], k), channel(c.beta[v], k));
+        nc[k].add(channel(m.beta[i][v], k) * channel(m.normalization, k), channel(c.beta[v], k));
+      }
+    auto& acm = m.absolute_channel.emplace_back();
+    auto& ncm = m.normalized_channel.emplace_back();
+    for (int k = 0; k < 3; ++k) {
+      a.add(ac[k]);
+      n.add(nc[k]);
+      acm[k] = ac[k].result();
+      ncm[k] = nc[k].result();
+    }
+    m.absolute.push_back(a.result());
+    m.normalized.push_back(n.result());
+    abs_all.add(a);
+    norm_all.add(n);
+  }
+  m.absolute_overall = abs_all.result();
+  m.normalized_overall = norm_all.result();
+}
+
+}  // namespace
+
+VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
+                        const MeasuredInplane& measured, const VerifySettings& s,
+                        const ProgressCallback& progress) {
+  if (s.batches < 2) throw Error("", "batches", "the error bars need at least 2 batches");
+  if (s.particles_per_bin < static_cast<uint64_t>(s.batches))
+    throw Error("", "particles_per_bin", "fewer particles than batches");
+  if (in.fiber.resolution != s.resolution)
+    throw Error("", "fiber.resolution", "the fiber table's resolution differs from the settings'");
+  // The paper's normalization needs the measurement at normal incidence and view.
+  const MeasuredCurve* normal_curve = nullptr;
+  size_t normal_view = 0;
+  for (const auto& c : measured.curves)
+    if (c.theta_i_deg == 0)
+      for (size_t v = 0; v < c.view_deg.size(); ++v)
+        if (c.view_deg[v] == 0) {
+          normal_curve = &c;
+          normal_view = v;
+        }
+  if (!normal_curve)
+    throw Error(measured.file, "theta_i_deg",
+                "no row at theta_i_deg = 0, theta_o_deg = 0 (the paper's normalization needs it)");
+
+  VerifyReport rep;
+  rep.settings = s;
+  rep.measured = measured;
+  rep.seconds = in.seconds;
+  rep.fiber_name = in.fiber_name;
+  rep.sample_name = in.sample_name;
+  const auto t_all = std::chrono::steady_clock::now();
+
+  // Computed: the fiber-level ray trace of the fiber table.
+  auto t0 = std::chrono::steady_clock::now();
+  TracedCurves computed = trace_curves(sample, in.fiber, measured, s, "computed", progress);
+  if (computed.cancelled) {
+    rep.cancelled = true;
+    return rep;
+  }
+  rep.seconds["raytrace_computed"] = seconds_since(t0);
+  rep.raytrace_relative_noise = computed.relative_noise;
+  {
+    GamutClip clip;
+    table_to_rgb(computed.mean, &clip);
+    rep.fabric_table_gamut_clipped = clip.components;
+  }
+  rep.models.push_back(model_curves("computed_raytrace", "computed (fiber-level ray trace)",
+                                    computed.beta, computed.err));
+
+  // Computed: the paper's summation (deterministic up to its stratified cell sampling).
+  if (in.summation) {
+    const TabulatedBsdfTable rgb = table_to_rgb(*in.summation);
+    ModelCurves m = model_curves("computed_summation", "computed (paper's summation)", {}, {});
+    for (const auto& c : measured.curves) {
+      m.beta.push_back(inplane_beta(rgb, c.theta_i_deg, c.view_deg, s.azimuths));
+      m.beta_err.emplace_back(c.view_deg.size(), Rgb());
+    }
+    rep.models.push_back(std::move(m));
+  }
+
+  // Classic: Lambert + Cook-Torrance with the fiber's volume albedo as its diffuse colour, a
+  // reflectance, so components outside [0, 1] are removed (and reported).
+  t0 = std::chrono::steady_clock::now();
+  Rgb refl = bands_to_linear_srgb([&](int b) { return in.volume_albedo[b]; });
+  rep.classic_clip.clip(refl);
+  for (double* v : {&refl.r, &refl.g, &refl.b})
+    if (*v > 1) {
+      rep.classic_clip.largest = std::max(rep.classic_clip.largest, *v - 1);
+      ++rep.classic_clip.components;
+      *v = 1;
+    }
+  rep.classic_reflectance = refl;
+  const ClassicFiberBsdf classic =
+      ClassicFiberBsdf::create(refl, in.classic_distribution, in.classic_ior);
+  // Outside the fiber only: the ray trace lights the far crossing point from inside, where an
+  // opaque classic fiber reflects nothing.
+  TabulatedBsdfTable classic_fiber = TabulatedBsdfTable::from_function(
+      s.resolution, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const Rgb f = wo.z > 0 && wi.z > 0 ? classic.eval(wo, wi) : Rgb();
+        v[0] = f.r;
+        v[1] = f.g;
+        v[2] = f.b;
+      },
+      s.summation_samples, s.seed, s.threads, progress);
+  classic_fiber.kind = "fiber";
+  TracedCurves cl = trace_curves(sample, classic_fiber, measured, s, "classic", progress);
+  if (cl.cancelled) {
+    rep.cancelled = true;
+    return rep;
+  }
+  rep.seconds["raytrace_classic"] = seconds_since(t0);
+  rep.models.push_back(
+      model_curves("classic", "classic (Lambert + Cook-Torrance)", cl.beta, cl.err));
+
+  for (auto& m : rep.models) score(m, measured, *normal_curve, normal_view);
+
+  // Colour table (paper's Table 1): the spectral ray-traced fabric at normal incidence.
+  if (computed.mean.channels == kNumBands) {
+    const FabricSpectra sp = normal_incidence_spectra(computed.mean);
+    rep.colours.push_back(colour_of_spectrum(
+        "computed fabric, reflection", sp.reflectance,
+        "directional reflectance at normal incidence (light and viewer on the same side)"));
+    rep.colours.push_back(colour_of_spectrum(
+        "computed fabric, transmission", sp.transmittance,
+        "directional transmittance at normal incidence (light and viewer on opposite sides)"));
+    if (in.summation && in.summation->channels == kNumBands) {
+      const FabricSpectra ss = normal_incidence_spectra(*in.summation);
+      rep.colours.push_back(colour_of_spectrum("paper's summation, reflection", ss.reflectance,
+                                               "the summation transmits nothing"));
+    }
+    rep.colours.push_back(colour_of_spectrum("fiber volume albedo (classic diffuse colour)",
+                                             in.volume_albedo, "before clipping to [0, 1]"));
+  }
+  {
+    ColourEntry paper;
+    paper.name = "real fabric (paper, Table 1)";
+    paper.hsv = {0.98, 0.99, 0.8};
+    paper.linear_srgb = {std::nan(""), std::nan(""), std::nan("")};
+    paper.note = "Voloboy et al. 2010, Table 1, as quoted in issue 8 (HSV only)";
+    rep.colours.push_back(paper);
+    ColourEntry merl;
+    merl.name = "measured (this table), normal incidence and view";
+    merl.linear_srgb = normal_curve->beta[normal_view];
+    merl.hsv = rgb_to_hsv(merl.linear_srgb);
+    merl.note = "camera RGB of the measurement's database, not sRGB: hue only roughly comparable";
+    rep.colours.push_back(merl);
+  }
+  rep.seconds["verify_library"] = seconds_since(t_all);
+  return rep;
+}
+
+// ---- Report files ---------------------------------------------------------------------------
+
+std::string verify_inplane_csv(const VerifyReport& r) {
+  std::ostringstream o;
+  o.precision(9);
+  o << "theta_i_deg,view_zenith_deg,model,channel,beta,beta_err,beta_norm,norm_factor\n";
+  const char* ch[3] = {"R", "G", "B"};
+  for (size_t i = 0; i < r.measured.curves.size(); ++i) {
+    const auto& c = r.measured.curves[i];
+    for (size_t v = 0; v < c.view_deg.size(); ++v) {
+      for (int k = 0; k < 3; ++k)
+        o << c.theta_i_deg << ',' << c.view_deg[v] << ",measured," << ch[k] << ','
+          << channel(c.beta[v], k) << ",0," << channel(c.beta[v], k) << ",1\n";
+      for (const auto& m : r.models)
+        for (int k = 0; k < 3; ++k) {
+          const double f = channel(m.normalization, k);
+          o << c.theta_i_deg << ',' << c.view_deg[v] << ',' << m.key << ',' << ch[k] << ','
+            << channel(m.beta[i][v], k) << ',' << channel(m.beta_err[i][v], k) << ','
+            << channel(m.beta[i][v], k) * f << ',' << f << '\n';
+        }
+    }
+  }
+  return o.str();
+}
+
+std::string verify_metrics_json(const VerifyReport& r) {
+  nlohmann::json j;
+  j["report"] = "weft verify";
+  j["measured"] = r.measured.file;
+  j["fiber"] = r.fiber_name;
+  j["sample"] = r.sample_name;
+  const VerifySettings& s = r.settings;
+  j["settings"] = {{"quality", quality_name(s.quality)},
+                   {"resolution", s.resolution},
+                   {"fiber_photons_per_band", s.fiber_photons_per_band},
+                   {"particles_per_bin", s.particles_per_bin},
+                   {"batches", s.batches},
+                   {"summation_samples", s.summation_samples},
+                   {"azimuths", s.azimuths},
+                   {"threads", s.threads}};
+  j["seed"] = s.seed;
+  j["seconds"] = r.seconds;
+  j["normalization"] =
+      "paper (section 4): per model and channel, beta scaled so that beta at normal incidence and "
+      "view equals the measured one";
+  j["metrics"] =
+      "rms_log: RMS of ln(model / measured); rms_rel: RMS of (model - measured) / "
+      "measured; over every view, incidence and channel where both are positive";
+  nlohmann::json models = nlohmann::json::object();
+  for (const auto& m : r.models) {
+    nlohmann::json per = nlohmann::json::array();
+    for (size_t i = 0; i < r.measured.curves.size(); ++i) {
+      nlohmann::json channels = nlohmann::json::object();
+      if (i < m.absolute_channel.size())
+        for (int k = 0; k < 3; ++k)
+          channels[std::string(1, "RGB"[k])] = {
+              {"absolute", metrics_json(m.absolute_channel[i][k])},
+              {"normalized", metrics_json(m.normalized_channel[i][k])}};
+      per.push_back({{"theta_i_deg", r.measured.curves[i].theta_i_deg},
+                     {"absolute", metrics_json(m.absolute[i])},
+                     {"normalized", metrics_json(m.normalized[i])},
+                     {"channels", channels}});
+    }
+    models[m.key] = {{"label", m.label},
+                     {"normalization_factor", rgb_json(m.normalization)},
+                     {"absolute", metrics_json(m.absolute_overall)},
+                     {"normalized", metrics_json(m.normalized_overall)},
+                     {"per_incidence", per}};
+  }
+  j["models"] = models;
+  // The headline figures (issue 8): computed is the fiber-level ray trace.
+  for (const auto& m : r.models) {
+    if (m.key == "computed_raytrace") {
+      j["computed_rms_log"] = m.normalized_overall.rms_log;
+      j["computed_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["computed_rms_rel"] = m.normalized_overall.rms_rel;
+      j["computed_rms_rel_absolute"] = m.absolute_overall.rms_rel;
+    }
+    if (m.key == "classic") {
+      j["classic_rms_log"] = m.normalized_overall.rms_log;
+      j["classic_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["classic_rms_rel"] = m.normalized_overall.rms_rel;
+      j["classic_rms_rel_absolute"] = m.absolute_overall.rms_rel;
+    }
+  }
+  nlohmann::json colours = nlohmann::json::array();
+  for (const auto& c : r.colours) {
+    nlohmann::json e = {{"name", c.name}, {"hsv", {c.hsv.h, c.hsv.s, c.hsv.v}}, {"note", c.note}};
+    if (std::isfinite(c.linear_srgb.r)) e["linear_srgb"] = rgb_json(c.linear_srgb);
+    if (c.spectrum) e["spectrum"] = *c.spectrum;
+    colours.push_back(e);
+  }
+  j["colour_table"] = colours;
+  j["classic_reflectance_linear_srgb"] = rgb_json(r.classic_reflectance);
+  j["classic_reflectance_clipped_components"] = r.classic_clip.components;
+  j["fabric_table_gamut_clipped_components"] = r.fabric_table_gamut_clipped;
+  j["raytrace_relative_noise"] = r.raytrace_relative_noise;
+  return j.dump(2) + "\n";
+}
+
+std::string verify_index_html(const VerifyReport& r,
+                              const std::vector<std::pair<std::string, std::string>>& images) {
+  std::ostringstream h;
+  h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>weft verify</title>\n"
+       "<style>body{font-family:sans-serif;max-width:1400px;margin:auto}table{border-collapse:"
+       "collapse}td,th{border:1px solid #aaa;padding:3px 8px;text-align:right}"
+       "td:first-child,th:first-child{text-align:left}img{max-width:100%}</style></head><body>\n";
+  h << "<h1>weft verify: computed fabric vs measurement vs classic model</h1>\n";
+  h << "<p>Measurement: " << html_escape(r.measured.file)
+    << "<br>Fiber: " << html_escape(r.fiber_name) << "<br>Sample: " << html_escape(r.sample_name)
+    << "</p>\n";
+  h << "<h2>Metrics (over every view, incidence and channel)</h2>\n<table><tr><th>model</th>"
+       "<th>RMS log ratio, normalized</th><th>RMS relative, normalized</th><th>RMS log ratio, "
+       "absolute</th><th>RMS relative, absolute</th><th>normalization factor (R, G, B)</th>"
+       "<th>points (excluded)</th></tr>\n";
+  for (const auto& m : r.models)
+    h << "<tr><td>" << html_escape(m.label) << "</td><td>" << fmt(m.normalized_overall.rms_log)
+      << "</td><td>" << fmt(m.normalized_overall.rms_rel) << "</td><td>"
+      << fmt(m.absolute_overall.rms_log) << "</td><td>" << fmt(m.absolute_overall.rms_rel)
+      << "</td><td>" << fmt(m.normalization.r) << ", " << fmt(m.normalization.g) << ", "
+      << fmt(m.normalization.b) << "</td><td>" << m.normalized_overall.points << " ("
+      << m.normalized_overall.excluded << ")</td></tr>\n";
+  h << "</table>\n<h3>Per incidence: RMS log ratio, normalized (absolute)</h3>\n<table><tr>"
+       "<th>theta_i (deg)</th>";
+  for (const auto& m : r.models) h << "<th>" << html_escape(m.label) << "</th>";
+  h << "</tr>\n";
+  for (size_t i = 0; i < r.measured.curves.size(); ++i) {
+    h << "<tr><td>" << fmt(r.measured.curves[i].theta_i_deg) << "</td>";
+    for (const auto& m : r.models)
+      h << "<td>" << fmt(m.normalized[i].rms_log) << " (" << fmt(m.absolute[i].rms_log) << ")</td>";
+    h << "</tr>\n";
+  }
+  h << "</table>\n<h2>In-plane curves</h2>\n<p>beta / pi against the view zenith (positive on "
+       "the mirror side), one panel per incidence and channel; error bars one standard "
+       "error.</p>\n";
+  for (const auto& [name, bytes] : images) {
+    const auto* p = reinterpret_cast<const uint8_t*>(bytes.data());
+    h << "<h3>" << html_escape(name) << "</h3>\n<img alt=\"" << html_escape(name)
+      << "\" src=\"data:image/png;base64," << base64(std::span<const uint8_t>(p, bytes.size()))
+      << "\">\n";
+  }
+  h << "<h2>Colour (paper's Table 1): CIE 1931, D65</h2>\n<table><tr><th>what</th><th>linear "
+       "sRGB</th><th>H</th><th>S</th><th>V</th><th></th><th>note</th></tr>\n";
+  for (const auto& c : r.colours) {
+    h << "<tr><td>" << html_escape(c.name) << "</td><td>";
+    if (std::isfinite(c.linear_srgb.r))
+      h << fmt(c.linear_srgb.r) << ", " << fmt(c.linear_srgb.g) << ", " << fmt(c.linear_srgb.b);
+    else
+      h << "&mdash;";
+    // A swatch: HSV to display RGB.
+    const double hh = c.hsv.h * 6, cc = c.hsv.v * c.hsv.s;
+    const double x = cc * (1 - std::abs(std::fmod(hh, 2.0) - 1)), mm = c.hsv.v - cc;
+    double rr = 0, gg = 0, bb = 0;
+    const int sector = static_cast<int>(hh) % 6;
+    if (sector == 0)
+      rr = cc, gg = x;
+    else if (sector == 1)
+      rr = x, gg = cc;
+    else if (sector == 2)
+      gg = cc, bb = x;
+    else if (sector == 3)
+      gg = x, bb = cc;
+    else if (sector == 4)
+      rr = x, bb = cc;
+    else
+      rr = cc, bb = x;
+    auto byte = [&](double v) {
+      return std::clamp(static_cast<int>(std::lround(255 * linear_to_srgb_gamma(v + mm))), 0, 255);
+    };
+    char swatch[96];
+    std::snprintf(swatch, sizeof swatch, "background:rgb(%d,%d,%d);width:3em", byte(rr), byte(gg),
+                  byte(bb));
+    h << "</td><td>" << fmt(c.hsv.h) << "</td><td>" << fmt(c.hsv.s) << "</td><td>" << fmt(c.hsv.v)
+      << "</td><td style=\"" << swatch << "\"></td><td>" << html_escape(c.note) << "</td></tr>\n";
+  }
+  h << "</table>\n<p>Classic diffuse colour (linear sRGB): " << fmt(r.classic_reflectance.r) << ", "
+    << fmt(r.classic_reflectance.g) << ", " << fmt(r.classic_reflectance.b) << " ("
+    << r.classic_clip.components << " components clipped to [0, 1]).</p>\n";
+  const VerifySettings& s = r.settings;
+  h << "<h2>Settings, seed and timings</h2>\n<table>"
+    << "<tr><td>quality</td><td>" << quality_name(s.quality) << "</td></tr>"
+    << "<tr><td>table resolution R</td><td>" << s.resolution << "</td></tr>"
+    << "<tr><td>fiber photons per band</td><td>" << s.fiber_photons_per_band << "</td></tr>"
+    << "<tr><td>ray-trace particles per incident bin (all batches)</td><td>" << s.particles_per_bin
+    << "</td></tr><tr><td>batches</td><td>" << s.batches
+    << "</td></tr><tr><td>summation samples per cell pair</td><td>" << s.summation_samples
+    << "</td></tr><tr><td>planes of incidence averaged</td><td>" << s.azimuths
+    << "</td></tr><tr><td>seed</td><td>" << s.seed << "</td></tr><tr><td>threads</td><td>"
+    << s.threads << "</td></tr><tr><td>ray-trace relative noise</td><td>"
+    << fmt(r.raytrace_relative_noise) << "</td></tr>\n";
+  for (const auto& [k, v] : r.seconds)
+    h << "<tr><td>" << html_escape(k) << " (s)</td><td>" << fmt(v, 4) << "</td></tr>";
+  h << "</table>\n</body></html>\n";
+  return h.str();
+}
+
+void check_verify_output(const std::filesystem::path& dir) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path target = fs::absolute(dir);
+  const fs::path parent = target.parent_path();
+  if (!fs::is_directory(parent, ec))
+    throw Error(dir.string(), "-o", "the output's parent directory does not exist");
+  if (fs::exists(target, ec)) {
+    if (!fs::is_directory(target, ec))
+      throw Error(dir.string(), "-o", "exists and is not a directory");
+    if (!fs::is_empty(target, ec)) {
+      std::ifstream m(target / "metrics.json");
+      nlohmann::json j = nlohmann::json::parse(m, nullptr, false);
+      if (j.is_discarded() || !j.is_object() || j.value("report", "") != "weft verify")
+        throw Error(dir.string(), "-o",
+                    "exists and holds something other than an earlier weft verify report; "
+                    "refusing to replace it");
+    }
+  }
+}
+
+void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
+                         const std::function<void(const std::filesystem::path&)>& draw) {
+  namespace fs = std::filesystem;
+  check_verify_output(dir);
+  std::error_code ec;
+  const fs::path target = fs::absolute(dir);
+  const fs::path parent = target.parent_path();
+  static std::atomic<uint64_t> calls{0};
+  const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(calls.fetch_add(1));
+  const fs::path staging = parent / (".tmp-" + target.filename().string() + "-" + tag + "-partial");
+  const fs::path old = parent / (".tmp-" + target.filename().string() + "-" + tag + "-old");
+  try {
+    if (!fs::create_directory(staging, ec) || ec)
+      throw Error(dir.string(), "-o", "cannot create a staging folder beside it");
+    write_text_atomically(staging / "inplane.csv", verify_inplane_csv(report));
+    write_text_atomically(staging / "metrics.json", verify_metrics_json(report));
+    draw(staging);
+    std::vector<std::pair<std::string, std::string>> images;
+    std::vector<fs::path> pngs;
+    for (const auto& e : fs::directory_iterator(staging))
+      if (e.path().extension() == ".png") pngs.push_back(e.path());
+    std::sort(pngs.begin(), pngs.end());
+    for (const auto& p : pngs) {
+      std::ifstream f(p, std::ios::binary);
+      std::ostringstream b;
+      b << f.rdbuf();
+      images.emplace_back(p.filename().string(), b.str());
+    }
+    write_text_atomically(staging / "index.html", verify_index_html(report, images));
+    // The earlier report (if any) is moved aside, the new one moved in, the old one removed.
+    if (fs::exists(target, ec)) {
+      fs::rename(target, old, ec);
+      if (ec) throw Error(dir.string(), "-o", "cannot move the earlier report aside");
+    }
+    fs::rename(staging, target, ec);
+    if (ec) throw Error(dir.string(), "-o", "cannot move the finished report into place");
+  } catch (...) {
+    fs::remove_all(staging, ec);
+    if (fs::exists(old, ec) && !fs::exists(target, ec)) fs::rename(old, target, ec);
+    throw;
+  }
+  fs::remove_all(old, ec);
+}
+
+}  // namespace weft

@@ -1,0 +1,264 @@
+// weft verify's library logic (integrators/verify.h): metrics on curves with known answers, the
+// paper's normalization, the measured-table reader (values and errors), in-plane evaluation of a
+// table, colour, the all-or-none report folder, and the same bits at any thread count.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+
+#include "test_util.h"
+#include "weft/core/error.h"
+#include "weft/integrators/verify.h"
+
+namespace fs = std::filesystem;
+using weft::testing::error_of;
+using weft::testing::fresh_test_dir;
+
+namespace weft {
+namespace {
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+
+TEST(VerifyMetrics, ConstantRatioGivesItsLogAndRelativeDifference) {
+  // model = e^0.1 * measured at every point: ln ratio 0.1, relative difference e^0.1 - 1.
+  MetricsAccumulator a;
+  for (double m : {0.01, 0.3, 2.0, 7.5}) a.add(m * std::exp(0.1), m);
+  const CurveMetrics r = a.result();
+  EXPECT_EQ(r.points, 4u);
+  EXPECT_EQ(r.excluded, 0u);
+  EXPECT_NEAR(r.rms_log, 0.1, 1e-12);
+  EXPECT_NEAR(r.rms_rel, std::exp(0.1) - 1, 1e-12);
+}
+
+TEST(VerifyMetrics, MixedRatiosAndExcludedPoints) {
+  // ln ratios 0.3 and -0.4: RMS sqrt((0.09 + 0.16) / 2); relative e^0.3 - 1, e^-0.4 - 1.
+  MetricsAccumulator a, b;
+  a.add(std::exp(0.3), 1.0);
+  b.add(2 * std::exp(-0.4), 2.0);
+  b.add(0.0, 1.0);  // model zero: no log ratio
+  b.add(1.0, 0.0);  // measurement zero
+  a.add(b);
+  const CurveMetrics r = a.result();
+  EXPECT_EQ(r.points, 2u);
+  EXPECT_EQ(r.excluded, 2u);
+  EXPECT_NEAR(r.rms_log, std::sqrt(0.125), 1e-12);
+  const double e1 = std::exp(0.3) - 1, e2 = std::exp(-0.4) - 1;
+  EXPECT_NEAR(r.rms_rel, std::sqrt((e1 * e1 + e2 * e2) / 2), 1e-12);
+  EXPECT_TRUE(std::isnan(MetricsAccumulator{}.result().rms_log));
+}
+
+TEST(VerifyMetrics, PaperNormalizationPerChannel) {
+  const Rgb f = paper_normalization({2, 4, 8}, {1, 1, 2}, "m");
+  EXPECT_DOUBLE_EQ(f.r, 0.5);
+  EXPECT_DOUBLE_EQ(f.g, 0.25);
+  EXPECT_DOUBLE_EQ(f.b, 0.25);
+  EXPECT_NE(error_of([] {
+              paper_normalization({1, 0, 1}, {1, 1, 1}, "classic");
+            }).find("not positive"),
+            std::string::npos);
+}
+
+TEST(VerifyMeasured, BundledTableHasNineIncidencesAndThePapersSign) {
+  const MeasuredInplane m = read_measured_inplane(bundled_measured_inplane());
+  ASSERT_EQ(m.curves.size(), 9u);
+  const std::vector<double> want = {0, 10, 20, 30, 40, 45, 50, 60, 70};
+  for (size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(m.curves[i].theta_i_deg, want[i]);
+    EXPECT_EQ(m.curves[i].view_deg.size(), 35u);  // -85..85 in 5 deg steps
+  }
+  // Rows of materials/data/measured/merl-red-fabric/inplane.csv: "0,0,...,0.280098,..." and
+  // "30,-30,...,0.257877,..." (theta_o = -30 is the mirror side there, view +30 here).
+  const auto& c0 = m.curves[0];
+  const size_t v0 = std::find(c0.view_deg.begin(), c0.view_deg.end(), 0.0) - c0.view_deg.begin();
+  EXPECT_DOUBLE_EQ(c0.beta[v0].r, 0.280098);
+  const auto& c30 = m.curves[3];
+  const size_t v30 =
+      std::find(c30.view_deg.begin(), c30.view_deg.end(), 30.0) - c30.view_deg.begin();
+  EXPECT_DOUBLE_EQ(c30.beta[v30].r, 0.257877);
+  EXPECT_DOUBLE_EQ(c30.beta[v30].b, 0.0255022);
+}
+
+TEST(VerifyMeasured, BadTablesNameFileAndField) {
+  const fs::path dir = fresh_test_dir();
+  const std::string head = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n";
+  struct Case {
+    std::string text, part;
+  } cases[] = {
+      {"theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_B\n0,0,1,1\n", "nbrdf_beta_G"},
+      {head + "0,0,1,x,1\n", "line 2 nbrdf_beta_G"},
+      {head + "0,0,1,1,1\n0,0,1,1,1\n", "duplicate"},
+      {head + "0,0,1,-1,1\n", "line 2 nbrdf_beta_G"},
+      {head + "95,0,1,1,1\n", "theta_i_deg"},
+      {head + "0,0,1,1\n", "line 2"},
+      {head, "no data rows"},
+  };
+  for (const auto& c : cases) {
+    const fs::path p = dir / "bad.csv";
+    write(p, c.text);
+    const std::string e = error_of([&] { read_measured_inplane(p); });
+    EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+    EXPECT_NE(e.find(c.part), std::string::npos) << c.text << " -> " << e;
+  }
+  EXPECT_NE(error_of([&] { read_measured_inplane(dir / "missing.csv"); }).find("missing.csv"),
+            std::string::npos);
+}
+
+// A table of f = c / pi: beta = pi f = c at every incidence and view (the cell average of a
+// constant is exact, bsdf_table.h).
+TabulatedBsdfTable constant_table(int resolution, int channels, double beta) {
+  return TabulatedBsdfTable::from_function(
+      resolution, channels,
+      [beta](const Vec3&, const Vec3&, std::span<double> v) {
+        for (double& x : v) x = beta / std::numbers::pi;
+      },
+      2, 1, 1);
+}
+
+TEST(VerifyInplane, ConstantTableGivesItsBetaEverywhere) {
+  const TabulatedBsdfTable t = constant_table(4, 3, 0.37);
+  for (double ti : {0.0, 30.0, 70.0}) {
+    const auto b = inplane_beta(t, ti, {-85, -30, 0, 5, 45, 85}, 7);
+    for (const Rgb& c : b) {
+      EXPECT_NEAR(c.r, 0.37, 1e-6);
+      EXPECT_NEAR(c.b, 0.37, 1e-6);
+    }
+  }
+}
+
+TEST(VerifyInplane, InPlaneDirectionsFollowThePapersSign) {
+  // f nonzero only when the view lies on the mirror side (wo.x * wi.x < 0 in the plane phi = 0):
+  // views > 0 see it, views < 0 do not.
+  const TabulatedBsdfTable t = TabulatedBsdfTable::from_function(
+      8, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const double f =
+            wo.z > 0 && wi.z > 0 && wo.x * wi.x < 0 && std::abs(wo.y) < 0.3 && std::abs(wi.y) < 0.3
+                ? 1.0
+                : 0.0;
+        for (double& x : v) x = f;
+      },
+      4, 1, 1);
+  const auto b = inplane_beta(t, 45, {-45, 45}, 1);
+  EXPECT_EQ(b[0].r, 0.0);
+  EXPECT_GT(b[1].r, 0.5);
+}
+
+TEST(VerifyColour, WhiteAndGreyAreNeutral) {
+  Spectrum s;
+  s.fill(0.5);
+  const ColourEntry e = colour_of_spectrum("grey", s, "");
+  EXPECT_NEAR(e.linear_srgb.r, 0.5, 2e-3);  // D65 white -> sRGB white (spectrum.h)
+  EXPECT_NEAR(e.linear_srgb.g, 0.5, 2e-3);
+  EXPECT_NEAR(e.linear_srgb.b, 0.5, 2e-3);
+  EXPECT_LT(e.hsv.s, 0.01);
+  // A spectral constant table converts to equal RGB channels.
+  const TabulatedBsdfTable rgb = table_to_rgb(constant_table(2, kNumBands, 1.0));
+  EXPECT_EQ(rgb.channels, 3);
+  EXPECT_NEAR(rgb.values[0], 1.0 / std::numbers::pi, 1e-3);
+  EXPECT_NEAR(rgb.values[2], 1.0 / std::numbers::pi, 1e-3);
+}
+
+VerifyReport tiny_report() {
+  VerifyReport r;
+  r.measured.file = "m.csv";
+  r.measured.curves.push_back(MeasuredCurve{0, {0, 30}, {Rgb(0.5), Rgb(0.4)}});
+  ModelCurves m;
+  m.key = m.label = "classic";
+  m.beta = {{Rgb(1.0), Rgb(0.8)}};
+  m.beta_err = {{Rgb(0.1), Rgb(0.1)}};
+  m.normalization = Rgb(0.5);
+  m.absolute.push_back({});
+  m.normalized.push_back({});
+  r.models.push_back(m);
+  return r;
+}
+
+TEST(VerifyReportFiles, AllOrNone) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "report";
+  // A failing plot leaves nothing, not even a staging folder.
+  EXPECT_THROW(write_verify_report(out, tiny_report(),
+                                   [](const fs::path&) { throw Error("plot", "", "failed"); }),
+               Error);
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << e.path();
+  // A good run writes every file; a second run replaces it.
+  for (int k = 0; k < 2; ++k) {
+    write_verify_report(out, tiny_report(), [](const fs::path& s) { write(s / "p.png", "PNG"); });
+    for (const char* f : {"inplane.csv", "metrics.json", "index.html", "p.png"})
+      EXPECT_TRUE(fs::exists(out / f)) << f;
+  }
+  std::ifstream csv(out / "inplane.csv");
+  std::stringstream ss;
+  ss << csv.rdbuf();
+  // The classic row at view 30: beta 0.8, err 0.1, normalized 0.4 with factor 0.5.
+  EXPECT_NE(ss.str().find("0,30,classic,R,0.8,0.1,0.4,0.5"), std::string::npos) << ss.str();
+  // A folder holding something else is refused and left alone.
+  const fs::path other = dir / "other";
+  fs::create_directory(other);
+  write(other / "keep.txt", "x");
+  EXPECT_NE(error_of([&] {
+              write_verify_report(other, tiny_report(), [](const fs::path&) {});
+            }).find("refusing"),
+            std::string::npos);
+  EXPECT_TRUE(fs::exists(other / "keep.txt"));
+  EXPECT_FALSE(fs::exists(other / "metrics.json"));
+}
+
+TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
+  WeaveOptions w;
+  w.detail = "fiber";
+  const WovenSample sample = make_woven_sample(overlay(red_cotton_weave_options(), w));
+  VerifySettings s = verify_settings(VerifyQuality::kDraft);
+  s.resolution = 2;
+  s.particles_per_bin = 200;
+  s.batches = 2;
+  s.summation_samples = 2;
+  s.azimuths = 3;
+  VerifyInputs in;
+  in.fiber = constant_table(2, kNumBands, 0.2);
+  in.volume_albedo.fill(0.6);
+  in.classic_distribution = {MicrofacetModel::kBeckmann, 0.35};
+  in.classic_ior = 1.557;
+  MeasuredInplane m;
+  m.file = "synthetic";
+  m.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  m.curves.push_back({30, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  std::string first;
+  for (int threads : {1, 2}) {
+    s.threads = threads;
+    VerifyReport r = run_verify(sample, in, m, s);
+    ASSERT_FALSE(r.cancelled);
+    ASSERT_EQ(r.models.size(), 2u);  // ray trace and classic (no summation given)
+    // A flat volume albedo of 0.6 is grey 0.6 in linear sRGB.
+    EXPECT_NEAR(r.classic_reflectance.r, 0.6, 2e-3);
+    EXPECT_NEAR(r.classic_reflectance.b, 0.6, 2e-3);
+    ASSERT_GE(r.colours.size(), 2u);
+    // Per curve (incidence, channel): their points add up to the incidence's.
+    for (const auto& mc : r.models)
+      for (size_t i = 0; i < m.curves.size(); ++i) {
+        size_t points = 0;
+        for (const auto& c : mc.normalized_channel[i]) points += c.points + c.excluded;
+        EXPECT_EQ(points, mc.normalized[i].points + mc.normalized[i].excluded);
+        EXPECT_EQ(points, 3u * m.curves[i].view_deg.size());
+      }
+    EXPECT_EQ(r.colours[0].name, "computed fabric, reflection");
+    r.seconds.clear();
+    r.settings.threads = 0;
+    const std::string csv = verify_inplane_csv(r) + verify_metrics_json(r);
+    if (threads == 1)
+      first = csv;
+    else
+      EXPECT_EQ(csv, first);
+  }
+  // The measurement must hold normal incidence and view.
+  m.curves.erase(m.curves.begin());
+  EXPECT_NE(error_of([&] { run_verify(sample, in, m, s); }).find("theta_i_deg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace weft
