@@ -17,7 +17,7 @@ int main(int argc, char** argv) {
        {cli::add_slab_command, cli::add_spectrum_command, cli::add_bake_command,
         cli::add_bench_command, cli::add_mie_command, cli::add_medium_command,
         cli::add_table_command, cli::add_render_command, cli::add_sweep_command,
-        cli::add_weave_command, cli::add_compare_command})
+        cli::add_weave_command, cli::add_compare_command, cli::add_scene_command})
     add(app, commands);
 
   try {
