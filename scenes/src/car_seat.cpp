@@ -345,6 +345,13 @@ CarSeat make_car_seat(const CarSeatOptions& o) {
                               rounded_box({ph, 0.0059, 1, nullptr, place}, std::min(cell, 0.003)),
                               place.rotate({0, 1, 0})));
   }
+  // The frame under the cushion, down to the floor (y = 0), so the seat stands on the ground.
+  {
+    const Vec3 fh{0.2, 0.125, 0.21};
+    const Rigid place = translate({0, fh.y + 0.002, 0.0});
+    seat.parts.push_back(
+        part("base", "base", rounded_box({fh, 0.02, 2, nullptr, place}, 2 * cell), {}));
+  }
   return seat;
 }
 
