@@ -51,7 +51,7 @@ void add_scene_command(CLI::App& app, Commands& commands) {
   auto* seat = scene->add_subcommand(
       "car-seat",
       "Car seat: cushion and backrest (centre panels with seams, bolsters, piping) and a headrest; "
-      "materials centre, bolster, piping, headrest, post");
+      "materials centre, bolster, piping, headrest, post, base");
   seat->add_option("-o,--output", o->output, "output .gltf or .glb")->required();
   seat->add_option("--cell-mm", o->seat.cell_mm, "surface grid cell (mm)")
       ->check(CLI::Range(1.0, 100.0))

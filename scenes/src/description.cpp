@@ -53,13 +53,34 @@ Vec3 parse_direction(ParamReader& f, const AngleFrame& frame, const std::string&
   return frame.direction(deg_to_rad(zen), deg_to_rad(azi));
 }
 
-void parse_light(ParamReader f, const AngleFrame& frame, Lights& lights) {
+// {"type": "environment", "file": "sky.exr", "scale": c}: an equirectangular OpenEXR map
+// (environment_map.h) in the description's angle frame; without "file", constant radiance.
+void parse_environment_map(ParamReader& f, const AngleFrame& frame,
+                           const std::filesystem::path& base_dir, Lights& lights) {
+  if (f.has("radiance"))
+    throw Error(f.file(), f.field("radiance"), "give either 'radiance' or 'file' (use 'scale')");
+  std::filesystem::path file = f.string("file");
+  if (file.is_relative()) file = base_dir / file;
+  const Rgb scale = f.has("scale") ? f.rgb("scale", 0, kMaxRadiometric) : Rgb(1.0);
+  try {
+    lights.environment_maps.emplace_back(read_environment_exr(file),
+                                         Frame::from_normal_tangent(frame.normal, frame.tangent),
+                                         scale, file.string());
+  } catch (const Error& e) {
+    throw Error(f.file(), f.field("file"), e.what());
+  }
+}
+
+void parse_light(ParamReader f, const AngleFrame& frame, const std::filesystem::path& base_dir,
+                 Lights& lights) {
   const std::string type = f.string("type");
   if (type == "parallel") {
     DirectionalLight d;
     d.irradiance = f.has("irradiance") ? f.rgb("irradiance", 0, kMaxRadiometric) : Rgb(1.0);
     d.to_light = parse_direction(f, frame, "direction");
     lights.directional.push_back(d);
+  } else if (type == "environment" && f.has("file")) {
+    parse_environment_map(f, frame, base_dir, lights);
   } else if (type == "environment") {
     lights.environment += f.rgb("radiance", 0, kMaxRadiometric);
   } else if (type == "point" || type == "spot") {
@@ -302,7 +323,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     if (!ls.is_array()) throw Error(source, "lights", "must be a list");
     for (size_t i = 0; i < ls.size(); ++i)
       parse_light(ParamReader(ls[i], source, "lights[" + std::to_string(i) + "]"), d.frame,
-                  d.lights);
+                  base_dir, d.lights);
   }
   if (f.has("fiber_geometry")) d.fiber_geometry = parse_fiber_geometry(f.object("fiber_geometry"));
   if (f.has("render")) d.render = f.at("render");

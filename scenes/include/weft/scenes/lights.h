@@ -35,6 +35,7 @@
 #include "weft/core/rng.h"
 #include "weft/core/spectrum.h"
 #include "weft/core/vec.h"
+#include "weft/scenes/environment_map.h"
 #include "weft/scenes/mesh.h"
 
 namespace weft {
@@ -140,7 +141,8 @@ concept LightModel = requires(const T& l, const Vec3& p, Rng& rng, const LightHi
   { l.eval(hit) } -> std::same_as<Rgb>;
 };
 
-using LightVariant = std::variant<DirectionalLight, PointLight, EnvironmentLight, AreaLight>;
+using LightVariant =
+    std::variant<DirectionalLight, PointLight, EnvironmentLight, AreaLight, EnvironmentMap>;
 
 class Light {
  public:
@@ -172,6 +174,7 @@ struct Lights {
   std::vector<DirectionalLight> directional;
   std::vector<PointLight> points;
   Rgb environment{0.0};  // constant radiance arriving from every direction (environments add up)
+  std::vector<EnvironmentMap> environment_maps;  // environment_map.h, each its own light
 };
 
 }  // namespace weft
