@@ -65,6 +65,46 @@ EnvironmentTexels read_environment_exr(const std::filesystem::path& path) {
   return t;
 }
 
+double cie_clear_sky_relative(double zenith, double gamma, double sun_zenith) {
+  const double cz = std::cos(zenith);
+  if (!(cz > 0)) return 0;
+  auto gradation = [](double cos_z) { return 1 - std::exp(-0.32 / cos_z); };
+  auto indicatrix = [](double x) {
+    const double c = std::cos(x);
+    return 1 + 10 * (std::exp(-3 * x) - std::exp(-1.5 * kPi)) + 0.45 * c * c;
+  };
+  return indicatrix(gamma) * gradation(cz) / (indicatrix(sun_zenith) * gradation(1.0));
+}
+
+EnvironmentTexels cie_clear_sky_texels(const Rgb& zenith_radiance, double sun_zenith,
+                                       double sun_azimuth, int width, int height) {
+  EnvironmentTexels t;
+  t.width = width, t.height = height;
+  t.rgb.assign(size_t(3) * width * height, 0.0f);
+  const Vec3 sun = spherical_direction(sun_zenith, sun_azimuth);
+  constexpr int kSub = 4;
+  for (int j = 0; j < height; ++j) {
+    const double c0 = std::cos(kPi * j / height), c1 = std::cos(kPi * (j + 1) / height);
+    for (int i = 0; i < width; ++i) {
+      double sum = 0;
+      for (int a = 0; a < kSub; ++a)
+        for (int b = 0; b < kSub; ++b) {
+          const double cz = c0 + (c1 - c0) * (a + 0.5) / kSub;
+          const double phi = 2 * kPi * (i + (b + 0.5) / kSub) / width;
+          const double z = safe_acos(cz);
+          const double gamma = safe_acos(dot(spherical_direction(z, phi), sun));
+          sum += cie_clear_sky_relative(z, gamma, sun_zenith);
+        }
+      const double rel = sum / (kSub * kSub);
+      const size_t k = 3 * (size_t(j) * width + i);
+      t.rgb[k] = float(rel * zenith_radiance.r);
+      t.rgb[k + 1] = float(rel * zenith_radiance.g);
+      t.rgb[k + 2] = float(rel * zenith_radiance.b);
+    }
+  }
+  return t;
+}
+
 EnvironmentMap::EnvironmentMap(EnvironmentTexels texels, const Frame& frame, const Rgb& scale,
                                const std::string& source) {
   const int w = texels.width, h = texels.height;

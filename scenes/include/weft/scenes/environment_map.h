@@ -36,6 +36,21 @@ struct EnvironmentTexels {
 inline constexpr size_t kMaxEnvironmentTexels = size_t(1) << 26;
 EnvironmentTexels read_environment_exr(const std::filesystem::path& path);
 
+// The CIE standard clear sky (CIE S 011 / ISO 15469, sky type 12; the "CIE clear" sky of
+// Radiance's gensky): luminance relative to the zenith's, for a sky point at zenith angle
+// 'zenith' and angle 'gamma' from the sun, the sun at zenith angle 'sun_zenith' (radians):
+//   L / L_z = f(gamma) phi(zenith) / (f(sun_zenith) phi(0)),
+//   phi(Z) = 1 - exp(-0.32 / cos Z),  f(x) = 1 + 10 (exp(-3 x) - exp(-3 pi / 2)) + 0.45 cos^2 x.
+// 0 below the horizon (the ground is geometry).
+double cie_clear_sky_relative(double zenith, double gamma, double sun_zenith);
+
+// That sky as a width x height map (row 0 at the zenith, as EnvironmentMap reads it), each texel
+// the mean over 4 x 4 points spread evenly in solid angle, times 'zenith_radiance' (the model
+// gives luminance only: the colour is the same everywhere). The sun's zenith and azimuth are in
+// the map's angles (radians); the sun's disc itself is not in the map (a parallel light is).
+EnvironmentTexels cie_clear_sky_texels(const Rgb& zenith_radiance, double sun_zenith,
+                                       double sun_azimuth, int width, int height);
+
 class EnvironmentMap {
  public:
   EnvironmentMap() = default;
