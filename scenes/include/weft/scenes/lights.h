@@ -1,7 +1,8 @@
 #pragma once
 // Lights, and the one interface the path tracer uses for all of them (after pbrt-v4's Light:
 // SampleLi, PDF_Li and L/Le, here sample, pdf and eval). The kinds: parallel (directional), point
-// and spot, a constant environment, and the emissive triangles of the geometry as one area light.
+// and spot, a constant environment, environment maps (environment_map.h: an OpenEXR file or the
+// CIE clear sky), and the emissive triangles of the geometry as one area light.
 // The closed set is weft::Light, a std::variant as for BSDFs (materials/bsdfs.h).
 //
 // Conventions, stated once for every light:
