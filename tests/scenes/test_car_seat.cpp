@@ -114,7 +114,8 @@ TEST(CarSeat, PartsAreNamedAndBoundToPanelMaterials) {
     EXPECT_TRUE(p.mesh.has_name(p.name));
     EXPECT_TRUE(p.mesh.has_name("seat"));
   }
-  EXPECT_EQ(materials, (std::set<std::string>{"centre", "bolster", "piping", "headrest", "post", "base"}));
+  EXPECT_EQ(materials,
+            (std::set<std::string>{"centre", "bolster", "piping", "headrest", "post", "base"}));
   for (const char* n : {"cushion_centre", "cushion_bolster_left", "cushion_bolster_right",
                         "cushion_piping", "backrest_centre", "backrest_bolster_left",
                         "backrest_bolster_right", "backrest_piping", "headrest"})
@@ -300,7 +301,7 @@ TEST(CarSeat, GltfLoadsBackWithPartsMaterialsAndTangents) {
                                  {"piping", {{"type", "lambert"}}},
                                  {"headrest", {{"type", "lambert"}}},
                                  {"post", {{"type", "lambert"}}},
-        {"base", {{"type", "lambert"}}}}}};
+                                 {"base", {{"type", "lambert"}}}}}};
   const SceneDescription d = parse_scene_description(desc, "/", "seat.json");
   ASSERT_EQ(d.meshes.size(), coarse_seat().parts.size());
   for (size_t i = 0; i < d.meshes.size(); ++i) {

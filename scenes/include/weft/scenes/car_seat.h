@@ -1,7 +1,8 @@
 #pragma once
 // A car seat for upholstery renders (`weft scene car-seat`): seat cushion and backrest, each a
 // centre panel with quilting seams between two side bolsters and a piping loop around the centre
-// panel, a headrest on two posts, and a base under the cushion standing on y = 0. glTF units (metres, +y up); the seat faces +z.
+// panel, a headrest on two posts, and a base under the cushion standing on y = 0. glTF units
+// (metres, +y up); the seat faces +z.
 //
 // Every part is one closed surface (a rounded box or a closed tube) deformed by maps that shift
 // one coordinate by a function of the others, so no part folds onto itself. Parts touch and
