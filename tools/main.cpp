@@ -18,7 +18,7 @@ int main(int argc, char** argv) {
         cli::add_bench_command, cli::add_mie_command, cli::add_medium_command,
         cli::add_table_command, cli::add_render_command, cli::add_sweep_command,
         cli::add_weave_command, cli::add_compare_command, cli::add_merge_command,
-        cli::add_slurm_command, cli::add_verify_command})
+        cli::add_slurm_command, cli::add_verify_command, cli::add_scene_command})
     add(app, commands);
 
   try {

@@ -53,13 +53,63 @@ Vec3 parse_direction(ParamReader& f, const AngleFrame& frame, const std::string&
   return frame.direction(deg_to_rad(zen), deg_to_rad(azi));
 }
 
-void parse_light(ParamReader f, const AngleFrame& frame, Lights& lights) {
+// {"type": "environment", "file": "sky.exr", "scale": c}: an equirectangular OpenEXR map
+// (environment_map.h) in the description's angle frame; without "file", constant radiance.
+void parse_environment_map(ParamReader& f, const AngleFrame& frame,
+                           const std::filesystem::path& base_dir, Lights& lights) {
+  if (f.has("radiance"))
+    throw Error(f.file(), f.field("radiance"), "give either 'radiance' or 'file' (use 'scale')");
+  std::filesystem::path file = f.string("file");
+  if (file.is_relative()) file = base_dir / file;
+  const Rgb scale = f.has("scale") ? f.rgb("scale", 0, kMaxRadiometric) : Rgb(1.0);
+  try {
+    lights.environment_maps.emplace_back(read_environment_exr(file),
+                                         Frame::from_normal_tangent(frame.normal, frame.tangent),
+                                         scale, file.string());
+  } catch (const Error& e) {
+    throw Error(f.file(), f.field("file"), e.what());
+  }
+}
+
+// {"type": "sky", "zenith_radiance": c, "sun_zenith_deg": t, "sun_azimuth_deg": p,
+//  "resolution": [w, h]}: the CIE standard clear sky (environment_map.h) as an environment map.
+void parse_sky(ParamReader& f, const AngleFrame& frame, Lights& lights) {
+  const Rgb zenith = f.rgb("zenith_radiance", 0, kMaxRadiometric);
+  const double sun_zen = deg_to_rad(f.number("sun_zenith_deg", 0.0, 0.0, 90.0));
+  const double sun_azi = deg_to_rad(f.number("sun_azimuth_deg", 0.0, -360.0, 360.0));
+  int w = 256, h = 128;
+  if (f.has("resolution")) {
+    const auto& r = f.at("resolution");
+    if (!r.is_array() || r.size() != 2)
+      throw Error(f.file(), f.field("resolution"), "must be [width, height]");
+    for (int k = 0; k < 2; ++k)
+      if (!r[k].is_number_integer())
+        throw Error(f.file(), f.field("resolution") + "[" + std::to_string(k) + "]",
+                    "must be an integer");
+    w = int(f.check_number(r[0], f.field("resolution") + "[0]", 4, 4096));
+    h = int(f.check_number(r[1], f.field("resolution") + "[1]", 2, 2048));
+  }
+  try {
+    lights.environment_maps.emplace_back(cie_clear_sky_texels(zenith, sun_zen, sun_azi, w, h),
+                                         Frame::from_normal_tangent(frame.normal, frame.tangent),
+                                         Rgb(1.0), f.file());
+  } catch (const Error& e) {
+    throw Error(f.file(), f.field("zenith_radiance"), e.what());
+  }
+}
+
+void parse_light(ParamReader f, const AngleFrame& frame, const std::filesystem::path& base_dir,
+                 Lights& lights) {
   const std::string type = f.string("type");
   if (type == "parallel") {
     DirectionalLight d;
     d.irradiance = f.has("irradiance") ? f.rgb("irradiance", 0, kMaxRadiometric) : Rgb(1.0);
     d.to_light = parse_direction(f, frame, "direction");
     lights.directional.push_back(d);
+  } else if (type == "environment" && f.has("file")) {
+    parse_environment_map(f, frame, base_dir, lights);
+  } else if (type == "sky") {
+    parse_sky(f, frame, lights);
   } else if (type == "environment") {
     lights.environment += f.rgb("radiance", 0, kMaxRadiometric);
   } else if (type == "point" || type == "spot") {
@@ -77,8 +127,9 @@ void parse_light(ParamReader f, const AngleFrame& frame, Lights& lights) {
     }
     lights.points.push_back(p);
   } else {
-    throw Error(f.file(), f.field("type"),
-                "unknown light type '" + type + "' (valid: parallel, environment, point, spot)");
+    throw Error(
+        f.file(), f.field("type"),
+        "unknown light type '" + type + "' (valid: parallel, environment, sky, point, spot)");
   }
   f.finish();
 }
@@ -308,7 +359,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     if (!ls.is_array()) throw Error(source, "lights", "must be a list");
     for (size_t i = 0; i < ls.size(); ++i)
       parse_light(ParamReader(ls[i], source, "lights[" + std::to_string(i) + "]"), d.frame,
-                  d.lights);
+                  base_dir, d.lights);
   }
   if (f.has("fiber_geometry")) d.fiber_geometry = parse_fiber_geometry(f.object("fiber_geometry"));
   if (f.has("render")) d.render = f.at("render");

@@ -420,6 +420,7 @@ void RenderScene::set_lights(const Lights& lights) {
     lights_.push_back(geo_->area_light);
   }
   if (!lights.environment.is_black()) lights_.push_back(EnvironmentLight{lights.environment});
+  for (const auto& map : lights.environment_maps) lights_.push_back(map);
 }
 
 bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fiber) const {

@@ -263,3 +263,24 @@ TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
   expect_refused("weave --repeats 1000x1000", dir / "h.glb", "repeats", dir);
   expect_no_temporaries(dir);
 }
+
+TEST(Cli, SceneCarSeatWritesTheSeatAndRefusesBadInput) {
+  const fs::path dir = fresh_test_dir();
+  const CliRun r =
+      run("scene car-seat --cell-mm 20 --json -o '" + (dir / "seat.glb").string() + "'", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["scene"], "car-seat");
+  size_t sum = 0;
+  for (const auto& p : j["parts"]) sum += p["triangles"].get<size_t>();
+  EXPECT_EQ(j["triangles"].get<size_t>(), sum);
+  EXPECT_GT(sum, 0u);
+  EXPECT_TRUE(fs::exists(dir / "seat.glb"));
+  expect_refused("scene car-seat", dir / "seat.obj", "must end in .gltf or .glb", dir);
+  const CliRun small =
+      run("scene car-seat --cell-mm 0.5 -o '" + (dir / "s.glb").string() + "'", dir);
+  EXPECT_NE(small.exit_code, 0);
+  EXPECT_NE(small.err.find("cell-mm"), std::string::npos) << small.err;
+  EXPECT_FALSE(fs::exists(dir / "s.glb"));
+  expect_no_temporaries(dir);
+}

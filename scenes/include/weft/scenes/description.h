@@ -22,6 +22,9 @@
 //   "lights": [ {"type": "parallel", "irradiance": c, "zenith_deg": t, "azimuth_deg": p} |
 //               {"type": "parallel", "irradiance": c, "direction": [3]}  (towards the light) |
 //               {"type": "environment", "radiance": c} |
+//               {"type": "environment", "file": "sky.exr", "scale": c} |  (environment_map.h)
+//               {"type": "sky", "zenith_radiance": c, "sun_zenith_deg": t, "sun_azimuth_deg": p,
+//                "resolution": [256, 128]} |               (CIE clear sky, environment_map.h)
 //               {"type": "point", "position": [3], "intensity": c} |
 //               {"type": "spot", "position": [3], "direction": [3], "intensity": c,
 //                "inner_cone_deg": a, "outer_cone_deg": b} ],

@@ -1,7 +1,8 @@
 #pragma once
 // Lights, and the one interface the path tracer uses for all of them (after pbrt-v4's Light:
 // SampleLi, PDF_Li and L/Le, here sample, pdf and eval). The kinds: parallel (directional), point
-// and spot, a constant environment, and the emissive triangles of the geometry as one area light.
+// and spot, a constant environment, environment maps (environment_map.h: an OpenEXR file or the
+// CIE clear sky), and the emissive triangles of the geometry as one area light.
 // The closed set is weft::Light, a std::variant as for BSDFs (materials/bsdfs.h).
 //
 // Conventions, stated once for every light:
@@ -36,6 +37,7 @@
 #include "weft/core/rng.h"
 #include "weft/core/spectrum.h"
 #include "weft/core/vec.h"
+#include "weft/scenes/environment_map.h"
 #include "weft/scenes/mesh.h"
 
 namespace weft {
@@ -141,7 +143,8 @@ concept LightModel = requires(const T& l, const Vec3& p, Rng& rng, const LightHi
   { l.eval(hit) } -> std::same_as<Rgb>;
 };
 
-using LightVariant = std::variant<DirectionalLight, PointLight, EnvironmentLight, AreaLight>;
+using LightVariant =
+    std::variant<DirectionalLight, PointLight, EnvironmentLight, AreaLight, EnvironmentMap>;
 
 class Light {
  public:
@@ -173,6 +176,7 @@ struct Lights {
   std::vector<DirectionalLight> directional;
   std::vector<PointLight> points;
   Rgb environment{0.0};  // constant radiance arriving from every direction (environments add up)
+  std::vector<EnvironmentMap> environment_maps;  // environment_map.h, each its own light
 };
 
 // One line per light for a render log: its kind, where it is, and its radiometric value with the

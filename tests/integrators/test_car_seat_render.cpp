@@ -1,0 +1,227 @@
+// The car seat (scenes/car_seat.h) in the bundled description (scenes/examples/car-seat):
+//  * it loads with every panel bound and renders finite;
+//  * the three upholstery variants (measured NBRDF, a summed fabric table, the classic fiber
+//    baseline) differ on the fabric and nowhere else: with direct light only (max_depth 1) a
+//    pixel whose samples all land on the ground or the base does not depend on the seat's BSDF,
+//    so it is bit-identical across variants (the random streams depend on seed, pixel and sample
+//    only, core/rng.h);
+//  * a fabric table baked from a Lambert BSDF renders the Lambert image on the curved panels:
+//    the shading frame (panel normal, warp tangent, binormal) and the table's lookup and sampling
+//    add nothing (as tests/integrators/test_table_material.cpp shows on a plane).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "weft/core/math.h"
+#include "weft/integrators/path_tracer.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/materials/fabric/fabric_summation.h"
+#include "weft/scenes/car_seat.h"
+#include "weft/scenes/description.h"
+#include "weft/scenes/render_scene.h"
+
+using namespace weft;
+namespace fs = std::filesystem;
+
+namespace {
+const fs::path kSeatDir = fs::path(WEFT_SOURCE_DIR) / "scenes/examples/car-seat";
+const char* const kFabricKeys[] = {"centre", "bolster", "piping", "headrest"};
+
+fs::path test_dir() {
+  const fs::path dir =
+      fs::temp_directory_path() /
+      (std::string("weft-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+  fs::create_directories(dir);
+  return dir;
+}
+
+// The bundled description with a coarse seat written next to it in a temporary folder.
+nlohmann::json seat_description(const fs::path& dir) {
+  CarSeatOptions o;
+  o.cell_mm = 20;
+  write_car_seat_gltf(dir / "seat.glb", make_car_seat(o), o);
+  std::ifstream in(kSeatDir / "car-seat.json");
+  nlohmann::json j = nlohmann::json::parse(in);
+  j["gltf"] = (dir / "seat.glb").string();
+  return j;
+}
+
+void bind_fabric(nlohmann::json& j, const nlohmann::json& binding) {
+  for (const char* key : kFabricKeys) j["materials"][key] = binding;
+}
+
+// A red-tinted Lambert fiber table summed into a fabric table by the paper's formula.
+fs::path summed_fabric_table(const fs::path& dir) {
+  auto fiber = TabulatedBsdfTable::from_function(
+      4, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const bool lit = wo.z > 0 && wi.z > 0;
+        v[0] = lit ? 0.7 * kInvPi : 0.0;
+        v[1] = v[2] = lit ? 0.1 * kInvPi : 0.0;
+      },
+      2, 1);
+  fiber.kind = "fiber";
+  FabricSummationOptions o;
+  o.resolution = 4;
+  o.samples_per_cell = 2;
+  const fs::path file = dir / "fabric.exr";
+  sum_fabric_table(fiber, o).write_exr(file);
+  return file;
+}
+
+// Per pixel: the mesh every sample's camera ray met first, or -2 when they differ (-1: none).
+struct Classified {
+  RenderResult result;
+  std::vector<int64_t> first;
+};
+Classified render_classified(const SceneDescription& d, const RenderSettings& s) {
+  Classified c;
+  c.first.assign(size_t(s.width) * s.height, -3);
+  RenderObservers obs;
+  obs.on_sample = [&](uint64_t pixel, int64_t first, const Rgb&) {
+    int64_t& f = c.first[pixel];
+    f = f == -3 ? first : (f == first ? f : -2);
+  };
+  RenderSettings one = s;
+  one.threads = 1;  // the observer writes without locks
+  c.result = render(RenderScene(d), *d.camera, one, no_progress(), obs);
+  return c;
+}
+
+}  // namespace
+
+TEST(CarSeatScene, BundledDescriptionLoadsAndRendersFinite) {
+  const fs::path dir = test_dir();
+  const SceneDescription d = parse_scene_description(seat_description(dir), kSeatDir, "seat.json");
+  ASSERT_TRUE(d.camera);
+  EXPECT_EQ(d.lights.directional.size(), 1u);
+  EXPECT_EQ(d.lights.environment_maps.size(), 1u);  // the sky
+  EXPECT_TRUE(d.warnings.empty()) << d.warnings.front();
+  RenderSettings s;
+  s.width = 40, s.height = 30, s.spp = 1, s.max_depth = 2;
+  const RenderResult r = render(RenderScene(d), *d.camera, s);
+  EXPECT_EQ(r.nonfinite_samples, 0u);
+  double sum = 0;
+  for (float v : r.image.rgb) {
+    ASSERT_TRUE(std::isfinite(v));
+    ASSERT_GE(v, 0);
+    sum += v;
+  }
+  EXPECT_GT(sum, 0);
+}
+
+TEST(CarSeatScene, ThreeVariantsDifferOnTheFabricAndNowhereElse) {
+  const fs::path dir = test_dir();
+  nlohmann::json base = seat_description(dir);
+  nlohmann::json measured = base, table = base, classic = base;  // bundled: measured_nbrdf
+  bind_fabric(
+      table, {{"type", "fabric_table"}, {"params", {{"file", summed_fabric_table(dir).string()}}}});
+  bind_fabric(classic, {{"type", "classic_fiber"},
+                        {"params", {{"reflectance", {0.45, 0.06, 0.05}}, {"alpha", 0.35}}}});
+  RenderSettings s;
+  s.width = 64, s.height = 48, s.spp = 2, s.max_depth = 1, s.seed = 5;
+  std::vector<Classified> v;
+  std::vector<SceneDescription> descs;
+  for (const auto* j : {&measured, &table, &classic})
+    descs.push_back(parse_scene_description(*j, kSeatDir, "seat.json"));
+  for (const auto& d : descs) v.push_back(render_classified(d, s));
+  // Which meshes are fabric, which are not (ground quad, base, posts).
+  const SceneDescription& d = descs[0];
+  auto is_fabric = [&](int64_t mesh) {
+    if (mesh < 0 || size_t(mesh) >= d.meshes.size()) return false;
+    for (const char* key : kFabricKeys)
+      if (d.meshes[mesh]->material == key) return true;
+    return false;
+  };
+  size_t fabric_pixels = 0, other_pixels = 0;
+  std::vector<double> diff(3, 0.0), level(3, 0.0);
+  for (size_t p = 0; p < v[0].first.size(); ++p) {
+    const int64_t f = v[0].first[p];
+    ASSERT_EQ(f, v[1].first[p]);  // the camera rays are the same
+    if (f == -2) continue;        // mixed pixel
+    for (int c = 0; c < 3; ++c) {
+      const double a = v[0].result.image.rgb[3 * p + c], b = v[1].result.image.rgb[3 * p + c],
+                   e = v[2].result.image.rgb[3 * p + c];
+      if (is_fabric(f)) {
+        diff[0] += std::abs(a - b), diff[1] += std::abs(a - e), diff[2] += std::abs(b - e);
+        level[0] += a, level[1] += b, level[2] += e;
+      } else {
+        ASSERT_EQ(a, b) << "pixel " << p << " (mesh " << f << ")";
+        ASSERT_EQ(a, e) << "pixel " << p << " (mesh " << f << ")";
+      }
+    }
+    (is_fabric(f) ? fabric_pixels : other_pixels)++;
+  }
+  ASSERT_GT(fabric_pixels, 300u);
+  ASSERT_GT(other_pixels, 300u);
+  const double mean_level = (level[0] + level[1] + level[2]) / 3;
+  ASSERT_GT(mean_level, 0);
+  // Three different BSDFs on the panels: every pair differs by more than 5% of the fabric's
+  // mean radiance, pixel by pixel on average (the models differ by tens of percent).
+  for (int k = 0; k < 3; ++k) EXPECT_GT(diff[k] / mean_level, 0.05) << "pair " << k;
+}
+
+TEST(CarSeatScene, LambertFabricTableRendersTheLambertImage) {
+  const fs::path dir = test_dir();
+  const Rgb rho{0.6, 0.25, 0.15};
+  auto lam_table = TabulatedBsdfTable::from_function(
+      8, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const bool same_side = wo.z * wi.z > 0;  // two-sided, as lambert is
+        v[0] = same_side ? rho.r * kInvPi : 0.0;
+        v[1] = same_side ? rho.g * kInvPi : 0.0;
+        v[2] = same_side ? rho.b * kInvPi : 0.0;
+      },
+      2, 1);
+  lam_table.kind = "fabric";
+  lam_table.write_exr(dir / "lambert-fabric.exr");
+  nlohmann::json lam = seat_description(dir), tab = lam;
+  bind_fabric(lam, {{"type", "lambert"}, {"params", {{"reflectance", {rho.r, rho.g, rho.b}}}}});
+  bind_fabric(tab, {{"type", "fabric_table"},
+                    {"params", {{"file", (dir / "lambert-fabric.exr").string()}}}});
+  const SceneDescription a = parse_scene_description(lam, kSeatDir, "seat.json");
+  const SceneDescription b = parse_scene_description(tab, kSeatDir, "seat.json");
+
+  // Direct sunlight only: no sampling of the BSDF matters, so the images agree to the table's
+  // float storage (1e-6 relative) wherever the frames agree.
+  {
+    SceneDescription sa = a, sb = b;
+    sa.lights.environment = sb.lights.environment = Rgb(0.0);
+    sa.lights.environment_maps.clear();
+    sb.lights.environment_maps.clear();
+    RenderSettings s;
+    s.width = 48, s.height = 36, s.spp = 2, s.max_depth = 1;
+    const RenderResult ra = render(RenderScene(sa), *sa.camera, s);
+    const RenderResult rb = render(RenderScene(sb), *sb.camera, s);
+    double max_rel = 0, sum = 0;
+    for (size_t i = 0; i < ra.image.rgb.size(); ++i) {
+      sum += ra.image.rgb[i];
+      if (ra.image.rgb[i] > 1e-6)
+        max_rel = std::max(max_rel,
+                           std::abs(double(ra.image.rgb[i]) - rb.image.rgb[i]) / ra.image.rgb[i]);
+    }
+    ASSERT_GT(sum, 0);
+    EXPECT_LT(max_rel, 1e-4);
+  }
+  // Sun, sky and inter-reflection: the table samples its own directions, so the images differ
+  // by noise only: the mean per-pixel difference lies within 4 standard errors of zero.
+  {
+    RenderSettings s;
+    s.width = 32, s.height = 24, s.spp = 8, s.max_depth = 3;
+    const RenderResult ra = render(RenderScene(a), *a.camera, s);
+    const RenderResult rb = render(RenderScene(b), *b.camera, s);
+    const size_t n = ra.image.rgb.size();
+    double m = 0, m2 = 0, level = 0;
+    for (size_t i = 0; i < n; ++i) {
+      const double dlt = double(ra.image.rgb[i]) - rb.image.rgb[i];
+      m += dlt, m2 += dlt * dlt, level += ra.image.rgb[i];
+    }
+    m /= n, m2 /= n, level /= n;
+    const double se = std::sqrt(std::max(0.0, m2 - m * m) / n);
+    ASSERT_GT(level, 0);
+    EXPECT_LT(std::abs(m), 4 * se + 1e-6 * level) << "mean difference " << m << ", se " << se;
+    EXPECT_LT(std::abs(m) / level, 0.02);
+  }
+}
