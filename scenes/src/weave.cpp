@@ -91,6 +91,12 @@ double check_length(const std::optional<double>& v, double fallback, const std::
   return x;
 }
 
+// An error's message without its "field '...': " prefix, to nest it in another about that field.
+std::string without_field(const std::string& what) {
+  const auto at = what.find("': ");
+  return what.rfind("field '", 0) == 0 && at != std::string::npos ? what.substr(at + 3) : what;
+}
+
 struct Resolved {
   std::string detail;
   int repeats_x = 1, repeats_z = 1;
@@ -650,7 +656,7 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
         bad(options.fibers_per_yarn ? "fibers-per-yarn" : "packing",
             "in sections perpendicular to the yarns the fibers would interpenetrate (" +
                 ParamReader::fmt(s.min_fiber_distance_um) +
-                " um apart); in vertical sections: " + e.what());
+                " um apart); in vertical sections: " + without_field(e.what()));
       }
       d = min_fiber_distance(out.fibers, L.period_x * kMetresPerMm, L.period_z * kMetresPerMm,
                              4 * r_m);
