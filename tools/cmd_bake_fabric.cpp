@@ -91,9 +91,13 @@ int run(const BakeFabricOptions& o) {
       return 130;
     }
     table = res.table;
-    extra = {{"particles", res.particles}, {"scatterings", res.scatterings},
-             {"exited", res.exited},       {"absorbed", res.absorbed},
-             {"lost", res.lost},           {"relative_noise", res.relative_noise}};
+    extra = {{"particles", res.particles},
+             {"scatterings", res.scatterings},
+             {"exited", res.exited},
+             {"absorbed", res.absorbed},
+             {"lost", res.lost},
+             {"relative_noise", res.relative_noise},
+             {"relative_noise_per_channel", res.relative_noise_per_channel}};
   } else {
     FabricSummationOptions s;
     s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <memory>
 #include <string>
 
@@ -97,7 +98,7 @@ struct TaskTally {
   std::vector<ExitRecord> exits;
   std::vector<double> weights;  // channels per exit
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
-  uint64_t particles = 0, scatterings = 0, wraps = 0;
+  uint64_t particles = 0, scatterings = 0, wraps = 0, continuation_caps = 0, inside_hits = 0;
 };
 
 // Where the line through 'h' along 'along' crosses the surface again, leaving the material it
@@ -193,6 +194,36 @@ bool fiber_exit_point(const RenderScene& scene, const SurfaceHit& entry, const V
   return true;
 }
 
+// For each curve of the sample, the curves that continue it across the repeat's sides (the one
+// starting where it ends, and the one ending where it starts, a period away; weave.h): -1 where
+// none does.
+struct Continuations {
+  std::vector<int64_t> next, prev;
+  bool joined(int64_t a, int64_t b) const {  // curves of the sample, not scene-wide ids
+    return next[a] == b || prev[a] == b;
+  }
+};
+
+Continuations continuations(const FiberCurves& f, double px, double pz) {
+  Continuations c;
+  c.next.assign(f.curve_count(), -1);
+  c.prev.assign(f.curve_count(), -1);
+  std::map<uint32_t, std::vector<uint32_t>> by_yarn;
+  for (size_t k = 0; k < f.curve_count(); ++k) by_yarn[f.curve_yarn[k]].push_back(uint32_t(k));
+  for (const auto& [yarn, curves] : by_yarn)
+    for (uint32_t a : curves) {
+      const Vec3 end = f.point(f.curve_first[a] + f.curve_points[a] - 1);
+      for (uint32_t b : curves) {
+        Vec3 d = f.point(f.curve_first[b]) - end;
+        d.x -= px * std::round(d.x / px);
+        d.z -= pz * std::round(d.z / pz);
+        // Points stored as floats: a joint is exact to float rounding of sub-millimetre values.
+        if (length(d) < 1e-9) c.next[a] = b, c.prev[b] = a;
+      }
+    }
+  return c;
+}
+
 }  // namespace
 
 std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_above,
@@ -247,6 +278,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   const double x0 = -0.5 * px, z0 = -0.5 * pz;
   const RenderScene scene(tiled_geometry(sample, px, pz));
   const auto curves = static_cast<int64_t>(sample.fibers.curve_count());
+  const Continuations joints = continuations(sample.fibers, px, pz);
   const FiberSampler fs(fiber);
   const int nc = fiber.channels;
   const DirectionGrid grid{o.resolution};
@@ -255,7 +287,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   const uint64_t per_bin = o.particles_per_bin;
 
   std::vector<double> sum(static_cast<size_t>(bins) * bins * nc, 0.0);
-  std::vector<double> sum2(static_cast<size_t>(bins) * bins, 0.0);
+  std::vector<double> sum2(static_cast<size_t>(bins) * bins * nc, 0.0);
   FabricRaytraceResult result;
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
 
@@ -333,6 +365,21 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               }
               continue;
             }
+            // A particle that leaves a fiber near its end at the repeat's side may start inside
+            // the end cap of the fiber's continuation (the same fiber, one period on): it leaves
+            // through the fiber itself, so that cap is passed through like the fiber's own body.
+            if (h.on_fiber() && ignore != kNoFiber && dot(d, h.ng) >= 0 &&
+                joints.joined(ignore % curves, h.fiber % curves)) {
+              p = h.spawn_origin(d);
+              ignore = h.fiber;
+              ++tally.continuation_caps;
+              if (++events > 100 * o.max_scatterings) {
+                tally.lost += mean_w;
+                break;
+              }
+              continue;
+            }
+            if (h.on_fiber() && dot(d, h.ng) >= 0) ++tally.inside_hits;
             // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is
             // where the line leaves its cylinder. Yarn tubes that press on each other share
             // surfaces, so a particle may find itself inside one: then this hit is B'' and B' lies
@@ -402,15 +449,12 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         }
       },
       [&](const TaskTally& t) {
-        for (const auto& e : t.exits) {
-          double m = 0;
+        for (const auto& e : t.exits)
           for (int c = 0; c < nc; ++c) {
-            sum[e.cell * nc + c] += t.weights[e.first + c];
-            m += t.weights[e.first + c];
+            const double x = t.weights[e.first + c];
+            sum[e.cell * nc + c] += x;
+            sum2[e.cell * nc + c] += x * x;
           }
-          m /= nc;
-          sum2[e.cell] += m * m;
-        }
         launched += t.launched;
         exited += t.exited;
         lost += t.lost;
@@ -419,6 +463,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         result.particles += t.particles;
         result.scatterings += t.scatterings;
         result.wraps += t.wraps;
+        result.continuation_caps += t.continuation_caps;
+        result.inside_hits += t.inside_hits;
       });
 
   result.cancelled = status.cancelled;
@@ -429,28 +475,34 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   table.values.assign(static_cast<size_t>(bins) * bins * nc, 0.0f);
   const double n = static_cast<double>(per_bin);
   const double omega = grid.bin_solid_angle();
-  double noise2 = 0, signal2 = 0;
+  result.standard_error.assign(table.values.size(), 0.0f);
+  std::vector<double> noise2(nc, 0.0), signal2(nc, 0.0);
   for (int a = 0; a < bins; ++a)
     for (int b = 0; b < bins; ++b) {
       const size_t cell = static_cast<size_t>(a) * bins + b;
       const double scale = omega / (n * areas[a] * areas[b]);
-      double mean = 0;
+      const double w = areas[a] * areas[b];
       for (int c = 0; c < nc; ++c) {
-        const double f = sum[cell * nc + c] * scale;
-        table.values[cell * nc + c] = static_cast<float>(f);
-        mean += f;
+        const size_t v = cell * nc + c;
+        const double f = sum[v] * scale;
+        table.values[v] = static_cast<float>(f);
+        // Per particle the cell receives one exit or none: the sample variance of its weight.
+        const double m1 = sum[v] / n;
+        const double se = std::sqrt(std::max(0.0, sum2[v] / n - m1 * m1) / n) * n * scale;
+        result.standard_error[v] = static_cast<float>(se);
+        noise2[c] += se * se * w;
+        signal2[c] += f * f * w;
       }
-      mean /= nc;
-      // Per particle the cell receives one exit or none: the sample variance of the mean weight.
-      double m1 = 0;
-      for (int c = 0; c < nc; ++c) m1 += sum[cell * nc + c];
-      m1 /= nc * n;
-      const double var = std::max(0.0, sum2[cell] / n - m1 * m1) / n;
-      const double se = std::sqrt(var) * omega / (areas[a] * areas[b]);
-      noise2 += se * se * areas[a] * areas[b];
-      signal2 += mean * mean * areas[a] * areas[b];
     }
-  result.relative_noise = signal2 > 0 ? std::sqrt(noise2 / signal2) : 0.0;
+  // Each channel on its own, and all together as weft compare's rel_rms sums them.
+  double all_noise2 = 0, all_signal2 = 0;
+  result.relative_noise_per_channel.resize(nc);
+  for (int c = 0; c < nc; ++c) {
+    result.relative_noise_per_channel[c] = signal2[c] > 0 ? std::sqrt(noise2[c] / signal2[c]) : 0;
+    all_noise2 += noise2[c];
+    all_signal2 += signal2[c];
+  }
+  result.relative_noise = all_signal2 > 0 ? std::sqrt(all_noise2 / all_signal2) : 0.0;
   if (launched > 0) {
     result.exited = exited / launched;
     result.lost = lost / launched;

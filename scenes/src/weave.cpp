@@ -69,7 +69,7 @@ constexpr double kRedWarpSpacing = 0.2117, kRedWarpWidth = 0.2117, kRedWarpThick
 constexpr double kRedWeftSpacing = 0.4233, kRedWeftWidth = 0.2310, kRedWeftThickness = 0.1047;
 constexpr double kRedWarpCrimpShare = 1.0;
 constexpr double kRedFiberRadiusUm = 8.0;
-constexpr double kRedPacking = 0.25;
+constexpr double kRedPacking = 0.55;
 constexpr double kRedTwistPerMm = 1.0;
 
 // Limits checked before anything is sized by them.
@@ -89,6 +89,12 @@ double check_length(const std::optional<double>& v, double fallback, const std::
                    "], got " + ParamReader::fmt(x) +
                    (v || where.empty() ? "" : " (" + where + ")"));
   return x;
+}
+
+// An error's message without its "field '...': " prefix, to nest it in another about that field.
+std::string without_field(const std::string& what) {
+  const auto at = what.find("': ");
+  return what.rfind("field '", 0) == 0 && at != std::string::npos ? what.substr(at + 3) : what;
 }
 
 struct Resolved {
@@ -478,6 +484,7 @@ nlohmann::json summary_object(const WeaveSummary& s) {
   if (s.detail == "fiber") {
     j["fibers"] = {{"warp", fibers(s.warp_fibers)}, {"weft", fibers(s.weft_fibers)}};
     j["min_fiber_distance_um"] = s.min_fiber_distance_um;
+    j["fiber_sections"] = s.fiber_sections;
   }
   return j;
 }
@@ -631,7 +638,38 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
     out.meshes.push_back(std::move(warp));
     out.meshes.push_back(std::move(weft));
   } else {
-    detail::build_fibers(L, r.fibers, out.fibers, s.warp_fibers, s.weft_fibers);
+    const double r_m = r.fibers.radius_mm * kMetresPerMm;
+    // Perpendicular sections pack denser, but where the centre line slopes the bundle stands
+    // taller than the tube by sqrt(1 + slope^2); crossings pressed together along their whole
+    // length (balanced crimp, yarns as wide as their spacing) have no room for that, and the
+    // measurement finds it. Then the fibers go in vertical sections, within the tubes.
+    double d = 0;
+    for (const bool perpendicular : {true, false}) {
+      out.fibers = FiberCurves{};
+      s.warp_fibers.clear();
+      s.weft_fibers.clear();
+      r.fibers.perpendicular = perpendicular;
+      try {
+        detail::build_fibers(L, r.fibers, out.fibers, s.warp_fibers, s.weft_fibers);
+      } catch (const Error& e) {
+        if (perpendicular) throw;
+        bad(options.fibers_per_yarn ? "fibers-per-yarn" : "packing",
+            "in sections perpendicular to the yarns the fibers would interpenetrate (" +
+                ParamReader::fmt(s.min_fiber_distance_um) +
+                " um apart); in vertical sections: " + without_field(e.what()));
+      }
+      d = min_fiber_distance(out.fibers, L.period_x * kMetresPerMm, L.period_z * kMetresPerMm,
+                             4 * r_m);
+      s.min_fiber_distance_um = d * 1e6;
+      s.fiber_sections = perpendicular ? "perpendicular" : "vertical";
+      // The layout keeps 2r plus a margin; refuse anything that still comes closer.
+      if (d >= 2 * r_m * (1 - 1e-2)) break;
+    }
+    if (d < 2 * r_m * (1 - 1e-2))
+      bad(options.fibers_per_yarn ? "fibers-per-yarn" : "packing",
+          "fibers would interpenetrate: closest centre lines " + ParamReader::fmt(d * 1e6) +
+              " um apart, less than twice the fiber radius; use fewer fibers, less twist or "
+              "more segments per crossing");
     out.fibers.names = {"patch"};
     const FiberCurves& f = out.fibers;
     s.curves = f.curve_count();
@@ -641,16 +679,6 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
       ylo = std::min(ylo, f.point(i).y - f.radius(i));
       yhi = std::max(yhi, f.point(i).y + f.radius(i));
     }
-    const double r_m = r.fibers.radius_mm * kMetresPerMm;
-    const double d =
-        min_fiber_distance(f, L.period_x * kMetresPerMm, L.period_z * kMetresPerMm, 4 * r_m);
-    s.min_fiber_distance_um = d * 1e6;
-    // The layout keeps 2r plus a margin; refuse anything that still comes closer.
-    if (d < 2 * r_m * (1 - 1e-2))
-      bad(options.fibers_per_yarn ? "fibers-per-yarn" : "packing",
-          "fibers would interpenetrate: closest centre lines " + ParamReader::fmt(d * 1e6) +
-              " um apart, less than twice the fiber radius; use fewer fibers, less twist or "
-              "more segments per crossing");
   }
   s.y_min_mm = ylo / kMetresPerMm;
   s.y_max_mm = yhi / kMetresPerMm;

@@ -18,7 +18,7 @@ namespace {
 
 // Spacing margin over 2 x radius: covers the polyline's chords and second-order effects of the
 // tilt that the first-order spacing below leaves out; the final measurement checks the result.
-constexpr double kMargin = 0.05;
+constexpr double kMargin = 0.02;
 constexpr int kLensVertices = 128;
 
 struct V2 {
@@ -176,10 +176,15 @@ struct FiberRing {
   int n = 0;
   double rate = 0;   // turns per mm (signed: > 0 is Z twist)
   double phase = 0;  // fraction of the fiber spacing
+  // The core: fibers in a straight row from 'ring.pts[0]' to 'ring.pts[1]', not carried round
+  // (the axis of a twisted yarn does not turn). Used where the section left inside the last ring
+  // is too thin for a ring whose two sides stay 2 radii apart; there a row holds more fibers.
+  bool row = false;
 };
 
 // Rings of fibers in a convex section: nested insets 'ring_gap' apart starting at 'inset', each
-// with as many fibers as keep 'chord(u)' apart where u is the fibers' in-section speed.
+// with as many fibers as keep 'chord(u)' apart where u is the fibers' in-section speed; the
+// innermost level may be a core row instead (whichever holds more fibers in all).
 struct RingPlan {
   std::vector<FiberRing> rings;
   std::vector<int> capacity;
@@ -188,19 +193,51 @@ struct RingPlan {
 
 struct Requirements {
   double two_r = 0;   // 2 x radius x (1 + margin)
-  double slope = 0;   // largest crimp slope of the yarn
+  double slope = 0;   // vertical sections: largest crimp slope of the yarn; perpendicular: 0
   double rate = 0;    // fiber turns per mm about the section's own axis
   double carry = 0;   // in-section speed added by a carrying motion (ply twist), mm per mm
   double period = 0;  // along the yarn
 };
 
+// The chord of the convex polygon 'e' along x through its centroid's height, as a row ring.
+std::optional<FiberRing> core_row(const Poly& e) {
+  if (e.size() < 3) return std::nullopt;
+  double yc = 0;
+  for (const V2& p : e) yc += p.y;
+  yc /= static_cast<double>(e.size());
+  double x0 = 1e300, x1 = -1e300;
+  for (size_t i = 0; i < e.size(); ++i) {
+    const V2 &a = e[i], &b = e[(i + 1) % e.size()];
+    if ((a.y - yc) * (b.y - yc) > 0) continue;
+    const double x = a.y == b.y ? a.x : a.x + (b.x - a.x) * (yc - a.y) / (b.y - a.y);
+    x0 = std::min({x0, x, a.y == b.y ? b.x : x});
+    x1 = std::max({x1, x, a.y == b.y ? b.x : x});
+  }
+  if (!(x1 >= x0)) return std::nullopt;
+  FiberRing fr;
+  fr.row = true;
+  fr.ring.pts = {{x0, yc}, {x1, yc}};
+  fr.ring.per = x1 - x0;  // the row's length
+  return fr;
+}
+
+int row_capacity(const FiberRing& fr, double spacing) {
+  return static_cast<int>(std::floor(fr.ring.per / spacing)) + 1;
+}
+
 RingPlan plan_rings(const Poly& section, double inset, const Requirements& q, double lambda,
                     double min_area) {
-  RingPlan plan;
   const double gap = lambda * q.two_r * std::sqrt(1 + q.slope * q.slope);
+  std::vector<FiberRing> rings, rows;
+  std::vector<int> ring_cap, row_cap;
   for (int k = 0; k < 64; ++k) {
     const auto ring = inset_ring(section, inset + k * gap, gap, min_area);
     if (!ring) break;
+    // Every point of the section eroded by this level's inset lies a gap inside the previous
+    // ring, so a row there keeps clear of it.
+    const auto row = core_row(erode(section, inset + k * gap));
+    rows.push_back(row.value_or(FiberRing{}));
+    row_cap.push_back(row ? row_capacity(*row, gap) : 0);
     FiberRing fr;
     fr.ring = *ring;
     int best = 1;
@@ -215,15 +252,31 @@ RingPlan plan_rings(const Poly& section, double inset, const Requirements& q, do
         }
       }
     }
-    plan.capacity.push_back(best);
-    plan.total += best;
-    plan.rings.push_back(std::move(fr));
+    ring_cap.push_back(best);
+    rings.push_back(std::move(fr));
   }
+  // The innermost level 'cut' is a row (cut < levels) or every level is a ring (cut = levels).
+  const size_t levels = rings.size();
+  size_t best_cut = levels;
+  int best_total = 0, sum = 0;
+  for (int c : ring_cap) best_total += c;
+  for (size_t cut = 0; cut < levels; ++cut) {
+    if (row_cap[cut] > 0 && sum + row_cap[cut] > best_total)
+      best_total = sum + row_cap[cut], best_cut = cut;
+    sum += ring_cap[cut];
+  }
+  RingPlan plan;
+  for (size_t k = 0; k < std::min(best_cut + 1, levels); ++k) {
+    const bool row = k == best_cut;
+    plan.rings.push_back(row ? rows[k] : rings[k]);
+    plan.capacity.push_back(row ? row_cap[k] : ring_cap[k]);
+  }
+  plan.total = best_total;
   return plan;
 }
 
 bool ring_ok(const FiberRing& fr, int n, const Requirements& q, double lambda) {
-  if (n <= 1) return true;
+  if (n <= 1 || fr.row) return true;  // fewer fibers on a row lie further apart
   const double rate = periodic_rate(q.rate, q.period, n);
   const double u = std::abs(rate) * fr.ring.per + q.carry + q.slope;
   return min_pair_distance(fr.ring, n) >= lambda * q.two_r * std::sqrt(1 + u * u);
@@ -268,7 +321,7 @@ std::vector<FiberRing> fit_rings(const Poly& section, double inset, const Requir
     if (n[k] == 0) continue;
     FiberRing fr = best.rings[k];
     fr.n = n[k];
-    fr.rate = periodic_rate(q.rate, q.period, fr.n);
+    fr.rate = fr.row ? 0 : periodic_rate(q.rate, q.period, fr.n);
     fr.phase = 0.5 * (k % 2);  // alternate rings start half a spacing apart
     out.push_back(std::move(fr));
   }
@@ -300,9 +353,15 @@ struct Bundle {
     size_t k = 0;
     while (i >= rings[k].n) i -= rings[k++].n;
     const FiberRing& fr = rings[k];
-    // Z twist (rate > 0) turns right-handedly about the yarn's direction: clockwise in (l, y).
-    const double sigma = fr.ring.per * ((i + fr.phase) / fr.n - fr.rate * s);
-    V2 p = fr.ring.at(sigma);
+    V2 p;
+    if (fr.row) {
+      p = fr.n == 1 ? (fr.ring.pts[0] + fr.ring.pts[1]) * 0.5
+                    : fr.ring.pts[0] + (fr.ring.pts[1] - fr.ring.pts[0]) * (double(i) / (fr.n - 1));
+    } else {
+      // Z twist (rate > 0) turns right-handedly about the yarn's direction: clockwise in (l, y).
+      const double sigma = fr.ring.per * ((i + fr.phase) / fr.n - fr.rate * s);
+      p = fr.ring.at(sigma);
+    }
     if (plies > 1) {
       const double ps = ply_ring.per * (double(ply) / plies - ply_rate * s);
       p = p + ply_ring.at(ps);
@@ -324,9 +383,11 @@ Bundle make_bundle(double w, double t, double slope, double period, const FiberS
   const std::string field = fs.fibers_per_yarn > 0 ? "fibers-per-yarn" : "packing";
   Requirements q;
   q.two_r = 2 * r * (1 + kMargin);
-  q.slope = slope;
+  // Vertical sections: fibers one above the other, both sloping, are closer than their
+  // vertical distance by the cosine of the slope, so spacings grow by sqrt(1 + slope^2).
+  q.slope = fs.perpendicular ? 0 : slope;
   q.period = period;
-  const double inset = r * (1 + kMargin) * std::sqrt(1 + slope * slope);
+  const double inset = r * (1 + kMargin) * std::sqrt(1 + q.slope * q.slope);
   const Poly lens = lens_polygon(w, t);
   const double min_area = 1e-12 * w * t;
   auto twist_rate = [&](double outer_perimeter) {
@@ -372,8 +433,7 @@ Bundle make_bundle(double w, double t, double slope, double period, const FiberS
                 "at most " + std::to_string(capacity) + " fibers of radius " +
                     ParamReader::fmt(r * 1e3) + " um fit in a " + ParamReader::fmt(w) + " x " +
                     ParamReader::fmt(t) + " mm " + dir + " section (" + std::to_string(fs.plies) +
-                    " ply) at this twist and crimp without touching; " + std::to_string(count) +
-                    " asked");
+                    " ply) at this twist without touching; " + std::to_string(count) + " asked");
   b.info.fibers = b.fibers;
   b.info.packing = b.fibers * kPi * r * r / section_area;
   b.info.twist_per_mm = b.rings.front().rate;
@@ -413,8 +473,15 @@ void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& ou
         const double along = y.period * k / K;              // from the sample's start
         const double s = y.start + y.period * (k % K) / K;  // crimp: exactly periodic
         const V2 o = b.offset(f, along);
-        const Vec3 p = (y.along() * (y.start + along) + y.across() * y.centre +
-                        up * (y.height_at(s) + o.y) + y.lateral() * o.x) *
+        // Perpendicular sections: the section's 'up' axis is the centre line's normal in the
+        // vertical plane, so the fibers of a yarn are parallel curves (equal offsets keep equal
+        // distances wherever the line slopes). Vertical sections: straight up, as the tubes.
+        double slope = 0;
+        const double h = y.height_at(s, &slope);
+        const Vec3 normal =
+            fs.perpendicular ? (up - y.along() * slope) * (1 / std::sqrt(1 + slope * slope)) : up;
+        const Vec3 p = (y.along() * (y.start + along) + y.across() * y.centre + up * h +
+                        normal * o.y + y.lateral() * o.x) *
                        kMetresPerMm;
         out.points.insert(out.points.end(), {static_cast<float>(p.x), static_cast<float>(p.y),
                                              static_cast<float>(p.z), radius_m});

@@ -56,6 +56,10 @@ struct FiberSettings {
   double twist_angle_deg = 0;  // used when twist_per_mm is not given (then > 0)
   bool twist_from_angle = false;
   double ply_twist_per_mm = 0;
+  // Fibers in sections perpendicular to the yarn's centre line (denser: the crimp does not tilt
+  // one fiber against another) or in vertical sections like the tubes' (the bundle then stays
+  // within the tube where the yarn slopes, which closely packed crossings need).
+  bool perpendicular = true;
 };
 
 // Fills 'out' with the fibers of every yarn; per distinct yarn section the layout info.

@@ -156,3 +156,45 @@ TEST(FabricSummation, RejectsBadOptionsAndTables) {
   EXPECT_NE(weft::testing::error_of([&] { sum_fabric_table(fabric, FabricSummationOptions{}); }),
             "");
 }
+
+TEST(FabricSummation, WeaveTurnedBy90DegreesTurnsTheTable) {
+  // A plain weave turned by 90 degrees about the normal swaps warp and weft: its visible fiber
+  // orientations turn by T(x, y, z) = (-y, x, z) (cloth frame), and the visible-layer sum turns
+  // with them, f_B(T wo, T wi) = f_A(wo, wi), exactly (to rounding) for any fiber table: every
+  // fiber's frame turns along. The orientations are tilted out of the cloth (z > 0) so that
+  // none is stored as its reverse, which would ask the fiber table for a symmetry it need not
+  // have. A fiber table without symmetry: it depends on the azimuth about the axis.
+  auto fiber = TabulatedBsdfTable::from_function(
+      6, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const double s = (0.2 + 0.1 * wo.x + 0.05 * wi.y + 0.04 * wo.y * wi.x) * kInvPi;
+        v[0] = s, v[1] = 0.5 * s * (wo.z > 0), v[2] = 0.3 * s;
+      },
+      2, 1);
+  fiber.kind = "fiber";
+  auto turn = [](const Vec3& v) { return Vec3{-v.y, v.x, v.z}; };
+  FabricSummationOptions a;
+  a.method = FabricSummation::kVisible;
+  a.top = {{{1, 0, 0.15}, 2}, {{0.1, 1, 0.3}, 1}};
+  a.bottom = {{{1, 0.05, 0.2}, 1}, {{0, 1, 0.1}, 1}};
+  FabricSummationOptions b = a;
+  for (auto* list : {&b.top, &b.bottom})
+    for (auto& o : *list) o.tangent = turn(o.tangent);
+  std::vector<double> fa(3), fb(3), fs(3);
+  double worst = 0, differs = 0;
+  for (int i = 0; i < 40; ++i) {
+    const double ti = 0.05 + 1.45 * (i % 8) / 8, pi = 0.7 * i, to = 0.1 + 2.9 * (i % 5) / 5,
+                 po = 1.3 * i + 0.4;
+    const Vec3 wi{std::sin(ti) * std::cos(pi), std::sin(ti) * std::sin(pi), std::cos(ti)};
+    const Vec3 wo{std::sin(to) * std::cos(po), std::sin(to) * std::sin(po), std::cos(to)};
+    fabric_sum(fiber, a, wo, wi, fa);
+    fabric_sum(fiber, b, turn(wo), turn(wi), fb);
+    fabric_sum(fiber, b, wo, wi, fs);
+    for (int c = 0; c < 3; ++c) {
+      worst = std::max(worst, std::abs(fa[c] - fb[c]) / std::max(fa[c], 1e-12));
+      differs = std::max(differs, std::abs(fa[c] - fs[c]) / std::max(fa[c], 1e-12));
+    }
+  }
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(differs, 0.01);  // the sample is not symmetric by itself: the turn is needed
+}

@@ -48,9 +48,15 @@ struct FabricRaytraceResult {
   // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
   double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0;
+  // Fiber detail: end caps of a fiber's continuation across the repeat's sides that a particle
+  // leaving the fiber passed through, and hits on a fiber from inside it otherwise (taken alone,
+  // without their B'': none are expected, fibers keep 2 radii apart).
+  uint64_t continuation_caps = 0, inside_hits = 0;
   // Standard error of the table relative to its values, weighted like weft compare's rel_rms
-  // (by D_i D_o): what two independent runs would differ by, over sqrt(2).
+  // (by D_i D_o, channels summed): what two independent runs would differ by, over sqrt(2).
   double relative_noise = 0;
+  std::vector<double> relative_noise_per_channel;  // the same, channel by channel
+  std::vector<float> standard_error;               // per value of the table (cell pair and channel)
   bool cancelled = false;
 };
 

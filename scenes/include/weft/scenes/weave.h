@@ -27,11 +27,18 @@
 //   no end caps, which would be faces inside the cloth).
 // Fiber model: each yarn (or ply) is a bundle of round fibers on nested rings inside its section
 // (rings are the section eroded step by step, corners rounded), fibers evenly spaced along each
-// ring and carried around it by the twist (the idealised helical yarn, flattened); plies are
-// discs carried around the yarn by the ply twist, their fibers on circles turning with the
-// fiber twist. Ring and fiber spacings include the tilt of the fibers (crimp slope and twist) so
-// that fibers keep 2 x radius apart; the generator measures the minimum distance between fiber
-// segments of the whole sample, periodic copies included, and refuses a sample below it.
+// ring and carried around it by the twist (the idealised helical yarn, flattened), and where the
+// section left inside the last ring is too thin for a ring, a straight core row (the yarn's axis
+// does not turn); plies are discs carried around the yarn by the ply twist, their fibers on
+// circles turning with the fiber twist. The section is perpendicular to the centre line (fibers
+// of a yarn are parallel curves, so the crimp does not bring them closer: packing up to about
+// 0.55 for red cotton); where that makes the bundle stand out of the tube into a crossing yarn
+// (it is taller than the vertical lens by sqrt(1 + slope^2)), as with balanced crossings pressed
+// together along their length, the generator falls back to vertical sections like the tubes'
+// (spacings then grow with the slope: sparser). Ring and fiber spacings include the tilt of the
+// fibers so that fibers keep 2 x radius apart; the generator measures the minimum distance
+// between fiber segments of the whole sample, periodic copies included, and refuses a sample
+// below it.
 #include <array>
 #include <cstdint>
 #include <filesystem>
@@ -114,7 +121,8 @@ struct WeaveSummary {
   size_t curves = 0, curve_segments = 0, curve_points = 0;
   std::vector<FiberLayoutInfo> warp_fibers, weft_fibers;  // per distinct thread size
   double min_fiber_distance_um = 0;                       // measured (fiber detail), centre lines
-  double seconds = 0;                                     // generation time
+  std::string fiber_sections;  // "perpendicular" or "vertical" (fiber detail; see the top)
+  double seconds = 0;          // generation time
 };
 
 struct WovenSample {
