@@ -57,20 +57,18 @@ void Camera::validate(const std::string& file, const std::string& field) const {
 
 Camera Camera::look_at(Type type, const Vec3& position, const Vec3& target, const Vec3& up_hint) {
   if (!within(position, kMaxCameraCoordinate_m))
-    throw Error("", "camera",
-                "camera position " + format_vec(position) + " is not finite or beyond " +
-                    format_number(kMaxCameraCoordinate_m) + " m");
+    throw Error("camera position " + format_vec(position) + " is not finite or beyond " +
+                format_number(kMaxCameraCoordinate_m) + " m");
   if (!within(target, 1e300) || !within(up_hint, 1e300))
-    throw Error("", "camera", "look_at and up must be finite");
+    throw Error("look_at and up must be finite");
   Camera c;
   c.type = type;
   c.position = position;
   const Vec3 f = target - position;
-  if (!(length(f) > 0)) throw Error("", "camera", "look_at equals position");
+  if (!(length(f) > 0)) throw Error("look_at equals position");
   c.forward = normalize(f);
   Vec3 r = cross(c.forward, up_hint);
-  if (!(length(r) > 1e-12 * length(up_hint)))
-    throw Error("", "camera", "up is parallel to the view");
+  if (!(length(r) > 1e-12 * length(up_hint))) throw Error("up is parallel to the view");
   c.right = normalize(r);
   c.up = cross(c.right, c.forward);
   return c;

@@ -304,6 +304,8 @@ TEST(Gltf, DescriptionCameraAt1e30IsAClearError) {
   EXPECT_NE(e.find("camera position (1e+30, 1, 0) is not finite or beyond 1e+15 m"),
             std::string::npos)
       << e;
+  // The field is named once, not once by the camera and again by the description.
+  EXPECT_EQ(e.find("field 'camera': field"), std::string::npos) << e;
 }
 
 TEST(Gltf, RequiredExtensionsThatWeftCannotReadAreNamed) {
