@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "commands.h"
 #include "weft/core/error.h"
@@ -68,6 +69,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
 
   commands.push_back(
       {fiber, [opt] {
+         TabulatedBsdfTable::check_output_path(opt->output, "--output");
          const FiberSpec spec = load_fiber_spec(opt->spec);
          FiberTableBakeOptions o;
          o.resolution = opt->resolution;
@@ -77,6 +79,14 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          o.spectral = opt->bands == "spectral";
          o.route = opt->route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
          o.passes = opt->passes;
+         check_memory(fiber_table_bake_bytes(o), "", "--resolution",
+                      "a bake at resolution " + std::to_string(o.resolution));
+         const unsigned cores = o.threads > 0 ? o.threads : std::thread::hardware_concurrency();
+         check_long_work(
+             static_cast<double>(o.photons_per_band) * kNumBands * kMinSecondsPerPhoton /
+                 std::max(1u, cores),
+             "", "--photons", std::to_string(o.photons_per_band) + " photons per band",
+             "0.5 us per photon per core at least, " + std::to_string(cores) + " cores");
          const auto start = std::chrono::steady_clock::now();
          FiberTableBakeResult r = bake_fiber_table(spec, o, progress_bar(opt->quiet));
          const double seconds =

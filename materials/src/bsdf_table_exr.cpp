@@ -18,9 +18,91 @@
 #include "weft/materials/bsdf_table.h"
 
 namespace weft {
+namespace {
+
+// Walks the OpenEXR header (magic, version, then attributes "name\0type\0" int32 size, value,
+// up to an empty name) before OpenEXR reads it: OpenEXR allocates what an attribute's size field
+// claims, and the line offset table from the data window, before it checks either against the
+// file (a 3 KB file whose string attribute claims 1.9 GB took 2 GB). Every size must fit in the
+// bytes the file has, and the data window in the largest table.
+void check_exr_header(const std::filesystem::path& path, const std::string& file) {
+  std::error_code ec;
+  const uint64_t file_size = std::filesystem::file_size(path, ec);
+  if (ec) throw Error(file, "", "cannot read: " + ec.message());
+  std::ifstream in(path, std::ios::binary);
+  unsigned char head[8] = {};
+  in.read(reinterpret_cast<char*>(head), 8);
+  if (!in) throw Error(file, "", "truncated: no OpenEXR header");
+  const uint32_t flags = head[5] | (head[6] << 8) | (head[7] << 16);  // the version field >> 8
+  if (head[4] != 2) throw Error(file, "version", "OpenEXR file version must be 2");
+  if (flags & 0x18)  // bits 11 (deep data) and 12 (several parts) of the version field
+    throw Error(file, "version", "a table is a single-part flat image (no deep data, one part)");
+  const size_t max_name = (flags & 0x4) ? 255 : 31;  // bit 10: long names
+  auto read_name = [&](const char* what) {
+    std::string s;
+    for (int c; (c = in.get()) != 0;) {
+      if (c == EOF)
+        throw Error(file, "", std::string("truncated header (in an attribute ") + what + ")");
+      if (s.size() >= max_name)
+        throw Error(file, "",
+                    std::string("attribute ") + what + " longer than " + std::to_string(max_name) +
+                        " characters");
+      s += static_cast<char>(c);
+    }
+    return s;
+  };
+  const int64_t max_pixel = 2 * int64_t{TabulatedBsdfTable::kMaxResolution} *
+                            TabulatedBsdfTable::kMaxResolution;  // bins of the largest table
+  for (int count = 0;; ++count) {
+    const std::string name = read_name("name");
+    if (name.empty()) break;
+    if (count >= 1000) throw Error(file, "", "more than 1000 header attributes");
+    const std::string type = read_name("type");
+    unsigned char sz[4] = {};
+    in.read(reinterpret_cast<char*>(sz), 4);
+    if (!in) throw Error(file, name, "truncated header (attribute size)");
+    const int32_t size =
+        static_cast<int32_t>(sz[0] | (sz[1] << 8) | (sz[2] << 16) | (uint32_t(sz[3]) << 24));
+    const uint64_t at = static_cast<uint64_t>(in.tellg());
+    if (size < 0 || at + static_cast<uint64_t>(size) > file_size)
+      throw Error(file, name,
+                  "header attribute claims " + std::to_string(size) + " bytes; the file has " +
+                      std::to_string(file_size > at ? file_size - at : 0) + " left");
+    if (name == "dataWindow" && type == "box2i" && size == 16) {
+      unsigned char b[16];
+      in.read(reinterpret_cast<char*>(b), 16);
+      int64_t v[4];
+      for (int i = 0; i < 4; ++i)
+        v[i] = static_cast<int32_t>(b[4 * i] | (b[4 * i + 1] << 8) | (b[4 * i + 2] << 16) |
+                                    (uint32_t(b[4 * i + 3]) << 24));
+      if (v[0] != 0 || v[1] != 0 || v[2] < 0 || v[3] < 0 || v[2] >= max_pixel || v[3] >= max_pixel)
+        throw Error(file, "dataWindow",
+                    "must start at (0, 0) and hold at most " + std::to_string(max_pixel) +
+                        " pixels a side (the largest table)");
+    } else {
+      in.seekg(size, std::ios::cur);
+    }
+    if (!in) throw Error(file, name, "truncated header");
+  }
+}
+
+}  // namespace
+
+void TabulatedBsdfTable::check_output_path(const std::filesystem::path& path,
+                                           const std::string& field) {
+  if (path.extension() != ".exr")
+    throw Error(path.string(), field,
+                "a table is written as OpenEXR: the name must end in .exr, not '" +
+                    path.extension().string() + "'");
+  std::error_code ec;
+  const auto dir = std::filesystem::absolute(path, ec).parent_path();
+  if (ec || !std::filesystem::is_directory(dir, ec))
+    throw Error(path.string(), field, "output directory does not exist");
+}
 
 void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
   const std::string file = path.string();
+  check_output_path(path, "");
   validate(file);
   write_atomically(path, [&](const std::filesystem::path& tmp) {
     try {
@@ -67,6 +149,7 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
     in.read(magic, 4);
     if (!in || !Imf::isImfMagic(magic)) throw Error(file, "", "not an OpenEXR file");
   }
+  check_exr_header(path, file);
 
   TabulatedBsdfTable table;
   try {
