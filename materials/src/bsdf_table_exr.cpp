@@ -206,6 +206,19 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
       throw Error(file, "dataWindow",
                   "must be " + std::to_string(n) + " x " + std::to_string(n) +
                       " pixels from (0, 0) for resolution " + std::to_string(table.resolution));
+    // The pixels must be in the file before their buffer is allocated: write_exr compresses with
+    // ZIP, and deflate expands at most 1032:1 (zlib's technical details), so a 3 KB file cannot
+    // hold a 553 MB table (R = 32, 33 bands).
+    const double pixel_bytes = double(n) * n * table.channels * sizeof(float);
+    std::error_code size_ec;
+    const double file_bytes = double(std::filesystem::file_size(path, size_ec));
+    if (pixel_bytes > 1032.0 * file_bytes + 65536)
+      throw Error(file, "resolution",
+                  std::to_string(table.resolution) + " and bands " + bands + " need " +
+                      std::to_string(static_cast<uint64_t>(pixel_bytes)) +
+                      " bytes of pixels, more than a file of " +
+                      std::to_string(static_cast<uint64_t>(file_bytes)) +
+                      " bytes can hold (truncated?)");
 
     const std::vector<std::string> names = table.channel_names();
     const std::set<std::string> wanted(names.begin(), names.end());

@@ -212,3 +212,32 @@ TEST(CliBadInput, ExrAttributeClaimingMoreThanTheFileIsRefusedBeforeReading) {
   const CliRun r = run("table info bad.exr", dir, "ulimit -v 1000000 && ");
   expect_error(r, {"bad.exr", "field 'units'", "claims 1900000000 bytes"}, dir / "none");
 }
+
+// Found by fuzz_table_exr: a small table whose header says R = 32 (a 2048 x 2048 data window) had
+// its pixel buffer allocated (50 MB in RGB, 553 MB spectral) before the short file failed to
+// fill it, 10 s and 1.5 GB per input.
+TEST(CliBadInput, ExrTableClaimingMorePixelsThanTheFileHoldsIsRefused) {
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(run("table bake lambert -R 2 -o t.exr --quiet", dir).exit_code, 0);
+  std::string bytes;
+  {
+    std::ifstream in(dir / "t.exr", std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    bytes = ss.str();
+  }
+  auto set_int = [&](const std::string& key, size_t offset, int32_t v) {
+    const size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos) << key;
+    for (int i = 0; i < 4; ++i)
+      bytes[at + key.size() + 4 + offset + i] = static_cast<char>(uint32_t(v) >> (8 * i));
+  };
+  set_int(std::string("resolution") + '\0' + "int" + '\0', 0, 32);
+  set_int(std::string("dataWindow") + '\0' + "box2i" + '\0', 8, 2047);   // max.x
+  set_int(std::string("dataWindow") + '\0' + "box2i" + '\0', 12, 2047);  // max.y
+  bytes += std::string(4096, '\0');  // room for the line offsets of 2048 lines
+  std::ofstream(dir / "big.exr", std::ios::binary) << bytes;
+  expect_error(run("table info big.exr", dir),
+               {"big.exr", "field 'resolution'", "50331648 bytes of pixels", "can hold"},
+               dir / "none");
+}
