@@ -37,6 +37,13 @@ CliRun run(const std::string& args, const fs::path& dir, const std::string& pref
   return r;
 }
 
+// 'text' with the first 'from' replaced by 'to' (which must be there).
+std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from;
+  return at == std::string::npos ? text : text.substr(0, at) + to + text.substr(at + from.size());
+}
+
 void write(const fs::path& p, const std::string& text) {
   std::ofstream(p) << text;
 }
@@ -92,7 +99,7 @@ TEST(CliBadInput, SweepViewListWithAStrayCommaOrTooFineAStepIsRefused) {
   ss << in.rdbuf();
   std::string scene = ss.str();
   const std::string step = "\"step\": 10";
-  scene.replace(scene.find(step), step.size(), "\"step\": 1e-6");
+  scene = replaced(scene, step, "\"step\": 1e-6");
   write(dir / "plane.json", scene);
   fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
   expect_error(run("sweep plane.json -o s.csv", dir),
@@ -120,18 +127,11 @@ TEST(CliBadInput, ExtremeFiberSpecsAreRefusedNamingTheField) {
     "roughness": {"distribution": "ggx", "alpha": 0.2}, "host": {"n": HOST},
     "species": [SPECIES]})";
   auto spec = [&](const std::string& host, const std::string& species) {
-    std::string s = base;
-    s.replace(s.find("HOST"), 4, host);
-    s.replace(s.find("SPECIES"), 7, species);
-    return s;
+    return replaced(replaced(base, "HOST", host), "SPECIES", species);
   };
   const std::string voids = R"({"name": "v", "n": 1.0, "k": 0, "volume_fraction": 0.001,
     "size": {"distribution": "lognormal", "median_radius_um": MEDIAN, "sigma": 0.3}})";
-  auto with_median = [&](const std::string& m) {
-    std::string s = voids;
-    s.replace(s.find("MEDIAN"), 6, m);
-    return s;
-  };
+  auto with_median = [&](const std::string& m) { return replaced(voids, "MEDIAN", m); };
   // Each of these ran for hours without a word.
   write(dir / "median.json", spec("1.5", with_median("1e4")));
   expect_error(run("bake fiber median.json -o t.exr", dir),
