@@ -141,7 +141,10 @@ TEST(CliBadInput, ExtremeFiberSpecsAreRefusedNamingTheField) {
   expect_error(run("bake fiber host.json -o t.exr", dir), {"host.json", "host.n", "[1, 3]"},
                dir / "t.exr");
   std::string many;
-  for (int i = 0; i < 1000; ++i) many += (i ? "," : "") + with_median("0.2");
+  for (int i = 0; i < 1000; ++i) {
+    if (i) many += ",";
+    many += with_median("0.2");
+  }
   write(dir / "species.json", spec("1.5", many));
   expect_error(run("bake fiber species.json -o t.exr", dir),
                {"species.json", "'species'", "1000 species, more than 16"}, dir / "t.exr");
