@@ -68,7 +68,27 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
       throw Error(file, name,
                   "header attribute claims " + std::to_string(size) + " bytes; the file has " +
                       std::to_string(file_size > at ? file_size - at : 0) + " left");
-    if (name == "dataWindow" && type == "box2i" && size == 16) {
+    // OpenEXR reads a value of a known type at the type's size whatever the size field says,
+    // and then reads the next attribute out of step (found by fuzz_table_exr: a dataWindow of
+    // size 272 became a window of 458752 pixels a side, 2 GB of line buffers).
+    static const std::pair<const char*, int> kFixed[] = {
+        {"int", 4},      {"float", 4},       {"double", 8},         {"v2i", 8},
+        {"v2f", 8},      {"v3i", 12},        {"v3f", 12},           {"box2i", 16},
+        {"box2f", 16},   {"compression", 1}, {"lineOrder", 1},      {"envmap", 1},
+        {"m33f", 36},    {"m44f", 64},       {"tiledesc", 9},       {"rational", 8},
+        {"timecode", 8}, {"keycode", 28},    {"chromaticities", 32}};
+    for (const auto& [t, bytes] : kFixed)
+      if (type == t && size != bytes)
+        throw Error(file, name,
+                    "a " + type + " attribute holds " + std::to_string(bytes) +
+                        " bytes; its size field says " + std::to_string(size));
+    // A table has at most 33 channels of names up to 31 characters (48 bytes each in "chlist").
+    if (type == "chlist" && size > 4096)
+      throw Error(file, name,
+                  "channel list of " + std::to_string(size) + " bytes: too many channels");
+    if (name == "dataWindow" && type != "box2i")
+      throw Error(file, name, "must be a box2i, not " + type);
+    if (name == "dataWindow") {
       unsigned char b[16];
       in.read(reinterpret_cast<char*>(b), 16);
       int64_t v[4];
@@ -79,6 +99,25 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
         throw Error(file, "dataWindow",
                     "must start at (0, 0) and hold at most " + std::to_string(max_pixel) +
                         " pixels a side (the largest table)");
+    } else if (type == "chlist") {
+      // OpenEXR reads channels up to an empty name, not by the size: both must end together.
+      for (int channels = 0;; ++channels) {
+        if (read_name("channel name").empty()) break;
+        if (channels >= 64) throw Error(file, name, "more than 64 channels");
+        in.seekg(16, std::ios::cur);  // pixel type, linear flag, reserved, x and y sampling
+        if (!in || static_cast<uint64_t>(in.tellg()) > at + size) break;
+      }
+      if (!in || static_cast<uint64_t>(in.tellg()) != at + static_cast<uint64_t>(size))
+        throw Error(file, name, "channel list does not match its size field");
+    } else if (type == "preview") {
+      // OpenEXR allocates 4 x width x height bytes from the two numbers in front.
+      unsigned char wh[8] = {};
+      in.read(reinterpret_cast<char*>(wh), 8);
+      const uint64_t w = wh[0] | (wh[1] << 8) | (wh[2] << 16) | (uint64_t(wh[3]) << 24);
+      const uint64_t h = wh[4] | (wh[5] << 8) | (wh[6] << 16) | (uint64_t(wh[7]) << 24);
+      if (!in || w > 65535 || h > 65535 || 8 + 4 * w * h != static_cast<uint64_t>(size))
+        throw Error(file, name, "preview image does not match its size field");
+      in.seekg(size - 8, std::ios::cur);
     } else {
       in.seekg(size, std::ios::cur);
     }
