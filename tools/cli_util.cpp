@@ -2,17 +2,22 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <cstdlib>
+#include <fstream>
 #include <memory>
 #include <sstream>
 
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
 
@@ -95,6 +100,83 @@ int report_render_outcome(const RenderOutcome& r, const std::string& what) {
   return 0;
 }
 
+RunLimits& run_limits() {
+  static RunLimits limits;  // set once by main() from the global options, before a command runs
+  return limits;
+}
+
+double available_memory_bytes() {
+  std::ifstream in("/proc/meminfo");
+  std::string key, unit;
+  double kb = 0;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024;
+  const long pages = sysconf(_SC_AVPHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? double(pages) * double(page) : 0;
+}
+
+std::string format_bytes(double bytes) {
+  char buf[32];
+  if (bytes >= 1e9)
+    std::snprintf(buf, sizeof buf, "%.1f GB", bytes / 1e9);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f MB", std::ceil(bytes / 1e6));
+  return buf;
+}
+
+std::string format_seconds(double s) {
+  char buf[32];
+  if (s < 3600)
+    std::snprintf(buf, sizeof buf, "%.0f min", std::ceil(s / 60));
+  else if (s < 3 * 86400)
+    std::snprintf(buf, sizeof buf, "%.1f h", s / 3600);
+  else if (s < 3 * 365 * 86400.0)
+    std::snprintf(buf, sizeof buf, "%.1f days", s / 86400);
+  else
+    std::snprintf(buf, sizeof buf, "%.2g years", s / (365 * 86400.0));
+  return buf;
+}
+
+void check_memory(double bytes, const std::string& file, const std::string& field,
+                  const std::string& what) {
+  const RunLimits& l = run_limits();
+  const double budget = l.max_memory_bytes > 0 ? l.max_memory_bytes : available_memory_bytes();
+  if (budget > 0 && bytes > budget)
+    throw Error(file, field,
+                what + " needs about " + format_bytes(bytes) + " of memory, more than the " +
+                    format_bytes(budget) +
+                    (l.max_memory_bytes > 0 ? " allowed by --max-memory-gb"
+                                            : " available (set the budget with --max-memory-gb)"));
+}
+
+double render_bytes(int width, int height, bool preview, bool mask) {
+  const double per_pixel = 3 * sizeof(float) + (preview ? 3 : 0) +
+                           (mask ? sizeof(uint32_t) + 6 * sizeof(double) + sizeof(float) : 0);
+  return double(width) * double(height) * per_pixel;
+}
+
+void check_long_work(double seconds, const std::string& file, const std::string& field,
+                     const std::string& what, const std::string& basis) {
+  if (seconds <= kLongWorkSeconds || run_limits().yes_long) return;
+  throw Error(file, field,
+              what + " would take at least " + format_seconds(seconds) + " (" + basis +
+                  "); add --yes-long to run it anyway");
+}
+
+CLI::Validator seed_validator() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string {
+        const bool digits = !s.empty() && s.find_first_not_of("0123456789") == std::string::npos;
+        if (!digits || (s.size() > 1 && s[0] == '0'))
+          return "a seed is a decimal integer in [0, 18446744073709551615], got '" + s + "'";
+        errno = 0;
+        std::strtoull(s.c_str(), nullptr, 10);
+        if (errno == ERANGE) return "a seed must be below 2^64, got '" + s + "'";
+        return "";
+      },
+      "SEED");
+}
+
 std::optional<double> finite_number(const std::string& text) {
   size_t used = 0;
   double v = 0;
@@ -115,7 +197,8 @@ void validate_output_paths(const std::vector<std::string>& outputs,
   check_output_paths(out, in);
 }
 
-std::vector<double> parse_range(const std::string& text, const std::string& option_name) {
+std::vector<double> parse_range(const std::string& text, const std::string& option_name,
+                                size_t max_count) {
   auto to_number = [&](const std::string& s) {
     if (const auto v = finite_number(s)) return *v;
     throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
@@ -130,14 +213,29 @@ std::vector<double> parse_range(const std::string& text, const std::string& opti
       throw Error("", option_name, "range must be a:b:step, got '" + text + "'");
     const double a = to_number(parts[0]), b = to_number(parts[1]), step = to_number(parts[2]);
     if (!(step > 0) || b < a) throw Error("", option_name, "range needs a <= b and step > 0");
-    const long n = std::lround(std::floor((b - a) / step + 1e-9));
+    const double count = std::floor((b - a) / step + 1e-9) + 1;  // finite: a, b and step are
+    if (count > static_cast<double>(max_count))
+      throw Error("", option_name,
+                  "range '" + text + "' has " + ParamReader::fmt(count) + " values, more than " +
+                      std::to_string(max_count));
+    const long n = static_cast<long>(count) - 1;
     for (long i = 0; i <= n; ++i) out.push_back(a + step * i);
     return out;
   }
   std::stringstream ss(text);
   std::string p;
-  while (std::getline(ss, p, ',')) out.push_back(to_number(p));
-  if (out.empty()) throw Error("", option_name, "empty list");
+  // getline drops a trailing empty item ("1,2,"): count the commas, refuse every empty item.
+  const size_t items = static_cast<size_t>(std::count(text.begin(), text.end(), ',')) + 1;
+  if (items > max_count)
+    throw Error(
+        "", option_name,
+        "lists " + std::to_string(items) + " values, more than " + std::to_string(max_count));
+  while (std::getline(ss, p, ',')) {
+    if (p.empty()) break;
+    out.push_back(to_number(p));
+  }
+  if (out.size() != items)
+    throw Error("", option_name, "'" + text + "' has an empty item (a stray comma)");
   return out;
 }
 

@@ -43,6 +43,36 @@ SceneDescription load_scene_reporting_warnings(const std::string& path,
 // Returns the exit code to stop with, or 0 to go on to the outputs.
 int report_render_outcome(const RenderOutcome& r, const std::string& what);
 
+// The limits of one run of weft, from the global options (main.cpp): --max-memory-gb (default:
+// the memory available when weft starts) and --yes-long (work estimated above kLongWorkSeconds).
+struct RunLimits {
+  double max_memory_bytes = 0;  // 0: available_memory_bytes()
+  bool yes_long = false;
+};
+RunLimits& run_limits();
+// MemAvailable from /proc/meminfo (what can be allocated without swapping), else free pages.
+double available_memory_bytes();
+// Error(file, field, ...) when an estimate of 'bytes' exceeds the memory budget: checked before
+// allocating, so a run that cannot fit stops at once instead of dying of std::bad_alloc.
+void check_memory(double bytes, const std::string& file, const std::string& field,
+                  const std::string& what);
+// Work estimated to take at least this long needs --yes-long.
+inline constexpr double kLongWorkSeconds = 3600;
+// Error(file, field, ...) unless --yes-long when 'seconds' (a lower bound) exceeds
+// kLongWorkSeconds; 'basis' says how the estimate was made.
+void check_long_work(double seconds, const std::string& file, const std::string& field,
+                     const std::string& what, const std::string& basis);
+// The per-pixel buffers of a render: the image (3 floats), the sRGB preview (3 bytes) and a
+// masked render's hit counts, sums and squares (3 + 3 doubles) and coverage (a float).
+double render_bytes(int width, int height, bool preview, bool mask);
+// "2.3 GB", "41 min", "3.2 h", "2.1 days" for messages.
+std::string format_bytes(double bytes);
+std::string format_seconds(double seconds);
+
+// A seed is a plain decimal number below 2^64: CLI11 would read "-5" as 2^64 - 5 and "010" as
+// octal 8. main.cpp adds it to every --seed option.
+CLI::Validator seed_validator();
+
 // The finite number that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
 std::optional<double> finite_number(const std::string& text);
 
@@ -53,7 +83,10 @@ std::optional<double> finite_number(const std::string& text);
 void validate_output_paths(const std::vector<std::string>& outputs,
                            const std::vector<std::string>& inputs);
 
-// Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers.
-std::vector<double> parse_range(const std::string& text, const std::string& option_name);
+// Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers; at most
+// max_count of them (a range's count is checked before the list is built), no empty items.
+inline constexpr size_t kMaxRangeCount = 100000;
+std::vector<double> parse_range(const std::string& text, const std::string& option_name,
+                                size_t max_count = kMaxRangeCount);
 
 }  // namespace weft::cli

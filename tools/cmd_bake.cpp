@@ -7,6 +7,7 @@
 #include <iostream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "commands.h"
 #include "job_part.h"
@@ -219,6 +220,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
 
   commands.push_back(
       {fiber, [opt] {
+         TabulatedBsdfTable::check_output_path(opt->output, "--output");
          const FiberSpec spec = load_fiber_spec(opt->spec);
          validate_output_paths({opt->output}, {opt->spec});
          FiberTableBakeOptions o;
@@ -249,6 +251,15 @@ void add_bake_command(CLI::App& app, Commands& commands) {
                cp.units[range.first + i] = encode_fiber_band(states[i]);
              write_job_part(checkpoint_path(opt->output), cp);
            };
+         check_memory(fiber_table_bake_bytes(o), "", "--resolution",
+                      "a bake at resolution " + std::to_string(o.resolution));
+         const unsigned cores = o.threads > 0 ? o.threads : std::thread::hardware_concurrency();
+         check_long_work(
+             static_cast<double>(o.photons_per_band) * static_cast<double>(range.last - range.first) *
+                 kMinSecondsPerPhoton /
+                 std::max(1u, cores),
+             "", "--photons", std::to_string(o.photons_per_band) + " photons per band",
+             "0.5 us per photon per core at least, " + std::to_string(cores) + " cores");
          const auto start = std::chrono::steady_clock::now();
          FiberBandsResult traced;
          if (range.last > range.first) {

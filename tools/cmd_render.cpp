@@ -134,6 +134,12 @@ void add_render_command(CLI::App& app, Commands& commands) {
            check_crop(*job.settings.crop, job.settings.width, job.settings.height, "", "--crop");
          }
          job.settings.threads = o->threads;
+         check_memory(render_bytes(job.settings.width, job.settings.height, job.png.has_value(),
+                                   job.mask.has_value()),
+                      o->scene, "width x height",
+                      "a " + std::to_string(job.settings.width) + " x " +
+                          std::to_string(job.settings.height) + " render" +
+                          (job.mask ? " with a mask" : ""));
          const auto t0 = std::chrono::steady_clock::now();
          const RenderJobResult r =
              render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());

@@ -7,6 +7,7 @@
 #include "commands.h"
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
+#include "weft/core/params.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/registry.h"
 
@@ -56,16 +57,9 @@ struct BakeOptions {
 };
 
 int run_bake(const BakeOptions& o) {
-  nlohmann::json params;
-  try {
-    params = nlohmann::json::parse(o.params);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error("", "--params", std::string("not valid JSON: ") + e.what());
-  }
+  const nlohmann::json params = parse_json(o.params, "--params");
   // Fail before the work, not after it.
-  const std::filesystem::path out_dir = std::filesystem::absolute(o.output).parent_path();
-  if (!std::filesystem::is_directory(out_dir))
-    throw Error(o.output, "", "output directory does not exist");
+  TabulatedBsdfTable::check_output_path(o.output, "--output");
   MaterialContext ctx;
   ctx.field_prefix = "--params";
   const Bsdf bsdf = make_bsdf(o.type, params, ctx);

@@ -8,6 +8,7 @@
 #include "cli_util.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 
 namespace weft::cli {
 namespace {
@@ -94,7 +95,7 @@ JobPart read_job_part(const std::filesystem::path& path) {
   if (!in) throw Error(file, "header", "truncated");
   JobPart p;
   try {
-    const auto h = nlohmann::json::parse(line);
+    const auto h = parse_json(line, file);
     p.command = h.at("command").get<std::string>();
     p.job = h.at("job");
     p.units_total = h.at("units_total").get<uint64_t>();

@@ -2,10 +2,123 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "weft/core/error.h"
 
 namespace weft {
+namespace {
+
+// Builds the value like nlohmann's own DOM parser and keeps the JSON path of the value being read,
+// so that an error can name it.
+class PathTrackingSax : public nlohmann::json_sax<nlohmann::json> {
+ public:
+  using json = nlohmann::json;
+  PathTrackingSax(json& root, const std::string& file) : dom_(root, true), file_(file) {}
+
+  bool null() override { return value(dom_.null()); }
+  bool boolean(bool v) override { return value(dom_.boolean(v)); }
+  bool number_integer(number_integer_t v) override { return value(dom_.number_integer(v)); }
+  bool number_unsigned(number_unsigned_t v) override { return value(dom_.number_unsigned(v)); }
+  bool number_float(number_float_t v, const string_t& s) override {
+    return value(dom_.number_float(v, s));
+  }
+  bool string(string_t& v) override { return value(dom_.string(v)); }
+  bool binary(binary_t& v) override { return value(dom_.binary(v)); }
+  bool start_object(std::size_t n) override {
+    frames_.push_back({false, 0, ""});
+    return dom_.start_object(n);
+  }
+  bool key(string_t& k) override {
+    frames_.back().key = k;
+    return dom_.key(k);
+  }
+  bool end_object() override {
+    frames_.pop_back();
+    return value(dom_.end_object());
+  }
+  bool start_array(std::size_t n) override {
+    frames_.push_back({true, 0, ""});
+    return dom_.start_array(n);
+  }
+  bool end_array() override {
+    frames_.pop_back();
+    return value(dom_.end_array());
+  }
+  bool parse_error(std::size_t position, const std::string& token,
+                   const nlohmann::detail::exception& ex) override {
+    (void)position;
+    if (ex.id == 406)  // a number nlohmann cannot hold (out of the range of a double)
+      throw Error(file_, path(), "number " + token + " is out of range (largest: 1.8e308)");
+    throw Error(file_, path(), std::string("invalid JSON: ") + ex.what());
+  }
+
+ private:
+  struct Frame {
+    bool array;
+    size_t index;  // arrays: the element being read
+    std::string key;
+  };
+  // A value ended: the next one of an array has the next index.
+  bool value(bool ok) {
+    if (!frames_.empty() && frames_.back().array) ++frames_.back().index;
+    return ok;
+  }
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : frames_) {
+      if (f.array)
+        p += "[" + std::to_string(f.index) + "]";
+      else if (!f.key.empty())
+        p += (p.empty() ? "" : ".") + f.key;
+    }
+    return p;
+  }
+
+  nlohmann::detail::json_sax_dom_parser<json> dom_;
+  const std::string& file_;
+  std::vector<Frame> frames_;
+};
+
+}  // namespace
+
+void check_json_depth(std::string_view text, const std::string& file) {
+  int depth = 0;
+  size_t line = 1, column = 0;
+  bool in_string = false, escaped = false;
+  for (const char c : text) {
+    ++column;
+    if (c == '\n') ++line, column = 0;
+    if (in_string) {
+      if (escaped)
+        escaped = false;
+      else if (c == '\\')
+        escaped = true;
+      else if (c == '"')
+        in_string = false;
+      continue;
+    }
+    if (c == '"') {
+      in_string = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth)
+        throw Error(file, "",
+                    "JSON nested deeper than " + std::to_string(kMaxJsonDepth) +
+                        " arrays and objects (at line " + std::to_string(line) + ", column " +
+                        std::to_string(column) + ")");
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+}
+
+nlohmann::json parse_json(std::string_view text, const std::string& file) {
+  check_json_depth(text, file);
+  nlohmann::json root;
+  PathTrackingSax sax(root, file);
+  nlohmann::json::sax_parse(text, &sax);
+  return root;
+}
 
 ParamReader::ParamReader(const nlohmann::json& j, std::string file, std::string path)
     : j_(j), file_(std::move(file)), path_(std::move(path)) {

@@ -69,7 +69,12 @@ std::vector<double> read_angle_list(ParamReader& p, const std::string& key) {
                  s = r.number("step", 1e-6, 180);
     r.finish();
     if (b < a) throw Error(p.file(), p.field(key), "needs from <= to");
-    const long n = std::lround(std::floor((b - a) / s + 1e-9));
+    // Counted before the list is built: a tiny step would ask for 10^8 views (hours of work).
+    const double views = std::floor((b - a) / s + 1e-9) + 1;
+    if (views > 100000)
+      throw Error(p.file(), r.field("step"),
+                  "gives " + ParamReader::fmt(views) + " views, more than 100000");
+    const long n = static_cast<long>(views) - 1;
     for (long i = 0; i <= n; ++i) out.push_back(a + s * i);
   } else {
     throw Error(p.file(), p.field(key), "must be a list of angles or {from, to, step}");

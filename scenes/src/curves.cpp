@@ -6,6 +6,7 @@
 #include "weft/core/error.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
 
 namespace weft {
 
@@ -90,6 +91,15 @@ FiberTubes make_fiber_tubes(const FiberCurves& curves, int sides) {
     throw Error("", "tube_sides",
                 "must lie in [" + std::to_string(FiberGeometry::kMinTubeSides) + ", " +
                     std::to_string(FiberGeometry::kMaxTubeSides) + "]");
+  // Counted before anything is reserved: 3e7 curve points (the weave's limit) at 32 sides made
+  // 2e9 triangles and died of std::bad_alloc. 5e7 is the weave's limit for yarn tubes too.
+  const double triangles = 2.0 * sides * double(curves.segment_count());
+  if (triangles > 5e7)
+    throw Error("", "fiber_geometry.sides",
+                "tubes of " + std::to_string(sides) + " sides around " +
+                    std::to_string(curves.segment_count()) + " fiber segments make " +
+                    ParamReader::fmt(triangles) +
+                    " triangles (limit 5e7): use \"curves\", fewer sides or fewer fibers");
   FiberTubes out;
   TriangleMesh& m = out.mesh;
   m.names = curves.names;

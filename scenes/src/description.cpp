@@ -588,12 +588,7 @@ SceneDescription load_scene_description(const std::filesystem::path& path,
   if (!in) throw Error(source, "", "cannot open scene description");
   std::stringstream ss;
   ss << in.rdbuf();
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(ss.str());
-  } catch (const nlohmann::json::parse_error& e) {
-    throw Error(source, "", std::string("invalid JSON: ") + e.what());
-  }
+  nlohmann::json j = parse_json(ss.str(), source);
   apply_scene_overrides(j, overrides, source);
   const auto base = path.has_parent_path() ? path.parent_path() : std::filesystem::path(".");
   return parse_scene_description(j, base, source);

@@ -12,10 +12,12 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <sstream>
 
 #include "weft/core/error.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
 
 namespace weft {
 namespace {
@@ -805,6 +807,28 @@ bool is_glb(const std::string& file) {
   return true;
 }
 
+// tinygltf parses JSON recursively: bound the nesting before it sees the text (a deep 'extras'
+// would overflow the stack). For GLB only the JSON chunk is JSON.
+void check_gltf_json_depth(const std::string& file, bool binary) {
+  std::ifstream in(file, std::ios::binary);
+  std::string text;
+  if (binary) {
+    unsigned char head[20] = {};
+    if (!in.read(reinterpret_cast<char*>(head), 20)) return;  // tinygltf reports the truncation
+    uint32_t chunk_bytes = 0;
+    std::memcpy(&chunk_bytes, head + 12, 4);
+    const auto size = std::filesystem::file_size(file);
+    if (std::memcmp(head + 16, "JSON", 4) != 0 || chunk_bytes > size - 20) return;
+    text.resize(chunk_bytes);
+    in.read(text.data(), static_cast<std::streamsize>(chunk_bytes));
+  } else {
+    std::stringstream ss;
+    ss << in.rdbuf();
+    text = ss.str();
+  }
+  check_json_depth(text, file);
+}
+
 }  // namespace
 
 GltfContent load_gltf(const std::filesystem::path& path, GltfLightUnits light_units) {
@@ -816,6 +840,7 @@ GltfContent load_gltf(const std::filesystem::path& path, GltfLightUnits light_un
   tinygltf::Model model;
   std::string err, warn;
   const bool binary = is_glb(file);
+  check_gltf_json_depth(file, binary);
   bool ok = false;
   try {
     ok = binary ? loader.LoadBinaryFromFile(&model, &err, &warn, file)

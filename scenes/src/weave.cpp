@@ -582,14 +582,11 @@ WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& bas
 }
 
 WeaveOptions read_weave_options(const std::filesystem::path& json_file) {
-  std::ifstream in(json_file);
+  std::ifstream in(json_file, std::ios::binary);
   if (!in) throw Error(json_file.string(), "", "cannot open");
-  nlohmann::json j;
-  try {
-    j = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& e) {
-    throw Error(json_file.string(), "", std::string("invalid JSON: ") + e.what());
-  }
+  std::stringstream text;
+  text << in.rdbuf();
+  const nlohmann::json j = parse_json(text.str(), json_file.string());
   ParamReader r(j, json_file.string(), "");  // keeps a reference to j
   return read_weave_options(r, json_file.parent_path());
 }

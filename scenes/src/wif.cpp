@@ -322,12 +322,19 @@ WifDraft parse_wif(std::string_view text, const std::string& source) {
     std::vector<std::vector<int>> tie(static_cast<size_t>(w.treadles));
     for (const auto& [t, e] : d.indexed("TIEUP", w.treadles, false))
       tie[t] = d.int_list("TIEUP", e->key, e->value, 1, w.shafts);
+    // A pick lifts the union of its treadles' shafts: masks of shafts / 64 words, so a pick that
+    // presses all 4096 treadles, each tied to all 4096 shafts, costs 4096 x 64 operations.
+    const size_t words = static_cast<size_t>(w.shafts) / 64 + 1;
+    std::vector<uint64_t> tie_mask(tie.size() * words, 0), mask(words);
+    for (size_t t = 0; t < tie.size(); ++t)
+      for (int s : tie[t]) tie_mask[t * words + s / 64] |= uint64_t{1} << (s % 64);
     for (const auto& [j, e] : d.indexed("TREADLING", nweft, true)) {
-      std::vector<int> lifted;
+      std::fill(mask.begin(), mask.end(), 0);
       for (int t : d.int_list("TREADLING", e->key, e->value, 1, w.treadles))
-        lifted.insert(lifted.end(), tie[t - 1].begin(), tie[t - 1].end());
-      std::sort(lifted.begin(), lifted.end());
-      lifted.erase(std::unique(lifted.begin(), lifted.end()), lifted.end());
+        for (size_t k = 0; k < words; ++k) mask[k] |= tie_mask[(t - 1) * words + k];
+      std::vector<int> lifted;
+      for (int s = 1; s <= w.shafts; ++s)
+        if (mask[s / 64] >> (s % 64) & 1) lifted.push_back(s);
       w.weft[j].shafts = std::move(lifted);
     }
   }
@@ -352,13 +359,18 @@ Interlacing WifDraft::interlacing() const {
   m.warps = static_cast<int>(warp.size());
   m.wefts = static_cast<int>(weft.size());
   m.warp_over.assign(static_cast<size_t>(m.warps) * m.wefts, 0);  // bounded by parse_wif
-  std::vector<uint8_t> lifted(static_cast<size_t>(shafts) + 1);
+  // Shaft sets as bit masks: a crossing costs shafts / 64 word operations, not one per listed
+  // shaft (a draft may thread each of 2e7 crossings' warps on all 4096 shafts).
+  const size_t words = static_cast<size_t>(shafts) / 64 + 1;
+  std::vector<uint64_t> warp_mask(static_cast<size_t>(m.warps) * words, 0), lifted(words);
+  for (int i = 0; i < m.warps; ++i)
+    for (int s : warp[i].shafts) warp_mask[i * words + s / 64] |= uint64_t{1} << (s % 64);
   for (int j = 0; j < m.wefts; ++j) {
     std::fill(lifted.begin(), lifted.end(), 0);
-    for (int s : weft[j].shafts) lifted[s] = 1;
+    for (int s : weft[j].shafts) lifted[s / 64] |= uint64_t{1} << (s % 64);
     for (int i = 0; i < m.warps; ++i) {
       bool up = false;
-      for (int s : warp[i].shafts) up = up || lifted[s];
+      for (size_t w = 0; w < words && !up; ++w) up = (warp_mask[i * words + w] & lifted[w]) != 0;
       // Sinking shed: the listed shafts go down, the others make the face.
       m.warp_over[static_cast<size_t>(j) * m.warps + i] = (up == rising_shed) ? 1 : 0;
     }

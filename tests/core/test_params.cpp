@@ -154,3 +154,44 @@ TEST(ParamReader, StringsChoicesBooleansAndVectors) {
   expect_error(error_of([&] { r.vec3("short"); }), "materials.seat.short",
                "must be an array of 3 numbers");
 }
+
+// Issue 10, "Bad input": deeply nested JSON segfaulted (unbounded recursion). The depth is bounded
+// before the parser sees the text; the error names the file and where the limit was passed.
+TEST(ParseJson, DeeplyNestedJsonIsRefusedBeforeParsing) {
+  const std::string deep(100000, '[');  // the hostile input of the issue: 10^5 open arrays
+  const std::string msg = error_of([&] { parse_json(deep, "deep.json"); });
+  EXPECT_EQ(msg.rfind("deep.json: JSON nested deeper than 128", 0), 0u) << msg;
+  EXPECT_NE(msg.find("line 1, column 129"), std::string::npos) << msg;
+  // Exactly the limit parses; one more level does not.
+  const std::string at_limit = std::string(kMaxJsonDepth, '[') + std::string(kMaxJsonDepth, ']');
+  EXPECT_EQ(error_of([&] { parse_json(at_limit, "ok.json"); }), "");
+  const std::string over = "[" + at_limit + "]";
+  EXPECT_NE(error_of([&] { parse_json(over, "over.json"); }).find("nested deeper"),
+            std::string::npos);
+  // Brackets inside strings (escaped quotes included) do not count.
+  const std::string in_string = "{\"a\": \"\\\"" + std::string(1000, '[') + "\"}";
+  EXPECT_EQ(parse_json(in_string, "s.json")["a"].get<std::string>().size(), 1001u);
+}
+
+// Issue 10: `1e400` in a scene was an "internal error" (nlohmann's out_of_range escaped); it is a
+// clear error naming the file and the JSON path of the number.
+TEST(ParseJson, NumberOutOfRangeNamesFileAndField) {
+  const std::string text = R"({"lights": [{"type": "parallel"}, {"irradiance": 1e400}]})";
+  const std::string msg = error_of([&] { parse_json(text, "scene.json"); });
+  EXPECT_EQ(msg.rfind("scene.json: field 'lights[1].irradiance': number 1e400 is out of range", 0),
+            0u)
+      << msg;
+  const std::string neg = error_of([&] { parse_json(R"({"a": {"b": [1, -1e999]}})", "x.json"); });
+  EXPECT_EQ(neg.rfind("x.json: field 'a.b[1]': number -1e999", 0), 0u) << neg;
+}
+
+TEST(ParseJson, SyntaxErrorsNameFileAndFieldAndValidJsonRoundTrips) {
+  const std::string msg = error_of([&] { parse_json(R"({"render": {"spp": 4,}})", "s.json"); });
+  EXPECT_EQ(msg.rfind("s.json: field 'render.spp': invalid JSON", 0), 0u) << msg;
+  EXPECT_NE(error_of([&] { parse_json("{} trailing", "t.json"); }).find("invalid JSON"),
+            std::string::npos);
+  const json j = parse_json(
+      R"({"a": [1, 2.5, "x", true, null, {"b": -3}], "c": 18446744073709551615})", "ok.json");
+  EXPECT_EQ(
+      j, json::parse(R"({"a": [1, 2.5, "x", true, null, {"b": -3}], "c": 18446744073709551615})"));
+}

@@ -403,6 +403,31 @@ TEST(Gltf, GlbVersionOneAndGltfOneAreRefused) {
   EXPECT_NE(v1.find("asset.version"), std::string::npos) << v1;
 }
 
+TEST(Gltf, DeeplyNestedJsonIsRefusedBeforeTinygltfParsesIt) {
+  // Found by fuzzing (issue 10): 10^5 nested arrays in 'extras' overflowed tinygltf's recursive
+  // parser (segfault). Both containers: a .gltf and the JSON chunk of a GLB.
+  const auto dir = weft::testing::fresh_test_dir();
+  const int n = 100000;
+  const std::string json =
+      R"({"asset":{"version":"2.0"},"extras":)" + std::string(n, '[') + std::string(n, ']') + "}";
+  std::ofstream(dir / "deep.gltf", std::ios::binary) << json;
+  const std::string e = weft::testing::error_of([&] { load_gltf(dir / "deep.gltf"); });
+  EXPECT_NE(e.find("deep.gltf"), std::string::npos) << e;
+  EXPECT_NE(e.find("nested deeper than"), std::string::npos) << e;
+
+  std::string bytes = "glTF";
+  auto u32 = [&](uint32_t v) { bytes.append(reinterpret_cast<const char*>(&v), 4); };
+  u32(2);
+  u32(static_cast<uint32_t>(20 + json.size()));
+  u32(static_cast<uint32_t>(json.size()));
+  u32(0x4E4F534A);  // "JSON"
+  bytes += json;
+  std::ofstream(dir / "deep.glb", std::ios::binary) << bytes;
+  const std::string b = weft::testing::error_of([&] { load_gltf(dir / "deep.glb"); });
+  EXPECT_NE(b.find("deep.glb"), std::string::npos) << b;
+  EXPECT_NE(b.find("nested deeper than"), std::string::npos) << b;
+}
+
 TEST(Gltf, IgnoredContentIsOneWarningPerKind) {
   const auto dir = weft::testing::fresh_test_dir();
   nlohmann::json doc = triangle_doc();

@@ -86,23 +86,33 @@ Spectrum spectral(ParamReader& parent, const std::string& key) {
 }
 
 void require_range(const Spectrum& s, const ParamReader& p, const std::string& key, double lo,
-                   bool lo_open, const char* what) {
+                   bool lo_open, const char* what, double hi = 1e300) {
   for (int b = 0; b < kNumBands; ++b) {
-    const bool bad = lo_open ? !(s[b] > lo) : !(s[b] >= lo);
+    const bool bad = (lo_open ? !(s[b] > lo) : !(s[b] >= lo)) || !(s[b] <= hi);
     if (bad)
       throw Error(p.file(), p.field(key),
-                  std::string(what) + " at " + fmt(band_wavelength_nm(b)) + " nm is " + fmt(s[b]));
+                  std::string(what) + " at " + fmt(band_wavelength_nm(b)) + " nm is " + fmt(s[b]) +
+                      (hi < 1e300 ? " (must lie in " + std::string(lo_open ? "(" : "[") + fmt(lo) +
+                                        ", " + fmt(hi) + "])"
+                                  : ""));
   }
 }
 
-SizeDistribution parse_size(ParamReader p) {
+SizeDistribution parse_size(ParamReader p, double fiber_radius_um) {
   const std::string kind = p.choice("distribution", "", {"monodisperse", "lognormal"});
+  const double max_um = kMaxParticleShareOfFiberRadius * fiber_radius_um;
   SizeDistribution d;
   if (kind == "monodisperse") {
-    d = SizeDistribution::monodisperse(p.number("radius_um", 1e-300, 1e300));
+    d = SizeDistribution::monodisperse(p.number("radius_um", 1e-300, max_um));
   } else {
-    const double median = p.number("median_radius_um", 1e-300, 1e300);
     const double sigma = p.number("sigma", 1e-300, kMaxLognormalSigma);
+    const double median = p.number("median_radius_um", 1e-300, 1e300);
+    const double volume_median = median * std::exp(3 * sigma * sigma);
+    if (volume_median > max_um)
+      throw Error(p.file(), p.field("median_radius_um"),
+                  "gives a volume-weighted median radius of " + fmt(volume_median) +
+                      " um (median x exp(3 sigma^2)), above half the fiber radius (" + fmt(max_um) +
+                      " um): particles that large are not a scattering medium");
     d = SizeDistribution::lognormal(median, sigma);
   }
   p.finish();
@@ -116,19 +126,14 @@ json spectrum_json(const Spectrum& s) {
 }  // namespace
 
 FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file) {
-  json root;
-  try {
-    root = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw Error(file, "", std::string("invalid JSON: ") + e.what());
-  }
+  const json root = parse_json(json_text, file);
   ParamReader p(root, file, "");
   FiberSpec spec;
   spec.name = p.string("name");
   if (p.has("notes")) {
     if (!p.at("notes").is_string()) throw Error(file, "notes", "must be a string");
   }
-  spec.fiber_radius_um = p.number("fiber_radius_um", 1e-300, 1e300);
+  spec.fiber_radius_um = p.number("fiber_radius_um", kMinFiberRadiusUm, kMaxFiberRadiusUm);
 
   ParamReader rough = p.object("roughness");
   spec.roughness_distribution = rough.choice("distribution", "", {"beckmann", "ggx"}) == "ggx"
@@ -139,7 +144,7 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
 
   ParamReader host = p.object("host");
   spec.host_n = spectral(host, "n");
-  require_range(spec.host_n, host, "n", 0.0, true, "refractive index");
+  require_range(spec.host_n, host, "n", kMinHostIndex, false, "refractive index", kMaxHostIndex);
   const bool per_um = host.has("absorption_per_um"), per_mm = host.has("absorption_per_mm");
   if (per_um && per_mm)
     throw Error(file, "host", "give absorption_per_um or absorption_per_mm, not both");
@@ -155,17 +160,21 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
 
   const json& species = p.at("species");
   if (!species.is_array()) throw Error(file, "species", "must be an array");
+  if (species.size() > static_cast<size_t>(kMaxSpecies))
+    throw Error(file, "species",
+                "lists " + std::to_string(species.size()) + " species, more than " +
+                    std::to_string(kMaxSpecies) + " (each costs a Mie computation per band)");
   double total_fraction = 0;
   for (size_t i = 0; i < species.size(); ++i) {
     ParamReader s(species[i], file, "species[" + std::to_string(i) + "]");
     ParticleSpecies sp;
     sp.name = s.string("name");
     sp.n = spectral(s, "n");
-    require_range(sp.n, s, "n", 0.0, true, "refractive index");
+    require_range(sp.n, s, "n", 0.0, true, "refractive index", kMaxParticleIndex);
     sp.k = spectral(s, "k");
-    require_range(sp.k, s, "k", 0.0, false, "extinction coefficient k");
+    require_range(sp.k, s, "k", 0.0, false, "extinction coefficient k", kMaxParticleK);
     sp.volume_fraction = s.number("volume_fraction", 0.0, kMaxVolumeFraction);
-    sp.size = parse_size(s.object("size"));
+    sp.size = parse_size(s.object("size"), spec.fiber_radius_um);
     s.finish();
     total_fraction += sp.volume_fraction;
     spec.species.push_back(std::move(sp));

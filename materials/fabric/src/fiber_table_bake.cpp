@@ -25,6 +25,15 @@ void validate(const FiberTableBakeOptions& o) {
 
 }  // namespace
 
+double fiber_table_bake_bytes(const FiberTableBakeOptions& o) {
+  const double cells = DirectionGrid{std::clamp(o.resolution, 1, 1 << 12)}.bins();
+  const double pairs = cells * cells;
+  const int channels = o.spectral ? kNumBands : 3;
+  // weighted_sum and band_f for every band, one band's table and mean_sum in flight, the table.
+  return pairs *
+         (2.0 * kNumBands * sizeof(double) + 2.0 * sizeof(double) + channels * sizeof(float));
+}
+
 FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOptions& o,
                                    const FiberBandWork& work, const ProgressCallback& progress) {
   validate(o);

@@ -12,12 +12,27 @@
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "weft/core/spectrum.h"
 #include "weft/core/vec.h"
 
 namespace weft {
+
+// JSON nested deeper than this is refused before it is parsed: parsing is iterative, but copying,
+// comparing and printing a value recurse once per level (and so does tinygltf), so a file of
+// 10^5 '[' would overflow the stack. Real inputs nest fewer than 10 levels.
+inline constexpr int kMaxJsonDepth = 128;
+
+// Throws weft::Error(file, "", ...) naming the line and column where 'text' nests deeper than
+// kMaxJsonDepth arrays and objects. Scans bytes only (strings and escapes are skipped).
+void check_json_depth(std::string_view text, const std::string& file);
+
+// The one JSON parser of user files: check_json_depth, then a strict parse whose errors name the
+// file and, where it is known, the JSON path of the value (e.g. a number out of the range of a
+// double: "scene.json: field 'lights[0].irradiance': number 1e400 is out of range").
+nlohmann::json parse_json(std::string_view text, const std::string& file);
 
 class ParamReader {
  public:

@@ -128,6 +128,9 @@ struct TabulatedBsdfTable {
 
   // Writes the OpenEXR file atomically (a complete file or none). Throws weft::Error.
   void write_exr(const std::filesystem::path& path) const;
+  // Throws weft::Error(path, field, ...) unless a table can be written there: the name ends in
+  // .exr (the only format written) and the folder exists. Commands call it before the work.
+  static void check_output_path(const std::filesystem::path& path, const std::string& field);
   // Reads and validates an OpenEXR table; throws weft::Error naming the file and the attribute or
   // field at fault (missing file, not EXR, truncated or corrupt data, wrong version, sizes,
   // channels, non-finite or negative values).

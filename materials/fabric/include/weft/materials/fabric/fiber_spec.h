@@ -48,6 +48,25 @@ struct FiberSpec {
 
 inline constexpr double kMaxVolumeFraction = 0.74;  // close packing of equal spheres
 
+// Physical bounds of a spec, checked when it is read: beyond them the physics does not hold and
+// the work (Mie series, photon walks) grows without limit (a median radius of 1e4 um, a host index
+// of 1e6 or 1000 species each ran for hours).
+// Textile fibres: microfibres are about 1 um in radius, cotton 6-10 um, PET 6 um (docs/presets.md),
+// coarse monofilaments about 100 um; 0.5-500 um covers them all.
+inline constexpr double kMinFiberRadiusUm = 0.5, kMaxFiberRadiusUm = 500;
+// A fibre's host is a polymer or a glass: n 1.3-1.8 for polymers (docs/presets.md: cellulose
+// 1.557, PET 1.60, wax 1.47); 3 leaves room for high-index glasses.
+inline constexpr double kMinHostIndex = 1.0, kMaxHostIndex = 3.0;
+// Inclusions: metals have n below 1 and k up to about 10 in the visible, rutile TiO2 n = 3.0
+// (docs/presets.md), silicon 5.6 at 400 nm.
+inline constexpr double kMaxParticleIndex = 10, kMaxParticleK = 20;
+// Presets have one or two species (pigment, voids, wax, delustrant).
+inline constexpr int kMaxSpecies = 16;
+// The medium treats particles as small scatterers spread through the fibre: the volume-weighted
+// median radius (the radius for monodisperse, median x exp(3 sigma^2) for lognormal) may be at
+// most this share of the fibre radius.
+inline constexpr double kMaxParticleShareOfFiberRadius = 0.5;
+
 // Parses a spec from JSON text; 'file' names the source in error messages.
 FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file);
 // Loads a spec from a file path, or from a bundled preset by name when no such file exists.

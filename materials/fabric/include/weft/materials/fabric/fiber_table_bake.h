@@ -61,6 +61,15 @@ struct FiberTableBakeResult {
   bool cancelled = false;           // the table then holds the passes finished (metadata "photons")
 };
 
+// The most memory bake_fiber_table holds at once, bytes: per band a running sum and the cell
+// averages over all (cells x cells) direction pairs, as doubles, and the finished table (about
+// 2.3 GB at R = 32 in RGB). A front end compares it with its budget before baking.
+double fiber_table_bake_bytes(const FiberTableBakeOptions& options);
+// A lower bound on the CPU time of a photon, seconds: a fiber without particles (no scattering
+// events) took 0.41x the time per photon of red-cotton here, whose full bake PERFORMANCE.md gives
+// as 1.2 us per photon per core; so 0.5 us. Denser media take longer.
+inline constexpr double kMinSecondsPerPhoton = 0.5e-6;
+
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
                                       const ProgressCallback& progress = no_progress());
 
