@@ -220,9 +220,10 @@ void add_bake_command(CLI::App& app, Commands& commands) {
 
   commands.push_back(
       {fiber, [opt] {
-         TabulatedBsdfTable::check_output_path(opt->output, "--output");
-         const FiberSpec spec = load_fiber_spec(opt->spec);
          validate_output_paths({opt->output}, {opt->spec});
+         // A shard writes a part file for `weft merge`, not a table.
+         if (opt->shard.empty()) TabulatedBsdfTable::check_output_path(opt->output, "--output");
+         const FiberSpec spec = load_fiber_spec(opt->spec);
          FiberTableBakeOptions o;
          o.resolution = opt->resolution;
          o.photons_per_band = opt->photons;

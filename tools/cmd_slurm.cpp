@@ -69,7 +69,10 @@ void add_slurm_command(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(1, 4096));
   sub->add_flag("--dry-run", o->dry_run,
                 "print the scripts and the sbatch commands; submit nothing");
+  // The wrapped command line is this command's own: keep it here rather than passing it up to
+  // weft's global options (main.cpp sets fallthrough for --yes-long / --max-memory-gb).
   sub->allow_extras();
+  sub->fallthrough(false);
   sub->footer(
       "Example: weft slurm --shards 8 --partition cpu bake fiber spec.json -o fiber.exr "
       "--photons 1000000");
