@@ -46,7 +46,7 @@ struct FabricRaytraceOptions {
   int max_scatterings = 1000;        // beyond it a particle's weight is booked as lost
   double roulette_threshold = 0.05;  // Russian roulette below this weight (see ChannelSampling)
   // A particle whose largest channel weight exceeds this splits into copies (spectral_mis only).
-  double split_threshold = 0.25;
+  double split_threshold = 1.0;
   ChannelSampling channel_sampling = ChannelSampling::spectral_mis;
   // Trace only incident bins [first_bin, first_bin + bin_count) (0: all), for a table split over
   // processes: their rows have the bits of a whole run's, the other rows are zero.
