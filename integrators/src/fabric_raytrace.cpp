@@ -348,6 +348,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         // docs/fabric-bsdf.md): w_c = w0 prod f_c / mean_j prod (f_j / S_j), S_j = A_j' + A_j''.
         // The weights do not depend on h, so roulette on them keeps the estimate unbiased.
         const bool mis = o.channel_sampling == ChannelSampling::spectral_mis && nc > 1;
+        // Roulette on the largest weight and splitting: all but the estimator before (mean).
+        const bool window = o.channel_sampling != ChannelSampling::mean;
         const int n_strategies = mis ? nc : 1;
         std::vector<double> w(nc), pdf(n_strategies), s_sum(n_strategies);
         std::vector<PendingCopy> pending;
@@ -515,7 +517,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               double max_w = 0;
               for (double x : w) mean_w += x, max_w = std::max(max_w, x);
               mean_w /= nc;
-              const double steer = mis ? max_w : mean_w;
+              const double steer = window ? max_w : mean_w;
               if (steer < o.roulette_threshold) {
                 const double survive = steer / (o.roulette_threshold);
                 if (rng.uniform() < survive) {
@@ -530,9 +532,9 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               // where the line runs near its axis (up to ~3 in red for red cotton), so weights grow
               // along a path; a few heavy paths would carry much of the table. n copies of weight
               // w / n each, which go their own ways from the next fiber on.
-              if (mis && max_w > o.split_threshold) {
+              if (window && max_w > o.split_threshold) {
                 const int n = static_cast<int>(
-                    std::min<double>(kMaxSplit, std::ceil(max_w / (o.split_threshold))));
+                    std::min<double>(kMaxSplit, std::ceil(max_w / o.split_threshold)));
                 for (double& x : w) x /= n;
                 for (int copy = 1; copy < n; ++copy)
                   pending.push_back({p, d, events, ignore, w, pdf});

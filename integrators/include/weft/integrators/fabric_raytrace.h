@@ -45,7 +45,7 @@ struct FabricRaytraceOptions {
   int threads = 0;                   // 0 = all cores; results do not depend on it
   int max_scatterings = 1000;        // beyond it a particle's weight is booked as lost
   double roulette_threshold = 0.05;  // Russian roulette below this weight (see ChannelSampling)
-  // A particle whose largest channel weight exceeds this splits into copies (spectral_mis only).
+  // A particle whose largest channel weight exceeds this splits into copies (not with mean).
   double split_threshold = 1.0;
   ChannelSampling channel_sampling = ChannelSampling::spectral_mis;
   // Trace only incident bins [first_bin, first_bin + bin_count) (0: all), for a table split over
@@ -62,7 +62,7 @@ struct FabricRaytraceResult {
   // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
   double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0;
-  uint64_t splits = 0;  // copies made by splitting (spectral_mis)
+  uint64_t splits = 0;  // copies made by splitting
   // Fiber detail: end caps of a fiber's continuation across the repeat's sides that a particle
   // leaving the fiber passed through, and hits on a fiber from inside it otherwise (taken alone,
   // without their B'': none are expected, fibers keep 2 radii apart).
