@@ -5,6 +5,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <span>
 #include <string>
 
 #include "weft/core/direction_grid.h"
@@ -28,19 +29,21 @@ Vec3 world_to_cloth(const Vec3& w) {
   return {w.x, -w.z, w.y};
 }
 
-// The fiber table as the particle tracer draws from it: per light bin i the albedo of each
-// channel, A_c[i] = sum_o f_c[i][o] D_o, and a distribution over exit cells o with weights
-// mean_c f_c[i][o] D_o; within a cell, directions are drawn in proportion to |cos theta|.
+// The fiber table as the particle tracer draws from it: per light bin i and channel c the albedo
+// A_c[i] = sum_o f_c[i][o] D_o and a distribution over exit cells o with weights f_c[i][o] D_o,
+// and the same for the channels' mean (channel index nc: the estimator before spectral MIS);
+// within a cell, directions are drawn in proportion to |cos theta|.
 struct FiberSampler {
   const TabulatedBsdfTable* table = nullptr;
   DirectionGrid grid;
+  int strategies = 0;  // channels + 1 (their mean)
   std::vector<double> areas, max_cos;
-  std::vector<double> albedo;       // [i * channels + c]
-  std::vector<double> mean_albedo;  // [i]
-  std::vector<Distribution1D> rows;
+  std::vector<double> albedo;        // [i * strategies + s]
+  std::vector<Distribution1D> rows;  // [i * strategies + s]
 
   explicit FiberSampler(const TabulatedBsdfTable& t) : table(&t), grid(t.grid()) {
     const int bins = grid.bins(), nc = t.channels;
+    strategies = nc + 1;
     areas = grid.cosine_weighted_areas();
     max_cos.resize(bins);
     for (int b = 0; b < bins; ++b) {
@@ -53,23 +56,40 @@ struct FiberSampler {
               m, std::abs(DirectionGrid::to_direction(grid.chart_point(b, i / 16.0, j / 16.0)).z));
       max_cos[b] = std::min(1.0, 1.02 * m + 1e-6);
     }
-    albedo.assign(static_cast<size_t>(bins) * nc, 0.0);
-    mean_albedo.assign(bins, 0.0);
-    rows.resize(bins);
-    std::vector<double> w(bins);
+    albedo.assign(static_cast<size_t>(bins) * strategies, 0.0);
+    rows.resize(static_cast<size_t>(bins) * strategies);
+    std::vector<double> w(static_cast<size_t>(strategies) * bins);
     for (int i = 0; i < bins; ++i) {
       for (int o = 0; o < bins; ++o) {
         double mean = 0;
         for (int c = 0; c < nc; ++c) {
           const double f = t.at(i, o, c);
-          albedo[static_cast<size_t>(i) * nc + c] += f * areas[o];
+          w[static_cast<size_t>(c) * bins + o] = f * areas[o];
           mean += f;
         }
-        w[o] = mean / nc * areas[o];
-        mean_albedo[i] += w[o];
+        w[static_cast<size_t>(nc) * bins + o] = mean / nc * areas[o];
       }
-      rows[i] = Distribution1D(w);
+      for (int s = 0; s < strategies; ++s) {
+        const std::span<const double> ws(w.data() + static_cast<size_t>(s) * bins, bins);
+        for (double x : ws) albedo[static_cast<size_t>(i) * strategies + s] += x;
+        rows[static_cast<size_t>(i) * strategies + s] = Distribution1D(ws);
+      }
     }
+  }
+
+  double albedo_of(int bin, int s) const {
+    return albedo[static_cast<size_t>(bin) * strategies + s];
+  }
+  const Distribution1D& row(int bin, int s) const {
+    return rows[static_cast<size_t>(bin) * strategies + s];
+  }
+  // The table value that strategy s samples in proportion to.
+  double value(int i, int o, int s) const {
+    const int nc = table->channels;
+    if (s < nc) return table->at(i, o, s);
+    double mean = 0;
+    for (int c = 0; c < nc; ++c) mean += table->at(i, o, c);
+    return mean / nc;
   }
 
   // A direction in cell b with density proportional to |cos theta| (rejection against the bound).
@@ -94,11 +114,24 @@ struct ExitRecord {
   uint32_t first;  // index of its channel weights in the task's weight list
 };
 
+// A copy of a split particle, waiting to be traced on from where it was split.
+struct PendingCopy {
+  Vec3 p, d;
+  int events = 0;
+  int64_t ignore = kNoFiber;
+  std::vector<double> w, pdf;  // channel weights, relative path densities (see the tracer)
+};
+
+// The most copies one split makes (the weights are divided by the count made, so any cap is
+// unbiased; it bounds the work a freak weight can cause).
+constexpr int kMaxSplit = 16;
+
 struct TaskTally {
   std::vector<ExitRecord> exits;
   std::vector<double> weights;  // channels per exit
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0, continuation_caps = 0, inside_hits = 0;
+  uint64_t splits = 0;
 };
 
 // Where the line through 'h' along 'along' crosses the surface again, leaving the material it
@@ -256,6 +289,8 @@ void FabricRaytraceOptions::validate() const {
   if (max_scatterings < 1) throw Error("", "max_scatterings", "must be >= 1");
   if (!(roulette_threshold > 0 && roulette_threshold < 1))
     throw Error("", "roulette_threshold", "must lie in (0, 1)");
+  if (!(split_threshold > roulette_threshold) || !std::isfinite(split_threshold))
+    throw Error("", "split_threshold", "must be finite and above roulette_threshold");
   if (threads < 0) throw Error("", "threads", "must be >= 0");
   const int bins = DirectionGrid{resolution}.bins();
   if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
@@ -306,7 +341,18 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
       batch,
       [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, TaskTally& task_tally) {
         if (first + count <= first_item || first >= last_item) return;
-        std::vector<double> w(nc);
+        // Per particle: the channel weights w and, per sampling strategy j, the density p_j of
+        // its path so far relative to their mean. With spectral MIS the strategies are the
+        // channels: each particle draws its path for one hero channel h (uniform), and weights
+        // channel c by the balance heuristic over the channels' path densities (one-sample MIS,
+        // docs/fabric-bsdf.md): w_c = w0 prod f_c / mean_j prod (f_j / S_j), S_j = A_j' + A_j''.
+        // The weights do not depend on h, so roulette on them keeps the estimate unbiased.
+        const bool mis = o.channel_sampling == ChannelSampling::spectral_mis && nc > 1;
+        // Roulette on the largest weight and splitting: all but the estimator before (mean).
+        const bool window = o.channel_sampling != ChannelSampling::mean;
+        const int n_strategies = mis ? nc : 1;
+        std::vector<double> w(nc), pdf(n_strategies), s_sum(n_strategies);
+        std::vector<PendingCopy> pending;
         TaskTally outside;  // a task's particles of bins not asked for: traced, not tallied
         for (uint64_t k = first; k < first + count; ++k) {
           const int a = static_cast<int>(k / per_bin);
@@ -316,133 +362,183 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
           const Vec3 wi_cloth =
               DirectionGrid::to_direction(grid.chart_point(a, rng.uniform(), rng.uniform()));
           const double w0 = std::abs(wi_cloth.z);
-          Vec3 d = -cloth_to_world(wi_cloth);
-          Vec3 p{x0 + px * rng.uniform(), wi_cloth.z > 0 ? y1 : y0, z0 + pz * rng.uniform()};
-          std::fill(w.begin(), w.end(), w0);
+          const Vec3 d = -cloth_to_world(wi_cloth);
+          const Vec3 p{x0 + px * rng.uniform(), wi_cloth.z > 0 ? y1 : y0, z0 + pz * rng.uniform()};
+          // The strategy this particle's path follows (a FiberSampler strategy index).
+          const int hero =
+              mis ? std::min(nc - 1, static_cast<int>(rng.uniform() * nc)) : fs.strategies - 1;
           tally.launched += w0;
           ++tally.particles;
-          int events = 0;
-          int64_t ignore = kNoFiber;  // the fiber the particle last left (fiber detail)
-          while (true) {
-            double mean_w = 0;
-            for (double x : w) mean_w += x;
-            mean_w /= nc;
-            // Distances to the repeat's sides and to the slab's faces.
-            double t_side = kInfinity;
-            int side = -1;
-            const double lo[2] = {x0, z0}, hi[2] = {x0 + px, z0 + pz};
-            const double pc[2] = {p.x, p.z}, dc[2] = {d.x, d.z};
-            for (int ax = 0; ax < 2; ++ax) {
-              if (dc[ax] > 0 && (hi[ax] - pc[ax]) / dc[ax] < t_side)
-                t_side = (hi[ax] - pc[ax]) / dc[ax], side = 2 * ax + 1;
-              if (dc[ax] < 0 && (lo[ax] - pc[ax]) / dc[ax] < t_side)
-                t_side = (lo[ax] - pc[ax]) / dc[ax], side = 2 * ax;
-            }
-            t_side = std::max(0.0, t_side);
-            const double t_slab = d.y > 0   ? (y1 - p.y) / d.y
-                                  : d.y < 0 ? (y0 - p.y) / d.y
-                                            : kInfinity;
-            SurfaceHit h;
-            if (!scene.intersect({p, d, std::min(t_side, t_slab)}, &h, ignore)) {
-              if (t_slab <= t_side) {  // left the cloth: binned by its direction
-                const int exit_bin = grid.bin_of(world_to_cloth(d));
-                tally.exits.push_back({static_cast<uint64_t>(a) * bins + exit_bin,
-                                       static_cast<uint32_t>(tally.weights.size())});
-                tally.weights.insert(tally.weights.end(), w.begin(), w.end());
-                tally.exited += mean_w;
+          // Copies of the particle made by splitting wait here; they share its hero channel. Its
+          // exits are merged per cell (from first_exit on) so that the per-cell variance below
+          // stays that of one particle's total.
+          const size_t first_exit = tally.exits.size();
+          pending.clear();
+          pending.push_back({p, d, 0, kNoFiber, std::vector<double>(nc, w0),
+                             std::vector<double>(n_strategies, 1.0)});
+          while (!pending.empty()) {
+            Vec3 p = pending.back().p, d = pending.back().d;
+            int events = pending.back().events;
+            int64_t ignore = pending.back().ignore;  // the fiber last left (fiber detail)
+            w.swap(pending.back().w);
+            pdf.swap(pending.back().pdf);
+            pending.pop_back();
+            while (true) {
+              double mean_w = 0;
+              for (double x : w) mean_w += x;
+              mean_w /= nc;
+              // Distances to the repeat's sides and to the slab's faces.
+              double t_side = kInfinity;
+              int side = -1;
+              const double lo[2] = {x0, z0}, hi[2] = {x0 + px, z0 + pz};
+              const double pc[2] = {p.x, p.z}, dc[2] = {d.x, d.z};
+              for (int ax = 0; ax < 2; ++ax) {
+                if (dc[ax] > 0 && (hi[ax] - pc[ax]) / dc[ax] < t_side)
+                  t_side = (hi[ax] - pc[ax]) / dc[ax], side = 2 * ax + 1;
+                if (dc[ax] < 0 && (lo[ax] - pc[ax]) / dc[ax] < t_side)
+                  t_side = (lo[ax] - pc[ax]) / dc[ax], side = 2 * ax;
+              }
+              t_side = std::max(0.0, t_side);
+              const double t_slab = d.y > 0   ? (y1 - p.y) / d.y
+                                    : d.y < 0 ? (y0 - p.y) / d.y
+                                              : kInfinity;
+              SurfaceHit h;
+              if (!scene.intersect({p, d, std::min(t_side, t_slab)}, &h, ignore)) {
+                if (t_slab <= t_side) {  // left the cloth: binned by its direction
+                  const int exit_bin = grid.bin_of(world_to_cloth(d));
+                  const uint64_t cell = static_cast<uint64_t>(a) * bins + exit_bin;
+                  size_t e = first_exit;
+                  while (e < tally.exits.size() && tally.exits[e].cell != cell) ++e;
+                  if (e < tally.exits.size()) {
+                    for (int c = 0; c < nc; ++c) tally.weights[tally.exits[e].first + c] += w[c];
+                  } else {
+                    tally.exits.push_back({cell, static_cast<uint32_t>(tally.weights.size())});
+                    tally.weights.insert(tally.weights.end(), w.begin(), w.end());
+                  }
+                  tally.exited += mean_w;
+                  break;
+                }
+                // Through a side of the repeat: in again through the opposite one.
+                p += t_side * d;
+                if (side == 0) p.x += px;
+                if (side == 1) p.x -= px;
+                if (side == 2) p.z += pz;
+                if (side == 3) p.z -= pz;
+                ignore = fiber_after_wrap(ignore, side, curves);
+                if (++tally.wraps, ++events > 100 * o.max_scatterings) {
+                  tally.lost += mean_w;
+                  break;
+                }
+                continue;
+              }
+              // A particle that leaves a fiber near its end at the repeat's side may start inside
+              // the end cap of the fiber's continuation (the same fiber, one period on): it leaves
+              // through the fiber itself, so that cap is passed through like the fiber's own body.
+              if (h.on_fiber() && ignore != kNoFiber && dot(d, h.ng) >= 0 &&
+                  joints.joined(ignore % curves, h.fiber % curves)) {
+                p = h.spawn_origin(d);
+                ignore = h.fiber;
+                ++tally.continuation_caps;
+                if (++events > 100 * o.max_scatterings) {
+                  tally.lost += mean_w;
+                  break;
+                }
+                continue;
+              }
+              if (h.on_fiber() && dot(d, h.ng) >= 0) ++tally.inside_hits;
+              // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is
+              // where the line leaves its cylinder. Yarn tubes that press on each other share
+              // surfaces, so a particle may find itself inside one: then this hit is B'' and B'
+              // lies behind it (for round fibers, apart by 2 radii, that happens only where a
+              // fiber's end cap meets its continuation in the next repeat; the hit is then taken
+              // alone).
+              FiberPoint pts[2];
+              int n_pts = 0;
+              const bool from_outside = dot(d, h.ng) < 0;
+              pts[n_pts++].hit = h;
+              SurfaceHit other;
+              if (h.on_fiber()) {
+                if (from_outside && fiber_exit_point(scene, h, d, &other)) pts[n_pts++].hit = other;
+              } else if (find_crossing(scene, h, from_outside ? d : -d, &other)) {
+                pts[n_pts++].hit = other;
+              }
+              // Per strategy j the sum S_j of the albedos at the crossings; the hero picks B' or
+              // B'' in proportion to its own and draws an exit cell o from its row there, with
+              // probability (A_h(q) / S_h) (f_h D_o / A_h(q)) = f_h D_o / S_h.
+              for (int q = 0; q < n_pts; ++q) {
+                pts[q].wi_local = pts[q].hit.shading.to_local(-d);
+                pts[q].bin = fs.grid.bin_of(pts[q].wi_local);
+              }
+              auto strategy = [&](int j) { return mis ? j : fs.strategies - 1; };
+              for (int j = 0; j < n_strategies; ++j) {
+                s_sum[j] = 0;
+                for (int q = 0; q < n_pts; ++q) s_sum[j] += fs.albedo_of(pts[q].bin, strategy(j));
+              }
+              const int hj = mis ? hero : 0;
+              const double a_hero0 = fs.albedo_of(pts[0].bin, hero);
+              if (!(s_sum[hj] > 0)) {  // the fiber absorbs all of the hero's light
+                tally.absorbed += mean_w;
                 break;
               }
-              // Through a side of the repeat: in again through the opposite one.
-              p += t_side * d;
-              if (side == 0) p.x += px;
-              if (side == 1) p.x -= px;
-              if (side == 2) p.z += pz;
-              if (side == 3) p.z -= pz;
-              ignore = fiber_after_wrap(ignore, side, curves);
-              if (++tally.wraps, ++events > 100 * o.max_scatterings) {
-                tally.lost += mean_w;
+              const int q = n_pts == 2 && rng.uniform() * s_sum[hj] >= a_hero0 ? 1 : 0;
+              const FiberPoint& pt = pts[q];
+              const int ob = static_cast<int>(fs.row(pt.bin, hero).sample_discrete(rng.uniform()));
+              const Vec3 wo_local = fs.cosine_direction_in(ob, rng);
+              // Throughput f_c D_o over the strategies' mean probability of this step (D_o and the
+              // within-cell density are common to all and cancel); densities kept relative to
+              // their mean so that long paths neither underflow nor overflow.
+              double mean_pdf = 0;
+              for (int j = 0; j < n_strategies; ++j) {
+                pdf[j] *= s_sum[j] > 0 ? fs.value(pt.bin, ob, strategy(j)) / s_sum[j] : 0.0;
+                mean_pdf += pdf[j];
+              }
+              mean_pdf /= n_strategies;
+              double before = 0, after = 0;
+              for (int c = 0; c < nc; ++c) {
+                before += w[c];
+                w[c] *= fiber.at(pt.bin, ob, c) / mean_pdf;
+                after += w[c];
+              }
+              for (double& x : pdf) x /= mean_pdf;
+              tally.absorbed += (before - after) / nc;
+              d = normalize(pt.hit.shading.to_world(wo_local));
+              p = pt.hit.spawn_origin(d);
+              ignore = pt.hit.fiber;  // light leaves a fiber through the fiber itself
+              ++tally.scatterings;
+              if (++events >= o.max_scatterings) {
+                double m = 0;
+                for (double x : w) m += x;
+                tally.lost += m / nc;
                 break;
               }
-              continue;
-            }
-            // A particle that leaves a fiber near its end at the repeat's side may start inside
-            // the end cap of the fiber's continuation (the same fiber, one period on): it leaves
-            // through the fiber itself, so that cap is passed through like the fiber's own body.
-            if (h.on_fiber() && ignore != kNoFiber && dot(d, h.ng) >= 0 &&
-                joints.joined(ignore % curves, h.fiber % curves)) {
-              p = h.spawn_origin(d);
-              ignore = h.fiber;
-              ++tally.continuation_caps;
-              if (++events > 100 * o.max_scatterings) {
-                tally.lost += mean_w;
-                break;
+              // Russian roulette on the largest channel weight (on their mean before spectral
+              // MIS, which let the dominant channel's weights grow where the mean fell).
+              mean_w = 0;
+              double max_w = 0;
+              for (double x : w) mean_w += x, max_w = std::max(max_w, x);
+              mean_w /= nc;
+              const double steer = window ? max_w : mean_w;
+              if (steer < o.roulette_threshold) {
+                const double survive = steer / (o.roulette_threshold);
+                if (rng.uniform() < survive) {
+                  for (double& x : w) x /= survive;
+                  tally.roulette_net -= mean_w / survive - mean_w;
+                } else {
+                  tally.roulette_net += mean_w;
+                  break;
+                }
               }
-              continue;
-            }
-            if (h.on_fiber() && dot(d, h.ng) >= 0) ++tally.inside_hits;
-            // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is
-            // where the line leaves its cylinder. Yarn tubes that press on each other share
-            // surfaces, so a particle may find itself inside one: then this hit is B'' and B' lies
-            // behind it (for round fibers, apart by 2 radii, that happens only where a fiber's end
-            // cap meets its continuation in the next repeat; the hit is then taken alone).
-            FiberPoint pts[2];
-            int n_pts = 0;
-            const bool from_outside = dot(d, h.ng) < 0;
-            pts[n_pts++].hit = h;
-            SurfaceHit other;
-            if (h.on_fiber()) {
-              if (from_outside && fiber_exit_point(scene, h, d, &other)) pts[n_pts++].hit = other;
-            } else if (find_crossing(scene, h, from_outside ? d : -d, &other)) {
-              pts[n_pts++].hit = other;
-            }
-            double a_sum = 0, a_pt[2] = {0, 0};
-            for (int q = 0; q < n_pts; ++q) {
-              pts[q].wi_local = pts[q].hit.shading.to_local(-d);
-              pts[q].bin = fs.grid.bin_of(pts[q].wi_local);
-              a_pt[q] = fs.mean_albedo[pts[q].bin];
-              a_sum += a_pt[q];
-            }
-            if (!(a_sum > 0)) {  // the fiber absorbs all
-              tally.absorbed += mean_w;
-              break;
-            }
-            const int q = n_pts == 2 && rng.uniform() * a_sum >= a_pt[0] ? 1 : 0;
-            const FiberPoint& pt = pts[q];
-            double pmf = 0;
-            const int ob = static_cast<int>(fs.rows[pt.bin].sample_discrete(rng.uniform(), &pmf));
-            const Vec3 wo_local = fs.cosine_direction_in(ob, rng);
-            double fmean = 0;
-            for (int c = 0; c < nc; ++c) fmean += fiber.at(pt.bin, ob, c);
-            fmean /= nc;
-            // w_c f_c D_o / (P_q pmf) = w_c (f_c / mean f) (A' + A'').
-            double before = 0, after = 0;
-            for (int c = 0; c < nc; ++c) {
-              before += w[c];
-              w[c] *= fiber.at(pt.bin, ob, c) / fmean * a_sum;
-              after += w[c];
-            }
-            tally.absorbed += (before - after) / nc;
-            d = normalize(pt.hit.shading.to_world(wo_local));
-            p = pt.hit.spawn_origin(d);
-            ignore = pt.hit.fiber;  // light leaves a fiber through the fiber itself
-            ++tally.scatterings;
-            if (++events >= o.max_scatterings) {
-              double m = 0;
-              for (double x : w) m += x;
-              tally.lost += m / nc;
-              break;
-            }
-            mean_w = 0;
-            for (double x : w) mean_w += x;
-            mean_w /= nc;
-            if (mean_w < o.roulette_threshold) {
-              const double survive = mean_w / o.roulette_threshold;
-              if (rng.uniform() < survive) {
-                for (double& x : w) x /= survive;
-                tally.roulette_net -= mean_w / survive - mean_w;
-              } else {
-                tally.roulette_net += mean_w;
-                break;
+              // Splitting above the window: a fiber's albedo along one line, A' + A'', exceeds 1
+              // where the line runs near its axis (up to ~3 in red for red cotton), so weights grow
+              // along a path; a few heavy paths would carry much of the table. n copies of weight
+              // w / n each, which go their own ways from the next fiber on.
+              if (window && max_w > o.split_threshold) {
+                const int n = static_cast<int>(
+                    std::min<double>(kMaxSplit, std::ceil(max_w / o.split_threshold)));
+                for (double& x : w) x /= n;
+                for (int copy = 1; copy < n; ++copy)
+                  pending.push_back({p, d, events, ignore, w, pdf});
+                tally.splits += n - 1;
               }
             }
           }
@@ -465,6 +561,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         result.wraps += t.wraps;
         result.continuation_caps += t.continuation_caps;
         result.inside_hits += t.inside_hits;
+        result.splits += t.splits;
       });
 
   result.cancelled = status.cancelled;

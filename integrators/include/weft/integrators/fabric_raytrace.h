@@ -13,8 +13,9 @@
 // fiber therefore lights both points where that line crosses the fiber's surface: where it enters
 // (B') and where it would leave (B''); it is re-emitted from one of them (chosen in proportion to
 // the table's albedo there, weighted to stay unbiased) into a direction drawn from the table's cell
-// averages at that point. The cloth is periodic: the geometry is the repeat and its eight
-// neighbours, and a particle crossing a side of the repeat re-enters through the opposite side.
+// averages at that point, both for the channel the particle follows (ChannelSampling). The cloth is
+// periodic: the geometry is the repeat and its eight neighbours, and a particle crossing a side of
+// the repeat re-enters through the opposite side.
 //
 // Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
@@ -27,13 +28,26 @@
 
 namespace weft {
 
+// How a particle's path is drawn when the fiber table's channels differ. spectral_mis: each
+// particle follows one hero channel, chosen uniformly, and every channel is weighted by the balance
+// heuristic over the channels' path densities (one-sample MIS over channels, as Wilkie et al. 2014
+// do over wavelengths); Russian roulette on the largest channel weight. Every channel's paths are
+// then drawn about as often as it needs, so the channels' relative noises are alike. mean: the
+// channels' mean steers the path and the roulette (the estimator before spectral MIS, kept to
+// compare with: in a strongly coloured fabric the dominant channel's weights grow along multiply
+// scattered paths and it is far noisier than the others).
+enum class ChannelSampling { spectral_mis, mean };
+
 struct FabricRaytraceOptions {
   int resolution = 8;                  // of the fabric table (DirectionGrid R)
   uint64_t particles_per_bin = 20000;  // per incident bin
   uint64_t seed = 1;
   int threads = 0;                   // 0 = all cores; results do not depend on it
   int max_scatterings = 1000;        // beyond it a particle's weight is booked as lost
-  double roulette_threshold = 0.05;  // Russian roulette below this weight (mean over channels)
+  double roulette_threshold = 0.05;  // Russian roulette below this weight (see ChannelSampling)
+  // A particle whose largest channel weight exceeds this splits into copies (not with mean).
+  double split_threshold = 1.0;
+  ChannelSampling channel_sampling = ChannelSampling::spectral_mis;
   // Trace only incident bins [first_bin, first_bin + bin_count) (0: all), for a table split over
   // processes: their rows have the bits of a whole run's, the other rows are zero.
   int first_bin = 0, bin_count = 0;
@@ -48,6 +62,7 @@ struct FabricRaytraceResult {
   // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
   double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0;
+  uint64_t splits = 0;  // copies made by splitting
   // Fiber detail: end caps of a fiber's continuation across the repeat's sides that a particle
   // leaving the fiber passed through, and hits on a fiber from inside it otherwise (taken alone,
   // without their B'': none are expected, fibers keep 2 radii apart).
