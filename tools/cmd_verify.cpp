@@ -26,7 +26,8 @@ struct VerifyCliOptions {
   std::string fit_params =
       "dye_scale,particle_fraction_scale,particle_radius_scale,roughness_alpha";
   int fit_evaluations = 100;
-  bool fit_params_given = false, fit_evaluations_given = false;
+  std::string fit_inner = "raytrace";
+  bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false;
   uint64_t seed = 1;
   int threads = 0;
   bool quiet = false, json = false;
@@ -42,12 +43,13 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
          const FitOptions& options, const VerifySettings& s, const WovenSample& sample,
          const VerifyInputs& base, const MeasuredInplane& measured, VerifyReport& report,
          const ProgressCallback& progress) {
-  const FitInnerSettings inner = fit_inner_settings(s);
+  FitInnerSettings inner = fit_inner_settings(s);
+  inner.inner = parse_fit_inner(o.fit_inner);
   if (!o.quiet) std::fprintf(stderr, "\nweft: fitting the computed model (%s)\n", o.fiber.c_str());
   FitResult computed = fit_inplane(
       "computed", spec_fit_parameters(spec, names),
       [&](const std::vector<double>& x) {
-        return computed_inner_curves(apply_spec_fit(spec, names, x), inner, measured);
+        return computed_inner_curves(apply_spec_fit(spec, names, x), sample, inner, measured);
       },
       measured, options);
   computed.inner_model = computed_inner_model_name(inner);
@@ -57,8 +59,8 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
       "classic",
       classic_fit_parameters(report.classic_reflectance, base.classic_distribution.alpha),
       [&](const std::vector<double>& x) {
-        return classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior, inner,
-                                    measured);
+        return classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior, sample,
+                                    inner, measured);
       },
       measured, options);
   classic.inner_model = classic_inner_model_name(inner);
@@ -132,6 +134,7 @@ int run(const VerifyCliOptions& o) {
   FitOptions fit_options;
   if (o.fit) {
     fit_names = parse_spec_fit_names(o.fit_params);
+    (void)parse_fit_inner(o.fit_inner);
     fit_options.max_evaluations = o.fit_evaluations;
     fit_options.validate(4);                     // the classic model always fits four
     (void)spec_fit_parameters(spec, fit_names);  // a spec without particles is refused here
@@ -260,6 +263,12 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                   "objective evaluations per model's search (the uncertainty adds 2 per parameter)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_evaluations_given = true; });
+  sub->add_option("--fit-inner", o->fit_inner,
+                  "the model the fit evaluates: raytrace (the run's pipeline, few particles) or "
+                  "summation (the paper's summation table: smooth, cheaper, no light between "
+                  "fibers)")
+      ->capture_default_str()
+      ->each([o](const std::string&) { o->fit_inner_given = true; });
   sub->add_flag("--json", o->json, "print metrics.json on stdout");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
   commands.push_back({sub, [o] { return run(*o); }});

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "weft/core/error.h"
+#include "weft/integrators/fabric_raytrace.h"
 #include "weft/integrators/verify.h"
 #include "weft/materials/fabric/fabric_summation.h"
 #include "weft/materials/fabric/fiber_spec.h"
@@ -93,34 +94,51 @@ inline FiberSpec apply_spec_fit(FiberSpec spec, const std::vector<std::string>& 
   return spec;
 }
 
-inline FabricSummationOptions fit_summation_options(const FitInnerSettings& f) {
-  FabricSummationOptions so;
-  so.method = FabricSummation::kPaper;
-  so.resolution = f.resolution;
-  so.samples_per_cell = f.summation_samples;
-  so.seed = f.seed;
-  so.threads = f.threads;
-  return so;
+inline std::string inner_step_name(const FitInnerSettings& f) {
+  return f.inner == FitInner::kRaytrace
+             ? "fiber-level ray trace (R = " + std::to_string(f.resolution) + ", " +
+                   std::to_string(f.particles_per_bin) + " particles per incident bin)"
+             : "paper's summation table (R = " + std::to_string(f.resolution) + ", " +
+                   std::to_string(f.summation_samples) + " samples per cell pair)";
 }
 
 inline std::string computed_inner_model_name(const FitInnerSettings& f) {
-  return "paper's summation (R = " + std::to_string(f.resolution) + ", " +
-         std::to_string(f.summation_samples) +
-         " samples) of an RGB fiber bake (R = " + std::to_string(f.resolution) + ", " +
-         std::to_string(f.fiber_photons_per_band) + " photons per band, seed " +
-         std::to_string(f.seed) + " at every evaluation)";
+  return inner_step_name(f) + " of an RGB fiber bake (" + std::to_string(f.fiber_photons_per_band) +
+         " photons per band), seed " + std::to_string(f.seed) + " at every evaluation";
 }
 
 inline std::string classic_inner_model_name(const FitInnerSettings& f) {
-  return "paper's summation (R = " + std::to_string(f.resolution) + ", " +
-         std::to_string(f.summation_samples) +
-         " samples) of the classic fiber table (same R and samples, seed " +
-         std::to_string(f.seed) + ")";
+  return inner_step_name(f) + " of the classic fiber table (" +
+         std::to_string(f.summation_samples) + " samples per cell pair), seed " +
+         std::to_string(f.seed) + " at every evaluation";
 }
 
-// The computed model's inner curves: an RGB fiber bake with a fixed seed (common random numbers),
-// then the paper's summation table.
+// The inner model's step from a fiber table to the curves, with the fixed seed.
+inline std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& sample,
+                                                         const TabulatedBsdfTable& fiber,
+                                                         const FitInnerSettings& f,
+                                                         const MeasuredInplane& measured) {
+  if (f.inner == FitInner::kSummation) {
+    FabricSummationOptions so;
+    so.method = FabricSummation::kPaper;
+    so.resolution = f.resolution;
+    so.samples_per_cell = f.summation_samples;
+    so.seed = f.seed;
+    so.threads = f.threads;
+    return table_curves(sum_fabric_table(fiber, so), measured, f.azimuths);
+  }
+  FabricRaytraceOptions o;
+  o.resolution = f.resolution;
+  o.particles_per_bin = f.particles_per_bin;
+  o.seed = f.seed;
+  o.threads = f.threads;
+  return table_curves(raytrace_fabric_table(sample, fiber, o).table, measured, f.azimuths);
+}
+
+// The computed model's inner curves: an RGB fiber bake, then the inner model's step, both with
+// fixed seeds.
 inline std::vector<std::vector<Rgb>> computed_inner_curves(const FiberSpec& spec,
+                                                           const WovenSample& sample,
                                                            const FitInnerSettings& f,
                                                            const MeasuredInplane& measured) {
   FiberTableBakeOptions b;
@@ -129,19 +147,19 @@ inline std::vector<std::vector<Rgb>> computed_inner_curves(const FiberSpec& spec
   b.seed = f.seed;
   b.threads = f.threads;
   b.spectral = false;
-  const FiberTableBakeResult fiber = bake_fiber_table(spec, b);
-  return table_curves(sum_fabric_table(fiber.table, fit_summation_options(f)), measured,
-                      f.azimuths);
+  return inner_fabric_curves(sample, bake_fiber_table(spec, b).table, f, measured);
 }
 
-// The classic model's inner curves: its fiber table, then the same summation.
+// The classic model's inner curves: its fiber table, then the same step.
 inline std::vector<std::vector<Rgb>> classic_inner_curves(const Rgb& diffuse,
                                                           const MicrofacetDistribution& d,
-                                                          double ior, const FitInnerSettings& f,
+                                                          double ior, const WovenSample& sample,
+                                                          const FitInnerSettings& f,
                                                           const MeasuredInplane& measured) {
-  const TabulatedBsdfTable fiber =
-      classic_fiber_table(diffuse, d, ior, f.resolution, f.summation_samples, f.seed, f.threads);
-  return table_curves(sum_fabric_table(fiber, fit_summation_options(f)), measured, f.azimuths);
+  return inner_fabric_curves(
+      sample,
+      classic_fiber_table(diffuse, d, ior, f.resolution, f.summation_samples, f.seed, f.threads), f,
+      measured);
 }
 
 // The classic model's four: its diffuse colour per channel (a reflectance, on a log scale: the

@@ -624,6 +624,16 @@ std::vector<std::vector<Rgb>> table_curves(const TabulatedBsdfTable& table,
   return out;
 }
 
+FitInner parse_fit_inner(const std::string& name) {
+  if (name == "raytrace") return FitInner::kRaytrace;
+  if (name == "summation") return FitInner::kSummation;
+  throw Error("", "--fit-inner", "'" + name + "' is not raytrace or summation");
+}
+
+std::string fit_inner_name(FitInner inner) {
+  return inner == FitInner::kRaytrace ? "raytrace" : "summation";
+}
+
 FitInnerSettings fit_inner_settings(const VerifySettings& s) {
   FitInnerSettings f;
   f.seed = s.seed;

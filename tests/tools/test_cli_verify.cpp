@@ -119,6 +119,13 @@ weft::MeasuredInplane synthetic(const std::vector<std::vector<weft::Rgb>>& beta)
   return m;
 }
 
+// The command's sample: the bundled poplin at fiber detail.
+weft::WovenSample verify_sample() {
+  weft::WeaveOptions given;
+  given.detail = "fiber";
+  return weft::make_woven_sample(weft::overlay(weft::WeaveOptions{}, given));
+}
+
 }  // namespace
 
 // The computed model: a red-cotton fiber with its dye 1.8 times as strong and roughness 0.22
@@ -130,19 +137,23 @@ TEST(CliVerify, FitRecoversKnownFiberParametersFromASyntheticMeasurement) {
   const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
   weft::VerifySettings s = weft::verify_settings(weft::VerifyQuality::kDraft);
   weft::FitInnerSettings inner = weft::fit_inner_settings(s);
-  inner.fiber_photons_per_band = 2000;  // the test's budget; the command uses 5000
+  // The smooth inner model, with the test's budget (the command uses 5000 photons).
+  inner.inner = weft::FitInner::kSummation;
+  inner.fiber_photons_per_band = 2000;
+  const weft::WovenSample sample = verify_sample();
   const std::vector<std::string> names = {"dye_scale", "roughness_alpha"};
   const std::vector<double> truth = {1.8, 0.22};
   weft::MeasuredInplane geometry = weft::read_measured_inplane(
       fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
-  const weft::MeasuredInplane measured = synthetic(
-      weft::computed_inner_curves(weft::apply_spec_fit(spec, names, truth), inner, geometry));
+  const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
+      weft::apply_spec_fit(spec, names, truth), sample, inner, geometry));
   weft::FitOptions options;
   options.max_evaluations = 60;
   const weft::FitResult r = weft::fit_inplane(
       "computed", weft::spec_fit_parameters(spec, names),
       [&](const std::vector<double>& x) {
-        return weft::computed_inner_curves(weft::apply_spec_fit(spec, names, x), inner, measured);
+        return weft::computed_inner_curves(weft::apply_spec_fit(spec, names, x), sample, inner,
+                                           measured);
       },
       measured, options);
   ASSERT_EQ(r.parameters.size(), 2u);
@@ -161,21 +172,23 @@ TEST(CliVerify, FitRecoversKnownFiberParametersFromASyntheticMeasurement) {
 // measurement, from the start the command uses for red-cotton (its volume albedo, 0.35).
 TEST(CliVerify, FitRecoversKnownClassicParametersFromASyntheticMeasurement) {
   weft::VerifySettings s = weft::verify_settings(weft::VerifyQuality::kDraft);
-  const weft::FitInnerSettings inner = weft::fit_inner_settings(s);
+  weft::FitInnerSettings inner = weft::fit_inner_settings(s);
+  inner.inner = weft::FitInner::kSummation;
+  const weft::WovenSample sample = verify_sample();
   weft::MeasuredInplane geometry = weft::read_measured_inplane(
       fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
   const weft::MicrofacetModel model = weft::MicrofacetModel::kBeckmann;
   const double ior = 1.557;
   const std::vector<double> truth = {0.3, 0.05, 0.03, 0.6};
   const weft::MeasuredInplane measured = synthetic(weft::classic_inner_curves(
-      weft::Rgb(truth[0], truth[1], truth[2]), {model, truth[3]}, ior, inner, geometry));
+      weft::Rgb(truth[0], truth[1], truth[2]), {model, truth[3]}, ior, sample, inner, geometry));
   weft::FitOptions options;
   options.max_evaluations = 150;
   const weft::FitResult r = weft::fit_inplane(
       "classic", weft::classic_fit_parameters(weft::Rgb(0.849, 0.147, 0.209), 0.35),
       [&](const std::vector<double>& x) {
-        return weft::classic_inner_curves(weft::Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, inner,
-                                          measured);
+        return weft::classic_inner_curves(weft::Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, sample,
+                                          inner, measured);
       },
       measured, options);
   ASSERT_EQ(r.parameters.size(), 4u);
@@ -203,6 +216,7 @@ TEST(CliVerify, BadFitOptionsAreRefusedBeforeAnyWork) {
       {"--fit --fit-params dye_scale,", "--fit-params", "an empty name"},
       {"--fit --fit-evaluations 5", "--fit-evaluations", "fewer than 2 p + 2"},
       {"--fit-params dye_scale", "--fit-params", "only with --fit"},
+      {"--fit --fit-inner exact", "--fit-inner", "not raytrace or summation"},
       {"--fit --fiber '" + bare_spec.string() + "' --fit-params particle_radius_scale",
        "--fit-params", "the spec has no particle species"}};
   for (const auto& c : cases) {

@@ -229,13 +229,23 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
                       const InplaneModel& inplane, const MeasuredInplane& measured,
                       const FitOptions& options);
 
-// The inner model's settings (docs/verify.md): low-resolution, low-photon fiber bakes with a
-// fixed seed (common random numbers, so the objective is smooth in the parameters), the paper's
-// summation table, the run's azimuths.
+// The inner model the fit evaluates (docs/verify.md), both with fixed seeds at every evaluation
+// (common random numbers):
+//   kRaytrace: the run's own pipeline (RGB fiber bake, then the fiber-level ray trace) with few
+//     photons and particles; its objective is jagged at the level of its noise (a changed table
+//     changes the paths' discrete choices);
+//   kSummation: the paper's summation table of the same bake; smooth and about 20 times cheaper,
+//     but without light travelling between fibers, so its optimum is not the ray trace's.
+enum class FitInner { kRaytrace, kSummation };
+FitInner parse_fit_inner(const std::string& name);  // weft::Error naming "--fit-inner"
+std::string fit_inner_name(FitInner inner);
+
 struct FitInnerSettings {
+  FitInner inner = FitInner::kRaytrace;
   int resolution = 6;
   uint64_t fiber_photons_per_band = 5000;
-  int summation_samples = 4;
+  uint64_t particles_per_bin = 2000;  // kRaytrace: one ray trace
+  int summation_samples = 4;          // the summation's and the classic fiber table's
   uint64_t seed = 1;
   int azimuths = 24;
   int threads = 0;
