@@ -764,9 +764,11 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
     for (size_t k = 0; k < n; ++k) x[k] = to_value(params[k], std::clamp(u[k], 0.0, 1.0));
     return x;
   };
+  std::vector<std::vector<Rgb>> last;  // the latest evaluation's curves (for the metrics)
   auto residuals_at = [&](const std::vector<double>& u) {
     ++res.evaluations;
-    return fit_residuals(inplane(values_of(u)), measured);
+    last = inplane(values_of(u));
+    return fit_residuals(last, measured);
   };
   auto objective = [&](const std::vector<double>& u) { return rms(residuals_at(u)); };
 
@@ -785,9 +787,11 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
     simplex.push_back(u);
   }
   std::vector<double> f;
-  for (const auto& u : simplex) f.push_back(objective(u));
+  for (const auto& u : simplex) {
+    f.push_back(objective(u));
+    if (f.size() == 1) res.start_metrics = absolute_metrics(last, measured);
+  }
   res.objective_start = f[0];
-  res.start_metrics = absolute_metrics(inplane(values_of(u0)), measured);
   while (res.evaluations < o.max_evaluations) {
     std::vector<size_t> order(n + 1);
     for (size_t k = 0; k <= n; ++k) order[k] = k;
@@ -852,7 +856,7 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
   const std::vector<double> ub = simplex[best];
   res.objective = f[best];
   const std::vector<double> r0 = residuals_at(ub);
-  res.fitted_metrics = absolute_metrics(inplane(values_of(ub)), measured);
+  res.fitted_metrics = absolute_metrics(last, measured);
 
   // Uncertainty: J by central differences in u (one-sided at a bound), s^2 = SSR / (m - p).
   const size_t m = r0.size();
