@@ -9,6 +9,7 @@
 
 #include "commands.h"
 #include "plot_util.h"
+#include "verify_fit.h"
 #include "weft/core/error.h"
 #include "weft/integrators/verify.h"
 #include "weft/materials/fabric/fabric_summation.h"
@@ -21,6 +22,12 @@ namespace {
 
 struct VerifyCliOptions {
   std::string measured, fiber = "red-cotton", weave, pattern, wif, quality = "default", output;
+  bool fit = false;
+  std::string fit_params =
+      "dye_scale,particle_fraction_scale,particle_radius_scale,roughness_alpha";
+  int fit_evaluations = 100;
+  std::string fit_inner = "raytrace";
+  bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false;
   uint64_t seed = 1;
   int threads = 0;
   bool quiet = false, json = false;
@@ -28,6 +35,77 @@ struct VerifyCliOptions {
 
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// --fit: both models fitted with the same objective and budget on their inner models, then the
+// fitted parameters evaluated at the run's quality (run_verify again) as the "_fitted" models.
+bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std::string>& names,
+         const FitOptions& options, const VerifySettings& s, const WovenSample& sample,
+         const VerifyInputs& base, const MeasuredInplane& measured, VerifyReport& report,
+         const ProgressCallback& progress) {
+  FitInnerSettings inner = fit_inner_settings(s);
+  inner.inner = parse_fit_inner(o.fit_inner);
+  if (!o.quiet) std::fprintf(stderr, "\nweft: fitting the computed model (%s)\n", o.fiber.c_str());
+  FitResult computed = fit_inplane(
+      "computed", spec_fit_parameters(spec, names),
+      [&](const std::vector<double>& x) {
+        return computed_inner_curves(apply_spec_fit(spec, names, x), sample, inner, measured);
+      },
+      measured, options);
+  computed.inner_model = computed_inner_model_name(inner);
+  if (!o.quiet) std::fprintf(stderr, "weft: fitting the classic model\n");
+  const MicrofacetModel model = base.classic_distribution.model;
+  FitResult classic = fit_inplane(
+      "classic",
+      classic_fit_parameters(report.classic_reflectance, base.classic_distribution.alpha),
+      [&](const std::vector<double>& x) {
+        return classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior, sample,
+                                    inner, measured);
+      },
+      measured, options);
+  classic.inner_model = classic_inner_model_name(inner);
+
+  // The fitted parameters at the run's quality.
+  std::vector<double> values;
+  for (const auto& p : computed.parameters) values.push_back(p.value);
+  const FiberSpec fitted = apply_spec_fit(spec, names, values);
+  VerifyInputs in;
+  in.fiber_name = base.fiber_name + " (fitted)";
+  in.sample_name = base.sample_name;
+  const auto t0 = std::chrono::steady_clock::now();
+  FiberTableBakeOptions b;
+  b.resolution = s.resolution;
+  b.photons_per_band = s.fiber_photons_per_band;
+  b.seed = s.seed;
+  b.threads = s.threads;
+  b.spectral = true;
+  FiberTableBakeResult fiber = bake_fiber_table(fitted, b, progress);
+  if (fiber.cancelled) {
+    std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
+    return false;
+  }
+  for (const auto& band : fiber.bands)
+    in.volume_albedo[band.band] = band.exit_fraction - band.surface_fraction;
+  in.fiber = std::move(fiber.table);
+  in.classic_distribution = {model, classic.parameters[3].value};
+  in.classic_ior = base.classic_ior;
+  in.classic_diffuse =
+      Rgb(classic.parameters[0].value, classic.parameters[1].value, classic.parameters[2].value);
+  const VerifyReport again = run_verify(sample, in, measured, s, progress);
+  if (again.cancelled) {
+    std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
+    return false;
+  }
+  for (ModelCurves m : again.models) {
+    m.key += "_fitted";
+    m.label += ", fitted";
+    report.models.push_back(std::move(m));
+  }
+  report.seconds["fit_computed"] = computed.seconds;
+  report.seconds["fit_classic"] = classic.seconds;
+  report.seconds["fit_at_run_quality"] = since(t0);
+  report.fits = {std::move(computed), std::move(classic)};
+  return true;
 }
 
 int run(const VerifyCliOptions& o) {
@@ -52,6 +130,17 @@ int run(const VerifyCliOptions& o) {
   if (!o.wif.empty()) given.wif = o.wif;
   given.detail = "fiber";  // the fiber-level reference
   const WeaveOptions base = o.weave.empty() ? WeaveOptions{} : read_weave_options(o.weave);
+  std::vector<std::string> fit_names;
+  FitOptions fit_options;
+  if (o.fit) {
+    fit_names = parse_spec_fit_names(o.fit_params);
+    (void)parse_fit_inner(o.fit_inner);
+    fit_options.max_evaluations = o.fit_evaluations;
+    fit_options.validate(4);                     // the classic model always fits four
+    (void)spec_fit_parameters(spec, fit_names);  // a spec without particles is refused here
+  } else if (o.fit_params_given || o.fit_evaluations_given) {
+    throw Error("", o.fit_params_given ? "--fit-params" : "--fit-evaluations", "only with --fit");
+  }
   check_verify_output(o.output);
 
   const auto progress = progress_bar(o.quiet);
@@ -96,6 +185,8 @@ int run(const VerifyCliOptions& o) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
     return 130;
   }
+  if (o.fit && !fit(o, spec, fit_names, fit_options, s, sample, in, measured, report, progress))
+    return 130;
   report.seconds["total_before_report"] = since(t_all);
   write_verify_report(o.output, report, [&](const std::filesystem::path& staging) {
     const auto tp = std::chrono::steady_clock::now();
@@ -118,11 +209,20 @@ int run(const VerifyCliOptions& o) {
                 measured.curves.size(), o.quality.c_str(), since(t_all));
     std::printf("  %-36s %10s %10s %10s %10s\n", "RMS vs measured", "log norm", "rel norm",
                 "log abs", "rel abs");
-    for (const char* key : {"computed_raytrace", "computed_summation", "classic"})
+    for (const char* key : {"computed_raytrace", "computed_summation", "classic",
+                            "computed_raytrace_fitted", "classic_fitted"})
       if (const ModelCurves* m = find(key))
         std::printf("  %-36s %10.3f %10.3f %10.3f %10.3f\n", m->label.c_str(),
                     m->normalized_overall.rms_log, m->normalized_overall.rms_rel,
                     m->absolute_overall.rms_log, m->absolute_overall.rms_rel);
+    for (const auto& f : report.fits) {
+      std::printf("  fit %s: inner rms_log %.3f -> %.3f, %d evaluations, %.1f s:", f.model.c_str(),
+                  f.objective_start, f.objective, f.evaluations, f.seconds);
+      for (const auto& p : f.parameters)
+        std::printf(" %s %.4g +- %.2g%s", p.parameter.name.c_str(), p.value, p.sigma,
+                    p.at_bound ? " (at bound)" : "");
+      std::printf("\n");
+    }
   }
   return 0;
 }
@@ -151,6 +251,24 @@ void add_verify_command(CLI::App& app, Commands& commands) {
   sub->add_option("--threads", o->threads, "threads (0 = all cores; results do not depend on it)")
       ->check(CLI::Range(0, 4096));
   sub->add_option("-o,--output", o->output, "report folder (replaced whole)")->required();
+  sub->add_flag("--fit", o->fit,
+                "fit at most four fiber parameters (computed) and the classic model's diffuse "
+                "colour and roughness to the measurement, then evaluate both at the run's quality");
+  sub->add_option("--fit-params", o->fit_params,
+                  "computed model's parameters, comma-separated: dye_scale, "
+                  "particle_fraction_scale, particle_radius_scale, roughness_alpha")
+      ->capture_default_str()
+      ->each([o](const std::string&) { o->fit_params_given = true; });
+  sub->add_option("--fit-evaluations", o->fit_evaluations,
+                  "objective evaluations per model's search (the uncertainty adds 2 per parameter)")
+      ->capture_default_str()
+      ->each([o](const std::string&) { o->fit_evaluations_given = true; });
+  sub->add_option("--fit-inner", o->fit_inner,
+                  "the model the fit evaluates: raytrace (the run's pipeline, few particles) or "
+                  "summation (the paper's summation table: smooth, cheaper, no light between "
+                  "fibers)")
+      ->capture_default_str()
+      ->each([o](const std::string&) { o->fit_inner_given = true; });
   sub->add_flag("--json", o->json, "print metrics.json on stdout");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
   commands.push_back({sub, [o] { return run(*o); }});

@@ -25,9 +25,13 @@ STYLE = {
     "computed_raytrace": dict(color="tab:red", linestyle="-", marker="o", markersize=2.5),
     "computed_summation": dict(color="tab:orange", linestyle=":", marker=""),
     "classic": dict(color="tab:blue", linestyle="-.", marker="s", markersize=2.5),
+    # weft verify --fit: the fitted parameters at the run's quality, thinner and lighter.
+    "computed_raytrace_fitted": dict(color="salmon", linestyle="-", marker="", alpha=0.8),
+    "classic_fitted": dict(color="lightskyblue", linestyle="-.", marker="", alpha=0.8),
 }
 SHORT = {"computed_raytrace": "ray trace", "computed_summation": "summation",
-         "classic": "classic"}
+         "classic": "classic", "computed_raytrace_fitted": "ray trace fitted",
+         "classic_fitted": "classic fitted"}
 
 
 def main():

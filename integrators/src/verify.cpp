@@ -536,21 +536,18 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
       ++rep.classic_clip.components;
       *v = 1;
     }
+  if (in.classic_diffuse) {
+    const Rgb d = *in.classic_diffuse;
+    for (int k = 0; k < 3; ++k)
+      if (!(channel(d, k) >= 0 && channel(d, k) <= 1))
+        throw Error("", "classic_diffuse", "a reflectance lies in [0, 1]");
+    refl = d;
+    rep.classic_clip = GamutClip();
+  }
   rep.classic_reflectance = refl;
-  const ClassicFiberBsdf classic =
-      ClassicFiberBsdf::create(refl, in.classic_distribution, in.classic_ior);
-  // Outside the fiber only: the ray trace lights the far crossing point from inside, where an
-  // opaque classic fiber reflects nothing.
-  TabulatedBsdfTable classic_fiber = TabulatedBsdfTable::from_function(
-      s.resolution, 3,
-      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        const Rgb f = wo.z > 0 && wi.z > 0 ? classic.eval(wo, wi) : Rgb();
-        v[0] = f.r;
-        v[1] = f.g;
-        v[2] = f.b;
-      },
-      s.summation_samples, s.seed, s.threads, progress);
-  classic_fiber.kind = "fiber";
+  const TabulatedBsdfTable classic_fiber =
+      classic_fiber_table(refl, in.classic_distribution, in.classic_ior, s.resolution,
+                          s.summation_samples, s.seed, s.threads, progress);
   TracedCurves cl = trace_curves(sample, classic_fiber, measured, s, "classic", progress);
   if (cl.cancelled) {
     rep.cancelled = true;
@@ -595,6 +592,305 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   }
   rep.seconds["verify_library"] = seconds_since(t_all);
   return rep;
+}
+
+// ---- Fitting ----------------------------------------------------------------------------------
+
+TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
+                                       double ior, int resolution, int samples, uint64_t seed,
+                                       int threads, const ProgressCallback& progress) {
+  const ClassicFiberBsdf classic = ClassicFiberBsdf::create(diffuse, d, ior);
+  // Outside the fiber only: the ray trace lights the far crossing point from inside, where an
+  // opaque classic fiber reflects nothing.
+  TabulatedBsdfTable t = TabulatedBsdfTable::from_function(
+      resolution, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const Rgb f = wo.z > 0 && wi.z > 0 ? classic.eval(wo, wi) : Rgb();
+        v[0] = f.r;
+        v[1] = f.g;
+        v[2] = f.b;
+      },
+      samples, seed, threads, progress);
+  t.kind = "fiber";
+  return t;
+}
+
+std::vector<std::vector<Rgb>> table_curves(const TabulatedBsdfTable& table,
+                                           const MeasuredInplane& measured, int azimuths) {
+  const TabulatedBsdfTable rgb = table_to_rgb(table);
+  std::vector<std::vector<Rgb>> out;
+  for (const auto& c : measured.curves)
+    out.push_back(inplane_beta(rgb, c.theta_i_deg, c.view_deg, azimuths));
+  return out;
+}
+
+FitInner parse_fit_inner(const std::string& name) {
+  if (name == "raytrace") return FitInner::kRaytrace;
+  if (name == "summation") return FitInner::kSummation;
+  throw Error("", "--fit-inner", "'" + name + "' is not raytrace or summation");
+}
+
+std::string fit_inner_name(FitInner inner) {
+  return inner == FitInner::kRaytrace ? "raytrace" : "summation";
+}
+
+FitInnerSettings fit_inner_settings(const VerifySettings& s) {
+  FitInnerSettings f;
+  f.seed = s.seed;
+  f.azimuths = s.azimuths;
+  f.threads = s.threads;
+  return f;
+}
+
+void FitOptions::validate(size_t parameters) const {
+  const int least = 2 * static_cast<int>(parameters) + 2;
+  if (max_evaluations < least)
+    throw Error("", "--fit-evaluations",
+                std::to_string(max_evaluations) + " is fewer than 2 p + 2 = " +
+                    std::to_string(least) + " (the simplex and a first step)");
+  if (!(tolerance > 0) || !std::isfinite(tolerance))
+    throw Error("", "tolerance", "must be a positive number");
+  if (!(initial_step > 0 && initial_step <= 0.5))
+    throw Error("", "initial_step", "must lie in (0, 0.5]");
+  if (!(jacobian_step > 0 && jacobian_step <= 0.25))
+    throw Error("", "jacobian_step", "must lie in (0, 0.25]");
+}
+
+std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
+                                  const MeasuredInplane& measured) {
+  if (model.size() != measured.curves.size())
+    throw Error(measured.file, "fit", "the model's incidences differ from the measurement's");
+  std::vector<double> r;
+  for (size_t i = 0; i < model.size(); ++i) {
+    const auto& c = measured.curves[i];
+    if (model[i].size() != c.view_deg.size())
+      throw Error(measured.file, "fit", "the model's views differ from the measurement's");
+    for (size_t v = 0; v < c.view_deg.size(); ++v)
+      for (int k = 0; k < 3; ++k) {
+        const double m = channel(c.beta[v], k), x = channel(model[i][v], k);
+        if (!(m > 0)) continue;
+        r.push_back(x > 0 ? std::log(x / m) : std::log(1e-6));
+      }
+  }
+  return r;
+}
+
+namespace {
+
+double rms(const std::vector<double>& r) {
+  double s = 0;
+  for (double x : r) s += x * x;
+  return r.empty() ? 0.0 : std::sqrt(s / static_cast<double>(r.size()));
+}
+
+// Unit-cube coordinate <-> the parameter's own value.
+double to_value(const FitParameter& p, double u) {
+  return p.log_scale ? std::exp(std::log(p.lo) + u * (std::log(p.hi) - std::log(p.lo)))
+                     : p.lo + u * (p.hi - p.lo);
+}
+double to_unit(const FitParameter& p, double x) {
+  return p.log_scale ? (std::log(x) - std::log(p.lo)) / (std::log(p.hi) - std::log(p.lo))
+                     : (x - p.lo) / (p.hi - p.lo);
+}
+
+CurveMetrics absolute_metrics(const std::vector<std::vector<Rgb>>& model,
+                              const MeasuredInplane& measured) {
+  MetricsAccumulator a;
+  for (size_t i = 0; i < model.size(); ++i)
+    for (size_t v = 0; v < model[i].size(); ++v)
+      for (int k = 0; k < 3; ++k)
+        a.add(channel(model[i][v], k), channel(measured.curves[i].beta[v], k));
+  return a.result();
+}
+
+// Inverse of a small symmetric matrix by Gauss-Jordan with partial pivoting; false if singular.
+bool invert(std::vector<std::vector<double>>& a) {
+  const size_t n = a.size();
+  std::vector<std::vector<double>> inv(n, std::vector<double>(n, 0.0));
+  for (size_t i = 0; i < n; ++i) inv[i][i] = 1;
+  double scale = 0;
+  for (const auto& row : a)
+    for (double x : row) scale = std::max(scale, std::abs(x));
+  for (size_t c = 0; c < n; ++c) {
+    size_t piv = c;
+    for (size_t r = c + 1; r < n; ++r)
+      if (std::abs(a[r][c]) > std::abs(a[piv][c])) piv = r;
+    if (!(std::abs(a[piv][c]) > 1e-12 * scale)) return false;
+    std::swap(a[piv], a[c]);
+    std::swap(inv[piv], inv[c]);
+    const double d = a[c][c];
+    for (size_t k = 0; k < n; ++k) {
+      a[c][k] /= d;
+      inv[c][k] /= d;
+    }
+    for (size_t r = 0; r < n; ++r) {
+      if (r == c) continue;
+      const double f = a[r][c];
+      for (size_t k = 0; k < n; ++k) {
+        a[r][k] -= f * a[c][k];
+        inv[r][k] -= f * inv[c][k];
+      }
+    }
+  }
+  a = inv;
+  return true;
+}
+
+}  // namespace
+
+FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>& params,
+                      const InplaneModel& inplane, const MeasuredInplane& measured,
+                      const FitOptions& o) {
+  if (params.empty() || params.size() > 4)
+    throw Error("", "--fit-params",
+                "fit between one and four parameters (issue 8's budget), not " +
+                    std::to_string(params.size()));
+  for (const auto& p : params) {
+    if (!(p.lo < p.hi) || !std::isfinite(p.lo) || !std::isfinite(p.hi) ||
+        (p.log_scale && !(p.lo > 0)))
+      throw Error("", p.name, "the fit's box must have lo < hi (and lo > 0 on a log scale)");
+    if (!(p.start >= p.lo && p.start <= p.hi))
+      throw Error("", p.name,
+                  "the start " + fmt(p.start, 6) + " lies outside [" + fmt(p.lo, 6) + ", " +
+                      fmt(p.hi, 6) + "]");
+  }
+  o.validate(params.size());
+  const auto t0 = std::chrono::steady_clock::now();
+  const size_t n = params.size();
+  FitResult res;
+  res.model = model;
+  auto values_of = [&](const std::vector<double>& u) {
+    std::vector<double> x(n);
+    for (size_t k = 0; k < n; ++k) x[k] = to_value(params[k], std::clamp(u[k], 0.0, 1.0));
+    return x;
+  };
+  std::vector<std::vector<Rgb>> last;  // the latest evaluation's curves (for the metrics)
+  auto residuals_at = [&](const std::vector<double>& u) {
+    ++res.evaluations;
+    last = inplane(values_of(u));
+    return fit_residuals(last, measured);
+  };
+  auto objective = [&](const std::vector<double>& u) { return rms(residuals_at(u)); };
+
+  // Nelder-Mead (standard coefficients 1, 2, 0.5, 0.5) on the unit cube; points are projected
+  // into the cube, so every evaluation is a valid parameter set.
+  auto project = [](std::vector<double> u) {
+    for (double& x : u) x = std::clamp(x, 0.0, 1.0);
+    return u;
+  };
+  std::vector<double> u0(n);
+  for (size_t k = 0; k < n; ++k) u0[k] = to_unit(params[k], params[k].start);
+  std::vector<std::vector<double>> simplex{u0};
+  for (size_t k = 0; k < n; ++k) {
+    auto u = u0;
+    u[k] += u[k] + o.initial_step <= 1 ? o.initial_step : -o.initial_step;
+    simplex.push_back(u);
+  }
+  std::vector<double> f;
+  for (const auto& u : simplex) {
+    f.push_back(objective(u));
+    if (f.size() == 1) res.start_metrics = absolute_metrics(last, measured);
+  }
+  res.objective_start = f[0];
+  while (res.evaluations < o.max_evaluations) {
+    std::vector<size_t> order(n + 1);
+    for (size_t k = 0; k <= n; ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return f[a] < f[b]; });
+    std::vector<std::vector<double>> s2;
+    std::vector<double> f2;
+    for (size_t k : order) {
+      s2.push_back(simplex[k]);
+      f2.push_back(f[k]);
+    }
+    simplex = std::move(s2);
+    f = std::move(f2);
+    double size = 0;
+    for (size_t k = 1; k <= n; ++k)
+      for (size_t d = 0; d < n; ++d) size = std::max(size, std::abs(simplex[k][d] - simplex[0][d]));
+    if (f[n] - f[0] < o.tolerance && size < 1e-3) {
+      res.converged = true;
+      break;
+    }
+    std::vector<double> centroid(n, 0.0);
+    for (size_t k = 0; k < n; ++k)
+      for (size_t d = 0; d < n; ++d) centroid[d] += simplex[k][d] / static_cast<double>(n);
+    auto along = [&](double t) {
+      std::vector<double> u(n);
+      for (size_t d = 0; d < n; ++d) u[d] = centroid[d] + t * (simplex[n][d] - centroid[d]);
+      return project(u);
+    };
+    const auto ur = along(-1.0);
+    const double fr = objective(ur);
+    if (fr < f[0]) {
+      const auto ue = along(-2.0);
+      const double fe = objective(ue);
+      if (fe < fr) {
+        simplex[n] = ue;
+        f[n] = fe;
+      } else {
+        simplex[n] = ur;
+        f[n] = fr;
+      }
+    } else if (fr < f[n - 1]) {
+      simplex[n] = ur;
+      f[n] = fr;
+    } else {
+      const bool outside = fr < f[n];
+      const auto uc = along(outside ? -0.5 : 0.5);
+      const double fc = objective(uc);
+      if (fc < (outside ? fr : f[n])) {
+        simplex[n] = uc;
+        f[n] = fc;
+      } else {  // shrink towards the best point
+        for (size_t k = 1; k <= n; ++k) {
+          for (size_t d = 0; d < n; ++d)
+            simplex[k][d] = simplex[0][d] + 0.5 * (simplex[k][d] - simplex[0][d]);
+          f[k] = objective(simplex[k]);
+        }
+      }
+    }
+  }
+  size_t best = 0;
+  for (size_t k = 1; k <= n; ++k)
+    if (f[k] < f[best]) best = k;
+  const std::vector<double> ub = simplex[best];
+  res.objective = f[best];
+  const std::vector<double> r0 = residuals_at(ub);
+  res.fitted_metrics = absolute_metrics(last, measured);
+
+  // Uncertainty: J by central differences in u (one-sided at a bound), s^2 = SSR / (m - p).
+  const size_t m = r0.size();
+  std::vector<std::vector<double>> jac(n);
+  for (size_t k = 0; k < n; ++k) {
+    auto up = ub, dn = ub;
+    up[k] = std::min(1.0, ub[k] + o.jacobian_step);
+    dn[k] = std::max(0.0, ub[k] - o.jacobian_step);
+    const auto rp = residuals_at(up), rm = residuals_at(dn);
+    jac[k].resize(m);
+    for (size_t i = 0; i < m; ++i) jac[k][i] = (rp[i] - rm[i]) / (up[k] - dn[k]);
+  }
+  std::vector<std::vector<double>> jtj(n, std::vector<double>(n, 0.0));
+  for (size_t a = 0; a < n; ++a)
+    for (size_t b = 0; b < n; ++b)
+      for (size_t i = 0; i < m; ++i) jtj[a][b] += jac[a][i] * jac[b][i];
+  double ssr = 0;
+  for (double x : r0) ssr += x * x;
+  const double s2 = m > n ? ssr / static_cast<double>(m - n) : std::nan("");
+  const bool ok = invert(jtj);
+  for (size_t k = 0; k < n; ++k) {
+    FitParameterResult p;
+    p.parameter = params[k];
+    p.value = to_value(params[k], ub[k]);
+    p.at_bound = ub[k] < 1e-3 || ub[k] > 1 - 1e-3;
+    // d value / d u converts the unit-cube standard deviation to the parameter's own units.
+    const double dxdu = params[k].log_scale
+                            ? p.value * (std::log(params[k].hi) - std::log(params[k].lo))
+                            : params[k].hi - params[k].lo;
+    p.sigma = ok && jtj[k][k] > 0 ? dxdu * std::sqrt(s2 * jtj[k][k]) : std::nan("");
+    res.parameters.push_back(p);
+  }
+  res.seconds = seconds_since(t0);
+  return res;
 }
 
 // ---- Report files ---------------------------------------------------------------------------
@@ -675,12 +971,58 @@ std::string verify_metrics_json(const VerifyReport& r) {
       j["computed_rms_rel"] = m.normalized_overall.rms_rel;
       j["computed_rms_rel_absolute"] = m.absolute_overall.rms_rel;
     }
+    if (m.key == "computed_raytrace_fitted") {
+      j["computed_fitted_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["computed_fitted_rms_log"] = m.normalized_overall.rms_log;
+    }
+    if (m.key == "classic_fitted") {
+      j["classic_fitted_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["classic_fitted_rms_log"] = m.normalized_overall.rms_log;
+    }
     if (m.key == "classic") {
       j["classic_rms_log"] = m.normalized_overall.rms_log;
       j["classic_rms_log_absolute"] = m.absolute_overall.rms_log;
       j["classic_rms_rel"] = m.normalized_overall.rms_rel;
       j["classic_rms_rel_absolute"] = m.absolute_overall.rms_rel;
     }
+  }
+  if (!r.fits.empty()) {
+    nlohmann::json fit = nlohmann::json::object();
+    for (const auto& f : r.fits) {
+      nlohmann::json ps = nlohmann::json::array();
+      for (const auto& p : f.parameters)
+        ps.push_back(
+            {{"name", p.parameter.name},
+             {"unit", p.parameter.unit},
+             {"start", p.parameter.start},
+             {"lo", p.parameter.lo},
+             {"hi", p.parameter.hi},
+             {"log_scale", p.parameter.log_scale},
+             {"value", p.value},
+             {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma) : nlohmann::json()},
+             {"at_bound", p.at_bound}});
+      nlohmann::json e = {{"parameters", ps},
+                          {"inner_model", f.inner_model},
+                          {"uncertainty", f.uncertainty},
+                          {"objective", "rms_log, absolute, of the inner model"},
+                          {"inner_rms_log_start", f.objective_start},
+                          {"inner_rms_log_fitted", f.objective},
+                          {"inner_start", metrics_json(f.start_metrics)},
+                          {"inner_fitted", metrics_json(f.fitted_metrics)},
+                          {"evaluations", f.evaluations},
+                          {"converged", f.converged},
+                          {"seconds", f.seconds}};
+      // The fitted parameters at the run's quality (the same ray trace as the unfitted curves).
+      const std::string key =
+          f.model == "computed" ? "computed_raytrace_fitted" : f.model + "_fitted";
+      for (const auto& m : r.models)
+        if (m.key == key)
+          e["at_run_quality"] = {{"model", key},
+                                 {"absolute", metrics_json(m.absolute_overall)},
+                                 {"normalized", metrics_json(m.normalized_overall)}};
+      fit[f.model] = e;
+    }
+    j["fit"] = fit;
   }
   nlohmann::json colours = nlohmann::json::array();
   for (const auto& c : r.colours) {
@@ -728,6 +1070,31 @@ std::string verify_index_html(const VerifyReport& r,
     for (const auto& m : r.models)
       h << "<td>" << fmt(m.normalized[i].rms_log) << " (" << fmt(m.absolute[i].rms_log) << ")</td>";
     h << "</tr>\n";
+  }
+  if (!r.fits.empty()) {
+    h << "</table>\n<h2>Fit (issue 8): at most four parameters per model, same objective</h2>\n"
+         "<p>Objective: RMS of ln(model / measured), absolute, of the inner model; then the fitted "
+         "parameters at the run's quality (the models marked fitted above).</p>\n<table><tr>"
+         "<th>model</th><th>parameter</th><th>start</th><th>box</th><th>fitted</th><th>sigma</th>"
+         "</tr>\n";
+    for (const auto& f : r.fits)
+      for (const auto& p : f.parameters)
+        h << "<tr><td>" << html_escape(f.model) << "</td><td>" << html_escape(p.parameter.name)
+          << (p.parameter.unit.empty() ? "" : " (" + html_escape(p.parameter.unit) + ")")
+          << "</td><td>" << fmt(p.parameter.start, 4) << "</td><td>[" << fmt(p.parameter.lo, 4)
+          << ", " << fmt(p.parameter.hi, 4) << "]</td><td>" << fmt(p.value, 4)
+          << (p.at_bound ? " (at bound)" : "") << "</td><td>"
+          << (std::isfinite(p.sigma) ? fmt(p.sigma, 2) : std::string("&mdash;")) << "</td></tr>\n";
+    h << "</table>\n<table><tr><th>model</th><th>inner RMS log, start</th><th>inner RMS log, "
+         "fitted</th><th>evaluations</th><th>converged</th><th>seconds</th></tr>\n";
+    for (const auto& f : r.fits)
+      h << "<tr><td>" << html_escape(f.model) << "</td><td>" << fmt(f.objective_start)
+        << "</td><td>" << fmt(f.objective) << "</td><td>" << f.evaluations << "</td><td>"
+        << (f.converged ? "yes" : "no") << "</td><td>" << fmt(f.seconds, 4) << "</td></tr>\n";
+    h << "</table>\n<p>Inner models: ";
+    for (const auto& f : r.fits)
+      h << html_escape(f.model) << ": " << html_escape(f.inner_model) << ". ";
+    h << "Uncertainty: " << html_escape(r.fits.front().uncertainty) << ".</p>\n<table>";
   }
   h << "</table>\n<h2>In-plane curves</h2>\n<p>beta / pi against the view zenith (positive on "
        "the mirror side), one panel per incidence and channel; error bars one standard "

@@ -1,5 +1,7 @@
 // weft verify as a user meets it: a draft run writes the whole report folder; a bad measured
-// table is refused naming the file and the column, exit code 2, nothing written.
+// table is refused naming the file and the column, exit code 2, nothing written. And --fit: the
+// fit recovers parameters from a synthetic measurement that its own inner model made; bad fit
+// options are refused before any work.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -10,6 +12,7 @@
 #include <sstream>
 #include <string>
 
+#include "../../tools/verify_fit.h"  // the fit's inner models, header-only (the command's own)
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -103,4 +106,143 @@ TEST(CliVerify, DraftWritesTheWholeReport) {
   EXPECT_EQ(r2.exit_code, 2);
   EXPECT_NE(r2.err.find("refusing"), std::string::npos) << r2.err;
   EXPECT_TRUE(fs::exists(other / "notes.txt"));
+}
+
+namespace {
+
+// The bundled measurement's geometry (its incidences and views), with beta replaced by a model's.
+weft::MeasuredInplane synthetic(const std::vector<std::vector<weft::Rgb>>& beta) {
+  weft::MeasuredInplane m = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  m.file = "synthetic";
+  for (size_t i = 0; i < m.curves.size(); ++i) m.curves[i].beta = beta[i];
+  return m;
+}
+
+// The command's sample: the bundled poplin at fiber detail.
+weft::WovenSample verify_sample() {
+  weft::WeaveOptions given;
+  given.detail = "fiber";
+  return weft::make_woven_sample(weft::overlay(weft::WeaveOptions{}, given));
+}
+
+}  // namespace
+
+// The computed model: a red-cotton fiber with its dye 1.8 times as strong and roughness 0.22
+// makes the measurement (the fit's own inner model, so a perfect fit exists); the fit starts from
+// the spec (1, 0.35) and must land on the chosen values. Tolerances: 3 % in the dye scale and 0.01
+// in roughness, well outside the simplex tolerance's reach (1e-3 of each box) and below the
+// distance of the start (ln 1.8 = 0.59, 0.13).
+TEST(CliVerify, FitRecoversKnownFiberParametersFromASyntheticMeasurement) {
+  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
+  weft::VerifySettings s = weft::verify_settings(weft::VerifyQuality::kDraft);
+  weft::FitInnerSettings inner = weft::fit_inner_settings(s);
+  // The smooth inner model, with the test's budget (the command uses 5000 photons).
+  inner.inner = weft::FitInner::kSummation;
+  inner.fiber_photons_per_band = 2000;
+  const weft::WovenSample sample = verify_sample();
+  const std::vector<std::string> names = {"dye_scale", "roughness_alpha"};
+  const std::vector<double> truth = {1.8, 0.22};
+  weft::MeasuredInplane geometry = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
+      weft::apply_spec_fit(spec, names, truth), sample, inner, geometry));
+  weft::FitOptions options;
+  options.max_evaluations = 60;
+  const weft::FitResult r = weft::fit_inplane(
+      "computed", weft::spec_fit_parameters(spec, names),
+      [&](const std::vector<double>& x) {
+        return weft::computed_inner_curves(weft::apply_spec_fit(spec, names, x), sample, inner,
+                                           measured);
+      },
+      measured, options);
+  ASSERT_EQ(r.parameters.size(), 2u);
+  EXPECT_GT(r.objective_start, 0.2);  // the start is far from the truth
+  EXPECT_NEAR(std::log(r.parameters[0].value / truth[0]), 0.0, 0.03) << r.parameters[0].value;
+  EXPECT_NEAR(r.parameters[1].value, truth[1], 0.01);
+  EXPECT_LT(r.objective, 0.02);
+  for (const auto& p : r.parameters) {
+    EXPECT_FALSE(p.at_bound) << p.parameter.name;
+    EXPECT_TRUE(std::isfinite(p.sigma) && p.sigma > 0) << p.parameter.name;
+  }
+  EXPECT_LE(r.evaluations, options.max_evaluations + 2 * 2 + 8);  // search, shrink, Jacobian
+}
+
+// The classic model's four (diffuse colour per channel, roughness) from its own synthetic
+// measurement, from the start the command uses for red-cotton (its volume albedo, 0.35).
+TEST(CliVerify, FitRecoversKnownClassicParametersFromASyntheticMeasurement) {
+  weft::VerifySettings s = weft::verify_settings(weft::VerifyQuality::kDraft);
+  weft::FitInnerSettings inner = weft::fit_inner_settings(s);
+  inner.inner = weft::FitInner::kSummation;
+  const weft::WovenSample sample = verify_sample();
+  weft::MeasuredInplane geometry = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  const weft::MicrofacetModel model = weft::MicrofacetModel::kBeckmann;
+  const double ior = 1.557;
+  const std::vector<double> truth = {0.3, 0.05, 0.03, 0.6};
+  const weft::MeasuredInplane measured = synthetic(weft::classic_inner_curves(
+      weft::Rgb(truth[0], truth[1], truth[2]), {model, truth[3]}, ior, sample, inner, geometry));
+  weft::FitOptions options;
+  options.max_evaluations = 150;
+  const weft::FitResult r = weft::fit_inplane(
+      "classic", weft::classic_fit_parameters(weft::Rgb(0.849, 0.147, 0.209), 0.35),
+      [&](const std::vector<double>& x) {
+        return weft::classic_inner_curves(weft::Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, sample,
+                                          inner, measured);
+      },
+      measured, options);
+  ASSERT_EQ(r.parameters.size(), 4u);
+  for (size_t k = 0; k < 3; ++k)
+    EXPECT_NEAR(std::log(r.parameters[k].value / truth[k]), 0.0, 0.03)
+        << r.parameters[k].parameter.name << " " << r.parameters[k].value;
+  EXPECT_NEAR(r.parameters[3].value, truth[3], 0.02);
+  EXPECT_LT(r.objective, 0.02);
+}
+
+TEST(CliVerify, BadFitOptionsAreRefusedBeforeAnyWork) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "report";
+  // A fiber without particles: nothing for the particle parameters to scale.
+  auto bare = nlohmann::json::parse(weft::fiber_preset_json("red-cotton"));
+  bare["species"] = nlohmann::json::array();
+  const fs::path bare_spec = dir / "bare.json";
+  std::ofstream(bare_spec) << bare.dump();
+  struct Case {
+    std::string args, field, words;
+  };
+  const std::vector<Case> cases = {
+      {"--fit --fit-params dye_scale,colour", "--fit-params", "'colour' is not one of"},
+      {"--fit --fit-params dye_scale,dye_scale", "--fit-params", "named twice"},
+      {"--fit --fit-params dye_scale,", "--fit-params", "an empty name"},
+      {"--fit --fit-evaluations 5", "--fit-evaluations", "fewer than 2 p + 2"},
+      {"--fit-params dye_scale", "--fit-params", "only with --fit"},
+      {"--fit --fit-inner exact", "--fit-inner", "not raytrace or summation"},
+      {"--fit --fiber '" + bare_spec.string() + "' --fit-params particle_radius_scale",
+       "--fit-params", "the spec has no particle species"}};
+  for (const auto& c : cases) {
+    const VerifyRun r =
+        run_weft("verify --quiet --quality draft " + c.args + " -o '" + out.string() + "'", dir);
+    EXPECT_EQ(r.exit_code, 2) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.field), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.words), std::string::npos) << c.args << ": " << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+  // The library refuses a fifth parameter and a start outside the box, naming them.
+  const weft::MeasuredInplane m = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  const weft::InplaneModel never =
+      [](const std::vector<double>&) -> std::vector<std::vector<weft::Rgb>> {
+    ADD_FAILURE() << "the model ran";
+    return {};
+  };
+  std::vector<weft::FitParameter> five(5, {"a", "", 0.1, 1, 0.5, false});
+  EXPECT_NE(weft::testing::error_of([&] {
+              weft::fit_inplane("x", five, never, m, {});
+            }).find("between one and four"),
+            std::string::npos);
+  const std::vector<weft::FitParameter> outside = {{"roughness_alpha", "", 0.05, 1, 1.5, false}};
+  EXPECT_NE(weft::testing::error_of([&] {
+              weft::fit_inplane("x", outside, never, m, {});
+            }).find("roughness_alpha"),
+            std::string::npos);
 }

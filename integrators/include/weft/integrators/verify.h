@@ -154,6 +154,8 @@ struct VerifyInputs {
   MicrofacetDistribution classic_distribution;  // the fiber's surface roughness
   double classic_ior = 1.5;
   std::optional<TabulatedBsdfTable> summation;  // the paper's summation table (any channels)
+  // A fitted classic colour (linear sRGB reflectance in [0, 1]) in place of the volume albedo.
+  std::optional<Rgb> classic_diffuse;
   std::string fiber_name, sample_name;
   std::map<std::string, double> seconds;  // timings of the caller's steps (fiber bake, ...)
 };
@@ -171,10 +173,101 @@ struct ModelCurves {
   CurveMetrics absolute_overall, normalized_overall;
 };
 
+// ---- Fitting (issue 8: at most four physical parameters, the same budget for both models) -----
+
+// One fitted parameter: its box [lo, hi] and start; 'log_scale' searches ln(x) (for scales that
+// span decades). The optimizer works in the unit cube u in [0, 1] of each box.
+struct FitParameter {
+  std::string name, unit;
+  double lo = 0, hi = 1, start = 0.5;
+  bool log_scale = false;
+};
+
+// The model being fitted: the in-plane beta [incidence][view] of the measurement's views for a
+// parameter vector (in the parameters' own units).
+using InplaneModel = std::function<std::vector<std::vector<Rgb>>(const std::vector<double>&)>;
+
+struct FitOptions {
+  int max_evaluations = 100;    // of the objective during the search (the uncertainty adds 2 p)
+  double tolerance = 1e-4;      // stop when the simplex's objective values span less than this
+  double initial_step = 0.15;   // simplex edge, as a fraction of each box
+  double jacobian_step = 0.02;  // central differences at the optimum, fraction of each box
+  void validate(size_t parameters) const;  // weft::Error naming the option
+};
+
+struct FitParameterResult {
+  FitParameter parameter;
+  double value = 0;
+  double sigma = 0;       // one standard deviation (NaN where the Jacobian does not determine it)
+  bool at_bound = false;  // within 1e-3 of the box's edge (a constrained optimum)
+};
+
+struct FitResult {
+  std::string model;        // "computed" or "classic"
+  std::string inner_model;  // what the objective evaluated (docs/verify.md)
+  std::vector<FitParameterResult> parameters;
+  double objective_start = 0, objective = 0;   // rms_log, absolute, of the inner model
+  CurveMetrics start_metrics, fitted_metrics;  // the inner model's absolute metrics
+  int evaluations = 0;
+  bool converged = false;  // the tolerance was met before max_evaluations
+  double seconds = 0;
+  std::string uncertainty =
+      "Gauss-Newton: covariance s^2 (J^T J)^-1 of the log residuals at the optimum, J by central "
+      "differences, s^2 = SSR / (n - p); treats the residuals as independent";
+};
+
+// The residuals the fit minimizes: ln(model / measured) at every view, incidence and channel
+// where the measurement is positive (the points of rms_log); a model value <= 0 counts as
+// ln(1e-6), a penalty, so the vector's length does not depend on the parameters.
+std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
+                                  const MeasuredInplane& measured);
+
+// Bounded, deterministic Nelder-Mead on the RMS of fit_residuals (= rms_log, absolute), then the
+// uncertainty from the Jacobian at the optimum. weft::Error on more than four parameters, an empty
+// or reversed box, a start outside it, or bad options.
+FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>& parameters,
+                      const InplaneModel& inplane, const MeasuredInplane& measured,
+                      const FitOptions& options);
+
+// The inner model the fit evaluates (docs/verify.md), both with fixed seeds at every evaluation
+// (common random numbers):
+//   kRaytrace: the run's own pipeline (RGB fiber bake, then the fiber-level ray trace) with few
+//     photons and particles; its objective is jagged at the level of its noise (a changed table
+//     changes the paths' discrete choices);
+//   kSummation: the paper's summation table of the same bake; smooth and about 20 times cheaper,
+//     but without light travelling between fibers, so its optimum is not the ray trace's.
+enum class FitInner { kRaytrace, kSummation };
+FitInner parse_fit_inner(const std::string& name);  // weft::Error naming "--fit-inner"
+std::string fit_inner_name(FitInner inner);
+
+struct FitInnerSettings {
+  FitInner inner = FitInner::kRaytrace;
+  int resolution = 6;
+  uint64_t fiber_photons_per_band = 5000;
+  uint64_t particles_per_bin = 2000;  // kRaytrace: one ray trace
+  int summation_samples = 4;          // the summation's and the classic fiber table's
+  uint64_t seed = 1;
+  int azimuths = 24;
+  int threads = 0;
+};
+FitInnerSettings fit_inner_settings(const VerifySettings& settings);
+
+// The classic fiber (Lambert + Cook-Torrance, outer hemisphere only: opaque) as a fiber table.
+TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
+                                       double ior, int resolution, int samples, uint64_t seed,
+                                       int threads,
+                                       const ProgressCallback& progress = no_progress());
+
+// beta [incidence][view] of an RGB or spectral table at the measurement's views.
+std::vector<std::vector<Rgb>> table_curves(const TabulatedBsdfTable& table,
+                                           const MeasuredInplane& measured, int azimuths);
+
 struct VerifyReport {
   VerifySettings settings;
   MeasuredInplane measured;
-  std::vector<ModelCurves> models;  // "computed_raytrace", "computed_summation"?, "classic"
+  // "computed_raytrace", "computed_summation"?, "classic"; with --fit also
+  // "computed_raytrace_fitted" and "classic_fitted" (the fitted parameters at the run's quality).
+  std::vector<ModelCurves> models;
   std::vector<ColourEntry> colours;
   Rgb classic_reflectance;  // the classic model's diffuse colour (linear sRGB, clipped to [0,1])
   GamutClip classic_clip;   // what making it a reflectance removed
@@ -182,6 +275,7 @@ struct VerifyReport {
   std::string fiber_name, sample_name;
   size_t fabric_table_gamut_clipped = 0;  // components of the computed table set to 0
   double raytrace_relative_noise = 0;     // of the combined computed table (fabric_raytrace.h)
+  std::vector<FitResult> fits;            // with --fit: "computed", "classic"
   bool cancelled = false;
 };
 

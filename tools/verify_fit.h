@@ -1,0 +1,176 @@
+#pragma once
+// weft verify --fit (docs/verify.md): the physical parameters of a fiber spec that the fit may
+// vary, and the inner models the fit evaluates, for the command and its tests (header-only: the
+// integrators library that runs the fit does not link the fiber physics).
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include "weft/core/error.h"
+#include "weft/integrators/fabric_raytrace.h"
+#include "weft/integrators/verify.h"
+#include "weft/materials/fabric/fabric_summation.h"
+#include "weft/materials/fabric/fiber_spec.h"
+#include "weft/materials/fabric/fiber_table_bake.h"
+
+namespace weft {
+
+// The spec's parameters a fit may vary, by name. Scales multiply the spec's own values, so 1 is
+// the spec as given.
+inline const std::vector<std::string>& spec_fit_parameter_names() {
+  static const std::vector<std::string> names = {"dye_scale", "particle_fraction_scale",
+                                                 "particle_radius_scale", "roughness_alpha"};
+  return names;
+}
+
+// Parses --fit-params ("a,b,..."): known names, no repeats, at most four.
+inline std::vector<std::string> parse_spec_fit_names(const std::string& list) {
+  std::vector<std::string> out;
+  std::string cur;
+  const auto& known = spec_fit_parameter_names();
+  auto flush = [&] {
+    if (cur.empty()) throw Error("", "--fit-params", "an empty name in '" + list + "'");
+    if (std::find(known.begin(), known.end(), cur) == known.end())
+      throw Error("", "--fit-params",
+                  "'" + cur +
+                      "' is not one of dye_scale, particle_fraction_scale, "
+                      "particle_radius_scale, roughness_alpha");
+    if (std::find(out.begin(), out.end(), cur) != out.end())
+      throw Error("", "--fit-params", "'" + cur + "' is named twice");
+    out.push_back(cur);
+    cur.clear();
+  };
+  for (char c : list) {
+    if (c == ',')
+      flush();
+    else
+      cur.push_back(c);
+  }
+  flush();
+  if (out.size() > 4) throw Error("", "--fit-params", "at most four parameters (issue 8)");
+  return out;
+}
+
+// The boxes: scales over a decade or more each way, on a log scale; the particles' total volume
+// fraction stays at or below 0.5 (the spec allows 0.74 per species).
+inline std::vector<FitParameter> spec_fit_parameters(const FiberSpec& spec,
+                                                     const std::vector<std::string>& names) {
+  std::vector<FitParameter> out;
+  for (const auto& n : names) {
+    if (n == "dye_scale") {
+      out.push_back({n, "x spec's absorption", 0.1, 10, 1, true});
+    } else if (n == "particle_fraction_scale" || n == "particle_radius_scale") {
+      if (spec.species.empty())
+        throw Error(spec.name, "--fit-params", "'" + n + "': the spec has no particle species");
+      if (n == "particle_radius_scale") {
+        out.push_back({n, "x spec's radii", 0.25, 4, 1, true});
+      } else {
+        double total = 0;
+        for (const auto& s : spec.species) total += s.volume_fraction;
+        if (!(total > 0))
+          throw Error(spec.name, "--fit-params", "'" + n + "': the particles' volume is zero");
+        out.push_back({n, "x spec's volume fractions", 0.1, std::min(10.0, 0.5 / total), 1, true});
+      }
+    } else {
+      out.push_back({n, "", std::min(0.05, spec.roughness_alpha), 1, spec.roughness_alpha, false});
+    }
+  }
+  return out;
+}
+
+inline FiberSpec apply_spec_fit(FiberSpec spec, const std::vector<std::string>& names,
+                                const std::vector<double>& values) {
+  for (size_t k = 0; k < names.size(); ++k) {
+    const double v = values[k];
+    if (names[k] == "dye_scale")
+      for (double& a : spec.host_absorption_per_um) a *= v;
+    else if (names[k] == "particle_fraction_scale")
+      for (auto& s : spec.species) s.volume_fraction *= v;
+    else if (names[k] == "particle_radius_scale")
+      for (auto& s : spec.species) s.size.radius_um *= v;
+    else
+      spec.roughness_alpha = v;
+  }
+  return spec;
+}
+
+inline std::string inner_step_name(const FitInnerSettings& f) {
+  return f.inner == FitInner::kRaytrace
+             ? "fiber-level ray trace (R = " + std::to_string(f.resolution) + ", " +
+                   std::to_string(f.particles_per_bin) + " particles per incident bin)"
+             : "paper's summation table (R = " + std::to_string(f.resolution) + ", " +
+                   std::to_string(f.summation_samples) + " samples per cell pair)";
+}
+
+inline std::string computed_inner_model_name(const FitInnerSettings& f) {
+  return inner_step_name(f) + " of an RGB fiber bake (" + std::to_string(f.fiber_photons_per_band) +
+         " photons per band), seed " + std::to_string(f.seed) + " at every evaluation";
+}
+
+inline std::string classic_inner_model_name(const FitInnerSettings& f) {
+  return inner_step_name(f) + " of the classic fiber table (" +
+         std::to_string(f.summation_samples) + " samples per cell pair), seed " +
+         std::to_string(f.seed) + " at every evaluation";
+}
+
+// The inner model's step from a fiber table to the curves, with the fixed seed.
+inline std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& sample,
+                                                         const TabulatedBsdfTable& fiber,
+                                                         const FitInnerSettings& f,
+                                                         const MeasuredInplane& measured) {
+  if (f.inner == FitInner::kSummation) {
+    FabricSummationOptions so;
+    so.method = FabricSummation::kPaper;
+    so.resolution = f.resolution;
+    so.samples_per_cell = f.summation_samples;
+    so.seed = f.seed;
+    so.threads = f.threads;
+    return table_curves(sum_fabric_table(fiber, so), measured, f.azimuths);
+  }
+  FabricRaytraceOptions o;
+  o.resolution = f.resolution;
+  o.particles_per_bin = f.particles_per_bin;
+  o.seed = f.seed;
+  o.threads = f.threads;
+  return table_curves(raytrace_fabric_table(sample, fiber, o).table, measured, f.azimuths);
+}
+
+// The computed model's inner curves: an RGB fiber bake, then the inner model's step, both with
+// fixed seeds.
+inline std::vector<std::vector<Rgb>> computed_inner_curves(const FiberSpec& spec,
+                                                           const WovenSample& sample,
+                                                           const FitInnerSettings& f,
+                                                           const MeasuredInplane& measured) {
+  FiberTableBakeOptions b;
+  b.resolution = f.resolution;
+  b.photons_per_band = f.fiber_photons_per_band;
+  b.seed = f.seed;
+  b.threads = f.threads;
+  b.spectral = false;
+  return inner_fabric_curves(sample, bake_fiber_table(spec, b).table, f, measured);
+}
+
+// The classic model's inner curves: its fiber table, then the same step.
+inline std::vector<std::vector<Rgb>> classic_inner_curves(const Rgb& diffuse,
+                                                          const MicrofacetDistribution& d,
+                                                          double ior, const WovenSample& sample,
+                                                          const FitInnerSettings& f,
+                                                          const MeasuredInplane& measured) {
+  return inner_fabric_curves(
+      sample,
+      classic_fiber_table(diffuse, d, ior, f.resolution, f.summation_samples, f.seed, f.threads), f,
+      measured);
+}
+
+// The classic model's four: its diffuse colour per channel (a reflectance, on a log scale: the
+// measured fabric's green and blue are an order below its red) and its roughness. A start below
+// the box's floor of 0.005 starts at the floor.
+inline std::vector<FitParameter> classic_fit_parameters(const Rgb& diffuse, double alpha) {
+  auto start = [](double v) { return std::clamp(v, 0.005, 1.0); };
+  return {{"diffuse_r", "reflectance", 0.005, 1, start(diffuse.r), true},
+          {"diffuse_g", "reflectance", 0.005, 1, start(diffuse.g), true},
+          {"diffuse_b", "reflectance", 0.005, 1, start(diffuse.b), true},
+          {"roughness_alpha", "", 0.05, 1, std::clamp(alpha, 0.05, 1.0), false}};
+}
+
+}  // namespace weft
