@@ -11,6 +11,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_run.h"
 #include "test_util.h"
 #include "weft/materials/bsdf_table.h"
 
@@ -21,27 +22,11 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using weft::testing::CliRun;
+using weft::testing::slurp;
 
 CliRun run(const std::string& args, const fs::path& dir, const std::string& prefix = "") {
-  const std::string cmd = prefix + "'" + std::string(WEFT_EXE) + "' " + args + " >'" +
-                          (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(dir / "stdout");
-  r.err = slurp(dir / "stderr");
-  return r;
+  return weft::testing::run_weft_cli(args, dir, prefix);
 }
 
 void write(const fs::path& p, const std::string& text) {

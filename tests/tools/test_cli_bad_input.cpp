@@ -10,6 +10,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_run.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -17,24 +18,12 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-struct CliRun {
-  int exit_code = -1;
-  std::string err;
-};
+using weft::testing::CliRun;
 
-// Runs weft with 'args' in 'dir' (stdout and stderr kept there); 'prefix' goes before the command
-// in the shell (e.g. a ulimit).
+// Runs weft with 'args' in 'dir' (its working folder; stdout and stderr kept there); 'prefix' goes
+// before the command in the shell (e.g. a ulimit).
 CliRun run(const std::string& args, const fs::path& dir, const std::string& prefix = "") {
-  const std::string cmd =
-      "cd '" + dir.string() + "' && " + prefix + "'" + WEFT_EXE + "' " + args + " >stdout 2>stderr";
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(dir / "stderr");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  return r;
+  return weft::testing::run_weft_cli(args, dir, "cd '" + dir.string() + "' && " + prefix);
 }
 
 // 'text' with the first 'from' replaced by 'to' (which must be there).

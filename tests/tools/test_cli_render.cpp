@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "cli_run.h"
 #include "test_util.h"
 #include "weft/core/spectrum.h"
 #include "weft/integrators/image.h"
@@ -24,26 +25,11 @@ namespace {
 
 const fs::path kExamples = fs::path(WEFT_SOURCE_DIR) / "scenes/examples";
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out, err;
-};
+using weft::testing::CliRun;
+using weft::testing::slurp;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
-// Runs weft with stdout and stderr in files (so stderr is not a terminal).
 CliRun run(const std::string& args, const fs::path& dir) {
-  const std::string cmd = "'" + std::string(WEFT_EXE) + "' " + args + " >'" +
-                          (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
-  const int status = std::system(cmd.c_str());
-  CliRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(dir / "stdout");
-  r.err = slurp(dir / "stderr");
-  return r;
+  return weft::testing::run_weft_cli(args, dir);
 }
 
 bool contains(const std::string& s, const std::string& part) {

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "../../tools/verify_fit.h"  // the fit's inner models, header-only (the command's own)
+#include "cli_run.h"
 #include "test_util.h"
 
 namespace fs = std::filesystem;
@@ -20,17 +21,8 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-struct VerifyRun {
-  int exit_code = -1;
-  std::string out, err;
-};
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using VerifyRun = weft::testing::CliRun;
+using weft::testing::slurp;
 
 VerifyRun run_weft(const std::string& args, const fs::path& dir) {
   // A python3 that fails, first on PATH: the plots must not depend on which python3 that finds.
@@ -38,15 +30,7 @@ VerifyRun run_weft(const std::string& args, const fs::path& dir) {
   fs::create_directories(bin);
   std::ofstream(bin / "python3") << "#!/bin/sh\nexit 1\n";
   fs::permissions(bin / "python3", fs::perms::owner_all);
-  const std::string cmd = "PATH='" + bin.string() + "':$PATH '" + std::string(WEFT_EXE) + "' " +
-                          args + " >'" + (dir / "stdout").string() + "' 2>'" +
-                          (dir / "stderr").string() + "'";
-  const int status = std::system(cmd.c_str());
-  VerifyRun r;
-  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  r.out = slurp(dir / "stdout");
-  r.err = slurp(dir / "stderr");
-  return r;
+  return weft::testing::run_weft_cli(args, dir, "PATH='" + bin.string() + "':$PATH ");
 }
 
 }  // namespace

@@ -1,0 +1,38 @@
+#pragma once
+// Running the weft executable from the command-line tests: stdout and stderr go to files in the
+// test's own folder, so stderr is not a terminal (progress comes as plain lines).
+#include <sys/wait.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+
+namespace weft::testing {
+
+struct CliRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Runs `weft ARGS` with stdout and stderr in dir/stdout and dir/stderr; 'prefix' goes before the
+// command in the shell (an environment variable, a ulimit, a cd).
+inline CliRun run_weft_cli(const std::string& args, const std::filesystem::path& dir,
+                           const std::string& prefix = "") {
+  const std::string cmd = prefix + "'" + std::string(WEFT_EXE) + "' " + args + " >'" +
+                          (dir / "stdout").string() + "' 2>'" + (dir / "stderr").string() + "'";
+  const int status = std::system(cmd.c_str());
+  CliRun r;
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(dir / "stdout");
+  r.err = slurp(dir / "stderr");
+  return r;
+}
+
+}  // namespace weft::testing
