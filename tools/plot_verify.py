@@ -100,7 +100,7 @@ def main():
         title = ("paper's normalization: each model scaled per channel to the measurement at "
                  "normal incidence and view" if kind == "normalized" else "absolute beta / pi")
         fig.suptitle(title, fontsize=10)
-        fig.tight_layout(rect=(0, 0, 1, 0.995))
+        fig.tight_layout(rect=(0, 0, 1, 0.985))  # room for the title above the first row
         for ext in ("png", "svg"):
             fig.savefig(os.path.join(out_dir, f"inplane-{kind}.{ext}"), dpi=80)
         plt.close(fig)
