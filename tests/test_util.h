@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
+#include <iterator>
 #include <string>
 
 #include "weft/core/error.h"
@@ -15,6 +17,12 @@ namespace weft::testing {
 
 // An empty folder for the running test, under the build folder: <build>/test_tmp/<suite>.<test>.
 // One per test, because ctest runs the tests of one executable as parallel processes.
+// The whole of a file, as bytes.
+inline std::string slurp(const std::filesystem::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
 inline std::filesystem::path fresh_test_dir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   const std::filesystem::path dir = std::filesystem::path(WEFT_BINARY_DIR) / "test_tmp" /

@@ -16,12 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using weft::testing::slurp;
 
 // The names in 'dir', to check that nothing but the expected files is there.
 std::vector<std::string> entries(const fs::path& dir) {
@@ -113,8 +108,8 @@ TEST(AtomicFile, SeveralOutputsAreWrittenAllOrNone) {
   auto text = [](const std::string& s) {
     return [s](const fs::path& tmp) { std::ofstream(tmp) << s; };
   };
-  EXPECT_THROW(write_all_atomically({{a, text("new")},
-                                     {b, [](const fs::path&) { throw std::runtime_error("x"); }}}),
+  EXPECT_THROW(write_all_atomically(
+                   {{a, text("new")}, {b, [](const fs::path&) { throw std::runtime_error("x"); }}}),
                std::runtime_error);
   EXPECT_EQ(slurp(a), "old");
   EXPECT_EQ(entries(dir), std::vector<std::string>{"image.exr"});

@@ -19,27 +19,11 @@ using namespace weft;
 namespace fs = std::filesystem;
 
 namespace {
-// A small woven patch (lambert warp and weft) under a parallel light and an environment (which
-// adds MIS paths), seen by an orthographic camera from 20 degrees.
 SceneDescription woven() {
-  SceneDescription d = weft::testing::woven_patch();
-  d.materials["warp"] = {"lambert", {{"reflectance", {0.6, 0.15, 0.1}}}, {}, {}, "materials.warp"};
-  d.materials["weft"] = {"lambert", {{"reflectance", 0.5}}, {}, {}, "materials.weft"};
-  d.lights.directional.push_back({d.frame.direction(deg_to_rad(30), 0), Rgb(1.0)});
-  d.lights.environment = Rgb(0.2);
-  d.camera = frame_box_orthographic(d.object_bounds(""), d.frame.direction(deg_to_rad(20), kPi),
-                                    d.frame.normal);
-  return d;
+  return weft::testing::lit_woven_patch();
 }
-
 RenderSettings small(int threads) {
-  RenderSettings s;
-  s.width = 45;  // not a multiple of the tile size
-  s.height = 37;
-  s.spp = 3;
-  s.seed = 5;
-  s.threads = threads;
-  return s;
+  return weft::testing::small_render_settings(threads);
 }
 
 fs::path fresh_dir(const std::string& name) {

@@ -25,26 +25,11 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-// The woven patch of test_render.cpp: inter-reflections, a parallel light and an environment.
 SceneDescription woven() {
-  SceneDescription d = weft::testing::woven_patch();
-  d.materials["warp"] = {"lambert", {{"reflectance", {0.6, 0.15, 0.1}}}, {}, {}, "materials.warp"};
-  d.materials["weft"] = {"lambert", {{"reflectance", 0.5}}, {}, {}, "materials.weft"};
-  d.lights.directional.push_back({d.frame.direction(deg_to_rad(30), 0), Rgb(1.0)});
-  d.lights.environment = Rgb(0.2);
-  d.camera = frame_box_orthographic(d.object_bounds(""), d.frame.direction(deg_to_rad(20), kPi),
-                                    d.frame.normal);
-  return d;
+  return weft::testing::lit_woven_patch();
 }
-
 RenderSettings small(int threads) {
-  RenderSettings s;
-  s.width = 45;  // not a multiple of the tile size
-  s.height = 37;
-  s.spp = 3;
-  s.seed = 5;
-  s.threads = threads;
-  return s;
+  return weft::testing::small_render_settings(threads);
 }
 
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {

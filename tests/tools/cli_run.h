@@ -9,17 +9,14 @@
 #include <iterator>
 #include <string>
 
+#include "test_util.h"  // slurp
+
 namespace weft::testing {
 
 struct CliRun {
   int exit_code = -1;
   std::string out, err;
 };
-
-inline std::string slurp(const std::filesystem::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
 
 // Runs `weft ARGS` with stdout and stderr in dir/stdout and dir/stderr; 'prefix' goes before the
 // command in the shell (an environment variable, a ulimit, a cd).

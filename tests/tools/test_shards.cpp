@@ -25,12 +25,7 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using weft::testing::slurp;
 
 std::vector<std::string> split(const std::string& args) {
   std::vector<std::string> out;
