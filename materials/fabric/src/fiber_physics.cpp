@@ -33,7 +33,8 @@ void FiberBandPhysics::validate() const {
     throw Error("", "n_inside", "fiber refractive index must be finite and >= 1");
   if (!(interior.geometry.n_outside(CylinderGeometry::kSurface) >= 1))
     throw Error("", "n_outside", "outside refractive index must be >= 1");
-  if (!surface.albedo) throw Error("", "surface", "the surface model needs an albedo");
+  if (!boundary && !surface.albedo)
+    throw Error("", "surface", "the surface model needs an albedo");
   if (!interior.trace) throw Error("", "trace", "the interior needs a tracer");
 }
 
@@ -86,6 +87,21 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
                                     uint64_t max_events_per_photon,
                                     std::shared_ptr<const SurfaceAlbedoTable> albedo) {
   FiberBandPhysics ph;
+  if (spec.boundary == FiberBoundary::kRoughDielectric) {
+    auto boundary = std::make_shared<const RoughDielectricInterface>(
+        spec.roughness_distribution, spec.roughness_alpha, 1.0, mb.host_n);
+    ph.boundary = boundary;
+    TransportOptions topt;
+    topt.max_events = max_events_per_photon;
+    topt.boundary_scatter = [boundary](const Vec3& d, Rng& rng) {
+      const RoughDielectricScatter s = boundary->scatter(d, rng);
+      return BoundaryScatter{s.direction, s.lost};
+    };
+    ph.interior = FiberInterior::transport(std::make_shared<const CylinderTransport>(
+        CylinderGeometry(spec.fiber_radius_um, 1.0),
+        TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt));
+    return ph;
+  }
   auto ct = std::make_shared<const CookTorranceBsdf>(
       CookTorranceBsdf{{spec.roughness_distribution, spec.roughness_alpha}, mb.host_n, Rgb(1.0)});
   if (!albedo)
@@ -125,6 +141,31 @@ void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, d
     books.lost += w0;
     return;
   }
+  const auto trace_inside = [&](const Vec3& d, double w) {
+    const PhotonTally inside = in.trace(point, normalize(d), w, rng, interior_exits);
+    books.exited += inside.exited;
+    books.absorbed += inside.absorbed;
+    books.roulette_gain += inside.roulette_gain;
+    books.roulette_loss += inside.roulette_loss;
+    books.lost += inside.lost;
+    books.scatterings += inside.scatterings;
+    books.reflections += inside.reflections;
+  };
+  if (fiber.boundary) {
+    // One rough interface: its walk reflects the photon (the surface part) or refracts it in.
+    const RoughDielectricScatter s = fiber.boundary->scatter(-omega_local, rng);
+    if (s.lost) {
+      books.lost += w0;
+    } else if (s.outside) {
+      books.specular += w0;
+      if (surface_exits)
+        surface_exits(
+            ExitEvent{point, frame.to_world(s.direction), w0, CylinderGeometry::kSurface, 0});
+    } else {
+      trace_inside(frame.to_world(s.direction), w0);
+    }
+    return;
+  }
   double sampled_surface = 0;
   // Surface lobe: one sampled reflected direction with weight f cos / pdf (expectation = albedo).
   Vec3 w_out;
@@ -150,14 +191,7 @@ void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, d
     books.lost += w_in;
     return;
   }
-  const PhotonTally inside = in.trace(point, normalize(d), w_in, rng, interior_exits);
-  books.exited += inside.exited;
-  books.absorbed += inside.absorbed;
-  books.roulette_gain += inside.roulette_gain;
-  books.roulette_loss += inside.roulette_loss;
-  books.lost += inside.lost;
-  books.scatterings += inside.scatterings;
-  books.reflections += inside.reflections;
+  trace_inside(d, w_in);
 }
 
 }  // namespace weft

@@ -179,12 +179,20 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
     total_fraction += sp.volume_fraction;
     spec.species.push_back(std::move(sp));
   }
+  spec.boundary = p.choice("boundary", "smooth", {"smooth", "rough-dielectric"}) ==
+                          "rough-dielectric"
+                      ? FiberBoundary::kRoughDielectric
+                      : FiberBoundary::kSmooth;
   p.finish();
   if (total_fraction > kMaxVolumeFraction)
     throw Error(
         file, "species",
         "volume fractions add up to " + fmt(total_fraction) + ", above " + fmt(kMaxVolumeFraction));
   return spec;
+}
+
+const char* fiber_boundary_name(FiberBoundary boundary) {
+  return boundary == FiberBoundary::kRoughDielectric ? "rough-dielectric" : "smooth";
 }
 
 std::vector<std::string> fiber_preset_names() {
@@ -250,6 +258,9 @@ std::string canonical_json(const FiberSpec& spec) {
                        {"size", size}});
   }
   j["species"] = species;
+  // Written only when not the default, so specs from before the option keep their hashes (and
+  // their cached tables).
+  if (spec.boundary != FiberBoundary::kSmooth) j["boundary"] = fiber_boundary_name(spec.boundary);
   return j.dump();  // nlohmann objects keep keys sorted; numbers print shortest round-trip
 }
 

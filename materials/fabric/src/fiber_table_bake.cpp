@@ -62,7 +62,7 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
   for (int i = 0; i < nb; ++i) {
     const MediumBand& mb = medium.bands[i];
     auto& albedo = albedo_by_ior[mb.host_n];
-    if (!albedo)
+    if (!albedo && spec.boundary == FiberBoundary::kSmooth)
       albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
                                                           spec.roughness_alpha, mb.host_n);
     physics[i] = fiber_band_physics(spec, mb, o.max_events_per_photon, albedo);
@@ -214,6 +214,9 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
       {"definition",
        "f = L_o / (E |cos theta_i|); cosine-weighted cell averages (docs/fiber-bsdf.md)"},
   };
+  // Only when not the default, so tables of the paper's model keep their header.
+  if (spec.boundary != FiberBoundary::kSmooth)
+    table.metadata["boundary"] = fiber_boundary_name(spec.boundary);
   if (!o.spectral)
     table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
   table.validate("");

@@ -27,6 +27,8 @@ void TransportOptions::validate() const {
   if (!(roulette_survival > 0 && roulette_survival <= 1))
     throw Error("", "roulette_survival", "must lie in (0, 1]");
   if (max_events == 0) throw Error("", "max_events", "must be >= 1");
+  if (boundary_scatter && exit_reflectance)
+    throw Error("", "boundary_scatter", "a rough boundary excludes exit_reflectance");
 }
 
 SlabGeometry::SlabGeometry(double thickness, double n_above, double n_below)

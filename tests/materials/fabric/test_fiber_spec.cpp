@@ -195,3 +195,25 @@ TEST(FiberSpec, NameAndNotesAreNotPartOfTheCanonicalFormOrHash) {
   // Notes must be text; they are read, not ignored.
   expect_error(edit("\"name\": \"test\",", "\"name\": \"test\", \"notes\": 3,"), {"notes"});
 }
+
+TEST(FiberSpec, BoundaryOptionDefaultsToSmoothAndKeepsOldHashes) {
+  const FiberSpec plain = parse_fiber_spec(kMinimal, "spec.json");
+  EXPECT_EQ(plain.boundary, FiberBoundary::kSmooth);
+  // Written out, the default changes nothing: specs and cached tables from before the option keep
+  // their hashes.
+  const FiberSpec smooth = parse_fiber_spec(
+      edit("\"name\": \"test\",", "\"name\": \"test\", \"boundary\": \"smooth\","), "spec.json");
+  EXPECT_EQ(smooth.boundary, FiberBoundary::kSmooth);
+  EXPECT_EQ(canonical_json(smooth), canonical_json(plain));
+  EXPECT_EQ(canonical_json(plain).find("boundary"), std::string::npos);
+  const FiberSpec rough = parse_fiber_spec(
+      edit("\"name\": \"test\",", "\"name\": \"test\", \"boundary\": \"rough-dielectric\","),
+      "spec.json");
+  EXPECT_EQ(rough.boundary, FiberBoundary::kRoughDielectric);
+  EXPECT_NE(fiber_spec_hash(rough), fiber_spec_hash(plain));
+  EXPECT_NE(canonical_json(rough).find("\"boundary\":\"rough-dielectric\""), std::string::npos);
+  // A bad value names the file, the field and the valid values.
+  expect_error(edit("\"name\": \"test\",", "\"name\": \"test\", \"boundary\": \"rough\","),
+               {"boundary", "rough-dielectric", "smooth"});
+  expect_error(edit("\"name\": \"test\",", "\"name\": \"test\", \"boundary\": 3,"), {"boundary"});
+}

@@ -16,6 +16,7 @@
 #include "weft/core/vec.h"
 #include "weft/materials/fabric/fiber_spec.h"
 #include "weft/materials/fabric/medium.h"
+#include "weft/materials/fabric/rough_dielectric.h"
 #include "weft/materials/fabric/transport.h"
 #include "weft/materials/microfacet.h"
 
@@ -52,6 +53,10 @@ struct FiberInterior {
 struct FiberBandPhysics {
   FiberSurfaceModel surface;
   FiberInterior interior;
+  // A rough dielectric boundary (the spec's "rough-dielectric"): when set, entry is one draw of
+  // its microsurface walk (reflected: the surface part; refracted: the volume part) and 'surface'
+  // is unused; the interior's transport exits through the same interface.
+  std::shared_ptr<const RoughDielectricInterface> boundary;
 
   // Throws weft::Error naming the field (n_inside, surface, trace).
   void validate() const;
@@ -76,10 +81,12 @@ class SurfaceAlbedoTable {
   std::vector<double> albedo_;
 };
 
-// One band of a spec: the Cook-Torrance surface lobe at the band's host index, the rough boundary
-// both ways (light leaving the fiber is transmitted with 1 - the lobe's albedo at the outside
-// angle, as on entry, which keeps the fiber reciprocal), and cylinder transport in the band's
-// medium. 'albedo' may be shared between bands of equal host index; null computes it.
+// One band of a spec. Boundary "smooth": the Cook-Torrance surface lobe at the band's host index,
+// the rough boundary both ways (light leaving the fiber is transmitted with 1 - the lobe's albedo
+// at the outside angle, as on entry, which keeps the fiber reciprocal). Boundary
+// "rough-dielectric": the rough dielectric interface of the spec's roughness at the band's host
+// index, both ways. Then cylinder transport in the band's medium. 'albedo' (smooth only) may be
+// shared between bands of equal host index; null computes it.
 FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& band,
                                     uint64_t max_events_per_photon = 10'000'000,
                                     std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr);
@@ -88,7 +95,9 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& ban
 // (axial position 0) with flux weight w0. The surface lobe's sampled reflection goes to
 // 'surface_exits' (may be empty; booked as specular and specular_excess either way); the rest,
 // 1 - albedo, enters refracted at the smooth normal and is traced, its exits going to
-// 'interior_exits'. Adds one launched photon to 'books'. Deterministic given rng.
+// 'interior_exits'. With a rough dielectric boundary the photon either reflects off it (to
+// 'surface_exits', booked as specular) or enters refracted by it, whole. Adds one launched photon
+// to 'books'. Deterministic given rng.
 void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
                  const ExitSink& surface_exits, const ExitSink& interior_exits, PhotonTally& books);
 

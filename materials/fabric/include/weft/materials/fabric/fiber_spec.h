@@ -12,8 +12,13 @@
 //   "species": [{"name": "air voids", "n": SPECTRAL, "k": SPECTRAL, "volume_fraction": 0.02,
 //                "size": {"distribution": "monodisperse", "radius_um": 0.3} |
 //                        {"distribution": "lognormal", "median_radius_um": 0.3, "sigma": 0.5}}],
+//   "boundary": "smooth" | "rough-dielectric" (optional, default "smooth"),
 //   "notes": "free text" (optional, not hashed)
 // }
+// boundary: "smooth" is the paper's model, a Cook-Torrance surface lobe whose complement is
+// refracted at the smooth normal (and leaves with it); "rough-dielectric" makes the roughness a
+// rough dielectric interface both ways, whose reflection is the surface part and whose refraction
+// feeds the volume (rough_dielectric.h, docs/fiber-bsdf.md).
 // host.absorption_* is optional (no dye: zero); species may be empty. SPECTRAL is one of
 //   - a number (the same in every band),
 //   - an array of 33 numbers, one per band 390, 400, ..., 710 nm,
@@ -36,6 +41,11 @@ struct ParticleSpecies {
   double volume_fraction = 0;  // in [0, 0.74]
 };
 
+// How light crosses the fiber's surface (the spec's "boundary").
+enum class FiberBoundary { kSmooth, kRoughDielectric };
+// "smooth" / "rough-dielectric".
+const char* fiber_boundary_name(FiberBoundary boundary);
+
 struct FiberSpec {
   std::string name;
   double fiber_radius_um = 0;
@@ -44,6 +54,7 @@ struct FiberSpec {
   Spectrum host_n{};                  // real refractive index of the fibre material
   Spectrum host_absorption_per_um{};  // absorption coefficient of the host (dye), >= 0
   std::vector<ParticleSpecies> species;
+  FiberBoundary boundary = FiberBoundary::kSmooth;
 };
 
 inline constexpr double kMaxVolumeFraction = 0.74;  // close packing of equal spheres

@@ -20,6 +20,8 @@
 // * Entry from outside (launch_external) splits deterministically: the Fresnel-reflected part
 //   w R goes to PhotonTally::specular (its mirror direction is returned), w (1 - R) is refracted
 //   in and traced, as MCML does with its specular reflectance.
+// * A rough boundary (TransportOptions::boundary_scatter) replaces both: every hit, from outside
+//   or inside, is one draw of the interface's scattering (reflected or transmitted, whole weight).
 // * Weights: WeightMode::implicit_capture deposits w mu_a / mu_t into 'absorbed' at each
 //   interaction and always scatters; below roulette_threshold the photon survives a Russian
 //   roulette with probability roulette_survival and has its weight divided by it (MCML's scheme,
@@ -67,6 +69,12 @@ struct TransportMedium {
 
 enum class WeightMode : uint8_t { implicit_capture, analog };
 
+// What a rough boundary (TransportOptions::boundary_scatter) did with a photon.
+struct BoundaryScatter {
+  Vec3 direction;     // after the interface, local frame of the boundary point (unit)
+  bool lost = false;  // the boundary model gave up on the photon (booked as lost)
+};
+
 struct TransportOptions {
   WeightMode mode = WeightMode::implicit_capture;
   double roulette_threshold = 1e-4;  // MCML's default weight threshold
@@ -80,6 +88,12 @@ struct TransportOptions {
   // transmittance, which keeps the fiber's scattering reciprocal. Total internal reflection is
   // unaffected.
   std::function<double(double cos_outside)> exit_reflectance;
+  // Optional: a rough interface in place of the smooth boundary, at entries (launch_external)
+  // and exits alike. Given the photon's travelling direction d in the local frame of the
+  // boundary point (z = outward normal; d.z < 0 arriving from outside, d.z > 0 from inside), it
+  // returns the direction after the interface: z > 0 outside, z < 0 inside. Empty: Fresnel at
+  // the smooth normal. Excludes exit_reflectance.
+  std::function<BoundaryScatter(const Vec3& d_local, Rng& rng)> boundary_scatter;
 
   void validate() const;
 };
@@ -292,6 +306,22 @@ class PhotonTransport {
       throw Error("", "direction", "must be a unit vector pointing into the medium");
     tally.photons += 1;
     tally.launched += weight;
+    if (options_.boundary_scatter) {
+      // The rough interface decides: reflected (whole weight, as specular) or refracted in.
+      const Frame frame = Frame::from_normal(n);
+      const BoundaryScatter b = options_.boundary_scatter(frame.to_local(direction), rng);
+      if (b.lost) {
+        tally.lost += weight;
+        return {};
+      }
+      const Vec3 out = normalize(frame.to_world(b.direction));
+      if (b.direction.z > 0) {
+        tally.specular += weight;
+        return {weight, out};
+      }
+      walk(p, out, weight, rng, recorder, tally);
+      return {};
+    }
     const double n_out = geometry_.n_outside(boundary);
     double cos_t = cos_i;
     const double r = n_out == medium_.n ? 0.0 : fresnel_dielectric(cos_i, n_out, medium_.n, &cos_t);
@@ -335,6 +365,22 @@ class PhotonTransport {
         const Vec3 n = geometry_.outward_normal(p, hit.boundary);
         const double n_out = geometry_.n_outside(hit.boundary);
         const double cos_i = dot(d, n);
+        if (options_.boundary_scatter) {
+          const Frame frame = Frame::from_normal(n);
+          const BoundaryScatter b = options_.boundary_scatter(frame.to_local(d), rng);
+          if (b.lost) break;
+          const Vec3 out = normalize(frame.to_world(b.direction));
+          if (b.direction.z > 0) {
+            recorder.on_exit(ExitEvent{p, out, w, hit.boundary, scatterings});
+            tally.exited += w;
+            tally.scatterings += scatterings;
+            return;
+          }
+          d = out;
+          ++tally.reflections;
+          if (++events >= options_.max_events) break;
+          continue;
+        }
         if (n_out == n_in) {
           recorder.on_exit(ExitEvent{p, d, w, hit.boundary, scatterings});
           tally.exited += w;
