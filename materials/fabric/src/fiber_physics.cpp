@@ -33,8 +33,7 @@ void FiberBandPhysics::validate() const {
     throw Error("", "n_inside", "fiber refractive index must be finite and >= 1");
   if (!(interior.geometry.n_outside(CylinderGeometry::kSurface) >= 1))
     throw Error("", "n_outside", "outside refractive index must be >= 1");
-  if (!boundary && !surface.albedo)
-    throw Error("", "surface", "the surface model needs an albedo");
+  if (!boundary && !surface.albedo) throw Error("", "surface", "the surface model needs an albedo");
   if (!interior.trace) throw Error("", "trace", "the interior needs a tracer");
 }
 

@@ -179,10 +179,10 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
     total_fraction += sp.volume_fraction;
     spec.species.push_back(std::move(sp));
   }
-  spec.boundary = p.choice("boundary", "smooth", {"smooth", "rough-dielectric"}) ==
-                          "rough-dielectric"
-                      ? FiberBoundary::kRoughDielectric
-                      : FiberBoundary::kSmooth;
+  spec.boundary =
+      p.choice("boundary", "smooth", {"smooth", "rough-dielectric"}) == "rough-dielectric"
+          ? FiberBoundary::kRoughDielectric
+          : FiberBoundary::kSmooth;
   p.finish();
   if (total_fraction > kMaxVolumeFraction)
     throw Error(

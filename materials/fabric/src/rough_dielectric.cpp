@@ -68,7 +68,9 @@ double beckmann_visible_slope_x(double cos_t, double sin_t, double u) {
   const double b = -a;
   if (b > 20) return a;
   const double sqrt_pi = 1 / kInvSqrtPi;
-  const auto tail = [&](double t) { return 0.5 * std::exp(-t * t) - 0.5 * b * sqrt_pi * std::erfc(t); };
+  const auto tail = [&](double t) {
+    return 0.5 * std::exp(-t * t) - 0.5 * b * sqrt_pi * std::erfc(t);
+  };
   const double norm = tail(b);
   if (!(norm > 0)) return a;
   const auto cdf_pdf = [&](double t) {  // of T, increasing in t
@@ -163,7 +165,8 @@ RoughDielectricScatter RoughDielectricInterface::scatter(const Vec3& d, Rng& rng
     const Vec3 wi = -ws;
     const Vec2 uv{rng.uniform(), rng.uniform()};
     const Vec3 wm = sample_visible_normal(wi, uv);
-    const double n_here = outside ? n_outside_ : n_inside_, n_there = outside ? n_inside_ : n_outside_;
+    const double n_here = outside ? n_outside_ : n_inside_,
+                 n_there = outside ? n_inside_ : n_outside_;
     const double cos_i = std::max(0.0, dot(wi, wm));
     double cos_t = 0;
     const double f = fresnel_dielectric(cos_i, n_here, n_there, &cos_t);

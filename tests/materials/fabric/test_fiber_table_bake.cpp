@@ -192,15 +192,19 @@ TEST(FiberTableBake, TableHasTheFibersMirrorSymmetries) {
   }
 }
 
-TEST(FiberTableBake, FiberScatteringIsReciprocal) {
-  // The fiber's scattering per unit length F(w_i, w_o) is reciprocal (the BSSRDF is, Fig. 1 of the
-  // paper with both media outside equal), while the point BSDF f is not (docs/fiber-bsdf.md).
-  // Binned by the axial cosines s_i, s_o and the azimuth difference, reciprocity reads
-  // H[a][b][c] = H[b][a][n - 1 - c]. Tested within noise over 6 independent bakes.
-  const FiberSpec spec = test_spec(6, 0.04, 0.003);
-  const MediumBand mb = compute_medium_band(spec, 10);
-  const FiberBandPhysics ph = fiber_band_physics(spec, mb);
-  FiberBakeSettings s = weft::testing::bake_settings(2, 50000, 2);
+namespace {
+
+// The fiber's scattering per unit length F(w_i, w_o) is reciprocal (the BSSRDF is, Fig. 1 of the
+// paper with both media outside equal), while the point BSDF f is not (docs/fiber-bsdf.md).
+// Binned by the axial cosines s_i, s_o and the azimuth difference, reciprocity reads
+// H[a][b][c] = H[b][a][n - 1 - c]. Over 6 independent bakes of 'photons': the number of bins
+// where the two differ by more than 4.5 standard errors, and the largest over the smallest bin.
+struct ReciprocityCheck {
+  int outliers = 0;
+  double spread = 0;
+};
+ReciprocityCheck far_field_reciprocity(const FiberBandPhysics& ph, uint64_t photons) {
+  FiberBakeSettings s = weft::testing::bake_settings(2, photons, 2);
   s.far_field_s_bins = 4;
   s.far_field_psi_bins = 5;
   const int k = 6, ns = 4, np = 5;
@@ -208,9 +212,9 @@ TEST(FiberTableBake, FiberScatteringIsReciprocal) {
   for (int rep = 0; rep < k; ++rep) {
     s.seed = 500 + rep;
     const auto t = bake_fiber_band_direct(ph, s, nullptr);
-    ASSERT_EQ(t.far_field.size(), static_cast<size_t>(ns * ns * np));
+    EXPECT_EQ(t.far_field.size(), static_cast<size_t>(ns * ns * np));
     if (sum.empty()) sum.assign(t.far_field.size(), 0), sum2.assign(t.far_field.size(), 0);
-    for (size_t c = 0; c < t.far_field.size(); ++c)
+    for (size_t c = 0; c < t.far_field.size() && c < sum.size(); ++c)
       sum[c] += t.far_field[c], sum2[c] += t.far_field[c] * t.far_field[c];
   }
   std::vector<double> mean(sum.size()), se(sum.size());
@@ -226,13 +230,109 @@ TEST(FiberTableBake, FiberScatteringIsReciprocal) {
         swapped[(static_cast<size_t>(a) * ns + b) * np + c] = mean[src];
         swapped_se[(static_cast<size_t>(a) * ns + b) * np + c] = se[src];
       }
-  // 80 bins (40 distinct pairs): allow one 4.5-sigma outlier, as the errors come from 6 bakes.
-  EXPECT_LE(count_outliers(mean, se, swapped, swapped_se, 4.5), 1);
-  // The tally is not trivially symmetric: light mostly goes forward (s_o near s_i), so the
-  // bins differ a lot from each other.
+  ReciprocityCheck r;
+  r.outliers = count_outliers(mean, se, swapped, swapped_se, 4.5);
   double lo = 1e300, hi = 0;
   for (double v : mean) lo = std::min(lo, v), hi = std::max(hi, v);
-  EXPECT_GT(hi, 5 * lo);
+  r.spread = lo > 0 ? hi / lo : 1e300;
+  return r;
+}
+
+FiberSpec rough_dielectric(FiberSpec spec) {
+  spec.boundary = FiberBoundary::kRoughDielectric;
+  return spec;
+}
+
+}  // namespace
+
+TEST(FiberTableBake, FiberScatteringIsReciprocal) {
+  const FiberSpec spec = test_spec(6, 0.04, 0.003);
+  const MediumBand mb = compute_medium_band(spec, 10);
+  const ReciprocityCheck r = far_field_reciprocity(fiber_band_physics(spec, mb), 50000);
+  // 80 bins (40 distinct pairs): allow one 4.5-sigma outlier, as the errors come from 6 bakes.
+  EXPECT_LE(r.outliers, 1);
+  // The tally is not trivially symmetric: light mostly goes forward (s_o near s_i), so the
+  // bins differ a lot from each other.
+  EXPECT_GT(r.spread, 5);
+}
+
+TEST(FiberTableBake, RoughDielectricBoundaryIsReciprocal) {
+  // The same check with the rough dielectric boundary both ways (rough_dielectric.h), at the
+  // spec's roughness and at a rough 0.8 where light often scatters more than once on the
+  // microsurface.
+  for (const double alpha : {0.3, 0.8}) {
+    FiberSpec spec = rough_dielectric(test_spec(6, 0.04, 0.003));
+    spec.roughness_alpha = alpha;
+    const MediumBand mb = compute_medium_band(spec, 10);
+    const FiberBandPhysics ph = fiber_band_physics(spec, mb);
+    ASSERT_TRUE(ph.boundary);
+    const ReciprocityCheck r = far_field_reciprocity(ph, 50000);
+    EXPECT_LE(r.outliers, 1) << "alpha " << alpha;
+    EXPECT_GT(r.spread, 5) << "alpha " << alpha;
+  }
+}
+
+TEST(FiberTableBake, RoughDielectricBoundaryConservesEnergy) {
+  // A lossless fiber (no dye, non-absorbing voids; and a clear one without particles, where
+  // light bounces between the rough walls) returns all light: the microsurface walk keeps the
+  // energy that single-scattering microfacet models lose (reported by single_scatter_albedo).
+  for (const double alpha : {0.3, 0.8})
+    for (const double voids : {0.0, 0.02}) {
+      FiberSpec spec = rough_dielectric(test_spec(8, voids, 0.0));
+      spec.roughness_alpha = alpha;
+      const FiberBandPhysics ph = fiber_band_physics(spec, compute_medium_band(spec, 16));
+      FiberBakeSettings s = weft::testing::bake_settings(3, 20000, 2);
+      const auto t = bake_fiber_band_direct(ph, s, nullptr);
+      const std::string where =
+          "alpha " + std::to_string(alpha) + " voids " + std::to_string(voids);
+      EXPECT_NEAR(t.exit_fraction, 1.0, 1e-12) << where;
+      EXPECT_EQ(t.absorbed_fraction, 0.0) << where;
+      EXPECT_EQ(t.lost_fraction, 0.0) << where;
+      EXPECT_EQ(t.surface_sampling_excess, 0.0) << where;
+      EXPECT_NEAR(t.energy_balance(), 1.0, 1e-12) << where;
+      EXPECT_NEAR(fiber_table_energy(t) / kPi, 1.0, 1e-12) << where;
+      // Both parts are there: light reflected by the interface and light through the volume.
+      EXPECT_GT(t.surface_fraction, 0.02) << where;
+      EXPECT_LT(t.surface_fraction, 0.5) << where;
+    }
+  // At alpha 0.8 a single-scattering model would lose a measurable share at grazing incidence
+  // (what the walk keeps): the quadrature of its first step.
+  const RoughDielectricInterface rd(MicrofacetModel::kGgx, 0.8, 1.0, 1.557);
+  const RoughDielectricAlbedo a = rd.single_scatter_albedo(Vec3{safe_sqrt(1 - 0.01), 0, 0.1});
+  EXPECT_LT(a.reflected + a.transmitted, 0.99);
+}
+
+TEST(FiberTableBake, RoughDielectricBoundaryTendsToTheSmoothOneAsAlphaVanishes) {
+  // alpha -> 0: the rough interface is the smooth dielectric boundary both ways (Fresnel at
+  // entry and exit, smooth_fiber_physics). Every cell of the table within noise (5 bakes each).
+  FiberSpec spec = rough_dielectric(test_spec(8, 0.03, 0.005));
+  spec.roughness_alpha = 1e-4;
+  const MediumBand mb = compute_medium_band(spec, 20);
+  const FiberBandPhysics rough = fiber_band_physics(spec, mb);
+  const FiberBandPhysics smooth =
+      smooth_fiber_physics(TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase},
+                           spec.fiber_radius_um, 1.0);
+  FiberBakeSettings s = weft::testing::bake_settings(3, 30000, 2);
+  const int k = 5;
+  double surface_rough = 0, surface_smooth = 0;
+  const CellStats a = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed;
+    const auto t = bake_fiber_band_direct(rough, s, nullptr);
+    surface_rough += t.surface_fraction / k;
+    return t;
+  });
+  const CellStats b = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed + 50;
+    const auto t = bake_fiber_band_direct(smooth, s, nullptr);
+    surface_smooth += t.surface_fraction / k;
+    return t;
+  });
+  // 324 cells at 4.5 standard errors from 5 bakes each: allow one outlier (as the route test).
+  EXPECT_LE(count_outliers(a.mean, a.se, b.mean, b.se, 4.5), 1);
+  // The surface share (smooth: the Fresnel reflectance averaged over the fiber, about 0.08 at
+  // n = 1.557) within the rough one's binomial noise over 150 000 photons.
+  EXPECT_NEAR(surface_rough, surface_smooth, 4.5 * std::sqrt(0.1 * 0.9 / (k * 30000.0)));
+  EXPECT_GT(surface_smooth, 0.05);
 }
 
 TEST(FiberTableBake, BitIdenticalAtOneAndTwoThreads) {
@@ -244,6 +344,20 @@ TEST(FiberTableBake, BitIdenticalAtOneAndTwoThreads) {
   EXPECT_EQ(a.table.checksum(), b.table.checksum());
   for (size_t i = 0; i < a.table.values.size(); ++i)
     ASSERT_EQ(a.table.values[i], b.table.values[i]);
+}
+
+TEST(FiberTableBake, RoughDielectricBoundaryIsBitIdenticalAtOneAndTwoThreads) {
+  FiberTableBakeOptions o{.resolution = 4, .photons_per_band = 200, .threads = 1, .passes = 2};
+  const FiberSpec spec = rough_dielectric(load_fiber_spec("red-cotton"));
+  const auto a = bake_fiber_table(spec, o);
+  o.threads = 2;
+  const auto b = bake_fiber_table(spec, o);
+  EXPECT_EQ(a.table.checksum(), b.table.checksum());
+  EXPECT_EQ(a.table.metadata.at("boundary"), "rough-dielectric");
+  // The default's header has no boundary entry (its tables are those of before the option).
+  o.photons_per_band = 20;
+  EXPECT_EQ(bake_fiber_table(load_fiber_spec("red-cotton"), o).table.metadata.count("boundary"),
+            0u);
 }
 
 TEST(FiberTableBake, ExtremesStayFiniteAndBalanced) {

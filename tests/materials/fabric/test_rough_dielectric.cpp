@@ -160,7 +160,8 @@ TEST(RoughDielectric, GrazingEntryFollowsTheRoughInterface) {
   RecordProperty("entered", std::to_string(entered));
   RecordProperty("single_scatter_T1", std::to_string(a.transmitted));
   RecordProperty("single_scatter_R1", std::to_string(a.reflected));
-  std::printf("grazing cos %.2f: rough interface enters %.4f (T1 %.4f, 1 - R1 %.4f); smooth %.4f; "
-              "paper's model %.4f\n",
-              c, entered, a.transmitted, 1 - a.reflected, smooth_in, paper_in);
+  std::printf(
+      "grazing cos %.2f: rough interface enters %.4f (T1 %.4f, 1 - R1 %.4f); smooth %.4f; "
+      "paper's model %.4f\n",
+      c, entered, a.transmitted, 1 - a.reflected, smooth_in, paper_in);
 }

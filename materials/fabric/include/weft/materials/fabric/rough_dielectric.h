@@ -2,9 +2,9 @@
 // A rough dielectric interface as a random walk on its microsurface: the boundary of the fiber
 // when its spec says "boundary": "rough-dielectric" (docs/fiber-bsdf.md).
 //
-// The microsurface is a Smith microsurface (Beckmann or GGX normals of roughness alpha, uncorrelated
-// heights) between index n_outside (above, the side the normal points to) and n_inside (below).
-// A photon meeting it walks on it until it leaves (Heitz, Hanika, d'Eon, Dachsbacher,
+// The microsurface is a Smith microsurface (Beckmann or GGX normals of roughness alpha,
+// uncorrelated heights) between index n_outside (above, the side the normal points to) and n_inside
+// (below). A photon meeting it walks on it until it leaves (Heitz, Hanika, d'Eon, Dachsbacher,
 // "Multiple-scattering microfacet BSDFs with the Smith model", ACM TOG 35(4) 2016, sec. 3-5, their
 // dielectric): at each step the next height follows from the Smith masking (the photon leaves with
 // probability G1(w, h)), the microfacet normal from the distribution of visible normals (Heitz
@@ -38,8 +38,7 @@ class RoughDielectricInterface {
   static constexpr int kMaxOrder = 100000;
 
   // alpha in (0, 1], indices finite and >= 1e-6; throws weft::Error naming the field.
-  RoughDielectricInterface(MicrofacetModel model, double alpha, double n_outside,
-                           double n_inside);
+  RoughDielectricInterface(MicrofacetModel model, double alpha, double n_outside, double n_inside);
 
   // A photon travelling along unit 'd' (local frame, z = the normal pointing outside) meets the
   // interface: from outside when d.z < 0, from inside when d.z > 0 (d.z = 0: from outside).
