@@ -4,13 +4,16 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <string>
 
+#include "transport_test_util.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
 #include "weft/materials/fabric/fiber_physics.h"
 #include "weft/materials/fabric/medium.h"
 #include "weft/materials/fabric/rough_dielectric.h"
+#include "weft/materials/fabric/transport_cylinder.h"
 #include "weft/materials/fresnel.h"
 
 using namespace weft;
@@ -165,4 +168,42 @@ TEST(RoughDielectric, GrazingEntryFollowsTheRoughInterface) {
       "grazing cos %.2f: rough interface enters %.4f (T1 %.4f, 1 - R1 %.4f); smooth %.4f; "
       "paper's model %.4f\n",
       c, entered, a.transmitted, 1 - a.reflected, smooth_in, paper_in);
+}
+
+TEST(RoughDielectric, TransportEngineUsesItAtEntryAndExit) {
+  // The transport engine's own external launch (simulate_cylinder_beam) with the rough interface
+  // as its boundary: at alpha 1e-4 the beam's books match the smooth Fresnel boundary within
+  // noise (an absorbing, scattering cylinder); rough, it conserves energy exactly.
+  CylinderBeamSetup smooth;
+  smooth.medium = weft::testing::hg_medium(0.02, 0.1, 0.8, kCellulose);
+  smooth.radius = 10;
+  smooth.direction = normalize(Vec3{0.3, 0, -1});
+  const auto batch = weft::testing::batch_options(40000, 3, 2, 1000);
+  const CylinderBeamResult a = simulate_cylinder_beam(smooth, batch);
+  for (const double alpha : {1e-4, 0.5}) {
+    auto rd = std::make_shared<const RoughDielectricInterface>(MicrofacetModel::kGgx, alpha, 1.0,
+                                                               kCellulose);
+    CylinderBeamSetup rough = smooth;
+    rough.options.boundary_scatter = [rd](const Vec3& d, Rng& rng) {
+      const RoughDielectricScatter s = rd->scatter(d, rng);
+      return BoundaryScatter{s.direction, s.lost};
+    };
+    const CylinderBeamResult b = simulate_cylinder_beam(rough, batch);
+    EXPECT_NEAR(b.energy_imbalance, 0, 1e-12) << alpha;
+    EXPECT_EQ(b.lost.mean, 0.0) << alpha;
+    if (alpha < 1e-3) {
+      EXPECT_TRUE(
+          weft::testing::within_sigma(b.specular, a.specular.mean, 4.5, a.specular.std_error));
+      EXPECT_TRUE(
+          weft::testing::within_sigma(b.absorbed, a.absorbed.mean, 4.5, a.absorbed.std_error));
+    }
+  }
+  // The rough boundary replaces the exit reflectance: both at once is an error naming it.
+  CylinderBeamSetup both = smooth;
+  both.options.exit_reflectance = [](double) { return 0.1; };
+  both.options.boundary_scatter = [](const Vec3& d, Rng&) { return BoundaryScatter{d}; };
+  EXPECT_NE(weft::testing::error_of([&] {
+              simulate_cylinder_beam(both, batch);
+            }).find("boundary_scatter"),
+            std::string::npos);
 }
