@@ -615,3 +615,23 @@ TEST(FiberTableBake, ReciprocityCheckDetectsAMismatchedBoundary) {
           .interior;
   EXPECT_GT(far_field_reciprocity(ph, 50000).outliers, 1);
 }
+
+TEST(FiberTableBake, RoughDielectricBoundaryDirectAndBssrdfRoutesAgree) {
+  // Both routes launch through enter_fiber, so the rough boundary reaches the paper's route too:
+  // the same comparison as DirectAndBssrdfRoutesAgreeWithinStatisticalError, with the rough
+  // dielectric boundary.
+  const FiberSpec spec = rough_dielectric(test_spec(20, 0.10, 0.01));
+  const MediumBand mb = compute_medium_band(spec, 16);
+  const FiberBandPhysics ph = fiber_band_physics(spec, mb);
+  FiberBakeSettings s = weft::testing::bake_settings(3, 60000, 2);
+  const int k = 5;
+  const CellStats direct = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed;
+    return bake_fiber_band_direct(ph, s, nullptr);
+  });
+  const CellStats bssrdf = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed + 100;
+    return bake_fiber_band_bssrdf(ph, s, BssrdfRouteSettings{}, nullptr);
+  });
+  EXPECT_LE(count_outliers(direct.mean, direct.se, bssrdf.mean, bssrdf.se, 4.5), 1);
+}
