@@ -3,12 +3,14 @@
 // bake, summation table) that the integrators library does not link, calls run_verify, plots.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <sstream>
+#include <thread>
 
 #include "cli_util.h"
 #include "commands.h"
@@ -41,6 +43,49 @@ struct VerifyCliOptions {
 
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The run's CPU time, estimated before any work from its photons and particles (docs/verify.md
+// "Time"): 'typical' at the rates measured on the bundled defaults, 'least' at the fastest rates
+// measured anywhere (the fiber bake's kMinSecondsPerPhoton; 0.8 M particles/s on a sparse sample,
+// docs/PERFORMANCE.md), which is what --yes-long is checked against.
+struct VerifyEstimate {
+  double typical = 0, least = 0;  // CPU seconds
+  double photons = 0, particles = 0;
+};
+// Measured (docs/verify.md "Time"): red-cotton's full bake, 1.2 us per photon per core
+// (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default quality, computed
+// and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so 18 us per
+// particle; the plots and the rest, about 10 s of CPU whatever the quality.
+constexpr double kTypicalSecondsPerPhoton = 1.2e-6;
+constexpr double kTypicalSecondsPerParticle = 18e-6;
+constexpr double kTypicalFixedSeconds = 10;
+constexpr double kLeastSecondsPerParticle = 1.25e-6;
+
+VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
+                               size_t fit_params) {
+  VerifyEstimate e;
+  const double bins = 2.0 * s.resolution * s.resolution;
+  const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
+  // Computed and classic, each 'particles_per_bin' per incident bin over all batches.
+  const double run_particles = 2.0 * double(s.particles_per_bin) * bins;
+  e.photons = run_photons;
+  e.particles = run_particles;
+  if (fit) {
+    const FitInnerSettings inner = fit_inner_settings(s);
+    const double inner_bins = 2.0 * inner.resolution * inner.resolution;
+    // Per model: the search, the optimum again and the Jacobian (2 per parameter; the classic
+    // model has 4).
+    const double computed_evals = fit_evaluations + 1 + 2.0 * double(fit_params);
+    const double classic_evals = fit_evaluations + 1 + 8.0;
+    e.photons += computed_evals * double(inner.fiber_photons_per_band) * kNumBands + run_photons;
+    e.particles += (computed_evals + classic_evals) * double(inner.particles_per_bin) * inner_bins +
+                   run_particles;
+  }
+  e.typical = e.photons * kTypicalSecondsPerPhoton + e.particles * kTypicalSecondsPerParticle +
+              kTypicalFixedSeconds;
+  e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
+  return e;
 }
 
 // A baked fiber table (--fiber TABLE): read and validated (read_exr names the file and the field at
@@ -251,6 +296,28 @@ int run(const VerifyCliOptions& o) {
     throw Error("", o.fit_params_given ? "--fit-params" : "--fit-evaluations", "only with --fit");
   }
   check_verify_output(o.output);
+  // The time it will take, before it starts; above an hour (at the fastest rates) needs --yes-long.
+  {
+    const unsigned cores =
+        std::max(1u, s.threads > 0 ? unsigned(s.threads) : std::thread::hardware_concurrency());
+    const VerifyEstimate e =
+        estimate_verify(s, !fiber_table, o.fit, fit_options.max_evaluations, fit_names.size());
+    check_long_work(e.least / cores, "", "--quality",
+                    "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
+                    "0.5 us per photon and 1.25 us per particle per core at least, " +
+                        std::to_string(cores) + " cores");
+    const auto when = [](double sec) {
+      return sec < 120 ? std::to_string(static_cast<int>(std::ceil(sec))) + " s"
+                       : format_seconds(sec);
+    };
+    if (!o.quiet)
+      std::fprintf(stderr,
+                   "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on "
+                   "%u cores (%s of CPU; at least %s)\n",
+                   o.quality.c_str(), o.fit ? " with --fit" : "", e.photons * 1e-6,
+                   e.particles * 1e-6, when(e.typical / cores).c_str(), cores,
+                   when(e.typical).c_str(), when(e.least / cores).c_str());
+  }
 
   const auto progress = progress_bar(o.quiet);
   VerifyInputs in;
