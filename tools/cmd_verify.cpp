@@ -302,10 +302,6 @@ int run(const VerifyCliOptions& o) {
         std::max(1u, s.threads > 0 ? unsigned(s.threads) : std::thread::hardware_concurrency());
     const VerifyEstimate e =
         estimate_verify(s, !fiber_table, o.fit, fit_options.max_evaluations, fit_names.size());
-    check_long_work(e.least / cores, "", "--quality",
-                    "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
-                    "0.5 us per photon and 1.25 us per particle per core at least, " +
-                        std::to_string(cores) + " cores");
     const auto when = [](double sec) {
       return sec < 120 ? std::to_string(static_cast<int>(std::ceil(sec))) + " s"
                        : format_seconds(sec);
@@ -317,6 +313,10 @@ int run(const VerifyCliOptions& o) {
                    o.quality.c_str(), o.fit ? " with --fit" : "", e.photons * 1e-6,
                    e.particles * 1e-6, when(e.typical / cores).c_str(), cores,
                    when(e.typical).c_str(), when(e.least / cores).c_str());
+    check_long_work(e.least / cores, "", "--quality",
+                    "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
+                    "0.5 us per photon and 1.25 us per particle per core at least, " +
+                        std::to_string(cores) + " cores");
   }
 
   const auto progress = progress_bar(o.quiet);

@@ -385,3 +385,19 @@ TEST(CliVerify, BadFiberTablesAreRefusedNamingTheFile) {
   refused("--fiber '" + table.string() + "' --classic-albedo 2,0,0", {"--classic-albedo"});
   refused("--classic-albedo 0.3,0.2", {"--classic-albedo"});
 }
+
+// The estimate comes first, then the refusal of work above an hour at the fastest rates (the
+// long-work rule of docs/ARCHITECTURE.md): 20 000 fit evaluations per model on one thread are at
+// least 20 009 x 165 000 photons x 0.5 us + 40 018 x 144 000 particles x 1.25 us = 2.5 h of CPU.
+TEST(CliVerify, PrintsItsEstimateAndRefusesLongWorkWithoutYesLong) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "report";
+  const VerifyRun r = run_weft(
+      "verify --quality draft --threads 1 --fit --fit-evaluations 20000 -o '" + out.string() + "'",
+      dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("weft verify: quality draft with --fit"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("M particles: about"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--yes-long"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+}
