@@ -1,6 +1,8 @@
 // The renders of weft verify's report (paper's Figs. 8-9): a flat patch of cloth with each model's
 // fabric table, lit from the viewer's side and from behind, through the one renderer (a scene
 // description in memory, RenderScene, render) as `weft render` would draw it.
+#include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
