@@ -1,17 +1,24 @@
 // weft verify: computed fabric vs measurement vs the classic model, at every measured incidence,
 // in one report folder (docs/verify.md). Binds options, makes the fiber physics' inputs (fiber
 // bake, summation table) that the integrators library does not link, calls run_verify, plots.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+#include <thread>
 
+#include "cli_util.h"
 #include "commands.h"
 #include "plot_util.h"
 #include "verify_fit.h"
 #include "weft/core/error.h"
 #include "weft/integrators/verify.h"
+#include "weft/materials/cook_torrance.h"
 #include "weft/materials/fabric/fabric_summation.h"
 #include "weft/materials/fabric/fiber_spec.h"
 #include "weft/materials/fabric/fiber_table_bake.h"
@@ -27,6 +34,7 @@ struct VerifyCliOptions {
       "dye_scale,particle_fraction_scale,particle_radius_scale,roughness_alpha";
   int fit_evaluations = 100;
   std::string fit_inner = "raytrace";
+  std::string classic_albedo;
   bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false;
   uint64_t seed = 1;
   int threads = 0;
@@ -35,6 +43,141 @@ struct VerifyCliOptions {
 
 double since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// The run's CPU time, estimated before any work from its photons and particles (docs/verify.md
+// "Time"): 'typical' at the rates measured on the bundled defaults, 'least' at the fastest rates
+// measured anywhere (the fiber bake's kMinSecondsPerPhoton; 0.8 M particles/s on a sparse sample,
+// docs/PERFORMANCE.md), which is what --yes-long is checked against.
+struct VerifyEstimate {
+  double typical = 0, least = 0;  // CPU seconds
+  double photons = 0, particles = 0;
+};
+// Measured (docs/verify.md "Time"): red-cotton's full bake, 1.2 us per photon per core
+// (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default quality, computed
+// and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so 18 us per
+// particle; the plots and the rest, about 10 s of CPU whatever the quality.
+constexpr double kTypicalSecondsPerPhoton = 1.2e-6;
+constexpr double kTypicalSecondsPerParticle = 18e-6;
+constexpr double kTypicalFixedSeconds = 10;
+constexpr double kLeastSecondsPerParticle = 1.25e-6;
+
+VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
+                               size_t fit_params) {
+  VerifyEstimate e;
+  const double bins = 2.0 * s.resolution * s.resolution;
+  const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
+  // Computed and classic, each 'particles_per_bin' per incident bin over all batches.
+  const double run_particles = 2.0 * double(s.particles_per_bin) * bins;
+  e.photons = run_photons;
+  e.particles = run_particles;
+  if (fit) {
+    const FitInnerSettings inner = fit_inner_settings(s);
+    const double inner_bins = 2.0 * inner.resolution * inner.resolution;
+    // Per model: the search, the optimum again and the Jacobian (2 per parameter; the classic
+    // model has 4).
+    const double computed_evals = fit_evaluations + 1 + 2.0 * double(fit_params);
+    const double classic_evals = fit_evaluations + 1 + 8.0;
+    e.photons += computed_evals * double(inner.fiber_photons_per_band) * kNumBands + run_photons;
+    e.particles += (computed_evals + classic_evals) * double(inner.particles_per_bin) * inner_bins +
+                   run_particles;
+  }
+  e.typical = e.photons * kTypicalSecondsPerPhoton + e.particles * kTypicalSecondsPerParticle +
+              kTypicalFixedSeconds;
+  e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
+  return e;
+}
+
+// A baked fiber table (--fiber TABLE): read and validated (read_exr names the file and the field at
+// fault), and of kind "fiber".
+TabulatedBsdfTable read_fiber_table(const std::string& file) {
+  TabulatedBsdfTable t;
+  try {
+    t = TabulatedBsdfTable::read_exr(file);
+  } catch (const Error& e) {
+    throw Error("", "--fiber", std::string("not a usable fiber table: ") + e.what());
+  }
+  if (t.kind != "fiber")
+    throw Error(file, "--fiber",
+                "holds a " + t.kind + " table; verify needs a fiber table (weft bake fiber)");
+  return t;
+}
+
+// "R,G,B", each a reflectance in [0, 1].
+Rgb parse_classic_albedo(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    const auto x = finite_number(part);
+    if (!x || *x < 0 || *x > 1)
+      throw Error("", "--classic-albedo",
+                  "'" + text + "' is not three reflectances R,G,B in [0, 1] (linear sRGB)");
+    v.push_back(*x);
+  }
+  if (v.size() != 3)
+    throw Error("", "--classic-albedo",
+                "'" + text + "' is not three reflectances R,G,B in [0, 1] (linear sRGB)");
+  return {v[0], v[1], v[2]};
+}
+
+// The classic baseline from a baked table (docs/verify.md "A baked fiber table"): roughness from
+// the header; index from the spec the header names when a preset of that name has the header's
+// spec hash, else cotton's; diffuse colour from --classic-albedo, else the table's total albedo
+// minus the classic Cook-Torrance lobe's.
+void classic_from_table(const std::string& file, const TabulatedBsdfTable& t,
+                        const std::optional<Rgb>& albedo, const VerifySettings& s,
+                        VerifyInputs& in) {
+  const auto rough = fiber_table_roughness(t, file);
+  if (!rough)
+    throw Error(file, "roughness",
+                "the table's header does not state the fiber's surface roughness (weft bake "
+                "fiber writes it), which the classic baseline needs: bake the table with weft "
+                "bake fiber, or give a fiber spec or preset");
+  in.classic_distribution = *rough;
+  in.classic_ior = kCottonIor;
+  std::string ior_source = "cotton's index " + std::to_string(kCottonIor).substr(0, 5) +
+                           " (the header names no preset with its spec hash)";
+  const auto name = t.metadata.find("spec_name"), hash = t.metadata.find("spec_hash");
+  if (name != t.metadata.end() && hash != t.metadata.end()) {
+    const auto presets = fiber_preset_names();
+    if (std::find(presets.begin(), presets.end(), name->second) != presets.end()) {
+      const FiberSpec spec = parse_fiber_spec(fiber_preset_json(name->second), name->second);
+      if (fiber_spec_hash_hex(spec) == hash->second) {
+        in.classic_ior = spec.host_n[kNumBands / 2];  // 550 nm
+        ior_source =
+            "the index at 550 nm of preset " + name->second + " (the header's spec name and hash)";
+      }
+    }
+  }
+  if (albedo) {
+    in.classic_diffuse = albedo;
+    in.classic_source = "--classic-albedo; the table header's roughness; " + ior_source;
+    return;
+  }
+  const std::vector<double> diffuse =
+      classic_diffuse_from_fiber_table(t, *rough, in.classic_ior, s.seed, s.threads);
+  Rgb rgb;
+  if (t.channels == kNumBands) {
+    for (int b = 0; b < kNumBands; ++b) in.volume_albedo[b] = diffuse[b];
+    rgb = bands_to_linear_srgb([&](int b) { return diffuse[b]; });
+  } else {
+    rgb = Rgb(diffuse[0], diffuse[1], diffuse[2]);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double v = k == 0 ? rgb.r : k == 1 ? rgb.g : rgb.b;
+    if (!(v >= 0 && v <= 1))
+      throw Error(file, "--classic-albedo",
+                  "the classic baseline's diffuse colour from the table (its total albedo minus "
+                  "the Cook-Torrance lobe's) is " +
+                      std::to_string(v) + " in channel " + "RGB"[k] +
+                      ", not a reflectance in [0, 1]: give --classic-albedo R,G,B");
+  }
+  if (t.channels != kNumBands) in.classic_diffuse = rgb;
+  in.classic_source =
+      "the fiber table: its total albedo minus the classic Cook-Torrance lobe's, per " +
+      std::string(t.channels == kNumBands ? "band" : "channel") +
+      "; the table header's roughness; " + ior_source;
 }
 
 // --fit: both models fitted with the same objective and budget on their inner models, then the
@@ -118,11 +261,22 @@ int run(const VerifyCliOptions& o) {
   const std::filesystem::path measured_path =
       o.measured.empty() ? bundled_measured_inplane() : std::filesystem::path(o.measured);
   const MeasuredInplane measured = read_measured_inplane(measured_path);
-  if (std::filesystem::path(o.fiber).extension() == ".exr")
-    throw Error(o.fiber, "--fiber",
-                "give a fiber spec or preset: the classic baseline's diffuse colour is the "
-                "fiber's volume albedo, which a baked table does not record");
-  const FiberSpec spec = load_fiber_spec(o.fiber);
+  // --fiber names a spec or preset, or (.exr) a baked fiber table, whose resolution the run takes.
+  std::optional<TabulatedBsdfTable> fiber_table;
+  FiberSpec spec;
+  if (std::filesystem::path(o.fiber).extension() == ".exr") {
+    fiber_table = read_fiber_table(o.fiber);
+    if (o.fit)
+      throw Error(o.fiber, "--fit",
+                  "the fit changes the fiber spec's parameters, and a baked table has no spec: "
+                  "give a spec or preset");
+    s.resolution = fiber_table->resolution;
+  } else {
+    spec = load_fiber_spec(o.fiber);
+  }
+  const std::optional<Rgb> classic_albedo =
+      o.classic_albedo.empty() ? std::nullopt
+                               : std::optional<Rgb>(parse_classic_albedo(o.classic_albedo));
   if (!o.pattern.empty() && !o.wif.empty())
     throw Error("", "--wif", "give either --pattern or --wif, not both");
   WeaveOptions given;
@@ -142,6 +296,28 @@ int run(const VerifyCliOptions& o) {
     throw Error("", o.fit_params_given ? "--fit-params" : "--fit-evaluations", "only with --fit");
   }
   check_verify_output(o.output);
+  // The time it will take, before it starts; above an hour (at the fastest rates) needs --yes-long.
+  {
+    const unsigned cores =
+        std::max(1u, s.threads > 0 ? unsigned(s.threads) : std::thread::hardware_concurrency());
+    const VerifyEstimate e =
+        estimate_verify(s, !fiber_table, o.fit, fit_options.max_evaluations, fit_names.size());
+    const auto when = [](double sec) {
+      return sec < 120 ? std::to_string(static_cast<int>(std::ceil(sec))) + " s"
+                       : format_seconds(sec);
+    };
+    if (!o.quiet)
+      std::fprintf(stderr,
+                   "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on "
+                   "%u cores (%s of CPU; at least %s)\n",
+                   o.quality.c_str(), o.fit ? " with --fit" : "", e.photons * 1e-6,
+                   e.particles * 1e-6, when(e.typical / cores).c_str(), cores,
+                   when(e.typical).c_str(), when(e.least / cores).c_str());
+    check_long_work(e.least / cores, "", "--quality",
+                    "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
+                    "0.5 us per photon and 1.25 us per particle per core at least, " +
+                        std::to_string(cores) + " cores");
+  }
 
   const auto progress = progress_bar(o.quiet);
   VerifyInputs in;
@@ -152,23 +328,33 @@ int run(const VerifyCliOptions& o) {
   in.seconds["woven_sample"] = since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  FiberTableBakeOptions b;
-  b.resolution = s.resolution;
-  b.photons_per_band = s.fiber_photons_per_band;
-  b.seed = s.seed;
-  b.threads = s.threads;
-  b.spectral = true;  // the colour table needs the spectrum
-  FiberTableBakeResult fiber = bake_fiber_table(spec, b, progress);
-  if (fiber.cancelled) {
-    std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
-    return 130;
+  if (fiber_table) {
+    classic_from_table(o.fiber, *fiber_table, classic_albedo, s, in);
+    in.fiber = std::move(*fiber_table);
+    in.seconds["classic_from_table"] = since(t0);
+  } else {
+    FiberTableBakeOptions b;
+    b.resolution = s.resolution;
+    b.photons_per_band = s.fiber_photons_per_band;
+    b.seed = s.seed;
+    b.threads = s.threads;
+    b.spectral = true;  // the colour table needs the spectrum
+    FiberTableBakeResult fiber = bake_fiber_table(spec, b, progress);
+    if (fiber.cancelled) {
+      std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
+      return 130;
+    }
+    in.seconds["fiber_bake"] = since(t0);
+    for (const auto& band : fiber.bands)
+      in.volume_albedo[band.band] = band.exit_fraction - band.surface_fraction;
+    in.classic_distribution = {spec.roughness_distribution, spec.roughness_alpha};
+    in.classic_ior = spec.host_n[kNumBands / 2];  // 550 nm
+    if (classic_albedo) {
+      in.classic_diffuse = classic_albedo;
+      in.classic_source = "--classic-albedo; the spec's roughness and index at 550 nm";
+    }
+    in.fiber = std::move(fiber.table);
   }
-  in.seconds["fiber_bake"] = since(t0);
-  for (const auto& band : fiber.bands)
-    in.volume_albedo[band.band] = band.exit_fraction - band.surface_fraction;
-  in.classic_distribution = {spec.roughness_distribution, spec.roughness_alpha};
-  in.classic_ior = spec.host_n[kNumBands / 2];  // 550 nm
-  in.fiber = std::move(fiber.table);
 
   t0 = std::chrono::steady_clock::now();
   FabricSummationOptions so;
@@ -240,7 +426,9 @@ void add_verify_command(CLI::App& app, Commands& commands) {
   sub->add_option("--measured", o->measured,
                   "measured in-plane table (format of materials/data/measured/*/inplane.csv; "
                   "default: the bundled MERL red fabric)");
-  sub->add_option("--fiber", o->fiber, "fiber spec (.json) or preset")->capture_default_str();
+  sub->add_option("--fiber", o->fiber,
+                  "fiber spec (.json) or preset, or a baked fiber table (.exr, weft bake fiber)")
+      ->capture_default_str();
   sub->add_option("--weave", o->weave, "woven sample options (.json; default: the bundled poplin)");
   sub->add_option("--pattern", o->pattern, "weave pattern: plain, twill:N/M, satin:N");
   sub->add_option("--wif", o->wif, "WIF weaving draft");
@@ -269,6 +457,10 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                   "fibers)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_inner_given = true; });
+  sub->add_option("--classic-albedo", o->classic_albedo,
+                  "the classic baseline's diffuse colour R,G,B (linear sRGB reflectances); "
+                  "default: the spec's volume albedo, or for a fiber table its total albedo "
+                  "minus the Cook-Torrance lobe's");
   sub->add_flag("--json", o->json, "print metrics.json on stdout");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
   commands.push_back({sub, [o] { return run(*o); }});

@@ -331,6 +331,8 @@ VerifySettings verify_settings(VerifyQuality q) {
       s.particles_per_bin = 4000;
       s.batches = 2;
       s.summation_samples = 4;
+      s.render_size = 64;
+      s.render_spp = 2;
       break;
     case VerifyQuality::kDefault:
       s.resolution = 8;
@@ -338,6 +340,8 @@ VerifySettings verify_settings(VerifyQuality q) {
       s.particles_per_bin = 64000;
       s.batches = 4;
       s.summation_samples = 8;
+      s.render_size = 128;
+      s.render_spp = 4;
       break;
     case VerifyQuality::kPublication:
       s.resolution = 12;
@@ -345,6 +349,8 @@ VerifySettings verify_settings(VerifyQuality q) {
       s.particles_per_bin = 256000;
       s.batches = 8;
       s.summation_samples = 16;
+      s.render_size = 384;
+      s.render_spp = 64;
       break;
   }
   return s;
@@ -513,6 +519,7 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   }
   rep.models.push_back(model_curves("computed_raytrace", "computed (fiber-level ray trace)",
                                     computed.beta, computed.err));
+  rep.computed_fabric = computed.mean;
 
   // Computed: the paper's summation (deterministic up to its stratified cell sampling).
   if (in.summation) {
@@ -545,6 +552,7 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
     rep.classic_clip = GamutClip();
   }
   rep.classic_reflectance = refl;
+  rep.classic_source = in.classic_source;
   const TabulatedBsdfTable classic_fiber =
       classic_fiber_table(refl, in.classic_distribution, in.classic_ior, s.resolution,
                           s.summation_samples, s.seed, s.threads, progress);
@@ -556,6 +564,13 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   rep.seconds["raytrace_classic"] = seconds_since(t0);
   rep.models.push_back(
       model_curves("classic", "classic (Lambert + Cook-Torrance)", cl.beta, cl.err));
+  rep.classic_fabric = std::move(cl.mean);
+  // The measured BRDF's neural fit, where the measurement has one (materials/data/measured/*/).
+  {
+    std::error_code ec;
+    const auto net = std::filesystem::path(measured.file).parent_path() / "nbrdf_weights.txt";
+    if (std::filesystem::is_regular_file(net, ec)) rep.measured_nbrdf = net;
+  }
 
   for (auto& m : rep.models) score(m, measured, *normal_curve, normal_view);
 
@@ -573,8 +588,10 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
       rep.colours.push_back(colour_of_spectrum("paper's summation, reflection", ss.reflectance,
                                                "the summation transmits nothing"));
     }
-    rep.colours.push_back(colour_of_spectrum("fiber volume albedo (classic diffuse colour)",
-                                             in.volume_albedo, "before clipping to [0, 1]"));
+    if (!in.classic_diffuse)
+      rep.colours.push_back(colour_of_spectrum("fiber volume albedo (classic diffuse colour)",
+                                               in.volume_albedo,
+                                               "before clipping to [0, 1]; " + in.classic_source));
   }
   {
     ColourEntry paper;
@@ -613,6 +630,45 @@ TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistr
       samples, seed, threads, progress);
   t.kind = "fiber";
   return t;
+}
+
+std::vector<double> table_total_albedo(const TabulatedBsdfTable& t) {
+  const DirectionGrid g = t.grid();
+  const std::vector<double> d = g.cosine_weighted_areas();
+  std::vector<double> out(static_cast<size_t>(t.channels), 0.0);
+  for (int i = 0; i < g.bins(); ++i) {
+    const auto a = t.directional_albedo(i);
+    for (int c = 0; c < t.channels; ++c) out[c] += d[static_cast<size_t>(i)] * a.total(c) / kPi;
+  }
+  return out;
+}
+
+std::vector<double> classic_diffuse_from_fiber_table(const TabulatedBsdfTable& fiber,
+                                                     const MicrofacetDistribution& d, double ior,
+                                                     uint64_t seed, int threads) {
+  // The lobe at a fixed fine resolution, not the table's: at R = 3 with 4 samples per cell pair
+  // the tabulated lobe loses a fifth of its albedo (0.0587 for Beckmann 0.35, n 1.557); at R = 16
+  // it is within 0.0002 of its value at R = 24 with 16 samples (0.0729).
+  const double lobe =
+      table_total_albedo(classic_fiber_table(Rgb(0.0), d, ior, 16, 4, seed, threads))[0];
+  std::vector<double> out = table_total_albedo(fiber);
+  for (double& v : out) v -= lobe;
+  return out;
+}
+
+std::optional<MicrofacetDistribution> fiber_table_roughness(const TabulatedBsdfTable& t,
+                                                            const std::string& file) {
+  const auto it = t.metadata.find("roughness");
+  if (it == t.metadata.end()) return std::nullopt;
+  std::istringstream in(it->second);
+  std::string model, word;
+  double alpha = 0;
+  if (!(in >> model >> word >> alpha) || word != "alpha" || !(in >> std::ws).eof() ||
+      !(model == "beckmann" || model == "ggx") || !(alpha > 0 && alpha <= 1))
+    throw Error(file, "roughness",
+                "'" + it->second + "' is not '<beckmann|ggx> alpha A' with A in (0, 1]");
+  return MicrofacetDistribution{
+      model == "beckmann" ? MicrofacetModel::kBeckmann : MicrofacetModel::kGgx, alpha};
 }
 
 std::vector<std::vector<Rgb>> table_curves(const TabulatedBsdfTable& table,
@@ -932,6 +988,8 @@ std::string verify_metrics_json(const VerifyReport& r) {
                    {"batches", s.batches},
                    {"summation_samples", s.summation_samples},
                    {"azimuths", s.azimuths},
+                   {"render_size", s.render_size},
+                   {"render_spp", s.render_spp},
                    {"threads", s.threads}};
   j["seed"] = s.seed;
   j["seconds"] = r.seconds;
@@ -1032,8 +1090,19 @@ std::string verify_metrics_json(const VerifyReport& r) {
     colours.push_back(e);
   }
   j["colour_table"] = colours;
+  nlohmann::json renders = nlohmann::json::array();
+  for (const auto& v : r.renders)
+    renders.push_back({{"model", v.model},
+                       {"configuration", v.configuration},
+                       {"exr", v.stem + ".exr"},
+                       {"png", v.stem + ".png"},
+                       {"caption", v.caption},
+                       {"patch_radiance_linear_srgb", rgb_json(v.patch_radiance)}});
+  j["renders"] = renders;
+  j["render_setup"] = kVerifyRenderSetup;
   j["classic_reflectance_linear_srgb"] = rgb_json(r.classic_reflectance);
   j["classic_reflectance_clipped_components"] = r.classic_clip.components;
+  j["classic_source"] = r.classic_source;
   j["fabric_table_gamut_clipped_components"] = r.fabric_table_gamut_clipped;
   j["raytrace_relative_noise"] = r.raytrace_relative_noise;
   return j.dump(2) + "\n";
@@ -1105,6 +1174,19 @@ std::string verify_index_html(const VerifyReport& r,
       << "\" src=\"data:image/png;base64," << base64(std::span<const uint8_t>(p, bytes.size()))
       << "\">\n";
   }
+  if (!r.renders.empty()) {
+    h << "<h2>Renders of the sample (paper's Figs. 8-9)</h2>\n<p>"
+      << html_escape(kVerifyRenderSetup)
+      << "</p>\n<table><tr><th>render</th><th>what</th><th>patch radiance (linear "
+         "sRGB)</th></tr>\n";
+    for (const auto& v : r.renders)
+      h << "<tr><td><a href=\"" << html_escape(v.stem) << ".exr\"><img src=\""
+        << html_escape(v.stem) << ".png\" alt=\"" << html_escape(v.stem)
+        << "\" style=\"width:160px\"></a></td><td>" << html_escape(v.caption) << "<br>"
+        << html_escape(v.stem) << ".png (.exr: linear)</td><td>" << fmt(v.patch_radiance.r) << ", "
+        << fmt(v.patch_radiance.g) << ", " << fmt(v.patch_radiance.b) << "</td></tr>\n";
+    h << "</table>\n";
+  }
   h << "<h2>Colour (paper's Table 1): CIE 1931, D65</h2>\n<table><tr><th>what</th><th>linear "
        "sRGB</th><th>H</th><th>S</th><th>V</th><th></th><th>note</th></tr>\n";
   for (const auto& c : r.colours) {
@@ -1141,7 +1223,8 @@ std::string verify_index_html(const VerifyReport& r,
   }
   h << "</table>\n<p>Classic diffuse colour (linear sRGB): " << fmt(r.classic_reflectance.r) << ", "
     << fmt(r.classic_reflectance.g) << ", " << fmt(r.classic_reflectance.b) << " ("
-    << r.classic_clip.components << " components clipped to [0, 1]).</p>\n";
+    << r.classic_clip.components << " components clipped to [0, 1]); from "
+    << html_escape(r.classic_source) << ".</p>\n";
   const VerifySettings& s = r.settings;
   h << "<h2>Settings, seed and timings</h2>\n<table>"
     << "<tr><td>quality</td><td>" << quality_name(s.quality) << "</td></tr>"
@@ -1195,13 +1278,24 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
   try {
     if (!fs::create_directory(staging, ec) || ec)
       throw Error(dir.string(), "-o", "cannot create a staging folder beside it");
-    write_text_atomically(staging / "inplane.csv", verify_inplane_csv(report));
-    write_text_atomically(staging / "metrics.json", verify_metrics_json(report));
+    // The renders first, so that metrics.json and index.html describe them and their time.
+    VerifyReport r = report;
+    const auto t0 = std::chrono::steady_clock::now();
+    r.renders = render_verify_samples(staging, r);
+    for (const auto& v : r.renders) {
+      write_exr(staging / (v.stem + ".exr"), v.image);
+      write_png_preview(staging / (v.stem + ".png"), v.image, kVerifyRenderExposure);
+    }
+    r.seconds["renders"] = seconds_since(t0);
+    write_text_atomically(staging / "inplane.csv", verify_inplane_csv(r));
+    write_text_atomically(staging / "metrics.json", verify_metrics_json(r));
     draw(staging);
     std::vector<std::pair<std::string, std::string>> images;
     std::vector<fs::path> pngs;
+    // The plots are embedded; the renders are linked (relative paths) beside their EXR.
     for (const auto& e : fs::directory_iterator(staging))
-      if (e.path().extension() == ".png") pngs.push_back(e.path());
+      if (e.path().extension() == ".png" && e.path().filename().string().rfind("render-", 0) != 0)
+        pngs.push_back(e.path());
     std::sort(pngs.begin(), pngs.end());
     for (const auto& p : pngs) {
       std::ifstream f(p, std::ios::binary);
@@ -1209,7 +1303,7 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
       b << f.rdbuf();
       images.emplace_back(p.filename().string(), b.str());
     }
-    write_text_atomically(staging / "index.html", verify_index_html(report, images));
+    write_text_atomically(staging / "index.html", verify_index_html(r, images));
     // The earlier report (if any) is moved aside, the new one moved in, the old one removed.
     if (fs::exists(target, ec)) {
       fs::rename(target, old, ec);

@@ -11,6 +11,7 @@
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/integrators/verify.h"
+#include "weft/materials/registry.h"
 
 namespace fs = std::filesystem;
 using weft::testing::error_of;
@@ -258,6 +259,68 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
   // The measurement must hold normal incidence and view.
   m.curves.erase(m.curves.begin());
   EXPECT_NE(error_of([&] { run_verify(sample, in, m, s); }).find("theta_i_deg"), std::string::npos);
+}
+
+// The renders (paper's Figs. 8-9): a flat patch under a parallel light of irradiance pi has the
+// radiance L = f E |cos theta_i| = pi f (lights.h: a parallel light's value is the irradiance on
+// a plane facing it; the light is at normal incidence). So the patch's pixels must be pi times
+// the table interpolated (TabulatedBsdfTable::interpolate, "like the table material does") at the
+// camera's direction (zenith 30 deg, azimuth 180 deg: local (-1/2, 0, sqrt(3)/2), the patch's
+// tangent being x) and the light's (+z in reflection, -z in transmission). The table differs in
+// each channel, between reflection and transmission, and with wo.x (so a wrong side, azimuth or
+// light direction fails). Tolerance 1e-4 relative: float pixels and table, nothing random (one
+// light, nothing else in the scene, every camera ray of an orthographic camera parallel).
+double channel(const Rgb& c, int k) {
+  return k == 0 ? c.r : k == 1 ? c.g : c.b;
+}
+
+TEST(VerifyRender, PatchRadianceIsPiTimesTheTableForEachConfiguration) {
+  const fs::path dir = fresh_test_dir();
+  auto f = [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+    const bool same_side = (wo.z > 0) == (wi.z > 0);
+    const double a = 1 + 0.8 * wo.x;
+    v[0] = (same_side ? 0.30 : 0.05) * a;
+    v[1] = (same_side ? 0.04 : 0.10) * a;
+    v[2] = (same_side ? 0.02 : 0.20) * a;
+  };
+  TabulatedBsdfTable t = TabulatedBsdfTable::from_function(4, 3, f, 4, 1);
+  t.kind = "fabric";
+  VerifyReport r;
+  r.settings = verify_settings(VerifyQuality::kDraft);
+  r.settings.render_size = 24;
+  r.settings.render_spp = 1;
+  r.computed_fabric = t;
+  r.measured_nbrdf =
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric" / "nbrdf_weights.txt";
+  const std::vector<VerifyRender> renders = render_verify_samples(dir, r);
+  ASSERT_EQ(renders.size(), 3u);  // computed in both configurations, measured in reflection
+  EXPECT_TRUE(fs::exists(dir / "fabric-computed.exr"));
+  const double s = std::sin(kVerifyRenderViewZenithDeg * std::numbers::pi / 180);
+  const Vec3 wo{-s, 0, std::sqrt(1 - s * s)};
+  for (const VerifyRender& v : renders) {
+    const bool transmission = v.configuration == "transmission";
+    Rgb want;
+    if (v.model == "computed") {
+      double e[3];
+      t.interpolate(wo, {0, 0, transmission ? -1.0 : 1.0}, e);
+      want = Rgb(e[0], e[1], e[2]) * kVerifyRenderIrradiance;
+    } else {
+      ASSERT_EQ(v.model, "measured");
+      MaterialContext ctx;
+      const Bsdf m = make_bsdf("measured_nbrdf", {{"file", r.measured_nbrdf.string()}}, ctx);
+      want = m.eval(wo, {0, 0, 1}) * kVerifyRenderIrradiance;
+    }
+    ASSERT_EQ(v.image.width, 24);
+    for (int y = 6; y < 18; ++y)
+      for (int x = 6; x < 18; ++x)
+        for (int k = 0; k < 3; ++k)
+          ASSERT_NEAR(channel(v.image.at(x, y), k), channel(want, k), 1e-4 * channel(want, k))
+              << v.stem << " pixel " << x << "," << y << " channel " << k;
+    EXPECT_NEAR(v.patch_radiance.r, want.r, 1e-4 * want.r) << v.stem;
+  }
+  // Light from behind shows the transmission colour: blue over red here, red over blue in front.
+  EXPECT_GT(renders[1].patch_radiance.b, renders[1].patch_radiance.r);
+  EXPECT_GT(renders[0].patch_radiance.r, renders[0].patch_radiance.b);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -15,6 +16,8 @@
 #include "../../tools/verify_fit.h"  // the fit's inner models, header-only (the command's own)
 #include "cli_run.h"
 #include "test_util.h"
+#include "weft/materials/fabric/fiber_spec.h"
+#include "weft/materials/fabric/fiber_table_bake.h"
 
 namespace fs = std::filesystem;
 using weft::testing::fresh_test_dir;
@@ -55,10 +58,11 @@ TEST(CliVerify, BadMeasuredTableNamesFileAndColumnAndWritesNothing) {
   EXPECT_EQ(r2.exit_code, 2);
   EXPECT_NE(r2.err.find("line 3 nbrdf_beta_G"), std::string::npos) << r2.err;
   EXPECT_FALSE(fs::exists(out));
-  // A baked table cannot give the classic model its colour.
+  // A fiber table that is not there: the file and the option.
   const VerifyRun r3 = run_weft("verify --quiet --fiber x.exr -o '" + out.string() + "'", dir);
   EXPECT_EQ(r3.exit_code, 2);
-  EXPECT_NE(r3.err.find("--fiber"), std::string::npos) << r3.err;
+  EXPECT_NE(r3.err.find("x.exr"), std::string::npos) << r3.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(CliVerify, DraftWritesTheWholeReport) {
@@ -82,6 +86,41 @@ TEST(CliVerify, DraftWritesTheWholeReport) {
   EXPECT_NE(html.find("real fabric (paper, Table 1)"), std::string::npos);
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
+  // The renders (paper's Figs. 8-9): computed and classic in both configurations, the measured
+  // BRDF in reflection, EXR and PNG, linked from the page by relative path (readable offline).
+  std::map<std::string, weft::Rgb> patch;
+  for (const auto& v : j.at("renders")) {
+    const std::string stem = "render-" + v.at("configuration").get<std::string>() + "-" +
+                             v.at("model").get<std::string>();
+    const auto& c = v.at("patch_radiance_linear_srgb");
+    patch[stem] = weft::Rgb(c[0].get<double>(), c[1].get<double>(), c[2].get<double>());
+  }
+  for (const char* stem :
+       {"render-reflection-computed", "render-transmission-computed", "render-reflection-classic",
+        "render-transmission-classic", "render-reflection-measured"}) {
+    ASSERT_EQ(patch.count(stem), 1u) << stem;
+    for (const char* ext : {".exr", ".png"})
+      EXPECT_TRUE(fs::exists(out / (std::string(stem) + ext))) << stem << ext;
+    EXPECT_NE(html.find(std::string("src=\"") + stem + ".png\""), std::string::npos) << stem;
+    EXPECT_GT(patch[stem].r, 0) << stem;
+  }
+  // Lit from behind, the computed fabric is less saturated (purpler) than lit from the front: its
+  // G/R and B/R are larger, and they must be larger in the render exactly when the colour table
+  // (directional reflectance and transmittance at normal incidence, from the same fabric table)
+  // says so: the renders show the table the colour table describes.
+  std::map<std::string, weft::Rgb> colour;
+  for (const auto& c : j.at("colour_table"))
+    if (c.contains("linear_srgb"))
+      colour[c.at("name")] =
+          weft::Rgb(c.at("linear_srgb")[0].get<double>(), c.at("linear_srgb")[1].get<double>(),
+                    c.at("linear_srgb")[2].get<double>());
+  const weft::Rgb cr = colour.at("computed fabric, reflection");
+  const weft::Rgb ct = colour.at("computed fabric, transmission");
+  const weft::Rgb rr = patch["render-reflection-computed"];
+  const weft::Rgb rt = patch["render-transmission-computed"];
+  EXPECT_EQ(rt.g / rt.r > rr.g / rr.r, ct.g / ct.r > cr.g / cr.r);
+  EXPECT_EQ(rt.b / rt.r > rr.b / rr.r, ct.b / ct.r > cr.b / cr.r);
+  EXPECT_GT(rt.g / rt.r, rr.g / rr.r);  // the paper's "purple to dark red" (issue 8)
   // A second run into a folder that holds something else is refused, and the folder kept.
   const fs::path other = dir / "other";
   fs::create_directories(other);
@@ -229,4 +268,136 @@ TEST(CliVerify, BadFitOptionsAreRefusedBeforeAnyWork) {
               weft::fit_inplane("x", outside, never, m, {});
             }).find("roughness_alpha"),
             std::string::npos);
+}
+
+namespace {
+
+// A small red-cotton fiber table as weft bake fiber makes it (R = 3 keeps the verify run short:
+// the ray trace's cost grows with the incident bins, R^2), and the bake's per-band summary.
+weft::FiberTableBakeResult small_red_cotton_bake() {
+  weft::FiberTableBakeOptions b;
+  b.resolution = 3;
+  b.photons_per_band = 20000;
+  b.seed = 3;
+  b.spectral = true;
+  return weft::bake_fiber_table(weft::load_fiber_spec("red-cotton"), b);
+}
+
+}  // namespace
+
+// --fiber TABLE: the classic baseline's colour from the table alone. Its total albedo is the
+// bake's exit fraction (the bake's own energy_table check), so the table's albedo minus the
+// classic Cook-Torrance lobe's must equal the spec path's volume albedo, exit - surface, up to the
+// difference between the lobe's albedo (0.0729 for this Beckmann 0.35 surface of index 1.557,
+// docs/verify.md) and the bake's surface fraction of the same surface, whose standard error at
+// 20 000 photons per band is sqrt(0.073 x 0.927 / 20000) = 0.0018: 0.0065 per band is 3.5 of
+// them. A band offset common to all bands moves each linear sRGB channel by about the same (D65
+// white is (1, 1, 1)), so the same 0.0065 per channel. Then the whole command runs on the table,
+// with the derived colour and with --classic-albedo.
+TEST(CliVerify, FiberTableGivesTheClassicColourFromItsAlbedo) {
+  const fs::path dir = fresh_test_dir();
+  const weft::FiberTableBakeResult bake = small_red_cotton_bake();
+  const fs::path table = dir / "fiber.exr";
+  bake.table.write_exr(table);
+  const auto derived = weft::classic_diffuse_from_fiber_table(
+      bake.table, {weft::MicrofacetModel::kBeckmann, 0.35}, 1.557, 1, 0);
+  weft::Spectrum volume{};
+  for (const auto& band : bake.bands) {
+    volume[band.band] = band.exit_fraction - band.surface_fraction;
+    EXPECT_NEAR(derived[band.band], volume[band.band], 0.0065) << "band " << band.band;
+  }
+  weft::Rgb want = weft::bands_to_linear_srgb([&](int b) { return volume[b]; });
+  weft::GamutClip clip;
+  clip.clip(want);
+
+  const fs::path out = dir / "report";
+  const VerifyRun r = run_weft("verify --quiet --quality draft --threads 2 --fiber '" +
+                                   table.string() + "' -o '" + out.string() + "'",
+                               dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(slurp(out / "metrics.json"));
+  EXPECT_EQ(j.at("fiber"), table.string());
+  EXPECT_EQ(j.at("settings").at("resolution"), 3);  // the table's
+  const std::string source = j.at("classic_source");
+  EXPECT_NE(source.find("total albedo"), std::string::npos) << source;
+  EXPECT_NE(source.find("preset red-cotton"), std::string::npos) << source;
+  const auto& c = j.at("classic_reflectance_linear_srgb");
+  EXPECT_NEAR(c[0].get<double>(), want.r, 0.0065);
+  EXPECT_NEAR(c[1].get<double>(), want.g, 0.0065);
+  EXPECT_NEAR(c[2].get<double>(), want.b, 0.0065);
+  EXPECT_TRUE(fs::exists(out / "render-transmission-classic.png"));
+
+  // An explicit colour is used as given.
+  const VerifyRun r2 =
+      run_weft("verify --quiet --quality draft --threads 2 --fiber '" + table.string() +
+                   "' --classic-albedo 0.3,0.05,0.03 -o '" + out.string() + "'",
+               dir);
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  const auto j2 = nlohmann::json::parse(slurp(out / "metrics.json"));
+  EXPECT_EQ(j2.at("classic_reflectance_linear_srgb"), nlohmann::json({0.3, 0.05, 0.03}));
+  EXPECT_NE(j2.at("classic_source").get<std::string>().find("--classic-albedo"), std::string::npos);
+}
+
+// Bad tables and options are refused before any work, naming the file (and the field), exit 2,
+// nothing written.
+TEST(CliVerify, BadFiberTablesAreRefusedNamingTheFile) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "report";
+  weft::TabulatedBsdfTable good = small_red_cotton_bake().table;
+  const fs::path table = dir / "fiber.exr";
+  good.write_exr(table);
+  auto refused = [&](const std::string& args, const std::vector<std::string>& words) {
+    const VerifyRun r =
+        run_weft("verify --quiet --quality draft " + args + " -o '" + out.string() + "'", dir);
+    EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
+    for (const auto& w : words) EXPECT_NE(r.err.find(w), std::string::npos) << w << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << args;
+  };
+  // Truncated: the first half of a good file.
+  const std::string bytes = slurp(table);
+  const fs::path cut = dir / "cut.exr";
+  std::ofstream(cut, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  refused("--fiber '" + cut.string() + "'", {cut.string(), "--fiber"});
+  // Not an EXR at all.
+  const fs::path text = dir / "text.exr";
+  std::ofstream(text) << "not a table";
+  refused("--fiber '" + text.string() + "'", {text.string(), "--fiber"});
+  // A fabric table.
+  weft::TabulatedBsdfTable fabric = good;
+  fabric.kind = "fabric";
+  const fs::path fabric_file = dir / "fabric.exr";
+  fabric.write_exr(fabric_file);
+  refused("--fiber '" + fabric_file.string() + "'", {fabric_file.string(), "fabric table"});
+  // No roughness in the header: the classic baseline cannot be made.
+  weft::TabulatedBsdfTable bare = good;
+  bare.metadata.erase("roughness");
+  const fs::path bare_file = dir / "bare.exr";
+  bare.write_exr(bare_file);
+  refused("--fiber '" + bare_file.string() + "'", {bare_file.string(), "roughness"});
+  // A fiber darker than its own surface: no diffuse colour follows; the error asks for one.
+  weft::TabulatedBsdfTable dark = good;
+  for (float& v : dark.values) v *= 0.05f;
+  const fs::path dark_file = dir / "dark.exr";
+  dark.write_exr(dark_file);
+  refused("--fiber '" + dark_file.string() + "'", {dark_file.string(), "--classic-albedo R,G,B"});
+  // The fit needs a spec; the colour must be three reflectances.
+  refused("--fit --fiber '" + table.string() + "'", {table.string(), "--fit"});
+  refused("--fiber '" + table.string() + "' --classic-albedo 2,0,0", {"--classic-albedo"});
+  refused("--classic-albedo 0.3,0.2", {"--classic-albedo"});
+}
+
+// The estimate comes first, then the refusal of work above an hour at the fastest rates (the
+// long-work rule of docs/ARCHITECTURE.md): 20 000 fit evaluations per model on one thread are at
+// least 20 009 x 165 000 photons x 0.5 us + 40 018 x 144 000 particles x 1.25 us = 2.5 h of CPU.
+TEST(CliVerify, PrintsItsEstimateAndRefusesLongWorkWithoutYesLong) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "report";
+  const VerifyRun r = run_weft(
+      "verify --quality draft --threads 1 --fit --fit-evaluations 20000 -o '" + out.string() + "'",
+      dir);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find("weft verify: quality draft with --fit"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("M particles: about"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--yes-long"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
 }

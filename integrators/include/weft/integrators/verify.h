@@ -29,12 +29,14 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "weft/core/progress.h"
 #include "weft/core/spectrum.h"
+#include "weft/integrators/image.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/microfacet.h"
 #include "weft/scenes/weave.h"
@@ -140,6 +142,8 @@ struct VerifySettings {
   int batches = 4;                      // independent ray traces (the error bars)
   int summation_samples = 8;            // direction pairs per cell pair (summation, classic)
   int azimuths = 24;                    // planes of incidence averaged
+  int render_size = 96;                 // the renders of the sample (pixels per side)
+  int render_spp = 4;                   // their samples per pixel
   uint64_t seed = 1;
   int threads = 0;  // 0 = all cores; results do not depend on it
 };
@@ -157,6 +161,10 @@ struct VerifyInputs {
   // A fitted classic colour (linear sRGB reflectance in [0, 1]) in place of the volume albedo.
   std::optional<Rgb> classic_diffuse;
   std::string fiber_name, sample_name;
+  // Where the classic model's colour, roughness and index came from (for the report).
+  std::string classic_source =
+      "the fiber spec: volume albedo of the bake, the spec's roughness "
+      "and index at 550 nm";
   std::map<std::string, double> seconds;  // timings of the caller's steps (fiber bake, ...)
 };
 
@@ -258,9 +266,77 @@ TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistr
                                        int threads,
                                        const ProgressCallback& progress = no_progress());
 
+// ---- A baked fiber table in place of a spec (weft verify --fiber TABLE) ------------------------
+
+// A table's total albedo per channel, (1/pi) sum_i sum_o f[i][o] D_i D_o (D: the bins'
+// cosine-weighted areas, core/direction_grid.h). For a fiber table it is the fraction of the light
+// hitting the fiber that leaves it: the bake's exit_fraction, which the bake states is the same
+// sum (fiber_table_bake.h FiberBandSummary::energy_table).
+std::vector<double> table_total_albedo(const TabulatedBsdfTable& table);
+
+// The classic fiber's diffuse colour from a fiber table alone, per channel of the table: the
+// table's total albedo minus that of the classic fiber's own Cook-Torrance lobe (diffuse colour 0,
+// tabulated by classic_fiber_table at R = 16, 4 samples per cell pair), so that the classic fiber
+// sends out as much light in all as the table's fiber. For a table baked from a spec this stands
+// for the volume albedo exit_fraction - surface_fraction: the lobe's albedo and the bake's surface
+// fraction are those of the same rough surface (docs/verify.md gives the figures). Channels may
+// come out negative (a table darker than its surface alone); the caller decides.
+std::vector<double> classic_diffuse_from_fiber_table(const TabulatedBsdfTable& fiber,
+                                                     const MicrofacetDistribution& d, double ior,
+                                                     uint64_t seed, int threads);
+
+// The fiber surface's roughness that a fiber table's header states ("roughness": "beckmann alpha
+// 0.350000", as weft bake fiber writes it); nullopt when the header has none; weft::Error naming
+// 'file' and "roughness" when it is malformed or out of (0, 1].
+std::optional<MicrofacetDistribution> fiber_table_roughness(const TabulatedBsdfTable& table,
+                                                            const std::string& file);
+
 // beta [incidence][view] of an RGB or spectral table at the measurement's views.
 std::vector<std::vector<Rgb>> table_curves(const TabulatedBsdfTable& table,
                                            const MeasuredInplane& measured, int azimuths);
+
+// ---- Renders of the sample (paper's Figs. 8-9) -----------------------------------------------
+
+// One render of a flat patch of cloth (docs/verify.md "Renders"): the model's fabric table (or the
+// measured BRDF) on a 1 m square, a parallel light of irradiance pi at normal incidence, from the
+// viewer's side ("reflection") or from behind ("transmission"), an orthographic camera at 30 deg
+// from the normal. A flat patch under a parallel light has one radiance, L = f E cos theta_i =
+// pi f = beta for this (view, light): the image is that colour, as the renderer shades it.
+struct VerifyRender {
+  std::string stem;           // file name without extension, e.g. "render-reflection-computed"
+  std::string model;          // "computed", "classic", "measured"
+  std::string configuration;  // "reflection", "transmission"
+  std::string caption;
+  Image image;         // linear sRGB radiance
+  Rgb patch_radiance;  // mean over the central half of the film (wholly inside the patch)
+};
+
+// The geometry of every render (one place for the numbers the captions and tests quote).
+inline constexpr double kVerifyRenderViewZenithDeg = 30;
+inline constexpr double kVerifyRenderIrradiance = 3.14159265358979323846;  // pi: L = beta
+// The PNGs: linear radiance times 1 (a white Lambertian patch would be 1, white), clipped to
+// [0, 1], sRGB transfer curve (image.h write_png_preview); no other tone mapping. EXR: linear.
+inline constexpr double kVerifyRenderExposure = 1;
+inline constexpr const char* kVerifyRenderSetup =
+    "A flat 1 m square of cloth with the model's fabric table (the measured BRDF's neural fit for "
+    "the measurement), lit by a parallel light of irradiance pi at normal incidence, from the "
+    "viewer's side (reflection) or from behind (transmission), seen by an orthographic camera 30 "
+    "deg from the normal; the path tracer of weft render. Under a parallel light a flat patch has "
+    "one radiance, beta = pi f for that view and light, so each image is one colour. PNG: linear "
+    "radiance times 1 (a white Lambertian patch would be white), clipped to [0, 1], sRGB transfer "
+    "curve, no other tone mapping; EXR: linear sRGB radiance.";
+
+// The renders' scene description (in memory): the patch named "cloth" bound to 'material'.
+nlohmann::json verify_render_scene(const nlohmann::json& material, bool transmission,
+                                   const VerifySettings& settings);
+
+// Renders what the report holds: computed and classic fabric tables in both configurations, the
+// measured BRDF (report.measured_nbrdf) in reflection. The tables are written into 'folder' first
+// (fabric-computed.exr, fabric-classic.exr, RGB), where the renderer reads them as any scene's
+// fabric_table; the images are returned, not written.
+struct VerifyReport;
+std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& folder,
+                                                const VerifyReport& report);
 
 struct VerifyReport {
   VerifySettings settings;
@@ -269,13 +345,20 @@ struct VerifyReport {
   // "computed_raytrace_fitted" and "classic_fitted" (the fitted parameters at the run's quality).
   std::vector<ModelCurves> models;
   std::vector<ColourEntry> colours;
-  Rgb classic_reflectance;  // the classic model's diffuse colour (linear sRGB, clipped to [0,1])
-  GamutClip classic_clip;   // what making it a reflectance removed
+  Rgb classic_reflectance;     // the classic model's diffuse colour (linear sRGB, clipped to [0,1])
+  GamutClip classic_clip;      // what making it a reflectance removed
+  std::string classic_source;  // VerifyInputs::classic_source
   std::map<std::string, double> seconds;
   std::string fiber_name, sample_name;
   size_t fabric_table_gamut_clipped = 0;  // components of the computed table set to 0
   double raytrace_relative_noise = 0;     // of the combined computed table (fabric_raytrace.h)
   std::vector<FitResult> fits;            // with --fit: "computed", "classic"
+  // What the renders show: the ray-traced fabric tables of the computed and the classic fiber
+  // (the mean of the batches) and the measured BRDF's network, where the measurement has one
+  // (nbrdf_weights.txt beside the table; empty: none).
+  std::optional<TabulatedBsdfTable> computed_fabric, classic_fabric;
+  std::filesystem::path measured_nbrdf;
+  std::vector<VerifyRender> renders;  // made by write_verify_report
   bool cancelled = false;
 };
 
@@ -290,12 +373,13 @@ std::string verify_metrics_json(const VerifyReport& report);
 std::string verify_index_html(const VerifyReport& report,
                               const std::vector<std::pair<std::string, std::string>>& images);
 
-// Writes DIR whole or not at all: inplane.csv and metrics.json into a staging folder beside DIR,
-// then draw(staging) (the plots: PNG and SVG files it writes there), then index.html embedding the
-// PNGs, then the staging folder replaces DIR. DIR must not exist, be empty, or hold an earlier
-// report (its metrics.json has "report": "weft verify"); anything else is refused (weft::Error
-// naming DIR) and left alone.
-// The check write_verify_report makes first, for callers to make before the work.
+// Writes DIR whole or not at all: the renders (render_verify_samples: fabric-*.exr, render-*.exr
+// and .png), inplane.csv and metrics.json into a staging folder beside DIR, then draw(staging)
+// (the plots: inplane-*.png and .svg files it writes there), then index.html embedding the plots
+// and linking the renders by relative path, then the staging folder replaces DIR. DIR must not
+// exist, be empty, or hold an earlier report (its metrics.json has "report": "weft verify");
+// anything else is refused (weft::Error naming DIR) and left alone. The check write_verify_report
+// makes first, for callers to make before the work.
 void check_verify_output(const std::filesystem::path& dir);
 void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
                          const std::function<void(const std::filesystem::path& staging)>& draw);
