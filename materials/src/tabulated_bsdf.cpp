@@ -25,6 +25,15 @@ std::array<int, 9> neighbourhood(const DirectionGrid& grid, int bin) {
   return out;
 }
 
+// How many fine sampling cells each table cell is split into per side: enough that the fine grid
+// has 32 cells per hemisphere side (a 2048-cell distribution per wo bin), at least 1.
+int subdivision_for(int resolution) {
+  return std::max(1, 32 / resolution);
+}
+
+// The share of the sampling density that is flat over each table cell (the coverage term).
+constexpr double kSamplingCoverage = 0.2;
+
 }  // namespace
 
 std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
@@ -80,13 +89,59 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
   std::vector<double> cos_avg = grid.cosine_weighted_areas();
   for (double& c : cos_avg) c /= grid.bin_solid_angle();
 
+  // The fine grid: each table cell split k x k, so the density follows the interpolated f cos
+  // within a cell instead of being flat over it (a flat cell density against a peaked, bilinearly
+  // interpolated f gave a few samples large weights: speckle on indirect light).
+  const int k = subdivision_for(r), fr = k * r;
+  const DirectionGrid fine{fr};
+  const int fn = fine.bins();
+  std::vector<double> fine_cos = fine.cosine_weighted_areas();
+  for (double& c : fine_cos) c /= fine.bin_solid_angle();
+  std::vector<Vec3> fine_dir(fn);
+  std::vector<int> coarse_of(fn);
+  for (int s = 0; s < fn; ++s) {
+    fine_dir[s] = fine.bin_center(s);
+    const int x = s % fr, row = s / fr;
+    coarse_of[s] = (row / k) * r + x / k;
+  }
+  data->sampling_subdivision = k;
+
   data->sampling.resize(n);
   parallel_for(static_cast<uint64_t>(n), 0, [&](uint64_t task) {
     const int wo = static_cast<int>(task);
-    std::vector<double> w(n);
-    for (int wi = 0; wi < n; ++wi)
-      w[wi] = cos_avg[wi] * 0.5 * (static_cast<double>(mean[at(wi, wo)]) + blur[at(wi, wo)]);
-    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(r), static_cast<size_t>(2 * r));
+    // Coverage: per table cell, cos_avg * (m + m3) / 2, which is > 0 wherever the interpolated f
+    // can be for any wo in this bin.
+    std::vector<double> cell(n);
+    double cell_sum = 0;
+    for (int wi = 0; wi < n; ++wi) {
+      cell[wi] = cos_avg[wi] * 0.5 * (static_cast<double>(mean[at(wi, wo)]) + blur[at(wi, wo)]);
+      cell_sum += cell[wi];
+    }
+    // Shape: the interpolated channel mean times |cos| at the centre of each fine cell, averaged
+    // over wo at the 2 x 2 quarter points of its bin (eval interpolates over wo too).
+    std::array<Vec3, 4> wo_at;
+    for (int q = 0; q < 4; ++q)
+      wo_at[q] = DirectionGrid::to_direction(
+          grid.chart_point(wo, 0.25 + 0.5 * (q % 2), 0.25 + 0.5 * (q / 2)));
+    std::vector<double> shape(fn);
+    double shape_sum = 0;
+    for (int s = 0; s < fn; ++s) {
+      double v = 0;
+      for (const Vec3& o_dir : wo_at)
+        for_each_interpolated_cell(grid, o_dir, fine_dir[s],
+                                   [&](int i, int o, double w) { v += mean[at(i, o)] * w; });
+      shape[s] = std::max(0.0, v) * fine_cos[s];
+      shape_sum += shape[s];
+    }
+    std::vector<double> w(fn, 0.0);
+    if (cell_sum > 0) {
+      const double a = shape_sum > 0 ? kSamplingCoverage : 1.0;
+      for (int s = 0; s < fn; ++s) {
+        w[s] = a * cell[coarse_of[s]] / (cell_sum * k * k);
+        if (shape_sum > 0) w[s] += (1 - a) * shape[s] / shape_sum;
+      }
+    }
+    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(fr), static_cast<size_t>(2 * fr));
   });
   return data;
 }
@@ -104,9 +159,16 @@ double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
   const DirectionGrid& grid = data->grid;
   const Distribution2D& dist = data->sampling[grid.bin_of(wo)];
   if (dist.integral() == 0) return 0;
-  // The density is constant over wi's cell: evaluate it at the centre of the cell the grid
-  // assigns, so the cell is decided by DirectionGrid alone.
-  const Vec2 centre = grid.chart_point(grid.bin_of(wi), 0.5, 0.5);
+  // The density is constant over each fine cell: evaluate it at the centre of the fine cell that
+  // holds wi, taken within the table cell the grid assigns, so the table cell is decided by
+  // DirectionGrid alone.
+  const int bin = grid.bin_of(wi), r = grid.resolution, k = data->sampling_subdivision;
+  const Vec2 p = DirectionGrid::to_chart(wi);
+  const int cx = bin % r, crow = bin / r;
+  const int fx = std::clamp(static_cast<int>(std::floor(p.x * k * r)), cx * k, cx * k + k - 1);
+  const int frow =
+      std::clamp(static_cast<int>(std::floor(p.y * 2 * k * r)), crow * k, crow * k + k - 1);
+  const Vec2 centre{(fx + 0.5) / (k * r), (frow + 0.5) / (2.0 * k * r)};
   return dist.pdf(centre) * kInv4Pi;  // area on the chart = solid angle / (4 pi)
 }
 

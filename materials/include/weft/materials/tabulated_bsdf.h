@@ -7,14 +7,19 @@
 // at the horizon. This makes f continuous within each hemisphere instead of faceted, and never
 // blends reflection with transmission; the cell averages themselves are what the table stores.
 //
-// Sampling: for the bin b holding wo, a Distribution2D over the chart's R x 2R wi cells with
-// weights
-//   w(b, c) = cos_avg(c) * (m(b, c) + m3(b, c)) / 2,
-// where m is the channel mean of the table, m3 its mean over the 3 x 3 neighbourhoods of b and of
-// c within their hemispheres (what bilinear eval can reach), and cos_avg(c) the mean |cos theta|
-// over cell c. wi is uniform (in solid angle) within the chosen cell. pdf(wo, wi) =
-// p_chart(wi | bin(wo)) / (4 pi), using the same DirectionGrid for both directions as sample
-// does; the m3 term makes pdf > 0 wherever the interpolated f > 0.
+// Sampling: for the bin b holding wo, a Distribution2D over a fine chart grid, each table cell c
+// split into k x k fine cells s (k = sampling_subdivision: 32 fine cells per hemisphere side), a
+// mixture of two parts:
+//   shape (80%): g(b, s) = cos_avg(s) * mean over wo at the 2 x 2 quarter points of b of the
+//     interpolated channel mean of f at the centre of s: follows f cos within a cell, where a
+//     density flat over the cell against a peaked, interpolated f gives large weights;
+//   coverage (20%): w(b, c) = cos_avg(c) * (m(b, c) + m3(b, c)) / 2, spread evenly over c's fine
+//     cells, where m is the channel mean of the table and m3 its mean over the 3 x 3
+//     neighbourhoods of b and of c within their hemispheres (what bilinear eval can reach): it
+//     makes pdf > 0 wherever the interpolated f > 0, for any wo in b.
+// cos_avg is the mean |cos theta| over a cell. wi is uniform (in solid angle) within the chosen
+// fine cell. pdf(wo, wi) = p_chart(wi | bin(wo)) / (4 pi), the fine cell taken within the table
+// cell that DirectionGrid assigns wi, as sample does.
 #include <memory>
 #include <optional>
 #include <string>
@@ -31,7 +36,8 @@ struct TabulatedBsdfData {
   std::string kind;                             // "fiber" | "fabric"
   std::map<std::string, std::string> metadata;  // from the table
   std::vector<float> rgb;                       // [wi_bin][wo_bin][3]
-  std::vector<Distribution2D> sampling;         // one per wo bin, over wi cells
+  std::vector<Distribution2D> sampling;         // one per wo bin, over fine wi cells
+  int sampling_subdivision = 1;                 // fine cells per table cell, per side
   // Spectral tables: how many RGB components were negative (out of the sRGB gamut) after the
   // D65 band reduction and were set to 0. Always 0 for RGB tables.
   size_t clamped_components = 0;
