@@ -272,24 +272,29 @@ TabulatedBsdf::BackedLobes TabulatedBsdf::backed_lobes(const Vec3& wo) const {
   return l;
 }
 
+double TabulatedBsdf::pdf_backed(const BackedLobes& l, const Vec3& wo, const Vec3& wi) const {
+  if (l.p_table < 0 || !(wi.z > 0)) return 0;
+  double p = (1 - l.p_table) * wi.z * kInvPi;
+  if (l.p_table > 0) p += l.p_table * pdf_table(wo, wi) / l.upper_mass;
+  return p;
+}
+
 double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
   if (!data) return 0;
   if (!backing) return pdf_table(wo, wi);
   if (!(wo.z > 0) || !(wi.z > 0)) return 0;
-  const BackedLobes l = backed_lobes(wo);
-  if (l.p_table < 0) return 0;
-  double p = (1 - l.p_table) * wi.z * kInvPi;
-  if (l.p_table > 0) p += l.p_table * pdf_table(wo, wi) / l.upper_mass;
-  return p;
+  return pdf_backed(backed_lobes(wo), wo, wi);
 }
 
 std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double u_lobe) const {
   if (!data) return std::nullopt;
   const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
   Vec3 wi;
+  double p = 0;
   if (!backing) {
     if (dist.integral() == 0) return std::nullopt;
     wi = DirectionGrid::to_direction(dist.sample(u).p);
+    p = pdf_table(wo, wi);
   } else {
     if (!(wo.z > 0)) return std::nullopt;
     const BackedLobes l = backed_lobes(wo);
@@ -300,9 +305,8 @@ std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double u
     } else {
       wi = sample_cosine_hemisphere(u);
     }
-    if (!(wi.z > 0)) return std::nullopt;
+    p = pdf_backed(l, wo, wi);  // 0 below the cloth
   }
-  const double p = pdf(wo, wi);
   if (!(p > 0)) return std::nullopt;
   return BsdfSample{wi, eval(wo, wi) * (std::abs(wi.z) / p), p, false};
 }

@@ -123,6 +123,7 @@ struct TabulatedBsdf {
     double p_table = 0, upper_mass = 0;
   };
   BackedLobes backed_lobes(const Vec3& wo) const;
+  double pdf_backed(const BackedLobes& lobes, const Vec3& wo, const Vec3& wi) const;
 };
 
 }  // namespace weft
