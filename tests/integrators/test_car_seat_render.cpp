@@ -79,7 +79,8 @@ fs::path summed_transmitting_fabric_table(const fs::path& dir) {
   auto fiber = TabulatedBsdfTable::from_function(
       4, 3,
       [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        const bool lit = wo.z > 0 && wi.z > 0, through = wo.z * wi.z < 0;
+        // Like a baked fiber table, light leaves only through the point (w_o above it).
+        const bool lit = wo.z > 0 && wi.z > 0, through = wo.z > 0 && wi.z < 0;
         v[0] = (lit ? 0.25 : through ? 0.6 : 0.0) * kInvPi;
         v[1] = v[2] = (lit ? 0.04 : through ? 0.1 : 0.0) * kInvPi;
       },
