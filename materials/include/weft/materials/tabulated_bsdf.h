@@ -33,10 +33,12 @@
 // the cloth's underside is lit diffusely: the light returning from the backing is diffuse, which
 // is what r_under and tau(wo) assume. The one approximation: tau(wi) stands for the fraction of
 // light from wi that goes down, int_lower f_table(w', wi) |cos w'| dw', equal to it for a
-// reciprocal table; one function for both keeps the backed BSDF reciprocal. The backing is a
-// plane in contact with the cloth (light leaves where it entered). tau and the albedos are the
-// exact integrals of the interpolated table (hemisphere_weights), so a white furnace sees the
-// closed form.
+// reciprocal table; one function for both keeps the backed BSDF reciprocal. (The paper's summed
+// tables send nothing below the cloth, so that fraction would be 0: they are read here as the
+// reciprocal sheet their transmission seen from above describes; their r_under is 0.) The
+// backing is a plane in contact with the cloth (light leaves where it entered). tau and the
+// albedos are the exact integrals of the interpolated table (hemisphere_weights), so a white
+// furnace sees the closed form.
 // Sampling with a backing: the table's reflection part (its sampling distribution restricted to
 // wi above the cloth) or a cosine lobe for the backing term, chosen with probability in
 // proportion to each part's albedo for this wo.
