@@ -6,6 +6,7 @@
 #include <map>
 #include <vector>
 
+#include "weft/core/math.h"
 #include "weft/core/rng.h"
 #include "weft/core/sphere_mapping.h"
 #include "weft/materials/bsdfs.h"
