@@ -3,13 +3,16 @@
 # enlarged crops below (the paper's Fig. 10 layout): left to right
 #   1. measured: the MERL red fabric as a neural BRDF (measured_nbrdf merl-red-fabric),
 #   2. computed: the fabric table summed (the paper's formula) from the red-cotton fiber table,
+#      on a light-grey foam backing (backing_reflectance, WEFT_BACKING, default 0.6; "none" for
+#      the bare sheet, whose transmitted light is lost inside the seat: docs/car-seat.md),
 #   3. classic: Lambert + Cook-Torrance fibers, diffuse colour = the computed table's reflectance
 #      at normal incidence (same brightness, classic angular behaviour).
 # Outputs in ${WEFT_OUT:-out/seat}/: seat.glb, the three renders (.exr linear, .png preview),
 # the crops (crop-*.exr/png), side-by-side.exr and side-by-side.png (top row: whole seat; bottom
 # row: the crop of the cushion's front edge, piping and bolster, 4x, nearest),
 # timings.json. The fiber and fabric tables are cached in that folder (delete them to re-bake).
-# WEFT_SPP overrides the scene's samples per pixel, WEFT_THREADS the thread count (0 = all).
+# WEFT_SPP overrides the scene's samples per pixel, WEFT_THREADS the thread count (0 = all),
+# WEFT_BACKING the computed fabric's backing reflectance.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 weft=$(pwd)/${WEFT_BUILD_DIR:-build}/tools/weft
@@ -34,15 +37,17 @@ if [ ! -f "$out/red-cotton-fabric.exr" ] || [ ! -f "$out/fabric.json" ]; then
 fi
 
 echo "== 3. three descriptions"
-/usr/bin/python3 - "$scene_dir" "$out" <<'PY'
+/usr/bin/python3 - "$scene_dir" "$out" "${WEFT_BACKING:-0.6}" <<'PY'
 import json, sys
-scene_dir, out = sys.argv[1], sys.argv[2]
+scene_dir, out, backing = sys.argv[1], sys.argv[2], sys.argv[3]
 base = json.load(open(f"{scene_dir}/car-seat.json"))
 base["gltf"] = f"{out}/seat.glb"
 rho = [min(1.0, max(0.0, v)) for v in json.load(open(f"{out}/fabric.json"))["reflectance_normal_incidence"]]
 variants = {
     "measured": None,  # the bundled binding
-    "computed": {"type": "fabric_table", "params": {"file": f"{out}/red-cotton-fabric.exr"}},
+    # Upholstery cloth lies on foam: the light the table transmits comes back through it.
+    "computed": {"type": "fabric_table", "params": {"file": f"{out}/red-cotton-fabric.exr",
+                 **({} if backing == "none" else {"backing_reflectance": float(backing)})}},
     "classic": {"type": "classic_fiber", "params": {"reflectance": rho, "distribution": "beckmann",
                                                     "alpha": 0.35, "ior": 1.557}},
 }
@@ -53,6 +58,7 @@ for name, mat in variants.items():
             scene["materials"][key] = mat
     json.dump(scene, open(f"{out}/seat-{name}.json", "w"), indent=2)
 print(f"classic diffuse colour = computed table's reflectance at normal incidence: {rho}")
+print(f"computed fabric's backing reflectance: {backing}")
 PY
 
 echo "== 4. render"

@@ -117,23 +117,34 @@ int run(const BakeFabricOptions& o) {
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
   table.write_exr(o.output);
   const DirectionGrid g = table.grid();
+  // Light arriving along the normal, where it goes; and what a view along the normal gathers
+  // under uniform light (the renderer's reading). They differ for a non-reciprocal table: the
+  // paper's sum transmits nothing downwards but light from below upwards (fabric_summation.h).
   const auto normal = table.directional_albedo(g.bin_of({0, 0, 1}));
+  const auto view = table.directional_albedo_seen_from(g.bin_of({0, 0, 1}));
   nlohmann::json j = {{"output", o.output},
                       {"method", o.method},
                       {"resolution", o.resolution},
                       {"seconds", seconds},
                       {"sample", table.metadata["sample"]},
                       {"reflectance_normal_incidence", normal.reflectance},
-                      {"transmittance_normal_incidence", normal.transmittance}};
+                      {"transmittance_normal_incidence", normal.transmittance},
+                      {"reflectance_normal_view", view.reflectance},
+                      {"transmittance_normal_view", view.transmittance}};
   if (extra.is_object()) j.update(extra);
   if (o.json) {
     std::cout << j.dump(2) << "\n";
   } else {
+    auto mean = [](const std::vector<double>& v) {
+      double s = 0;
+      for (double x : v) s += x;
+      return s / static_cast<double>(v.size());
+    };
     std::printf(
-        "%s: %s, R = %d, %.2f s; at normal incidence R = %.4f, T = %.4f (mean of channels)\n",
-        o.output.c_str(), o.method.c_str(), o.resolution, seconds,
-        (normal.reflectance.front() + normal.reflectance.back()) / 2,
-        (normal.transmittance.front() + normal.transmittance.back()) / 2);
+        "%s: %s, R = %d, %.2f s; light along the normal: reflected %.4f, transmitted %.4f; seen "
+        "along the normal: reflected %.4f, transmitted %.4f (means over channels)\n",
+        o.output.c_str(), o.method.c_str(), o.resolution, seconds, mean(normal.reflectance),
+        mean(normal.transmittance), mean(view.reflectance), mean(view.transmittance));
   }
   return 0;
 }

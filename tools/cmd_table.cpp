@@ -26,6 +26,9 @@ int run_info(const InfoOptions& o) {
   const DirectionGrid g = t.grid();
   // Light arriving along the normal (w_i = n), summed over all exits.
   const auto normal = t.directional_albedo(g.bin_of({0, 0, 1}));
+  // Seen along the normal under uniform light (the renderer's reading; differs from the above
+  // for a non-reciprocal table, e.g. the paper's summed fabric tables).
+  const auto view = t.directional_albedo_seen_from(g.bin_of({0, 0, 1}));
   std::vector<double> albedo(t.channels);
   for (int c = 0; c < t.channels; ++c) albedo[c] = normal.total(c);
   const nlohmann::json j = {{"file", o.file},
@@ -40,7 +43,9 @@ int run_info(const InfoOptions& o) {
                             {"max_per_sr", hi},
                             {"albedo_normal_incidence", albedo},
                             {"reflectance_normal_incidence", normal.reflectance},
-                            {"transmittance_normal_incidence", normal.transmittance}};
+                            {"transmittance_normal_incidence", normal.transmittance},
+                            {"reflectance_normal_view", view.reflectance},
+                            {"transmittance_normal_view", view.transmittance}};
   if (o.json) {
     std::cout << j.dump(2) << "\n";
   } else {

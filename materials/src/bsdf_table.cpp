@@ -220,4 +220,20 @@ TabulatedBsdfTable::DirectionalAlbedo TabulatedBsdfTable::directional_albedo(int
   return out;
 }
 
+TabulatedBsdfTable::DirectionalAlbedo TabulatedBsdfTable::directional_albedo_seen_from(
+    int wo_bin) const {
+  const DirectionGrid g = grid();
+  if (wo_bin < 0 || wo_bin >= g.bins())
+    throw Error(
+        "", "wo_bin",
+        "must lie in [0, " + std::to_string(g.bins() - 1) + "], got " + std::to_string(wo_bin));
+  const auto d = g.cosine_weighted_areas();
+  DirectionalAlbedo out{std::vector<double>(channels, 0.0), std::vector<double>(channels, 0.0)};
+  for (int wi = 0; wi < g.bins(); ++wi) {
+    auto& side = g.upper(wi) == g.upper(wo_bin) ? out.reflectance : out.transmittance;
+    for (int c = 0; c < channels; ++c) side[c] += at(wi, wo_bin, c) * d[static_cast<size_t>(wi)];
+  }
+  return out;
+}
+
 }  // namespace weft

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <functional>
 #include <map>
+#include <optional>
 
 #include "weft/core/error.h"
 #include "weft/materials/table_cache.h"
@@ -65,6 +66,17 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
   }
   const Rgb tint = p.rgb("tint", Rgb(1.0), 0.0, 1.0);
   const double scale = p.number("scale", 1.0, 0.0, 10.0);
+  // An opaque Lambertian backing under the cloth (upholstery foam), fabric tables only.
+  std::optional<Rgb> backing;
+  if (kind == "fabric" && p.has("backing_reflectance")) {
+    backing = p.rgb("backing_reflectance", 0.0, 1.0);
+    if (!(backing->max_component() < 1))
+      throw Error(p.file(), p.field("backing_reflectance"),
+                  "must be below 1 in every component (a backing that reflects everything "
+                  "would trap light between it and the cloth without loss)");
+  }
+  if (kind == "fiber")
+    p.reject_unused("backing_reflectance", "applies only to fabric_table (a cloth on a backing)");
   p.finish();
   std::shared_ptr<const TabulatedBsdfData> data;
   try {
@@ -75,7 +87,15 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
   if (data->kind != kind)
     throw Error(p.file(), p.field(key),
                 file.string() + " holds a " + data->kind + " table, expected a " + kind + " table");
-  return TabulatedBsdf{data, tint * scale};
+  TabulatedBsdf bsdf{data, tint * scale};
+  if (backing) {
+    try {
+      bsdf.backing = TableBacking::make(*data, bsdf.scale, *backing);
+    } catch (const Error& e) {
+      throw Error(p.file(), p.field("backing_reflectance"), e.what());
+    }
+  }
+  return bsdf;
 }
 
 Bsdf make_measured(ParamReader& p, const MaterialContext& ctx) {

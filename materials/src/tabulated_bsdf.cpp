@@ -7,6 +7,7 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
+#include "weft/core/params.h"
 #include "weft/core/spectrum.h"
 
 namespace weft {
@@ -25,7 +26,71 @@ std::array<int, 9> neighbourhood(const DirectionGrid& grid, int bin) {
   return out;
 }
 
+// How many fine sampling cells each table cell is split into per side: enough that the fine grid
+// has 32 cells per hemisphere side (a 2048-cell distribution per wo bin), at least 1.
+int subdivision_for(int resolution) {
+  return std::max(1, 32 / resolution);
+}
+
+// The share of the sampling density that is flat over each table cell (the coverage term).
+constexpr double kSamplingCoverage = 0.2;
+
 }  // namespace
+
+std::vector<double> hemisphere_weights(const DirectionGrid& grid) {
+  constexpr int kPoints = 8;  // per side of each table cell
+  const int n = grid.bins();
+  const std::vector<double> d = grid.cosine_weighted_areas();
+  std::vector<double> w(static_cast<size_t>(n), 0.0);
+  for (int k = 0; k < n; ++k) {
+    // Equal-area points: each stands for the same solid angle, so |cos| weights them.
+    std::array<double, 16> hat{};  // per footprint bin of the cell's points (at most 9 bins)
+    std::array<int, 16> bin{};
+    int used = 0;
+    double cos_sum = 0;
+    for (int py = 0; py < kPoints; ++py)
+      for (int px = 0; px < kPoints; ++px) {
+        const Vec2 c = grid.chart_point(k, (px + 0.5) / kPoints, (py + 0.5) / kPoints);
+        const double cz = std::abs(DirectionGrid::to_direction(c).z);
+        cos_sum += cz;
+        const auto fp = grid.bilinear(c);
+        for (int a = 0; a < 4; ++a) {
+          int j = 0;
+          while (j < used && bin[j] != fp.bin[a]) ++j;
+          if (j == used) bin[used++] = fp.bin[a];
+          hat[j] += fp.weight[a] * cz;
+        }
+      }
+    if (cos_sum > 0)
+      for (int j = 0; j < used; ++j) w[bin[j]] += d[k] * hat[j] / cos_sum;
+  }
+  return w;
+}
+
+Rgb TabulatedBsdfData::interpolate(const std::vector<Rgb>& per_bin, const Vec3& w) const {
+  const auto fp = grid.bilinear(DirectionGrid::to_chart(w));
+  Rgb sum;
+  for (int a = 0; a < 4; ++a) sum += per_bin[fp.bin[a]] * fp.weight[a];
+  return sum;
+}
+
+TableBacking TableBacking::make(const TabulatedBsdfData& data, const Rgb& scale, const Rgb& rho_b) {
+  const Rgb r_under = data.underside_diffuse_albedo * scale;
+  // 1 - rho_b r_under per channel: the series of bounces between backing and cloth converges.
+  auto one_minus = [](double x) { return 1 - x; };
+  const Rgb rr = rho_b * r_under;
+  const Rgb denominator{one_minus(rr.r), one_minus(rr.g), one_minus(rr.b)};
+  if (!(denominator.r > 0 && denominator.g > 0 && denominator.b > 0))
+    throw Error("the backing (reflectance " + ParamReader::fmt(rho_b.max_component()) +
+                ") and the cloth's underside (diffuse albedo " +
+                ParamReader::fmt(r_under.max_component()) +
+                " with this tint and scale) would reflect all the light between them");
+  TableBacking b;
+  b.reflectance = rho_b;
+  b.gain = Rgb(rho_b.r / denominator.r, rho_b.g / denominator.g, rho_b.b / denominator.b) * kInvPi;
+  b.diffuse_transmittance = data.diffuse_transmittance * scale;
+  return b;
+}
 
 std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
     const TabulatedBsdfTable& table) {
@@ -80,42 +145,168 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
   std::vector<double> cos_avg = grid.cosine_weighted_areas();
   for (double& c : cos_avg) c /= grid.bin_solid_angle();
 
+  // The fine grid: each table cell split k x k, so the density follows the interpolated f cos
+  // within a cell instead of being flat over it (a flat cell density against a peaked, bilinearly
+  // interpolated f gave a few samples large weights: speckle on indirect light).
+  const int k = subdivision_for(r), fr = k * r;
+  const DirectionGrid fine{fr};
+  const int fn = fine.bins();
+  std::vector<double> fine_cos = fine.cosine_weighted_areas();
+  for (double& c : fine_cos) c /= fine.bin_solid_angle();
+  std::vector<Vec3> fine_dir(fn);
+  std::vector<int> coarse_of(fn);
+  for (int s = 0; s < fn; ++s) {
+    fine_dir[s] = fine.bin_center(s);
+    const int x = s % fr, row = s / fr;
+    coarse_of[s] = (row / k) * r + x / k;
+  }
+  data->sampling_subdivision = k;
+
+  // The directional albedos of the interpolated table per wo bin, and its diffuse ones.
+  {
+    const std::vector<double> hw = hemisphere_weights(grid);
+    data->same_side.assign(n, Rgb(0.0));
+    data->other_side.assign(n, Rgb(0.0));
+    for (int wo = 0; wo < n; ++wo)
+      for (int wi = 0; wi < n; ++wi) {
+        const Rgb f = data->lookup(wi, wo) * hw[wi];
+        (grid.upper(wi) == grid.upper(wo) ? data->same_side : data->other_side)[wo] += f;
+      }
+    for (int wo = 0; wo < n; ++wo) {
+      if (grid.upper(wo))
+        data->diffuse_transmittance += data->other_side[wo] * (hw[wo] * kInvPi);
+      else
+        data->underside_diffuse_albedo += data->same_side[wo] * (hw[wo] * kInvPi);
+    }
+  }
+
   data->sampling.resize(n);
   parallel_for(static_cast<uint64_t>(n), 0, [&](uint64_t task) {
     const int wo = static_cast<int>(task);
-    std::vector<double> w(n);
-    for (int wi = 0; wi < n; ++wi)
-      w[wi] = cos_avg[wi] * 0.5 * (static_cast<double>(mean[at(wi, wo)]) + blur[at(wi, wo)]);
-    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(r), static_cast<size_t>(2 * r));
+    // Coverage: per table cell, cos_avg * (m + m3) / 2, which is > 0 wherever the interpolated f
+    // can be for any wo in this bin.
+    std::vector<double> cell(n);
+    double cell_sum = 0;
+    for (int wi = 0; wi < n; ++wi) {
+      cell[wi] = cos_avg[wi] * 0.5 * (static_cast<double>(mean[at(wi, wo)]) + blur[at(wi, wo)]);
+      cell_sum += cell[wi];
+    }
+    // Shape: the interpolated channel mean times |cos| at the centre of each fine cell, averaged
+    // over wo at the 2 x 2 quarter points of its bin (eval interpolates over wo too).
+    std::array<Vec3, 4> wo_at;
+    for (int q = 0; q < 4; ++q)
+      wo_at[q] = DirectionGrid::to_direction(
+          grid.chart_point(wo, 0.25 + 0.5 * (q % 2), 0.25 + 0.5 * (q / 2)));
+    std::vector<double> shape(fn);
+    double shape_sum = 0;
+    for (int s = 0; s < fn; ++s) {
+      double v = 0;
+      for (const Vec3& o_dir : wo_at)
+        for_each_interpolated_cell(grid, o_dir, fine_dir[s],
+                                   [&](int i, int o, double w) { v += mean[at(i, o)] * w; });
+      shape[s] = std::max(0.0, v) * fine_cos[s];
+      shape_sum += shape[s];
+    }
+    std::vector<double> w(fn, 0.0);
+    if (cell_sum > 0) {
+      const double a = shape_sum > 0 ? kSamplingCoverage : 1.0;
+      for (int s = 0; s < fn; ++s) {
+        w[s] = a * cell[coarse_of[s]] / (cell_sum * k * k);
+        if (shape_sum > 0) w[s] += (1 - a) * shape[s] / shape_sum;
+      }
+    }
+    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(fr), static_cast<size_t>(2 * fr));
   });
   return data;
 }
 
-Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
-  if (!data) return Rgb(0.0);  // a default-constructed value is black, never a crash
+Rgb TabulatedBsdf::eval_table(const Vec3& wo, const Vec3& wi) const {
   Rgb sum;
   for_each_interpolated_cell(data->grid, wo, wi,
                              [&](int i, int o, double w) { sum += data->lookup(i, o) * w; });
   return sum * scale;
 }
 
-double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
-  if (!data) return 0;
+Rgb TabulatedBsdf::eval_backing(const Vec3& wo, const Vec3& wi) const {
+  if (!data || !backing || !(wo.z > 0) || !(wi.z > 0)) return Rgb(0.0);
+  return backing->gain * scale * scale * data->interpolate(data->other_side, wo) *
+         data->interpolate(data->other_side, wi);
+}
+
+Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
+  if (!data) return Rgb(0.0);  // a default-constructed value is black, never a crash
+  if (!backing) return eval_table(wo, wi);
+  // Backed: opaque, and black from below (the side below is the foam).
+  if (!(wo.z > 0) || !(wi.z > 0)) return Rgb(0.0);
+  return eval_table(wo, wi) + eval_backing(wo, wi);
+}
+
+double TabulatedBsdf::pdf_table(const Vec3& wo, const Vec3& wi) const {
   const DirectionGrid& grid = data->grid;
   const Distribution2D& dist = data->sampling[grid.bin_of(wo)];
   if (dist.integral() == 0) return 0;
-  // The density is constant over wi's cell: evaluate it at the centre of the cell the grid
-  // assigns, so the cell is decided by DirectionGrid alone.
-  const Vec2 centre = grid.chart_point(grid.bin_of(wi), 0.5, 0.5);
+  // The density is constant over each fine cell: evaluate it at the centre of the fine cell that
+  // holds wi, taken within the table cell the grid assigns, so the table cell is decided by
+  // DirectionGrid alone.
+  const int bin = grid.bin_of(wi), r = grid.resolution, k = data->sampling_subdivision;
+  const Vec2 p = DirectionGrid::to_chart(wi);
+  const int cx = bin % r, crow = bin / r;
+  const int fx = std::clamp(static_cast<int>(std::floor(p.x * k * r)), cx * k, cx * k + k - 1);
+  const int frow =
+      std::clamp(static_cast<int>(std::floor(p.y * 2 * k * r)), crow * k, crow * k + k - 1);
+  const Vec2 centre{(fx + 0.5) / (k * r), (frow + 0.5) / (2.0 * k * r)};
   return dist.pdf(centre) * kInv4Pi;  // area on the chart = solid angle / (4 pi)
 }
 
-std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double) const {
+TabulatedBsdf::BackedLobes TabulatedBsdf::backed_lobes(const Vec3& wo) const {
+  BackedLobes l;
+  const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
+  // The upper hemisphere is the first half of the chart's rows.
+  if (dist.integral() > 0) l.upper_mass = dist.marginal().cdf(dist.nv() / 2);
+  const double table =
+      l.upper_mass > 0 ? (data->interpolate(data->same_side, wo) * scale).average() : 0.0;
+  const double back = (backing->gain * scale * data->interpolate(data->other_side, wo) * kPi *
+                       backing->diffuse_transmittance)
+                          .average();
+  l.p_table = table + back > 0 ? table / (table + back) : -1;  // -1: nothing to sample
+  return l;
+}
+
+double TabulatedBsdf::pdf_backed(const BackedLobes& l, const Vec3& wo, const Vec3& wi) const {
+  if (l.p_table < 0 || !(wi.z > 0)) return 0;
+  double p = (1 - l.p_table) * wi.z * kInvPi;
+  if (l.p_table > 0) p += l.p_table * pdf_table(wo, wi) / l.upper_mass;
+  return p;
+}
+
+double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
+  if (!data) return 0;
+  if (!backing) return pdf_table(wo, wi);
+  if (!(wo.z > 0) || !(wi.z > 0)) return 0;
+  return pdf_backed(backed_lobes(wo), wo, wi);
+}
+
+std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double u_lobe) const {
   if (!data) return std::nullopt;
   const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
-  if (dist.integral() == 0) return std::nullopt;
-  const Vec3 wi = DirectionGrid::to_direction(dist.sample(u).p);
-  const double p = pdf(wo, wi);
+  Vec3 wi;
+  double p = 0;
+  if (!backing) {
+    if (dist.integral() == 0) return std::nullopt;
+    wi = DirectionGrid::to_direction(dist.sample(u).p);
+    p = pdf_table(wo, wi);
+  } else {
+    if (!(wo.z > 0)) return std::nullopt;
+    const BackedLobes l = backed_lobes(wo);
+    if (l.p_table < 0) return std::nullopt;
+    if (u_lobe < l.p_table) {
+      // The reflection part: the table's distribution restricted to its upper rows.
+      wi = DirectionGrid::to_direction(dist.sample({u.x, u.y * l.upper_mass}).p);
+    } else {
+      wi = sample_cosine_hemisphere(u);
+    }
+    p = pdf_backed(l, wo, wi);  // 0 below the cloth
+  }
   if (!(p > 0)) return std::nullopt;
   return BsdfSample{wi, eval(wo, wi) * (std::abs(wi.z) / p), p, false};
 }

@@ -67,7 +67,8 @@ const double kMeasuredAngles[] = {20, 70, 45};
 
 constexpr int kChi2Tests = 1 /* self-test acceptance */ + std::size(kLambertAngles) +
                            std::size(kCookTorranceCases) + std::size(kClassicFiberCases) +
-                           2 * std::size(kTableWo) + std::size(kMeasuredAngles);
+                           2 * std::size(kTableWo) + 2 /* backed table, wo above */ +
+                           std::size(kMeasuredAngles);
 const double kSignificance = sidak_significance(0.01, kChi2Tests);
 
 void expect_chi2(const Bsdf& bsdf, const Vec3& wo, uint64_t seed, const std::string& what) {
@@ -90,7 +91,7 @@ TabulatedBsdf fiber_like_table() {
       4, 7);
   return TabulatedBsdf{TabulatedBsdfData::prepare(table), Rgb(1.0)};
 }
-TabulatedBsdf fabric_like_table() {
+TabulatedBsdf fabric_like_table(std::optional<Rgb> backing = std::nullopt) {
   auto table = TabulatedBsdfTable::from_function(
       8, 3,
       [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
@@ -102,7 +103,9 @@ TabulatedBsdf fabric_like_table() {
       },
       4, 11);
   table.kind = "fabric";
-  return TabulatedBsdf{TabulatedBsdfData::prepare(table), Rgb(1.0)};
+  TabulatedBsdf b{TabulatedBsdfData::prepare(table), Rgb(1.0)};
+  if (backing) b.backing = TableBacking::make(*b.data, b.scale, *backing);
+  return b;
 }
 
 }  // namespace
@@ -171,6 +174,15 @@ TEST(Chi2, FiberAndFabricTables) {
           chi2_test(bsdf_sampler(b, wo), bsdf_pdf(b, wo), grid, kSamples, kSignificance, seed++);
       EXPECT_TRUE(r.passed) << "table, wo " << wo << ": " << r.message;
     }
+  }
+  // On a backing: the table's reflection part or a cosine lobe, by albedo (wo above only; from
+  // below a backed cloth is black and samples nothing).
+  const Bsdf backed = fabric_like_table(Rgb(0.6));
+  for (const Vec3& wo : {kTableWo[0], kTableWo[1]}) {
+    EXPECT_FALSE(backed.sample(kTableWo[2], {0.3, 0.6}, 0.5));
+    const auto r = chi2_test(bsdf_sampler(backed, wo), bsdf_pdf(backed, wo), grid, kSamples,
+                             kSignificance, seed++);
+    EXPECT_TRUE(r.passed) << "backed table, wo " << wo << ": " << r.message;
   }
 }
 

@@ -193,6 +193,42 @@ TEST(Cli, TableInfoReportsTheAlbedoForLightFromTheNormal) {
   // Reflected, not transmitted: at R = 8 the exit bins straddling the horizon can shift at most
   // 0.5 / pi times their projected solid angle on one side (0.245 sr) between the two: 0.039.
   EXPECT_GT(normal.reflectance[0], 10 * normal.transmittance[0]);
+  // Seen along the normal (the renderer's reading): the same for this reciprocal table.
+  const auto view = t.directional_albedo_seen_from(t.grid().bin_of({0, 0, 1}));
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_EQ(j["reflectance_normal_view"][c].get<double>(), view.reflectance[c]);
+    EXPECT_EQ(j["transmittance_normal_view"][c].get<double>(), view.transmittance[c]);
+  }
+}
+
+TEST(Cli, BakeFabricSummationReportsTheTransmittanceSeenFromAbove) {
+  // A fiber table like the baked ones: light leaves only through B (f = 0 for w_o below B's
+  // horizon); it reflects 0.25 and passes 0.6 of the light from behind B (analytic, constant per
+  // side, so the cell averages are exact). The paper's sum puts the fiber on top of the cloth:
+  // light from above is never transmitted (transmittance_normal_incidence is 0, which it
+  // reported alone before), while a view from above sees 0.6 of uniform light from below.
+  const fs::path dir = fresh_test_dir();
+  auto fiber = weft::TabulatedBsdfTable::from_function(
+      4, 3,
+      [](const weft::Vec3& wo, const weft::Vec3& wi, std::span<double> v) {
+        const double f = wo.z > 0 ? (wi.z > 0 ? 0.25 : 0.6) / 3.141592653589793 : 0.0;
+        v[0] = v[1] = v[2] = f;
+      },
+      2, 1);
+  fiber.kind = "fiber";
+  fiber.write_exr(dir / "fiber.exr");
+  const CliRun r =
+      run("bake fabric --method summation -R 4 --samples 2 --quiet --json --fiber '" +
+              (dir / "fiber.exr").string() + "' -o '" + (dir / "fabric.exr").string() + "'",
+          dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(j["reflectance_normal_incidence"][c].get<double>(), 0.25, 1e-6);
+    EXPECT_EQ(j["transmittance_normal_incidence"][c].get<double>(), 0.0);
+    EXPECT_NEAR(j["reflectance_normal_view"][c].get<double>(), 0.25, 1e-6);
+    EXPECT_NEAR(j["transmittance_normal_view"][c].get<double>(), 0.6, 1e-6);
+  }
 }
 
 TEST(Cli, MieRangeErrorsNameTheField) {

@@ -52,6 +52,28 @@ FabricSummationOptions visible(int resolution, int samples_per_cell, int circumf
 
 }  // namespace
 
+TEST(FabricSummation, PaperSumTransmitsLightFromBelowOnlyAndTheViewReadingShowsIt) {
+  // uniform_fiber sends 1/2 of the light from either side of a point out through it. On top of
+  // the cloth, the paper's sum then passes light from below to views above (f = 1 / (2 pi),
+  // transmittance 1/2 seen from above), and nothing below the cloth (light from above is never
+  // transmitted, the underside is black): not reciprocal. directional_albedo reads light from a
+  // direction, directional_albedo_seen_from what a view gathers; `weft bake fabric` reported the
+  // first alone (transmittance 0 at normal incidence).
+  FabricSummationOptions o;
+  o.resolution = 4;
+  o.samples_per_cell = 2;
+  const auto t = sum_fabric_table(uniform_fiber(4), o);
+  const DirectionGrid g = t.grid();
+  for (int k = 0; k < g.bins(); ++k) {
+    const auto from = t.directional_albedo(k), seen = t.directional_albedo_seen_from(k);
+    const bool up = g.upper(k);
+    EXPECT_NEAR(from.reflectance[0], up ? 0.5 : 0.0, 1e-6) << k;
+    EXPECT_NEAR(from.transmittance[0], up ? 0.0 : 0.5, 1e-6) << k;
+    EXPECT_NEAR(seen.reflectance[0], up ? 0.5 : 0.0, 1e-6) << k;
+    EXPECT_NEAR(seen.transmittance[0], up ? 0.5 : 0.0, 1e-6) << k;
+  }
+}
+
 TEST(FabricSummation, PaperSumOfALambertianFiberIsALambertianFabric) {
   // The paper's formula looks at each fiber on its top, where its frame is the cloth's (up to a
   // turn about the normal): a Lambertian fiber gives a Lambertian fabric, reflecting rho / pi and

@@ -26,9 +26,10 @@ class Distribution1D {
   };
   Sample sample_continuous(double u) const;
   size_t sample_discrete(double u, double* pmf = nullptr) const;
-  double pdf(double x) const;     // density at x in [0,1)
-  double pmf(size_t bin) const;   // probability of a bin
-  size_t bin_of(double x) const;  // the bin holding x (clamped to the range)
+  double pdf(double x) const;                     // density at x in [0,1)
+  double pmf(size_t bin) const;                   // probability of a bin
+  double cdf(size_t i) const { return cdf_[i]; }  // probability of bins [0, i), i <= size()
+  size_t bin_of(double x) const;                  // the bin holding x (clamped to the range)
 
  private:
   std::vector<double> func_, cdf_;
@@ -50,6 +51,10 @@ class Distribution2D {
   double integral() const { return marginal_.integral(); }
   size_t nu() const { return nu_; }
   size_t nv() const { return nv_; }
+  // The distribution of rows (v): marginal().cdf(k) is the probability of the rows below k, and
+  // sample({u.x, u.y * marginal().cdf(k)}) samples the density restricted to them (it never
+  // returns a row of zero probability).
+  const Distribution1D& marginal() const { return marginal_; }
 
  private:
   size_t nu_ = 0, nv_ = 0;

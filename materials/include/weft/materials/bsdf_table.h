@@ -148,6 +148,14 @@ struct TabulatedBsdfTable {
     double total(int channel) const { return reflectance[channel] + transmittance[channel]; }
   };
   DirectionalAlbedo directional_albedo(int wi_bin) const;
+  // The same seen from one wo bin, as a renderer gathers it: int f(w_o, w_i) |cos theta_i| d w_i
+  // over all arrivals (sum_i f[i][o] D_i), the radiance towards w_o under uniform unit radiance;
+  // reflectance counts light arriving on w_o's side, transmittance light from the other side.
+  // Equal to directional_albedo for a reciprocal table. The paper's summed fabric tables are
+  // not: their fiber sits on top of the cloth, so nothing leaves below it (light from above is
+  // never transmitted, directional_albedo's transmittance is 0), while light from below passes
+  // through the fiber to a view from above (this one's transmittance is 0.6-0.8 for red cotton).
+  DirectionalAlbedo directional_albedo_seen_from(int wo_bin) const;
 };
 
 }  // namespace weft

@@ -7,14 +7,41 @@
 // at the horizon. This makes f continuous within each hemisphere instead of faceted, and never
 // blends reflection with transmission; the cell averages themselves are what the table stores.
 //
-// Sampling: for the bin b holding wo, a Distribution2D over the chart's R x 2R wi cells with
-// weights
-//   w(b, c) = cos_avg(c) * (m(b, c) + m3(b, c)) / 2,
-// where m is the channel mean of the table, m3 its mean over the 3 x 3 neighbourhoods of b and of
-// c within their hemispheres (what bilinear eval can reach), and cos_avg(c) the mean |cos theta|
-// over cell c. wi is uniform (in solid angle) within the chosen cell. pdf(wo, wi) =
-// p_chart(wi | bin(wo)) / (4 pi), using the same DirectionGrid for both directions as sample
-// does; the m3 term makes pdf > 0 wherever the interpolated f > 0.
+// Sampling: for the bin b holding wo, a Distribution2D over a fine chart grid, each table cell c
+// split into k x k fine cells s (k = sampling_subdivision: 32 fine cells per hemisphere side), a
+// mixture of two parts:
+//   shape (80%): g(b, s) = cos_avg(s) * mean over wo at the 2 x 2 quarter points of b of the
+//     interpolated channel mean of f at the centre of s: follows f cos within a cell, where a
+//     density flat over the cell against a peaked, interpolated f gives large weights;
+//   coverage (20%): w(b, c) = cos_avg(c) * (m(b, c) + m3(b, c)) / 2, spread evenly over c's fine
+//     cells, where m is the channel mean of the table and m3 its mean over the 3 x 3
+//     neighbourhoods of b and of c within their hemispheres (what bilinear eval can reach): it
+//     makes pdf > 0 wherever the interpolated f > 0, for any wo in b.
+// cos_avg is the mean |cos theta| over a cell. wi is uniform (in solid angle) within the chosen
+// fine cell. pdf(wo, wi) = p_chart(wi | bin(wo)) / (4 pi), the fine cell taken within the table
+// cell that DirectionGrid assigns wi, as sample does.
+//
+// Backing (fabric_table's backing_reflectance; docs/scenes.md): the cloth lies on an opaque
+// Lambertian backing of albedo rho_b (upholstery foam). Light the cloth transmits downwards
+// reaches the backing, bounces between it and the cloth's underside and leaves through the cloth
+// (adding-doubling of a diffuse layer under a sheet):
+//   f(wo, wi) = f_table(wo, wi) + rho_b / (1 - rho_b r_under) tau(wo) tau(wi) / pi
+// for wo, wi above the cloth, 0 otherwise (a backed cloth is opaque, and black from below: the
+// side below is the foam). tau(w) = int_lower f_table(w, w') |cos w'| dw' is the table's
+// directional transmittance and r_under = (1/pi) int_lower int_lower f_table |cos| |cos| the
+// underside's albedo under diffuse light. The backing re-emits diffusely whatever reaches it, so
+// the cloth's underside is lit diffusely: the light returning from the backing is diffuse, which
+// is what r_under and tau(wo) assume. The one approximation: tau(wi) stands for the fraction of
+// light from wi that goes down, int_lower f_table(w', wi) |cos w'| dw', equal to it for a
+// reciprocal table; one function for both keeps the backed BSDF reciprocal. (The paper's summed
+// tables send nothing below the cloth, so that fraction would be 0: they are read here as the
+// reciprocal sheet their transmission seen from above describes; their r_under is 0.) The
+// backing is a plane in contact with the cloth (light leaves where it entered). tau and the
+// albedos are the exact integrals of the interpolated table (hemisphere_weights), so a white
+// furnace sees the closed form.
+// Sampling with a backing: the table's reflection part (its sampling distribution restricted to
+// wi above the cloth) or a cosine lobe for the backing term, chosen with probability in
+// proportion to each part's albedo for this wo.
 #include <memory>
 #include <optional>
 #include <string>
@@ -31,13 +58,25 @@ struct TabulatedBsdfData {
   std::string kind;                             // "fiber" | "fabric"
   std::map<std::string, std::string> metadata;  // from the table
   std::vector<float> rgb;                       // [wi_bin][wo_bin][3]
-  std::vector<Distribution2D> sampling;         // one per wo bin, over wi cells
+  std::vector<Distribution2D> sampling;         // one per wo bin, over fine wi cells
+  int sampling_subdivision = 1;                 // fine cells per table cell, per side
+  // Per wo bin o: the integral of the interpolated f(wo in o's centre footprint, wi) |cos wi|
+  // over wi in o's own hemisphere (same_side: reflection, for the lower bins the underside's)
+  // and in the other one (other_side: transmission): sum_i f[i][o] W_i (hemisphere_weights).
+  // Interpolated over wo like f, they give the directional albedos of the interpolated table.
+  std::vector<Rgb> same_side, other_side;
+  // The underside's albedo under diffuse light from below, (1/pi) sum_{o lower} W_o same_side[o],
+  // and the transmittance of diffuse light from above, (1/pi) sum_{o upper} W_o other_side[o].
+  Rgb underside_diffuse_albedo, diffuse_transmittance;
   // Spectral tables: how many RGB components were negative (out of the sRGB gamut) after the
   // D65 band reduction and were set to 0. Always 0 for RGB tables.
   size_t clamped_components = 0;
 
   // Reduces a (validated) table to RGB and builds the per-wo-bin sampling distributions.
   static std::shared_ptr<const TabulatedBsdfData> prepare(const TabulatedBsdfTable& table);
+
+  // A per-bin quantity interpolated at direction w like eval interpolates f over wo.
+  Rgb interpolate(const std::vector<Rgb>& per_bin, const Vec3& w) const;
 
   Rgb lookup(int wi_bin, int wo_bin) const {
     const size_t i = (static_cast<size_t>(wi_bin) * static_cast<size_t>(grid.bins()) +
@@ -47,13 +86,46 @@ struct TabulatedBsdfData {
   }
 };
 
+// W_k = the integral of bin k's interpolation weight (DirectionGrid::bilinear) times |cos theta|
+// over its hemisphere: the integral of the interpolated f over wi is sum_k f[k][o] W_k. Per table
+// cell by midpoint quadrature on 8 x 8 equal-area points, scaled so that the cell's total is
+// its exact D_k; so sum_k W_k = pi per hemisphere exactly (the weights sum to 1 everywhere).
+std::vector<double> hemisphere_weights(const DirectionGrid& grid);
+
+// An opaque Lambertian backing under a table (fabric_table's backing_reflectance): what
+// TabulatedBsdf needs, from the table's data, its scale and rho_b (see the top of this file).
+struct TableBacking {
+  Rgb reflectance;            // rho_b, each component in [0, 1)
+  Rgb gain;                   // rho_b / (1 - rho_b r_under) / pi, with r_under of the scaled table
+  Rgb diffuse_transmittance;  // of the scaled table, for diffuse light from above
+  // Throws weft::Error (field "") when rho_b r_under >= 1 (a scale > 1 can make the underside
+  // reflect more than it receives).
+  static TableBacking make(const TabulatedBsdfData& data, const Rgb& scale, const Rgb& rho_b);
+};
+
 struct TabulatedBsdf {
   std::shared_ptr<const TabulatedBsdfData> data;
   Rgb scale{1.0};  // tint * scale from the material parameters
+  std::optional<TableBacking> backing =
+      std::nullopt;  // none: the bare table (transmission included)
 
   Rgb eval(const Vec3& wo, const Vec3& wi) const;
   std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const;
   double pdf(const Vec3& wo, const Vec3& wi) const;
+
+  // The backing term alone (0 without a backing), for the tests.
+  Rgb eval_backing(const Vec3& wo, const Vec3& wi) const;
+
+ private:
+  Rgb eval_table(const Vec3& wo, const Vec3& wi) const;
+  double pdf_table(const Vec3& wo, const Vec3& wi) const;
+  // With a backing: the probability of sampling the table's reflection part for wo, and that
+  // part's share of the table's sampling distribution (wi above the cloth).
+  struct BackedLobes {
+    double p_table = 0, upper_mass = 0;
+  };
+  BackedLobes backed_lobes(const Vec3& wo) const;
+  double pdf_backed(const BackedLobes& lobes, const Vec3& wo, const Vec3& wi) const;
 };
 
 }  // namespace weft

@@ -8,7 +8,10 @@
 //     f_fabric(w_i, w_o) = 1/2 sum over {warp, weft} of f_fiber(w_i, w_o in that fiber's frame),
 //   a fiber along the warp (t = x) or the weft (t = y), looked at on its top (n = the cloth's
 //   normal). One point per orientation; a view below the cloth is below that point's horizon, so
-//   the paper's sum transmits nothing.
+//   nothing leaves below the cloth: light from above is never transmitted, and the underside is
+//   black. Light from below still reaches a view from above, through the fiber table's light
+//   from behind the point: the table is not reciprocal (TabulatedBsdfTable::
+//   directional_albedo_seen_from).
 // * kVisible: our extension. Each orientation of the fibers seen at the cloth's surface (from the
 //   woven sample's own geometry, with weights) stands for a closed layer of parallel fibers of
 //   radius R at pitch 2R; the cloth's radiance towards w_o is the fibers' radiance averaged over
