@@ -158,6 +158,10 @@ TEST(Cli, InterruptedBakeLeavesACompleteTableOrNone) {
   if (r.exit_code == 130 && r.err.find("nothing was written") != std::string::npos) {
     // Interrupted in the Mie/medium stage, before any photon: exit 130, no table.
     EXPECT_FALSE(fs::exists(out));
+  } else if (r.exit_code == 130 && r.err.empty()) {
+    // On a loaded machine the signal can arrive before the program installs its handler: the
+    // default action ends it at start-up (timeout reports 128 + 2), before anything was written.
+    EXPECT_FALSE(fs::exists(out));
   } else if (r.exit_code == 130) {
     const auto table = weft::TabulatedBsdfTable::read_exr(out);
     EXPECT_EQ(table.metadata.at("interrupted"), "yes");
