@@ -1,6 +1,8 @@
 #include "weft/integrators/fabric_raytrace.h"
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -131,7 +133,15 @@ struct TaskTally {
   std::vector<double> weights;  // channels per exit
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0, continuation_caps = 0, inside_hits = 0;
-  uint64_t splits = 0;
+  uint64_t splits = 0, roulette_kills = 0;
+  // Per incident bin that the task's particles belong to (a task spans at most two): {bin,
+  // splits, roulette kills}.
+  std::vector<std::array<uint64_t, 3>> per_bin;
+  std::array<uint64_t, 3>& bin_counts(int bin) {
+    if (per_bin.empty() || per_bin.back()[0] != static_cast<uint64_t>(bin))
+      per_bin.push_back({static_cast<uint64_t>(bin), 0, 0});
+    return per_bin.back();
+  }
 };
 
 // Where the line through 'h' along 'along' crosses the surface again, leaving the material it
@@ -280,6 +290,10 @@ std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_ab
   return out;
 }
 
+const char* channel_sampling_name(ChannelSampling s) {
+  return s == ChannelSampling::mean ? "mean" : "hero";
+}
+
 void FabricRaytraceOptions::validate() const {
   if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
     throw Error("", "resolution",
@@ -324,6 +338,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   std::vector<double> sum(static_cast<size_t>(bins) * bins * nc, 0.0);
   std::vector<double> sum2(static_cast<size_t>(bins) * bins * nc, 0.0);
   FabricRaytraceResult result;
+  result.splits_per_bin.assign(bins, 0);
+  result.roulette_kills_per_bin.assign(bins, 0);
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
 
   const uint64_t first_item = per_bin * static_cast<uint64_t>(o.first_bin);
@@ -525,6 +541,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                   tally.roulette_net -= mean_w / survive - mean_w;
                 } else {
                   tally.roulette_net += mean_w;
+                  ++tally.roulette_kills;
+                  ++tally.bin_counts(a)[2];
                   break;
                 }
               }
@@ -539,6 +557,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 for (int copy = 1; copy < n; ++copy)
                   pending.push_back({p, d, events, ignore, w, pdf});
                 tally.splits += n - 1;
+                tally.bin_counts(a)[1] += n - 1;
               }
             }
           }
@@ -562,6 +581,11 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         result.continuation_caps += t.continuation_caps;
         result.inside_hits += t.inside_hits;
         result.splits += t.splits;
+        result.roulette_kills += t.roulette_kills;
+        for (const auto& [bin, splits, kills] : t.per_bin) {
+          result.splits_per_bin[bin] += splits;
+          result.roulette_kills_per_bin[bin] += kills;
+        }
       });
 
   result.cancelled = status.cancelled;
@@ -610,7 +634,13 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                     {"fiber_checksum", fiber.checksum()},
                     {"particles_per_bin", std::to_string(per_bin)},
                     {"seed", std::to_string(o.seed)},
+                    {"estimator", channel_sampling_name(o.channel_sampling)},
                     {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
+  if (o.channel_sampling != ChannelSampling::mean) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;
+    table.metadata["split_threshold"] = std::string(text, end);
+  }
   for (const char* key : {"spec_hash", "spec_name"})
     if (const auto it = fiber.metadata.find(key); it != fiber.metadata.end())
       table.metadata[std::string("fiber_") + key] = it->second;

@@ -394,3 +394,51 @@ TEST(FabricRaytrace, ChannelsOfAStronglyColouredFiberAreAlikeInNoise) {
   // The books still close.
   EXPECT_NEAR(mis.exited + mis.absorbed + mis.lost + mis.roulette_net, 1.0, 1e-9);
 }
+
+TEST(FabricRaytrace, SplitsAndRouletteKillsAreCountedPerIncidentBin) {
+  // The red fiber of ChannelsOfAStronglyColouredFiberAreAlikeInNoise (point albedo 3 in red):
+  // weights grow, so the hero estimator splits, and roulette ends dim paths. The counts per
+  // incident bin add up to the totals, depend only on (seed, bin) (a run of some bins counts what
+  // the whole run counts there), and a lower split threshold splits more; the mean estimator
+  // never splits. The table's metadata names the estimator and its threshold.
+  const auto red = fiber_table3(3, [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+    v[0] = wi.z < -0.9 ? 3 * 0.5 * kInvPi : 0;
+    v[1] = v[2] = wi.z > 0 && wo.z > 0 ? 0.05 * kInvPi : 0;
+  });
+  const WovenSample sample = default_sample("fiber");
+  FabricRaytraceOptions o = options(2, 1500);
+  const auto whole = raytrace_fabric_table(sample, red, o);
+  const int bins = DirectionGrid{2}.bins();
+  ASSERT_EQ(whole.splits_per_bin.size(), static_cast<size_t>(bins));
+  ASSERT_EQ(whole.roulette_kills_per_bin.size(), static_cast<size_t>(bins));
+  uint64_t splits = 0, kills = 0;
+  for (int b = 0; b < bins; ++b) splits += whole.splits_per_bin[b];
+  for (int b = 0; b < bins; ++b) kills += whole.roulette_kills_per_bin[b];
+  EXPECT_GT(whole.splits, 0u);
+  EXPECT_GT(whole.roulette_kills, 0u);
+  EXPECT_EQ(splits, whole.splits);
+  EXPECT_EQ(kills, whole.roulette_kills);
+  EXPECT_EQ(whole.table.metadata.at("estimator"), "hero");
+  EXPECT_EQ(whole.table.metadata.at("split_threshold"), "1");
+
+  FabricRaytraceOptions piece = o;
+  piece.first_bin = 3, piece.bin_count = 4;
+  const auto part = raytrace_fabric_table(sample, red, piece);
+  for (int b = 0; b < bins; ++b) {
+    const bool in = b >= 3 && b < 7;
+    EXPECT_EQ(part.splits_per_bin[b], in ? whole.splits_per_bin[b] : 0u) << b;
+    EXPECT_EQ(part.roulette_kills_per_bin[b], in ? whole.roulette_kills_per_bin[b] : 0u) << b;
+  }
+
+  o.split_threshold = 0.25;
+  const auto eager = raytrace_fabric_table(sample, red, o);
+  EXPECT_GT(eager.splits, 2 * whole.splits);
+  EXPECT_EQ(eager.table.metadata.at("split_threshold"), "0.25");
+
+  o.channel_sampling = ChannelSampling::mean;
+  const auto mean = raytrace_fabric_table(sample, red, o);
+  EXPECT_EQ(mean.splits, 0u);
+  EXPECT_GT(mean.roulette_kills, 0u);
+  EXPECT_EQ(mean.table.metadata.at("estimator"), "mean");
+  EXPECT_EQ(mean.table.metadata.count("split_threshold"), 0u);
+}

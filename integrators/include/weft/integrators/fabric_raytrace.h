@@ -37,6 +37,8 @@ namespace weft {
 // compare with: in a strongly coloured fabric the dominant channel's weights grow along multiply
 // scattered paths and it is far noisier than the others).
 enum class ChannelSampling { spectral_mis, mean };
+// The names the command line and the table's metadata use: "hero" (spectral_mis) and "mean".
+const char* channel_sampling_name(ChannelSampling s);
 
 struct FabricRaytraceOptions {
   int resolution = 8;                  // of the fabric table (DirectionGrid R)
@@ -62,7 +64,10 @@ struct FabricRaytraceResult {
   // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
   double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0;
-  uint64_t splits = 0;  // copies made by splitting
+  // Copies made by splitting, and particles (or copies) ended by Russian roulette, in all and
+  // per incident bin (what a bin's particles did depends only on (seed, bin), like its row).
+  uint64_t splits = 0, roulette_kills = 0;
+  std::vector<uint64_t> splits_per_bin, roulette_kills_per_bin;
   // Fiber detail: end caps of a fiber's continuation across the repeat's sides that a particle
   // leaving the fiber passed through, and hits on a fiber from inside it otherwise (taken alone,
   // without their B'': none are expected, fibers keep 2 radii apart).
