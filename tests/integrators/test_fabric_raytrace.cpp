@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "weft/core/math.h"
 #include "weft/integrators/fabric_raytrace.h"
@@ -253,16 +254,21 @@ TEST(FabricRaytrace, TablesAreReciprocalWithinTheirNoise) {
   // With a reciprocal fiber table the fabric's is reciprocal: f(wi, wo) = f(wo, wi). Cell pair
   // (i, o) against (o, i), each with its stated standard error: the z-scores have rms about 1
   // (the two cells are estimated from different particles) and almost none lie beyond 4.
-  // At yarn detail the tables are not reciprocal within noise (z rms 1.5 at 20 000 particles per
-  // bin): not checked there until that is understood.
-  for (const char* detail : {"fiber"}) {
+  // At yarn detail, before light a tube sent into itself passed through it (it was scattered by
+  // the same tube again) and before the table's frame on a tube was its facet's, z rms was 1.49
+  // at 20 000 particles per bin (1.39 with the facet frame alone, 1.12 with the passing alone).
+  const std::pair<const char*, uint64_t> cases[] = {{"fiber", 6000}, {"yarn", 20000}};
+  for (const auto& [detail, particles] : cases) {
     const auto fiber = reciprocal_fiber(4);
-    FabricRaytraceOptions o = options(3, 6000);
+    FabricRaytraceOptions o = options(3, particles);
     const auto r = raytrace_fabric_table(default_sample(detail), fiber, o);
     const ZStats z = z_scores(r, r, [](int i, int k) { return std::pair{k, i}; });
     EXPECT_GT(z.cells, 200u) << detail;
     EXPECT_NEAR(z.rms, 1.0, 0.25) << detail;
     EXPECT_LT(z.beyond4, 0.01) << detail;
+    // This fiber sends light into itself (its table is 0.5 x below the point's tangent plane):
+    // at yarn detail that light passes through its tube.
+    if (std::string(detail) == "yarn") EXPECT_GT(r.tube_passes, r.particles / 10) << detail;
   }
 }
 
@@ -318,9 +324,10 @@ TEST(FabricRaytrace, PlainWeaveTurnedBy90DegreesSwapsWarpAndWeft) {
   EXPECT_GT(z.cells, 200u);
   EXPECT_NEAR(z.rms, 1.0, 0.25);
   EXPECT_LT(z.beyond4, 0.01);
-  // Not trivially: the table is not symmetric under T by itself (warp and weft differ).
+  // Not trivially: the table is not symmetric under T by itself (warp and weft differ), so the
+  // identity map fails the criterion the turned map passes above (z rms 1.49 here).
   const ZStats same = z_scores(ra, rb, [](int i, int k) { return std::pair{i, k}; });
-  EXPECT_GT(same.rms, 1.5) << z.rms;
+  EXPECT_GT(same.rms, 1.25) << z.rms;
 }
 
 TEST(FabricRaytrace, ParticlesPassThroughTheCapsOfAFibersContinuation) {

@@ -17,6 +17,10 @@
 // periodic: the geometry is the repeat and its eight neighbours, and a particle crossing a side of
 // the repeat re-enters through the opposite side.
 //
+// At yarn detail the tubes take the fibers' part: light a tube sends into itself leaves it through
+// its far side (as light leaves a fiber through the fiber), and the table's frame at a tube point
+// is its facet's (normal and the yarn's tangent), so that the transport is reciprocal.
+//
 // Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
 #include <cstdint>
@@ -72,6 +76,8 @@ struct FabricRaytraceResult {
   // leaving the fiber passed through, and hits on a fiber from inside it otherwise (taken alone,
   // without their B'': none are expected, fibers keep 2 radii apart).
   uint64_t continuation_caps = 0, inside_hits = 0;
+  // Yarn detail: particles that a tube sent into itself and that left it through its far side.
+  uint64_t tube_passes = 0;
   // Standard error of the table relative to its values, weighted like weft compare's rel_rms
   // (by D_i D_o, channels summed): what two independent runs would differ by, over sqrt(2).
   double relative_noise = 0;
