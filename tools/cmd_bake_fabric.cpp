@@ -1,10 +1,12 @@
 // weft bake fabric: a fiber table (file, or a spec baked on demand) and a woven sample -> a fabric
 // BSDF table, by the paper's summation, our visible-layer summation or the ray-traced reference.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "commands.h"
 #include "fabric_parts.h"
@@ -19,9 +21,10 @@ namespace {
 
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
-  std::string detail = "yarn", shard;
+  std::string detail = "yarn", shard, estimator;  // estimator: "" = hero
   int resolution = 8, threads = 0;
   uint64_t samples = 0, seed = 1;
+  std::optional<double> split_threshold;  // the library's default unless given
   bool json = false, quiet = false, resume = false;
 };
 
@@ -55,9 +58,41 @@ std::vector<FiberOrientation> orientations(const std::vector<Vec3>& tangents) {
   return out;
 }
 
+// The ray tracer's settings from the command line, checked before any work: options that do
+// nothing in the configuration given are errors, and a bad value names its option.
+FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
+  FabricRaytraceOptions r;
+  r.resolution = o.resolution;
+  if (o.samples) r.particles_per_bin = o.samples;
+  r.seed = o.seed;
+  r.threads = o.threads;
+  r.channel_sampling =
+      o.estimator == "mean" ? ChannelSampling::mean : ChannelSampling::spectral_mis;
+  if (o.split_threshold) {
+    if (r.channel_sampling == ChannelSampling::mean)
+      throw Error("", "--split-threshold",
+                  "the mean estimator does not split: give --estimator hero");
+    r.split_threshold = *o.split_threshold;
+    if (!std::isfinite(r.split_threshold) || !(r.split_threshold > r.roulette_threshold))
+      throw Error("", "--split-threshold",
+                  "must be finite and above the roulette threshold " +
+                      std::to_string(r.roulette_threshold) + ", got " +
+                      std::to_string(r.split_threshold));
+  }
+  r.validate();
+  return r;
+}
+
 int run(const BakeFabricOptions& o) {
   if ((!o.shard.empty() || o.resume) && o.method != "raytrace")
     throw Error("", "--shard", "--shard and --resume need --method raytrace");
+  if (o.method != "raytrace" && !o.estimator.empty())
+    throw Error("", "--estimator", "the estimator is the ray tracer's: it needs --method raytrace");
+  if (o.method != "raytrace" && o.split_threshold)
+    throw Error("", "--split-threshold",
+                "splitting is the ray tracer's: it needs --method raytrace");
+  const FabricRaytraceOptions r =
+      o.method == "raytrace" ? raytrace_options(o) : FabricRaytraceOptions{};
   if (std::filesystem::path(o.output).extension() != ".exr" && o.shard.empty())
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
   const auto dir = std::filesystem::absolute(o.output).parent_path();
@@ -71,11 +106,6 @@ int run(const BakeFabricOptions& o) {
   TabulatedBsdfTable table;
   nlohmann::json extra;
   if (o.method == "raytrace") {
-    FabricRaytraceOptions r;
-    r.resolution = o.resolution;
-    if (o.samples) r.particles_per_bin = o.samples;
-    r.seed = o.seed;
-    r.threads = o.threads;
     FabricRaytraceResult res;
     if (!o.shard.empty() || o.resume) {
       int code = 0;
@@ -91,7 +121,14 @@ int run(const BakeFabricOptions& o) {
       return 130;
     }
     table = res.table;
+    record_particle_counts(table, res.splits, res.roulette_kills);
     extra = {{"particles", res.particles},
+             {"estimator", channel_sampling_name(r.channel_sampling)},
+             {"split_threshold", r.channel_sampling == ChannelSampling::mean
+                                     ? nlohmann::json(nullptr)
+                                     : nlohmann::json(r.split_threshold)},
+             {"splits", res.splits},
+             {"roulette_kills", res.roulette_kills},
              {"scatterings", res.scatterings},
              {"exited", res.exited},
              {"absorbed", res.absorbed},
@@ -174,6 +211,16 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   sub->add_option(
       "--samples", o->samples,
       "summations: direction pairs per cell pair; raytrace: particles per incident bin");
+  sub->add_option(
+         "--estimator", o->estimator,
+         "raytrace: hero (one channel steers each path, MIS over channels, roulette on the "
+         "largest weight, splitting; the default) | mean (the channels' mean steers; no "
+         "splitting)")
+      ->check(CLI::IsMember({"hero", "mean"}));
+  sub->add_option("--split-threshold", o->split_threshold,
+                  "raytrace, hero: split a particle whose largest channel weight exceeds this "
+                  "(default " +
+                      std::to_string(FabricRaytraceOptions{}.split_threshold) + ")");
   sub->add_option("--seed", o->seed, "random seed")->capture_default_str();
   sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
   sub->add_option("-o,--output", o->output, "output fabric table (.exr)")->required();

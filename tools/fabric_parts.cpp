@@ -27,14 +27,20 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
            {"seed", r.seed},
            {"max_scatterings", r.max_scatterings},
            {"roulette_threshold", r.roulette_threshold},
+           {"estimator", channel_sampling_name(r.channel_sampling)},
+           {"split_threshold", r.split_threshold},
            {"program_version", WEFT_VERSION}};
   p.units_total = static_cast<uint64_t>(DirectionGrid{r.resolution}.bins());
   p.shard = shard;
   return p;
 }
 
-// The table from the rows of every bin, with the metadata of the pieces.
-TabulatedBsdfTable assemble(const JobPart& all, int resolution) {
+// A unit is an incident bin's row of the table followed by its particles' splits and roulette
+// kills (counts, exact in a double), so that merged parts count what one process counts.
+constexpr size_t kUnitCounts = 2;
+
+// The table from the rows of every bin, with the metadata of the pieces and the counts summed.
+TabulatedBsdfTable assemble(const JobPart& all, int resolution, uint64_t* splits, uint64_t* kills) {
   TabulatedBsdfTable t;
   t.resolution = resolution;
   t.kind = "fabric";
@@ -42,15 +48,24 @@ TabulatedBsdfTable assemble(const JobPart& all, int resolution) {
   t.metadata = all.extra.at("metadata").get<std::map<std::string, std::string>>();
   const size_t bins = all.units_total, row = bins * static_cast<size_t>(t.channels);
   t.values.assign(bins * row, 0.0f);
+  *splits = *kills = 0;
   for (const auto& [a, v] : all.units) {
-    if (v.size() != row) throw Error("", "units", "a row of another size");
+    if (v.size() != row + kUnitCounts) throw Error("", "units", "a row of another size");
     for (size_t k = 0; k < row; ++k) t.values[a * row + k] = static_cast<float>(v[k]);
+    *splits += static_cast<uint64_t>(v[row]);
+    *kills += static_cast<uint64_t>(v[row + 1]);
   }
   t.validate("");
+  record_particle_counts(t, *splits, *kills);
   return t;
 }
 
 }  // namespace
+
+void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t roulette_kills) {
+  t.metadata["splits"] = std::to_string(splits);
+  t.metadata["roulette_kills"] = std::to_string(roulette_kills);
+}
 
 std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     const WovenSample& sample, const TabulatedBsdfTable& fiber, const FabricRaytraceOptions& r,
@@ -85,9 +100,13 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
       *exit_code = 130;
       return std::nullopt;
     }
-    for (uint64_t u = a; u < b; ++u)
-      done.units[u].assign(res.table.values.begin() + static_cast<std::ptrdiff_t>(u * row),
-                           res.table.values.begin() + static_cast<std::ptrdiff_t>((u + 1) * row));
+    for (uint64_t u = a; u < b; ++u) {
+      auto& unit = done.units[u];
+      unit.assign(res.table.values.begin() + static_cast<std::ptrdiff_t>(u * row),
+                  res.table.values.begin() + static_cast<std::ptrdiff_t>((u + 1) * row));
+      unit.push_back(static_cast<double>(res.splits_per_bin[u]));
+      unit.push_back(static_cast<double>(res.roulette_kills_per_bin[u]));
+    }
     done.extra = {{"channels", res.table.channels}, {"metadata", res.table.metadata}};
     sum.particles += res.particles, sum.scatterings += res.scatterings, sum.wraps += res.wraps;
     if (resume) write_job_part(checkpoint_path(output), done);
@@ -115,14 +134,15 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     return std::nullopt;
   }
   std::filesystem::remove(checkpoint_path(output));
-  sum.table = assemble(done, r.resolution);
+  sum.table = assemble(done, r.resolution, &sum.splits, &sum.roulette_kills);
   // The energy books and the noise are sums over all bins at once: not kept across pieces.
   sum.exited = sum.absorbed = sum.lost = sum.roulette_net = sum.relative_noise = NAN;
   return sum;
 }
 
 int merge_fabric_bake(const JobPart& all, const std::string& output, bool json) {
-  TabulatedBsdfTable t = assemble(all, all.job.at("resolution").get<int>());
+  uint64_t splits = 0, kills = 0;
+  TabulatedBsdfTable t = assemble(all, all.job.at("resolution").get<int>(), &splits, &kills);
   t.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;  // as bake fabric writes
   t.write_exr(output);
   if (json)

@@ -8,6 +8,9 @@
 
 namespace weft::cli {
 
+// The ray tracer's splits and roulette kills in the table's metadata (whole runs and merges).
+void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t roulette_kills);
+
 // With --shard K/N: traces the shard's incident bins and writes them as a part to 'output'
 // (returns nothing). With --resume: checkpoints every finished piece beside 'output' and starts
 // from a checkpoint left there; a whole table is returned for the caller to write. A cancelled

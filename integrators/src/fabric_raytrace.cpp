@@ -1,6 +1,8 @@
 #include "weft/integrators/fabric_raytrace.h"
 
 #include <algorithm>
+#include <array>
+#include <charconv>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -119,6 +121,7 @@ struct PendingCopy {
   Vec3 p, d;
   int events = 0;
   int64_t ignore = kNoFiber;
+  bool in_tube = false;        // sent into the yarn tube it left (yarn detail)
   std::vector<double> w, pdf;  // channel weights, relative path densities (see the tracer)
 };
 
@@ -131,7 +134,16 @@ struct TaskTally {
   std::vector<double> weights;  // channels per exit
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0, continuation_caps = 0, inside_hits = 0;
-  uint64_t splits = 0;
+  uint64_t tube_passes = 0;
+  uint64_t splits = 0, roulette_kills = 0;
+  // Per incident bin that the task's particles belong to (a task spans at most two): {bin,
+  // splits, roulette kills}.
+  std::vector<std::array<uint64_t, 3>> per_bin;
+  std::array<uint64_t, 3>& bin_counts(int bin) {
+    if (per_bin.empty() || per_bin.back()[0] != static_cast<uint64_t>(bin))
+      per_bin.push_back({static_cast<uint64_t>(bin), 0, 0});
+    return per_bin.back();
+  }
 };
 
 // Where the line through 'h' along 'along' crosses the surface again, leaving the material it
@@ -280,6 +292,10 @@ std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_ab
   return out;
 }
 
+const char* channel_sampling_name(ChannelSampling s) {
+  return s == ChannelSampling::mean ? "mean" : "hero";
+}
+
 void FabricRaytraceOptions::validate() const {
   if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
     throw Error("", "resolution",
@@ -324,6 +340,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   std::vector<double> sum(static_cast<size_t>(bins) * bins * nc, 0.0);
   std::vector<double> sum2(static_cast<size_t>(bins) * bins * nc, 0.0);
   FabricRaytraceResult result;
+  result.splits_per_bin.assign(bins, 0);
+  result.roulette_kills_per_bin.assign(bins, 0);
   double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
 
   const uint64_t first_item = per_bin * static_cast<uint64_t>(o.first_bin);
@@ -374,12 +392,13 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
           // stays that of one particle's total.
           const size_t first_exit = tally.exits.size();
           pending.clear();
-          pending.push_back({p, d, 0, kNoFiber, std::vector<double>(nc, w0),
+          pending.push_back({p, d, 0, kNoFiber, false, std::vector<double>(nc, w0),
                              std::vector<double>(n_strategies, 1.0)});
           while (!pending.empty()) {
             Vec3 p = pending.back().p, d = pending.back().d;
             int events = pending.back().events;
             int64_t ignore = pending.back().ignore;  // the fiber last left (fiber detail)
+            bool in_tube = pending.back().in_tube;   // see PendingCopy
             w.swap(pending.back().w);
             pdf.swap(pending.back().pdf);
             pending.pop_back();
@@ -445,6 +464,21 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 }
                 continue;
               }
+              // Light that a yarn tube sent into itself leaves it through its far side, as light
+              // leaves a fiber through the fiber itself: the table already holds the whole yarn's
+              // part (taking that exit as a new crossing scattered it twice, and only when it left
+              // into the tube, which made the yarn-detail tables non-reciprocal).
+              if (in_tube && !h.on_fiber() && dot(d, h.ng) > 0) {
+                p = h.spawn_origin(d);
+                in_tube = false;
+                ++tally.tube_passes;
+                if (++events > 100 * o.max_scatterings) {
+                  tally.lost += mean_w;
+                  break;
+                }
+                continue;
+              }
+              in_tube = false;
               if (h.on_fiber() && dot(d, h.ng) >= 0) ++tally.inside_hits;
               // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is
               // where the line leaves its cylinder. Yarn tubes that press on each other share
@@ -466,6 +500,14 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               // B'' in proportion to its own and draws an exit cell o from its row there, with
               // probability (A_h(q) / S_h) (f_h D_o / A_h(q)) = f_h D_o / S_h.
               for (int q = 0; q < n_pts; ++q) {
+                // On a yarn tube the table's frame is the facet's (its normal, the yarn's tangent
+                // in its plane), not the interpolated shading normal: light arrives on a facet in
+                // proportion to its cosine with the facet, and leaves drawn by the cosine with the
+                // frame's normal; the two normals differing would make the transport
+                // non-reciprocal (Veach's thesis, 1997, ch. 5, on shading normals).
+                if (!pts[q].hit.on_fiber())
+                  pts[q].hit.shading =
+                      Frame::from_normal_tangent(pts[q].hit.ng, pts[q].hit.shading.s);
                 pts[q].wi_local = pts[q].hit.shading.to_local(-d);
                 pts[q].bin = fs.grid.bin_of(pts[q].wi_local);
               }
@@ -504,6 +546,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               d = normalize(pt.hit.shading.to_world(wo_local));
               p = pt.hit.spawn_origin(d);
               ignore = pt.hit.fiber;  // light leaves a fiber through the fiber itself
+              in_tube = !pt.hit.on_fiber() && dot(d, pt.hit.ng) < 0;  // into its own yarn tube
               ++tally.scatterings;
               if (++events >= o.max_scatterings) {
                 double m = 0;
@@ -525,6 +568,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                   tally.roulette_net -= mean_w / survive - mean_w;
                 } else {
                   tally.roulette_net += mean_w;
+                  ++tally.roulette_kills;
+                  ++tally.bin_counts(a)[2];
                   break;
                 }
               }
@@ -537,8 +582,9 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                     std::min<double>(kMaxSplit, std::ceil(max_w / o.split_threshold)));
                 for (double& x : w) x /= n;
                 for (int copy = 1; copy < n; ++copy)
-                  pending.push_back({p, d, events, ignore, w, pdf});
+                  pending.push_back({p, d, events, ignore, in_tube, w, pdf});
                 tally.splits += n - 1;
+                tally.bin_counts(a)[1] += n - 1;
               }
             }
           }
@@ -561,7 +607,13 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         result.wraps += t.wraps;
         result.continuation_caps += t.continuation_caps;
         result.inside_hits += t.inside_hits;
+        result.tube_passes += t.tube_passes;
         result.splits += t.splits;
+        result.roulette_kills += t.roulette_kills;
+        for (const auto& [bin, splits, kills] : t.per_bin) {
+          result.splits_per_bin[bin] += splits;
+          result.roulette_kills_per_bin[bin] += kills;
+        }
       });
 
   result.cancelled = status.cancelled;
@@ -610,7 +662,13 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                     {"fiber_checksum", fiber.checksum()},
                     {"particles_per_bin", std::to_string(per_bin)},
                     {"seed", std::to_string(o.seed)},
+                    {"estimator", channel_sampling_name(o.channel_sampling)},
                     {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
+  if (o.channel_sampling != ChannelSampling::mean) {
+    char text[32];
+    const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;
+    table.metadata["split_threshold"] = std::string(text, end);
+  }
   for (const char* key : {"spec_hash", "spec_name"})
     if (const auto it = fiber.metadata.find(key); it != fiber.metadata.end())
       table.metadata[std::string("fiber_") + key] = it->second;

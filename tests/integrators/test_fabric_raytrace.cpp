@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include "weft/core/math.h"
 #include "weft/integrators/fabric_raytrace.h"
@@ -253,16 +254,21 @@ TEST(FabricRaytrace, TablesAreReciprocalWithinTheirNoise) {
   // With a reciprocal fiber table the fabric's is reciprocal: f(wi, wo) = f(wo, wi). Cell pair
   // (i, o) against (o, i), each with its stated standard error: the z-scores have rms about 1
   // (the two cells are estimated from different particles) and almost none lie beyond 4.
-  // At yarn detail the tables are not reciprocal within noise (z rms 1.5 at 20 000 particles per
-  // bin): not checked there until that is understood.
-  for (const char* detail : {"fiber"}) {
+  // At yarn detail, before light a tube sent into itself passed through it (it was scattered by
+  // the same tube again) and before the table's frame on a tube was its facet's, z rms was 1.49
+  // at 20 000 particles per bin (1.39 with the facet frame alone, 1.12 with the passing alone).
+  const std::pair<const char*, uint64_t> cases[] = {{"fiber", 6000}, {"yarn", 20000}};
+  for (const auto& [detail, particles] : cases) {
     const auto fiber = reciprocal_fiber(4);
-    FabricRaytraceOptions o = options(3, 6000);
+    FabricRaytraceOptions o = options(3, particles);
     const auto r = raytrace_fabric_table(default_sample(detail), fiber, o);
     const ZStats z = z_scores(r, r, [](int i, int k) { return std::pair{k, i}; });
     EXPECT_GT(z.cells, 200u) << detail;
     EXPECT_NEAR(z.rms, 1.0, 0.25) << detail;
     EXPECT_LT(z.beyond4, 0.01) << detail;
+    // This fiber sends light into itself (its table is 0.5 x below the point's tangent plane):
+    // at yarn detail that light passes through its tube.
+    if (std::string(detail) == "yarn") EXPECT_GT(r.tube_passes, r.particles / 10) << detail;
   }
 }
 
@@ -318,9 +324,10 @@ TEST(FabricRaytrace, PlainWeaveTurnedBy90DegreesSwapsWarpAndWeft) {
   EXPECT_GT(z.cells, 200u);
   EXPECT_NEAR(z.rms, 1.0, 0.25);
   EXPECT_LT(z.beyond4, 0.01);
-  // Not trivially: the table is not symmetric under T by itself (warp and weft differ).
+  // Not trivially: the table is not symmetric under T by itself (warp and weft differ), so the
+  // identity map fails the criterion the turned map passes above (z rms 1.49 here).
   const ZStats same = z_scores(ra, rb, [](int i, int k) { return std::pair{i, k}; });
-  EXPECT_GT(same.rms, 1.5) << z.rms;
+  EXPECT_GT(same.rms, 1.25) << z.rms;
 }
 
 TEST(FabricRaytrace, ParticlesPassThroughTheCapsOfAFibersContinuation) {
@@ -393,4 +400,52 @@ TEST(FabricRaytrace, ChannelsOfAStronglyColouredFiberAreAlikeInNoise) {
   }
   // The books still close.
   EXPECT_NEAR(mis.exited + mis.absorbed + mis.lost + mis.roulette_net, 1.0, 1e-9);
+}
+
+TEST(FabricRaytrace, SplitsAndRouletteKillsAreCountedPerIncidentBin) {
+  // The red fiber of ChannelsOfAStronglyColouredFiberAreAlikeInNoise (point albedo 3 in red):
+  // weights grow, so the hero estimator splits, and roulette ends dim paths. The counts per
+  // incident bin add up to the totals, depend only on (seed, bin) (a run of some bins counts what
+  // the whole run counts there), and a lower split threshold splits more; the mean estimator
+  // never splits. The table's metadata names the estimator and its threshold.
+  const auto red = fiber_table3(3, [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+    v[0] = wi.z < -0.9 ? 3 * 0.5 * kInvPi : 0;
+    v[1] = v[2] = wi.z > 0 && wo.z > 0 ? 0.05 * kInvPi : 0;
+  });
+  const WovenSample sample = default_sample("fiber");
+  FabricRaytraceOptions o = options(2, 1500);
+  const auto whole = raytrace_fabric_table(sample, red, o);
+  const int bins = DirectionGrid{2}.bins();
+  ASSERT_EQ(whole.splits_per_bin.size(), static_cast<size_t>(bins));
+  ASSERT_EQ(whole.roulette_kills_per_bin.size(), static_cast<size_t>(bins));
+  uint64_t splits = 0, kills = 0;
+  for (int b = 0; b < bins; ++b) splits += whole.splits_per_bin[b];
+  for (int b = 0; b < bins; ++b) kills += whole.roulette_kills_per_bin[b];
+  EXPECT_GT(whole.splits, 0u);
+  EXPECT_GT(whole.roulette_kills, 0u);
+  EXPECT_EQ(splits, whole.splits);
+  EXPECT_EQ(kills, whole.roulette_kills);
+  EXPECT_EQ(whole.table.metadata.at("estimator"), "hero");
+  EXPECT_EQ(whole.table.metadata.at("split_threshold"), "1");
+
+  FabricRaytraceOptions piece = o;
+  piece.first_bin = 3, piece.bin_count = 4;
+  const auto part = raytrace_fabric_table(sample, red, piece);
+  for (int b = 0; b < bins; ++b) {
+    const bool in = b >= 3 && b < 7;
+    EXPECT_EQ(part.splits_per_bin[b], in ? whole.splits_per_bin[b] : 0u) << b;
+    EXPECT_EQ(part.roulette_kills_per_bin[b], in ? whole.roulette_kills_per_bin[b] : 0u) << b;
+  }
+
+  o.split_threshold = 0.25;
+  const auto eager = raytrace_fabric_table(sample, red, o);
+  EXPECT_GT(eager.splits, 2 * whole.splits);
+  EXPECT_EQ(eager.table.metadata.at("split_threshold"), "0.25");
+
+  o.channel_sampling = ChannelSampling::mean;
+  const auto mean = raytrace_fabric_table(sample, red, o);
+  EXPECT_EQ(mean.splits, 0u);
+  EXPECT_GT(mean.roulette_kills, 0u);
+  EXPECT_EQ(mean.table.metadata.at("estimator"), "mean");
+  EXPECT_EQ(mean.table.metadata.count("split_threshold"), 0u);
 }

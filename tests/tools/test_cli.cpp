@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
@@ -308,4 +309,56 @@ TEST(Cli, SceneCarSeatWritesTheSeatAndRefusesBadInput) {
   EXPECT_NE(small.err.find("cell-mm"), std::string::npos) << small.err;
   EXPECT_FALSE(fs::exists(dir / "s.glb"));
   expect_no_temporaries(dir);
+}
+
+TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported) {
+  // --estimator and --split-threshold reach the ray tracer; the splits and roulette kills are in
+  // the JSON summary and the table's metadata (the same numbers); a bad or idle option is refused
+  // by name before any work, with nothing written.
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = dir / "fiber.exr";
+  ASSERT_EQ(run("bake fiber red-cotton --photons 2000 --resolution 3 --bands rgb --quiet -o '" +
+                    fiber.string() + "'",
+                dir)
+                .exit_code,
+            0);
+  const std::string base = "bake fabric --fiber '" + fiber.string() +
+                           "' --method raytrace --detail fiber -R 2 --samples 400 --quiet --json";
+  std::map<std::string, uint64_t> splits;
+  for (const std::string& est : {"hero", "mean"}) {
+    const fs::path out = dir / (est + ".exr");
+    const CliRun r = run(base + " --estimator " + est + " -o '" + out.string() + "'", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j.at("estimator"), est);
+    const auto t = weft::TabulatedBsdfTable::read_exr(out);
+    EXPECT_EQ(t.metadata.at("estimator"), est);
+    EXPECT_EQ(t.metadata.at("splits"), std::to_string(j.at("splits").get<uint64_t>()));
+    EXPECT_EQ(t.metadata.at("roulette_kills"),
+              std::to_string(j.at("roulette_kills").get<uint64_t>()));
+    EXPECT_GT(j.at("roulette_kills").get<uint64_t>(), 0u);
+    splits[est] = j.at("splits").get<uint64_t>();
+  }
+  // Red cotton's fiber weights exceed 1 along a line near the axis: the hero estimator splits.
+  EXPECT_GT(splits["hero"], 0u);
+  EXPECT_EQ(splits["mean"], 0u);
+  const fs::path low = dir / "low.exr";
+  const CliRun r = run(base + " --split-threshold 0.25 -o '" + low.string() + "'", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("split_threshold").get<double>(), 0.25);
+  EXPECT_GT(j.at("splits").get<uint64_t>(), splits["hero"]);
+
+  const fs::path out = dir / "refused.exr";
+  for (const char* bad : {"0.05", "0.01", "-1", "inf", "nan"})
+    expect_refused(base + " --split-threshold " + bad, out, "--split-threshold", dir);
+  expect_refused(base + " --estimator mean --split-threshold 2", out, "--split-threshold", dir);
+  // An unknown name is the option parser's refusal (its own exit code), naming the option.
+  const CliRun fancy = run(base + " --estimator fancy -o '" + out.string() + "'", dir);
+  EXPECT_NE(fancy.exit_code, 0);
+  EXPECT_NE(fancy.err.find("--estimator"), std::string::npos) << fancy.err;
+  EXPECT_FALSE(fs::exists(out));
+  const std::string sum = "bake fabric --fiber '" + fiber.string() + "' --method summation -R 2";
+  expect_refused(sum + " --estimator hero", out, "--estimator", dir);
+  expect_refused(sum + " --split-threshold 2", out, "--split-threshold", dir);
 }

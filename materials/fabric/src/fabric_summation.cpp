@@ -18,9 +18,13 @@ namespace {
 struct LayerFiber {
   Vec3 t, n0, c0;
   double weight = 0;
+  // The frames of the circumference's midpoints phi_k = (k + 1/2) 2 pi / samples: normal n(phi_k)
+  // and n(phi_k) x t, computed once per orientation (the sines and cosines were most of the time).
+  std::vector<Vec3> n, b;
+  std::vector<double> sin_phi, cos_phi;
 };
 
-std::vector<LayerFiber> prepare(const std::vector<FiberOrientation>& given) {
+std::vector<LayerFiber> prepare(const std::vector<FiberOrientation>& given, int samples) {
   std::vector<FiberOrientation> list = given;
   if (list.empty()) list = {{{1, 0, 0}, 1}, {{0, 1, 0}, 1}};
   // t and -t are one fiber: cluster on the upper hemisphere of a coarse grid, so that a sample's
@@ -49,22 +53,30 @@ std::vector<LayerFiber> prepare(const std::vector<FiberOrientation>& given) {
     total += w;
     out.push_back(f);
   }
-  for (auto& f : out) f.weight /= total;
+  const double dphi = 2 * kPi / samples;
+  for (auto& f : out) {
+    f.weight /= total;
+    for (int k = 0; k < samples; ++k) {
+      const double phi = (k + 0.5) * dphi;
+      const Vec3 n = std::cos(phi) * f.n0 + std::sin(phi) * f.c0;
+      f.n.push_back(n);
+      f.b.push_back(cross(n, f.t));
+      f.sin_phi.push_back(std::sin(phi));
+      f.cos_phi.push_back(std::cos(phi));
+    }
+  }
   return out;
 }
 
-// Direction w in the frame of the point at angle phi of fiber f (x = t, y = n x t, z = n).
-Vec3 to_fiber_point(const LayerFiber& f, double phi, const Vec3& w) {
-  const Vec3 n = std::cos(phi) * f.n0 + std::sin(phi) * f.c0;
-  return {dot(w, f.t), dot(w, cross(n, f.t)), dot(w, n)};
+// Direction w in the frame of circumference point k of fiber f (x = t, y = n x t, z = n).
+Vec3 to_fiber_point(const LayerFiber& f, int k, const Vec3& w) {
+  return {dot(w, f.t), dot(w, f.b[k]), dot(w, f.n[k])};
 }
 
 // In the cross-section of a closed layer of fibers of radius 1 at pitch 2 (centres at (2k, 0),
-// coordinates (across, up)), whether the ray from the point at angle phi of the fiber at the
-// origin along (sin alpha, cos alpha) misses every neighbour.
-bool clear_of_neighbours(double phi, double alpha) {
-  const double px = std::sin(phi), py = std::cos(phi);
-  const double dx = std::sin(alpha), dy = std::cos(alpha);
+// coordinates (across, up)), whether the ray from the point (px, py) = (sin phi, cos phi) of the
+// fiber at the origin along (dx, dy) = (sin alpha, cos alpha) misses every neighbour.
+bool clear_of_neighbours(double px, double py, double dx, double dy) {
   for (int k = -4; k <= 4; ++k) {
     if (k == 0) continue;
     const double ox = px - 2 * k, oy = py;  // from the neighbour's centre to the point
@@ -75,24 +87,27 @@ bool clear_of_neighbours(double phi, double alpha) {
   return true;
 }
 
-// One orientation's layer: s_i / (2 |cos_i| |cos_o|) * int_{seen} f |cos_i(B)| |cos_o(B)| d phi.
+// One orientation's layer: s_i / (2 |cos_i| |cos_o|) * int_{seen} f |cos_i(B)| |cos_o(B)| d phi,
+// by the midpoint rule on the circumference points prepared in f.
 void layer_sum(const TabulatedBsdfTable& fiber, const LayerFiber& f, const Vec3& wo, const Vec3& wi,
-               int samples, std::span<double> acc, std::span<double> tmp) {
+               std::span<double> acc, std::span<double> tmp) {
+  const int samples = static_cast<int>(f.n.size());
   const double cos_o = std::abs(wo.z), cos_i = std::abs(wi.z);
   if (!(cos_o > 0) || !(cos_i > 0)) return;
   // The two directions across the layer: their angles from n0 and their lengths there.
   const double on = dot(wo, f.n0), oc = dot(wo, f.c0), in = dot(wi, f.n0), ic = dot(wi, f.c0);
   const double alpha_o = std::atan2(oc, on);
+  const double sin_alpha_o = std::sin(alpha_o), cos_alpha_o = std::cos(alpha_o);
   const double rho_i = std::hypot(in, ic);
   // Shadowing by the neighbours: the layer's beam width per fiber over an isolated fiber's.
   const double lit = rho_i > 1e-12 ? std::abs(in) / rho_i : 1.0;
   const double dphi = 2 * kPi / samples;
   const double scale = lit * dphi / (2 * cos_i * cos_o) * f.weight;
   for (int k = 0; k < samples; ++k) {
-    const double phi = (k + 0.5) * dphi;
-    const Vec3 o = to_fiber_point(f, phi, wo);
-    if (!(o.z > 0) || !clear_of_neighbours(phi, alpha_o)) continue;  // not seen from w_o
-    const Vec3 i = to_fiber_point(f, phi, wi);
+    const Vec3 o = to_fiber_point(f, k, wo);
+    if (!(o.z > 0) || !clear_of_neighbours(f.sin_phi[k], f.cos_phi[k], sin_alpha_o, cos_alpha_o))
+      continue;  // not seen from w_o
+    const Vec3 i = to_fiber_point(f, k, wi);
     fiber.interpolate(o, i, tmp);
     const double w = scale * std::abs(i.z) * o.z;
     for (size_t c = 0; c < acc.size(); ++c) acc[c] += w * tmp[c];
@@ -129,8 +144,8 @@ void fabric_sum(const TabulatedBsdfTable& fiber, const FabricSummationOptions& o
     }
     return;
   }
-  const auto fibers = prepare(wo.z >= 0 ? o.top : o.bottom);
-  for (const auto& f : fibers) layer_sum(fiber, f, wo, wi, o.circumference_samples, out, tmp);
+  const auto fibers = prepare(wo.z >= 0 ? o.top : o.bottom, o.circumference_samples);
+  for (const auto& f : fibers) layer_sum(fiber, f, wo, wi, out, tmp);
 }
 
 TabulatedBsdfTable sum_fabric_table(const TabulatedBsdfTable& fiber,
@@ -149,14 +164,14 @@ TabulatedBsdfTable sum_fabric_table(const TabulatedBsdfTable& fiber,
         o.samples_per_cell, o.seed, o.threads, progress);
   } else {
     // Prepared once: the clustered orientations of either side.
-    const auto top = prepare(o.top), bottom = prepare(o.bottom);
+    const auto top = prepare(o.top, o.circumference_samples),
+               bottom = prepare(o.bottom, o.circumference_samples);
     t = TabulatedBsdfTable::from_function(
         o.resolution, fiber.channels,
         [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
           std::fill(v.begin(), v.end(), 0.0);
           std::vector<double> tmp(fiber.channels);
-          for (const auto& f : wo.z >= 0 ? top : bottom)
-            layer_sum(fiber, f, wo, wi, o.circumference_samples, v, tmp);
+          for (const auto& f : wo.z >= 0 ? top : bottom) layer_sum(fiber, f, wo, wi, v, tmp);
         },
         o.samples_per_cell, o.seed, o.threads, progress);
   }

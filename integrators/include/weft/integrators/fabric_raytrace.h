@@ -17,6 +17,10 @@
 // periodic: the geometry is the repeat and its eight neighbours, and a particle crossing a side of
 // the repeat re-enters through the opposite side.
 //
+// At yarn detail the tubes take the fibers' part: light a tube sends into itself leaves it through
+// its far side (as light leaves a fiber through the fiber), and the table's frame at a tube point
+// is its facet's (normal and the yarn's tangent), so that the transport is reciprocal.
+//
 // Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
 #include <cstdint>
@@ -37,6 +41,8 @@ namespace weft {
 // compare with: in a strongly coloured fabric the dominant channel's weights grow along multiply
 // scattered paths and it is far noisier than the others).
 enum class ChannelSampling { spectral_mis, mean };
+// The names the command line and the table's metadata use: "hero" (spectral_mis) and "mean".
+const char* channel_sampling_name(ChannelSampling s);
 
 struct FabricRaytraceOptions {
   int resolution = 8;                  // of the fabric table (DirectionGrid R)
@@ -62,11 +68,16 @@ struct FabricRaytraceResult {
   // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
   double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0;
-  uint64_t splits = 0;  // copies made by splitting
+  // Copies made by splitting, and particles (or copies) ended by Russian roulette, in all and
+  // per incident bin (what a bin's particles did depends only on (seed, bin), like its row).
+  uint64_t splits = 0, roulette_kills = 0;
+  std::vector<uint64_t> splits_per_bin, roulette_kills_per_bin;
   // Fiber detail: end caps of a fiber's continuation across the repeat's sides that a particle
   // leaving the fiber passed through, and hits on a fiber from inside it otherwise (taken alone,
   // without their B'': none are expected, fibers keep 2 radii apart).
   uint64_t continuation_caps = 0, inside_hits = 0;
+  // Yarn detail: particles that a tube sent into itself and that left it through its far side.
+  uint64_t tube_passes = 0;
   // Standard error of the table relative to its values, weighted like weft compare's rel_rms
   // (by D_i D_o, channels summed): what two independent runs would differ by, over sqrt(2).
   double relative_noise = 0;
