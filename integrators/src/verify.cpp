@@ -1,9 +1,6 @@
 #include "weft/integrators/verify.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -1187,11 +1184,10 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
   check_verify_output(dir);
   std::error_code ec;
   const fs::path target = fs::absolute(dir);
-  const fs::path parent = target.parent_path();
-  static std::atomic<uint64_t> calls{0};
-  const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(calls.fetch_add(1));
-  const fs::path staging = parent / (".tmp-" + target.filename().string() + "-" + tag + "-partial");
-  const fs::path old = parent / (".tmp-" + target.filename().string() + "-" + tag + "-old");
+  // A staging folder named as atomic_file.h names temporaries, so that one a killed run left is
+  // removed by the next; the earlier report moved aside is never removed that way.
+  const fs::path staging = temporary_sibling(target);
+  const fs::path old = fs::path(staging.string() + "-old");
   try {
     if (!fs::create_directory(staging, ec) || ec)
       throw Error(dir.string(), "-o", "cannot create a staging folder beside it");
