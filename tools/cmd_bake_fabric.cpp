@@ -79,8 +79,12 @@ int run(const BakeFabricOptions& o) {
     FabricRaytraceResult res;
     if (!o.shard.empty() || o.resume) {
       int code = 0;
-      auto pieces =
-          raytrace_fabric_in_pieces(sample, fiber, r, o.output, o.shard, o.resume, progress, &code);
+      // The files the woven sample was made from (the fiber table is in the job by checksum).
+      std::vector<std::filesystem::path> inputs;
+      for (const auto& f : {o.weave, o.wif})
+        if (!f.empty()) inputs.emplace_back(f);
+      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
+                                              o.shard, o.resume, progress, &code);
       if (!pieces) return code;
       res = std::move(*pieces);
     } else {

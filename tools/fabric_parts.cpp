@@ -16,10 +16,11 @@ namespace weft::cli {
 namespace {
 
 JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
-                   const FabricRaytraceOptions& r, Shard shard) {
+                   const nlohmann::json& inputs, const FabricRaytraceOptions& r, Shard shard) {
   JobPart p;
   p.command = "bake fabric";
   p.job = {{"method", "raytrace"},
+           {"inputs", inputs},
            {"fiber_checksum", fiber.checksum()},
            {"sample", sample.summary.source + " (" + sample.summary.detail + ")"},
            {"resolution", r.resolution},
@@ -53,12 +54,12 @@ TabulatedBsdfTable assemble(const JobPart& all, int resolution) {
 }  // namespace
 
 std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
-    const WovenSample& sample, const TabulatedBsdfTable& fiber, const FabricRaytraceOptions& r,
-    const std::string& output, const std::string& shard_text, bool resume,
-    const ProgressCallback& progress, int* exit_code) {
+    const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
+    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
+    bool resume, const ProgressCallback& progress, int* exit_code) {
   *exit_code = 0;
   const Shard shard = shard_text.empty() ? Shard{} : parse_shard(shard_text, "--shard");
-  JobPart job = fabric_job(fiber, sample, r, shard);
+  JobPart job = fabric_job(fiber, sample, inputs, r, shard);
   const UnitRange range = shard_units(job.units_total, shard);
   const size_t row = job.units_total * static_cast<size_t>(fiber.channels);
   JobPart done = job;
