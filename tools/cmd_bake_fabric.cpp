@@ -95,13 +95,7 @@ int run(const BakeFabricOptions& o) {
       return 130;
     }
     table = res.table;
-    extra = {{"particles", res.particles},
-             {"scatterings", res.scatterings},
-             {"exited", res.exited},
-             {"absorbed", res.absorbed},
-             {"lost", res.lost},
-             {"relative_noise", res.relative_noise},
-             {"relative_noise_per_channel", res.relative_noise_per_channel}};
+    extra = raytrace_summary(res);
   } else {
     FabricSummationOptions s;
     s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
@@ -120,15 +114,8 @@ int run(const BakeFabricOptions& o) {
   table.metadata["sample"] = sample.summary.source + " (" + sample.summary.detail + ")";
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
   table.write_exr(o.output);
-  const DirectionGrid g = table.grid();
-  const auto normal = table.directional_albedo(g.bin_of({0, 0, 1}));
-  nlohmann::json j = {{"output", o.output},
-                      {"method", o.method},
-                      {"resolution", o.resolution},
-                      {"seconds", seconds},
-                      {"sample", table.metadata["sample"]},
-                      {"reflectance_normal_incidence", normal.reflectance},
-                      {"transmittance_normal_incidence", normal.transmittance}};
+  nlohmann::json j = {{"output", o.output}, {"method", o.method}, {"seconds", seconds}};
+  j.update(fabric_table_summary(table));
   if (extra.is_object()) j.update(extra);
   if (o.json) {
     std::cout << j.dump(2) << "\n";
@@ -144,6 +131,7 @@ int run(const BakeFabricOptions& o) {
 
 }  // namespace
 
+    const auto normal = table.directional_albedo(table.grid().bin_of({0, 0, 1}));
 void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   auto o = std::make_shared<BakeFabricOptions>();
   auto* sub =

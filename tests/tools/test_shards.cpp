@@ -70,9 +70,12 @@ std::vector<std::string> operator+(std::vector<std::string> a, const std::vector
   return a;
 }
 
-// Runs 'args' as 4 shards, merges them and expects the bytes of 'reference'.
+// Runs 'args' as 4 shards, merges them (with 'merge_options') and expects the bytes of
+// 'reference'; what the merge printed goes to 'printed' when given.
 void expect_shards_merge_to(const std::vector<std::string>& args, const fs::path& reference,
-                            const fs::path& dir, const std::string& ext) {
+                            const fs::path& dir, const std::string& ext,
+                            const std::vector<std::string>& merge_options = {},
+                            std::string* printed = nullptr) {
   std::vector<std::string> merge = {"merge"};
   for (int k = 0; k < 4; ++k) {
     const fs::path part = dir / ("part-" + std::to_string(k) + ".part");
@@ -86,8 +89,10 @@ void expect_shards_merge_to(const std::vector<std::string>& args, const fs::path
   // Any order of the parts.
   std::swap(merge[1], merge[3]);
   const fs::path merged = dir / ("merged" + ext);
-  ASSERT_EQ(run_weft(merge + std::vector<std::string>{"-o", merged.string()}, dir), 0)
+  ASSERT_EQ(run_weft(merge + merge_options + std::vector<std::string>{"-o", merged.string()}, dir),
+            0)
       << slurp(dir / "stderr");
+  if (printed) *printed = slurp(dir / "stdout");
   const std::string a = slurp(reference), b = slurp(merged);
   EXPECT_GT(a.size(), 0u);
   EXPECT_TRUE(a == b) << reference << " and " << merged << " differ";
@@ -123,9 +128,26 @@ TEST(Shards, RaytracedFabricOfFourShardsMergesToTheOneProcessBytes) {
   const auto args =
       split("bake fabric --method raytrace -R 2 --samples 2100 --quiet --fiber " + fiber.string());
   const fs::path one = dir / "one.exr";
-  ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
+  ASSERT_EQ(run_weft(args + std::vector<std::string>{"--json", "-o", one.string()}, dir), 0)
       << slurp(dir / "stderr");
-  expect_shards_merge_to(args, one, dir, ".exr");
+  const auto whole = nlohmann::json::parse(slurp(dir / "stdout"));
+  std::string printed;
+  expect_shards_merge_to(args, one, dir, ".exr", {"--json"}, &printed);
+  ASSERT_FALSE(printed.empty());
+  const auto merged = nlohmann::json::parse(printed);
+  // The energy books, counts and noise are sums over the bins in bin order: the merge has the
+  // whole run's bits (JSON numbers print with round-trip precision).
+  for (const char* key : {"exited", "absorbed", "lost", "roulette_net", "relative_noise",
+                          "relative_noise_per_channel", "particles", "scatterings",
+                          "reflectance_normal_incidence", "transmittance_normal_incidence"}) {
+    ASSERT_TRUE(whole.contains(key) && merged.contains(key)) << key;
+    EXPECT_FALSE(merged[key].is_null()) << key;
+    EXPECT_EQ(whole[key].dump(), merged[key].dump()) << key;
+  }
+  EXPECT_GT(merged["relative_noise"].get<double>(), 0.0);
+  EXPECT_NEAR(merged["exited"].get<double>() + merged["absorbed"].get<double>() +
+                  merged["lost"].get<double>() + merged["roulette_net"].get<double>(),
+              1.0, 1e-9);  // fabric_raytrace.h: the books add up to 1 to rounding
 }
 
 TEST(Shards, SweepOfFourShardsMergesToTheOneProcessBytes) {
@@ -249,28 +271,6 @@ TEST(Resume, ShardOfARaytracedFabricKilledAtRandomMomentsResumesToTheSameBytes) 
                   ".part", 4, dir);
 }
 
-TEST(Outputs, NeverOverwriteInputsOrEachOther) {
-  const fs::path dir = fresh_test_dir();
-  const fs::path scene = dir / "s.json", spec = dir / "spec.json";
-  fs::copy_file(kScene, scene);
-  fs::copy_file(fs::path(kScene).parent_path() / "woven-patch.gltf", dir / "woven-patch.gltf");
-  std::ofstream(spec) << R"({"name": "t", "fiber_radius_um": 6,
-    "roughness": {"distribution": "beckmann", "alpha": 0.3}, "host": {"n": 1.557},
-    "species": []})";
-  const std::string scene_bytes = slurp(scene), spec_bytes = slurp(spec);
-  auto refused = [&](const std::string& args) {
-    EXPECT_EQ(run_weft(split(args), dir), 2) << args;
-    EXPECT_NE(slurp(dir / "stderr").find("refusing to overwrite"), std::string::npos)
-        << slurp(dir / "stderr");
-  };
-  refused("sweep " + scene.string() + " --spp 1 --resolution 4 -o " + scene.string());
-  // The same file by another spelling.
-  refused("sweep " + scene.string() + " --spp 1 --resolution 4 -o " +
-          (dir / "." / "s.json").string());
-  refused("bake fiber " + spec.string() + " --photons 10 --resolution 2 -o " + spec.string());
-  const fs::path x = dir / "x.exr";
-  refused("render " + scene.string() + " --spp 1 --width 4 --height 4 -o " + x.string() +
-          " --mask " + x.string() + " --mask-object patch");
 namespace {
 
 // RFC 4648 base64 (the bundled glTF's data URI) to bytes.
@@ -347,6 +347,28 @@ TEST(Shards, ChangedGltfOrBufferInvalidatesPartsAndCheckpoints) {
   EXPECT_FALSE(fs::exists(out));
 }
 
+TEST(Outputs, NeverOverwriteInputsOrEachOther) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path scene = dir / "s.json", spec = dir / "spec.json";
+  fs::copy_file(kScene, scene);
+  fs::copy_file(fs::path(kScene).parent_path() / "woven-patch.gltf", dir / "woven-patch.gltf");
+  std::ofstream(spec) << R"({"name": "t", "fiber_radius_um": 6,
+    "roughness": {"distribution": "beckmann", "alpha": 0.3}, "host": {"n": 1.557},
+    "species": []})";
+  const std::string scene_bytes = slurp(scene), spec_bytes = slurp(spec);
+  auto refused = [&](const std::string& args) {
+    EXPECT_EQ(run_weft(split(args), dir), 2) << args;
+    EXPECT_NE(slurp(dir / "stderr").find("refusing to overwrite"), std::string::npos)
+        << slurp(dir / "stderr");
+  };
+  refused("sweep " + scene.string() + " --spp 1 --resolution 4 -o " + scene.string());
+  // The same file by another spelling.
+  refused("sweep " + scene.string() + " --spp 1 --resolution 4 -o " +
+          (dir / "." / "s.json").string());
+  refused("bake fiber " + spec.string() + " --photons 10 --resolution 2 -o " + spec.string());
+  const fs::path x = dir / "x.exr";
+  refused("render " + scene.string() + " --spp 1 --width 4 --height 4 -o " + x.string() +
+          " --mask " + x.string() + " --mask-object patch");
   EXPECT_FALSE(fs::exists(x));
   EXPECT_EQ(slurp(scene), scene_bytes);
   EXPECT_EQ(slurp(spec), spec_bytes);
