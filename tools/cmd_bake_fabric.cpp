@@ -64,6 +64,17 @@ int run(const BakeFabricOptions& o) {
   if (!std::filesystem::is_directory(dir))
     throw Error(o.output, "", "output directory does not exist");
   validate_output_paths({o.output}, {o.fiber, o.weave, o.wif});
+  if (o.method == "raytrace") {
+    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
+    const UnitRange r =
+        shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"));
+    const uint64_t per_bin = o.samples ? o.samples : FabricRaytraceOptions{}.particles_per_bin;
+    check_long_work(double(r.last - r.first) * double(per_bin), kMinSecondsPerFabricParticle,
+                    o.threads, "", "--samples",
+                    "a ray trace of " + std::to_string(r.last - r.first) + " incident bins x " +
+                        std::to_string(per_bin) + " particles",
+                    "0.25 us per particle per core at least");
+  }
   const auto progress = progress_bar(o.quiet);
   const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
   const WovenSample sample = woven_sample(o);
@@ -120,6 +131,7 @@ int run(const BakeFabricOptions& o) {
   if (o.json) {
     std::cout << j.dump(2) << "\n";
   } else {
+    const auto normal = table.directional_albedo(table.grid().bin_of({0, 0, 1}));
     std::printf(
         "%s: %s, R = %d, %.2f s; at normal incidence R = %.4f, T = %.4f (mean of channels)\n",
         o.output.c_str(), o.method.c_str(), o.resolution, seconds,
@@ -131,7 +143,6 @@ int run(const BakeFabricOptions& o) {
 
 }  // namespace
 
-    const auto normal = table.directional_albedo(table.grid().bin_of({0, 0, 1}));
 void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   auto o = std::make_shared<BakeFabricOptions>();
   auto* sub =

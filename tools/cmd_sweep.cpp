@@ -267,6 +267,13 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          }
          const bool partial = !shard.whole() || o->resume;
          if (partial) g.units = todo;
+         // Each view renders the sample, and the white reference unless --no-white-check.
+         check_long_work(double(todo.size()) * (g.white_check ? 2 : 1) * g.width * g.height * g.spp,
+                         kMinSecondsPerPathSample, g.threads, o->scene, "spp",
+                         "a sweep of " + std::to_string(todo.size()) + " views of " +
+                             std::to_string(g.width) + " x " + std::to_string(g.height) +
+                             " pixels at " + std::to_string(g.spp) + " spp",
+                         "0.05 us per path sample per core at least");
          auto part_of = [&](const GonioResult& r, bool checkpoint) {
            JobPart p = job;
            p.checkpoint = checkpoint;
