@@ -1,17 +1,22 @@
 // weft verify: computed fabric vs measurement vs the classic model, at every measured incidence,
 // in one report folder (docs/verify.md). Binds options, makes the fiber physics' inputs (fiber
 // bake, summation table) that the integrators library does not link, calls run_verify, plots.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "commands.h"
+#include "fabric_parts.h"
+#include "job_part.h"
 #include "plot_util.h"
 #include "verify_fit.h"
 #include "weft/core/error.h"
 #include "weft/integrators/verify.h"
+#include "weft/materials/fabric/bake_cache.h"
 #include "weft/materials/fabric/fabric_summation.h"
 #include "weft/materials/fabric/fiber_spec.h"
 #include "weft/materials/fabric/fiber_table_bake.h"
@@ -27,6 +32,7 @@ struct VerifyCliOptions {
       "dye_scale,particle_fraction_scale,particle_radius_scale,roughness_alpha";
   int fit_evaluations = 100;
   std::string fit_inner = "raytrace";
+  std::string shard;  // --shard K/N
   bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false;
   uint64_t seed = 1;
   int threads = 0;
@@ -108,21 +114,31 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
   return true;
 }
 
-int run(const VerifyCliOptions& o) {
-  const auto t_all = std::chrono::steady_clock::now();
-  // Everything the user gave is checked before any work.
+// The user's inputs, checked before any work (every way of running verify starts here).
+struct VerifyPlan {
+  VerifySettings s;
+  std::filesystem::path measured_path;
+  MeasuredInplane measured;
+  FiberSpec spec;
+  WeaveOptions weave;
+  std::vector<std::string> fit_names;
+  FitOptions fit_options;
+};
+
+VerifyPlan plan(const VerifyCliOptions& o) {
+  VerifyPlan p;
   const VerifyQuality q = parse_verify_quality(o.quality);
-  VerifySettings s = verify_settings(q);
-  s.seed = o.seed;
-  s.threads = o.threads;
-  const std::filesystem::path measured_path =
+  p.s = verify_settings(q);
+  p.s.seed = o.seed;
+  p.s.threads = o.threads;
+  p.measured_path =
       o.measured.empty() ? bundled_measured_inplane() : std::filesystem::path(o.measured);
-  const MeasuredInplane measured = read_measured_inplane(measured_path);
+  p.measured = read_measured_inplane(p.measured_path);
   if (std::filesystem::path(o.fiber).extension() == ".exr")
     throw Error(o.fiber, "--fiber",
                 "give a fiber spec or preset: the classic baseline's diffuse colour is the "
                 "fiber's volume albedo, which a baked table does not record");
-  const FiberSpec spec = load_fiber_spec(o.fiber);
+  p.spec = load_fiber_spec(o.fiber);
   if (!o.pattern.empty() && !o.wif.empty())
     throw Error("", "--wif", "give either --pattern or --wif, not both");
   WeaveOptions given;
@@ -130,45 +146,140 @@ int run(const VerifyCliOptions& o) {
   if (!o.wif.empty()) given.wif = o.wif;
   given.detail = "fiber";  // the fiber-level reference
   const WeaveOptions base = o.weave.empty() ? WeaveOptions{} : read_weave_options(o.weave);
-  std::vector<std::string> fit_names;
-  FitOptions fit_options;
+  p.weave = overlay(base, given);
   if (o.fit) {
-    fit_names = parse_spec_fit_names(o.fit_params);
+    if (!o.shard.empty()) throw Error("", "--fit", "runs in one process, not with --shard");
+    p.fit_names = parse_spec_fit_names(o.fit_params);
     (void)parse_fit_inner(o.fit_inner);
-    fit_options.max_evaluations = o.fit_evaluations;
-    fit_options.validate(4);                     // the classic model always fits four
-    (void)spec_fit_parameters(spec, fit_names);  // a spec without particles is refused here
+    p.fit_options.max_evaluations = o.fit_evaluations;
+    p.fit_options.validate(4);                       // the classic model always fits four
+    (void)spec_fit_parameters(p.spec, p.fit_names);  // a spec without particles is refused here
   } else if (o.fit_params_given || o.fit_evaluations_given) {
     throw Error("", o.fit_params_given ? "--fit-params" : "--fit-evaluations", "only with --fit");
   }
-  check_verify_output(o.output);
+  return p;
+}
+
+// A sharded verify's job: the options that fix its result (a merge runs them again for the parts
+// it does not hold), the content of its input files, and its units: the incident bins of every
+// ray trace (verify_traces), trace after trace.
+JobPart verify_job(const VerifyCliOptions& o, const VerifyPlan& p, Shard shard) {
+  std::vector<std::filesystem::path> files{p.measured_path};
+  std::error_code ec;
+  for (const std::string& f : {o.weave, o.wif, o.fiber})
+    if (!f.empty() && std::filesystem::is_regular_file(f, ec)) files.emplace_back(f);
+  JobPart job;
+  job.command = "verify";
+  job.job = {{"options",
+              {{"fiber", o.fiber},
+               {"measured", o.measured},
+               {"weave", o.weave},
+               {"pattern", o.pattern},
+               {"wif", o.wif},
+               {"quality", o.quality},
+               {"seed", o.seed}}},
+             {"inputs", input_file_hashes(files)},
+             {"spec_hash", fiber_spec_hash_hex(p.spec)},
+             {"program_version", WEFT_VERSION}};
+  job.units_total = verify_traces(p.s).size() * DirectionGrid{p.s.resolution}.bins();
+  job.shard = shard;
+  job.extra = {{"threads", o.threads}};  // reported in metrics.json; results do not depend on it
+  return job;
+}
+
+// The spectral fiber table through the bake cache (./.weft-cache, bake_cache.h): shards of a job
+// that need it at once bake it once, and the merge reuses it. Returns false when interrupted.
+bool fiber_from_cache(const VerifyPlan& p, VerifyInputs& in, const ProgressCallback& progress) {
+  FiberTableBakeOptions b;
+  b.resolution = p.s.resolution;
+  b.photons_per_band = p.s.fiber_photons_per_band;
+  b.seed = p.s.seed;
+  b.threads = p.s.threads;
+  b.spectral = true;  // the colour table needs the spectrum
+  std::filesystem::path file;
+  try {
+    file = cached_fiber_table(".weft-cache", p.spec, b, progress);
+  } catch (const Error&) {
+    if (interrupted()) return false;
+    throw;
+  }
+  in.fiber = TabulatedBsdfTable::read_exr(file);
+  in.volume_albedo = volume_albedo_of(in.fiber, file.string());
+  return true;
+}
+
+// --shard K/N: the shard's units of the ray traces into a part file at o.output.
+int run_shard(const VerifyCliOptions& o, const VerifyPlan& p, const WovenSample& sample,
+              const VerifyInputs& in, const JobPart& job, const ProgressCallback& progress) {
+  const uint64_t bins = DirectionGrid{p.s.resolution}.bins();
+  const UnitRange range = shard_units(job.units_total, job.shard);
+  const std::vector<VerifyTrace> traces = verify_traces(p.s);
+  std::optional<ClassicFiber> classic;
+  JobPart part = job;
+  for (size_t t = 0; t < traces.size(); ++t) {
+    const uint64_t first = std::max(range.first, t * bins),
+                   last = std::min(range.last, (t + 1) * bins);
+    if (first >= last) continue;
+    if (traces[t].model == "classic" && !classic) classic = verify_classic_fiber(in, p.s, progress);
+    FabricRaytraceOptions r = traces[t].options;
+    r.first_bin = static_cast<int>(first - t * bins);
+    r.bin_count = static_cast<int>(last - first);
+    const FabricRaytraceResult res = raytrace_fabric_table(
+        sample, traces[t].model == "classic" ? classic->table : in.fiber, r, progress);
+    if (res.cancelled) {
+      std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
+      return 130;
+    }
+    for (uint64_t u = first; u < last; ++u) encode_fabric_bin(res, u - t * bins, part.units[u]);
+  }
+  write_job_part(o.output, part);
+  std::printf("ray-trace units %llu..%llu of %llu (shard %u/%u) -> %s\n",
+              static_cast<unsigned long long>(range.first),
+              static_cast<unsigned long long>(range.last),
+              static_cast<unsigned long long>(job.units_total), job.shard.index, job.shard.count,
+              o.output.c_str());
+  return 0;
+}
+
+// The whole run, or the merge of a sharded one ('all': every unit of its ray traces).
+int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
+  const auto t_all = std::chrono::steady_clock::now();
+  const VerifyPlan p = plan(o);
+  const VerifySettings& s = p.s;
+  const MeasuredInplane& measured = p.measured;
+  const Shard shard = o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard");
+  std::optional<JobPart> job;
+  if (!o.shard.empty()) {
+    validate_output_paths({o.output}, {p.measured_path.string(), o.weave, o.wif, o.fiber});
+    job = verify_job(o, p, shard);
+  } else {
+    check_verify_output(o.output);
+  }
+  if (all) {
+    // The inputs must still be those the shards read.
+    const JobPart now = verify_job(o, p, all->shard);
+    if (const std::string why = job_difference(*all, now); !why.empty())
+      throw Error("", "parts",
+                  "the verify job's inputs changed since its shards ran (" + why + ")");
+  }
 
   const auto progress = progress_bar(o.quiet);
   VerifyInputs in;
   in.fiber_name = o.fiber;
   auto t0 = std::chrono::steady_clock::now();
-  const WovenSample sample = make_woven_sample(overlay(base, given));
+  const WovenSample sample = make_woven_sample(p.weave);
   in.sample_name = sample.summary.source + " (" + sample.summary.detail + ")";
   in.seconds["woven_sample"] = since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  FiberTableBakeOptions b;
-  b.resolution = s.resolution;
-  b.photons_per_band = s.fiber_photons_per_band;
-  b.seed = s.seed;
-  b.threads = s.threads;
-  b.spectral = true;  // the colour table needs the spectrum
-  FiberTableBakeResult fiber = bake_fiber_table(spec, b, progress);
-  if (fiber.cancelled) {
+  if (!fiber_from_cache(p, in, progress)) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
     return 130;
   }
   in.seconds["fiber_bake"] = since(t0);
-  for (const auto& band : fiber.bands)
-    in.volume_albedo[band.band] = band.exit_fraction - band.surface_fraction;
-  in.classic_distribution = {spec.roughness_distribution, spec.roughness_alpha};
-  in.classic_ior = spec.host_n[kNumBands / 2];  // 550 nm
-  in.fiber = std::move(fiber.table);
+  in.classic_distribution = {p.spec.roughness_distribution, p.spec.roughness_alpha};
+  in.classic_ior = p.spec.host_n[kNumBands / 2];  // 550 nm
+  if (job) return run_shard(o, p, sample, in, *job, progress);
 
   t0 = std::chrono::steady_clock::now();
   FabricSummationOptions so;
@@ -180,12 +291,24 @@ int run(const VerifyCliOptions& o) {
   in.summation = sum_fabric_table(in.fiber, so, progress);
   in.seconds["summation"] = since(t0);
 
-  VerifyReport report = run_verify(sample, in, measured, s, progress);
+  VerifyTraced traced;
+  if (all) {
+    const uint64_t bins = DirectionGrid{s.resolution}.bins();
+    const std::vector<VerifyTrace> traces = verify_traces(s);
+    for (size_t t = 0; t < traces.size(); ++t) {
+      const auto it = all->units.find(t * bins);
+      if (it == all->units.end()) throw Error("", "parts", "a ray trace's first bin is missing");
+      traced[{traces[t].model, traces[t].batch}] = assemble_fabric_bins(
+          all->units, t * bins, bins, s.resolution, fabric_bin_channels(it->second, bins));
+    }
+  }
+  VerifyReport report = run_verify(sample, in, measured, s, progress, all ? &traced : nullptr);
   if (report.cancelled) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
     return 130;
   }
-  if (o.fit && !fit(o, spec, fit_names, fit_options, s, sample, in, measured, report, progress))
+  if (o.fit &&
+      !fit(o, p.spec, p.fit_names, p.fit_options, s, sample, in, measured, report, progress))
     return 130;
   report.seconds["total_before_report"] = since(t_all);
   write_verify_report(o.output, report, [&](const std::filesystem::path& staging) {
@@ -218,9 +341,9 @@ int run(const VerifyCliOptions& o) {
     for (const auto& f : report.fits) {
       std::printf("  fit %s: inner rms_log %.3f -> %.3f, %d evaluations, %.1f s:", f.model.c_str(),
                   f.objective_start, f.objective, f.evaluations, f.seconds);
-      for (const auto& p : f.parameters)
-        std::printf(" %s %.4g +- %.2g%s", p.parameter.name.c_str(), p.value, p.sigma,
-                    p.at_bound ? " (at bound)" : "");
+      for (const auto& fp : f.parameters)
+        std::printf(" %s %.4g +- %.2g%s", fp.parameter.name.c_str(), fp.value, fp.sigma,
+                    fp.at_bound ? " (at bound)" : "");
       std::printf("\n");
     }
   }
@@ -271,7 +394,27 @@ void add_verify_command(CLI::App& app, Commands& commands) {
       ->each([o](const std::string&) { o->fit_inner_given = true; });
   sub->add_flag("--json", o->json, "print metrics.json on stdout");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
+  sub->add_option("--shard", o->shard,
+                  "K/N: run only shard K of N of the ray traces (their incident bins) into a part "
+                  "file -o PART; `weft merge` makes the report folder from all parts");
   commands.push_back({sub, [o] { return run(*o); }});
+}
+
+int merge_verify(const JobPart& all, const std::string& output, bool json) {
+  VerifyCliOptions o;
+  const auto& opt = all.job.at("options");
+  o.fiber = opt.at("fiber").get<std::string>();
+  o.measured = opt.at("measured").get<std::string>();
+  o.weave = opt.at("weave").get<std::string>();
+  o.pattern = opt.at("pattern").get<std::string>();
+  o.wif = opt.at("wif").get<std::string>();
+  o.quality = opt.at("quality").get<std::string>();
+  o.seed = opt.at("seed").get<uint64_t>();
+  o.threads = all.extra.value("threads", 0);
+  o.output = output;
+  o.json = json;
+  o.quiet = true;
+  return run(o, &all);
 }
 
 }  // namespace weft::cli

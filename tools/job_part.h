@@ -83,4 +83,5 @@ namespace weft::cli {
 int merge_fiber_bake(const JobPart& all, const std::string& output, bool json);
 int merge_fabric_bake(const JobPart& all, const std::string& output, bool json);
 int merge_sweep(const JobPart& all, const std::string& output, bool json);
+int merge_verify(const JobPart& all, const std::string& output, bool json);
 }  // namespace weft::cli

@@ -360,21 +360,36 @@ struct TracedCurves {
   bool cancelled = false;
 };
 
+FabricRaytraceOptions trace_options(const VerifySettings& s, const std::string& model, int k) {
+  FabricRaytraceOptions o;
+  o.resolution = s.resolution;
+  o.particles_per_bin = s.particles_per_bin / static_cast<uint64_t>(s.batches);
+  o.seed = batch_seed(s.seed, model, k);
+  o.threads = s.threads;
+  return o;
+}
+
 TracedCurves trace_curves(const WovenSample& sample, const TabulatedBsdfTable& fiber,
                           const MeasuredInplane& measured, const VerifySettings& s,
-                          const std::string& model, const ProgressCallback& progress) {
+                          const std::string& model, const ProgressCallback& progress,
+                          const VerifyTraced* traced) {
   TracedCurves out;
   const size_t n_inc = measured.curves.size();
   std::vector<std::vector<std::vector<Rgb>>> per_batch;  // [batch][incidence][view]
   std::vector<double> sum;
   double noise2 = 0;
   for (int k = 0; k < s.batches; ++k) {
-    FabricRaytraceOptions o;
-    o.resolution = s.resolution;
-    o.particles_per_bin = s.particles_per_bin / static_cast<uint64_t>(s.batches);
-    o.seed = batch_seed(s.seed, model, k);
-    o.threads = s.threads;
-    const FabricRaytraceResult r = raytrace_fabric_table(sample, fiber, o, progress);
+    FabricRaytraceResult here;
+    const FabricRaytraceResult* found = nullptr;
+    if (traced)
+      if (const auto it = traced->find({model, k}); it != traced->end()) found = &it->second;
+    if (!found) {
+      here = raytrace_fabric_table(sample, fiber, trace_options(s, model, k), progress);
+      found = &here;
+    }
+    const FabricRaytraceResult& r = *found;
+    if (r.table.channels != fiber.channels || r.table.resolution != s.resolution)
+      throw Error("", model, "a ray trace handed in is of another table");
     if (r.cancelled) {
       out.cancelled = true;
       return out;
@@ -464,9 +479,43 @@ void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& nor
 
 }  // namespace
 
+std::vector<VerifyTrace> verify_traces(const VerifySettings& s) {
+  std::vector<VerifyTrace> out;
+  for (const char* model : {"computed", "classic"})
+    for (int k = 0; k < s.batches; ++k) out.push_back({model, k, trace_options(s, model, k)});
+  return out;
+}
+
+ClassicFiber verify_classic_fiber(const VerifyInputs& in, const VerifySettings& s,
+                                  const ProgressCallback& progress) {
+  ClassicFiber c;
+  // The fiber's volume albedo as a reflectance: components outside [0, 1] are removed (and
+  // reported).
+  Rgb refl = bands_to_linear_srgb([&](int b) { return in.volume_albedo[b]; });
+  c.clip.clip(refl);
+  for (double* v : {&refl.r, &refl.g, &refl.b})
+    if (*v > 1) {
+      c.clip.largest = std::max(c.clip.largest, *v - 1);
+      ++c.clip.components;
+      *v = 1;
+    }
+  if (in.classic_diffuse) {
+    const Rgb d = *in.classic_diffuse;
+    for (int k = 0; k < 3; ++k)
+      if (!(channel(d, k) >= 0 && channel(d, k) <= 1))
+        throw Error("", "classic_diffuse", "a reflectance lies in [0, 1]");
+    refl = d;
+    c.clip = GamutClip();
+  }
+  c.reflectance = refl;
+  c.table = classic_fiber_table(refl, in.classic_distribution, in.classic_ior, s.resolution,
+                                s.summation_samples, s.seed, s.threads, progress);
+  return c;
+}
+
 VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
                         const MeasuredInplane& measured, const VerifySettings& s,
-                        const ProgressCallback& progress) {
+                        const ProgressCallback& progress, const VerifyTraced* traced) {
   if (s.batches < 2) throw Error("", "batches", "the error bars need at least 2 batches");
   if (s.particles_per_bin < static_cast<uint64_t>(s.batches))
     throw Error("", "particles_per_bin", "fewer particles than batches");
@@ -496,7 +545,7 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
 
   // Computed: the fiber-level ray trace of the fiber table.
   auto t0 = std::chrono::steady_clock::now();
-  TracedCurves computed = trace_curves(sample, in.fiber, measured, s, "computed", progress);
+  TracedCurves computed = trace_curves(sample, in.fiber, measured, s, "computed", progress, traced);
   if (computed.cancelled) {
     rep.cancelled = true;
     return rep;
@@ -522,30 +571,12 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
     rep.models.push_back(std::move(m));
   }
 
-  // Classic: Lambert + Cook-Torrance with the fiber's volume albedo as its diffuse colour, a
-  // reflectance, so components outside [0, 1] are removed (and reported).
+  // Classic: Lambert + Cook-Torrance with the fiber's volume albedo as its diffuse colour.
   t0 = std::chrono::steady_clock::now();
-  Rgb refl = bands_to_linear_srgb([&](int b) { return in.volume_albedo[b]; });
-  rep.classic_clip.clip(refl);
-  for (double* v : {&refl.r, &refl.g, &refl.b})
-    if (*v > 1) {
-      rep.classic_clip.largest = std::max(rep.classic_clip.largest, *v - 1);
-      ++rep.classic_clip.components;
-      *v = 1;
-    }
-  if (in.classic_diffuse) {
-    const Rgb d = *in.classic_diffuse;
-    for (int k = 0; k < 3; ++k)
-      if (!(channel(d, k) >= 0 && channel(d, k) <= 1))
-        throw Error("", "classic_diffuse", "a reflectance lies in [0, 1]");
-    refl = d;
-    rep.classic_clip = GamutClip();
-  }
-  rep.classic_reflectance = refl;
-  const TabulatedBsdfTable classic_fiber =
-      classic_fiber_table(refl, in.classic_distribution, in.classic_ior, s.resolution,
-                          s.summation_samples, s.seed, s.threads, progress);
-  TracedCurves cl = trace_curves(sample, classic_fiber, measured, s, "classic", progress);
+  const ClassicFiber classic = verify_classic_fiber(in, s, progress);
+  rep.classic_clip = classic.clip;
+  rep.classic_reflectance = classic.reflectance;
+  TracedCurves cl = trace_curves(sample, classic.table, measured, s, "classic", progress, traced);
   if (cl.cancelled) {
     rep.cancelled = true;
     return rep;
