@@ -9,11 +9,12 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
-#include <filesystem>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <memory>
 #include <sstream>
+#include <thread>
 
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
@@ -155,12 +156,19 @@ double render_bytes(int width, int height, bool preview, bool mask) {
   return double(width) * double(height) * per_pixel;
 }
 
-void check_long_work(double seconds, const std::string& file, const std::string& field,
-                     const std::string& what, const std::string& basis) {
-  if (seconds <= kLongWorkSeconds || run_limits().yes_long) return;
-  throw Error(file, field,
-              what + " would take at least " + format_seconds(seconds) + " (" + basis +
-                  "); add --yes-long to run it anyway");
+void check_long_work(double units, double seconds_per_unit, int threads, const std::string& file,
+                     const std::string& field, const std::string& what, const std::string& rate) {
+  const unsigned cores = threads > 0 ? static_cast<unsigned>(threads)
+                                     : std::max(1u, std::thread::hardware_concurrency());
+  const double seconds = units * seconds_per_unit / cores;
+  const std::string basis = rate + ", " + std::to_string(cores) + (cores == 1 ? " core" : " cores");
+  if (seconds > kLongWorkSeconds && !run_limits().yes_long)
+    throw Error(file, field,
+                what + " would take at least " + format_seconds(seconds) + " (" + basis +
+                    "); add --yes-long to run it anyway");
+  if (seconds > kAnnouncedWorkSeconds)
+    std::fprintf(stderr, "weft: %s: at least %s (%s)\n", what.c_str(),
+                 format_seconds(seconds).c_str(), basis.c_str());
 }
 
 CLI::Validator seed_validator() {

@@ -56,12 +56,17 @@ double available_memory_bytes();
 // allocating, so a run that cannot fit stops at once instead of dying of std::bad_alloc.
 void check_memory(double bytes, const std::string& file, const std::string& field,
                   const std::string& what);
-// Work estimated to take at least this long needs --yes-long.
+// Work estimated to take at least this long needs --yes-long; above a minute the estimate is
+// printed on stderr before the work starts.
 inline constexpr double kLongWorkSeconds = 3600;
-// Error(file, field, ...) unless --yes-long when 'seconds' (a lower bound) exceeds
-// kLongWorkSeconds; 'basis' says how the estimate was made.
-void check_long_work(double seconds, const std::string& file, const std::string& field,
-                     const std::string& what, const std::string& basis);
+inline constexpr double kAnnouncedWorkSeconds = 60;
+// Before long work, from a lower bound of its time: 'units' of work at 'seconds_per_unit' per
+// core on the cores 'threads' gives (0: all). Prints "weft: WHAT: at least T (BASIS)" on stderr
+// above kAnnouncedWorkSeconds, and throws Error(file, field, ...) above kLongWorkSeconds unless
+// --yes-long. 'rate' names the rate the bound assumes ("0.05 us per path sample per core"): the
+// basis printed is it with the cores.
+void check_long_work(double units, double seconds_per_unit, int threads, const std::string& file,
+                     const std::string& field, const std::string& what, const std::string& rate);
 // The per-pixel buffers of a render: the image (3 floats), the sRGB preview (3 bytes) and a
 // masked render's hit counts, sums and squares (3 + 3 doubles) and coverage (a float).
 double render_bytes(int width, int height, bool preview, bool mask);

@@ -7,7 +7,6 @@
 #include <iostream>
 #include <iterator>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "commands.h"
 #include "job_part.h"
@@ -254,13 +253,11 @@ void add_bake_command(CLI::App& app, Commands& commands) {
            };
          check_memory(fiber_table_bake_bytes(o), "", "--resolution",
                       "a bake at resolution " + std::to_string(o.resolution));
-         const unsigned cores = o.threads > 0 ? o.threads : std::thread::hardware_concurrency();
-         check_long_work(
-             static_cast<double>(o.photons_per_band) * static_cast<double>(range.last - range.first) *
-                 kMinSecondsPerPhoton /
-                 std::max(1u, cores),
-             "", "--photons", std::to_string(o.photons_per_band) + " photons per band",
-             "0.5 us per photon per core at least, " + std::to_string(cores) + " cores");
+         check_long_work(static_cast<double>(o.photons_per_band) *
+                             static_cast<double>(range.last - range.first),
+                         kMinSecondsPerPhoton, o.threads, "", "--photons",
+                         std::to_string(o.photons_per_band) + " photons per band",
+                         "0.5 us per photon per core at least");
          const auto start = std::chrono::steady_clock::now();
          FiberBandsResult traced;
          if (range.last > range.first) {

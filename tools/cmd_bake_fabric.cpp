@@ -99,6 +99,17 @@ int run(const BakeFabricOptions& o) {
   if (!std::filesystem::is_directory(dir))
     throw Error(o.output, "", "output directory does not exist");
   validate_output_paths({o.output}, {o.fiber, o.weave, o.wif});
+  if (o.method == "raytrace") {
+    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
+    const UnitRange r =
+        shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"));
+    const uint64_t per_bin = o.samples ? o.samples : FabricRaytraceOptions{}.particles_per_bin;
+    check_long_work(double(r.last - r.first) * double(per_bin), kMinSecondsPerFabricParticle,
+                    o.threads, "", "--samples",
+                    "a ray trace of " + std::to_string(r.last - r.first) + " incident bins x " +
+                        std::to_string(per_bin) + " particles",
+                    "0.25 us per particle per core at least");
+  }
   const auto progress = progress_bar(o.quiet);
   const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
   const WovenSample sample = woven_sample(o);
@@ -109,8 +120,12 @@ int run(const BakeFabricOptions& o) {
     FabricRaytraceResult res;
     if (!o.shard.empty() || o.resume) {
       int code = 0;
-      auto pieces =
-          raytrace_fabric_in_pieces(sample, fiber, r, o.output, o.shard, o.resume, progress, &code);
+      // The files the woven sample was made from (the fiber table is in the job by checksum).
+      std::vector<std::filesystem::path> inputs;
+      for (const auto& f : {o.weave, o.wif})
+        if (!f.empty()) inputs.emplace_back(f);
+      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
+                                              o.shard, o.resume, progress, &code);
       if (!pieces) return code;
       res = std::move(*pieces);
     } else {
@@ -122,19 +137,11 @@ int run(const BakeFabricOptions& o) {
     }
     table = res.table;
     record_particle_counts(table, res.splits, res.roulette_kills);
-    extra = {{"particles", res.particles},
-             {"estimator", channel_sampling_name(r.channel_sampling)},
-             {"split_threshold", r.channel_sampling == ChannelSampling::mean
-                                     ? nlohmann::json(nullptr)
-                                     : nlohmann::json(r.split_threshold)},
-             {"splits", res.splits},
-             {"roulette_kills", res.roulette_kills},
-             {"scatterings", res.scatterings},
-             {"exited", res.exited},
-             {"absorbed", res.absorbed},
-             {"lost", res.lost},
-             {"relative_noise", res.relative_noise},
-             {"relative_noise_per_channel", res.relative_noise_per_channel}};
+    extra = raytrace_summary(res);
+    extra["estimator"] = channel_sampling_name(r.channel_sampling);
+    extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
+                                   ? nlohmann::json(nullptr)
+                                   : nlohmann::json(r.split_threshold);
   } else {
     FabricSummationOptions s;
     s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
@@ -153,21 +160,8 @@ int run(const BakeFabricOptions& o) {
   table.metadata["sample"] = sample.summary.source + " (" + sample.summary.detail + ")";
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
   table.write_exr(o.output);
-  const DirectionGrid g = table.grid();
-  // Light arriving along the normal, where it goes; and what a view along the normal gathers
-  // under uniform light (the renderer's reading). They differ for a non-reciprocal table: the
-  // paper's sum transmits nothing downwards but light from below upwards (fabric_summation.h).
-  const auto normal = table.directional_albedo(g.bin_of({0, 0, 1}));
-  const auto view = table.directional_albedo_seen_from(g.bin_of({0, 0, 1}));
-  nlohmann::json j = {{"output", o.output},
-                      {"method", o.method},
-                      {"resolution", o.resolution},
-                      {"seconds", seconds},
-                      {"sample", table.metadata["sample"]},
-                      {"reflectance_normal_incidence", normal.reflectance},
-                      {"transmittance_normal_incidence", normal.transmittance},
-                      {"reflectance_normal_view", view.reflectance},
-                      {"transmittance_normal_view", view.transmittance}};
+  nlohmann::json j = {{"output", o.output}, {"method", o.method}, {"seconds", seconds}};
+  j.update(fabric_table_summary(table));
   if (extra.is_object()) j.update(extra);
   if (o.json) {
     std::cout << j.dump(2) << "\n";
@@ -177,6 +171,12 @@ int run(const BakeFabricOptions& o) {
       for (double x : v) s += x;
       return s / static_cast<double>(v.size());
     };
+    // Light arriving along the normal, where it goes; and what a view along the normal gathers
+    // under uniform light (the renderer's reading). They differ for a non-reciprocal table: the
+    // paper's sum transmits nothing downwards but light from below upwards (fabric_summation.h).
+    const DirectionGrid g = table.grid();
+    const auto normal = table.directional_albedo(g.bin_of({0, 0, 1}));
+    const auto view = table.directional_albedo_seen_from(g.bin_of({0, 0, 1}));
     std::printf(
         "%s: %s, R = %d, %.2f s; light along the normal: reflected %.4f, transmitted %.4f; seen "
         "along the normal: reflected %.4f, transmitted %.4f (means over channels)\n",

@@ -18,16 +18,20 @@ void add_merge_command(CLI::App& app, Commands& commands) {
   auto o = std::make_shared<Options>();
   auto* sub = app.add_subcommand(
       "merge",
-      "Merge the parts of a sharded `bake fiber`, `bake fabric --method raytrace` or `sweep` "
-      "(--shard K/N) into the output of the unsharded run, bit for bit");
+      "Merge the parts of a sharded `bake fiber`, `bake fabric --method raytrace`, `sweep` or "
+      "`verify` (--shard K/N) into the output of the unsharded run, bit for bit");
   sub->add_option("parts", o->parts, "part files, one per shard, in any order")->required();
-  sub->add_option("-o,--output", o->output, "output (.exr table or .csv sweep)")->required();
+  sub->add_option("-o,--output", o->output,
+                  "output (.exr table, .csv sweep or verify's report folder)")
+      ->required();
   sub->add_flag("--json", o->json, "print the command's summary as JSON");
   commands.push_back(
       {sub, [o] {
-         validate_output_paths({o->output}, o->parts);
          const JobPart all =
              merge_job_parts(std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
+         // A verify report is a folder, checked as verify checks it (check_verify_output).
+         if (all.command != "verify") validate_output_paths({o->output}, o->parts);
+         if (all.command == "verify") return merge_verify(all, o->output, o->json);
          if (all.command == "bake fiber") return merge_fiber_bake(all, o->output, o->json);
          if (all.command == "bake fabric") return merge_fabric_bake(all, o->output, o->json);
          if (all.command == "sweep") return merge_sweep(all, o->output, o->json);

@@ -140,6 +140,17 @@ void add_render_command(CLI::App& app, Commands& commands) {
                       "a " + std::to_string(job.settings.width) + " x " +
                           std::to_string(job.settings.height) + " render" +
                           (job.mask ? " with a mask" : ""));
+         // A time limit bounds the work itself.
+         if (!(job.settings.time_limit_s > 0)) {
+           const auto& c = job.settings.crop;
+           const double pixels = c ? double(c->width()) * c->height()
+                                   : double(job.settings.width) * job.settings.height;
+           check_long_work(pixels * job.settings.spp, kMinSecondsPerPathSample,
+                           job.settings.threads, o->scene, "spp",
+                           "a render of " + std::to_string(int64_t(pixels)) + " pixels at " +
+                               std::to_string(job.settings.spp) + " spp",
+                           "0.05 us per path sample per core at least");
+         }
          const auto t0 = std::chrono::steady_clock::now();
          const RenderJobResult r =
              render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());

@@ -1,8 +1,8 @@
-// weft slurm: a bake or sweep as a Slurm job array of N shards (`--shard K/N`) plus a merge job
-// that runs after all of them succeeded (`--dependency=afterok`). Writes the two batch scripts
-// beside the output and submits them with sbatch, or prints them (--dry-run) for users who submit
-// themselves. Shards run with --resume: a shard requeued after a node failure continues from its
-// checkpoint.
+// weft slurm: a bake, sweep or verify as a Slurm job array of N shards (`--shard K/N`) plus a
+// merge job that runs after all of them succeeded (`--dependency=afterok`). Writes the two batch
+// scripts beside the output and submits them with sbatch, or prints them (--dry-run) for users who
+// submit themselves. Bake and sweep shards run with --resume: a shard requeued after a node
+// failure continues from its checkpoint.
 #include <unistd.h>
 
 #include <array>
@@ -16,6 +16,7 @@
 #include "commands.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
+#include "weft/integrators/verify.h"
 
 namespace weft::cli {
 namespace {
@@ -57,8 +58,8 @@ void add_slurm_command(CLI::App& app, Commands& commands) {
   auto o = std::make_shared<Options>();
   auto* sub = app.add_subcommand(
       "slurm",
-      "Run `weft bake fiber|fabric ...` or `weft sweep ...` as a Slurm job array of --shards "
-      "shards and a merge job after them (scripts in OUTPUT.slurm/)");
+      "Run `weft bake fiber|fabric ...`, `weft sweep ...` or `weft verify ...` as a Slurm job "
+      "array of --shards shards and a merge job after them (scripts in OUTPUT.slurm/)");
   sub->add_option("--shards", o->shards, "number of shards (array tasks)")
       ->required()
       ->check(CLI::Range(1, 10000));
@@ -75,26 +76,33 @@ void add_slurm_command(CLI::App& app, Commands& commands) {
   sub->fallthrough(false);
   sub->footer(
       "Example: weft slurm --shards 8 --partition cpu bake fiber spec.json -o fiber.exr "
-      "--photons 1000000");
+      "--photons 1000000\n         weft slurm --shards 16 verify --quality publication -o report");
   commands.push_back(
       {sub, [o, sub] {
          std::vector<std::string> args = sub->remaining();
+         const bool verify = !args.empty() && args[0] == "verify";
          if (args.size() < 2 ||
              !((args[0] == "bake" && (args[1] == "fiber" || args[1] == "fabric")) ||
-               args[0] == "sweep"))
+               args[0] == "sweep" || verify))
            throw Error("", "command",
-                       "expected `bake fiber ...`, `bake fabric ...` or `sweep ...`");
+                       "expected `bake fiber ...`, `bake fabric ...`, `sweep ...` or `verify ...`");
          std::string output;
          size_t output_at = 0;
          for (size_t i = 0; i < args.size(); ++i) {
            if (args[i] == "--shard" || args[i].rfind("--shard=", 0) == 0 || args[i] == "--resume")
              throw Error("", args[i], "is set by weft slurm for each shard");
+           if (verify && args[i] == "--fit")
+             throw Error("", "--fit", "runs in one process: not as Slurm shards");
            if ((args[i] == "-o" || args[i] == "--output") && i + 1 < args.size())
              output = args[i + 1], output_at = i + 1;
          }
          if (output.empty()) throw Error("", "--output", "the command needs -o OUTPUT");
          const fs::path out_abs = fs::absolute(output);
-         validate_output_paths({out_abs.string()}, {});
+         // verify's output is its report folder.
+         if (verify)
+           check_verify_output(out_abs);
+         else
+           validate_output_paths({out_abs.string()}, {});
          const fs::path dir = out_abs.string() + ".slurm";
          const std::string weft = self_path();
          const std::string name = "weft-" + out_abs.filename().string();
@@ -117,7 +125,10 @@ void add_slurm_command(CLI::App& app, Commands& commands) {
            array += " " + (i == output_at ? shell_quote((dir / "part-").string()) +
                                                 "\"$SLURM_ARRAY_TASK_ID\".part"
                                           : shell_quote(args[i]));
-         array += " --shard \"$SLURM_ARRAY_TASK_ID/" + std::to_string(n) + "\" --resume --quiet\n";
+         // A requeued shard continues from its checkpoint; verify's shards start again (their
+         // fiber bake is cached, bake_cache.h).
+         array += " --shard \"$SLURM_ARRAY_TASK_ID/" + std::to_string(n) + "\"" +
+                  (verify ? "" : " --resume") + " --quiet\n";
          std::string merge = directives(name + "-merge", "merge.log");
          merge += "set -eu\ncd " + shell_quote(fs::current_path().string()) + "\nexec " +
                   shell_quote(weft) + " merge";

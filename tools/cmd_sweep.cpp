@@ -20,13 +20,6 @@ namespace weft::cli {
 
 namespace {
 
-std::string file_text(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 nlohmann::json rgb_json(const Rgb& c) {
   return {c.r, c.g, c.b};
 }
@@ -34,11 +27,37 @@ Rgb rgb_of(const nlohmann::json& j) {
   return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
 }
 
-// What fixes a sweep's bits: the scene file's bytes and every setting but threads.
-JobPart sweep_job(const std::string& scene, const GonioSettings& g, Shard shard) {
+// Every file a sweep of the description reads: the description, its glTF files and buffers and
+// environment maps, and what its materials name (tables, measured networks, fiber specs; a preset
+// name is no file, and its content is the program's). Relative names resolve as registry.cpp
+// and bake_cache.cpp resolve them.
+std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
+                                                     const SceneDescription& d) {
+  std::vector<std::filesystem::path> files{scene};
+  files.insert(files.end(), d.files.begin(), d.files.end());
+  auto add = [&](const MaterialBinding& b) {
+    for (const char* key : {"file", "spec"}) {
+      if (!b.params.contains(key) || !b.params[key].is_string()) continue;
+      std::filesystem::path f = b.params[key].get<std::string>();
+      std::error_code ec;
+      if (f.is_relative() &&
+          (std::string(key) == "file" || std::filesystem::exists(d.base_dir / f, ec)))
+        f = d.base_dir / f;
+      // A missing table is the renderer's error to report, with its field.
+      if (std::filesystem::is_regular_file(f, ec)) files.push_back(f);
+    }
+  };
+  for (const auto& [key, b] : d.materials) add(b);
+  if (d.default_material) add(*d.default_material);
+  return files;
+}
+
+// What fixes a sweep's bits: the content of every file it reads and every setting but threads.
+JobPart sweep_job(const std::string& scene, const SceneDescription& desc, const GonioSettings& g,
+                  Shard shard) {
   JobPart p;
   p.command = "sweep";
-  p.job = {{"scene_fnv1a64", hex64(fnv1a64(file_text(scene)))},
+  p.job = {{"inputs", input_file_hashes(scene_input_files(scene, desc))},
            {"sample", g.sample},
            {"light_zenith_deg", g.light_zenith_deg},
            {"light_azimuth_deg", g.light_azimuth_deg},
@@ -235,7 +254,7 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          g.threads = o->threads;
          validate_output_paths({o->output}, {o->scene});
          const Shard shard = o->shard.empty() ? Shard{} : parse_shard(o->shard, "--shard");
-         const JobPart job = sweep_job(o->scene, g, shard);
+         const JobPart job = sweep_job(o->scene, desc, g, shard);
          const UnitRange range = shard_units(job.units_total, shard);
          GonioResult done;  // the units of a checkpoint
          if (const auto cp = load_checkpoint(o->output, job, o->resume))
@@ -248,6 +267,13 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          }
          const bool partial = !shard.whole() || o->resume;
          if (partial) g.units = todo;
+         // Each view renders the sample, and the white reference unless --no-white-check.
+         check_long_work(double(todo.size()) * (g.white_check ? 2 : 1) * g.width * g.height * g.spp,
+                         kMinSecondsPerPathSample, g.threads, o->scene, "spp",
+                         "a sweep of " + std::to_string(todo.size()) + " views of " +
+                             std::to_string(g.width) + " x " + std::to_string(g.height) +
+                             " pixels at " + std::to_string(g.spp) + " spp",
+                         "0.05 us per path sample per core at least");
          auto part_of = [&](const GonioResult& r, bool checkpoint) {
            JobPart p = job;
            p.checkpoint = checkpoint;

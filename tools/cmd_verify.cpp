@@ -14,11 +14,14 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "fabric_parts.h"
+#include "job_part.h"
 #include "plot_util.h"
 #include "verify_fit.h"
 #include "weft/core/error.h"
 #include "weft/integrators/verify.h"
 #include "weft/materials/cook_torrance.h"
+#include "weft/materials/fabric/bake_cache.h"
 #include "weft/materials/fabric/fabric_summation.h"
 #include "weft/materials/fabric/fiber_spec.h"
 #include "weft/materials/fabric/fiber_table_bake.h"
@@ -35,6 +38,7 @@ struct VerifyCliOptions {
   int fit_evaluations = 100;
   std::string fit_inner = "raytrace";
   std::string classic_albedo;
+  std::string shard;  // --shard K/N
   bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false;
   uint64_t seed = 1;
   int threads = 0;
@@ -251,32 +255,40 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
   return true;
 }
 
-int run(const VerifyCliOptions& o) {
-  const auto t_all = std::chrono::steady_clock::now();
-  // Everything the user gave is checked before any work.
+// The user's inputs, checked before any work (every way of running verify starts here).
+struct VerifyPlan {
+  VerifySettings s;
+  std::filesystem::path measured_path;
+  MeasuredInplane measured;
+  FiberSpec spec;                                 // when --fiber is a spec or preset
+  std::optional<TabulatedBsdfTable> fiber_table;  // when --fiber is a baked table (.exr)
+  std::optional<Rgb> classic_albedo;              // --classic-albedo
+  WeaveOptions weave;
+  std::vector<std::string> fit_names;
+  FitOptions fit_options;
+};
+
+VerifyPlan plan(const VerifyCliOptions& o) {
+  VerifyPlan p;
   const VerifyQuality q = parse_verify_quality(o.quality);
-  VerifySettings s = verify_settings(q);
-  s.seed = o.seed;
-  s.threads = o.threads;
-  const std::filesystem::path measured_path =
+  p.s = verify_settings(q);
+  p.s.seed = o.seed;
+  p.s.threads = o.threads;
+  p.measured_path =
       o.measured.empty() ? bundled_measured_inplane() : std::filesystem::path(o.measured);
-  const MeasuredInplane measured = read_measured_inplane(measured_path);
+  p.measured = read_measured_inplane(p.measured_path);
   // --fiber names a spec or preset, or (.exr) a baked fiber table, whose resolution the run takes.
-  std::optional<TabulatedBsdfTable> fiber_table;
-  FiberSpec spec;
   if (std::filesystem::path(o.fiber).extension() == ".exr") {
-    fiber_table = read_fiber_table(o.fiber);
+    p.fiber_table = read_fiber_table(o.fiber);
     if (o.fit)
       throw Error(o.fiber, "--fit",
                   "the fit changes the fiber spec's parameters, and a baked table has no spec: "
                   "give a spec or preset");
-    s.resolution = fiber_table->resolution;
+    p.s.resolution = p.fiber_table->resolution;
   } else {
-    spec = load_fiber_spec(o.fiber);
+    p.spec = load_fiber_spec(o.fiber);
   }
-  const std::optional<Rgb> classic_albedo =
-      o.classic_albedo.empty() ? std::nullopt
-                               : std::optional<Rgb>(parse_classic_albedo(o.classic_albedo));
+  if (!o.classic_albedo.empty()) p.classic_albedo = parse_classic_albedo(o.classic_albedo);
   if (!o.pattern.empty() && !o.wif.empty())
     throw Error("", "--wif", "give either --pattern or --wif, not both");
   WeaveOptions given;
@@ -284,77 +296,173 @@ int run(const VerifyCliOptions& o) {
   if (!o.wif.empty()) given.wif = o.wif;
   given.detail = "fiber";  // the fiber-level reference
   const WeaveOptions base = o.weave.empty() ? WeaveOptions{} : read_weave_options(o.weave);
-  std::vector<std::string> fit_names;
-  FitOptions fit_options;
+  p.weave = overlay(base, given);
   if (o.fit) {
-    fit_names = parse_spec_fit_names(o.fit_params);
+    if (!o.shard.empty()) throw Error("", "--fit", "runs in one process, not with --shard");
+    p.fit_names = parse_spec_fit_names(o.fit_params);
     (void)parse_fit_inner(o.fit_inner);
-    fit_options.max_evaluations = o.fit_evaluations;
-    fit_options.validate(4);                     // the classic model always fits four
-    (void)spec_fit_parameters(spec, fit_names);  // a spec without particles is refused here
+    p.fit_options.max_evaluations = o.fit_evaluations;
+    p.fit_options.validate(4);                       // the classic model always fits four
+    (void)spec_fit_parameters(p.spec, p.fit_names);  // a spec without particles is refused here
   } else if (o.fit_params_given || o.fit_evaluations_given) {
     throw Error("", o.fit_params_given ? "--fit-params" : "--fit-evaluations", "only with --fit");
   }
-  check_verify_output(o.output);
-  // The time it will take, before it starts; above an hour (at the fastest rates) needs --yes-long.
-  {
-    const unsigned cores =
-        std::max(1u, s.threads > 0 ? unsigned(s.threads) : std::thread::hardware_concurrency());
-    const VerifyEstimate e =
-        estimate_verify(s, !fiber_table, o.fit, fit_options.max_evaluations, fit_names.size());
-    const auto when = [](double sec) {
-      return sec < 120 ? std::to_string(static_cast<int>(std::ceil(sec))) + " s"
-                       : format_seconds(sec);
-    };
-    if (!o.quiet)
-      std::fprintf(stderr,
-                   "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on "
-                   "%u cores (%s of CPU; at least %s)\n",
-                   o.quality.c_str(), o.fit ? " with --fit" : "", e.photons * 1e-6,
-                   e.particles * 1e-6, when(e.typical / cores).c_str(), cores,
-                   when(e.typical).c_str(), when(e.least / cores).c_str());
-    check_long_work(e.least / cores, "", "--quality",
-                    "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
-                    "0.5 us per photon and 1.25 us per particle per core at least, " +
-                        std::to_string(cores) + " cores");
+  return p;
+}
+
+// The time it will take, before it starts; above an hour (at the fastest rates) needs --yes-long.
+void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
+  const unsigned cores =
+      std::max(1u, p.s.threads > 0 ? unsigned(p.s.threads) : std::thread::hardware_concurrency());
+  const VerifyEstimate e = estimate_verify(p.s, !p.fiber_table, o.fit,
+                                           p.fit_options.max_evaluations, p.fit_names.size());
+  const auto when = [](double sec) {
+    return sec < 120 ? std::to_string(static_cast<int>(std::ceil(sec))) + " s"
+                     : format_seconds(sec);
+  };
+  if (!o.quiet)
+    std::fprintf(stderr,
+                 "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on "
+                 "%u cores (%s of CPU; at least %s)\n",
+                 o.quality.c_str(), o.fit ? " with --fit" : "", e.photons * 1e-6,
+                 e.particles * 1e-6, when(e.typical / cores).c_str(), cores,
+                 when(e.typical).c_str(), when(e.least / cores).c_str());
+  check_long_work(e.least, 1.0, p.s.threads, "", "--quality",
+                  "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
+                  "0.5 us per photon and 1.25 us per particle per core at least");
+}
+
+// A sharded verify's job: the options that fix its result (a merge runs them again for the parts
+// it does not hold), the content of its input files, and its units: the incident bins of every
+// ray trace (verify_traces), trace after trace.
+JobPart verify_job(const VerifyCliOptions& o, const VerifyPlan& p, Shard shard) {
+  std::vector<std::filesystem::path> files{p.measured_path};
+  std::error_code ec;
+  for (const std::string& f : {o.weave, o.wif, o.fiber})
+    if (!f.empty() && std::filesystem::is_regular_file(f, ec)) files.emplace_back(f);
+  JobPart job;
+  job.command = "verify";
+  job.job = {{"options",
+              {{"fiber", o.fiber},
+               {"measured", o.measured},
+               {"weave", o.weave},
+               {"pattern", o.pattern},
+               {"wif", o.wif},
+               {"quality", o.quality},
+               {"seed", o.seed}}},
+             {"inputs", input_file_hashes(files)},
+             {"spec_hash", p.fiber_table ? p.fiber_table->checksum() : fiber_spec_hash_hex(p.spec)},
+             {"program_version", WEFT_VERSION}};
+  job.units_total = verify_traces(p.s).size() * DirectionGrid{p.s.resolution}.bins();
+  job.shard = shard;
+  job.extra = {{"threads", o.threads}};  // reported in metrics.json; results do not depend on it
+  return job;
+}
+
+// The spectral fiber table through the bake cache (./.weft-cache, bake_cache.h): shards of a job
+// that need it at once bake it once, and the merge reuses it. Returns false when interrupted.
+bool fiber_from_cache(const VerifyPlan& p, VerifyInputs& in, const ProgressCallback& progress) {
+  FiberTableBakeOptions b;
+  b.resolution = p.s.resolution;
+  b.photons_per_band = p.s.fiber_photons_per_band;
+  b.seed = p.s.seed;
+  b.threads = p.s.threads;
+  b.spectral = true;  // the colour table needs the spectrum
+  std::filesystem::path file;
+  try {
+    file = cached_fiber_table(".weft-cache", p.spec, b, progress);
+  } catch (const Error&) {
+    if (interrupted()) return false;
+    throw;
+  }
+  in.fiber = TabulatedBsdfTable::read_exr(file);
+  in.volume_albedo = volume_albedo_of(in.fiber, file.string());
+  return true;
+}
+
+// --shard K/N: the shard's units of the ray traces into a part file at o.output.
+int run_shard(const VerifyCliOptions& o, const VerifyPlan& p, const WovenSample& sample,
+              const VerifyInputs& in, const JobPart& job, const ProgressCallback& progress) {
+  const uint64_t bins = DirectionGrid{p.s.resolution}.bins();
+  const UnitRange range = shard_units(job.units_total, job.shard);
+  const std::vector<VerifyTrace> traces = verify_traces(p.s);
+  std::optional<ClassicFiber> classic;
+  JobPart part = job;
+  for (size_t t = 0; t < traces.size(); ++t) {
+    const uint64_t first = std::max(range.first, t * bins),
+                   last = std::min(range.last, (t + 1) * bins);
+    if (first >= last) continue;
+    if (traces[t].model == "classic" && !classic) classic = verify_classic_fiber(in, p.s, progress);
+    FabricRaytraceOptions r = traces[t].options;
+    r.first_bin = static_cast<int>(first - t * bins);
+    r.bin_count = static_cast<int>(last - first);
+    const FabricRaytraceResult res = raytrace_fabric_table(
+        sample, traces[t].model == "classic" ? classic->table : in.fiber, r, progress);
+    if (res.cancelled) {
+      std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
+      return 130;
+    }
+    for (uint64_t u = first; u < last; ++u) encode_fabric_bin(res, u - t * bins, part.units[u]);
+  }
+  write_job_part(o.output, part);
+  std::printf("ray-trace units %llu..%llu of %llu (shard %u/%u) -> %s\n",
+              static_cast<unsigned long long>(range.first),
+              static_cast<unsigned long long>(range.last),
+              static_cast<unsigned long long>(job.units_total), job.shard.index, job.shard.count,
+              o.output.c_str());
+  return 0;
+}
+
+// The whole run, or the merge of a sharded one ('all': every unit of its ray traces).
+int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
+  const auto t_all = std::chrono::steady_clock::now();
+  const VerifyPlan p = plan(o);
+  const VerifySettings& s = p.s;
+  const MeasuredInplane& measured = p.measured;
+  const Shard shard = o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard");
+  std::optional<JobPart> job;
+  if (!o.shard.empty()) {
+    validate_output_paths({o.output}, {p.measured_path.string(), o.weave, o.wif, o.fiber});
+    job = verify_job(o, p, shard);
+  } else {
+    check_verify_output(o.output);
+    if (!all) check_verify_time(o, p);  // a merge's ray traces are done
+  }
+  if (all) {
+    // The inputs must still be those the shards read.
+    const JobPart now = verify_job(o, p, all->shard);
+    if (const std::string why = job_difference(*all, now); !why.empty())
+      throw Error("", "parts",
+                  "the verify job's inputs changed since its shards ran (" + why + ")");
   }
 
   const auto progress = progress_bar(o.quiet);
   VerifyInputs in;
   in.fiber_name = o.fiber;
   auto t0 = std::chrono::steady_clock::now();
-  const WovenSample sample = make_woven_sample(overlay(base, given));
+  const WovenSample sample = make_woven_sample(p.weave);
   in.sample_name = sample.summary.source + " (" + sample.summary.detail + ")";
   in.seconds["woven_sample"] = since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  if (fiber_table) {
-    classic_from_table(o.fiber, *fiber_table, classic_albedo, s, in);
-    in.fiber = std::move(*fiber_table);
+  if (p.fiber_table) {
+    classic_from_table(o.fiber, *p.fiber_table, p.classic_albedo, s, in);
+    in.fiber = *p.fiber_table;
     in.seconds["classic_from_table"] = since(t0);
   } else {
-    FiberTableBakeOptions b;
-    b.resolution = s.resolution;
-    b.photons_per_band = s.fiber_photons_per_band;
-    b.seed = s.seed;
-    b.threads = s.threads;
-    b.spectral = true;  // the colour table needs the spectrum
-    FiberTableBakeResult fiber = bake_fiber_table(spec, b, progress);
-    if (fiber.cancelled) {
+    if (!fiber_from_cache(p, in, progress)) {
       std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
       return 130;
     }
     in.seconds["fiber_bake"] = since(t0);
-    for (const auto& band : fiber.bands)
-      in.volume_albedo[band.band] = band.exit_fraction - band.surface_fraction;
-    in.classic_distribution = {spec.roughness_distribution, spec.roughness_alpha};
-    in.classic_ior = spec.host_n[kNumBands / 2];  // 550 nm
-    if (classic_albedo) {
-      in.classic_diffuse = classic_albedo;
+    in.classic_distribution = {p.spec.roughness_distribution, p.spec.roughness_alpha};
+    in.classic_ior = p.spec.host_n[kNumBands / 2];  // 550 nm
+    if (p.classic_albedo) {
+      in.classic_diffuse = p.classic_albedo;
       in.classic_source = "--classic-albedo; the spec's roughness and index at 550 nm";
     }
-    in.fiber = std::move(fiber.table);
   }
+  if (job) return run_shard(o, p, sample, in, *job, progress);
 
   t0 = std::chrono::steady_clock::now();
   FabricSummationOptions so;
@@ -366,12 +474,24 @@ int run(const VerifyCliOptions& o) {
   in.summation = sum_fabric_table(in.fiber, so, progress);
   in.seconds["summation"] = since(t0);
 
-  VerifyReport report = run_verify(sample, in, measured, s, progress);
+  VerifyTraced traced;
+  if (all) {
+    const uint64_t bins = DirectionGrid{s.resolution}.bins();
+    const std::vector<VerifyTrace> traces = verify_traces(s);
+    for (size_t t = 0; t < traces.size(); ++t) {
+      const auto it = all->units.find(t * bins);
+      if (it == all->units.end()) throw Error("", "parts", "a ray trace's first bin is missing");
+      traced[{traces[t].model, traces[t].batch}] = assemble_fabric_bins(
+          all->units, t * bins, bins, s.resolution, fabric_bin_channels(it->second, bins));
+    }
+  }
+  VerifyReport report = run_verify(sample, in, measured, s, progress, all ? &traced : nullptr);
   if (report.cancelled) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
     return 130;
   }
-  if (o.fit && !fit(o, spec, fit_names, fit_options, s, sample, in, measured, report, progress))
+  if (o.fit &&
+      !fit(o, p.spec, p.fit_names, p.fit_options, s, sample, in, measured, report, progress))
     return 130;
   report.seconds["total_before_report"] = since(t_all);
   write_verify_report(o.output, report, [&](const std::filesystem::path& staging) {
@@ -404,9 +524,9 @@ int run(const VerifyCliOptions& o) {
     for (const auto& f : report.fits) {
       std::printf("  fit %s: inner rms_log %.3f -> %.3f, %d evaluations, %.1f s:", f.model.c_str(),
                   f.objective_start, f.objective, f.evaluations, f.seconds);
-      for (const auto& p : f.parameters)
-        std::printf(" %s %.4g +- %.2g%s", p.parameter.name.c_str(), p.value, p.sigma,
-                    p.at_bound ? " (at bound)" : "");
+      for (const auto& fp : f.parameters)
+        std::printf(" %s %.4g +- %.2g%s", fp.parameter.name.c_str(), fp.value, fp.sigma,
+                    fp.at_bound ? " (at bound)" : "");
       std::printf("\n");
     }
   }
@@ -463,7 +583,27 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                   "minus the Cook-Torrance lobe's");
   sub->add_flag("--json", o->json, "print metrics.json on stdout");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
+  sub->add_option("--shard", o->shard,
+                  "K/N: run only shard K of N of the ray traces (their incident bins) into a part "
+                  "file -o PART; `weft merge` makes the report folder from all parts");
   commands.push_back({sub, [o] { return run(*o); }});
+}
+
+int merge_verify(const JobPart& all, const std::string& output, bool json) {
+  VerifyCliOptions o;
+  const auto& opt = all.job.at("options");
+  o.fiber = opt.at("fiber").get<std::string>();
+  o.measured = opt.at("measured").get<std::string>();
+  o.weave = opt.at("weave").get<std::string>();
+  o.pattern = opt.at("pattern").get<std::string>();
+  o.wif = opt.at("wif").get<std::string>();
+  o.quality = opt.at("quality").get<std::string>();
+  o.seed = opt.at("seed").get<uint64_t>();
+  o.threads = all.extra.value("threads", 0);
+  o.output = output;
+  o.json = json;
+  o.quiet = true;
+  return run(o, &all);
 }
 
 }  // namespace weft::cli

@@ -16,10 +16,11 @@ namespace weft::cli {
 namespace {
 
 JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
-                   const FabricRaytraceOptions& r, Shard shard) {
+                   const nlohmann::json& inputs, const FabricRaytraceOptions& r, Shard shard) {
   JobPart p;
   p.command = "bake fabric";
   p.job = {{"method", "raytrace"},
+           {"inputs", inputs},
            {"fiber_checksum", fiber.checksum()},
            {"sample", sample.summary.source + " (" + sample.summary.detail + ")"},
            {"resolution", r.resolution},
@@ -35,29 +36,17 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
   return p;
 }
 
-// A unit is an incident bin's row of the table followed by its particles' splits and roulette
-// kills (counts, exact in a double), so that merged parts count what one process counts.
-constexpr size_t kUnitCounts = 2;
+// A bin's unit: its row of the table, then its books (FabricBinBooks: the power as doubles, the
+// counts as raw 64-bit values, noise2 and signal2 per channel).
+constexpr size_t kBookValues = 5 + 8;
 
-// The table from the rows of every bin, with the metadata of the pieces and the counts summed.
-TabulatedBsdfTable assemble(const JobPart& all, int resolution, uint64_t* splits, uint64_t* kills) {
-  TabulatedBsdfTable t;
-  t.resolution = resolution;
-  t.kind = "fabric";
-  t.channels = all.extra.at("channels").get<int>();
-  t.metadata = all.extra.at("metadata").get<std::map<std::string, std::string>>();
-  const size_t bins = all.units_total, row = bins * static_cast<size_t>(t.channels);
-  t.values.assign(bins * row, 0.0f);
-  *splits = *kills = 0;
-  for (const auto& [a, v] : all.units) {
-    if (v.size() != row + kUnitCounts) throw Error("", "units", "a row of another size");
-    for (size_t k = 0; k < row; ++k) t.values[a * row + k] = static_cast<float>(v[k]);
-    *splits += static_cast<uint64_t>(v[row]);
-    *kills += static_cast<uint64_t>(v[row + 1]);
-  }
-  t.validate("");
-  record_particle_counts(t, *splits, *kills);
-  return t;
+// The table (with the metadata of the pieces) and its books from the units of every bin.
+FabricRaytraceResult assemble(const JobPart& all, int resolution) {
+  FabricRaytraceResult r = assemble_fabric_bins(all.units, 0, all.units_total, resolution,
+                                                all.extra.at("channels").get<int>());
+  r.table.metadata = all.extra.at("metadata").get<std::map<std::string, std::string>>();
+  record_particle_counts(r.table, r.splits, r.roulette_kills);
+  return r;
 }
 
 }  // namespace
@@ -67,19 +56,70 @@ void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t rou
   t.metadata["roulette_kills"] = std::to_string(roulette_kills);
 }
 
+void encode_fabric_bin(const FabricRaytraceResult& res, uint64_t a, std::vector<double>& v) {
+  const size_t row = res.bin_books.size() * static_cast<size_t>(res.table.channels);
+  v.assign(res.table.values.begin() + static_cast<std::ptrdiff_t>(a * row),
+           res.table.values.begin() + static_cast<std::ptrdiff_t>((a + 1) * row));
+  const FabricBinBooks& b = res.bin_books.at(a);
+  for (double x : {b.launched, b.exited, b.absorbed, b.lost, b.roulette_net}) v.push_back(x);
+  for (uint64_t x : {b.particles, b.scatterings, b.wraps, b.splits, b.continuation_caps,
+                     b.inside_hits, b.roulette_kills, b.tube_passes})
+    push_u64(v, x);
+  v.insert(v.end(), b.noise2.begin(), b.noise2.end());
+  v.insert(v.end(), b.signal2.begin(), b.signal2.end());
+}
+
+int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins) {
+  const size_t n = unit.size();
+  if (n < kBookValues || (n - kBookValues) % (bins + 2) != 0 || n == kBookValues)
+    throw Error("", "units", "not the record of an incident bin of a ray-traced table");
+  return static_cast<int>((n - kBookValues) / (bins + 2));
+}
+
+FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<double>>& units,
+                                          uint64_t first_unit, uint64_t bins, int resolution,
+                                          int channels) {
+  FabricRaytraceResult r;
+  TabulatedBsdfTable& t = r.table;
+  t.resolution = resolution;
+  t.kind = "fabric";
+  t.channels = channels;
+  const size_t nc = static_cast<size_t>(channels), row = bins * nc;
+  t.values.assign(bins * row, 0.0f);
+  r.bin_books.resize(bins);
+  for (uint64_t a = 0; a < bins; ++a) {
+    const auto it = units.find(first_unit + a);
+    if (it == units.end())
+      throw Error("", "units", "incident bin " + std::to_string(a) + " is missing");
+    const std::vector<double>& v = it->second;
+    if (v.size() != row + kBookValues + 2 * nc)
+      throw Error("", "units", "a bin's record of another size");
+    for (size_t k = 0; k < row; ++k) t.values[a * row + k] = static_cast<float>(v[k]);
+    FabricBinBooks& b = r.bin_books[a];
+    const double* x = v.data() + row;
+    b.launched = x[0], b.exited = x[1], b.absorbed = x[2], b.lost = x[3], b.roulette_net = x[4];
+    b.particles = as_u64(x[5]), b.scatterings = as_u64(x[6]), b.wraps = as_u64(x[7]);
+    b.splits = as_u64(x[8]), b.continuation_caps = as_u64(x[9]), b.inside_hits = as_u64(x[10]);
+    b.roulette_kills = as_u64(x[11]), b.tube_passes = as_u64(x[12]);
+    b.noise2.assign(x + kBookValues, x + kBookValues + nc);
+    b.signal2.assign(x + kBookValues + nc, x + kBookValues + 2 * nc);
+  }
+  t.validate("");
+  fabric_raytrace_totals(r);
+  return r;
+}
+
 std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
-    const WovenSample& sample, const TabulatedBsdfTable& fiber, const FabricRaytraceOptions& r,
-    const std::string& output, const std::string& shard_text, bool resume,
-    const ProgressCallback& progress, int* exit_code) {
+    const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
+    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
+    bool resume, const ProgressCallback& progress, int* exit_code) {
   *exit_code = 0;
   const Shard shard = shard_text.empty() ? Shard{} : parse_shard(shard_text, "--shard");
-  JobPart job = fabric_job(fiber, sample, r, shard);
+  JobPart job = fabric_job(fiber, sample, inputs, r, shard);
   const UnitRange range = shard_units(job.units_total, shard);
-  const size_t row = job.units_total * static_cast<size_t>(fiber.channels);
   JobPart done = job;
   if (const auto cp = load_checkpoint(output, job, resume)) done = *cp;
   done.checkpoint = true;
-  FabricRaytraceResult sum;
   // Pieces of about an eighth of the range between checkpoints; the whole range without them.
   const uint64_t step = resume ? std::max<uint64_t>(1, (range.last - range.first + 7) / 8)
                                : std::max<uint64_t>(1, range.last - range.first);
@@ -100,15 +140,8 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
       *exit_code = 130;
       return std::nullopt;
     }
-    for (uint64_t u = a; u < b; ++u) {
-      auto& unit = done.units[u];
-      unit.assign(res.table.values.begin() + static_cast<std::ptrdiff_t>(u * row),
-                  res.table.values.begin() + static_cast<std::ptrdiff_t>((u + 1) * row));
-      unit.push_back(static_cast<double>(res.splits_per_bin[u]));
-      unit.push_back(static_cast<double>(res.roulette_kills_per_bin[u]));
-    }
+    for (uint64_t u = a; u < b; ++u) encode_fabric_bin(res, u, done.units[u]);
     done.extra = {{"channels", res.table.channels}, {"metadata", res.table.metadata}};
-    sum.particles += res.particles, sum.scatterings += res.scatterings, sum.wraps += res.wraps;
     if (resume) write_job_part(checkpoint_path(output), done);
     a = b;
   }
@@ -134,21 +167,49 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     return std::nullopt;
   }
   std::filesystem::remove(checkpoint_path(output));
-  sum.table = assemble(done, r.resolution, &sum.splits, &sum.roulette_kills);
-  // The energy books and the noise are sums over all bins at once: not kept across pieces.
-  sum.exited = sum.absorbed = sum.lost = sum.roulette_net = sum.relative_noise = NAN;
-  return sum;
+  return assemble(done, r.resolution);
+}
+
+nlohmann::json raytrace_summary(const FabricRaytraceResult& res) {
+  return {{"particles", res.particles},
+          {"scatterings", res.scatterings},
+          {"splits", res.splits},
+          {"roulette_kills", res.roulette_kills},
+          {"exited", res.exited},
+          {"absorbed", res.absorbed},
+          {"lost", res.lost},
+          {"roulette_net", res.roulette_net},
+          {"relative_noise", res.relative_noise},
+          {"relative_noise_per_channel", res.relative_noise_per_channel}};
+}
+
+nlohmann::json fabric_table_summary(const TabulatedBsdfTable& table) {
+  // Light arriving along the normal, where it goes; and what a view along the normal gathers
+  // under uniform light (they differ for a non-reciprocal table, fabric_summation.h).
+  const auto normal = table.directional_albedo(table.grid().bin_of({0, 0, 1}));
+  const auto view = table.directional_albedo_seen_from(table.grid().bin_of({0, 0, 1}));
+  return {{"resolution", table.resolution},
+          {"sample", table.metadata.at("sample")},
+          {"reflectance_normal_incidence", normal.reflectance},
+          {"transmittance_normal_incidence", normal.transmittance},
+          {"reflectance_normal_view", view.reflectance},
+          {"transmittance_normal_view", view.transmittance}};
 }
 
 int merge_fabric_bake(const JobPart& all, const std::string& output, bool json) {
-  uint64_t splits = 0, kills = 0;
-  TabulatedBsdfTable t = assemble(all, all.job.at("resolution").get<int>(), &splits, &kills);
+  FabricRaytraceResult r = assemble(all, all.job.at("resolution").get<int>());
+  TabulatedBsdfTable& t = r.table;
+  t.metadata["sample"] = all.job.at("sample").get<std::string>();
   t.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;  // as bake fabric writes
   t.write_exr(output);
+  nlohmann::json j = {{"output", output}, {"method", "raytrace"}, {"parts_merged", true}};
+  j.update(fabric_table_summary(t));
+  j.update(raytrace_summary(r));
   if (json)
-    std::cout << nlohmann::json({{"output", output}, {"parts_merged", true}}).dump(2) << "\n";
+    std::cout << j.dump(2) << "\n";
   else
-    std::printf("%s: ray-traced fabric table, R = %d, merged\n", output.c_str(), t.resolution);
+    std::printf("%s: ray-traced fabric table, R = %d, merged; relative noise %.4g\n",
+                output.c_str(), t.resolution, r.relative_noise);
   return 0;
 }
 

@@ -8,6 +8,7 @@
 #include "cli_util.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
+#include "weft/core/hash.h"
 #include "weft/core/params.h"
 
 namespace weft::cli {
@@ -130,6 +131,45 @@ JobPart read_job_part(const std::filesystem::path& path) {
   return p;
 }
 
+nlohmann::json input_file_hashes(const std::vector<std::filesystem::path>& files) {
+  nlohmann::json out = nlohmann::json::object();
+  std::vector<char> buf(size_t{1} << 20);
+  for (const auto& f : files) {
+    std::ifstream in(f, std::ios::binary);
+    if (!in) throw Error(f.string(), "", "cannot read this input to identify the job");
+    uint64_t h = kFnv1a64Basis;
+    while (in) {
+      in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
+      h = fnv1a64(reinterpret_cast<const unsigned char*>(buf.data()),
+                  static_cast<size_t>(in.gcount()), h);
+    }
+    if (in.bad()) throw Error(f.string(), "", "read failed while identifying the job");
+    out[f.string()] = hex64(h);
+  }
+  return out;
+}
+
+std::string job_difference(const JobPart& then, const JobPart& now) {
+  if (then.command != now.command)
+    return "it is of `weft " + then.command + "`, not `weft " + now.command + "`";
+  const auto& a = then.job;
+  const auto& b = now.job;
+  if (a.contains("inputs") && b.contains("inputs") && a["inputs"] != b["inputs"]) {
+    for (const auto& [file, hash] : b["inputs"].items())
+      if (a["inputs"].contains(file) && a["inputs"][file] != hash)
+        return "the content of " + file + " differs";
+    return "the job reads other input files (" + b["inputs"].dump() + " against " +
+           a["inputs"].dump() + ")";
+  }
+  for (const auto& [key, value] : b.items())
+    if (!a.contains(key) || a[key] != value) return "setting '" + key + "' differs";
+  for (const auto& [key, value] : a.items())
+    if (!b.contains(key)) return "setting '" + key + "' differs";
+  if (then.units_total != now.units_total) return "the number of units differs";
+  if (then.shard.count != now.shard.count) return "the shard count differs";
+  return "";
+}
+
 std::filesystem::path checkpoint_path(const std::filesystem::path& output) {
   const auto name = "." + output.filename().string() + ".weft-checkpoint";
   return output.has_parent_path() ? output.parent_path() / name : std::filesystem::path(name);
@@ -147,10 +187,13 @@ std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, cons
     std::fprintf(stderr, "weft: warning: %s is unreadable; starting afresh\n", path.c_str());
     return std::nullopt;
   }
-  if (!p.checkpoint || !p.same_job(job) || p.shard.index != job.shard.index)
-    throw Error(path.string(), "",
-                "is the checkpoint of another job (settings, spec or shard differ): remove it or "
-                "run without --resume");
+  if (!p.checkpoint || !p.same_job(job) || p.shard.index != job.shard.index) {
+    std::string why = job_difference(p, job);
+    if (why.empty()) why = p.checkpoint ? "the shard differs" : "it is not a checkpoint";
+    throw Error(
+        path.string(), "",
+        "is the checkpoint of another job (" + why + "): remove it or run without --resume");
+  }
   return p;
 }
 
@@ -169,9 +212,9 @@ JobPart merge_job_parts(const std::vector<std::filesystem::path>& paths) {
       all.shard = {0, p.shard.count};
       all.extra = p.extra;
     } else if (!p.same_job(all)) {
-      throw Error(file, "job",
-                  "belongs to another job than " + paths[0].string() +
-                      " (command, spec, settings, seed or shard count differ)");
+      throw Error(
+          file, "job",
+          "belongs to another job than " + paths[0].string() + " (" + job_difference(all, p) + ")");
     }
     if (!shards_seen.insert(p.shard.index).second)
       throw Error(file, "shard",

@@ -61,6 +61,15 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& output);
 std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
                                        bool resume);
 
+// The content of a job's input files, for its identity: {"<file>": "<FNV-1a 64 hex>"}, so that a
+// file changed after a part or checkpoint was written makes it another job. weft::Error naming a
+// file that cannot be read.
+nlohmann::json input_file_hashes(const std::vector<std::filesystem::path>& files);
+
+// How job 'now' differs from the job 'then' a part or checkpoint was written for, in words for a
+// refusal ("the content of scene.gltf differs", "setting 'spp' differs"); "" when they agree.
+std::string job_difference(const JobPart& then, const JobPart& now);
+
 // Merges parts: all of one job, disjoint, together complete (a missing shard is named);
 // weft::Error naming the file otherwise. Returns the job (header of the first part) with every
 // unit.
@@ -74,4 +83,5 @@ namespace weft::cli {
 int merge_fiber_bake(const JobPart& all, const std::string& output, bool json);
 int merge_fabric_bake(const JobPart& all, const std::string& output, bool json);
 int merge_sweep(const JobPart& all, const std::string& output, bool json);
+int merge_verify(const JobPart& all, const std::string& output, bool json);
 }  // namespace weft::cli

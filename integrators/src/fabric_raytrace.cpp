@@ -132,17 +132,12 @@ constexpr int kMaxSplit = 16;
 struct TaskTally {
   std::vector<ExitRecord> exits;
   std::vector<double> weights;  // channels per exit
-  double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
-  uint64_t particles = 0, scatterings = 0, wraps = 0, continuation_caps = 0, inside_hits = 0;
-  uint64_t tube_passes = 0;
-  uint64_t splits = 0, roulette_kills = 0;
-  // Per incident bin that the task's particles belong to (a task spans at most two): {bin,
-  // splits, roulette kills}.
-  std::vector<std::array<uint64_t, 3>> per_bin;
-  std::array<uint64_t, 3>& bin_counts(int bin) {
-    if (per_bin.empty() || per_bin.back()[0] != static_cast<uint64_t>(bin))
-      per_bin.push_back({static_cast<uint64_t>(bin), 0, 0});
-    return per_bin.back();
+  // The books of the task's particles by incident bin (a task may straddle two bins): kept apart
+  // so that every bin's books sum alike however the bins are split over runs.
+  std::vector<std::pair<int, FabricBinBooks>> books;
+  FabricBinBooks& books_of(int bin) {
+    if (books.empty() || books.back().first != bin) books.emplace_back(bin, FabricBinBooks{});
+    return books.back().second;
   }
 };
 
@@ -313,6 +308,54 @@ void FabricRaytraceOptions::validate() const {
     throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
 }
 
+void FabricBinBooks::add(const FabricBinBooks& o) {
+  launched += o.launched, exited += o.exited, absorbed += o.absorbed, lost += o.lost;
+  roulette_net += o.roulette_net;
+  particles += o.particles, scatterings += o.scatterings, wraps += o.wraps, splits += o.splits;
+  roulette_kills += o.roulette_kills, tube_passes += o.tube_passes;
+  continuation_caps += o.continuation_caps, inside_hits += o.inside_hits;
+}
+
+void fabric_raytrace_totals(FabricRaytraceResult& r) {
+  FabricBinBooks all;
+  std::vector<double> noise2, signal2;
+  for (const FabricBinBooks& b : r.bin_books) {
+    all.add(b);
+    noise2.resize(std::max(noise2.size(), b.noise2.size()), 0.0);
+    signal2.resize(noise2.size(), 0.0);
+    for (size_t c = 0; c < b.noise2.size() && c < b.signal2.size(); ++c) {
+      noise2[c] += b.noise2[c];
+      signal2[c] += b.signal2[c];
+    }
+  }
+  r.particles = all.particles, r.scatterings = all.scatterings, r.wraps = all.wraps;
+  r.splits = all.splits, r.continuation_caps = all.continuation_caps;
+  r.inside_hits = all.inside_hits;
+  r.roulette_kills = all.roulette_kills, r.tube_passes = all.tube_passes;
+  r.splits_per_bin.assign(r.bin_books.size(), 0);
+  r.roulette_kills_per_bin.assign(r.bin_books.size(), 0);
+  for (size_t b = 0; b < r.bin_books.size(); ++b) {
+    r.splits_per_bin[b] = r.bin_books[b].splits;
+    r.roulette_kills_per_bin[b] = r.bin_books[b].roulette_kills;
+  }
+  r.exited = r.absorbed = r.lost = r.roulette_net = 0;
+  if (all.launched > 0) {
+    r.exited = all.exited / all.launched;
+    r.lost = all.lost / all.launched;
+    r.roulette_net = all.roulette_net / all.launched;
+    r.absorbed = all.absorbed / all.launched;
+  }
+  // Each channel on its own, and all together as weft compare's rel_rms sums them.
+  double all_noise2 = 0, all_signal2 = 0;
+  r.relative_noise_per_channel.assign(noise2.size(), 0.0);
+  for (size_t c = 0; c < noise2.size(); ++c) {
+    r.relative_noise_per_channel[c] = signal2[c] > 0 ? std::sqrt(noise2[c] / signal2[c]) : 0;
+    all_noise2 += noise2[c];
+    all_signal2 += signal2[c];
+  }
+  r.relative_noise = all_signal2 > 0 ? std::sqrt(all_noise2 / all_signal2) : 0.0;
+}
+
 FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                                            const TabulatedBsdfTable& fiber,
                                            const FabricRaytraceOptions& o,
@@ -340,9 +383,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   std::vector<double> sum(static_cast<size_t>(bins) * bins * nc, 0.0);
   std::vector<double> sum2(static_cast<size_t>(bins) * bins * nc, 0.0);
   FabricRaytraceResult result;
-  result.splits_per_bin.assign(bins, 0);
-  result.roulette_kills_per_bin.assign(bins, 0);
-  double launched = 0, exited = 0, lost = 0, roulette_net = 0, absorbed = 0;
+  result.bin_books.resize(bins);
 
   const uint64_t first_item = per_bin * static_cast<uint64_t>(o.first_bin);
   const uint64_t last_item =
@@ -375,6 +416,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         for (uint64_t k = first; k < first + count; ++k) {
           const int a = static_cast<int>(k / per_bin);
           TaskTally& tally = k >= first_item && k < last_item ? task_tally : outside;
+          FabricBinBooks& books = tally.books_of(a);
           // The light: a direction of bin a (uniform in solid angle), flux per unit area
           // proportional to |cos theta_i|; entering the slab through the face it faces.
           const Vec3 wi_cloth =
@@ -385,8 +427,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
           // The strategy this particle's path follows (a FiberSampler strategy index).
           const int hero =
               mis ? std::min(nc - 1, static_cast<int>(rng.uniform() * nc)) : fs.strategies - 1;
-          tally.launched += w0;
-          ++tally.particles;
+          books.launched += w0;
+          ++books.particles;
           // Copies of the particle made by splitting wait here; they share its hero channel. Its
           // exits are merged per cell (from first_exit on) so that the per-cell variance below
           // stays that of one particle's total.
@@ -434,7 +476,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                     tally.exits.push_back({cell, static_cast<uint32_t>(tally.weights.size())});
                     tally.weights.insert(tally.weights.end(), w.begin(), w.end());
                   }
-                  tally.exited += mean_w;
+                  books.exited += mean_w;
                   break;
                 }
                 // Through a side of the repeat: in again through the opposite one.
@@ -444,8 +486,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 if (side == 2) p.z += pz;
                 if (side == 3) p.z -= pz;
                 ignore = fiber_after_wrap(ignore, side, curves);
-                if (++tally.wraps, ++events > 100 * o.max_scatterings) {
-                  tally.lost += mean_w;
+                if (++books.wraps, ++events > 100 * o.max_scatterings) {
+                  books.lost += mean_w;
                   break;
                 }
                 continue;
@@ -457,9 +499,9 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                   joints.joined(ignore % curves, h.fiber % curves)) {
                 p = h.spawn_origin(d);
                 ignore = h.fiber;
-                ++tally.continuation_caps;
+                ++books.continuation_caps;
                 if (++events > 100 * o.max_scatterings) {
-                  tally.lost += mean_w;
+                  books.lost += mean_w;
                   break;
                 }
                 continue;
@@ -471,15 +513,15 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               if (in_tube && !h.on_fiber() && dot(d, h.ng) > 0) {
                 p = h.spawn_origin(d);
                 in_tube = false;
-                ++tally.tube_passes;
+                ++books.tube_passes;
                 if (++events > 100 * o.max_scatterings) {
-                  tally.lost += mean_w;
+                  books.lost += mean_w;
                   break;
                 }
                 continue;
               }
               in_tube = false;
-              if (h.on_fiber() && dot(d, h.ng) >= 0) ++tally.inside_hits;
+              if (h.on_fiber() && dot(d, h.ng) >= 0) ++books.inside_hits;
               // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is
               // where the line leaves its cylinder. Yarn tubes that press on each other share
               // surfaces, so a particle may find itself inside one: then this hit is B'' and B'
@@ -519,7 +561,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               const int hj = mis ? hero : 0;
               const double a_hero0 = fs.albedo_of(pts[0].bin, hero);
               if (!(s_sum[hj] > 0)) {  // the fiber absorbs all of the hero's light
-                tally.absorbed += mean_w;
+                books.absorbed += mean_w;
                 break;
               }
               const int q = n_pts == 2 && rng.uniform() * s_sum[hj] >= a_hero0 ? 1 : 0;
@@ -542,16 +584,16 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 after += w[c];
               }
               for (double& x : pdf) x /= mean_pdf;
-              tally.absorbed += (before - after) / nc;
+              books.absorbed += (before - after) / nc;
               d = normalize(pt.hit.shading.to_world(wo_local));
               p = pt.hit.spawn_origin(d);
               ignore = pt.hit.fiber;  // light leaves a fiber through the fiber itself
               in_tube = !pt.hit.on_fiber() && dot(d, pt.hit.ng) < 0;  // into its own yarn tube
-              ++tally.scatterings;
+              ++books.scatterings;
               if (++events >= o.max_scatterings) {
                 double m = 0;
                 for (double x : w) m += x;
-                tally.lost += m / nc;
+                books.lost += m / nc;
                 break;
               }
               // Russian roulette on the largest channel weight (on their mean before spectral
@@ -565,11 +607,10 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 const double survive = steer / (o.roulette_threshold);
                 if (rng.uniform() < survive) {
                   for (double& x : w) x /= survive;
-                  tally.roulette_net -= mean_w / survive - mean_w;
+                  books.roulette_net -= mean_w / survive - mean_w;
                 } else {
-                  tally.roulette_net += mean_w;
-                  ++tally.roulette_kills;
-                  ++tally.bin_counts(a)[2];
+                  books.roulette_net += mean_w;
+                  ++books.roulette_kills;
                   break;
                 }
               }
@@ -583,8 +624,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 for (double& x : w) x /= n;
                 for (int copy = 1; copy < n; ++copy)
                   pending.push_back({p, d, events, ignore, in_tube, w, pdf});
-                tally.splits += n - 1;
-                tally.bin_counts(a)[1] += n - 1;
+                books.splits += n - 1;
               }
             }
           }
@@ -597,23 +637,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
             sum[e.cell * nc + c] += x;
             sum2[e.cell * nc + c] += x * x;
           }
-        launched += t.launched;
-        exited += t.exited;
-        lost += t.lost;
-        roulette_net += t.roulette_net;
-        absorbed += t.absorbed;
-        result.particles += t.particles;
-        result.scatterings += t.scatterings;
-        result.wraps += t.wraps;
-        result.continuation_caps += t.continuation_caps;
-        result.inside_hits += t.inside_hits;
-        result.tube_passes += t.tube_passes;
-        result.splits += t.splits;
-        result.roulette_kills += t.roulette_kills;
-        for (const auto& [bin, splits, kills] : t.per_bin) {
-          result.splits_per_bin[bin] += splits;
-          result.roulette_kills_per_bin[bin] += kills;
-        }
+        for (const auto& [a, b] : t.books) result.bin_books[a].add(b);
       });
 
   result.cancelled = status.cancelled;
@@ -625,8 +649,11 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   const double n = static_cast<double>(per_bin);
   const double omega = grid.bin_solid_angle();
   result.standard_error.assign(table.values.size(), 0.0f);
-  std::vector<double> noise2(nc, 0.0), signal2(nc, 0.0);
-  for (int a = 0; a < bins; ++a)
+  for (int a = 0; a < bins; ++a) {
+    std::vector<double>& noise2 = result.bin_books[a].noise2;
+    std::vector<double>& signal2 = result.bin_books[a].signal2;
+    noise2.assign(nc, 0.0);
+    signal2.assign(nc, 0.0);
     for (int b = 0; b < bins; ++b) {
       const size_t cell = static_cast<size_t>(a) * bins + b;
       const double scale = omega / (n * areas[a] * areas[b]);
@@ -643,21 +670,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         signal2[c] += f * f * w;
       }
     }
-  // Each channel on its own, and all together as weft compare's rel_rms sums them.
-  double all_noise2 = 0, all_signal2 = 0;
-  result.relative_noise_per_channel.resize(nc);
-  for (int c = 0; c < nc; ++c) {
-    result.relative_noise_per_channel[c] = signal2[c] > 0 ? std::sqrt(noise2[c] / signal2[c]) : 0;
-    all_noise2 += noise2[c];
-    all_signal2 += signal2[c];
   }
-  result.relative_noise = all_signal2 > 0 ? std::sqrt(all_noise2 / all_signal2) : 0.0;
-  if (launched > 0) {
-    result.exited = exited / launched;
-    result.lost = lost / launched;
-    result.roulette_net = roulette_net / launched;
-    result.absorbed = absorbed / launched;
-  }
+  fabric_raytrace_totals(result);
   table.metadata = {{"method", "raytrace"},
                     {"fiber_checksum", fiber.checksum()},
                     {"particles_per_bin", std::to_string(per_bin)},

@@ -1,9 +1,6 @@
 #include "weft/integrators/verify.h"
 
-#include <unistd.h>
-
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -369,21 +366,36 @@ struct TracedCurves {
   bool cancelled = false;
 };
 
+FabricRaytraceOptions trace_options(const VerifySettings& s, const std::string& model, int k) {
+  FabricRaytraceOptions o;
+  o.resolution = s.resolution;
+  o.particles_per_bin = s.particles_per_bin / static_cast<uint64_t>(s.batches);
+  o.seed = batch_seed(s.seed, model, k);
+  o.threads = s.threads;
+  return o;
+}
+
 TracedCurves trace_curves(const WovenSample& sample, const TabulatedBsdfTable& fiber,
                           const MeasuredInplane& measured, const VerifySettings& s,
-                          const std::string& model, const ProgressCallback& progress) {
+                          const std::string& model, const ProgressCallback& progress,
+                          const VerifyTraced* traced) {
   TracedCurves out;
   const size_t n_inc = measured.curves.size();
   std::vector<std::vector<std::vector<Rgb>>> per_batch;  // [batch][incidence][view]
   std::vector<double> sum;
   double noise2 = 0;
   for (int k = 0; k < s.batches; ++k) {
-    FabricRaytraceOptions o;
-    o.resolution = s.resolution;
-    o.particles_per_bin = s.particles_per_bin / static_cast<uint64_t>(s.batches);
-    o.seed = batch_seed(s.seed, model, k);
-    o.threads = s.threads;
-    const FabricRaytraceResult r = raytrace_fabric_table(sample, fiber, o, progress);
+    FabricRaytraceResult here;
+    const FabricRaytraceResult* found = nullptr;
+    if (traced)
+      if (const auto it = traced->find({model, k}); it != traced->end()) found = &it->second;
+    if (!found) {
+      here = raytrace_fabric_table(sample, fiber, trace_options(s, model, k), progress);
+      found = &here;
+    }
+    const FabricRaytraceResult& r = *found;
+    if (r.table.channels != fiber.channels || r.table.resolution != s.resolution)
+      throw Error("", model, "a ray trace handed in is of another table");
     if (r.cancelled) {
       out.cancelled = true;
       return out;
@@ -473,9 +485,43 @@ void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& nor
 
 }  // namespace
 
+std::vector<VerifyTrace> verify_traces(const VerifySettings& s) {
+  std::vector<VerifyTrace> out;
+  for (const char* model : {"computed", "classic"})
+    for (int k = 0; k < s.batches; ++k) out.push_back({model, k, trace_options(s, model, k)});
+  return out;
+}
+
+ClassicFiber verify_classic_fiber(const VerifyInputs& in, const VerifySettings& s,
+                                  const ProgressCallback& progress) {
+  ClassicFiber c;
+  // The fiber's volume albedo as a reflectance: components outside [0, 1] are removed (and
+  // reported).
+  Rgb refl = bands_to_linear_srgb([&](int b) { return in.volume_albedo[b]; });
+  c.clip.clip(refl);
+  for (double* v : {&refl.r, &refl.g, &refl.b})
+    if (*v > 1) {
+      c.clip.largest = std::max(c.clip.largest, *v - 1);
+      ++c.clip.components;
+      *v = 1;
+    }
+  if (in.classic_diffuse) {
+    const Rgb d = *in.classic_diffuse;
+    for (int k = 0; k < 3; ++k)
+      if (!(channel(d, k) >= 0 && channel(d, k) <= 1))
+        throw Error("", "classic_diffuse", "a reflectance lies in [0, 1]");
+    refl = d;
+    c.clip = GamutClip();
+  }
+  c.reflectance = refl;
+  c.table = classic_fiber_table(refl, in.classic_distribution, in.classic_ior, s.resolution,
+                                s.summation_samples, s.seed, s.threads, progress);
+  return c;
+}
+
 VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
                         const MeasuredInplane& measured, const VerifySettings& s,
-                        const ProgressCallback& progress) {
+                        const ProgressCallback& progress, const VerifyTraced* traced) {
   if (s.batches < 2) throw Error("", "batches", "the error bars need at least 2 batches");
   if (s.particles_per_bin < static_cast<uint64_t>(s.batches))
     throw Error("", "particles_per_bin", "fewer particles than batches");
@@ -505,7 +551,7 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
 
   // Computed: the fiber-level ray trace of the fiber table.
   auto t0 = std::chrono::steady_clock::now();
-  TracedCurves computed = trace_curves(sample, in.fiber, measured, s, "computed", progress);
+  TracedCurves computed = trace_curves(sample, in.fiber, measured, s, "computed", progress, traced);
   if (computed.cancelled) {
     rep.cancelled = true;
     return rep;
@@ -532,31 +578,13 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
     rep.models.push_back(std::move(m));
   }
 
-  // Classic: Lambert + Cook-Torrance with the fiber's volume albedo as its diffuse colour, a
-  // reflectance, so components outside [0, 1] are removed (and reported).
+  // Classic: Lambert + Cook-Torrance with the fiber's volume albedo as its diffuse colour.
   t0 = std::chrono::steady_clock::now();
-  Rgb refl = bands_to_linear_srgb([&](int b) { return in.volume_albedo[b]; });
-  rep.classic_clip.clip(refl);
-  for (double* v : {&refl.r, &refl.g, &refl.b})
-    if (*v > 1) {
-      rep.classic_clip.largest = std::max(rep.classic_clip.largest, *v - 1);
-      ++rep.classic_clip.components;
-      *v = 1;
-    }
-  if (in.classic_diffuse) {
-    const Rgb d = *in.classic_diffuse;
-    for (int k = 0; k < 3; ++k)
-      if (!(channel(d, k) >= 0 && channel(d, k) <= 1))
-        throw Error("", "classic_diffuse", "a reflectance lies in [0, 1]");
-    refl = d;
-    rep.classic_clip = GamutClip();
-  }
-  rep.classic_reflectance = refl;
+  const ClassicFiber classic = verify_classic_fiber(in, s, progress);
+  rep.classic_clip = classic.clip;
+  rep.classic_reflectance = classic.reflectance;
   rep.classic_source = in.classic_source;
-  const TabulatedBsdfTable classic_fiber =
-      classic_fiber_table(refl, in.classic_distribution, in.classic_ior, s.resolution,
-                          s.summation_samples, s.seed, s.threads, progress);
-  TracedCurves cl = trace_curves(sample, classic_fiber, measured, s, "classic", progress);
+  TracedCurves cl = trace_curves(sample, classic.table, measured, s, "classic", progress, traced);
   if (cl.cancelled) {
     rep.cancelled = true;
     return rep;
@@ -1270,11 +1298,10 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
   check_verify_output(dir);
   std::error_code ec;
   const fs::path target = fs::absolute(dir);
-  const fs::path parent = target.parent_path();
-  static std::atomic<uint64_t> calls{0};
-  const std::string tag = std::to_string(::getpid()) + "-" + std::to_string(calls.fetch_add(1));
-  const fs::path staging = parent / (".tmp-" + target.filename().string() + "-" + tag + "-partial");
-  const fs::path old = parent / (".tmp-" + target.filename().string() + "-" + tag + "-old");
+  // A staging folder named as atomic_file.h names temporaries, so that one a killed run left is
+  // removed by the next; the earlier report moved aside is never removed that way.
+  const fs::path staging = temporary_sibling(target);
+  const fs::path old = fs::path(staging.string() + "-old");
   try {
     if (!fs::create_directory(staging, ec) || ec)
       throw Error(dir.string(), "-o", "cannot create a staging folder beside it");

@@ -56,7 +56,8 @@ Vec3 parse_direction(ParamReader& f, const AngleFrame& frame, const std::string&
 // {"type": "environment", "file": "sky.exr", "scale": c}: an equirectangular OpenEXR map
 // (environment_map.h) in the description's angle frame; without "file", constant radiance.
 void parse_environment_map(ParamReader& f, const AngleFrame& frame,
-                           const std::filesystem::path& base_dir, Lights& lights) {
+                           const std::filesystem::path& base_dir, Lights& lights,
+                           std::vector<std::filesystem::path>& files) {
   if (f.has("radiance"))
     throw Error(f.file(), f.field("radiance"), "give either 'radiance' or 'file' (use 'scale')");
   std::filesystem::path file = f.string("file");
@@ -69,6 +70,7 @@ void parse_environment_map(ParamReader& f, const AngleFrame& frame,
   } catch (const Error& e) {
     throw Error(f.file(), f.field("file"), e.what());
   }
+  files.push_back(file);
 }
 
 // {"type": "sky", "zenith_radiance": c, "sun_zenith_deg": t, "sun_azimuth_deg": p,
@@ -99,7 +101,7 @@ void parse_sky(ParamReader& f, const AngleFrame& frame, Lights& lights) {
 }
 
 void parse_light(ParamReader f, const AngleFrame& frame, const std::filesystem::path& base_dir,
-                 Lights& lights) {
+                 Lights& lights, std::vector<std::filesystem::path>& files) {
   const std::string type = f.string("type");
   if (type == "parallel") {
     DirectionalLight d;
@@ -107,7 +109,7 @@ void parse_light(ParamReader f, const AngleFrame& frame, const std::filesystem::
     d.to_light = parse_direction(f, frame, "direction");
     lights.directional.push_back(d);
   } else if (type == "environment" && f.has("file")) {
-    parse_environment_map(f, frame, base_dir, lights);
+    parse_environment_map(f, frame, base_dir, lights, files);
   } else if (type == "sky") {
     parse_sky(f, frame, lights);
   } else if (type == "environment") {
@@ -338,6 +340,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
                              content.lights.points.end());
       for (auto& w : content.warnings) d.warnings.push_back(std::move(w));
       for (auto& n : content.notes) d.notes.push_back(std::move(n));
+      d.files.insert(d.files.end(), content.files.begin(), content.files.end());
     }
   }
   if (f.has("objects")) {
@@ -359,7 +362,7 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
     if (!ls.is_array()) throw Error(source, "lights", "must be a list");
     for (size_t i = 0; i < ls.size(); ++i)
       parse_light(ParamReader(ls[i], source, "lights[" + std::to_string(i) + "]"), d.frame,
-                  base_dir, d.lights);
+                  base_dir, d.lights, d.files);
   }
   if (f.has("fiber_geometry")) d.fiber_geometry = parse_fiber_geometry(f.object("fiber_geometry"));
   if (f.has("render")) d.render = f.at("render");

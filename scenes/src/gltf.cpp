@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -867,6 +868,22 @@ GltfContent load_gltf(const std::filesystem::path& path, GltfLightUnits light_un
                     "ignores material and texture extensions); export without them, e.g. "
                     "without mesh compression");
   GltfContent out;
+  out.files.push_back(path);
+  for (const auto& b : model.buffers)
+    if (!b.uri.empty() && b.uri.rfind("data:", 0) != 0) {
+      // As tinygltf found it: relative to the glTF's folder, percent-escapes decoded.
+      std::string uri;
+      for (size_t k = 0; k < b.uri.size(); ++k) {
+        if (b.uri[k] == '%' && k + 2 < b.uri.size() && std::isxdigit(uint8_t(b.uri[k + 1])) &&
+            std::isxdigit(uint8_t(b.uri[k + 2]))) {
+          uri += static_cast<char>(std::stoi(b.uri.substr(k + 1, 2), nullptr, 16));
+          k += 2;
+        } else {
+          uri += b.uri[k];
+        }
+      }
+      out.files.push_back(path.parent_path() / uri);
+    }
   const Ctx c{model, file, &out, light_units};
   for (size_t i = 0; i < model.materials.size(); ++i) {
     const auto& mat = model.materials[i];

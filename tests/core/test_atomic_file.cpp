@@ -1,6 +1,9 @@
 // write_atomically: an output file appears whole or not at all, and no temporary is left behind.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -117,4 +120,45 @@ TEST(AtomicFile, SeveralOutputsAreWrittenAllOrNone) {
   EXPECT_EQ(slurp(a), "new");
   EXPECT_EQ(slurp(b), "png");
   EXPECT_EQ((entries(dir)), (std::vector<std::string>{"image.exr", "preview.png"}));
+}
+
+// A writer killed mid-write (SIGKILL: no handler, no unwinding) leaves its temporary; the next
+// write to the same destination removes it, because its process is gone. Temporaries of a live
+// process and of another host (a shared file system) are left alone.
+TEST(AtomicFile, TemporaryOfAKilledWriterIsRemovedByTheNextWrite) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "table.exr";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    // Only async-signal-safe work would be strictly allowed after fork in a threaded process; the
+    // writer below allocates, so the child ends by SIGKILL and never returns into gtest.
+    write_atomically(out, [](const fs::path& tmp) {
+      std::ofstream(tmp) << "half written";
+      ::raise(SIGKILL);
+    });
+    ::_exit(0);  // not reached
+  }
+  int status = 0;
+  ASSERT_EQ(::waitpid(child, &status, 0), child);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGKILL);
+  const auto left = entries(dir);
+  ASSERT_EQ(left.size(), 1u);
+  EXPECT_EQ(left[0].rfind(".tmp-table-", 0), 0u) << left[0];
+  EXPECT_NE(left[0].find("@" + std::to_string(child) + "-"), std::string::npos) << left[0];
+
+  // Stand-ins for a live writer (this process) and a writer on another host.
+  const std::string live = temporary_sibling(out).filename().string();  // this host and pid
+  std::ofstream(dir / live) << "live";
+  const std::string other_host =
+      ".tmp-table-another-host.example@" + std::to_string(child) + "-0-partial.exr";
+  std::ofstream(dir / other_host) << "elsewhere";
+
+  write_text_atomically(out, "whole");
+  EXPECT_EQ(slurp(out), "whole");
+  std::vector<std::string> kept{live, other_host, "table.exr"};
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(entries(dir), kept);
+  // Another destination's temporaries are not touched either.
+  EXPECT_EQ(remove_stale_temporaries(dir / "other.exr"), 0u);
 }

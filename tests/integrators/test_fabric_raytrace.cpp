@@ -449,3 +449,46 @@ TEST(FabricRaytrace, SplitsAndRouletteKillsAreCountedPerIncidentBin) {
   EXPECT_EQ(mean.table.metadata.at("estimator"), "mean");
   EXPECT_EQ(mean.table.metadata.count("split_threshold"), 0u);
 }
+
+// A table traced in pieces of incident bins (as `--shard` and `weft merge` do) has the whole run's
+// rows, and its per-bin books summed by fabric_raytrace_totals give the whole run's energy books,
+// counts and noise bit for bit: every total is a sum over bins in bin order. 300 particles per bin
+// with tasks of up to 2048: tasks straddle the pieces' edges.
+TEST(FabricRaytrace, PiecesAddUpToTheWholeRunsBooksAndNoise) {
+  const auto fiber = uniform_fiber(3, 0.4 * kInvPi);  // lossy: every book is used
+  const FabricRaytraceOptions o = options(2, 300);
+  const WovenSample sample = default_sample("fiber");
+  const auto whole = raytrace_fabric_table(sample, fiber, o);
+  const int bins = DirectionGrid{2}.bins();
+  FabricRaytraceResult pieces;
+  pieces.table = whole.table;
+  std::fill(pieces.table.values.begin(), pieces.table.values.end(), 0.0f);
+  pieces.bin_books.resize(bins);
+  for (const auto& [first, count] : {std::pair{0, 3}, std::pair{3, 1}, std::pair{4, bins - 4}}) {
+    FabricRaytraceOptions p = o;
+    p.first_bin = first;
+    p.bin_count = count;
+    const auto r = raytrace_fabric_table(sample, fiber, p);
+    const size_t row = static_cast<size_t>(bins) * fiber.channels;
+    for (int a = first; a < first + count; ++a) {
+      std::copy(r.table.values.begin() + a * row, r.table.values.begin() + (a + 1) * row,
+                pieces.table.values.begin() + a * row);
+      pieces.bin_books[a] = r.bin_books[a];
+    }
+  }
+  fabric_raytrace_totals(pieces);
+  EXPECT_EQ(pieces.table.values, whole.table.values);
+  EXPECT_EQ(pieces.exited, whole.exited);
+  EXPECT_EQ(pieces.absorbed, whole.absorbed);
+  EXPECT_EQ(pieces.lost, whole.lost);
+  EXPECT_EQ(pieces.roulette_net, whole.roulette_net);
+  EXPECT_EQ(pieces.relative_noise, whole.relative_noise);
+  EXPECT_EQ(pieces.relative_noise_per_channel, whole.relative_noise_per_channel);
+  EXPECT_EQ(pieces.particles, whole.particles);
+  EXPECT_EQ(pieces.scatterings, whole.scatterings);
+  EXPECT_EQ(pieces.splits, whole.splits);
+  EXPECT_EQ(pieces.roulette_kills, whole.roulette_kills);
+  EXPECT_EQ(pieces.splits_per_bin, whole.splits_per_bin);
+  EXPECT_EQ(pieces.particles, uint64_t(300) * bins);
+  EXPECT_GT(whole.relative_noise, 0.0);
+}

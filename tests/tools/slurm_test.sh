@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The Slurm path end to end on a real single-node Slurm: munge key, a minimal slurm.conf with one
 # node of nproc CPUs, munged, slurmctld and slurmd started here (as root, on private ports and
-# sockets, in a temporary folder), then `weft slurm --shards 4` for a fiber bake and a sweep
-# (sbatch --array and a dependent merge job), each merged output compared byte for byte with the
-# one-process run; the daemons are stopped at the end. Installs nothing (scripts/install-deps.sh
-# installs slurm-wlm and munge); exits 77 (skipped, with the reason) only where the scheduler
+# sockets, in a temporary folder), then `weft slurm --shards 4` for a fiber bake, a sweep and a
+# draft verify (sbatch --array and a dependent merge job), each merged output compared byte for
+# byte with the one-process run (verify's metrics.json but for its timings); the daemons are
+# stopped at the end. Installs nothing (scripts/install-deps.sh installs slurm-wlm and munge);
+# exits 77 (skipped, with the reason) only where the scheduler
 # cannot start: not root, no slurm-wlm or munge, or the daemons do not come up.
 # Usage: slurm_test.sh WEFT_EXE SOURCE_DIR
 set -uo pipefail
@@ -110,4 +111,35 @@ check() {
 cd "$T"
 check "bake fiber" fiber.exr bake fiber red-cotton --photons 400 --resolution 2 --passes 2 --quiet
 check "sweep" sweep.csv sweep "$src/scenes/examples/woven-patch.json" --spp 1 --resolution 8 --quiet
+
+# verify: its report folder; inplane.csv byte for byte, metrics.json but for its timings
+# ("seconds"). The shards share one fiber bake through the bake cache.
+t0=$(date +%s.%N)
+"$weft" slurm --shards 4 verify --quality draft --quiet -o "$T/out/report" ||
+  { echo "FAIL verify: weft slurm"; fail=1; }
+for i in $(seq 1200); do
+  [ -z "$(squeue -h 2>/dev/null)" ] && break
+  sleep 0.1
+done
+t1=$(date +%s.%N)
+"$weft" verify --quality draft --quiet -o "$T/out/one-report" >/dev/null ||
+  { echo "FAIL verify: one-process run"; fail=1; }
+t2=$(date +%s.%N)
+awk -v a="$t0" -v b="$t1" -v c="$t2" 'BEGIN { printf "slurm_test: verify draft wall time: " \
+  "4 shards + merge through Slurm %.1f s, one process %.1f s\n", b - a, c - b }'
+same_metrics() {
+  python3 -c 'import json, sys
+a, b = (json.load(open(f)) for f in sys.argv[1:])
+for j in (a, b): j.pop("seconds", None)
+sys.exit(a != b)' "$1/metrics.json" "$2/metrics.json"
+}
+if [ -f "$T/out/report/inplane.csv" ] &&
+  cmp -s "$T/out/report/inplane.csv" "$T/out/one-report/inplane.csv" &&
+  same_metrics "$T/out/report" "$T/out/one-report"; then
+  echo "slurm_test: verify: 4 shards through sbatch --array + merge == one process (inplane.csv bytes, metrics)"
+else
+  echo "FAIL verify: merged report missing or different"
+  tail -5 "$T/out/report.slurm/"*.log 2>/dev/null
+  fail=1
+fi
 exit $fail

@@ -155,6 +155,31 @@ TEST(CliBadInput, LongBakesNeedConfirmation) {
                {"--resolution", "needs about", "allowed by --max-memory-gb"}, dir / "t.exr");
 }
 
+// Renders, sweeps and ray-traced fabric tables estimate their time before starting, from a lower
+// bound on the rate (render_settings.h kMinSecondsPerPathSample: 0.05 us per path sample per core;
+// fabric_raytrace.h kMinSecondsPerFabricParticle: 0.25 us per particle per core), and refuse
+// above an hour without --yes-long, naming the option and the rate.
+TEST(CliBadInput, LongRendersSweepsAndRayTracesNeedConfirmation) {
+  const fs::path dir = fresh_test_dir();
+  // 4096^2 pixels x 10^6 spp x 0.05 us = 8.4e5 core-seconds: over an hour on up to 233 cores.
+  expect_error(
+      run("render " + kPlane + " --width 4096 --height 4096 --spp 1000000 -o t.exr", dir),
+      {"lambert-plane.json", "spp", "would take at least", "us per path sample", "--yes-long"},
+      dir / "t.exr");
+  // 15 views, each with its white reference, of 4096^2 pixels at 10^6 spp.
+  expect_error(
+      run("sweep " + kPlane + " --spp 1000000 --resolution 4096 -o t.csv", dir),
+      {"lambert-plane.json", "spp", "a sweep of 15 views", "would take at least", "--yes-long"},
+      dir / "t.csv");
+  // 128 incident bins x 2^36 particles x 0.25 us: 2.2e6 core-seconds. Refused before the fiber
+  // table is baked, so no bake cache appears either.
+  expect_error(
+      run("bake fabric --method raytrace -R 8 --samples 68719476736 -o t.exr", dir),
+      {"--samples", "128 incident bins", "would take at least", "us per particle", "--yes-long"},
+      dir / "t.exr");
+  EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
+}
+
 TEST(CliBadInput, MemoryBudgetRefusesBeforeAllocating) {
   const fs::path dir = fresh_test_dir();
   // A bake at R = 32 holds 33 bands of 2048^2 doubles twice: 2.3 GB even for one photon (the

@@ -33,7 +33,9 @@ VerifyRun run_weft(const std::string& args, const fs::path& dir) {
   fs::create_directories(bin);
   std::ofstream(bin / "python3") << "#!/bin/sh\nexit 1\n";
   fs::permissions(bin / "python3", fs::perms::owner_all);
-  return weft::testing::run_weft_cli(args, dir, "PATH='" + bin.string() + "':$PATH ");
+  // In 'dir': the bake cache (./.weft-cache) is the test's own.
+  return weft::testing::run_weft_cli(
+      args, dir, "cd '" + dir.string() + "' && PATH='" + bin.string() + "':$PATH ");
 }
 
 }  // namespace
@@ -283,6 +285,15 @@ weft::FiberTableBakeResult small_red_cotton_bake() {
   return weft::bake_fiber_table(weft::load_fiber_spec("red-cotton"), b);
 }
 
+// metrics.json without its timings ("seconds": wall-clock times of the steps, which differ from
+// run to run), as text.
+std::string metrics_without_seconds(const fs::path& report) {
+  auto j = nlohmann::json::parse(slurp(report / "metrics.json"));
+  EXPECT_TRUE(j.contains("seconds"));
+  j.erase("seconds");
+  return j.dump(1);
+}
+
 }  // namespace
 
 // --fiber TABLE: the classic baseline's colour from the table alone. Its total albedo is the
@@ -400,4 +411,82 @@ TEST(CliVerify, PrintsItsEstimateAndRefusesLongWorkWithoutYesLong) {
   EXPECT_NE(r.err.find("M particles: about"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--yes-long"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(out));
+}
+
+// verify split over processes: three shards of its ray traces (incident bins of every batch of
+// both models) and `weft merge` make the report of the one-process run: inplane.csv byte for byte,
+// metrics.json but for its timings (energy books and noise included). The fiber bake the shards
+// share is baked once, into the bake cache, and reused by the other shards and the merge.
+TEST(CliVerify, ShardsMergeToTheOneProcessReport) {
+  const fs::path dir = fresh_test_dir();
+  const std::string common = "verify --quiet --quality draft --threads 2 ";
+  const fs::path one = dir / "one";
+  VerifyRun r = run_weft(common + "-o '" + one.string() + "'", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  fs::remove_all(dir / ".weft-cache");  // the shards bake it again, once
+
+  std::string parts;
+  for (int k = 0; k < 3; ++k) {
+    const fs::path part = dir / ("part-" + std::to_string(k) + ".part");
+    r = run_weft(common + "--shard " + std::to_string(k) + "/3 -o '" + part.string() + "'", dir);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("shard " + std::to_string(k) + "/3"), std::string::npos) << r.out;
+    parts = "'" + part.string() + "' " + parts;  // any order
+  }
+  size_t cached = 0;
+  for (const auto& e : fs::directory_iterator(dir / ".weft-cache"))
+    cached += e.path().extension() == ".exr";
+  EXPECT_EQ(cached, 1u);  // one spectral fiber table for all three shards
+
+  const fs::path merged = dir / "merged";
+  r = run_weft("merge " + parts + "-o '" + merged.string() + "'", dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string a = slurp(one / "inplane.csv"), b = slurp(merged / "inplane.csv");
+  EXPECT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == b) << "inplane.csv differs";
+  EXPECT_EQ(metrics_without_seconds(one), metrics_without_seconds(merged));
+
+  // A missing shard is named; --fit is refused with --shard.
+  r = run_weft("merge '" + (dir / "part-0.part").string() + "' '" + (dir / "part-2.part").string() +
+                   "' -o '" + (dir / "m2").string() + "'",
+               dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("missing shard 1/3"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir / "m2"));
+  r = run_weft(common + "--fit --shard 0/2 -o '" + (dir / "p.part").string() + "'", dir);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--fit"), std::string::npos) << r.err;
+}
+
+// weft slurm verify --dry-run: the array script runs verify's shards (without --resume, which
+// verify does not have) into parts beside the report, and the merge script merges all of them
+// into the report folder; nothing is submitted or written.
+TEST(CliVerify, SlurmDryRunScripts) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path report = dir / "report";
+  const VerifyRun r = run_weft(
+      "slurm --shards 4 --partition cpu --time 1:00:00 --dry-run verify "
+      "--quality draft -o '" +
+          report.string() + "'",
+      dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string slurm = report.string() + ".slurm";
+  for (const std::string& s :
+       {std::string("#SBATCH --array=0-3"), std::string("#SBATCH --partition=cpu"),
+        std::string("#SBATCH --time=1:00:00"),
+        std::string("'verify' '--quality' 'draft' '-o' '") + slurm +
+            "/part-'\"$SLURM_ARRAY_TASK_ID\".part",
+        std::string("--shard \"$SLURM_ARRAY_TASK_ID/4\" --quiet\n"),
+        std::string("merge '") + slurm + "/part-0.part' '" + slurm + "/part-1.part' '" + slurm +
+            "/part-2.part' '" + slurm + "/part-3.part' -o '" + report.string() + "'",
+        std::string("sbatch --dependency=afterok:")})
+    EXPECT_NE(r.out.find(s), std::string::npos) << s << "\n" << r.out;
+  EXPECT_EQ(r.out.find("--resume"), std::string::npos) << r.out;
+  EXPECT_FALSE(fs::exists(slurm));
+  EXPECT_FALSE(fs::exists(report));
+  // --fit cannot run as shards.
+  const VerifyRun fit =
+      run_weft("slurm --shards 2 --dry-run verify --fit -o '" + report.string() + "'", dir);
+  EXPECT_EQ(fit.exit_code, 2);
+  EXPECT_NE(fit.err.find("--fit"), std::string::npos) << fit.err;
 }

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <random>
 #include <sstream>
 #include <string>
@@ -69,9 +70,12 @@ std::vector<std::string> operator+(std::vector<std::string> a, const std::vector
   return a;
 }
 
-// Runs 'args' as 4 shards, merges them and expects the bytes of 'reference'.
+// Runs 'args' as 4 shards, merges them (with 'merge_options') and expects the bytes of
+// 'reference'; what the merge printed goes to 'printed' when given.
 void expect_shards_merge_to(const std::vector<std::string>& args, const fs::path& reference,
-                            const fs::path& dir, const std::string& ext) {
+                            const fs::path& dir, const std::string& ext,
+                            const std::vector<std::string>& merge_options = {},
+                            std::string* printed = nullptr) {
   std::vector<std::string> merge = {"merge"};
   for (int k = 0; k < 4; ++k) {
     const fs::path part = dir / ("part-" + std::to_string(k) + ".part");
@@ -85,8 +89,10 @@ void expect_shards_merge_to(const std::vector<std::string>& args, const fs::path
   // Any order of the parts.
   std::swap(merge[1], merge[3]);
   const fs::path merged = dir / ("merged" + ext);
-  ASSERT_EQ(run_weft(merge + std::vector<std::string>{"-o", merged.string()}, dir), 0)
+  ASSERT_EQ(run_weft(merge + merge_options + std::vector<std::string>{"-o", merged.string()}, dir),
+            0)
       << slurp(dir / "stderr");
+  if (printed) *printed = slurp(dir / "stdout");
   const std::string a = slurp(reference), b = slurp(merged);
   EXPECT_GT(a.size(), 0u);
   EXPECT_TRUE(a == b) << reference << " and " << merged << " differ";
@@ -122,9 +128,26 @@ TEST(Shards, RaytracedFabricOfFourShardsMergesToTheOneProcessBytes) {
   const auto args =
       split("bake fabric --method raytrace -R 2 --samples 2100 --quiet --fiber " + fiber.string());
   const fs::path one = dir / "one.exr";
-  ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
+  ASSERT_EQ(run_weft(args + std::vector<std::string>{"--json", "-o", one.string()}, dir), 0)
       << slurp(dir / "stderr");
-  expect_shards_merge_to(args, one, dir, ".exr");
+  const auto whole = nlohmann::json::parse(slurp(dir / "stdout"));
+  std::string printed;
+  expect_shards_merge_to(args, one, dir, ".exr", {"--json"}, &printed);
+  ASSERT_FALSE(printed.empty());
+  const auto merged = nlohmann::json::parse(printed);
+  // The energy books, counts and noise are sums over the bins in bin order: the merge has the
+  // whole run's bits (JSON numbers print with round-trip precision).
+  for (const char* key : {"exited", "absorbed", "lost", "roulette_net", "relative_noise",
+                          "relative_noise_per_channel", "particles", "scatterings",
+                          "reflectance_normal_incidence", "transmittance_normal_incidence"}) {
+    ASSERT_TRUE(whole.contains(key) && merged.contains(key)) << key;
+    EXPECT_FALSE(merged[key].is_null()) << key;
+    EXPECT_EQ(whole[key].dump(), merged[key].dump()) << key;
+  }
+  EXPECT_GT(merged["relative_noise"].get<double>(), 0.0);
+  EXPECT_NEAR(merged["exited"].get<double>() + merged["absorbed"].get<double>() +
+                  merged["lost"].get<double>() + merged["roulette_net"].get<double>(),
+              1.0, 1e-9);  // fabric_raytrace.h: the books add up to 1 to rounding
 }
 
 TEST(Shards, SweepOfFourShardsMergesToTheOneProcessBytes) {
@@ -246,6 +269,82 @@ TEST(Resume, ShardOfARaytracedFabricKilledAtRandomMomentsResumesToTheSameBytes) 
                         "--threads 2 --fiber " +
                         fiber.string()),
                   ".part", 4, dir);
+}
+
+namespace {
+
+// RFC 4648 base64 (the bundled glTF's data URI) to bytes.
+std::string from_base64(const std::string& text) {
+  const std::string abc = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  uint32_t acc = 0;
+  int bits = 0;
+  for (char c : text) {
+    const auto v = abc.find(c);
+    if (v == std::string::npos) break;  // '=' padding
+    acc = (acc << 6) | static_cast<uint32_t>(v);
+    if ((bits += 6) >= 8) out.push_back(static_cast<char>((acc >> (bits -= 8)) & 0xff));
+  }
+  return out;
+}
+
+// The bundled Lambert plane with its buffer in an external plane.bin, in 'dir'; returns the
+// scene description's path.
+fs::path plane_with_external_buffer(const fs::path& dir) {
+  const fs::path examples = fs::path(WEFT_SOURCE_DIR) / "scenes/examples";
+  auto gltf = nlohmann::json::parse(slurp(examples / "lambert-plane.gltf"));
+  const std::string uri = gltf["buffers"][0]["uri"];
+  std::ofstream(dir / "plane.bin", std::ios::binary) << from_base64(uri.substr(uri.find(',') + 1));
+  gltf["buffers"][0]["uri"] = "plane.bin";
+  std::ofstream(dir / "lambert-plane.gltf") << gltf.dump(1);
+  fs::copy_file(examples / "lambert-plane.json", dir / "plane.json");
+  return dir / "plane.json";
+}
+
+}  // namespace
+
+// A sweep's identity holds the content of the files its scene reads: a glTF buffer changed between
+// two shards makes merge refuse, naming the file; a glTF changed after a killed run makes --resume
+// refuse its checkpoint, naming the file, instead of mixing views of two scenes.
+TEST(Shards, ChangedGltfOrBufferInvalidatesPartsAndCheckpoints) {
+  const fs::path dir = fresh_test_dir();
+  const std::string scene = plane_with_external_buffer(dir).string();
+  const auto sweep = split("sweep " + scene + " --quiet --threads 2");
+  const std::string p0 = (dir / "p0.part").string(), p1 = (dir / "p1.part").string();
+  ASSERT_EQ(run_weft(sweep + split("--shard 0/2 -o " + p0), dir), 0) << slurp(dir / "stderr");
+  // Texture coordinates (bytes 160..191, unused in shading, but content all the same).
+  std::string bin = slurp(dir / "plane.bin");
+  bin[170] = static_cast<char>(bin[170] ^ 1);
+  std::ofstream(dir / "plane.bin", std::ios::binary) << bin;
+  ASSERT_EQ(run_weft(sweep + split("--shard 1/2 -o " + p1), dir), 0) << slurp(dir / "stderr");
+  const fs::path merged = dir / "merged.csv";
+  EXPECT_EQ(run_weft({"merge", p0, p1, "-o", merged.string()}, dir), 2);
+  std::string err = slurp(dir / "stderr");
+  EXPECT_NE(err.find("another job"), std::string::npos) << err;
+  EXPECT_NE(err.find("content of " + (dir / "plane.bin").string()), std::string::npos) << err;
+  EXPECT_FALSE(fs::exists(merged));
+
+  // A run killed after its first checkpoint (heavy views: it lasts well beyond that).
+  const fs::path out = dir / "resumed.csv", checkpoint = dir / ".resumed.csv.weft-checkpoint";
+  const auto run = sweep + split("--spp 256 --resolution 64 --resume -o " + out.string());
+  const pid_t pid = spawn(run, dir);
+  int status = 0;
+  bool reaped = false;
+  while (!fs::exists(checkpoint) && !(reaped = waitpid(pid, &status, WNOHANG) == pid))
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  ASSERT_FALSE(reaped) << "the sweep ended before its first checkpoint";
+  kill(pid, SIGKILL);
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(fs::exists(checkpoint));
+  std::string gltf = slurp(dir / "lambert-plane.gltf");
+  gltf.insert(gltf.find("\"version\""), "\"copyright\": \"changed\", ");
+  std::ofstream(dir / "lambert-plane.gltf") << gltf;
+  EXPECT_EQ(run_weft(run, dir), 2);
+  err = slurp(dir / "stderr");
+  EXPECT_NE(err.find("checkpoint of another job"), std::string::npos) << err;
+  EXPECT_NE(err.find("content of " + (dir / "lambert-plane.gltf").string()), std::string::npos)
+      << err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(Outputs, NeverOverwriteInputsOrEachOther) {

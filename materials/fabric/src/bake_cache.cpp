@@ -5,6 +5,10 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
 #include <system_error>
 
 #include "weft/core/error.h"
@@ -20,6 +24,40 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
                           "|P" + std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") +
                           "|v" + std::to_string(TabulatedBsdfTable::kFormatVersion);
   return dir / ("fiber-" + fiber_spec_hash_hex(spec) + "-" + hex64(fnv1a64(key)) + ".exr");
+}
+
+std::string volume_albedo_metadata(const FiberTableBakeResult& r) {
+  Spectrum s{};
+  for (const auto& b : r.bands)
+    if (b.band >= 0 && b.band < kNumBands) s[b.band] = b.exit_fraction - b.surface_fraction;
+  std::string out;
+  char buf[40];
+  for (double v : s) {
+    std::snprintf(buf, sizeof buf, "%s%.17g", out.empty() ? "" : ",", v);
+    out += buf;
+  }
+  return out;
+}
+
+Spectrum volume_albedo_of(const TabulatedBsdfTable& table, const std::string& file) {
+  const auto it = table.metadata.find("volume_albedo");
+  if (it == table.metadata.end())
+    throw Error(file, "volume_albedo",
+                "missing (a cache entry written before it was recorded: remove the file)");
+  Spectrum s{};
+  std::stringstream in(it->second);
+  std::string item;
+  size_t n = 0;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const double v = std::strtod(item.c_str(), &end);
+    if (n >= s.size() || item.empty() || *end != '\0' || !std::isfinite(v))
+      throw Error(file, "volume_albedo", "is not " + std::to_string(s.size()) + " numbers");
+    s[n++] = v;
+  }
+  if (n != s.size())
+    throw Error(file, "volume_albedo", "is not " + std::to_string(s.size()) + " numbers");
+  return s;
 }
 
 namespace {
@@ -75,6 +113,7 @@ std::filesystem::path cached_fiber_table(const std::filesystem::path& dir, const
   FiberTableBakeResult r = bake_fiber_table(spec, options, progress);
   if (r.cancelled) throw Error(file.string(), "", "bake interrupted; nothing was cached");
   r.table.metadata["cache_key"] = file.stem().string();
+  r.table.metadata["volume_albedo"] = volume_albedo_metadata(r);
   r.table.write_exr(file);
   if (baked) *baked = true;
   return file;

@@ -31,6 +31,18 @@ struct NamedPath {
 void check_output_paths(const std::vector<NamedPath>& outputs,
                         const std::vector<NamedPath>& inputs);
 
+// The temporary sibling write_atomically writes 'path' through:
+// ".tmp-<stem>-<host>@<pid>-<n>-partial<ext>", a name of its own per process and call (writers of
+// one path never share one), the extension last (writers such as OpenImageIO choose the format by
+// it). A process killed mid-write (SIGKILL) leaves it behind, so naming one first removes the stale
+// temporaries of 'path' (remove_stale_temporaries). weft::Error when the directory is missing.
+std::filesystem::path temporary_sibling(const std::filesystem::path& path);
+
+// Removes the temporaries of 'path' (files or folders named as temporary_sibling names them) whose
+// writer ran on this host and no longer exists (kill(pid, 0) fails with ESRCH). Those of live
+// processes and of other hosts (a shared file system) are left alone. Returns how many it removed.
+size_t remove_stale_temporaries(const std::filesystem::path& path);
+
 // Same, for text content.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
 

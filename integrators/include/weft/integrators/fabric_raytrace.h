@@ -61,6 +61,19 @@ struct FabricRaytraceOptions {
   void validate() const;  // weft::Error naming the field
 };
 
+// What one incident bin's particles booked: the totals of FabricRaytraceResult are sums of these
+// in bin order (fabric_raytrace_totals), so a table traced in pieces (first_bin, bin_count) and
+// put together has the whole run's books and noise bit for bit.
+struct FabricBinBooks {
+  double launched = 0, exited = 0, absorbed = 0, lost = 0, roulette_net = 0;  // power
+  uint64_t particles = 0, scatterings = 0, wraps = 0, splits = 0, roulette_kills = 0;
+  uint64_t continuation_caps = 0, inside_hits = 0, tube_passes = 0;
+  // Per channel, over the bin's row of the table: sum of se^2 D_i D_o and of f^2 D_i D_o (the
+  // relative noise's numerator and denominator, D the cosine-weighted areas).
+  std::vector<double> noise2, signal2;
+  void add(const FabricBinBooks& other);  // the power and counts (not noise2, signal2)
+};
+
 struct FabricRaytraceResult {
   TabulatedBsdfTable table;  // kind "fabric", the fiber table's channels
   // Energy books, as fractions of the power that fell on the cloth (mean over channels): exited +
@@ -83,8 +96,18 @@ struct FabricRaytraceResult {
   double relative_noise = 0;
   std::vector<double> relative_noise_per_channel;  // the same, channel by channel
   std::vector<float> standard_error;               // per value of the table (cell pair and channel)
+  std::vector<FabricBinBooks> bin_books;  // per incident bin (zero outside the bins traced)
   bool cancelled = false;
 };
+
+// The totals above (energy books, counts, relative noise) from bin_books, summed in bin order.
+void fabric_raytrace_totals(FabricRaytraceResult& result);
+
+// A lower bound on the CPU time of one particle of the ray trace, seconds: PERFORMANCE.md gives
+// about 0.8 M particles/s at fiber detail and 1.2 M/s on yarn tubes on 2 threads (1.7 us per
+// particle per core on tubes); a particle that meets no fiber is cheaper, so 0.25 us. A front end
+// estimates a ray trace's time with it before starting.
+inline constexpr double kMinSecondsPerFabricParticle = 0.25e-6;
 
 // The fiber directions seen at the cloth's surface, for the summations: the unit tangents (cloth
 // frame) at the first hits of a rays_per_side x rays_per_side grid of rays along the normal over

@@ -44,6 +44,12 @@ struct RenderSettings {
   bool aov_albedo = false, aov_normal = false;
 };
 
+// A lower bound on the CPU time of one path sample (one pixel sample), seconds: a sample traces at
+// least its camera ray, and the path tracer ran 8.46 M rays/s on 2 threads on the 65 536-triangle
+// woven patch (PERFORMANCE.md, 0.24 us per ray per core); a scene of a few triangles is faster,
+// so 0.05 us. A front end estimates a render's or sweep's time with it before starting.
+inline constexpr double kMinSecondsPerPathSample = 0.05e-6;
+
 // RenderSettings{} with the description's "render" section applied. Unknown keys and bad values
 // are weft::Error naming the description's file and the key's path ("render.spp").
 RenderSettings render_settings_from(const SceneDescription& desc);

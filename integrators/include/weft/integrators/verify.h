@@ -36,6 +36,7 @@
 
 #include "weft/core/progress.h"
 #include "weft/core/spectrum.h"
+#include "weft/integrators/fabric_raytrace.h"
 #include "weft/integrators/image.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/microfacet.h"
@@ -362,9 +363,36 @@ struct VerifyReport {
   bool cancelled = false;
 };
 
+// The ray traces of a verification, most of its time: per model, settings.batches independent
+// raytrace_fabric_table runs of every incident bin ("computed": of the fiber table; "classic": of
+// verify_classic_fiber's table). In run_verify's order: the computed batches, then the classic.
+// A front end may run them in pieces over processes (first_bin, bin_count: the rows, energy books
+// and noise of the whole run, bit for bit, fabric_raytrace.h) and hand the results in.
+struct VerifyTrace {
+  std::string model;  // "computed" or "classic"
+  int batch = 0;
+  FabricRaytraceOptions options;  // of the whole table
+};
+std::vector<VerifyTrace> verify_traces(const VerifySettings& settings);
+
+// The classic model's fiber: its diffuse colour (the fiber's volume albedo as linear sRGB, made a
+// reflectance in [0, 1] with what that removed in 'clip'; or inputs.classic_diffuse) and its
+// fiber table, which the classic ray traces use.
+struct ClassicFiber {
+  Rgb reflectance;
+  GamutClip clip;
+  TabulatedBsdfTable table;
+};
+ClassicFiber verify_classic_fiber(const VerifyInputs& inputs, const VerifySettings& settings,
+                                  const ProgressCallback& progress = no_progress());
+
+// Ray traces done elsewhere, by (model, batch): run_verify takes them instead of tracing.
+using VerifyTraced = std::map<std::pair<std::string, int>, FabricRaytraceResult>;
+
 VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& inputs,
                         const MeasuredInplane& measured, const VerifySettings& settings,
-                        const ProgressCallback& progress = no_progress());
+                        const ProgressCallback& progress = no_progress(),
+                        const VerifyTraced* traced = nullptr);
 
 // The report's files, as text: the long-form curves CSV and metrics JSON (stable keys,
 // docs/verify.md), and the offline HTML page embedding the given images (file name -> bytes).

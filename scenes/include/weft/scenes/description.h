@@ -97,6 +97,9 @@ struct SceneDescription {
   std::optional<nlohmann::json> render, sweep;
   std::vector<std::string> warnings;
   std::vector<std::string> notes;  // for the render log (gltf.h: how glTF lights were converted)
+  // Every file the description read besides itself: glTF files and their buffers
+  // (GltfContent::files), environment maps. Material tables are read later (registry.h).
+  std::vector<std::filesystem::path> files;
 
   size_t shape_count() const { return meshes.size() + curves.size(); }
   // Bounding box of the shapes selected by 'object' (every shape when empty); Error when none.

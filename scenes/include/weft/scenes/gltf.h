@@ -53,6 +53,9 @@ struct GltfContent {
   std::vector<std::string> warnings;
   // What a render log should say about the file: each light with its glTF and converted values.
   std::vector<std::string> notes;
+  // The files read: the glTF itself, then its external buffers (.bin) in buffer order. Images are
+  // not read (textures do not shade), so they are not listed.
+  std::vector<std::filesystem::path> files;
 };
 
 // How KHR_lights_punctual intensities are read: photometric (lux, candela; the specification's

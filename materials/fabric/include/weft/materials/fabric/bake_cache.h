@@ -26,6 +26,13 @@ std::filesystem::path cached_fiber_table(const std::filesystem::path& dir, const
                                          const FiberTableBakeOptions& options,
                                          const ProgressCallback& progress, bool* baked = nullptr);
 
+// The fiber's volume albedo per band (exit minus surface fraction, FiberBandResult), which a table
+// does not hold but a cache entry records in its metadata "volume_albedo" (33 numbers, round-trip
+// precision): what the classic model of weft verify takes as its colour. volume_albedo_metadata
+// writes it, volume_albedo_of reads it (weft::Error naming 'file' when missing or malformed).
+std::string volume_albedo_metadata(const FiberTableBakeResult& result);
+Spectrum volume_albedo_of(const TabulatedBsdfTable& table, const std::string& file);
+
 // The material registry's FiberTableResolver: reads "spec" (a spec file relative to the scene's
 // folder, or a preset name) and the optional bake settings "resolution", "photons", "seed"
 // (defaults: FiberTableBakeOptions), and returns the cached table. 'cache_dir' empty: a
