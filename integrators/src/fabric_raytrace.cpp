@@ -128,6 +128,11 @@ struct PendingCopy {
 // The most copies one split makes (the weights are divided by the count made, so any cap is
 // unbiased; it bounds the work a freak weight can cause).
 constexpr int kMaxSplit = 16;
+// The most copies one particle's splits make in all. Splitting is optional (any count keeps the
+// estimate unbiased), so a cap changes only the noise; it bounds a particle's work where weights
+// grow at every event (a table whose line albedo stays above 1: the copies would grow
+// geometrically with the path's length).
+constexpr int kMaxCopiesPerParticle = 64;
 
 struct TaskTally {
   std::vector<ExitRecord> exits;
@@ -434,6 +439,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
           // stays that of one particle's total.
           const size_t first_exit = tally.exits.size();
           pending.clear();
+          int copies = 0;  // made by this particle's splits
           pending.push_back({p, d, 0, kNoFiber, false, std::vector<double>(nc, w0),
                              std::vector<double>(n_strategies, 1.0)});
           while (!pending.empty()) {
@@ -618,13 +624,15 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               // where the line runs near its axis (up to ~3 in red for red cotton), so weights grow
               // along a path; a few heavy paths would carry much of the table. n copies of weight
               // w / n each, which go their own ways from the next fiber on.
-              if (window && max_w > o.split_threshold) {
+              if (window && max_w > o.split_threshold && copies < kMaxCopiesPerParticle) {
                 const int n = static_cast<int>(
-                    std::min<double>(kMaxSplit, std::ceil(max_w / o.split_threshold)));
+                    std::min<double>({double(kMaxSplit), std::ceil(max_w / o.split_threshold),
+                                      double(kMaxCopiesPerParticle - copies + 1)}));
                 for (double& x : w) x /= n;
                 for (int copy = 1; copy < n; ++copy)
                   pending.push_back({p, d, events, ignore, in_tube, w, pdf});
                 books.splits += n - 1;
+                copies += n - 1;
               }
             }
           }
@@ -671,6 +679,14 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
       }
     }
   }
+  // Weights that overflow mean a fiber table that returns more light than it receives at every
+  // crossing (a baked table conserves energy over the whole fiber): refuse it, not a table of inf.
+  for (float v : table.values)
+    if (!std::isfinite(v))
+      throw Error("", "fiber",
+                  "the ray trace's path weights overflowed: the fiber table returns more light "
+                  "than it receives along paths (its albedo at B' plus B'' stays above 1); bake "
+                  "it with weft bake fiber");
   fabric_raytrace_totals(result);
   table.metadata = {{"method", "raytrace"},
                     {"fiber_checksum", fiber.checksum()},

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/integrators/fabric_raytrace.h"
 #include "weft/materials/table_compare.h"
@@ -491,4 +492,34 @@ TEST(FabricRaytrace, PiecesAddUpToTheWholeRunsBooksAndNoise) {
   EXPECT_EQ(pieces.splits_per_bin, whole.splits_per_bin);
   EXPECT_EQ(pieces.particles, uint64_t(300) * bins);
   EXPECT_GT(whole.relative_noise, 0.0);
+}
+
+TEST(FabricRaytrace, ColouredFiberFinishesWithBoundedCopiesPerParticle) {
+  // A fiber that keeps half, 0.3 and 0.1 of the light at every point (outer hemisphere): the
+  // channels' weights part along a path and splitting makes copies. Splitting is optional, so each
+  // particle's copies are capped (64): at most 63 per particle, a finite table.
+  const auto lossy = fiber_table3(2, [](const Vec3& wo, const Vec3&, std::span<double> v) {
+    v[0] = wo.z > 0 ? 0.5 * kInvPi : 0;
+    v[1] = wo.z > 0 ? 0.3 * kInvPi : 0;
+    v[2] = wo.z > 0 ? 0.1 * kInvPi : 0;
+  });
+  const FabricRaytraceOptions o = options(2, 300);
+  const WovenSample sample = default_sample("fiber");
+  const auto r = raytrace_fabric_table(sample, lossy, o);
+  EXPECT_EQ(r.particles, uint64_t(300) * DirectionGrid{2}.bins());
+  EXPECT_LE(r.splits, 63 * r.particles);
+  for (float v : r.table.values) ASSERT_TRUE(std::isfinite(v));
+  // The same on both hemispheres gives albedo 1 + 1 along every line through a fiber (in red): the
+  // weights double at each crossing. Without the cap the copies grew geometrically (the run did
+  // not end in 10 minutes); with it the weights overflow and the table is refused, naming it.
+  const auto creating = fiber_table3(2, [](const Vec3&, const Vec3&, std::span<double> v) {
+    v[0] = 0.5 * kInvPi, v[1] = 0.3 * kInvPi, v[2] = 0.1 * kInvPi;
+  });
+  try {
+    (void)raytrace_fabric_table(sample, creating, o);
+    ADD_FAILURE() << "an energy-creating fiber table was accepted";
+  } catch (const weft::Error& e) {
+    EXPECT_NE(std::string(e.what()).find("overflowed"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fiber"), std::string::npos) << e.what();
+  }
 }
