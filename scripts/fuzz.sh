@@ -17,7 +17,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 all=(fuzz_scene_description fuzz_fiber_spec fuzz_weave_options fuzz_table_exr fuzz_wif fuzz_nbrdf
-  fuzz_gltf fuzz_glb)
+  fuzz_inplane_csv fuzz_gltf fuzz_glb)
 [ ${#harnesses[@]} -gt 0 ] || harnesses=("${all[@]}")
 
 if ! command -v clang++ >/dev/null; then
@@ -47,6 +47,7 @@ seeds() {
     fuzz_table_exr) ls tests/fuzz/seeds/table/*.exr ;;
     fuzz_wif) ls scenes/data/wif/*.wif ;;
     fuzz_nbrdf) ls materials/data/measured/*/*.txt materials/data/measured/*/*.csv ;;
+    fuzz_inplane_csv) ls materials/data/measured/*/inplane.csv ;;
     fuzz_gltf) ls scenes/examples/*.gltf tests/scenes/data/*.gltf ;;
     fuzz_glb) ls tests/fuzz/seeds/glb/*.glb ;;
   esac
