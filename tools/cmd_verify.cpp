@@ -316,17 +316,13 @@ void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
       std::max(1u, p.s.threads > 0 ? unsigned(p.s.threads) : std::thread::hardware_concurrency());
   const VerifyEstimate e = estimate_verify(p.s, !p.fiber_table, o.fit,
                                            p.fit_options.max_evaluations, p.fit_names.size());
-  const auto when = [](double sec) {
-    return sec < 120 ? std::to_string(static_cast<int>(std::ceil(sec))) + " s"
-                     : format_seconds(sec);
-  };
   if (!o.quiet)
     std::fprintf(stderr,
                  "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on "
                  "%u cores (%s of CPU; at least %s)\n",
                  o.quality.c_str(), o.fit ? " with --fit" : "", e.photons * 1e-6,
-                 e.particles * 1e-6, when(e.typical / cores).c_str(), cores,
-                 when(e.typical).c_str(), when(e.least / cores).c_str());
+                 e.particles * 1e-6, format_seconds(e.typical / cores).c_str(), cores,
+                 format_seconds(e.typical).c_str(), format_seconds(e.least / cores).c_str());
   check_long_work(e.least, 1.0, p.s.threads, "", "--quality",
                   "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
                   "0.5 us per photon and 1.25 us per particle per core at least");
