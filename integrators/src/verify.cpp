@@ -353,7 +353,7 @@ VerifySettings verify_settings(VerifyQuality q) {
       s.render_size = 384;
       s.render_spp = 64;
       s.weave_render_size = 512;
-      s.weave_render_spp = 64;
+      s.weave_render_spp = 32;
       break;
   }
   return s;
