@@ -184,8 +184,8 @@ VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path
                             : "reflection: light on the viewer's side") +
               ", at normal incidence; orthographic view at " +
               std::to_string(static_cast<int>(kVerifyRenderViewZenithDeg)) +
-              " deg from the normal over " + std::to_string(f.repeats_z) + " x " +
-              std::to_string(f.repeats_x) + " repeats (across x along the warp); " +
+              " deg from the normal, the film " + std::to_string(f.repeats_z) +
+              " repeats across the warps by " + std::to_string(f.repeats_x) + " along them; " +
               std::to_string(s.weave_render_spp) + " spp";
   return v;
 }
