@@ -179,7 +179,7 @@ VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path
   v.mean = mean_of(v.image, 0, v.image.width, 0, v.image.height);
   v.patch_radiance = v.mean;
   const VerifyWeaveFrame f = verify_weave_frame(sample.summary, s.weave_render_size);
-  v.caption = label + ", fibers of the woven sample with the fiber table, " +
+  v.caption = label + " on every fiber of the woven sample, " +
               (transmission ? "transmission: light from behind the cloth"
                             : "reflection: light on the viewer's side") +
               ", at normal incidence; orthographic view at " +
@@ -220,9 +220,9 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
       const char* model;
       const char* label;
     };
-    for (const Fiber& t :
-         {Fiber{&report.computed_fiber, "computed", "computed fiber table"},
-          Fiber{&report.classic_fiber, "classic", "classic fiber (Lambert + Cook-Torrance)"}}) {
+    for (const Fiber& t : {Fiber{&report.computed_fiber, "computed", "computed fiber table"},
+                           Fiber{&report.classic_fiber, "classic",
+                                 "classic fiber table (Lambert + Cook-Torrance)"}}) {
       if (!*t.table) continue;
       const std::string file = std::string("fiber-") + t.model + ".exr";
       TabulatedBsdfTable rgb = table_to_rgb(**t.table);
