@@ -64,6 +64,11 @@ struct VerifyEstimate {
 constexpr double kTypicalSecondsPerPhoton = 1.2e-6;
 constexpr double kTypicalSecondsPerParticle = 18e-6;
 constexpr double kTypicalFixedSeconds = 10;
+// The fiber-level renders (docs/verify.md "Renders"): 23 s of CPU at default quality for the four
+// renders' 3.64 M camera samples on the bundled poplin, so 6.5 us per sample; counted here on a
+// square film of weave_render_size (an upper bound: the film is whole repeats, one side shorter).
+constexpr double kTypicalSecondsPerWeaveSample = 6.5e-6;
+constexpr int kWeaveRenders = 4;  // computed and classic, reflection and transmission
 constexpr double kLeastSecondsPerParticle = 1.25e-6;
 
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
@@ -86,8 +91,10 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
     e.particles += (computed_evals + classic_evals) * double(inner.particles_per_bin) * inner_bins +
                    run_particles;
   }
+  const double weave_samples =
+      double(kWeaveRenders) * s.weave_render_size * s.weave_render_size * s.weave_render_spp;
   e.typical = e.photons * kTypicalSecondsPerPhoton + e.particles * kTypicalSecondsPerParticle +
-              kTypicalFixedSeconds;
+              weave_samples * kTypicalSecondsPerWeaveSample + kTypicalFixedSeconds;
   e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
   return e;
 }
