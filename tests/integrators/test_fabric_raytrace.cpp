@@ -269,7 +269,9 @@ TEST(FabricRaytrace, TablesAreReciprocalWithinTheirNoise) {
     EXPECT_LT(z.beyond4, 0.01) << detail;
     // This fiber sends light into itself (its table is 0.5 x below the point's tangent plane):
     // at yarn detail that light passes through its tube.
-    if (std::string(detail) == "yarn") EXPECT_GT(r.tube_passes, r.particles / 10) << detail;
+    if (std::string(detail) == "yarn") {
+      EXPECT_GT(r.tube_passes, r.particles / 10) << detail;
+    }
   }
 }
 
