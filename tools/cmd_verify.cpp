@@ -220,12 +220,8 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
   in.fiber_name = base.fiber_name + " (fitted)";
   in.sample_name = base.sample_name;
   const auto t0 = std::chrono::steady_clock::now();
-  FiberTableBakeOptions b;
-  b.resolution = s.resolution;
-  b.photons_per_band = s.fiber_photons_per_band;
-  b.seed = s.seed;
-  b.threads = s.threads;
-  b.spectral = true;
+  const FiberTableBakeOptions b =
+      verify_bake_options(s.resolution, s.fiber_photons_per_band, s.seed, s.threads, false);
   FiberTableBakeResult fiber = bake_fiber_table(fitted, b, progress);
   if (fiber.cancelled) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
@@ -362,12 +358,8 @@ JobPart verify_job(const VerifyCliOptions& o, const VerifyPlan& p, Shard shard) 
 // The spectral fiber table through the bake cache (./.weft-cache, bake_cache.h): shards of a job
 // that need it at once bake it once, and the merge reuses it. Returns false when interrupted.
 bool fiber_from_cache(const VerifyPlan& p, VerifyInputs& in, const ProgressCallback& progress) {
-  FiberTableBakeOptions b;
-  b.resolution = p.s.resolution;
-  b.photons_per_band = p.s.fiber_photons_per_band;
-  b.seed = p.s.seed;
-  b.threads = p.s.threads;
-  b.spectral = true;  // the colour table needs the spectrum
+  const FiberTableBakeOptions b =
+      verify_bake_options(p.s.resolution, p.s.fiber_photons_per_band, p.s.seed, p.s.threads, false);
   std::filesystem::path file;
   try {
     file = cached_fiber_table(".weft-cache", p.spec, b, progress);
@@ -465,13 +457,9 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
   if (job) return run_shard(o, p, sample, in, *job, progress);
 
   t0 = std::chrono::steady_clock::now();
-  FabricSummationOptions so;
-  so.method = FabricSummation::kPaper;
-  so.resolution = s.resolution;
-  so.samples_per_cell = s.summation_samples;
-  so.seed = s.seed;
-  so.threads = s.threads;
-  in.summation = sum_fabric_table(in.fiber, so, progress);
+  in.summation = sum_fabric_table(
+      in.fiber, verify_summation_options(s.resolution, s.summation_samples, s.seed, s.threads),
+      progress);
   in.seconds["summation"] = since(t0);
 
   VerifyTraced traced;

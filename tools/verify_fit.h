@@ -94,6 +94,34 @@ inline FiberSpec apply_spec_fit(FiberSpec spec, const std::vector<std::string>& 
   return spec;
 }
 
+// What verify's fiber bakes and paper's summations are, from its settings: one place for the run's
+// bake (through the bake cache, and again for the fitted spec) and the fit's inner models. The
+// run's bake is spectral (the colour table needs the spectrum) with the default weights; the fit's
+// inner bake ('fit_inner') is RGB with absorption as a weight, so that at its fixed seed the table
+// is a smooth function of dye_scale (transport.h, docs/verify.md).
+inline FiberTableBakeOptions verify_bake_options(int resolution, uint64_t photons_per_band,
+                                                 uint64_t seed, int threads, bool fit_inner) {
+  FiberTableBakeOptions b;
+  b.resolution = resolution;
+  b.photons_per_band = photons_per_band;
+  b.seed = seed;
+  b.threads = threads;
+  b.spectral = !fit_inner;
+  if (fit_inner) b.weight_mode = WeightMode::absorption_weight;
+  return b;
+}
+
+inline FabricSummationOptions verify_summation_options(int resolution, int samples_per_cell,
+                                                       uint64_t seed, int threads) {
+  FabricSummationOptions so;
+  so.method = FabricSummation::kPaper;
+  so.resolution = resolution;
+  so.samples_per_cell = samples_per_cell;
+  so.seed = seed;
+  so.threads = threads;
+  return so;
+}
+
 inline std::string inner_step_name(const FitInnerSettings& f) {
   return f.inner == FitInner::kRaytrace
              ? "fiber-level ray trace (R = " + std::to_string(f.resolution) + ", " +
@@ -118,15 +146,11 @@ inline std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& samp
                                                          const TabulatedBsdfTable& fiber,
                                                          const FitInnerSettings& f,
                                                          const MeasuredInplane& measured) {
-  if (f.inner == FitInner::kSummation) {
-    FabricSummationOptions so;
-    so.method = FabricSummation::kPaper;
-    so.resolution = f.resolution;
-    so.samples_per_cell = f.summation_samples;
-    so.seed = f.seed;
-    so.threads = f.threads;
-    return table_curves(sum_fabric_table(fiber, so), measured, f.azimuths);
-  }
+  if (f.inner == FitInner::kSummation)
+    return table_curves(
+        sum_fabric_table(
+            fiber, verify_summation_options(f.resolution, f.summation_samples, f.seed, f.threads)),
+        measured, f.azimuths);
   FabricRaytraceOptions o;
   o.resolution = f.resolution;
   o.particles_per_bin = f.particles_per_bin;
@@ -135,18 +159,14 @@ inline std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& samp
   return table_curves(raytrace_fabric_table(sample, fiber, o).table, measured, f.azimuths);
 }
 
-// The computed model's inner curves: an RGB fiber bake, then the inner model's step, both with
-// fixed seeds.
+// The computed model's inner curves: an RGB fiber bake (absorption as a weight), then the inner
+// model's step, both with fixed seeds.
 inline std::vector<std::vector<Rgb>> computed_inner_curves(const FiberSpec& spec,
                                                            const WovenSample& sample,
                                                            const FitInnerSettings& f,
                                                            const MeasuredInplane& measured) {
-  FiberTableBakeOptions b;
-  b.resolution = f.resolution;
-  b.photons_per_band = f.fiber_photons_per_band;
-  b.seed = f.seed;
-  b.threads = f.threads;
-  b.spectral = false;
+  const FiberTableBakeOptions b =
+      verify_bake_options(f.resolution, f.fiber_photons_per_band, f.seed, f.threads, true);
   return inner_fabric_curves(sample, bake_fiber_table(spec, b).table, f, measured);
 }
 
