@@ -193,23 +193,23 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
   FitInnerSettings inner = fit_inner_settings(s);
   inner.inner = parse_fit_inner(o.fit_inner);
   if (!o.quiet) std::fprintf(stderr, "\nweft: fitting the computed model (%s)\n", o.fiber.c_str());
-  FitResult computed = fit_inplane(
+  FitResult computed = fit_inner_model(
       "computed", spec_fit_parameters(spec, names),
       [&](const std::vector<double>& x) {
-        return computed_inner_curves(apply_spec_fit(spec, names, x), sample, inner, measured);
+        return computed_inner_fiber_table(apply_spec_fit(spec, names, x), inner);
       },
-      measured, options);
+      sample, inner, measured, options);
   computed.inner_model = computed_inner_model_name(inner);
   if (!o.quiet) std::fprintf(stderr, "weft: fitting the classic model\n");
   const MicrofacetModel model = base.classic_distribution.model;
-  FitResult classic = fit_inplane(
+  FitResult classic = fit_inner_model(
       "classic",
       classic_fit_parameters(report.classic_reflectance, base.classic_distribution.alpha),
       [&](const std::vector<double>& x) {
-        return classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior, sample,
-                                    inner, measured);
+        return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior,
+                                         inner);
       },
-      measured, options);
+      sample, inner, measured, options);
   classic.inner_model = classic_inner_model_name(inner);
 
   // The fitted parameters at the run's quality.
