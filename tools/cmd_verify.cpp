@@ -556,13 +556,14 @@ void add_verify_command(CLI::App& app, Commands& commands) {
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_params_given = true; });
   sub->add_option("--fit-evaluations", o->fit_evaluations,
-                  "objective evaluations per model's search (the uncertainty adds 2 per parameter)")
+                  "objective evaluations per model's search, over all its restarts (each "
+                  "restart's uncertainty adds 2 per parameter)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_evaluations_given = true; });
   sub->add_option("--fit-inner", o->fit_inner,
-                  "the model the fit evaluates: raytrace (the run's pipeline, few particles) or "
-                  "summation (the paper's summation table: smooth, cheaper, no light between "
-                  "fibers)")
+                  "the model the fit evaluates: raytrace (the run's pipeline, few particles, "
+                  "paths drawn from a proposal table re-centred between restarts) or summation "
+                  "(the paper's summation table: cheaper, no light between fibers)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_inner_given = true; });
   sub->add_option("--classic-albedo", o->classic_albedo,
