@@ -223,7 +223,7 @@ inline FitResult fit_inner_model(
     for (const auto& p : parameters) x.push_back(p.start);
     const TabulatedBsdfTable proposal = table_of(x);
     FitOptions o = options;
-    o.max_evaluations = std::max(1, options.max_evaluations - evaluations);
+    o.max_evaluations = options.max_evaluations - evaluations;
     last = fit_inplane(model, parameters, curves_of(&proposal), measured, o);
     evaluations += last.evaluations;
     if (stage == 0) first = last;
@@ -232,7 +232,9 @@ inline FitResult fit_inner_model(
       moved = std::max(moved, std::abs(fit_unit(parameters[k], last.parameters[k].value) -
                                        fit_unit(parameters[k], x[k])));
     const bool settled = last.converged && moved < 0.01;
-    if (settled || evaluations >= options.max_evaluations) {
+    // A restart needs the simplex and a first step (FitOptions::validate).
+    const int least = 2 * static_cast<int>(parameters.size()) + 2;
+    if (settled || options.max_evaluations - evaluations < least) {
       last.converged = settled;
       break;
     }

@@ -232,6 +232,54 @@ TEST(CliVerify, FitInnerObjectiveIsSmoothInDyeAtAFixedSeed) {
   }
 }
 
+// The ray-trace inner model's search with its proposal re-centred (fit_inner_model): the dye 1.8
+// from the ray-trace inner model's own curves (traced directly at the truth), at a test's budget
+// (R = 3, 1000 photons per band, 300 particles per incident bin). The first search's proposal is
+// the start's table (dye 1); the restarts move the proposal to the optimum, and the search ends
+// converged there. The fitted curves follow other paths than the measurement's (their proposal's),
+// so the optimum can only be as good as the ray trace's noise: its objective is below that of the
+// truth traced with another seed (the noise floor; the fit reached 0.10), and the dye within 5 %
+// (measured 3.3 %; the summation's test above, without that noise, asks 3 %).
+TEST(CliVerify, RaytraceFitRecentresItsProposalAndConverges) {
+  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
+  weft::FitInnerSettings inner =
+      weft::fit_inner_settings(weft::verify_settings(weft::VerifyQuality::kDraft));
+  inner.inner = weft::FitInner::kRaytrace;
+  inner.resolution = 3;
+  inner.fiber_photons_per_band = 1000;
+  inner.particles_per_bin = 300;
+  inner.threads = 2;
+  const weft::WovenSample sample = verify_sample();
+  const std::vector<std::string> names = {"dye_scale"};
+  weft::MeasuredInplane geometry = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
+      weft::apply_spec_fit(spec, names, {1.8}), sample, inner, geometry));
+  weft::FitOptions options;
+  options.max_evaluations = 60;
+  const weft::FitResult r = weft::fit_inner_model(
+      "computed", weft::spec_fit_parameters(spec, names),
+      [&](const std::vector<double>& x) {
+        return weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), inner);
+      },
+      sample, inner, measured, options);
+  ASSERT_EQ(r.parameters.size(), 1u);
+  EXPECT_TRUE(r.converged);
+  EXPECT_GT(r.objective_start, 0.2);  // the first search's start, far from the truth
+  EXPECT_NEAR(std::log(r.parameters[0].value / 1.8), 0.0, 0.05) << r.parameters[0].value;
+  weft::FitInnerSettings other = inner;
+  other.seed = 2;
+  const auto floor =
+      weft::fit_residuals(weft::computed_inner_curves(weft::apply_spec_fit(spec, names, {1.8}),
+                                                      sample, other, measured),
+                          measured);
+  double ss = 0;
+  for (double v : floor) ss += v * v;
+  EXPECT_LT(r.objective, std::sqrt(ss / floor.size()));
+  EXPECT_EQ(r.parameters[0].parameter.start, 1.0);  // the given start, not a restart's
+  EXPECT_LE(r.evaluations, options.max_evaluations + 2);
+}
+
 // The classic model's four (diffuse colour per channel, roughness) from its own synthetic
 // measurement, from the start the command uses for red-cotton (its volume albedo, 0.35).
 TEST(CliVerify, FitRecoversKnownClassicParametersFromASyntheticMeasurement) {
