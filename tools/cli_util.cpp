@@ -127,7 +127,10 @@ std::string format_bytes(double bytes) {
 
 std::string format_seconds(double s) {
   char buf[32];
-  if (s < 3600)
+  // Rounded up: these are lower bounds of time still to come.
+  if (s < 120)
+    std::snprintf(buf, sizeof buf, "%.0f s", std::ceil(s));
+  else if (s < 3600)
     std::snprintf(buf, sizeof buf, "%.0f min", std::ceil(s / 60));
   else if (s < 3 * 86400)
     std::snprintf(buf, sizeof buf, "%.1f h", s / 3600);

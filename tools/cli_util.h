@@ -70,7 +70,7 @@ void check_long_work(double units, double seconds_per_unit, int threads, const s
 // The per-pixel buffers of a render: the image (3 floats), the sRGB preview (3 bytes) and a
 // masked render's hit counts, sums and squares (3 + 3 doubles) and coverage (a float).
 double render_bytes(int width, int height, bool preview, bool mask);
-// "2.3 GB", "41 min", "3.2 h", "2.1 days" for messages.
+// "2.3 GB", "95 s", "41 min", "3.2 h", "2.1 days" for messages (times rounded up).
 std::string format_bytes(double bytes);
 std::string format_seconds(double seconds);
 

@@ -64,6 +64,11 @@ struct VerifyEstimate {
 constexpr double kTypicalSecondsPerPhoton = 1.2e-6;
 constexpr double kTypicalSecondsPerParticle = 18e-6;
 constexpr double kTypicalFixedSeconds = 10;
+// The fiber-level renders (docs/verify.md "Renders"): 23 s of CPU at default quality for the four
+// renders' 3.64 M camera samples on the bundled poplin, so 6.5 us per sample; counted here on a
+// square film of weave_render_size (an upper bound: the film is whole repeats, one side shorter).
+constexpr double kTypicalSecondsPerWeaveSample = 6.5e-6;
+constexpr int kWeaveRenders = 4;  // computed and classic, reflection and transmission
 constexpr double kLeastSecondsPerParticle = 1.25e-6;
 
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
@@ -86,8 +91,10 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
     e.particles += (computed_evals + classic_evals) * double(inner.particles_per_bin) * inner_bins +
                    run_particles;
   }
+  const double weave_samples =
+      double(kWeaveRenders) * s.weave_render_size * s.weave_render_size * s.weave_render_spp;
   e.typical = e.photons * kTypicalSecondsPerPhoton + e.particles * kTypicalSecondsPerParticle +
-              kTypicalFixedSeconds;
+              weave_samples * kTypicalSecondsPerWeaveSample + kTypicalFixedSeconds;
   e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
   return e;
 }
@@ -312,17 +319,13 @@ void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
       std::max(1u, p.s.threads > 0 ? unsigned(p.s.threads) : std::thread::hardware_concurrency());
   const VerifyEstimate e = estimate_verify(p.s, !p.fiber_table, o.fit,
                                            p.fit_options.max_evaluations, p.fit_names.size());
-  const auto when = [](double sec) {
-    return sec < 120 ? std::to_string(static_cast<int>(std::ceil(sec))) + " s"
-                     : format_seconds(sec);
-  };
   if (!o.quiet)
     std::fprintf(stderr,
                  "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on "
                  "%u cores (%s of CPU; at least %s)\n",
                  o.quality.c_str(), o.fit ? " with --fit" : "", e.photons * 1e-6,
-                 e.particles * 1e-6, when(e.typical / cores).c_str(), cores,
-                 when(e.typical).c_str(), when(e.least / cores).c_str());
+                 e.particles * 1e-6, format_seconds(e.typical / cores).c_str(), cores,
+                 format_seconds(e.typical).c_str(), format_seconds(e.least / cores).c_str());
   check_long_work(e.least, 1.0, p.s.threads, "", "--quality",
                   "weft verify at quality " + o.quality + (o.fit ? " with --fit" : ""),
                   "0.5 us per photon and 1.25 us per particle per core at least");

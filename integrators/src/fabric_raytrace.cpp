@@ -160,45 +160,21 @@ bool find_crossing(const RenderScene& scene, const SurfaceHit& h, const Vec3& al
   return false;
 }
 
-// The repeat and its eight neighbours, for a renderer that only asks for geometry. Copy
-// (i, k), shifted by (i Px, k Pz) with i, k in {-1, 0, 1}, is copy number 3 (i + 1) + (k + 1):
+// The repeat and its eight neighbours (weave.h tiled_woven_description with one copy on each
+// side), for a renderer that only asks for geometry. Copy (i, k), shifted by (i Px, k Pz) with
+// i, k in {-1, 0, 1}, is copy number 3 (i + 1) + (k + 1):
 // copy q of the sample's mesh m is mesh 9 m + q; at fiber detail copy q is curve set q, and fiber
 // c of the sample in it is fiber id q * curves + c (RenderScene numbers fibers set by set).
 int copy_index(int i, int k) {
   return 3 * (i + 1) + (k + 1);
 }
 
-SceneDescription tiled_geometry(const WovenSample& sample, double px, double pz) {
-  SceneDescription d;
-  d.source = "woven sample";
-  const bool fibers = sample.fibers.curve_count() > 0;
-  if (!fibers && sample.meshes.empty())
+SceneDescription tiled_geometry(const WovenSample& sample) {
+  if (sample.fibers.curve_count() == 0 && sample.meshes.empty())
     throw Error("", "detail",
                 "the ray-traced estimator needs the sample's geometry (fibers or yarn tubes); "
                 "this sample has none");
-  for (int i = -1; i <= 1; ++i)
-    for (int k = -1; k <= 1; ++k) {
-      const float dx = static_cast<float>(i * px), dz = static_cast<float>(k * pz);
-      if (fibers) {
-        FiberCurves c = sample.fibers;
-        for (size_t v = 0; v < c.point_count(); ++v) {
-          c.points[4 * v] += dx;
-          c.points[4 * v + 2] += dz;
-        }
-        d.curves.push_back(std::make_shared<const FiberCurves>(std::move(c)));
-      }
-    }
-  if (!fibers)
-    for (const auto& mesh : sample.meshes)
-      for (int i = -1; i <= 1; ++i)
-        for (int k = -1; k <= 1; ++k) {
-          TriangleMesh m = mesh;
-          for (size_t v = 0; v < m.vertex_count(); ++v) {
-            m.positions[3 * v] += static_cast<float>(i * px);
-            m.positions[3 * v + 2] += static_cast<float>(k * pz);
-          }
-          d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
-        }
+  SceneDescription d = tiled_woven_description(sample, 1, 1, "woven sample");
   MaterialBinding any;
   any.type = "lambert";
   any.field = "fabric estimator";
@@ -280,7 +256,7 @@ std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_ab
   const double pz = sample.summary.period_z_mm * kMetresPerMm;
   const double y0 = sample.summary.y_min_mm * kMetresPerMm;
   const double y1 = sample.summary.y_max_mm * kMetresPerMm;
-  const RenderScene scene(tiled_geometry(sample, px, pz));
+  const RenderScene scene(tiled_geometry(sample));
   std::vector<Vec3> out;
   for (int i = 0; i < rays_per_side; ++i)
     for (int k = 0; k < rays_per_side; ++k) {
@@ -376,7 +352,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   if (!(px > 0 && pz > 0 && y1 > y0))
     throw Error("", "sample", "the woven sample has no period or no thickness");
   const double x0 = -0.5 * px, z0 = -0.5 * pz;
-  const RenderScene scene(tiled_geometry(sample, px, pz));
+  const RenderScene scene(tiled_geometry(sample));
   const auto curves = static_cast<int64_t>(sample.fibers.curve_count());
   const Continuations joints = continuations(sample.fibers, px, pz);
   if (o.proposal) {

@@ -330,6 +330,8 @@ VerifySettings verify_settings(VerifyQuality q) {
       s.summation_samples = 4;
       s.render_size = 64;
       s.render_spp = 2;
+      s.weave_render_size = 128;
+      s.weave_render_spp = 4;
       break;
     case VerifyQuality::kDefault:
       s.resolution = 8;
@@ -339,6 +341,8 @@ VerifySettings verify_settings(VerifyQuality q) {
       s.summation_samples = 8;
       s.render_size = 128;
       s.render_spp = 4;
+      s.weave_render_size = 256;
+      s.weave_render_spp = 16;
       break;
     case VerifyQuality::kPublication:
       s.resolution = 12;
@@ -348,6 +352,8 @@ VerifySettings verify_settings(VerifyQuality q) {
       s.summation_samples = 16;
       s.render_size = 384;
       s.render_spp = 64;
+      s.weave_render_size = 512;
+      s.weave_render_spp = 32;
       break;
   }
   return s;
@@ -566,6 +572,8 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   rep.models.push_back(model_curves("computed_raytrace", "computed (fiber-level ray trace)",
                                     computed.beta, computed.err));
   rep.computed_fabric = computed.mean;
+  rep.computed_fiber = in.fiber;
+  if (sample.fibers.curve_count() > 0) rep.sample = std::make_shared<const WovenSample>(sample);
 
   // Computed: the paper's summation (deterministic up to its stratified cell sampling).
   if (in.summation) {
@@ -593,6 +601,7 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   rep.models.push_back(
       model_curves("classic", "classic (Lambert + Cook-Torrance)", cl.beta, cl.err));
   rep.classic_fabric = std::move(cl.mean);
+  rep.classic_fiber = classic.table;
   // The measured BRDF's neural fit, where the measurement has one (materials/data/measured/*/).
   {
     std::error_code ec;
@@ -1019,6 +1028,8 @@ std::string verify_metrics_json(const VerifyReport& r) {
                    {"azimuths", s.azimuths},
                    {"render_size", s.render_size},
                    {"render_spp", s.render_spp},
+                   {"weave_render_size", s.weave_render_size},
+                   {"weave_render_spp", s.weave_render_spp},
                    {"threads", s.threads}};
   j["seed"] = s.seed;
   j["seconds"] = r.seconds;
@@ -1120,15 +1131,20 @@ std::string verify_metrics_json(const VerifyReport& r) {
   }
   j["colour_table"] = colours;
   nlohmann::json renders = nlohmann::json::array();
-  for (const auto& v : r.renders)
-    renders.push_back({{"model", v.model},
-                       {"configuration", v.configuration},
-                       {"exr", v.stem + ".exr"},
-                       {"png", v.stem + ".png"},
-                       {"caption", v.caption},
-                       {"patch_radiance_linear_srgb", rgb_json(v.patch_radiance)}});
+  for (const auto& v : r.renders) {
+    nlohmann::json e = {{"kind", v.kind},
+                        {"model", v.model},
+                        {"configuration", v.configuration},
+                        {"exr", v.stem + ".exr"},
+                        {"png", v.stem + ".png"},
+                        {"caption", v.caption},
+                        {"mean_linear_srgb", rgb_json(v.mean)}};
+    if (v.kind == "patch") e["patch_radiance_linear_srgb"] = rgb_json(v.patch_radiance);
+    renders.push_back(e);
+  }
   j["renders"] = renders;
   j["render_setup"] = kVerifyRenderSetup;
+  j["weave_render_setup"] = kVerifyWeaveRenderSetup;
   j["classic_reflectance_linear_srgb"] = rgb_json(r.classic_reflectance);
   j["classic_reflectance_clipped_components"] = r.classic_clip.components;
   j["classic_source"] = r.classic_source;
@@ -1204,17 +1220,29 @@ std::string verify_index_html(const VerifyReport& r,
       << "\">\n";
   }
   if (!r.renders.empty()) {
-    h << "<h2>Renders of the sample (paper's Figs. 8-9)</h2>\n<p>"
-      << html_escape(kVerifyRenderSetup)
-      << "</p>\n<table><tr><th>render</th><th>what</th><th>patch radiance (linear "
-         "sRGB)</th></tr>\n";
-    for (const auto& v : r.renders)
-      h << "<tr><td><a href=\"" << html_escape(v.stem) << ".exr\"><img src=\""
-        << html_escape(v.stem) << ".png\" alt=\"" << html_escape(v.stem)
-        << "\" style=\"width:160px\"></a></td><td>" << html_escape(v.caption) << "<br>"
-        << html_escape(v.stem) << ".png (.exr: linear)</td><td>" << fmt(v.patch_radiance.r) << ", "
-        << fmt(v.patch_radiance.g) << ", " << fmt(v.patch_radiance.b) << "</td></tr>\n";
-    h << "</table>\n";
+    h << "<h2>Renders of the sample (paper's Figs. 8-9)</h2>\n";
+    // The flat patches with the fabric tables, then the fibers with the fiber tables.
+    for (const char* kind : {"patch", "weave"}) {
+      const bool weave = std::string(kind) == "weave";
+      if (std::none_of(r.renders.begin(), r.renders.end(),
+                       [&](const VerifyRender& v) { return v.kind == kind; }))
+        continue;
+      if (weave) h << "<h3>The fibers of the woven sample</h3>\n";
+      h << "<p>" << html_escape(weave ? kVerifyWeaveRenderSetup : kVerifyRenderSetup)
+        << "</p>\n<table><tr><th>render</th><th>what</th><th>"
+        << (weave ? "mean" : "patch radiance") << " (linear sRGB)</th></tr>\n";
+      for (const auto& v : r.renders) {
+        if (v.kind != kind) continue;
+        const Rgb c = weave ? v.mean : v.patch_radiance;
+        h << "<tr><td><a href=\"" << html_escape(v.stem) << ".exr\"><img src=\""
+          << html_escape(v.stem) << ".png\" alt=\"" << html_escape(v.stem)
+          << "\" style=\"width:" << (weave ? 320 : 160) << "px\"></a></td><td>"
+          << html_escape(v.caption) << "<br>" << html_escape(v.stem)
+          << ".png (.exr: linear)</td><td>" << fmt(c.r) << ", " << fmt(c.g) << ", " << fmt(c.b)
+          << "</td></tr>\n";
+      }
+      h << "</table>\n";
+    }
   }
   h << "<h2>Colour (paper's Table 1): CIE 1931, D65</h2>\n<table><tr><th>what</th><th>linear "
        "sRGB</th><th>H</th><th>S</th><th>V</th><th></th><th>note</th></tr>\n";

@@ -633,4 +633,47 @@ SceneDescription fiber_patch_description(WeaveOptions options, const std::string
   return d;
 }
 
+SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, int half_z,
+                                         const std::string& source) {
+  for (const auto& [half, field] : {std::pair{half_x, "half_x"}, std::pair{half_z, "half_z"}})
+    if (half < 0 || half > 64)
+      throw Error(source, field, "copies on each side must lie in [0, 64]");
+  const double px = sample.summary.period_x_mm * detail::kMetresPerMm;
+  const double pz = sample.summary.period_z_mm * detail::kMetresPerMm;
+  if (!(px > 0 && pz > 0)) throw Error(source, "sample", "the woven sample has no period");
+  const bool fibers = sample.fibers.curve_count() > 0;
+  if (!fibers && sample.meshes.empty())
+    throw Error(source, "detail", "the woven sample has no geometry (neither fibers nor tubes)");
+  SceneDescription d;
+  d.source = source;
+  // Shifts in double, then rounded once to the geometry's float.
+  const auto shift = [&](int i, int k) {
+    return std::pair{static_cast<float>(i * px), static_cast<float>(k * pz)};
+  };
+  if (fibers)
+    for (int i = -half_x; i <= half_x; ++i)
+      for (int k = -half_z; k <= half_z; ++k) {
+        const auto [dx, dz] = shift(i, k);
+        FiberCurves c = sample.fibers;
+        for (size_t v = 0; v < c.point_count(); ++v) {
+          c.points[4 * v] += dx;
+          c.points[4 * v + 2] += dz;
+        }
+        d.curves.push_back(std::make_shared<const FiberCurves>(std::move(c)));
+      }
+  else
+    for (const auto& mesh : sample.meshes)
+      for (int i = -half_x; i <= half_x; ++i)
+        for (int k = -half_z; k <= half_z; ++k) {
+          const auto [dx, dz] = shift(i, k);
+          TriangleMesh m = mesh;
+          for (size_t v = 0; v < m.vertex_count(); ++v) {
+            m.positions[3 * v] += dx;
+            m.positions[3 * v + 2] += dz;
+          }
+          d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
+        }
+  return d;
+}
+
 }  // namespace weft

@@ -10,13 +10,14 @@
 #include <fstream>
 #include <functional>
 #include <map>
-#include <set>
 #include <nlohmann/json.hpp>
+#include <set>
 
 #include "mesh_checks.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
+#include "weft/scenes/description.h"
 #include "weft/scenes/gltf.h"
 #include "weft/scenes/weave.h"
 
@@ -700,4 +701,50 @@ TEST(Woven, PositiveTwistIsAZTwistRightHandedHelix) {
     }
     EXPECT_GT(checked, 0);
   }
+}
+
+// tiled_woven_description: copy (i, k) is the sample shifted by (i Px, k Pz), numbered
+// (2 half_z + 1)(i + half_x) + (k + half_z), at fiber detail as curve sets and at yarn detail
+// as meshes (each mesh's copies together); nothing is bound; bad counts and a sample without
+// geometry are refused.
+TEST(Woven, TiledCopiesAreShiftedByThePeriods) {
+  WeaveOptions o;
+  o.detail = "fiber";
+  const WovenSample s = make_woven_sample(overlay(red_cotton_weave_options(), o));
+  const double px = s.summary.period_x_mm * 1e-3, pz = s.summary.period_z_mm * 1e-3;
+  const SceneDescription d = tiled_woven_description(s, 2, 1, "tiled");
+  ASSERT_EQ(d.curves.size(), 15u);  // 5 x 3
+  EXPECT_TRUE(d.meshes.empty());
+  EXPECT_TRUE(d.materials.empty());
+  for (int i = -2; i <= 2; ++i)
+    for (int k = -1; k <= 1; ++k) {
+      const FiberCurves& c = *d.curves[static_cast<size_t>(3 * (i + 2) + (k + 1))];
+      ASSERT_EQ(c.points.size(), s.fibers.points.size());
+      for (size_t v = 0; v < c.point_count(); v += 97) {
+        EXPECT_FLOAT_EQ(c.points[4 * v], s.fibers.points[4 * v] + static_cast<float>(i * px));
+        EXPECT_EQ(c.points[4 * v + 1], s.fibers.points[4 * v + 1]);
+        EXPECT_FLOAT_EQ(c.points[4 * v + 2],
+                        s.fibers.points[4 * v + 2] + static_cast<float>(k * pz));
+        EXPECT_EQ(c.points[4 * v + 3], s.fibers.points[4 * v + 3]);
+      }
+    }
+  // Yarn detail: mesh m's copies are meshes 9 m .. 9 m + 8 with one copy on each side.
+  const WovenSample y = make_woven_sample(red_cotton_weave_options());
+  const SceneDescription dy = tiled_woven_description(y, 1, 1, "tiled");
+  ASSERT_EQ(dy.meshes.size(), 9 * y.meshes.size());
+  EXPECT_TRUE(dy.curves.empty());
+  EXPECT_FLOAT_EQ(dy.meshes[9 * 1 + 8]->positions[0],
+                  y.meshes[1].positions[0] + static_cast<float>(px));
+  EXPECT_FLOAT_EQ(dy.meshes[9 * 1 + 8]->positions[2],
+                  y.meshes[1].positions[2] + static_cast<float>(pz));
+  EXPECT_NE(
+      weft::testing::error_of([&] { tiled_woven_description(s, 65, 0, "tiled"); }).find("half_x"),
+      std::string::npos);
+  EXPECT_NE(
+      weft::testing::error_of([&] { tiled_woven_description(s, 0, -1, "tiled"); }).find("half_z"),
+      std::string::npos);
+  EXPECT_NE(weft::testing::error_of([] {
+              tiled_woven_description(WovenSample{}, 1, 1, "tiled");
+            }).find("tiled"),
+            std::string::npos);
 }

@@ -132,6 +132,9 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
 void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
                  const ExitSink& surface_exits, const ExitSink& interior_exits,
                  PhotonTally& books) {
+  // Light that enters must leave somewhere: an unset sink would drop it (or call an empty
+  // std::function) deep inside the transport.
+  if (!interior_exits) throw Error("enter_fiber: no sink for the interior's exits (internal)");
   const FiberInterior& in = fiber.interior;
   const Frame frame = CylinderGeometry::cylinder_frame(phi);
   const Vec3 point = in.geometry.radius() * frame.n;

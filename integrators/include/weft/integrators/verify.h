@@ -29,6 +29,7 @@
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
@@ -40,6 +41,7 @@
 #include "weft/integrators/image.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/microfacet.h"
+#include "weft/scenes/description.h"
 #include "weft/scenes/weave.h"
 
 namespace weft {
@@ -145,6 +147,8 @@ struct VerifySettings {
   int azimuths = 24;                    // planes of incidence averaged
   int render_size = 96;                 // the renders of the sample (pixels per side)
   int render_spp = 4;                   // their samples per pixel
+  int weave_render_size = 160;          // the fiber-level renders (pixels on the longer side)
+  int weave_render_spp = 16;            // their samples per pixel
   uint64_t seed = 1;
   int threads = 0;  // 0 = all cores; results do not depend on it
 };
@@ -309,11 +313,13 @@ std::vector<std::vector<Rgb>> table_curves(const TabulatedBsdfTable& table,
 // pi f = beta for this (view, light): the image is that colour, as the renderer shades it.
 struct VerifyRender {
   std::string stem;           // file name without extension, e.g. "render-reflection-computed"
+  std::string kind;           // "patch" (the fabric table) or "weave" (the fibers, below)
   std::string model;          // "computed", "classic", "measured"
   std::string configuration;  // "reflection", "transmission"
   std::string caption;
   Image image;         // linear sRGB radiance
-  Rgb patch_radiance;  // mean over the central half of the film (wholly inside the patch)
+  Rgb patch_radiance;  // patch: mean over the central half of the film (wholly inside the patch)
+  Rgb mean;            // mean over the whole image
 };
 
 // The geometry of every render (one place for the numbers the captions and tests quote).
@@ -335,10 +341,48 @@ inline constexpr const char* kVerifyRenderSetup =
 nlohmann::json verify_render_scene(const nlohmann::json& material, bool transmission,
                                    const VerifySettings& settings);
 
+// The fiber-level renders (docs/verify.md "Renders"): the woven sample's fibers, as Embree round
+// curves, every fiber with the model's fiber table, shaded by the renderer as any scene's fibers
+// (RenderScene, path_tracer.h: the whole-fiber table, rays leaving a fiber ignore it, every other
+// fiber occludes and inter-reflects). Lit as the patch (a parallel light of irradiance pi at
+// normal incidence, from the viewer's side or from behind) and seen from the same direction (30
+// deg from the normal, azimuth 180 deg from the warp) by an orthographic camera whose film is
+// whole repeats of the cloth: repeats_z along the film's width (the weft direction) and repeats_x
+// along its height (the warp, foreshortened by cos 30 deg), chosen so that each side comes near
+// kVerifyWeaveFrameMm. Over whole repeats the film's mean is the cloth's mean radiance for that
+// view and light, which the fabric table (the patch render) estimates too. The sample is tiled
+// (weave.h tiled_woven_description) so that the cloth reaches a repeat past the film on every side.
+inline constexpr double kVerifyWeaveFrameMm = 1.4;
+struct VerifyWeaveFrame {
+  int repeats_x = 1, repeats_z = 1;  // whole repeats on the film's height and width
+  double half_width_m = 0, half_height_m = 0;
+  int width = 1, height = 1;       // pixels: the longer side 'size', square to within a pixel
+  int copies_x = 1, copies_z = 1;  // tiled copies on each side of the sample's own
+};
+// weft::Error when the sample has no period or size < 1.
+VerifyWeaveFrame verify_weave_frame(const WeaveSummary& sample, int size);
+// The scene (in memory): the tiled fibers, materials "warp" and "weft" bound to 'material' (its
+// relative paths resolve against 'base_dir'), the light, the camera and the render settings
+// (weave_render_size, weave_render_spp, seed). weft::Error when the sample is not at fiber detail.
+SceneDescription verify_weave_scene(const WovenSample& sample, const nlohmann::json& material,
+                                    bool transmission, const VerifySettings& settings,
+                                    const std::filesystem::path& base_dir);
+inline constexpr const char* kVerifyWeaveRenderSetup =
+    "The woven sample at fiber detail, tiled, every fiber an Embree round curve with the model's "
+    "fiber table (shaded as weft render shades fibers: the whole-fiber table, no occlusion by the "
+    "fiber a ray leaves, occlusion and inter-reflection by every other fiber), lit and seen as "
+    "the patch above: a parallel light of irradiance pi at normal incidence, from the viewer's "
+    "side (reflection) or from behind (transmission), an orthographic camera 30 deg from the "
+    "normal whose film spans whole repeats, so the image's mean is the cloth's mean radiance for "
+    "that view and light. Black: gaps between the yarns. Same tone mapping as above.";
+
 // Renders what the report holds: computed and classic fabric tables in both configurations, the
-// measured BRDF (report.measured_nbrdf) in reflection. The tables are written into 'folder' first
-// (fabric-computed.exr, fabric-classic.exr, RGB), where the renderer reads them as any scene's
-// fabric_table; the images are returned, not written.
+// measured BRDF (report.measured_nbrdf) in reflection; and where the report holds the sample at
+// fiber detail, the fibers with the computed and classic fiber tables in both configurations
+// (verify_weave_scene; stems render-weave-CONFIGURATION-MODEL). The tables are written into
+// 'folder' first (fabric-computed.exr, fabric-classic.exr, fiber-computed.exr, fiber-classic.exr,
+// RGB), where the renderer reads them as any scene's fabric_table or fiber_table; the images are
+// returned, not written.
 struct VerifyReport;
 std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& folder,
                                                 const VerifyReport& report);
@@ -363,6 +407,10 @@ struct VerifyReport {
   // (nbrdf_weights.txt beside the table; empty: none).
   std::optional<TabulatedBsdfTable> computed_fabric, classic_fabric;
   std::filesystem::path measured_nbrdf;
+  // What the fiber-level renders show: the sample (when at fiber detail) and the fiber tables of
+  // the computed and the classic model (VerifyInputs::fiber, ClassicFiber::table).
+  std::shared_ptr<const WovenSample> sample;
+  std::optional<TabulatedBsdfTable> computed_fiber, classic_fiber;
   std::vector<VerifyRender> renders;  // made by write_verify_report
   bool cancelled = false;
 };

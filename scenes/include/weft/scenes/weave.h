@@ -161,6 +161,15 @@ std::string weave_summary_json(const WeaveSummary& summary, const std::string& o
 // benchmarks that render a fiber patch.
 SceneDescription fiber_patch_description(WeaveOptions options, const std::string& source,
                                          const std::string& object);
+// Copies of a periodic sample side by side, for renderers that need more cloth than one repeat:
+// copy (i, k), shifted by (i Px, k Pz) (the sample's periods, summary) for i in [-half_x, half_x]
+// and k in [-half_z, half_z], is copy number q = (2 half_z + 1) (i + half_x) + (k + half_z). At
+// fiber detail copy q is curve set q (fiber c of the sample in it is fiber id q * curves + c,
+// RenderScene numbering fibers set by set); at yarn detail copy q of the sample's mesh m is mesh
+// m * copies + q. No materials are bound. weft::Error naming 'source' when the sample has no
+// geometry or no period, or half_x, half_z lie outside [0, 64].
+SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, int half_z,
+                                         const std::string& source);
 
 // ---------------------------------------------------------------------------------------------
 // The open-mesh plain-weave patch of earlier versions (circular tubes around sinusoidal centre

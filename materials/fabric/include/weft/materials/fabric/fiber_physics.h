@@ -97,9 +97,9 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& ban
 // (axial position 0) with flux weight w0. The surface lobe's sampled reflection goes to
 // 'surface_exits' (may be empty; booked as specular and specular_excess either way); the rest,
 // 1 - albedo, enters refracted at the smooth normal and is traced, its exits going to
-// 'interior_exits'. With a rough dielectric boundary the photon either reflects off it (to
-// 'surface_exits', booked as specular) or enters refracted by it, whole. Adds one launched photon
-// to 'books'. Deterministic given rng.
+// 'interior_exits' (required: Error if empty). With a rough dielectric boundary the photon either
+// reflects off it (to 'surface_exits', booked as specular) or enters refracted by it, whole. Adds
+// one launched photon to 'books'. Deterministic given rng.
 void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
                  const ExitSink& surface_exits, const ExitSink& interior_exits, PhotonTally& books);
 
