@@ -202,7 +202,7 @@ inline std::vector<std::vector<Rgb>> classic_inner_curves(
 // there, until a search converges without moving more than 1 % of any box (in the search's unit
 // cube) from its proposal's point, or the evaluations are spent (options.max_evaluations over
 // all stages; each stage's uncertainty adds its 2 p). The result: the last stage's optimum and
-// uncertainty, the first's start, the evaluations of all.
+// uncertainty, the first's start, the evaluations and seconds of all.
 inline FitResult fit_inner_model(
     const std::string& model, std::vector<FitParameter> parameters,
     const std::function<TabulatedBsdfTable(const std::vector<double>&)>& table_of,
@@ -218,6 +218,7 @@ inline FitResult fit_inner_model(
   const std::vector<FitParameter> given = parameters;
   FitResult first, last;
   int evaluations = 0;
+  double seconds = 0;
   for (int stage = 0;; ++stage) {
     std::vector<double> x;
     for (const auto& p : parameters) x.push_back(p.start);
@@ -226,6 +227,7 @@ inline FitResult fit_inner_model(
     o.max_evaluations = options.max_evaluations - evaluations;
     last = fit_inplane(model, parameters, curves_of(&proposal), measured, o);
     evaluations += last.evaluations;
+    seconds += last.seconds;
     if (stage == 0) first = last;
     double moved = 0;
     for (size_t k = 0; k < parameters.size(); ++k)
@@ -244,6 +246,7 @@ inline FitResult fit_inner_model(
   last.objective_start = first.objective_start;
   last.start_metrics = first.start_metrics;
   last.evaluations = evaluations;
+  last.seconds = seconds;
   return last;
 }
 
