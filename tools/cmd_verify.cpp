@@ -200,23 +200,23 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
   FitInnerSettings inner = fit_inner_settings(s);
   inner.inner = parse_fit_inner(o.fit_inner);
   if (!o.quiet) std::fprintf(stderr, "\nweft: fitting the computed model (%s)\n", o.fiber.c_str());
-  FitResult computed = fit_inplane(
+  FitResult computed = fit_inner_model(
       "computed", spec_fit_parameters(spec, names),
       [&](const std::vector<double>& x) {
-        return computed_inner_curves(apply_spec_fit(spec, names, x), sample, inner, measured);
+        return computed_inner_fiber_table(apply_spec_fit(spec, names, x), inner);
       },
-      measured, options);
+      sample, inner, measured, options);
   computed.inner_model = computed_inner_model_name(inner);
   if (!o.quiet) std::fprintf(stderr, "weft: fitting the classic model\n");
   const MicrofacetModel model = base.classic_distribution.model;
-  FitResult classic = fit_inplane(
+  FitResult classic = fit_inner_model(
       "classic",
       classic_fit_parameters(report.classic_reflectance, base.classic_distribution.alpha),
       [&](const std::vector<double>& x) {
-        return classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior, sample,
-                                    inner, measured);
+        return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior,
+                                         inner);
       },
-      measured, options);
+      sample, inner, measured, options);
   classic.inner_model = classic_inner_model_name(inner);
 
   // The fitted parameters at the run's quality.
@@ -227,12 +227,8 @@ bool fit(const VerifyCliOptions& o, const FiberSpec& spec, const std::vector<std
   in.fiber_name = base.fiber_name + " (fitted)";
   in.sample_name = base.sample_name;
   const auto t0 = std::chrono::steady_clock::now();
-  FiberTableBakeOptions b;
-  b.resolution = s.resolution;
-  b.photons_per_band = s.fiber_photons_per_band;
-  b.seed = s.seed;
-  b.threads = s.threads;
-  b.spectral = true;
+  const FiberTableBakeOptions b =
+      verify_bake_options(s.resolution, s.fiber_photons_per_band, s.seed, s.threads, false);
   FiberTableBakeResult fiber = bake_fiber_table(fitted, b, progress);
   if (fiber.cancelled) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
@@ -365,12 +361,8 @@ JobPart verify_job(const VerifyCliOptions& o, const VerifyPlan& p, Shard shard) 
 // The spectral fiber table through the bake cache (./.weft-cache, bake_cache.h): shards of a job
 // that need it at once bake it once, and the merge reuses it. Returns false when interrupted.
 bool fiber_from_cache(const VerifyPlan& p, VerifyInputs& in, const ProgressCallback& progress) {
-  FiberTableBakeOptions b;
-  b.resolution = p.s.resolution;
-  b.photons_per_band = p.s.fiber_photons_per_band;
-  b.seed = p.s.seed;
-  b.threads = p.s.threads;
-  b.spectral = true;  // the colour table needs the spectrum
+  const FiberTableBakeOptions b =
+      verify_bake_options(p.s.resolution, p.s.fiber_photons_per_band, p.s.seed, p.s.threads, false);
   std::filesystem::path file;
   try {
     file = cached_fiber_table(".weft-cache", p.spec, b, progress);
@@ -468,13 +460,9 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
   if (job) return run_shard(o, p, sample, in, *job, progress);
 
   t0 = std::chrono::steady_clock::now();
-  FabricSummationOptions so;
-  so.method = FabricSummation::kPaper;
-  so.resolution = s.resolution;
-  so.samples_per_cell = s.summation_samples;
-  so.seed = s.seed;
-  so.threads = s.threads;
-  in.summation = sum_fabric_table(in.fiber, so, progress);
+  in.summation = sum_fabric_table(
+      in.fiber, verify_summation_options(s.resolution, s.summation_samples, s.seed, s.threads),
+      progress);
   in.seconds["summation"] = since(t0);
 
   VerifyTraced traced;
@@ -571,13 +559,14 @@ void add_verify_command(CLI::App& app, Commands& commands) {
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_params_given = true; });
   sub->add_option("--fit-evaluations", o->fit_evaluations,
-                  "objective evaluations per model's search (the uncertainty adds 2 per parameter)")
+                  "objective evaluations per model's search, over all its restarts (each "
+                  "restart's uncertainty adds 2 per parameter)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_evaluations_given = true; });
   sub->add_option("--fit-inner", o->fit_inner,
-                  "the model the fit evaluates: raytrace (the run's pipeline, few particles) or "
-                  "summation (the paper's summation table: smooth, cheaper, no light between "
-                  "fibers)")
+                  "the model the fit evaluates: raytrace (the run's pipeline, few particles, "
+                  "paths drawn from a proposal table re-centred between restarts) or summation "
+                  "(the paper's summation table: cheaper, no light between fibers)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_inner_given = true; });
   sub->add_option("--classic-albedo", o->classic_albedo,

@@ -3,6 +3,8 @@
 // vary, and the inner models the fit evaluates, for the command and its tests (header-only: the
 // integrators library that runs the fit does not link the fiber physics).
 #include <algorithm>
+#include <cmath>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -94,6 +96,34 @@ inline FiberSpec apply_spec_fit(FiberSpec spec, const std::vector<std::string>& 
   return spec;
 }
 
+// What verify's fiber bakes and paper's summations are, from its settings: one place for the run's
+// bake (through the bake cache, and again for the fitted spec) and the fit's inner models. The
+// run's bake is spectral (the colour table needs the spectrum) with the default weights; the fit's
+// inner bake ('fit_inner') is RGB with absorption as a weight, so that at its fixed seed the table
+// is a smooth function of dye_scale (transport.h, docs/verify.md).
+inline FiberTableBakeOptions verify_bake_options(int resolution, uint64_t photons_per_band,
+                                                 uint64_t seed, int threads, bool fit_inner) {
+  FiberTableBakeOptions b;
+  b.resolution = resolution;
+  b.photons_per_band = photons_per_band;
+  b.seed = seed;
+  b.threads = threads;
+  b.spectral = !fit_inner;
+  if (fit_inner) b.weight_mode = WeightMode::absorption_weight;
+  return b;
+}
+
+inline FabricSummationOptions verify_summation_options(int resolution, int samples_per_cell,
+                                                       uint64_t seed, int threads) {
+  FabricSummationOptions so;
+  so.method = FabricSummation::kPaper;
+  so.resolution = resolution;
+  so.samples_per_cell = samples_per_cell;
+  so.seed = seed;
+  so.threads = threads;
+  return so;
+}
+
 inline std::string inner_step_name(const FitInnerSettings& f) {
   return f.inner == FitInner::kRaytrace
              ? "fiber-level ray trace (R = " + std::to_string(f.resolution) + ", " +
@@ -113,53 +143,111 @@ inline std::string classic_inner_model_name(const FitInnerSettings& f) {
          std::to_string(f.seed) + " at every evaluation";
 }
 
-// The inner model's step from a fiber table to the curves, with the fixed seed.
-inline std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& sample,
-                                                         const TabulatedBsdfTable& fiber,
-                                                         const FitInnerSettings& f,
-                                                         const MeasuredInplane& measured) {
-  if (f.inner == FitInner::kSummation) {
-    FabricSummationOptions so;
-    so.method = FabricSummation::kPaper;
-    so.resolution = f.resolution;
-    so.samples_per_cell = f.summation_samples;
-    so.seed = f.seed;
-    so.threads = f.threads;
-    return table_curves(sum_fabric_table(fiber, so), measured, f.azimuths);
-  }
+// The inner model's step from a fiber table to the curves, with the fixed seed. The ray trace
+// draws its paths from 'proposal' when given (FabricRaytraceOptions::proposal): the fit passes the
+// table of its start, so that the objective is smooth in the parameters (docs/verify.md).
+inline std::vector<std::vector<Rgb>> inner_fabric_curves(
+    const WovenSample& sample, const TabulatedBsdfTable& fiber, const FitInnerSettings& f,
+    const MeasuredInplane& measured, const TabulatedBsdfTable* proposal = nullptr) {
+  if (f.inner == FitInner::kSummation)
+    return table_curves(
+        sum_fabric_table(
+            fiber, verify_summation_options(f.resolution, f.summation_samples, f.seed, f.threads)),
+        measured, f.azimuths);
   FabricRaytraceOptions o;
   o.resolution = f.resolution;
   o.particles_per_bin = f.particles_per_bin;
   o.seed = f.seed;
   o.threads = f.threads;
+  o.proposal = proposal;
   return table_curves(raytrace_fabric_table(sample, fiber, o).table, measured, f.azimuths);
 }
 
-// The computed model's inner curves: an RGB fiber bake, then the inner model's step, both with
-// fixed seeds.
-inline std::vector<std::vector<Rgb>> computed_inner_curves(const FiberSpec& spec,
-                                                           const WovenSample& sample,
-                                                           const FitInnerSettings& f,
-                                                           const MeasuredInplane& measured) {
-  FiberTableBakeOptions b;
-  b.resolution = f.resolution;
-  b.photons_per_band = f.fiber_photons_per_band;
-  b.seed = f.seed;
-  b.threads = f.threads;
-  b.spectral = false;
-  return inner_fabric_curves(sample, bake_fiber_table(spec, b).table, f, measured);
+// The computed model's inner fiber table: an RGB bake with absorption as a weight, fixed seed.
+inline TabulatedBsdfTable computed_inner_fiber_table(const FiberSpec& spec,
+                                                     const FitInnerSettings& f) {
+  const FiberTableBakeOptions b =
+      verify_bake_options(f.resolution, f.fiber_photons_per_band, f.seed, f.threads, true);
+  return bake_fiber_table(spec, b).table;
+}
+
+// The computed model's inner curves: its inner fiber table, then the inner model's step.
+inline std::vector<std::vector<Rgb>> computed_inner_curves(
+    const FiberSpec& spec, const WovenSample& sample, const FitInnerSettings& f,
+    const MeasuredInplane& measured, const TabulatedBsdfTable* proposal = nullptr) {
+  return inner_fabric_curves(sample, computed_inner_fiber_table(spec, f), f, measured, proposal);
+}
+
+// The classic model's inner fiber table (fixed seed).
+inline TabulatedBsdfTable classic_inner_fiber_table(const Rgb& diffuse,
+                                                    const MicrofacetDistribution& d, double ior,
+                                                    const FitInnerSettings& f) {
+  return classic_fiber_table(diffuse, d, ior, f.resolution, f.summation_samples, f.seed, f.threads);
 }
 
 // The classic model's inner curves: its fiber table, then the same step.
-inline std::vector<std::vector<Rgb>> classic_inner_curves(const Rgb& diffuse,
-                                                          const MicrofacetDistribution& d,
-                                                          double ior, const WovenSample& sample,
-                                                          const FitInnerSettings& f,
-                                                          const MeasuredInplane& measured) {
-  return inner_fabric_curves(
-      sample,
-      classic_fiber_table(diffuse, d, ior, f.resolution, f.summation_samples, f.seed, f.threads), f,
-      measured);
+inline std::vector<std::vector<Rgb>> classic_inner_curves(
+    const Rgb& diffuse, const MicrofacetDistribution& d, double ior, const WovenSample& sample,
+    const FitInnerSettings& f, const MeasuredInplane& measured,
+    const TabulatedBsdfTable* proposal = nullptr) {
+  return inner_fabric_curves(sample, classic_inner_fiber_table(diffuse, d, ior, f), f, measured,
+                             proposal);
+}
+
+// The fit of one model on its inner model. 'table_of' makes the model's inner fiber table for a
+// parameter vector. With the ray-trace inner model the particles draw their paths from a proposal
+// table (FabricRaytraceOptions::proposal), so that at the fixed seed the objective is smooth in
+// the parameters: first the start's table; the reweighted estimate's noise grows with the distance
+// from the proposal, so the proposal is then re-centred on the optimum and the search restarted
+// there, until a search converges without moving more than 1 % of any box (in the search's unit
+// cube) from its proposal's point, or the evaluations are spent (options.max_evaluations over
+// all stages; each stage's uncertainty adds its 2 p). The result: the last stage's optimum and
+// uncertainty, the first's start, the evaluations and seconds of all.
+inline FitResult fit_inner_model(
+    const std::string& model, std::vector<FitParameter> parameters,
+    const std::function<TabulatedBsdfTable(const std::vector<double>&)>& table_of,
+    const WovenSample& sample, const FitInnerSettings& f, const MeasuredInplane& measured,
+    const FitOptions& options) {
+  const auto curves_of = [&](const TabulatedBsdfTable* proposal) -> InplaneModel {
+    return [&, proposal](const std::vector<double>& x) {
+      return inner_fabric_curves(sample, table_of(x), f, measured, proposal);
+    };
+  };
+  if (f.inner != FitInner::kRaytrace)
+    return fit_inplane(model, parameters, curves_of(nullptr), measured, options);
+  const std::vector<FitParameter> given = parameters;
+  FitResult first, last;
+  int evaluations = 0;
+  double seconds = 0;
+  for (int stage = 0;; ++stage) {
+    std::vector<double> x;
+    for (const auto& p : parameters) x.push_back(p.start);
+    const TabulatedBsdfTable proposal = table_of(x);
+    FitOptions o = options;
+    o.max_evaluations = options.max_evaluations - evaluations;
+    last = fit_inplane(model, parameters, curves_of(&proposal), measured, o);
+    evaluations += last.evaluations;
+    seconds += last.seconds;
+    if (stage == 0) first = last;
+    double moved = 0;
+    for (size_t k = 0; k < parameters.size(); ++k)
+      moved = std::max(moved, std::abs(fit_unit(parameters[k], last.parameters[k].value) -
+                                       fit_unit(parameters[k], x[k])));
+    const bool settled = last.converged && moved < 0.01;
+    // A restart needs the simplex and a first step (FitOptions::validate).
+    const int least = 2 * static_cast<int>(parameters.size()) + 2;
+    if (settled || options.max_evaluations - evaluations < least) {
+      last.converged = settled;
+      break;
+    }
+    for (size_t k = 0; k < parameters.size(); ++k) parameters[k].start = last.parameters[k].value;
+  }
+  for (size_t k = 0; k < given.size(); ++k) last.parameters[k].parameter = given[k];
+  last.objective_start = first.objective_start;
+  last.start_metrics = first.start_metrics;
+  last.evaluations = evaluations;
+  last.seconds = seconds;
+  return last;
 }
 
 // The classic model's four: its diffuse colour per channel (a reflectance, on a log scale: the

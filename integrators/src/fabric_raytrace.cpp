@@ -123,6 +123,7 @@ struct PendingCopy {
   int64_t ignore = kNoFiber;
   bool in_tube = false;        // sent into the yarn tube it left (yarn detail)
   std::vector<double> w, pdf;  // channel weights, relative path densities (see the tracer)
+  std::vector<double> wp;      // the weights under the proposal (with one; else empty)
 };
 
 // The most copies one split makes (the weights are divided by the count made, so any cap is
@@ -354,7 +355,20 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   const RenderScene scene(tiled_geometry(sample));
   const auto curves = static_cast<int64_t>(sample.fibers.curve_count());
   const Continuations joints = continuations(sample.fibers, px, pz);
-  const FiberSampler fs(fiber);
+  if (o.proposal) {
+    o.proposal->validate("");
+    if (o.proposal->kind != "fiber" || o.proposal->resolution != fiber.resolution ||
+        o.proposal->channels != fiber.channels)
+      throw Error("", "proposal",
+                  "the proposal must be a fiber table of the traced table's resolution and "
+                  "channels");
+  }
+  // With a proposal, paths are drawn from it and the choices that end or split a path are made on
+  // the weights it gives (wp); the traced table's weights (w) follow the same path, each step
+  // multiplied by its f over the proposal's.
+  const bool reweight = o.proposal != nullptr;
+  const TabulatedBsdfTable& drawn = reweight ? *o.proposal : fiber;
+  const FiberSampler fs(drawn);
   const int nc = fiber.channels;
   const DirectionGrid grid{o.resolution};
   const int bins = grid.bins();
@@ -391,7 +405,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
         // Roulette on the largest weight and splitting: all but the estimator before (mean).
         const bool window = o.channel_sampling != ChannelSampling::mean;
         const int n_strategies = mis ? nc : 1;
-        std::vector<double> w(nc), pdf(n_strategies), s_sum(n_strategies);
+        std::vector<double> w(nc), wp(reweight ? nc : 0), pdf(n_strategies), s_sum(n_strategies);
         std::vector<PendingCopy> pending;
         TaskTally outside;  // a task's particles of bins not asked for: traced, not tallied
         for (uint64_t k = first; k < first + count; ++k) {
@@ -417,7 +431,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
           pending.clear();
           int copies = 0;  // made by this particle's splits
           pending.push_back({p, d, 0, kNoFiber, false, std::vector<double>(nc, w0),
-                             std::vector<double>(n_strategies, 1.0)});
+                             std::vector<double>(n_strategies, 1.0),
+                             std::vector<double>(reweight ? nc : 0, w0)});
           while (!pending.empty()) {
             Vec3 p = pending.back().p, d = pending.back().d;
             int events = pending.back().events;
@@ -425,6 +440,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
             bool in_tube = pending.back().in_tube;   // see PendingCopy
             w.swap(pending.back().w);
             pdf.swap(pending.back().pdf);
+            wp.swap(pending.back().wp);
             pending.pop_back();
             while (true) {
               double mean_w = 0;
@@ -565,6 +581,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 w[c] *= fiber.at(pt.bin, ob, c) / mean_pdf;
                 after += w[c];
               }
+              if (reweight)
+                for (int c = 0; c < nc; ++c) wp[c] *= drawn.at(pt.bin, ob, c) / mean_pdf;
               for (double& x : pdf) x /= mean_pdf;
               books.absorbed += (before - after) / nc;
               d = normalize(pt.hit.shading.to_world(wo_local));
@@ -582,13 +600,17 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               // MIS, which let the dominant channel's weights grow where the mean fell).
               mean_w = 0;
               double max_w = 0;
-              for (double x : w) mean_w += x, max_w = std::max(max_w, x);
+              for (double x : w) mean_w += x;
               mean_w /= nc;
-              const double steer = window ? max_w : mean_w;
+              double mean_p = 0;  // the deciding weights' mean: w's, or the proposal's
+              for (double x : reweight ? wp : w) mean_p += x, max_w = std::max(max_w, x);
+              mean_p /= nc;
+              const double steer = window ? max_w : mean_p;
               if (steer < o.roulette_threshold) {
                 const double survive = steer / (o.roulette_threshold);
                 if (rng.uniform() < survive) {
                   for (double& x : w) x /= survive;
+                  for (double& x : wp) x /= survive;
                   books.roulette_net -= mean_w / survive - mean_w;
                 } else {
                   books.roulette_net += mean_w;
@@ -605,8 +627,9 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                     std::min<double>({double(kMaxSplit), std::ceil(max_w / o.split_threshold),
                                       double(kMaxCopiesPerParticle - copies + 1)}));
                 for (double& x : w) x /= n;
+                for (double& x : wp) x /= n;
                 for (int copy = 1; copy < n; ++copy)
-                  pending.push_back({p, d, events, ignore, in_tube, w, pdf});
+                  pending.push_back({p, d, events, ignore, in_tube, w, pdf, wp});
                 books.splits += n - 1;
                 copies += n - 1;
               }
@@ -670,6 +693,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                     {"seed", std::to_string(o.seed)},
                     {"estimator", channel_sampling_name(o.channel_sampling)},
                     {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
+  if (reweight) table.metadata["proposal_checksum"] = o.proposal->checksum();
   if (o.channel_sampling != ChannelSampling::mean) {
     char text[32];
     const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;

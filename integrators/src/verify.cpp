@@ -781,10 +781,6 @@ double to_value(const FitParameter& p, double u) {
   return p.log_scale ? std::exp(std::log(p.lo) + u * (std::log(p.hi) - std::log(p.lo)))
                      : p.lo + u * (p.hi - p.lo);
 }
-double to_unit(const FitParameter& p, double x) {
-  return p.log_scale ? (std::log(x) - std::log(p.lo)) / (std::log(p.hi) - std::log(p.lo))
-                     : (x - p.lo) / (p.hi - p.lo);
-}
 
 CurveMetrics absolute_metrics(const std::vector<std::vector<Rgb>>& model,
                               const MeasuredInplane& measured) {
@@ -831,6 +827,11 @@ bool invert(std::vector<std::vector<double>>& a) {
 
 }  // namespace
 
+double fit_unit(const FitParameter& p, double x) {
+  return p.log_scale ? (std::log(x) - std::log(p.lo)) / (std::log(p.hi) - std::log(p.lo))
+                     : (x - p.lo) / (p.hi - p.lo);
+}
+
 FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>& params,
                       const InplaneModel& inplane, const MeasuredInplane& measured,
                       const FitOptions& o) {
@@ -872,7 +873,7 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
     return u;
   };
   std::vector<double> u0(n);
-  for (size_t k = 0; k < n; ++k) u0[k] = to_unit(params[k], params[k].start);
+  for (size_t k = 0; k < n; ++k) u0[k] = fit_unit(params[k], params[k].start);
   std::vector<std::vector<double>> simplex{u0};
   for (size_t k = 0; k < n; ++k) {
     auto u = u0;

@@ -220,6 +220,93 @@ TEST(CliVerify, FitRecoversKnownFiberParametersFromASyntheticMeasurement) {
   EXPECT_LE(r.evaluations, options.max_evaluations + 2 * 2 + 8);  // search, shrink, Jacobian
 }
 
+// The fit's objective is smooth in dye_scale at its fixed seed: its inner bake keeps the photons'
+// paths when the dye changes (absorption as a weight, transport.h), and its ray trace draws its
+// paths from a fixed proposal table (FabricRaytraceOptions::proposal; the fit's is the table of
+// its start, here dye 1), so the inner models' rms_log along dye 1.00, 1.01, ..., 1.04 (red-cotton,
+// the bundled measurement, the command's inner settings at draft) have second differences below
+// 1e-4 (summation) and 3e-4 (ray trace), curvatures below 1 and 3 per unit dye squared at h = 0.01
+// (measured 4.5e-5 and 1.1e-4, docs/verify.md). Before, the same steps gave second differences of
+// 2.5e-3 to 8.6e-3 (summation) and 1.7e-2 to 1.9e-2 (ray trace): the noise of the bake and of the
+// paths, 25 and 60 times over the bounds.
+TEST(CliVerify, FitInnerObjectiveIsSmoothInDyeAtAFixedSeed) {
+  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
+  weft::FitInnerSettings inner =
+      weft::fit_inner_settings(weft::verify_settings(weft::VerifyQuality::kDraft));
+  inner.threads = 2;
+  const weft::WovenSample sample = verify_sample();
+  const weft::MeasuredInplane measured = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  const weft::TabulatedBsdfTable proposal = weft::computed_inner_fiber_table(spec, inner);
+  for (const auto [model, bound] :
+       {std::pair{weft::FitInner::kSummation, 1e-4}, std::pair{weft::FitInner::kRaytrace, 3e-4}}) {
+    inner.inner = model;
+    std::vector<double> j;
+    for (int k = 0; k < 5; ++k) {
+      const weft::FiberSpec dyed = weft::apply_spec_fit(spec, {"dye_scale"}, {1 + 0.01 * k});
+      const auto r = weft::fit_residuals(
+          weft::inner_fabric_curves(sample, weft::computed_inner_fiber_table(dyed, inner), inner,
+                                    measured, &proposal),
+          measured);
+      double ss = 0;
+      for (double v : r) ss += v * v;
+      j.push_back(std::sqrt(ss / r.size()));
+    }
+    const std::string name = weft::fit_inner_name(model);
+    for (size_t k = 0; k + 2 < j.size(); ++k)
+      EXPECT_LT(std::abs(j[k + 2] - 2 * j[k + 1] + j[k]), bound) << name << " " << k;
+    EXPECT_GT(std::abs(j[4] - j[0]), 1e-3) << name;  // and the objective does move with the dye
+  }
+}
+
+// The ray-trace inner model's search with its proposal re-centred (fit_inner_model): the dye 1.8
+// from the ray-trace inner model's own curves (traced directly at the truth), at a test's budget
+// (R = 3, 1000 photons per band, 300 particles per incident bin). The first search's proposal is
+// the start's table (dye 1); the restarts move the proposal to the optimum, and the search ends
+// converged there. The fitted curves follow other paths than the measurement's (their proposal's),
+// so the optimum can only be as good as the ray trace's noise: its objective is below that of the
+// truth traced with another seed (the noise floor; the fit reached 0.10), and the dye within 5 %
+// (measured 3.3 %; the summation's test above, without that noise, asks 3 %).
+TEST(CliVerify, RaytraceFitRecentresItsProposalAndConverges) {
+  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
+  weft::FitInnerSettings inner =
+      weft::fit_inner_settings(weft::verify_settings(weft::VerifyQuality::kDraft));
+  inner.inner = weft::FitInner::kRaytrace;
+  inner.resolution = 3;
+  inner.fiber_photons_per_band = 1000;
+  inner.particles_per_bin = 300;
+  inner.threads = 2;
+  const weft::WovenSample sample = verify_sample();
+  const std::vector<std::string> names = {"dye_scale"};
+  weft::MeasuredInplane geometry = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
+      weft::apply_spec_fit(spec, names, {1.8}), sample, inner, geometry));
+  weft::FitOptions options;
+  options.max_evaluations = 60;
+  const weft::FitResult r = weft::fit_inner_model(
+      "computed", weft::spec_fit_parameters(spec, names),
+      [&](const std::vector<double>& x) {
+        return weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), inner);
+      },
+      sample, inner, measured, options);
+  ASSERT_EQ(r.parameters.size(), 1u);
+  EXPECT_TRUE(r.converged);
+  EXPECT_GT(r.objective_start, 0.2);  // the first search's start, far from the truth
+  EXPECT_NEAR(std::log(r.parameters[0].value / 1.8), 0.0, 0.05) << r.parameters[0].value;
+  weft::FitInnerSettings other = inner;
+  other.seed = 2;
+  const auto floor =
+      weft::fit_residuals(weft::computed_inner_curves(weft::apply_spec_fit(spec, names, {1.8}),
+                                                      sample, other, measured),
+                          measured);
+  double ss = 0;
+  for (double v : floor) ss += v * v;
+  EXPECT_LT(r.objective, std::sqrt(ss / floor.size()));
+  EXPECT_EQ(r.parameters[0].parameter.start, 1.0);  // the given start, not a restart's
+  EXPECT_LE(r.evaluations, options.max_evaluations + 2);
+}
+
 // The classic model's four (diffuse colour per channel, roughness) from its own synthetic
 // measurement, from the start the command uses for red-cotton (its volume albedo, 0.35).
 TEST(CliVerify, FitRecoversKnownClassicParametersFromASyntheticMeasurement) {

@@ -19,10 +19,13 @@ namespace weft {
 std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
                                              const FiberSpec& spec,
                                              const FiberTableBakeOptions& o) {
-  const std::string key = canonical_json(spec) + "|R" + std::to_string(o.resolution) + "|N" +
-                          std::to_string(o.photons_per_band) + "|S" + std::to_string(o.seed) +
-                          "|P" + std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") +
-                          "|v" + std::to_string(TabulatedBsdfTable::kFormatVersion);
+  const std::string key =
+      canonical_json(spec) + "|R" + std::to_string(o.resolution) + "|N" +
+      std::to_string(o.photons_per_band) + "|S" + std::to_string(o.seed) + "|P" +
+      std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") + "|v" +
+      std::to_string(TabulatedBsdfTable::kFormatVersion) +
+      // Only when not the default, so existing cache entries keep their names.
+      (o.weight_mode == WeightMode::absorption_weight ? "|absorption_weight" : "");
   return dir / ("fiber-" + fiber_spec_hash_hex(spec) + "-" + hex64(fnv1a64(key)) + ".exr");
 }
 

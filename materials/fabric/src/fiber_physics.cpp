@@ -84,7 +84,8 @@ double SurfaceAlbedoTable::operator()(double cos_theta) const {
 
 FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
                                     uint64_t max_events_per_photon,
-                                    std::shared_ptr<const SurfaceAlbedoTable> albedo) {
+                                    std::shared_ptr<const SurfaceAlbedoTable> albedo,
+                                    WeightMode mode) {
   FiberBandPhysics ph;
   if (spec.boundary == FiberBoundary::kRoughDielectric) {
     auto boundary = std::make_shared<const RoughDielectricInterface>(
@@ -92,6 +93,7 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
     ph.boundary = boundary;
     TransportOptions topt;
     topt.max_events = max_events_per_photon;
+    topt.mode = mode;
     topt.boundary_scatter = [boundary](const Vec3& d, Rng& rng) {
       const RoughDielectricScatter s = boundary->scatter(d, rng);
       return BoundaryScatter{s.direction, s.lost};
@@ -119,6 +121,7 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
   ph.surface.albedo = [albedo](double c) { return (*albedo)(c); };
   TransportOptions topt;
   topt.max_events = max_events_per_photon;
+  topt.mode = mode;
   topt.exit_reflectance = [albedo](double cos_outside) { return (*albedo)(cos_outside); };
   ph.interior = FiberInterior::transport(std::make_shared<const CylinderTransport>(
       CylinderGeometry(spec.fiber_radius_um, 1.0),

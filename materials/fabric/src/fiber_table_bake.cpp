@@ -21,6 +21,9 @@ void validate(const FiberTableBakeOptions& o) {
                 "must lie in [2, " + std::to_string(TabulatedBsdfTable::kMaxResolution) + "]");
   if (o.photons_per_band == 0) throw Error("", "photons", "must be positive");
   if (o.max_events_per_photon == 0) throw Error("", "max_events_per_photon", "must be positive");
+  if (o.weight_mode != WeightMode::implicit_capture &&
+      o.weight_mode != WeightMode::absorption_weight)
+    throw Error("", "weight_mode", "must be implicit_capture or absorption_weight");
 }
 
 }  // namespace
@@ -65,7 +68,7 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
     if (!albedo && spec.boundary == FiberBoundary::kSmooth)
       albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
                                                           spec.roughness_alpha, mb.host_n);
-    physics[i] = fiber_band_physics(spec, mb, o.max_events_per_photon, albedo);
+    physics[i] = fiber_band_physics(spec, mb, o.max_events_per_photon, albedo, o.weight_mode);
     FiberBandState& st = states[i];
     st.mu_s_per_um = mb.mu_s_per_um, st.mu_a_per_um = mb.mu_a_per_um, st.g = mb.g;
     if (work.start.empty()) st.weighted_sum.assign(cells * cells, 0.0);

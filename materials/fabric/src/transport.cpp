@@ -20,7 +20,8 @@ void TransportMedium::validate() const {
 }
 
 void TransportOptions::validate() const {
-  if (mode != WeightMode::implicit_capture && mode != WeightMode::analog)
+  if (mode != WeightMode::implicit_capture && mode != WeightMode::analog &&
+      mode != WeightMode::absorption_weight)
     throw Error("", "mode", "unknown weight mode");
   if (!std::isfinite(roulette_threshold) || !(roulette_threshold >= 0) || roulette_threshold >= 1)
     throw Error("", "roulette_threshold", "must lie in [0, 1)");

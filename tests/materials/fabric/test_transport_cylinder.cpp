@@ -147,7 +147,8 @@ TEST(TransportCylinder, MismatchedAbsorbingCylinderMatchesBounceSeries) {
   const double r = 10, mua = 0.03, n = 1.557;
   for (const Vec3& dir : {Vec3{0, 0, -1}, normalize(Vec3{0.8, 0.3, -0.5})}) {
     const BeamFate exact = non_scattering_cylinder(mua, r, n, 1.0, dir);
-    for (WeightMode mode : {WeightMode::implicit_capture, WeightMode::analog}) {
+    for (WeightMode mode :
+         {WeightMode::implicit_capture, WeightMode::analog, WeightMode::absorption_weight}) {
       CylinderBeamSetup s = beam(medium(mua, 0, 0, n), r, 1.0, dir);
       s.options.mode = mode;
       const CylinderBeamResult res = simulate_cylinder_beam(s, batch(150000, 32));

@@ -162,7 +162,8 @@ TEST(TransportSlab, NonScatteringSlabWithFresnelIsExact) {
   const double tb = (1 - r0) * (1 - r2) * att / (1 - r1 * r2 * att * att);
   const double rb = (1 - r0) * r2 * att * att * (1 - r1) / (1 - r1 * r2 * att * att);
   EXPECT_NEAR(r0, r1, 1e-14);  // Fresnel is symmetric in the direction of travel
-  for (WeightMode mode : {WeightMode::implicit_capture, WeightMode::analog}) {
+  for (WeightMode mode :
+       {WeightMode::implicit_capture, WeightMode::analog, WeightMode::absorption_weight}) {
     s.options.mode = mode;
     const SlabResult r = simulate_slab(s, batch(200000, 14));
     EXPECT_NEAR(r.specular.mean, r0, 1e-12);
@@ -225,6 +226,18 @@ TEST(TransportSlab, AnalogAndImplicitCaptureAgree) {
         std::pair{implicit.tb, analog.tb}, std::pair{implicit.absorbed, analog.absorbed}}) {
     EXPECT_TRUE(within_sigma(a, b.mean, 3, b.std_error));
   }
+}
+
+// Absorption as a weight (free paths from mu_s, weight exp(-mu_a l)) against van de Hulst's matched
+// slab (references as in McmlVanDeHulstMatchedSlab), and its books close without roulette.
+TEST(TransportSlab, AbsorptionWeightMatchesVanDeHulstSlab) {
+  SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
+  s.options.mode = WeightMode::absorption_weight;
+  const SlabResult r = simulate_slab(s, batch(400000, 21));
+  EXPECT_TRUE(within_sigma(r.rd, 0.09739, 3));
+  EXPECT_TRUE(within_sigma(r.tt, 0.66096, 3));
+  EXPECT_EQ(r.roulette.mean, 0.0);
+  EXPECT_NEAR(r.energy_imbalance, 0, 1e-12);
 }
 
 TEST(TransportSlab, SameBitsAtOneAndTwoThreads) {

@@ -57,6 +57,14 @@ struct FabricRaytraceOptions {
   // Trace only incident bins [first_bin, first_bin + bin_count) (0: all), for a table split over
   // processes: their rows have the bits of a whole run's, the other rows are zero.
   int first_bin = 0, bin_count = 0;
+  // Optional: draw the paths from this fiber table (same resolution and channels) and weight each
+  // step by f / f_proposal of the fiber table traced (likelihood-ratio reweighting). Every choice
+  // (B' or B'', exit cell and direction, roulette, splitting) then depends on the proposal alone,
+  // so at a fixed seed the particles keep their paths when the fiber table changes and the result
+  // is a smooth function of it: weft verify --fit's inner model (docs/verify.md). Unbiased where
+  // the proposal is nonzero wherever the table is; the noise grows as the two tables differ. Null:
+  // the fiber table itself (the default estimator, bit for bit).
+  const TabulatedBsdfTable* proposal = nullptr;
 
   void validate() const;  // weft::Error naming the field
 };

@@ -196,6 +196,9 @@ struct FitParameter {
   bool log_scale = false;
 };
 
+// A parameter's value as its coordinate in the optimizer's unit cube (ln x where log_scale).
+double fit_unit(const FitParameter& p, double x);
+
 // The model being fitted: the in-plane beta [incidence][view] of the measurement's views for a
 // parameter vector (in the parameters' own units).
 using InplaneModel = std::function<std::vector<std::vector<Rgb>>(const std::vector<double>&)>;
@@ -245,8 +248,9 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
 // The inner model the fit evaluates (docs/verify.md), both with fixed seeds at every evaluation
 // (common random numbers):
 //   kRaytrace: the run's own pipeline (RGB fiber bake, then the fiber-level ray trace) with few
-//     photons and particles; its objective is jagged at the level of its noise (a changed table
-//     changes the paths' discrete choices);
+//     photons and particles; the bake treats absorption as a weight and the ray trace draws its
+//     paths from a proposal table re-centred on the optimum (tools/verify_fit.h), so that the
+//     objective is smooth in the parameters at the fixed seed;
 //   kSummation: the paper's summation table of the same bake; smooth and about 20 times cheaper,
 //     but without light travelling between fibers, so its optimum is not the ray trace's.
 enum class FitInner { kRaytrace, kSummation };

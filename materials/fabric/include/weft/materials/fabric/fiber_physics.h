@@ -86,10 +86,12 @@ class SurfaceAlbedoTable {
 // at the outside angle, as on entry, which keeps the fiber reciprocal). Boundary
 // "rough-dielectric": the rough dielectric interface of the spec's roughness at the band's host
 // index, both ways. Then cylinder transport in the band's medium. 'albedo' (smooth only) may be
-// shared between bands of equal host index; null computes it.
+// shared between bands of equal host index; null computes it. 'mode': how the interior's transport
+// treats absorption (transport.h).
 FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& band,
                                     uint64_t max_events_per_photon = 10'000'000,
-                                    std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr);
+                                    std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr,
+                                    WeightMode mode = WeightMode::implicit_capture);
 
 // Light from world direction 'omega' (towards the light) meets the fiber at surface angle phi
 // (axial position 0) with flux weight w0. The surface lobe's sampled reflection goes to

@@ -31,6 +31,10 @@ struct FiberTableBakeOptions {
   bool spectral = true;  // 33 bands, else linear sRGB (D65) from the 33 bands
   FiberBakeRoute route = FiberBakeRoute::kDirect;
   uint64_t max_events_per_photon = 10'000'000;  // beyond it the weight is reported as lost
+  // How the fiber's interior treats absorption (transport.h). absorption_weight makes the table a
+  // smooth function of the absorption at a fixed seed (paths do not depend on it): weft verify
+  // --fit's inner bake (docs/verify.md). Both are unbiased; the default keeps its bits.
+  WeightMode weight_mode = WeightMode::implicit_capture;
   // Photons are traced in this many passes over all bands; an interrupted bake keeps every
   // finished pass (results depend on it, not on threads).
   uint64_t passes = 8;

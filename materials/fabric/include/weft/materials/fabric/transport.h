@@ -26,6 +26,13 @@
 //   interaction and always scatters; below roulette_threshold the photon survives a Russian
 //   roulette with probability roulette_survival and has its weight divided by it (MCML's scheme,
 //   unbiased). WeightMode::analog absorbs the whole photon with probability mu_a / mu_t.
+//   WeightMode::absorption_weight draws free paths from mu_s alone and multiplies the weight by
+//   exp(-mu_a l) over every length l travelled (to the boundary too), without roulette (it would
+//   decide on the weight): a photon's path and the random numbers it draws then do not depend on
+//   mu_a, so at a fixed seed a change of absorption changes weights, not paths, and an estimate is
+//   a smooth function of mu_a (the fit's inner bake, docs/verify.md). Unbiased: exp(-mu_a l) is
+//   the analog walk's probability of surviving the length l. Paths are as long as without
+//   absorption, so it costs more where mu_a is large.
 // * Energy bookkeeping is exact to rounding: per launched weight w,
 //     w = specular + exited + absorbed + roulette_loss - roulette_gain + lost,
 //   where roulette_loss is the weight of photons killed by roulette, roulette_gain the weight
@@ -67,7 +74,7 @@ struct TransportMedium {
   void validate() const;
 };
 
-enum class WeightMode : uint8_t { implicit_capture, analog };
+enum class WeightMode : uint8_t { implicit_capture, analog, absorption_weight };
 
 // What a rough boundary (TransportOptions::boundary_scatter) did with a photon.
 struct BoundaryScatter {
@@ -278,8 +285,10 @@ class PhotonTransport {
     options_.validate();
     mu_t_ = medium_.mu_a + medium_.mu_s;
     if (!std::isfinite(mu_t_)) throw Error("", "mu_a", "mu_a + mu_s overflows");
-    inv_mu_t_ = mu_t_ > 0 ? 1.0 / mu_t_ : kTransportInfinity;
     absorb_fraction_ = mu_t_ > 0 ? medium_.mu_a / mu_t_ : 0.0;
+    // mu_t_ is the coefficient free paths are drawn from: mu_s alone when absorption is a weight.
+    if (options_.mode == WeightMode::absorption_weight) mu_t_ = medium_.mu_s;
+    inv_mu_t_ = mu_t_ > 0 ? 1.0 / mu_t_ : kTransportInfinity;
     inv_survival_ = 1.0 / options_.roulette_survival;
   }
 
@@ -355,12 +364,22 @@ class PhotonTransport {
   void walk(Vec3 p, Vec3 d, double w, Rng& rng, Recorder& recorder, PhotonTally& tally) const {
     const double n_in = medium_.n;
     const bool analog = options_.mode == WeightMode::analog;
+    const bool weighted = options_.mode == WeightMode::absorption_weight;
+    // Absorption over a length, as a weight (absorption_weight only).
+    const auto attenuate = [&](double length) {
+      const double kept = w * std::exp(-medium_.mu_a * length);
+      tally.absorbed += w - kept;
+      w = kept;
+    };
     uint64_t events = 0, scatterings = 0;
-    while (w > 0) {
+    // A weighted photon walks on at weight 0 (underflow), so that the draws it makes, and so the
+    // next photon's, do not depend on mu_a.
+    while (w > 0 || weighted) {
       const BoundaryHit hit = geometry_.distance_to_boundary(p, d);
       const double s = mu_t_ > 0 ? -std::log(rng.uniform_open0()) * inv_mu_t_ : kTransportInfinity;
       if (s >= hit.distance) {
         if (!std::isfinite(hit.distance)) break;  // never interacts, never leaves: lost
+        if (weighted) attenuate(hit.distance);
         p = geometry_.snap(p + hit.distance * d, hit.boundary);
         const Vec3 n = geometry_.outward_normal(p, hit.boundary);
         const double n_out = geometry_.n_outside(hit.boundary);
@@ -405,7 +424,9 @@ class PhotonTransport {
         continue;
       }
       p += s * d;
-      if (analog) {
+      if (weighted) {
+        attenuate(s);
+      } else if (analog) {
         if (rng.uniform() < absorb_fraction_) {
           tally.absorbed += w;
           w = 0;
@@ -421,7 +442,7 @@ class PhotonTransport {
       d = medium_.phase.sample_direction(d, u1, u2);
       ++scatterings;
       if (++events >= options_.max_events) break;
-      if (!analog && w < options_.roulette_threshold && w > 0) {
+      if (!analog && !weighted && w < options_.roulette_threshold && w > 0) {
         if (rng.uniform() < options_.roulette_survival) {
           const double w_new = w * inv_survival_;
           tally.roulette_gain += w_new - w;
