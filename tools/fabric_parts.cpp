@@ -30,6 +30,7 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
            {"roulette_threshold", r.roulette_threshold},
            {"estimator", channel_sampling_name(r.channel_sampling)},
            {"split_threshold", r.split_threshold},
+           {"max_copies_per_particle", r.max_copies_per_particle},
            {"program_version", WEFT_VERSION}};
   p.units_total = static_cast<uint64_t>(DirectionGrid{r.resolution}.bins());
   p.shard = shard;

@@ -129,11 +129,6 @@ struct PendingCopy {
 // The most copies one split makes (the weights are divided by the count made, so any cap is
 // unbiased; it bounds the work a freak weight can cause).
 constexpr int kMaxSplit = 16;
-// The most copies one particle's splits make in all. Splitting is optional (any count keeps the
-// estimate unbiased), so a cap changes only the noise; it bounds a particle's work where weights
-// grow at every event (a table whose line albedo stays above 1: the copies would grow
-// geometrically with the path's length).
-constexpr int kMaxCopiesPerParticle = 64;
 
 struct TaskTally {
   std::vector<ExitRecord> exits;
@@ -284,6 +279,8 @@ void FabricRaytraceOptions::validate() const {
     throw Error("", "roulette_threshold", "must lie in (0, 1)");
   if (!(split_threshold > roulette_threshold) || !std::isfinite(split_threshold))
     throw Error("", "split_threshold", "must be finite and above roulette_threshold");
+  if (max_copies_per_particle < 1 || max_copies_per_particle > (1 << 20))
+    throw Error("", "max_copies_per_particle", "must lie in [1, 2^20]");
   if (threads < 0) throw Error("", "threads", "must be >= 0");
   const int bins = DirectionGrid{resolution}.bins();
   if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
@@ -622,10 +619,10 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               // where the line runs near its axis (up to ~3 in red for red cotton), so weights grow
               // along a path; a few heavy paths would carry much of the table. n copies of weight
               // w / n each, which go their own ways from the next fiber on.
-              if (window && max_w > o.split_threshold && copies < kMaxCopiesPerParticle) {
+              if (window && max_w > o.split_threshold && copies < o.max_copies_per_particle) {
                 const int n = static_cast<int>(
                     std::min<double>({double(kMaxSplit), std::ceil(max_w / o.split_threshold),
-                                      double(kMaxCopiesPerParticle - copies + 1)}));
+                                      double(o.max_copies_per_particle - copies + 1)}));
                 for (double& x : w) x /= n;
                 for (double& x : wp) x /= n;
                 for (int copy = 1; copy < n; ++copy)
@@ -698,6 +695,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
     char text[32];
     const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;
     table.metadata["split_threshold"] = std::string(text, end);
+    table.metadata["max_copies_per_particle"] = std::to_string(o.max_copies_per_particle);
   }
   for (const char* key : {"spec_hash", "spec_name"})
     if (const auto it = fiber.metadata.find(key); it != fiber.metadata.end())

@@ -463,6 +463,7 @@ TEST(FabricRaytrace, SplitsAndRouletteKillsAreCountedPerIncidentBin) {
   EXPECT_EQ(kills, whole.roulette_kills);
   EXPECT_EQ(whole.table.metadata.at("estimator"), "hero");
   EXPECT_EQ(whole.table.metadata.at("split_threshold"), "1");
+  EXPECT_EQ(whole.table.metadata.at("max_copies_per_particle"), "1024");
 
   FabricRaytraceOptions piece = o;
   piece.first_bin = 3, piece.bin_count = 4;
@@ -471,6 +472,17 @@ TEST(FabricRaytrace, SplitsAndRouletteKillsAreCountedPerIncidentBin) {
     const bool in = b >= 3 && b < 7;
     EXPECT_EQ(part.splits_per_bin[b], in ? whole.splits_per_bin[b] : 0u) << b;
     EXPECT_EQ(part.roulette_kills_per_bin[b], in ? whole.roulette_kills_per_bin[b] : 0u) << b;
+  }
+
+  for (int bad : {0, -3, (1 << 20) + 1}) {
+    FabricRaytraceOptions b = o;
+    b.max_copies_per_particle = bad;
+    try {
+      (void)raytrace_fabric_table(sample, red, b);
+      ADD_FAILURE() << "copy cap " << bad << " accepted";
+    } catch (const weft::Error& e) {
+      EXPECT_NE(std::string(e.what()).find("max_copies_per_particle"), std::string::npos);
+    }
   }
 
   o.split_threshold = 0.25;
@@ -532,13 +544,15 @@ TEST(FabricRaytrace, PiecesAddUpToTheWholeRunsBooksAndNoise) {
 TEST(FabricRaytrace, ColouredFiberFinishesWithBoundedCopiesPerParticle) {
   // A fiber that keeps half, 0.3 and 0.1 of the light at every point (outer hemisphere): the
   // channels' weights part along a path and splitting makes copies. Splitting is optional, so each
-  // particle's copies are capped (64): at most 63 per particle, a finite table.
+  // particle's copies are capped (here 64, to keep the test short): at most 63 per particle, a
+  // finite table.
   const auto lossy = fiber_table3(2, [](const Vec3& wo, const Vec3&, std::span<double> v) {
     v[0] = wo.z > 0 ? 0.5 * kInvPi : 0;
     v[1] = wo.z > 0 ? 0.3 * kInvPi : 0;
     v[2] = wo.z > 0 ? 0.1 * kInvPi : 0;
   });
-  const FabricRaytraceOptions o = options(2, 300);
+  FabricRaytraceOptions o = options(2, 300);
+  o.max_copies_per_particle = 64;
   const WovenSample sample = default_sample("fiber");
   const auto r = raytrace_fabric_table(sample, lossy, o);
   EXPECT_EQ(r.particles, uint64_t(300) * DirectionGrid{2}.bins());
