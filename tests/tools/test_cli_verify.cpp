@@ -238,7 +238,7 @@ TEST(CliVerify, FitInnerObjectiveIsSmoothInDyeAtAFixedSeed) {
   const weft::MeasuredInplane measured = weft::read_measured_inplane(
       fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
   const weft::TabulatedBsdfTable proposal = weft::computed_inner_fiber_table(spec, inner);
-  for (const auto [model, bound] :
+  for (const auto& [model, bound] :
        {std::pair{weft::FitInner::kSummation, 1e-4}, std::pair{weft::FitInner::kRaytrace, 3e-4}}) {
     inner.inner = model;
     std::vector<double> j;

@@ -436,7 +436,9 @@ TEST(FiberTableBake, AbsorptionWeightAgreesWithImplicitCaptureWithinStatisticalE
       s.seed = seed + 100 * m;
       const FiberBandTable t = bake_fiber_band_direct(ph, s, nullptr);
       EXPECT_NEAR(t.energy_balance(), 1.0, 1e-12);
-      if (m == 1) EXPECT_EQ(t.roulette_net, 0.0);  // no roulette: it would decide on the weight
+      if (m == 1) {
+        EXPECT_EQ(t.roulette_net, 0.0);  // no roulette: it would decide on the weight
+      }
       exit[m].push_back(t.exit_fraction);
       absorbed[m].push_back(t.absorbed_fraction);
       return t;
