@@ -20,6 +20,7 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
   JobPart p;
   p.command = "bake fabric";
   p.job = {{"method", "raytrace"},
+           {"estimator_revision", kFabricRaytraceRevision},
            {"inputs", inputs},
            {"fiber_checksum", fiber.checksum()},
            {"sample", sample.summary.source + " (" + sample.summary.detail + ")"},
@@ -39,7 +40,7 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
 
 // A bin's unit: its row of the table, then its books (FabricBinBooks: the power as doubles, the
 // counts as raw 64-bit values, noise2 and signal2 per channel).
-constexpr size_t kBookValues = 5 + 8;
+constexpr size_t kBookValues = 5 + 7;
 
 // The table (with the metadata of the pieces) and its books from the units of every bin.
 FabricRaytraceResult assemble(const JobPart& all, int resolution) {
@@ -63,8 +64,8 @@ void encode_fabric_bin(const FabricRaytraceResult& res, uint64_t a, std::vector<
            res.table.values.begin() + static_cast<std::ptrdiff_t>((a + 1) * row));
   const FabricBinBooks& b = res.bin_books.at(a);
   for (double x : {b.launched, b.exited, b.absorbed, b.lost, b.roulette_net}) v.push_back(x);
-  for (uint64_t x : {b.particles, b.scatterings, b.wraps, b.splits, b.continuation_caps,
-                     b.inside_hits, b.roulette_kills, b.tube_passes})
+  for (uint64_t x : {b.particles, b.scatterings, b.wraps, b.splits, b.inside_hits, b.roulette_kills,
+                     b.tube_passes})
     push_u64(v, x);
   v.insert(v.end(), b.noise2.begin(), b.noise2.end());
   v.insert(v.end(), b.signal2.begin(), b.signal2.end());
@@ -100,8 +101,8 @@ FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<d
     const double* x = v.data() + row;
     b.launched = x[0], b.exited = x[1], b.absorbed = x[2], b.lost = x[3], b.roulette_net = x[4];
     b.particles = as_u64(x[5]), b.scatterings = as_u64(x[6]), b.wraps = as_u64(x[7]);
-    b.splits = as_u64(x[8]), b.continuation_caps = as_u64(x[9]), b.inside_hits = as_u64(x[10]);
-    b.roulette_kills = as_u64(x[11]), b.tube_passes = as_u64(x[12]);
+    b.splits = as_u64(x[8]), b.inside_hits = as_u64(x[9]);
+    b.roulette_kills = as_u64(x[10]), b.tube_passes = as_u64(x[11]);
     b.noise2.assign(x + kBookValues, x + kBookValues + nc);
     b.signal2.assign(x + kBookValues + nc, x + kBookValues + 2 * nc);
   }

@@ -5,7 +5,6 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
-#include <map>
 #include <memory>
 #include <span>
 #include <string>
@@ -211,36 +210,6 @@ bool fiber_exit_point(const RenderScene& scene, const SurfaceHit& entry, const V
   return true;
 }
 
-// For each curve of the sample, the curves that continue it across the repeat's sides (the one
-// starting where it ends, and the one ending where it starts, a period away; weave.h): -1 where
-// none does.
-struct Continuations {
-  std::vector<int64_t> next, prev;
-  bool joined(int64_t a, int64_t b) const {  // curves of the sample, not scene-wide ids
-    return next[a] == b || prev[a] == b;
-  }
-};
-
-Continuations continuations(const FiberCurves& f, double px, double pz) {
-  Continuations c;
-  c.next.assign(f.curve_count(), -1);
-  c.prev.assign(f.curve_count(), -1);
-  std::map<uint32_t, std::vector<uint32_t>> by_yarn;
-  for (size_t k = 0; k < f.curve_count(); ++k) by_yarn[f.curve_yarn[k]].push_back(uint32_t(k));
-  for (const auto& [yarn, curves] : by_yarn)
-    for (uint32_t a : curves) {
-      const Vec3 end = f.point(f.curve_first[a] + f.curve_points[a] - 1);
-      for (uint32_t b : curves) {
-        Vec3 d = f.point(f.curve_first[b]) - end;
-        d.x -= px * std::round(d.x / px);
-        d.z -= pz * std::round(d.z / pz);
-        // Points stored as floats: a joint is exact to float rounding of sub-millimetre values.
-        if (length(d) < 1e-9) c.next[a] = b, c.prev[b] = a;
-      }
-    }
-  return c;
-}
-
 }  // namespace
 
 std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_above,
@@ -292,7 +261,7 @@ void FabricBinBooks::add(const FabricBinBooks& o) {
   roulette_net += o.roulette_net;
   particles += o.particles, scatterings += o.scatterings, wraps += o.wraps, splits += o.splits;
   roulette_kills += o.roulette_kills, tube_passes += o.tube_passes;
-  continuation_caps += o.continuation_caps, inside_hits += o.inside_hits;
+  inside_hits += o.inside_hits;
 }
 
 void fabric_raytrace_totals(FabricRaytraceResult& r) {
@@ -308,7 +277,7 @@ void fabric_raytrace_totals(FabricRaytraceResult& r) {
     }
   }
   r.particles = all.particles, r.scatterings = all.scatterings, r.wraps = all.wraps;
-  r.splits = all.splits, r.continuation_caps = all.continuation_caps;
+  r.splits = all.splits;
   r.inside_hits = all.inside_hits;
   r.roulette_kills = all.roulette_kills, r.tube_passes = all.tube_passes;
   r.splits_per_bin.assign(r.bin_books.size(), 0);
@@ -351,7 +320,6 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   const double x0 = -0.5 * px, z0 = -0.5 * pz;
   const RenderScene scene(tiled_geometry(sample));
   const auto curves = static_cast<int64_t>(sample.fibers.curve_count());
-  const Continuations joints = continuations(sample.fibers, px, pz);
   if (o.proposal) {
     o.proposal->validate("");
     if (o.proposal->kind != "fiber" || o.proposal->resolution != fiber.resolution ||
@@ -487,20 +455,6 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 }
                 continue;
               }
-              // A particle that leaves a fiber near its end at the repeat's side may start inside
-              // the end cap of the fiber's continuation (the same fiber, one period on): it leaves
-              // through the fiber itself, so that cap is passed through like the fiber's own body.
-              if (h.on_fiber() && ignore != kNoFiber && dot(d, h.ng) >= 0 &&
-                  joints.joined(ignore % curves, h.fiber % curves)) {
-                p = h.spawn_origin(d);
-                ignore = h.fiber;
-                ++books.continuation_caps;
-                if (++events > 100 * o.max_scatterings) {
-                  books.lost += mean_w;
-                  break;
-                }
-                continue;
-              }
               // Light that a yarn tube sent into itself leaves it through its far side, as light
               // leaves a fiber through the fiber itself: the table already holds the whole yarn's
               // part (taking that exit as a new crossing scattered it twice, and only when it left
@@ -520,9 +474,9 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
               // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is
               // where the line leaves its cylinder. Yarn tubes that press on each other share
               // surfaces, so a particle may find itself inside one: then this hit is B'' and B'
-              // lies behind it (for round fibers, apart by 2 radii, that happens only where a
-              // fiber's end cap meets its continuation in the next repeat; the hit is then taken
-              // alone).
+              // lies behind it. The scene never returns a fiber hit from inside (RenderScene:
+              // a ray inside a fiber passes through it, as it passes through its own fiber); a
+              // hit counted here grazed the surface (taken alone, without B'').
               FiberPoint pts[2];
               int n_pts = 0;
               const bool from_outside = dot(d, h.ng) < 0;
@@ -685,6 +639,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                   "it with weft bake fiber");
   fabric_raytrace_totals(result);
   table.metadata = {{"method", "raytrace"},
+                    {"estimator_revision", std::to_string(kFabricRaytraceRevision)},
                     {"fiber_checksum", fiber.checksum()},
                     {"particles_per_bin", std::to_string(per_bin)},
                     {"seed", std::to_string(o.seed)},

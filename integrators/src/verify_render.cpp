@@ -168,7 +168,10 @@ VerifyRender render_one(const std::filesystem::path& folder, const nlohmann::jso
 VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path& folder,
                           const std::string& fiber_file, const std::string& model,
                           const std::string& label, bool transmission, const VerifySettings& s) {
-  const nlohmann::json material = {{"type", "fiber_table"}, {"params", {{"file", fiber_file}}}};
+  // Read by cell, as the ray trace reads it: the image's mean is then the ray-traced fabric
+  // table's value for this view and light (TableLookup).
+  const nlohmann::json material = {{"type", "fiber_table"},
+                                   {"params", {{"file", fiber_file}, {"interpolation", "cell"}}}};
   const SceneDescription desc = verify_weave_scene(sample, material, transmission, s, folder);
   VerifyRender v;
   v.kind = "weave";

@@ -77,6 +77,17 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
   }
   if (kind == "fiber")
     p.reject_unused("backing_reflectance", "applies only to fabric_table (a cloth on a backing)");
+  // Fiber tables only: a fabric table's backing and albedos are those of the interpolated table.
+  TableLookup lookup = TableLookup::bilinear;
+  if (kind == "fiber") {
+    const std::string how = p.string("interpolation", "bilinear");
+    if (how == "cell")
+      lookup = TableLookup::cell;
+    else if (how != "bilinear")
+      throw Error(p.file(), p.field("interpolation"), "'" + how + "' is not one of bilinear, cell");
+  } else {
+    p.reject_unused("interpolation", "applies only to fiber_table");
+  }
   p.finish();
   std::shared_ptr<const TabulatedBsdfData> data;
   try {
@@ -87,7 +98,7 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
   if (data->kind != kind)
     throw Error(p.file(), p.field(key),
                 file.string() + " holds a " + data->kind + " table, expected a " + kind + " table");
-  TabulatedBsdf bsdf{data, tint * scale};
+  TabulatedBsdf bsdf{data, tint * scale, lookup};
   if (backing) {
     try {
       bsdf.backing = TableBacking::make(*data, bsdf.scale, *backing);

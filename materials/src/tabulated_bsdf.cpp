@@ -221,6 +221,8 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
 }
 
 Rgb TabulatedBsdf::eval_table(const Vec3& wo, const Vec3& wi) const {
+  if (lookup == TableLookup::cell)
+    return data->lookup(data->grid.bin_of(wi), data->grid.bin_of(wo)) * scale;
   Rgb sum;
   for_each_interpolated_cell(data->grid, wo, wi,
                              [&](int i, int o, double w) { sum += data->lookup(i, o) * w; });

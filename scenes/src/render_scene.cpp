@@ -9,6 +9,7 @@
 #include <mutex>
 
 #include "weft/core/error.h"
+#include "weft/core/math.h"
 #include "weft/materials/registry.h"
 #include "weft/scenes/embree_context.h"
 
@@ -29,6 +30,7 @@ struct CurveRecord {
   int64_t first_fiber = 0;                  // scene-wide id of curve 0
   std::shared_ptr<const FiberTubes> tubes;  // set when the fibers are tubes
   std::vector<uint32_t> prim_curve;         // per Embree primitive (segment or triangle): curve
+  double scale = 1;  // of the space Embree traces these primitives in (Geometry::curve_scale)
 };
 }  // namespace
 
@@ -94,24 +96,78 @@ RTCRayHit embree_ray(const Ray& ray) {
   return rh;
 }
 
-// Embree calls this for every candidate hit on a fiber geometry (intersect and occluded): a hit on
-// the fiber the query ignores is rejected, and Embree goes on looking behind it.
-void ignore_fiber_filter(const RTCFilterFunctionNArguments* args) {
-  const auto* ctx = reinterpret_cast<const FiberQueryContext*>(args->context);
-  const auto* rec = static_cast<const CurveRecord*>(args->geometryUserPtr);
-  const int64_t local = ctx->ignore_fiber - rec->first_fiber;
-  if (local < 0 || local >= static_cast<int64_t>(rec->curves->curve_count())) return;
-  for (unsigned i = 0; i < args->N; ++i) {
-    if (args->valid[i] != -1) continue;
-    if (rec->prim_curve[RTCHitN_primID(args->hit, args->N, i)] == static_cast<uint32_t>(local))
-      args->valid[i] = 0;
-  }
-}
-
 FiberSegment segment_of(const CurveRecord& rec, uint32_t segment) {
   const FiberCurves& c = *rec.curves;
   const uint32_t i = rec.segments.first_point[segment];
   return {c.point(i), c.point(i + 1), c.radius(i), c.radius(i + 1)};
+}
+
+// Whether candidate hit i of a filter call meets its fiber's surface from inside (the ray runs
+// outwards there). Embree has set the ray's tfar to the candidate's distance.
+bool meets_from_inside(const CurveRecord& rec, const RTCFilterFunctionNArguments* args,
+                       unsigned i) {
+  const unsigned n = args->N;
+  const uint32_t prim = RTCHitN_primID(args->hit, n, i);
+  const Vec3 o{RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i),
+               RTCRayN_org_z(args->ray, n, i)};
+  const Vec3 d{RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i),
+               RTCRayN_dir_z(args->ray, n, i)};
+  Vec3 outward;
+  if (rec.tubes) {  // counter-clockwise seen from outside (make_fiber_tubes)
+    const TriangleMesh& m = rec.tubes->mesh;
+    const Vec3 p0 = m.position(m.indices[3 * prim]), p1 = m.position(m.indices[3 * prim + 1]),
+               p2 = m.position(m.indices[3 * prim + 2]);
+    outward = cross(p1 - p0, p2 - p0);
+  } else {  // the segment's cone or its end sphere: away from the nearest axis point
+    const Vec3 p = (o + d * static_cast<double>(RTCRayN_tfar(args->ray, n, i))) / rec.scale;
+    const FiberSegment s = segment_of(rec, prim);
+    outward = p - s.axis_point(s.closest_u(p));
+  }
+  return dot(d, outward) > 0;
+}
+
+// Whether candidate hit i lies inside one of the ignored fiber's end segments (the next piece of
+// a cut fiber begins with an end sphere inside the fiber's own end).
+bool inside_ignored_end(const CurveRecord& rec, const FiberQueryContext& ctx,
+                        const RTCFilterFunctionNArguments* args, unsigned i) {
+  const unsigned n = args->N;
+  const Vec3 o{RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i),
+               RTCRayN_org_z(args->ray, n, i)};
+  const Vec3 d{RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i),
+               RTCRayN_dir_z(args->ray, n, i)};
+  const Vec3 p = (o + d * static_cast<double>(RTCRayN_tfar(args->ray, n, i))) / rec.scale;
+  for (int k = 0; k < ctx.end_count; ++k) {
+    const FiberSegment& s = ctx.ends[k];
+    const double u = s.closest_u(p);
+    // Within float rounding of the surface counts as inside: there the two end spheres coincide.
+    if (length(p - s.axis_point(u)) < s.radius_at(u) * (1 + 1e-5)) return true;
+  }
+  return false;
+}
+
+// Embree calls this for every candidate hit on a fiber geometry (intersect and occluded); a
+// rejected one lets Embree go on looking behind it. For a ray that leaves a fiber (the query
+// ignores it), rejected: hits on that fiber, hits on any fiber from inside, and hits inside the
+// fiber's end segments (on its next piece's end sphere). A fiber is shaded
+// as a whole, so a ray that leaves it may run through its body; fibers do not overlap, so the
+// ray can be inside another only where that one continues the fiber it left: a fiber cut into
+// several curves, such as the tiles of a woven sample, whose fibers end at the repeat's sides
+// where their continuation begins, the two end spheres overlapping. Such a surface is neither
+// shaded (a fiber table sends no light into its fiber) nor a blocker: taken as a hit it stopped
+// the light that crosses a joint (docs/fabric-bsdf.md, "One transport, two estimators").
+void fiber_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* ctx = reinterpret_cast<const FiberQueryContext*>(args->context);
+  if (ctx->ignore_fiber == kNoFiber) return;
+  const auto* rec = static_cast<const CurveRecord*>(args->geometryUserPtr);
+  const int64_t local = ctx->ignore_fiber - rec->first_fiber;
+  const bool ignored_here = local >= 0 && local < static_cast<int64_t>(rec->curves->curve_count());
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    if ((ignored_here &&
+         rec->prim_curve[RTCHitN_primID(args->hit, args->N, i)] == static_cast<uint32_t>(local)) ||
+        meets_from_inside(*rec, args, i) || inside_ignored_end(*rec, *ctx, args, i))
+      args->valid[i] = 0;
+  }
 }
 
 // Fills the hit on triangle 'prim' of 'm' at barycentrics (b1, b2).
@@ -298,6 +354,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     const auto& curves = desc.curves[k];
     CurveRecord& rec = geo->curve_sets.emplace_back();
     rec.curves = curves;
+    rec.scale = tubes ? 1.0 : geo->curve_scale;
     rec.segments = index_segments(*curves);
     rec.first_fiber = geo->fibers;
     geo->fibers += static_cast<int64_t>(curves->curve_count());
@@ -374,8 +431,8 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
       throw Error(desc.source, "", "Embree could not allocate buffers: " + errors.message);
     }
     rtcSetGeometryUserData(g, &rec);
-    rtcSetGeometryIntersectFilterFunction(g, ignore_fiber_filter);
-    rtcSetGeometryOccludedFilterFunction(g, ignore_fiber_filter);
+    rtcSetGeometryIntersectFilterFunction(g, fiber_filter);
+    rtcSetGeometryOccludedFilterFunction(g, fiber_filter);
     rtcCommitGeometry(g);
     // Tubes: shape IDs in the scene; round curves: set k in the curve scene.
     if (tubes)
@@ -423,9 +480,26 @@ void RenderScene::set_lights(const Lights& lights) {
   for (const auto& map : lights.environment_maps) lights_.push_back(map);
 }
 
+FiberQueryContext RenderScene::query_context(int64_t ignore_fiber) const {
+  FiberQueryContext ctx(ignore_fiber);
+  if (ignore_fiber == kNoFiber || ignore_fiber < 0 || ignore_fiber >= geo_->fibers) return ctx;
+  const FiberRef r = fiber_ref(ignore_fiber);
+  const FiberCurves& c = *geo_->curve_sets[r.curve_set].curves;
+  const uint32_t first = c.curve_first[r.curve], last = first + c.curve_points[r.curve] - 2;
+  // Tubes reach out to their polygon's corners (make_fiber_tubes keeps the circle's mean width).
+  const int sides = geo_->fiber_geometry.tube_sides;
+  const double corner = geo_->fiber_geometry.type == FiberGeometry::Type::tubes
+                            ? kPi / (sides * std::sin(kPi / sides)) / std::cos(kPi / sides)
+                            : 1.0;
+  for (const uint32_t i : {first, last})
+    ctx.ends[ctx.end_count++] = {c.point(i), c.point(i + 1), c.radius(i) * corner,
+                                 c.radius(i + 1) * corner};
+  return ctx;
+}
+
 bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fiber) const {
   RTCRayHit rh = embree_ray(ray);
-  FiberQueryContext ctx(ignore_fiber);
+  FiberQueryContext ctx = query_context(ignore_fiber);
   rtcIntersect1(geo_->scene, &ctx.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit->t = rh.ray.tfar;
@@ -459,7 +533,7 @@ RTCSceneTy* RenderScene::embree_scene() const {
 
 bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax,
                            int64_t ignore_fiber) const {
-  FiberQueryContext ctx(ignore_fiber);
+  FiberQueryContext ctx = query_context(ignore_fiber);
   RTCRay r;
   r.org_x = static_cast<float>(origin.x);
   r.org_y = static_cast<float>(origin.y);

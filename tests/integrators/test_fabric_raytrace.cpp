@@ -366,17 +366,17 @@ TEST(FabricRaytrace, PlainWeaveTurnedBy90DegreesSwapsWarpAndWeft) {
   EXPECT_GT(same.rms, 1.25) << z.rms;
 }
 
-TEST(FabricRaytrace, ParticlesPassThroughTheCapsOfAFibersContinuation) {
-  // Fibers end at the repeat's sides, where their continuation (the same fiber a period on)
-  // begins with a cap. A particle leaving a fiber there starts inside that cap; it passes
-  // through (the fiber's own body).
+TEST(FabricRaytrace, NoFiberIsMetFromInside) {
+  // Fibers end at the repeat's sides, where their continuation (the same fiber a period on) begins
+  // with an end sphere that overlaps the fiber's; a particle leaving a fiber there through its body
+  // starts inside it, and a B'' on the straight segment's cylinder beyond a bent fiber's segment
+  // may lie inside a neighbour. The scene passes such rays through (RenderScene), so no hit comes
+  // from inside but at ties of rounding (before: 281 per 400 000 scatterings here at R = 2).
   const auto fiber = uniform_fiber(3, 0.4 * kInvPi);
   FabricRaytraceOptions o = options(2, 3000);
   const auto r = raytrace_fabric_table(default_sample("fiber"), fiber, o);
-  EXPECT_GT(r.continuation_caps, 0u);
-  // Still hit from inside, taken alone: a few per ten thousand scatterings, not explained yet
-  // (before the continuation's caps were passed through they were five times as many).
-  EXPECT_LT(r.inside_hits, 1e-3 * r.scatterings) << r.continuation_caps;
+  EXPECT_GT(r.scatterings, 10000u);
+  EXPECT_LT(r.inside_hits, 1e-5 * r.scatterings);
 }
 
 namespace {

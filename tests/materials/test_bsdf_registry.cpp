@@ -8,6 +8,8 @@
 #include "table_context.h"
 #include "test_util.h"
 #include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/rng.h"
 #include "weft/materials/bsdfs.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
@@ -88,6 +90,27 @@ TEST(Registry, ParametersReachTheMaterial) {
   const Bsdf t2 = make_bsdf("fiber_table", {{"file", "./tables/../tables/fiber.exr"}}, ctx);
   EXPECT_EQ(std::get<TabulatedBsdf>(t.variant()).data.get(),
             std::get<TabulatedBsdf>(t2.variant()).data.get());
+  // Interpolation: bilinear by default; "cell" reads the cell pair's own average, constant over
+  // it (the table of seat_context varies with wi.z, so bilinear reads differ from it).
+  EXPECT_EQ(std::get<TabulatedBsdf>(t2.variant()).lookup, TableLookup::bilinear);
+  const Bsdf cell =
+      make_bsdf("fiber_table", {{"file", "tables/fiber.exr"}, {"interpolation", "cell"}}, ctx);
+  const auto& tc = std::get<TabulatedBsdf>(cell.variant());
+  const auto& tb = std::get<TabulatedBsdf>(t2.variant());
+  EXPECT_EQ(tc.lookup, TableLookup::cell);
+  const DirectionGrid& g = tc.data->grid;
+  int differ = 0;
+  for (int k = 0; k < 200; ++k) {
+    Rng rng(3, uint64_t(k));
+    auto dir = [&] {
+      const double z = 2 * rng.uniform() - 1, phi = 2 * kPi * rng.uniform();
+      return Vec3{std::sqrt(1 - z * z) * std::cos(phi), std::sqrt(1 - z * z) * std::sin(phi), z};
+    };
+    const Vec3 wo = dir(), wi = dir();
+    EXPECT_EQ(cell.eval(wo, wi), tc.data->lookup(g.bin_of(wi), g.bin_of(wo))) << k;
+    differ += std::abs(tb.eval(wo, wi).r - cell.eval(wo, wi).r) > 1e-4;
+  }
+  EXPECT_GT(differ, 100);
 }
 
 TEST(Registry, UnknownTypeListsTheValidNames) {
@@ -123,6 +146,12 @@ TEST(Registry, BadParametersAreNamed) {
   expect_error("fabric_table", {{"file", "tables/fiber.exr"}}, ctx, "file", "fiber table");
   expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", -1}}, ctx, "scale");
   expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"scale", nan}}, ctx, "scale");
+  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"interpolation", "nearest"}}, ctx,
+               "interpolation", "bilinear, cell");
+  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"interpolation", 1}}, ctx,
+               "interpolation");
+  expect_error("fabric_table", {{"file", "tables/fabric.exr"}, {"interpolation", "cell"}}, ctx,
+               "interpolation", "only to fiber_table");
   expect_error("measured_nbrdf", {{"name", "blue-fabric"}}, ctx, "name", "merl-white-fabric");
   expect_error("measured_nbrdf", json::object(), ctx, "name", "exactly one");
   expect_error("measured_nbrdf", {{"file", "nbrdf.txt"}}, ctx, "file", "nbrdf.txt");

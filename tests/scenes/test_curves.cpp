@@ -437,6 +437,72 @@ TEST(Curves, RaysLeavingAFiberIgnoreItButNotTheOthers) {
   }
 }
 
+TEST(Curves, RaysLeavingAFiberPassThroughItsNextPiece) {
+  // One fiber along x (radius 0.25) whole, or cut at x = 0 into two curves whose end spheres
+  // overlap there (as the tiles of a woven sample join a fiber to its continuation in the next
+  // repeat), and a second fiber below it at z = -1. A ray from a point of the fiber's first
+  // piece that runs through its body across x = 0 must go on as through the whole fiber: the next
+  // piece, met from inside, is neither a hit nor a blocker (it was both: the whole-fiber table's
+  // light from behind stopped at every joint). The other fiber still stops it.
+  for (const char* geometry : {"curves", "tubes"}) {
+    SCOPED_TRACE(geometry);
+    auto scene = [&](const std::vector<std::pair<double, double>>& pieces) {
+      json objs = json::array();
+      for (size_t i = 0; i < pieces.size(); ++i)
+        objs.push_back({{"type", "fiber"},
+                        {"name", "f" + std::to_string(i)},
+                        {"material", "fiber"},
+                        {"from", {pieces[i].first, 0, 0}},
+                        {"to", {pieces[i].second, 0, 0}},
+                        {"radius", 0.25},
+                        {"segments", 2}});
+      objs.push_back({{"type", "fiber"},
+                      {"name", "below"},
+                      {"material", "fiber"},
+                      {"from", {-10, 0, -1}},
+                      {"to", {10, 0, -1}},
+                      {"radius", 0.25},
+                      {"segments", 4}});
+      const json j = {{"objects", objs},
+                      {"materials", {{"fiber", {{"type", "lambert"}}}}},
+                      {"fiber_geometry", {{"type", geometry}}}};
+      return RenderScene(parse_scene_description(j, ".", "pieces.json"));
+    };
+    const RenderScene whole = scene({{-10, 10}}), cut = scene({{-10, 0}, {0, 10}});
+    int crossing = 0, below = 0;
+    for (int k = 0; k < 400; ++k) {
+      Rng rng(11, uint64_t(k));
+      // A point B on the first piece near the joint, seen from above.
+      const double x = -0.6 * rng.uniform(), phi = kPi * (0.1 + 0.8 * rng.uniform());
+      const Vec3 from{x, 5 * std::cos(phi), 5 * std::sin(phi)};
+      SurfaceHit b;
+      ASSERT_TRUE(cut.intersect({from, normalize(Vec3{x, 0, 0} - from)}, &b));
+      ASSERT_EQ(b.fiber, 0);
+      // Into the fiber's body, towards +x (so along a chord that may cross the joint).
+      const double s = 0.3 + 0.65 * rng.uniform(), psi = 2 * kPi * rng.uniform();
+      Vec3 d{s, std::sqrt(1 - s * s) * std::cos(psi), std::sqrt(1 - s * s) * std::sin(psi)};
+      if (dot(d, b.ng) > 0) d = d - b.ng * (2 * dot(d, b.ng));
+      d.x = std::abs(d.x);
+      const Vec3 o = b.spawn_origin(d);
+      const auto chord = cylinder_exit_distance({{-10, 0, 0}, {10, 0, 0}, 0.25, 0.25}, o, d);
+      if (chord && o.x + d.x * *chord > 0) ++crossing;
+      SurfaceHit hw, hc;
+      const bool w = whole.intersect({o, d}, &hw, 0), c = cut.intersect({o, d}, &hc, 0);
+      ASSERT_EQ(w, c) << k;
+      if (w) {
+        EXPECT_EQ(hw.fiber, 1) << k;  // the fiber below: ids 1 (whole) and 2 (cut)
+        EXPECT_EQ(hc.fiber, 2) << k;
+        EXPECT_NEAR(hw.t, hc.t, 1e-9) << k;
+        ++below;
+      }
+      EXPECT_EQ(whole.occluded(o, d, 1e300, 0), cut.occluded(o, d, 1e300, 0)) << k;
+      EXPECT_FALSE(cut.occluded(o, d, 3.0 * 0.25, 0)) << k;  // nothing within its own body
+    }
+    EXPECT_GT(crossing, 100);  // the test crosses the joint often
+    EXPECT_GT(below, 50);      // and still meets the other fiber
+  }
+}
+
 TEST(Curves, MeshesAndCurvesTogetherKeepTheirIds) {
   // A quad (shape 0) and two inline fibers (shapes 1, 2): mesh hits have no fiber, fiber ids
   // count the curves across sets.

@@ -44,6 +44,14 @@ enum class ChannelSampling { spectral_mis, mean };
 // The names the command line and the table's metadata use: "hero" (spectral_mis) and "mean".
 const char* channel_sampling_name(ChannelSampling s);
 
+// The estimator's revision, raised whenever a change alters its results for the same options: it
+// is part of a sharded or resumed run's identity (parts of another revision are refused, not
+// merged) and of the table's metadata. 2: the scene passes rays through fibers they are inside
+// (a fiber's continuation across the repeat's sides), before which particles leaving a fiber near
+// the side were passed through that cap by a rule of the estimator's own and scattered by any
+// other fiber met from inside.
+inline constexpr int kFabricRaytraceRevision = 2;
+
 struct FabricRaytraceOptions {
   int resolution = 8;                  // of the fabric table (DirectionGrid R)
   uint64_t particles_per_bin = 20000;  // per incident bin
@@ -82,7 +90,7 @@ struct FabricRaytraceOptions {
 struct FabricBinBooks {
   double launched = 0, exited = 0, absorbed = 0, lost = 0, roulette_net = 0;  // power
   uint64_t particles = 0, scatterings = 0, wraps = 0, splits = 0, roulette_kills = 0;
-  uint64_t continuation_caps = 0, inside_hits = 0, tube_passes = 0;
+  uint64_t inside_hits = 0, tube_passes = 0;
   // Per channel, over the bin's row of the table: sum of se^2 D_i D_o and of f^2 D_i D_o (the
   // relative noise's numerator and denominator, D the cosine-weighted areas).
   std::vector<double> noise2, signal2;
@@ -100,10 +108,10 @@ struct FabricRaytraceResult {
   // per incident bin (what a bin's particles did depends only on (seed, bin), like its row).
   uint64_t splits = 0, roulette_kills = 0;
   std::vector<uint64_t> splits_per_bin, roulette_kills_per_bin;
-  // Fiber detail: end caps of a fiber's continuation across the repeat's sides that a particle
-  // leaving the fiber passed through, and hits on a fiber from inside it otherwise (taken alone,
-  // without their B'': none are expected, fibers keep 2 radii apart).
-  uint64_t continuation_caps = 0, inside_hits = 0;
+  // Fiber detail: hits on a fiber that the particle's line only grazes from inside (taken alone,
+  // without their B''); the scene passes a ray through any fiber it is inside (RenderScene), so
+  // none are expected but at ties of rounding.
+  uint64_t inside_hits = 0;
   // Yarn detail: particles that a tube sent into itself and that left it through its far side.
   uint64_t tube_passes = 0;
   // Standard error of the table relative to its values, weighted like weft compare's rel_rms

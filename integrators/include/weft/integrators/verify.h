@@ -370,7 +370,8 @@ SceneDescription verify_weave_scene(const WovenSample& sample, const nlohmann::j
 inline constexpr const char* kVerifyWeaveRenderSetup =
     "The woven sample at fiber detail, tiled, every fiber an Embree round curve with the model's "
     "fiber table (shaded as weft render shades fibers: the whole-fiber table, no occlusion by the "
-    "fiber a ray leaves, occlusion and inter-reflection by every other fiber), lit and seen as "
+    "fiber a ray leaves, occlusion and inter-reflection by every other fiber; the table read by "
+    "cell, as the fabric ray trace reads it, so the two are one transport), lit and seen as "
     "the patch above: a parallel light of irradiance pi at normal incidence, from the viewer's "
     "side (reflection) or from behind (transmission), an orthographic camera 30 deg from the "
     "normal whose film spans whole repeats, so the image's mean is the cloth's mean radiance for "

@@ -7,11 +7,18 @@
 
 #include <cstdint>
 
+#include "weft/scenes/curves.h"
+
 namespace weft {
 
 struct FiberQueryContext {
   RTCIntersectContext embree;  // first member: Embree hands its address back to the filters
   int64_t ignore_fiber = -1;   // kNoFiber (render_scene.h): ignore nothing
+  // The ignored fiber's first and last segments (world units; tubes: the radius of their polygon's
+  // corners), where a fiber cut into several curves overlaps its next piece: RenderScene fills
+  // them for its own queries; without them (end_count 0) only hits from inside are passed.
+  FiberSegment ends[2];
+  int end_count = 0;
 
   explicit FiberQueryContext(int64_t ignore = -1) : ignore_fiber(ignore) {
     rtcInitIntersectContext(&embree);

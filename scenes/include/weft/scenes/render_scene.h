@@ -26,6 +26,8 @@ struct RTCSceneTy;  // Embree's scene (RTCScene is a pointer to it)
 
 namespace weft {
 
+struct FiberQueryContext;  // embree_context.h
+
 // Fiber ids are scene-wide: the curves of the description's curve sets numbered in order (set 0's
 // curves first). kNoFiber: a triangle of a mesh, or "ignore nothing" in queries.
 inline constexpr int64_t kNoFiber = -1;
@@ -80,8 +82,12 @@ class RenderScene {
 
   // The closest hit along the ray, ignoring every primitive of fiber 'ignore_fiber' (kNoFiber:
   // ignore nothing). A fiber is shaded as a whole (docs/fiber-bsdf.md): rays leaving a point of a
-  // fiber pass through that fiber and meet every other one. Embree filter functions on the fiber
-  // geometries do the ignoring; meshes have none, so triangle-only scenes pay nothing for it.
+  // fiber pass through that fiber and meet every other one from outside. Where a fiber is cut
+  // into several curves (a woven sample's tiles join each fiber to its continuation across the
+  // repeat's sides) the ray runs on through the next piece too: for a ray that leaves a fiber,
+  // no fiber is met from inside, nor inside the left fiber's end segments. Embree filter
+  // functions on the fiber geometries do the ignoring; meshes have none, so triangle-only scenes
+  // pay nothing for it.
   bool intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fiber = kNoFiber) const;
   // Whether anything but fiber 'ignore_fiber' lies along origin + t dir, 0 < t < tmax.
   bool occluded(const Vec3& origin, const Vec3& dir, double tmax,
@@ -122,6 +128,8 @@ class RenderScene {
 
  private:
   struct Geometry;
+  // The query context for a ray that leaves fiber 'ignore_fiber' (kNoFiber: none).
+  FiberQueryContext query_context(int64_t ignore_fiber) const;
   RenderScene() = default;
   void set_lights(const Lights& lights);
   std::shared_ptr<const Geometry> geo_;
