@@ -262,8 +262,12 @@ TEST(CliVerify, FitInnerObjectiveIsSmoothInDyeAtAFixedSeed) {
 // the start's table (dye 1); the restarts move the proposal to the optimum, and the search ends
 // converged there. The fitted curves follow other paths than the measurement's (their proposal's),
 // so the optimum can only be as good as the ray trace's noise: its objective is below that of the
-// truth traced with another seed (the noise floor; the fit reached 0.10), and the dye within 5 %
-// (measured 3.3 %; the summation's test above, without that noise, asks 3 %).
+// truth traced with another seed (the noise floor), and the dye within 10 % (the summation's test
+// above, without that noise, asks 3 %). Measured with the seeds of measurement and fit 1, 2, 3, 4
+// (2026-12-02, estimator revision 2): dye +6.2, -0.2, -5.3, -1.8 %; converged after 63, 42 and
+// 84 evaluations, the fourth not in 120 (a budget of 60 converged one seed in four). Before the
+// ray trace's revision 2 one realization was measured (3.3 %, converged within 60) and the test
+// asked 5 % of it; the spread over seeds says that was luck.
 TEST(CliVerify, RaytraceFitRecentresItsProposalAndConverges) {
   const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
   weft::FitInnerSettings inner =
@@ -280,7 +284,7 @@ TEST(CliVerify, RaytraceFitRecentresItsProposalAndConverges) {
   const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
       weft::apply_spec_fit(spec, names, {1.8}), sample, inner, geometry));
   weft::FitOptions options;
-  options.max_evaluations = 60;
+  options.max_evaluations = 120;
   const weft::FitResult r = weft::fit_inner_model(
       "computed", weft::spec_fit_parameters(spec, names),
       [&](const std::vector<double>& x) {
@@ -290,7 +294,7 @@ TEST(CliVerify, RaytraceFitRecentresItsProposalAndConverges) {
   ASSERT_EQ(r.parameters.size(), 1u);
   EXPECT_TRUE(r.converged);
   EXPECT_GT(r.objective_start, 0.2);  // the first search's start, far from the truth
-  EXPECT_NEAR(std::log(r.parameters[0].value / 1.8), 0.0, 0.05) << r.parameters[0].value;
+  EXPECT_NEAR(std::log(r.parameters[0].value / 1.8), 0.0, 0.1) << r.parameters[0].value;
   weft::FitInnerSettings other = inner;
   other.seed = 2;
   const auto floor =
