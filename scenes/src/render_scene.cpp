@@ -137,6 +137,8 @@ bool inside_ignored_end(const CurveRecord& rec, const FiberQueryContext& ctx,
                RTCRayN_dir_z(args->ray, n, i)};
   const Vec3 p = (o + d * static_cast<double>(RTCRayN_tfar(args->ray, n, i))) / rec.scale;
   for (int k = 0; k < ctx.end_count; ++k) {
+    // Most candidates lie far from both ends: a bounding sphere first.
+    if (length_squared(p - ctx.end_centre[k]) > ctx.end_reach2[k]) continue;
     const FiberSegment& s = ctx.ends[k];
     const double u = s.closest_u(p);
     // Within float rounding of the surface counts as inside: there the two end spheres coincide.
@@ -165,7 +167,7 @@ void fiber_filter(const RTCFilterFunctionNArguments* args) {
     if (args->valid[i] != -1) continue;
     if ((ignored_here &&
          rec->prim_curve[RTCHitN_primID(args->hit, args->N, i)] == static_cast<uint32_t>(local)) ||
-        meets_from_inside(*rec, args, i) || inside_ignored_end(*rec, *ctx, args, i))
+        inside_ignored_end(*rec, *ctx, args, i) || meets_from_inside(*rec, args, i))
       args->valid[i] = 0;
   }
 }
@@ -491,9 +493,14 @@ FiberQueryContext RenderScene::query_context(int64_t ignore_fiber) const {
   const double corner = geo_->fiber_geometry.type == FiberGeometry::Type::tubes
                             ? kPi / (sides * std::sin(kPi / sides)) / std::cos(kPi / sides)
                             : 1.0;
-  for (const uint32_t i : {first, last})
-    ctx.ends[ctx.end_count++] = {c.point(i), c.point(i + 1), c.radius(i) * corner,
-                                 c.radius(i + 1) * corner};
+  for (const uint32_t i : {first, last}) {
+    const FiberSegment s{c.point(i), c.point(i + 1), c.radius(i) * corner,
+                         c.radius(i + 1) * corner};
+    const double reach = 0.5 * length(s.p1 - s.p0) + 1.01 * std::max(s.r0, s.r1);
+    ctx.end_centre[ctx.end_count] = 0.5 * (s.p0 + s.p1);
+    ctx.end_reach2[ctx.end_count] = reach * reach;
+    ctx.ends[ctx.end_count++] = s;
+  }
   return ctx;
 }
 

@@ -18,6 +18,8 @@ struct FiberQueryContext {
   // corners), where a fiber cut into several curves overlaps its next piece: RenderScene fills
   // them for its own queries; without them (end_count 0) only hits from inside are passed.
   FiberSegment ends[2];
+  Vec3 end_centre[2];  // their bounding spheres, to skip candidates far from them
+  double end_reach2[2] = {0, 0};
   int end_count = 0;
 
   explicit FiberQueryContext(int64_t ignore = -1) : ignore_fiber(ignore) {
