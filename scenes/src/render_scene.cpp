@@ -102,47 +102,50 @@ FiberSegment segment_of(const CurveRecord& rec, uint32_t segment) {
   return {c.point(i), c.point(i + 1), c.radius(i), c.radius(i + 1)};
 }
 
-// Whether candidate hit i of a filter call meets its fiber's surface from inside (the ray runs
-// outwards there). Embree has set the ray's tfar to the candidate's distance.
-bool meets_from_inside(const CurveRecord& rec, const RTCFilterFunctionNArguments* args,
-                       unsigned i) {
+// Candidate hit i of a filter call: the ray's origin and direction (in the space Embree traces
+// the geometry in) and the hit point in world units. Embree has set the ray's tfar to the
+// candidate's distance.
+struct Candidate {
+  Vec3 o, d, p;
+  uint32_t prim = 0;
+};
+Candidate candidate(const CurveRecord& rec, const RTCFilterFunctionNArguments* args, unsigned i) {
   const unsigned n = args->N;
-  const uint32_t prim = RTCHitN_primID(args->hit, n, i);
-  const Vec3 o{RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i),
-               RTCRayN_org_z(args->ray, n, i)};
-  const Vec3 d{RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i),
-               RTCRayN_dir_z(args->ray, n, i)};
+  Candidate c;
+  c.prim = RTCHitN_primID(args->hit, n, i);
+  c.o = {RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i),
+         RTCRayN_org_z(args->ray, n, i)};
+  c.d = {RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i),
+         RTCRayN_dir_z(args->ray, n, i)};
+  c.p = (c.o + c.d * static_cast<double>(RTCRayN_tfar(args->ray, n, i))) / rec.scale;
+  return c;
+}
+
+// Whether the candidate meets its fiber's surface from inside (the ray runs outwards there).
+bool meets_from_inside(const CurveRecord& rec, const Candidate& c) {
   Vec3 outward;
   if (rec.tubes) {  // counter-clockwise seen from outside (make_fiber_tubes)
     const TriangleMesh& m = rec.tubes->mesh;
-    const Vec3 p0 = m.position(m.indices[3 * prim]), p1 = m.position(m.indices[3 * prim + 1]),
-               p2 = m.position(m.indices[3 * prim + 2]);
+    const Vec3 p0 = m.position(m.indices[3 * c.prim]), p1 = m.position(m.indices[3 * c.prim + 1]),
+               p2 = m.position(m.indices[3 * c.prim + 2]);
     outward = cross(p1 - p0, p2 - p0);
   } else {  // the segment's cone or its end sphere: away from the nearest axis point
-    const Vec3 p = (o + d * static_cast<double>(RTCRayN_tfar(args->ray, n, i))) / rec.scale;
-    const FiberSegment s = segment_of(rec, prim);
-    outward = p - s.axis_point(s.closest_u(p));
+    const FiberSegment s = segment_of(rec, c.prim);
+    outward = c.p - s.axis_point(s.closest_u(c.p));
   }
-  return dot(d, outward) > 0;
+  return dot(c.d, outward) > 0;
 }
 
-// Whether candidate hit i lies inside one of the ignored fiber's end segments (the next piece of
+// Whether the candidate lies inside one of the ignored fiber's end segments (the next piece of
 // a cut fiber begins with an end sphere inside the fiber's own end).
-bool inside_ignored_end(const CurveRecord& rec, const FiberQueryContext& ctx,
-                        const RTCFilterFunctionNArguments* args, unsigned i) {
-  const unsigned n = args->N;
-  const Vec3 o{RTCRayN_org_x(args->ray, n, i), RTCRayN_org_y(args->ray, n, i),
-               RTCRayN_org_z(args->ray, n, i)};
-  const Vec3 d{RTCRayN_dir_x(args->ray, n, i), RTCRayN_dir_y(args->ray, n, i),
-               RTCRayN_dir_z(args->ray, n, i)};
-  const Vec3 p = (o + d * static_cast<double>(RTCRayN_tfar(args->ray, n, i))) / rec.scale;
+bool inside_ignored_end(const FiberQueryContext& ctx, const Candidate& c) {
   for (int k = 0; k < ctx.end_count; ++k) {
     // Most candidates lie far from both ends: a bounding sphere first.
-    if (length_squared(p - ctx.end_centre[k]) > ctx.end_reach2[k]) continue;
+    if (length_squared(c.p - ctx.end_centre[k]) > ctx.end_reach2[k]) continue;
     const FiberSegment& s = ctx.ends[k];
-    const double u = s.closest_u(p);
+    const double u = s.closest_u(c.p);
     // Within float rounding of the surface counts as inside: there the two end spheres coincide.
-    if (length(p - s.axis_point(u)) < s.radius_at(u) * (1 + 1e-5)) return true;
+    if (length(c.p - s.axis_point(u)) < s.radius_at(u) * (1 + 1e-5)) return true;
   }
   return false;
 }
@@ -165,10 +168,13 @@ void fiber_filter(const RTCFilterFunctionNArguments* args) {
   const bool ignored_here = local >= 0 && local < static_cast<int64_t>(rec->curves->curve_count());
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
-    if ((ignored_here &&
-         rec->prim_curve[RTCHitN_primID(args->hit, args->N, i)] == static_cast<uint32_t>(local)) ||
-        inside_ignored_end(*rec, *ctx, args, i) || meets_from_inside(*rec, args, i))
+    if (ignored_here &&
+        rec->prim_curve[RTCHitN_primID(args->hit, args->N, i)] == static_cast<uint32_t>(local)) {
       args->valid[i] = 0;
+      continue;
+    }
+    const Candidate c = candidate(*rec, args, i);
+    if (inside_ignored_end(*ctx, c) || meets_from_inside(*rec, c)) args->valid[i] = 0;
   }
 }
 
