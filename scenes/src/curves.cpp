@@ -86,6 +86,10 @@ std::optional<double> cylinder_exit_distance(const FiberSegment& seg, const Vec3
   return B <= 0 ? (-B + q) / A : -C / (B + q);
 }
 
+double tube_corner_radius_scale(int sides) {
+  return kPi / (sides * std::sin(kPi / sides));  // same mean width as the circle
+}
+
 FiberTubes make_fiber_tubes(const FiberCurves& curves, int sides) {
   if (sides < FiberGeometry::kMinTubeSides || sides > FiberGeometry::kMaxTubeSides)
     throw Error("", "tube_sides",
@@ -108,7 +112,7 @@ FiberTubes make_fiber_tubes(const FiberCurves& curves, int sides) {
   m.normals.reserve(3 * n * curves.point_count());
   m.tangents.reserve(4 * n * curves.point_count());
   m.indices.reserve(6 * n * curves.segment_count());
-  const double stretch = kPi / (sides * std::sin(kPi / sides));  // same mean width as the circle
+  const double stretch = tube_corner_radius_scale(sides);
   std::vector<double> cos_j(n), sin_j(n);
   for (size_t j = 0; j < n; ++j) {
     cos_j[j] = std::cos(2 * kPi * double(j) / sides);

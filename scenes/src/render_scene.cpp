@@ -494,10 +494,9 @@ FiberQueryContext RenderScene::query_context(int64_t ignore_fiber) const {
   const FiberRef r = fiber_ref(ignore_fiber);
   const FiberCurves& c = *geo_->curve_sets[r.curve_set].curves;
   const uint32_t first = c.curve_first[r.curve], last = first + c.curve_points[r.curve] - 2;
-  // Tubes reach out to their polygon's corners (make_fiber_tubes keeps the circle's mean width).
-  const int sides = geo_->fiber_geometry.tube_sides;
+  // Tubes reach out to their polygon's corners.
   const double corner = geo_->fiber_geometry.type == FiberGeometry::Type::tubes
-                            ? kPi / (sides * std::sin(kPi / sides)) / std::cos(kPi / sides)
+                            ? tube_corner_radius_scale(geo_->fiber_geometry.tube_sides)
                             : 1.0;
   for (const uint32_t i : {first, last}) {
     const FiberSegment s{c.point(i), c.point(i + 1), c.radius(i) * corner,

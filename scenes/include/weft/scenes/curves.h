@@ -95,5 +95,8 @@ struct FiberTubes {
   std::vector<uint32_t> curve_first_triangle;  // per curve: its first triangle (contiguous)
 };
 FiberTubes make_fiber_tubes(const FiberCurves& curves, int sides);
+// The tubes' polygon of 'sides' sides has the circle's mean width: its corners lie at this
+// multiple of the fiber's radius.
+double tube_corner_radius_scale(int sides);
 
 }  // namespace weft
