@@ -80,11 +80,8 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
   // Fiber tables only: a fabric table's backing and albedos are those of the interpolated table.
   TableLookup lookup = TableLookup::bilinear;
   if (kind == "fiber") {
-    const std::string how = p.string("interpolation", "bilinear");
-    if (how == "cell")
+    if (p.choice("interpolation", "bilinear", {"bilinear", "cell"}) == "cell")
       lookup = TableLookup::cell;
-    else if (how != "bilinear")
-      throw Error(p.file(), p.field("interpolation"), "'" + how + "' is not one of bilinear, cell");
   } else {
     p.reject_unused("interpolation", "applies only to fiber_table");
   }
