@@ -49,7 +49,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
     int threads = RenderSettings{}.threads;
     uint64_t seed = 0;  // used only when --seed is given
     double exposure_ev = 0, time_limit_s = 0;
-    bool quiet = false, json = false;
+    bool quiet = false, json = false, spectral = false;
   };
   auto o = std::make_shared<Options>();
   auto* sub =
@@ -90,6 +90,9 @@ void add_render_command(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(1, 16384));
   sub->add_option("--max-depth", o->max_depth, "maximum bounces (default: the scene's)")
       ->check(CLI::Range(0, 100000));
+  sub->add_flag("--spectral", o->spectral,
+                "transport light per wavelength band (33 bands; every material spectral, every "
+                "light grey), as the scene's render.spectral");
   sub->add_flag("--quiet", o->quiet, "no progress and no summary on stderr");
   sub->add_flag("--json", o->json, "print a JSON summary on stdout");
   commands.push_back(
@@ -128,6 +131,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
          if (o->height) job.settings.height = o->height;
          if (o->max_depth >= 0) job.settings.max_depth = o->max_depth;
          if (seed->count()) job.settings.seed = o->seed;
+         if (o->spectral) job.settings.spectral = true;
          if (o->time_limit_s > 0) job.settings.time_limit_s = o->time_limit_s;
          if (!o->crop.empty()) {
            job.settings.crop = parse_crop(o->crop);

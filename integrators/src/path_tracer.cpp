@@ -23,10 +23,20 @@ bool finite(const Rgb& c) {
   return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
 }
 
+// A spectral sample's linear sRGB: its three bands of 'group' through the D65 band weights,
+// times the number of groups (the group was drawn with probability 1 / kBandGroups).
+Rgb group_to_srgb(const Rgb& bands, int group) {
+  const auto& w = srgb_band_weights_d65();
+  return (w[band_of_group(group, 0)] * bands.r + w[band_of_group(group, 1)] * bands.g +
+          w[band_of_group(group, 2)] * bands.b) *
+         static_cast<double>(kBandGroups);
+}
+
 }  // namespace
 
 Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings,
-               Rng& rng, RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
+               Rng& rng, RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray,
+               int band_group) {
   auto occluded = [&](const Vec3& o, const Vec3& d, double tmax, int64_t ignore_fiber) {
     ++rays.shadow;
     if (on_ray) (*on_ray)({o, d, tmax}, true);
@@ -73,7 +83,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       add_found_light(*light, LightHit::on_surface(ray.d, hit.shape, hit.prim, hit.ng, hit.t));
     if (depth >= settings.max_depth) break;
 
-    const Bsdf& bsdf = scene.bsdf(hit);
+    const Bsdf& bsdf = scene.bsdf(hit, band_group);
     const Frame& frame = hit.shading;
     const Vec3 wo = frame.to_local(wo_world);
     // Shading normals differ from the facets: a direction the BSDF treats as reflection may lie
@@ -158,6 +168,7 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
     throw Error("", "render.time_limit_s", "must be a finite number of seconds >= 0");
   const PixelWindow win = s.crop.value_or(PixelWindow{0, s.width, 0, s.height});
   check_crop(win, s.width, s.height, "", "render.crop");
+  if (s.spectral) scene.check_spectral();
   RenderResult out;
   const int ww = win.width(), wh = win.height();
   const size_t npx = size_t(ww) * wh;
@@ -189,13 +200,24 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   auto sample_pixel = [&](int x, int y, int k0, int k1, Sums& acc, RayCounts& rays,
                           uint64_t& nonfinite) {
     const uint64_t pixel = uint64_t(y) * s.width + x;
+    // Spectral: sample k of the pixel draws band group (k + offset) mod kBandGroups, the offset
+    // uniform per pixel from its own stream (every sample index bit set, never a render's), so
+    // each sample's group is uniform and a pixel's first kBandGroups samples see every group once.
+    int group_offset = 0;
+    if (s.spectral) {
+      Rng offset_rng(s.seed, pixel, ~uint64_t(0));
+      group_offset =
+          std::min(kBandGroups - 1, static_cast<int>(offset_rng.uniform() * kBandGroups));
+    }
     for (int k = k0; k < k1; ++k) {
       Rng rng(s.seed, pixel, uint64_t(k));
+      const int group = s.spectral ? (k + group_offset) % kBandGroups : -1;
       const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
       const Ray ray = camera.generate_ray(fx, fy, aspect);
       ++rays.camera;
       int64_t first = -1;
-      Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray);
+      Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray, group);
+      if (s.spectral) L = group_to_srgb(L, group);
       if (!finite(L)) {
         ++nonfinite;
         L = Rgb(0.0);
@@ -217,10 +239,11 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
           const Vec3 wo = hit.shading.to_local(wo_world);
           const double u_lobe = aov_rng.uniform();
           const Vec2 u{aov_rng.uniform(), aov_rng.uniform()};
-          const auto bs = scene.bsdf(hit).sample(wo, u, u_lobe);
-          if (bs && finite(bs->weight))
-            acc.albedo[0] += bs->weight.r, acc.albedo[1] += bs->weight.g,
-                acc.albedo[2] += bs->weight.b;
+          const auto bs = scene.bsdf(hit, group).sample(wo, u, u_lobe);
+          if (bs && finite(bs->weight)) {
+            const Rgb a = s.spectral ? group_to_srgb(bs->weight, group) : bs->weight;
+            acc.albedo[0] += a.r, acc.albedo[1] += a.g, acc.albedo[2] += a.b;
+          }
         }
       }
     }

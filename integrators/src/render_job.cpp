@@ -81,6 +81,7 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   meta.spp_requested = settings.spp;
   meta.time_limit_s = settings.time_limit_s;
   meta.camera = *desc.camera;
+  if (settings.spectral) meta.pass = "linear sRGB radiance, transported in 33 bands (spectral)";
   RenderMetadata albedo_meta = meta, normal_meta = meta;
   albedo_meta.pass = "albedo";
   normal_meta.pass = "normal (world space, towards the camera)";

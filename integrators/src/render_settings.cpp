@@ -42,6 +42,7 @@ RenderSettings render_settings_from(const SceneDescription& desc) {
     check_crop(*s.crop, s.width, s.height, desc.source, p.field("crop"));
   }
   s.time_limit_s = p.number("time_limit_s", s.time_limit_s, 0, 1e9);
+  s.spectral = p.boolean("spectral", s.spectral);
   p.finish();
   return s;
 }

@@ -167,12 +167,16 @@ VerifyRender render_one(const std::filesystem::path& folder, const nlohmann::jso
 
 VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path& folder,
                           const std::string& fiber_file, const std::string& model,
-                          const std::string& label, bool transmission, const VerifySettings& s) {
+                          const std::string& label, bool transmission, bool spectral,
+                          const VerifySettings& s) {
   // Read by cell, as the ray trace reads it: the image's mean is then the ray-traced fabric
   // table's value for this view and light (TableLookup).
   const nlohmann::json material = {{"type", "fiber_table"},
                                    {"params", {{"file", fiber_file}, {"interpolation", "cell"}}}};
-  const SceneDescription desc = verify_weave_scene(sample, material, transmission, s, folder);
+  SceneDescription desc = verify_weave_scene(sample, material, transmission, s, folder);
+  // A spectral fiber table is rendered band by band, as the ray trace traces it: light that
+  // scatters many times in a coloured fiber is not the RGB transport of the reduced table.
+  (*desc.render)["spectral"] = spectral;
   VerifyRender v;
   v.kind = "weave";
   v.model = model;
@@ -189,7 +193,8 @@ VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path
               std::to_string(static_cast<int>(kVerifyRenderViewZenithDeg)) +
               " deg from the normal, the film " + std::to_string(f.repeats_z) +
               " repeats across the warps by " + std::to_string(f.repeats_x) + " along them; " +
-              std::to_string(s.weave_render_spp) + " spp";
+              std::to_string(s.weave_render_spp) + " spp" +
+              (spectral ? ", light transported in 33 bands" : ", light transported in RGB");
   return v;
 }
 
@@ -227,13 +232,16 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
                            Fiber{&report.classic_fiber, "classic",
                                  "classic fiber table (Lambert + Cook-Torrance)"}}) {
       if (!*t.table) continue;
+      // The table as the model has it: spectral for the computed fiber (rendered in bands), RGB
+      // for the classic one.
       const std::string file = std::string("fiber-") + t.model + ".exr";
-      TabulatedBsdfTable rgb = table_to_rgb(**t.table);
-      rgb.kind = "fiber";
-      rgb.write_exr(folder / file);
+      TabulatedBsdfTable table = **t.table;
+      table.kind = "fiber";
+      table.write_exr(folder / file);
+      const bool spectral = table.channels == kNumBands;
       for (bool transmission : {false, true})
-        out.push_back(
-            render_weave(*report.sample, folder, file, t.model, t.label, transmission, s));
+        out.push_back(render_weave(*report.sample, folder, file, t.model, t.label, transmission,
+                                   spectral, s));
     }
   }
   // The measurement is of reflection only.

@@ -122,6 +122,7 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
     mean[cell] = static_cast<float>(c.average());
   }
   data->clamped_components = gamut.components;
+  if (table.channels == kNumBands) data->bands = table.values;
 
   // m3: mean of m over the 3 x 3 neighbourhoods of the wi bin and of the wo bin (separably).
   std::vector<std::array<int, 9>> nbr(n);
@@ -221,11 +222,14 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
 }
 
 Rgb TabulatedBsdf::eval_table(const Vec3& wo, const Vec3& wi) const {
+  auto value = [&](int i, int o) {
+    return band_group < 0 ? data->lookup(i, o) : data->lookup_bands(i, o, band_group);
+  };
   if (lookup == TableLookup::cell)
-    return data->lookup(data->grid.bin_of(wi), data->grid.bin_of(wo)) * scale;
+    return value(data->grid.bin_of(wi), data->grid.bin_of(wo)) * scale;
   Rgb sum;
   for_each_interpolated_cell(data->grid, wo, wi,
-                             [&](int i, int o, double w) { sum += data->lookup(i, o) * w; });
+                             [&](int i, int o, double w) { sum += value(i, o) * w; });
   return sum * scale;
 }
 

@@ -7,6 +7,8 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <type_traits>
+#include <variant>
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -51,7 +53,13 @@ struct RenderScene::Geometry {
   std::vector<MeshRecord> meshes;
   std::vector<CurveRecord> curve_sets;  // reserved once: Embree holds pointers to its elements
   std::vector<Bsdf> bsdfs;
-  AreaLight area_light;  // the emissive triangles
+  // A spectral render's BSDFs, [bsdf][band group] (bsdfs.h band_group_bsdf); empty when a
+  // material has no spectral values, then the first such material's field and why.
+  std::vector<Bsdf> band_bsdfs;
+  std::string spectral_field, spectral_why;
+  std::string source;         // the description's, for errors
+  bool grey_emission = true;  // every emissive mesh emits the same in R, G and B
+  AreaLight area_light;       // the emissive triangles
   Bounds3 bounds;
   size_t triangles = 0, curve_segments = 0;
   int64_t fibers = 0;
@@ -288,6 +296,17 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     ctx.fiber_tables = options.fiber_tables;
     geo->bsdfs.push_back(make_bsdf(b.type, b.params, ctx));
     const auto id = static_cast<uint32_t>(geo->bsdfs.size() - 1);
+    if (geo->spectral_why.empty()) {
+      for (int g = 0; g < kBandGroups; ++g) {
+        std::optional<Bsdf> bands = band_group_bsdf(geo->bsdfs.back(), g, geo->spectral_why);
+        if (!bands) break;
+        geo->band_bsdfs.push_back(std::move(*bands));
+      }
+      if (!geo->spectral_why.empty()) {
+        geo->spectral_field = b.field.empty() ? "materials" : b.field;
+        geo->band_bsdfs.clear();
+      }
+    }
     bsdf_of[&b] = id;
     return id;
   };
@@ -463,6 +482,10 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   rtcCommitScene(geo->scene);
   if (!errors.message.empty()) throw Error(desc.source, "", errors.message);
   geo->area_light = AreaLight(desc.meshes, emission);
+  geo->source = desc.source;
+  for (const AreaLight::Emission& e : emission)
+    geo->grey_emission =
+        geo->grey_emission && e.radiance.r == e.radiance.g && e.radiance.g == e.radiance.b;
   for (size_t i = 0; i < geo->meshes.size(); ++i)
     geo->meshes[i].emits = geo->area_light.emits(static_cast<uint32_t>(i));
   geo_ = std::move(geo);
@@ -562,11 +585,50 @@ bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax,
   return r.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 
-const Bsdf& RenderScene::bsdf(const SurfaceHit& hit) const {
-  if (!hit.on_fiber()) return geo_->bsdfs[geo_->meshes[hit.shape].bsdf];
+uint32_t RenderScene::bsdf_index(const SurfaceHit& hit) const {
+  if (!hit.on_fiber()) return geo_->meshes[hit.shape].bsdf;
   const CurveRecord& rec = geo_->curve_sets[hit.shape - geo_->meshes.size()];
   const auto curve = static_cast<size_t>(hit.fiber - rec.first_fiber);
-  return geo_->bsdfs[rec.yarn_bsdf[rec.curves->curve_yarn[curve]]];
+  return rec.yarn_bsdf[rec.curves->curve_yarn[curve]];
+}
+
+const Bsdf& RenderScene::bsdf(const SurfaceHit& hit) const {
+  return geo_->bsdfs[bsdf_index(hit)];
+}
+
+const Bsdf& RenderScene::bsdf(const SurfaceHit& hit, int band_group) const {
+  if (band_group < 0) return bsdf(hit);
+  return geo_->band_bsdfs[static_cast<size_t>(bsdf_index(hit)) * kBandGroups +
+                          static_cast<size_t>(band_group)];
+}
+
+void RenderScene::check_spectral() const {
+  if (!geo_->spectral_why.empty())
+    throw Error(geo_->source, geo_->spectral_field,
+                "a spectral render needs spectral values of every material: " + geo_->spectral_why);
+  auto grey = [](const Rgb& c) { return c.r == c.g && c.g == c.b; };
+  auto refuse = [&](const std::string& what) {
+    throw Error(geo_->source, "lights",
+                "a spectral render needs lights of one colour at every wavelength (grey: equal R, "
+                "G and B): " +
+                    what);
+  };
+  if (!geo_->grey_emission) refuse("an emissive material's emission is coloured");
+  for (const Light& light : lights_)
+    std::visit(
+        [&](const auto& l) {
+          using T = std::decay_t<decltype(l)>;
+          if constexpr (std::is_same_v<T, DirectionalLight>) {
+            if (!grey(l.irradiance)) refuse("a parallel light's irradiance is coloured");
+          } else if constexpr (std::is_same_v<T, PointLight>) {
+            if (!grey(l.intensity)) refuse("a point light's intensity is coloured");
+          } else if constexpr (std::is_same_v<T, EnvironmentLight>) {
+            if (!grey(l.radiance)) refuse("the environment's radiance is coloured");
+          } else if constexpr (std::is_same_v<T, EnvironmentMap>) {
+            refuse("an environment map is an RGB image");
+          }
+        },
+        light.variant());
 }
 
 size_t RenderScene::fiber_count() const {

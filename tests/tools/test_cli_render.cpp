@@ -202,6 +202,35 @@ TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
   EXPECT_EQ(weft::read_image(dir / "out.exr").rgb, weft::read_image(dir / "one.exr").rgb);
 }
 
+// --spectral: light per band (docs/scenes.md "Spectral renders"). The bundled plane is grey (the
+// same at every wavelength), so at 11 samples per pixel (every band group once) the image is the
+// RGB render's; a coloured reflectance is refused, naming the material, with nothing written.
+TEST(CliRender, SpectralRendersGreyScenesAndRefusesRgbColours) {
+  const fs::path dir = fresh_test_dir();
+  const CliRun a = run(plane(dir / "spectral.exr", "--spectral", 11), dir);
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  ASSERT_EQ(run(plane(dir / "rgb.exr", "", 11), dir).exit_code, 0);
+  const auto s = weft::read_image(dir / "spectral.exr"), r = weft::read_image(dir / "rgb.exr");
+  ASSERT_EQ(s.rgb.size(), r.rgb.size());
+  // A grey spectrum reduces to the reduction's white, the sum of the band weights (1 to 1e-3: the
+  // sRGB matrix's white is D65 to its printed digits).
+  double white[3] = {0, 0, 0};
+  for (const weft::Rgb& w : weft::srgb_band_weights_d65())
+    white[0] += w.r, white[1] += w.g, white[2] += w.b;
+  for (size_t i = 0; i < s.rgb.size(); ++i)
+    ASSERT_NEAR(s.rgb[i], r.rgb[i] * white[i % 3], 1e-5 * r.rgb[i]) << i;
+  EXPECT_TRUE(contains(
+      weft::read_image_metadata(dir / "spectral.exr").at("weft:content").get<std::string>(),
+      "33 bands"));
+  const CliRun bad =
+      run(plane(dir / "red.exr", "--spectral -D materials.plane.params.reflectance=[0.5,0.2,0.1]"),
+          dir);
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_TRUE(contains(bad.err, "materials.plane")) << bad.err;
+  EXPECT_TRUE(contains(bad.err, "lambert")) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "red.exr"));
+}
+
 TEST(CliRender, AovPassesAreFilesBesideTheImage) {
   const fs::path dir = fresh_test_dir();
   const CliRun r = run(plane(dir / "out.exr", "--aov albedo,normal"), dir);

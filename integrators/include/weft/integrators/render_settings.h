@@ -2,7 +2,7 @@
 // What the path tracer is told, and the scene description's "render" section that sets it:
 //
 //   "render": {"width": 256, "height": 256, "spp": 16, "max_depth": 16, "rr_depth": 3, "seed": 0,
-//              "crop": [x0, x1, y0, y1], "time_limit_s": 60}
+//              "crop": [x0, x1, y0, y1], "time_limit_s": 60, "spectral": false}
 //
 // Every key is optional; the defaults are RenderSettings{}, the renderer's one set of defaults
 // (the command line and the benchmarks start from it too).
@@ -42,6 +42,12 @@ struct RenderSettings {
   double time_limit_s = 0;
   // Extra passes of the first surface each camera sample sees (RenderResult::albedo, normal).
   bool aov_albedo = false, aov_normal = false;
+  // Light transport per wavelength band instead of in RGB (path_tracer.h): for scenes of spectral
+  // tables, whose light scattered many times is not the RGB reduction's (multiple scattering does
+  // not commute with reducing a spectrum to three numbers). Every material needs spectral values
+  // and every light a grey colour (RenderScene::check_spectral). The image is linear sRGB either
+  // way.
+  bool spectral = false;
 };
 
 // A lower bound on the CPU time of one path sample (one pixel sample), seconds: a sample traces at

@@ -3,6 +3,8 @@
 // Dispatch is a std::variant: adding a material adds its alternative here and its factory in
 // registry.cpp. fiber_table and fabric_table are both TabulatedBsdf (the table's kind tells them
 // apart).
+#include <optional>
+#include <string>
 #include <variant>
 
 #include "weft/materials/bsdf.h"
@@ -38,5 +40,12 @@ class Bsdf {
  private:
   BsdfVariant impl_;
 };
+
+// What a spectral render shades with (render_settings.h RenderSettings::spectral): the BSDF whose
+// three components are the values at the three bands of band group 'group' (core/spectrum.h).
+// A spectral table gives its bands; a material whose colour is grey (equal components: the same
+// value at every wavelength) is itself. Anything else has no spectral values (an RGB colour or
+// RGB table, a measured RGB BRDF, a table on a backing): nullopt, and 'why' says what is missing.
+std::optional<Bsdf> band_group_bsdf(const Bsdf& bsdf, int group, std::string& why);
 
 }  // namespace weft

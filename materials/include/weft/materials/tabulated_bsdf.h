@@ -1,6 +1,7 @@
 #pragma once
-// The fiber_table and fabric_table materials: a TabulatedBsdfTable reduced to RGB and prepared for
-// sampling, shared immutable between every material that uses the same file.
+// The fiber_table and fabric_table materials: a TabulatedBsdfTable reduced to RGB (a spectral one
+// also kept per band, for spectral renders) and prepared for sampling, shared immutable between
+// every material that uses the same file.
 //
 // Evaluation: bilinear interpolation over the 4 nearest bin centres of the direction's own
 // hemisphere in the DirectionGrid chart, separately for wo and for wi (16 table entries), clamped
@@ -48,6 +49,7 @@
 #include <vector>
 
 #include "weft/core/distribution.h"
+#include "weft/core/spectrum.h"
 #include "weft/materials/bsdf.h"
 #include "weft/materials/bsdf_table.h"
 
@@ -58,8 +60,12 @@ struct TabulatedBsdfData {
   std::string kind;                             // "fiber" | "fabric"
   std::map<std::string, std::string> metadata;  // from the table
   std::vector<float> rgb;                       // [wi_bin][wo_bin][3]
-  std::vector<Distribution2D> sampling;         // one per wo bin, over fine wi cells
-  int sampling_subdivision = 1;                 // fine cells per table cell, per side
+  // Spectral tables: the band values as stored, [wi_bin][wo_bin][kNumBands], which a spectral
+  // render reads (TabulatedBsdf::band_group); empty for RGB tables. Sampling follows the RGB
+  // mean either way (its coverage term keeps the density > 0 wherever any band is).
+  std::vector<float> bands;
+  std::vector<Distribution2D> sampling;  // one per wo bin, over fine wi cells
+  int sampling_subdivision = 1;          // fine cells per table cell, per side
   // Per wo bin o: the integral of the interpolated f(wo in o's centre footprint, wi) |cos wi|
   // over wi in o's own hemisphere (same_side: reflection, for the lower bins the underside's)
   // and in the other one (other_side: transmission): sum_i f[i][o] W_i (hemisphere_weights).
@@ -83,6 +89,14 @@ struct TabulatedBsdfData {
                       static_cast<size_t>(wo_bin)) *
                      3;
     return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+  // The three bands of band group 'group' (core/spectrum.h band_of_group) of a spectral table.
+  Rgb lookup_bands(int wi_bin, int wo_bin, int group) const {
+    const size_t i = (static_cast<size_t>(wi_bin) * static_cast<size_t>(grid.bins()) +
+                      static_cast<size_t>(wo_bin)) *
+                     kNumBands;
+    return {bands[i + band_of_group(group, 0)], bands[i + band_of_group(group, 1)],
+            bands[i + band_of_group(group, 2)]};
   }
 };
 
@@ -119,6 +133,10 @@ struct TabulatedBsdf {
   TableLookup lookup = TableLookup::bilinear;
   std::optional<TableBacking> backing =
       std::nullopt;  // none: the bare table (transmission included)
+  // -1: the table in RGB. 0 .. kBandGroups - 1: a spectral render's view of a spectral table, whose
+  // three components are the bands of that group (bsdfs.h band_group_bsdf); scale is then grey
+  // and there is no backing.
+  int band_group = -1;
 
   Rgb eval(const Vec3& wo, const Vec3& wi) const;
   std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const;
