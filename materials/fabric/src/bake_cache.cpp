@@ -25,7 +25,11 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
       std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") + "|v" +
       std::to_string(TabulatedBsdfTable::kFormatVersion) +
       // Only when not the default, so existing cache entries keep their names.
-      (o.weight_mode == WeightMode::absorption_weight ? "|absorption_weight" : "");
+      (o.weight_mode == WeightMode::absorption_weight ? "|absorption_weight" : "") +
+      (o.route == FiberBakeRoute::kBssrdf ? "|bssrdf" : "") +
+      (o.max_events_per_photon != FiberTableBakeOptions{}.max_events_per_photon
+           ? "|E" + std::to_string(o.max_events_per_photon)
+           : "");
   return dir / ("fiber-" + fiber_spec_hash_hex(spec) + "-" + hex64(fnv1a64(key)) + ".exr");
 }
 

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <vector>
 
 #include "chi2.h"
@@ -514,6 +515,32 @@ TEST(FiberTableBake, RejectsBadOptions) {
   o.photons_per_band = 10;
   o.weight_mode = WeightMode::analog;  // the fiber bakers keep weights; analog is the slab's
   EXPECT_THROW(bake_fiber_table(load_fiber_spec("white-cotton"), o), Error);
+}
+
+// Every option that changes a bake's table changes its cache entry's name, and the defaults keep
+// the names entries had before the key grew (so existing caches stay valid).
+TEST(FiberTableBake, CacheKeyHoldsEveryOptionThatChangesTheTable) {
+  const std::filesystem::path dir = "cache";
+  const FiberSpec spec = load_fiber_spec("white-cotton");
+  const FiberTableBakeOptions base;
+  const auto name = [&](const FiberTableBakeOptions& o) {
+    return fiber_table_cache_file(dir, spec, o).filename().string();
+  };
+  std::vector<FiberTableBakeOptions> variants(8, base);
+  variants[0].resolution = 6;
+  variants[1].photons_per_band = 1000;
+  variants[2].seed = 2;
+  variants[3].passes = 4;
+  variants[4].spectral = false;
+  variants[5].weight_mode = WeightMode::absorption_weight;
+  variants[6].route = FiberBakeRoute::kBssrdf;
+  variants[7].max_events_per_photon = 1000;
+  std::set<std::string> names{name(base)};
+  for (const auto& v : variants) EXPECT_TRUE(names.insert(name(v)).second) << name(v);
+  // Threads change nothing (a bake's bits do not depend on them).
+  FiberTableBakeOptions threads = base;
+  threads.threads = 7;
+  EXPECT_EQ(name(threads), name(base));
 }
 
 TEST(FiberTableBake, FiberTableMaterialBakesASpecOnDemandOnce) {
