@@ -73,7 +73,10 @@ JobPart sweep_job(const std::string& scene, const SceneDescription& desc, const 
            {"max_depth", g.max_depth},
            {"rr_depth", g.rr_depth},
            {"seed", g.seed},
+           {"renderer_revision", kPathTracerRevision},
            {"program_version", WEFT_VERSION}};
+  // Only when set, so that RGB sweeps' parts keep their identity.
+  if (g.spectral) p.job["spectral"] = true;
   p.units_total = gonio_unit_count(g);
   p.shard = shard;
   return p;

@@ -98,6 +98,7 @@ GonioSettings gonio_settings_from(const SceneDescription& desc) {
   g.max_depth = r.max_depth;
   g.rr_depth = r.rr_depth;
   g.seed = r.seed;
+  g.spectral = r.spectral;
   if (!desc.sweep) return g;
   ParamReader p(*desc.sweep, desc.source, "sweep");
   constexpr double kMax = kMaxDescriptionRadiometric;
@@ -157,6 +158,10 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
     if (!(std::abs(v) < 90)) throw Error(src, "view_zenith_deg", "views must lie in (-90, 90)");
   if (!(g.irradiance.r > 0 && g.irradiance.g > 0 && g.irradiance.b > 0))
     throw Error(src, "irradiance", "must be positive in every channel");
+  if (g.spectral && !(g.irradiance.r == g.irradiance.g && g.irradiance.g == g.irradiance.b))
+    throw Error(src, "irradiance",
+                "a spectral sweep needs a grey irradiance (equal R, G and B: the same at every "
+                "wavelength)");
   if (g.width < 1 || g.height < 1 || g.spp < 1)
     throw Error(src, "sweep", "width, height and spp must be positive");
 
@@ -213,6 +218,7 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   rs.rr_depth = g.rr_depth;
   rs.seed = g.seed;
   rs.threads = g.threads;
+  rs.spectral = g.spectral;
   uint64_t renders_done = 0;
 
   GonioResult res;

@@ -7,8 +7,12 @@
 #include <cmath>
 #include <filesystem>
 
+#include "test_util.h"
 #include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/core/spectrum.h"
 #include "weft/integrators/gonio.h"
+#include "weft/materials/bsdf_table.h"
 #include "weft/scenes/description.h"
 #include "woven_patch.h"
 
@@ -74,6 +78,52 @@ TEST(Gonio, ColouredAlbedoOffPlaneViewsAndBackSide) {
       EXPECT_NEAR(row.beta.b, 0.6, 1e-9);
     }
   }
+}
+
+// A spectral sweep (the description's render.spectral) of a plane bound to a spectral diffuser
+// (albedo 0.1 below 590 nm, 0.8 from it): light scatters once, so beta is the band reduction of
+// the albedo spectrum, exactly at 11 samples per pixel (every band group once), at every view.
+// The white reference reduces the grey spectrum 1 to the reduction's white (the sum of the band
+// weights). A coloured irradiance is refused naming it.
+TEST(Gonio, SpectralSweepOfASpectralTableIsItsBandReduction) {
+  const std::filesystem::path dir = weft::testing::fresh_test_dir();
+  auto albedo = [](int b) { return b >= 20 ? 0.8 : 0.1; };
+  TabulatedBsdfTable::from_function(
+      4, kNumBands,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        for (int b = 0; b < kNumBands; ++b) v[b] = wo.z * wi.z > 0 ? albedo(b) / kPi : 0;
+      },
+      2, 1)
+      .write_exr(dir / "diffuser.exr");
+  SceneDescription d = load_scene_description(kExamples / "lambert-plane.json");
+  d.materials["plane"].type = "fiber_table";
+  d.materials["plane"].params = {{"file", (dir / "diffuser.exr").string()}};
+  d.render = nlohmann::json{{"spectral", true}};
+  GonioSettings g = gonio_settings_from(d);
+  ASSERT_TRUE(g.spectral);
+  const GonioSettings base = settings(30, 0);
+  g.sample = base.sample;
+  g.light_zenith_deg = base.light_zenith_deg;
+  g.irradiance = base.irradiance;
+  g.view_zenith_deg = {-50, 0, 40};
+  g.width = g.height = 8;
+  g.spp = kBandGroups;
+  const Rgb want = bands_to_linear_srgb(albedo);
+  Rgb white;
+  for (const Rgb& w : srgb_band_weights_d65()) white += w;
+  const GonioResult r = run_gonio(d, g);
+  ASSERT_EQ(r.rows.size(), 3u);
+  for (const auto& row : r.rows) {
+    EXPECT_NEAR(row.beta.r, want.r, 1e-5 * want.r) << row.view_zenith_deg;
+    EXPECT_NEAR(row.beta.g, want.g, 1e-5 * want.g) << row.view_zenith_deg;
+    EXPECT_NEAR(row.beta.b, want.b, 1e-5 * want.b) << row.view_zenith_deg;
+    ASSERT_TRUE(row.white);
+    EXPECT_NEAR(row.white->g, white.g, 1e-6);
+  }
+  g.irradiance = Rgb(2.5, 2.0, 2.0);
+  const std::string e = weft::testing::error_of([&] { run_gonio(d, g); });
+  EXPECT_NE(e.find("irradiance"), std::string::npos) << e;
+  EXPECT_NE(e.find("grey"), std::string::npos) << e;
 }
 
 TEST(Gonio, PaperNormalization) {

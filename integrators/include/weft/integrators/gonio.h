@@ -21,7 +21,8 @@
 //             "view_zenith_deg": [list] | {"from": a, "to": b, "step": s}, "view_azimuth_deg": p,
 //             "normalize_to": c, "white_check": true, "width": 64, "height": 64, "spp": 16}
 //
-// and its "render" section the path tracer's max_depth, rr_depth and seed.
+// and its "render" section the path tracer's max_depth, rr_depth, seed and spectral (a spectral
+// sweep needs a grey irradiance, RenderSettings::spectral).
 #include <functional>
 #include <optional>
 #include <string>
@@ -49,6 +50,7 @@ struct GonioSettings {
   int max_depth = RenderSettings{}.max_depth, rr_depth = RenderSettings{}.rr_depth;
   uint64_t seed = RenderSettings{}.seed;
   int threads = RenderSettings{}.threads;
+  bool spectral = RenderSettings{}.spectral;
   // A sweep split over processes or resumed renders some of its units (gonio_unit_count): unit v
   // < views is view v, the last one, when there is one, the normal-incidence reference that the
   // normalization needs when no row gives it. Empty: every unit, then the normalization.
