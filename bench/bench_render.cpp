@@ -1,14 +1,19 @@
 // Render throughput on a generated woven patch (~65k triangles): raw Embree rtcIntersect1 against
 // the path tracer (rays per second as counters), single-threaded so the two compare directly.
-// `weft bench render` runs the same comparison with thread scaling and a ~1M-triangle patch.
+// `weft bench render` runs the same comparison with thread scaling and a ~1M-triangle patch. And a
+// spectral render's cost against an RGB one of the same spectral table.
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
 #include <memory>
+#include <span>
 
 #include "weft/bench/render_bench.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
+#include "weft/core/spectrum.h"
 #include "weft/integrators/path_tracer.h"
+#include "weft/materials/bsdf_table.h"
 #include "weft/scenes/render_scene.h"
 
 namespace {
@@ -64,5 +69,65 @@ void BM_PathTraceWovenPatch(benchmark::State& state) {
   state.counters["rays_per_s"] = benchmark::Counter(double(rays), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_PathTraceWovenPatch)->Unit(benchmark::kMillisecond);
+
+// The same patch with both yarns bound to a spectral fiber-like table (33 bands: red reflection
+// and a diffuse transmission that carries red, so light scatters through the cloth), rendered in
+// RGB (the table reduced at load) and as a spectral render (every band on every path), with the
+// table read bilinearly and by cell: the spectral render's cost against the RGB baseline of the
+// same run. Args: spectral (0/1), cell reads (0/1).
+const weft::SceneDescription& spectral_table_patch(bool cell) {
+  static const auto make = [](bool by_cell) {
+    const std::filesystem::path file =
+        std::filesystem::temp_directory_path() / "weft-bench-spectral-table.exr";
+    static const bool written = [&] {
+      weft::TabulatedBsdfTable::from_function(
+          8, weft::kNumBands,
+          [](const weft::Vec3& wo, const weft::Vec3& wi, std::span<double> v) {
+            for (int b = 0; b < weft::kNumBands; ++b) {
+              const double red = b >= 20 ? 0.7 : 0.1;
+              v[b] = (wo.z * wi.z > 0 ? red * (0.5 + wi.z * wi.z) : 0.4 * red) * weft::kInvPi;
+            }
+          },
+          1, 1)
+          .write_exr(file);
+      return true;
+    }();
+    (void)written;
+    weft::SceneDescription d = fixture().desc;
+    for (const char* key : {"warp", "weft"}) {
+      d.materials[key].type = "fiber_table";
+      d.materials[key].params = {{"file", file.string()},
+                                 {"interpolation", by_cell ? "cell" : "bilinear"}};
+    }
+    return d;
+  };
+  static const weft::SceneDescription bilinear = make(false), by_cell = make(true);
+  return cell ? by_cell : bilinear;
+}
+
+void BM_PathTraceSpectralTablePatch(benchmark::State& state) {
+  const weft::SceneDescription& d = spectral_table_patch(state.range(1) != 0);
+  const weft::RenderScene scene(d);
+  weft::RenderSettings s;
+  s.width = s.height = 64;
+  s.spp = 2;
+  s.threads = 1;
+  s.spectral = state.range(0) != 0;
+  uint64_t samples = 0;
+  for (auto _ : state) {
+    const weft::RenderResult r = weft::render(scene, *d.camera, s);
+    samples += uint64_t(s.width) * s.height * s.spp;
+    benchmark::DoNotOptimize(r.image.rgb.data());
+  }
+  state.counters["samples_per_s"] =
+      benchmark::Counter(double(samples), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_PathTraceSpectralTablePatch)
+    ->ArgNames({"spectral", "cell"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({0, 1})
+    ->Args({1, 1})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
+#include "weft/core/spectrum.h"
+#include "weft/materials/bsdfs.h"
 
 namespace weft {
 namespace {
@@ -23,20 +25,70 @@ bool finite(const Rgb& c) {
   return std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
 }
 
-// A spectral sample's linear sRGB: its three bands of 'group' through the D65 band weights,
-// times the number of groups (the group was drawn with probability 1 / kBandGroups).
-Rgb group_to_srgb(const Rgb& bands, int group) {
-  const auto& w = srgb_band_weights_d65();
-  return (w[band_of_group(group, 0)] * bands.r + w[band_of_group(group, 1)] * bands.g +
-          w[band_of_group(group, 2)] * bands.b) *
-         static_cast<double>(kBandGroups);
+// Light per band along a spectral render's path.
+struct Bands {
+  Spectrum v{};
+  Bands() = default;
+  explicit Bands(double x) { v.fill(x); }
+  Bands& operator+=(const Bands& o) {
+    for (int b = 0; b < kNumBands; ++b) v[b] += o.v[b];
+    return *this;
+  }
+  Bands& operator*=(const Bands& o) {
+    for (int b = 0; b < kNumBands; ++b) v[b] *= o.v[b];
+    return *this;
+  }
+  Bands& operator*=(double s) {
+    for (double& x : v) x *= s;
+    return *this;
+  }
+  double max_component() const { return *std::max_element(v.begin(), v.end()); }
+  bool is_black() const {
+    return std::all_of(v.begin(), v.end(), [](double x) { return x == 0; });
+  }
+};
+Bands operator*(Bands a, const Bands& b) {
+  return a *= b;
+}
+Bands operator*(Bands a, double s) {
+  return a *= s;
+}
+Bands operator/(Bands a, double s) {
+  return a *= 1.0 / s;
 }
 
-}  // namespace
+// How a path's colour is shaded: in RGB, or per band (a spectral render, whose lights are grey:
+// RenderScene::check_spectral). Directions and light samples are drawn the same way in both (a
+// table by its RGB mean); Russian roulette follows the largest value the path carries.
+struct RgbShading {
+  using Color = Rgb;
+  static Rgb f(const Bsdf& b, const Vec3& wo, const Vec3& wi) { return b.eval(wo, wi); }
+  static Rgb weight(const Bsdf&, const Vec3&, const BsdfSample& s) { return s.weight; }
+  static Rgb light(const Rgb& L) { return L; }
+  static Rgb to_rgb(const Rgb& c) { return c; }
+};
+struct BandShading {
+  using Color = Bands;
+  static Bands f(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
+    Bands out;
+    eval_bands(b, wo, wi, out.v);
+    return out;
+  }
+  static Bands weight(const Bsdf& b, const Vec3& wo, const BsdfSample& s) {
+    Bands out;
+    sample_weight_bands(b, wo, s, out.v);
+    return out;
+  }
+  static Bands light(const Rgb& L) { return Bands(L.r); }
+  static Rgb to_rgb(const Bands& c) {
+    return bands_to_linear_srgb([&c](int b) { return c.v[b]; });
+  }
+};
 
-Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings,
-               Rng& rng, RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray,
-               int band_group) {
+template <class Shading>
+Rgb trace(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings, Rng& rng,
+          RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
+  using Color = typename Shading::Color;
   auto occluded = [&](const Vec3& o, const Vec3& d, double tmax, int64_t ignore_fiber) {
     ++rays.shadow;
     if (on_ray) (*on_ray)({o, d, tmax}, true);
@@ -44,7 +96,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
   };
   const bool use_mis = settings.sampling == LightSampling::mis;
   const bool nee_area = settings.sampling != LightSampling::bsdf_only;
-  Rgb L(0.0), beta(1.0);
+  Color L(0.0), beta(1.0);
   Ray ray = camera_ray;
   bool specular = true;  // camera rays and delta bounces are not covered by next-event estimation
   double prev_pdf = 0;
@@ -65,7 +117,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
     if (Le.is_black()) return;
     double w = 1;
     if (!specular) w = use_mis ? power_heuristic(prev_pdf, light.pdf(at)) : (nee_area ? 0.0 : 1.0);
-    L += beta * Le * w;
+    L += beta * Shading::light(Le) * w;
   };
 
   for (int depth = 0;; ++depth) {
@@ -83,7 +135,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       add_found_light(*light, LightHit::on_surface(ray.d, hit.shape, hit.prim, hit.ng, hit.t));
     if (depth >= settings.max_depth) break;
 
-    const Bsdf& bsdf = scene.bsdf(hit, band_group);
+    const Bsdf& bsdf = scene.bsdf(hit);
     const Frame& frame = hit.shading;
     const Vec3 wo = frame.to_local(wo_world);
     // Shading normals differ from the facets: a direction the BSDF treats as reflection may lie
@@ -113,7 +165,7 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       const bool lifted = !hit.on_fiber() && wo.z * wi.z > 0 && !(lift == Vec3{});
       const bool agrees = consistent(ls->wi, wi);
       if (!lifted && !agrees) continue;
-      const Rgb f = bsdf.eval(wo, wi);
+      const Color f = Shading::f(bsdf, wo, wi);
       if (f.is_black()) continue;
       // BSDF sampling stops at directions the facet disagrees on, so there this is the only
       // strategy and takes the whole weight.
@@ -134,7 +186,8 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
         blocked = ls->at_infinity ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300, hit.fiber)
                                   : occluded_between(hit, ls->p_light);
       }
-      if (!blocked) L += beta * f * ls->L * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
+      if (!blocked)
+        L += beta * f * Shading::light(ls->L) * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
     }
 
     // Continue the path by sampling the BSDF.
@@ -144,7 +197,9 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
     if (!bs || bs->weight.is_black() || !(bs->pdf > 0 || bs->is_delta)) break;
     const Vec3 wi = normalize(frame.to_world(bs->wi));
     if (!consistent(wi, bs->wi)) break;
-    beta *= bs->weight;
+    const Color weight = Shading::weight(bsdf, wo, *bs);
+    if (weight.is_black()) break;
+    beta *= weight;
     specular = bs->is_delta;
     prev_pdf = bs->pdf;
     ray = {hit.spawn_origin(wi), wi};
@@ -156,7 +211,15 @@ Rgb trace_path(const RenderScene& scene, const Ray& camera_ray, const RenderSett
       beta = beta / q;
     }
   }
-  return L;
+  return Shading::to_rgb(L);
+}
+
+}  // namespace
+
+Rgb trace_path(const RenderScene& scene, const Ray& ray, const RenderSettings& settings, Rng& rng,
+               RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
+  return settings.spectral ? trace<BandShading>(scene, ray, settings, rng, rays, first_mesh, on_ray)
+                           : trace<RgbShading>(scene, ray, settings, rng, rays, first_mesh, on_ray);
 }
 
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
@@ -200,24 +263,13 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   auto sample_pixel = [&](int x, int y, int k0, int k1, Sums& acc, RayCounts& rays,
                           uint64_t& nonfinite) {
     const uint64_t pixel = uint64_t(y) * s.width + x;
-    // Spectral: sample k of the pixel draws band group (k + offset) mod kBandGroups, the offset
-    // uniform per pixel from its own stream (every sample index bit set, never a render's), so
-    // each sample's group is uniform and a pixel's first kBandGroups samples see every group once.
-    int group_offset = 0;
-    if (s.spectral) {
-      Rng offset_rng(s.seed, pixel, ~uint64_t(0));
-      group_offset =
-          std::min(kBandGroups - 1, static_cast<int>(offset_rng.uniform() * kBandGroups));
-    }
     for (int k = k0; k < k1; ++k) {
       Rng rng(s.seed, pixel, uint64_t(k));
-      const int group = s.spectral ? (k + group_offset) % kBandGroups : -1;
       const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
       const Ray ray = camera.generate_ray(fx, fy, aspect);
       ++rays.camera;
       int64_t first = -1;
-      Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray, group);
-      if (s.spectral) L = group_to_srgb(L, group);
+      Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray);
       if (!finite(L)) {
         ++nonfinite;
         L = Rgb(0.0);
@@ -239,9 +291,11 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
           const Vec3 wo = hit.shading.to_local(wo_world);
           const double u_lobe = aov_rng.uniform();
           const Vec2 u{aov_rng.uniform(), aov_rng.uniform()};
-          const auto bs = scene.bsdf(hit, group).sample(wo, u, u_lobe);
+          const Bsdf& bsdf = scene.bsdf(hit);
+          const auto bs = bsdf.sample(wo, u, u_lobe);
           if (bs && finite(bs->weight)) {
-            const Rgb a = s.spectral ? group_to_srgb(bs->weight, group) : bs->weight;
+            const Rgb a =
+                s.spectral ? BandShading::to_rgb(BandShading::weight(bsdf, wo, *bs)) : bs->weight;
             acc.albedo[0] += a.r, acc.albedo[1] += a.g, acc.albedo[2] += a.b;
           }
         }

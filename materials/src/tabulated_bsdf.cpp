@@ -222,15 +222,26 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
 }
 
 Rgb TabulatedBsdf::eval_table(const Vec3& wo, const Vec3& wi) const {
-  auto value = [&](int i, int o) {
-    return band_group < 0 ? data->lookup(i, o) : data->lookup_bands(i, o, band_group);
-  };
   if (lookup == TableLookup::cell)
-    return value(data->grid.bin_of(wi), data->grid.bin_of(wo)) * scale;
+    return data->lookup(data->grid.bin_of(wi), data->grid.bin_of(wo)) * scale;
   Rgb sum;
   for_each_interpolated_cell(data->grid, wo, wi,
-                             [&](int i, int o, double w) { sum += value(i, o) * w; });
+                             [&](int i, int o, double w) { sum += data->lookup(i, o) * w; });
   return sum * scale;
+}
+
+void TabulatedBsdf::eval_bands(const Vec3& wo, const Vec3& wi, Spectrum& out) const {
+  out.fill(0.0);
+  if (!data || data->bands.empty()) return;
+  auto add = [&](int i, int o, double w) {
+    const float* v = data->lookup_bands(i, o);
+    for (int b = 0; b < kNumBands; ++b) out[b] += w * v[b];
+  };
+  if (lookup == TableLookup::cell)
+    add(data->grid.bin_of(wi), data->grid.bin_of(wo), scale.r);
+  else
+    for_each_interpolated_cell(data->grid, wo, wi,
+                               [&](int i, int o, double w) { add(i, o, w * scale.r); });
 }
 
 Rgb TabulatedBsdf::eval_backing(const Vec3& wo, const Vec3& wi) const {

@@ -53,9 +53,8 @@ struct RenderScene::Geometry {
   std::vector<MeshRecord> meshes;
   std::vector<CurveRecord> curve_sets;  // reserved once: Embree holds pointers to its elements
   std::vector<Bsdf> bsdfs;
-  // A spectral render's BSDFs, [bsdf][band group] (bsdfs.h band_group_bsdf); empty when a
-  // material has no spectral values, then the first such material's field and why.
-  std::vector<Bsdf> band_bsdfs;
+  // The first material without values per band (bsdfs.h spectral_obstacle): its field and why
+  // (empty: every material has them).
   std::string spectral_field, spectral_why;
   std::string source;         // the description's, for errors
   bool grey_emission = true;  // every emissive mesh emits the same in R, G and B
@@ -297,15 +296,8 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
     geo->bsdfs.push_back(make_bsdf(b.type, b.params, ctx));
     const auto id = static_cast<uint32_t>(geo->bsdfs.size() - 1);
     if (geo->spectral_why.empty()) {
-      for (int g = 0; g < kBandGroups; ++g) {
-        std::optional<Bsdf> bands = band_group_bsdf(geo->bsdfs.back(), g, geo->spectral_why);
-        if (!bands) break;
-        geo->band_bsdfs.push_back(std::move(*bands));
-      }
-      if (!geo->spectral_why.empty()) {
-        geo->spectral_field = b.field.empty() ? "materials" : b.field;
-        geo->band_bsdfs.clear();
-      }
+      geo->spectral_why = spectral_obstacle(geo->bsdfs.back());
+      if (!geo->spectral_why.empty()) geo->spectral_field = b.field.empty() ? "materials" : b.field;
     }
     bsdf_of[&b] = id;
     return id;
@@ -585,21 +577,11 @@ bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax,
   return r.tfar < 0;  // Embree sets tfar to -inf on a hit
 }
 
-uint32_t RenderScene::bsdf_index(const SurfaceHit& hit) const {
-  if (!hit.on_fiber()) return geo_->meshes[hit.shape].bsdf;
+const Bsdf& RenderScene::bsdf(const SurfaceHit& hit) const {
+  if (!hit.on_fiber()) return geo_->bsdfs[geo_->meshes[hit.shape].bsdf];
   const CurveRecord& rec = geo_->curve_sets[hit.shape - geo_->meshes.size()];
   const auto curve = static_cast<size_t>(hit.fiber - rec.first_fiber);
-  return rec.yarn_bsdf[rec.curves->curve_yarn[curve]];
-}
-
-const Bsdf& RenderScene::bsdf(const SurfaceHit& hit) const {
-  return geo_->bsdfs[bsdf_index(hit)];
-}
-
-const Bsdf& RenderScene::bsdf(const SurfaceHit& hit, int band_group) const {
-  if (band_group < 0) return bsdf(hit);
-  return geo_->band_bsdfs[static_cast<size_t>(bsdf_index(hit)) * kBandGroups +
-                          static_cast<size_t>(band_group)];
+  return geo_->bsdfs[rec.yarn_bsdf[rec.curves->curve_yarn[curve]]];
 }
 
 void RenderScene::check_spectral() const {

@@ -1,8 +1,8 @@
 // Spectral renders (RenderSettings::spectral, path_tracer.h): light carried per band, reduced to
 // linear sRGB after.
 //  * Single scattering is linear in f, so a spectral render of a spectral table equals the RGB
-//    render of the table reduced to RGB (in gamut), pixel by pixel once a pixel's samples have
-//    drawn every band group (the stratification makes that exact at kBandGroups samples).
+//    render of the table reduced to RGB (in gamut), pixel by pixel (a path carries every band and
+//    draws its directions as in RGB).
 //  * Inside a closed enclosure whose walls emit Le and reflect diffusely with albedo rho, the
 //    radiance is Le / (1 - rho) (test_furnace.cpp); with a band-dependent rho it is that per band,
 //    and the image is its D65 reduction, not Le / (1 - rho reduced): the case the RGB transport
@@ -133,7 +133,7 @@ TEST(SpectralRender, SingleScatteringEqualsTheRgbRenderOfTheReducedTable) {
   rgb.write_exr(dir / "rgb.exr");
   RenderSettings s;
   s.width = s.height = 8;
-  s.spp = kBandGroups;  // every band group once per pixel
+  s.spp = 3;
   s.seed = 5;
   const SceneDescription a =
       patch({{"type", "fiber_table"}, {"params", {{"file", (dir / "spectral.exr").string()}}}});
@@ -155,8 +155,7 @@ TEST(SpectralRender, SingleScatteringEqualsTheRgbRenderOfTheReducedTable) {
   const RenderResult rc = render(RenderScene(a), *a.camera, s);
   for (size_t i = 0; i < rc.image.rgb.size(); ++i)
     EXPECT_NEAR(rc.image.rgb[i] / rb.image.rgb[i], 1.0, 1e-5);
-  // Fewer samples than groups: noisy, but the same bits at any thread count.
-  ss.spp = 3;
+  // The same bits at any thread count.
   ss.threads = 1;
   const RenderResult one = render(RenderScene(a), *a.camera, ss);
   ss.threads = 2;
@@ -181,7 +180,7 @@ TEST(SpectralRender, EmittingEnclosureReachesLeOverOneMinusAlbedoInEveryBand) {
 
   RenderSettings s;
   s.width = s.height = 24;
-  s.spp = 2 * kBandGroups;
+  s.spp = 16;
   s.max_depth = 200;
   s.seed = 3;
   s.spectral = true;

@@ -455,8 +455,8 @@ TEST(VerifyWeaveRender, MeanOverWholeRepeatsIsTheFabricRayTracesValueInReflectio
 // reduction to RGB (the reduced table's red albedo is 0.99). The fiber-level render of the
 // spectral table agrees with the spectral ray trace (tolerance as in the test above, from the
 // trace's own noise); the RGB transport of the reduced table is redder. Measured (48 px, 16 spp,
-// 8 000 particles per bin; tolerance 8.2 %): spectral render against trace +0.9, +4.9, +6.1 % in R,
-// G, B; the RGB render's red 1.070 times the spectral render's (the renders' noise about 0.5 %).
+// 8 000 particles per bin; tolerance 8.2 %): spectral render against trace +1.1, +5.0, +5.8 % in R,
+// G, B; the RGB render's red 1.068 times the spectral render's (the renders' noise about 0.5 %).
 // At 64 000 particles the trace's red is 12 % below its RGB trace's, and green and blue render
 // 6 % above the trace in RGB as in bands (R = 4 cells, not the spectral transport).
 TEST(VerifyWeaveRender, SpectralFiberTableRendersAsItsSpectralRayTrace) {

@@ -203,8 +203,8 @@ TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
 }
 
 // --spectral: light per band (docs/scenes.md "Spectral renders"). The bundled plane is grey (the
-// same at every wavelength), so at 11 samples per pixel (every band group once) the image is the
-// RGB render's; a coloured reflectance is refused, naming the material, with nothing written.
+// same at every wavelength), so the image is the RGB render's reduced to the reduction's white; a
+// coloured reflectance is refused, naming the material, with nothing written.
 TEST(CliRender, SpectralRendersGreyScenesAndRefusesRgbColours) {
   const fs::path dir = fresh_test_dir();
   const CliRun a = run(plane(dir / "spectral.exr", "--spectral", 11), dir);

@@ -17,16 +17,6 @@ constexpr double band_wavelength_nm(int band) {
 
 using Spectrum = std::array<double, kNumBands>;
 
-// Spectral rendering carries three bands per path (in the spirit of hero-wavelength sampling):
-// band group g holds the bands g, g + 11 and g + 22, equally spaced, so that every group spans the
-// whole range and a path of any group sees blue, green and red light. A camera sample draws its
-// group uniformly; the renderer weights its radiance by kBandGroups.
-inline constexpr int kBandGroups = kNumBands / 3;
-static_assert(kBandGroups * 3 == kNumBands, "band groups hold three bands each");
-constexpr int band_of_group(int group, int slot) {
-  return group + slot * kBandGroups;
-}
-
 struct Xyz {
   double x = 0, y = 0, z = 0;
 };

@@ -17,17 +17,15 @@
 // and light from behind B, through its own fiber, is the table's to account for. Every other
 // fiber occludes and inter-reflects as any surface does. Triangles of meshes are unaffected.
 //
-// Spectral renders (RenderSettings::spectral): light is carried per wavelength band, not in RGB.
-// Each camera sample draws one band group (three bands spread over the spectrum, core/spectrum.h),
-// stratified over a pixel's samples, and its path carries those three bands in the three
-// components every material and light already has (bsdfs.h band_group_bsdf: a spectral table's
-// bands; a grey colour is the same at every band); the sample's radiance is reduced to linear
-// sRGB through the D65 band weights (the one reduction of tables, spectrum.h) and weighted by the
-// number of groups. The mean is the per-band transport reduced after, which for light scattered
-// many times in a coloured material differs from the RGB transport of the reduced table. The
-// image is unclipped linear sRGB (a saturated spectrum can leave the gamut), the sample costs
-// what an RGB one does, and the band draw adds colour noise that a pixel's first kBandGroups
-// samples cancel by stratification.
+// Spectral renders (RenderSettings::spectral): light is carried per wavelength band, all 33 on
+// every path (as the fabric ray trace's particles carry them), not in RGB. Directions, lights and
+// Russian roulette are drawn as in RGB (a table samples by its RGB mean, whose coverage keeps the
+// density > 0 wherever any band is); the path's values are the materials' bands (bsdfs.h
+// eval_bands: a spectral table's, or a grey colour's, the same at every band) and the lights'
+// grey colour; each sample's radiance is reduced to linear sRGB through the D65 band weights (the
+// one reduction of tables, spectrum.h). The mean is the per-band transport reduced after, which
+// for light scattered many times in a coloured material differs from the RGB transport of the
+// reduced table. The image is unclipped linear sRGB (a saturated spectrum can leave the gamut).
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -99,11 +97,10 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
                     const RenderObservers& observers = {});
 
 // Radiance arriving along 'ray' (one path sample). 'first_mesh' receives the shape the ray hits
-// first (-1 for none); 'on_ray' sees every ray traced. band_group >= 0: the radiance of the three
-// bands of that group (core/spectrum.h band_of_group) in its r, g, b, shaded with the scene's
-// spectral BSDFs (RenderScene::check_spectral first). Exposed for tests of the estimator itself.
+// first (-1 for none); 'on_ray' sees every ray traced. With settings.spectral the path carries
+// every band and returns their linear sRGB (RenderScene::check_spectral first). Exposed for tests
+// of the estimator itself.
 Rgb trace_path(const RenderScene& scene, const Ray& ray, const RenderSettings& settings, Rng& rng,
-               RayCounts& rays, int64_t* first_mesh = nullptr, const RayObserver* on_ray = nullptr,
-               int band_group = -1);
+               RayCounts& rays, int64_t* first_mesh = nullptr, const RayObserver* on_ray = nullptr);
 
 }  // namespace weft

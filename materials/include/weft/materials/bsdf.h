@@ -13,8 +13,7 @@
 //   weight = f(wo, wi) * |cos theta_i| / pdf. It returns nullopt when no direction can be drawn.
 // * pdf(wo, wi) is the solid-angle density of sample; it agrees with sample to rounding.
 // * Colours are linear RGB (weft::Rgb). Spectral tables are reduced to RGB when loaded; a
-//   spectral render shades with three of their bands in the three components instead (bsdfs.h
-//   band_group_bsdf).
+//   spectral render reads their bands instead (bsdfs.h eval_bands).
 //
 // Every material is a small value type with eval, sample and pdf as below (the BsdfModel concept);
 // the closed set a scene can name is weft::Bsdf in bsdfs.h.

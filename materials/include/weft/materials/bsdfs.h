@@ -3,7 +3,6 @@
 // Dispatch is a std::variant: adding a material adds its alternative here and its factory in
 // registry.cpp. fiber_table and fabric_table are both TabulatedBsdf (the table's kind tells them
 // apart).
-#include <optional>
 #include <string>
 #include <variant>
 
@@ -41,11 +40,15 @@ class Bsdf {
   BsdfVariant impl_;
 };
 
-// What a spectral render shades with (render_settings.h RenderSettings::spectral): the BSDF whose
-// three components are the values at the three bands of band group 'group' (core/spectrum.h).
-// A spectral table gives its bands; a material whose colour is grey (equal components: the same
-// value at every wavelength) is itself. Anything else has no spectral values (an RGB colour or
-// RGB table, a measured RGB BRDF, a table on a backing): nullopt, and 'why' says what is missing.
-std::optional<Bsdf> band_group_bsdf(const Bsdf& bsdf, int group, std::string& why);
+// What a spectral render (render_settings.h RenderSettings::spectral) needs of a material: f per
+// band. A spectral table has it (without a backing, with a grey tint); a material whose colour is
+// grey (equal components) is the same at every band. spectral_obstacle is "" for those, else
+// what is missing (an RGB colour or table, a measured RGB BRDF, a table on a backing).
+std::string spectral_obstacle(const Bsdf& bsdf);
+// f(wo, wi) per band, for a material without a spectral obstacle.
+void eval_bands(const Bsdf& bsdf, const Vec3& wo, const Vec3& wi, Spectrum& out);
+// The weight of a sample of bsdf.sample(wo, ...) per band: f |cos theta_i| / pdf (for a grey
+// material the sample's own weight, delta lobes included).
+void sample_weight_bands(const Bsdf& bsdf, const Vec3& wo, const BsdfSample& sample, Spectrum& out);
 
 }  // namespace weft

@@ -61,7 +61,7 @@ struct TabulatedBsdfData {
   std::map<std::string, std::string> metadata;  // from the table
   std::vector<float> rgb;                       // [wi_bin][wo_bin][3]
   // Spectral tables: the band values as stored, [wi_bin][wo_bin][kNumBands], which a spectral
-  // render reads (TabulatedBsdf::band_group); empty for RGB tables. Sampling follows the RGB
+  // render reads (TabulatedBsdf::eval_bands); empty for RGB tables. Sampling follows the RGB
   // mean either way (its coverage term keeps the density > 0 wherever any band is).
   std::vector<float> bands;
   std::vector<Distribution2D> sampling;  // one per wo bin, over fine wi cells
@@ -90,13 +90,11 @@ struct TabulatedBsdfData {
                      3;
     return {rgb[i], rgb[i + 1], rgb[i + 2]};
   }
-  // The three bands of band group 'group' (core/spectrum.h band_of_group) of a spectral table.
-  Rgb lookup_bands(int wi_bin, int wo_bin, int group) const {
-    const size_t i = (static_cast<size_t>(wi_bin) * static_cast<size_t>(grid.bins()) +
-                      static_cast<size_t>(wo_bin)) *
-                     kNumBands;
-    return {bands[i + band_of_group(group, 0)], bands[i + band_of_group(group, 1)],
-            bands[i + band_of_group(group, 2)]};
+  // The band values of a spectral table's cell pair.
+  const float* lookup_bands(int wi_bin, int wo_bin) const {
+    return &bands[(static_cast<size_t>(wi_bin) * static_cast<size_t>(grid.bins()) +
+                   static_cast<size_t>(wo_bin)) *
+                  kNumBands];
   }
 };
 
@@ -133,14 +131,13 @@ struct TabulatedBsdf {
   TableLookup lookup = TableLookup::bilinear;
   std::optional<TableBacking> backing =
       std::nullopt;  // none: the bare table (transmission included)
-  // -1: the table in RGB. 0 .. kBandGroups - 1: a spectral render's view of a spectral table, whose
-  // three components are the bands of that group (bsdfs.h band_group_bsdf); scale is then grey
-  // and there is no backing.
-  int band_group = -1;
 
   Rgb eval(const Vec3& wo, const Vec3& wi) const;
   std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const;
   double pdf(const Vec3& wo, const Vec3& wi) const;
+  // A spectral render's f per band (bsdfs.h eval_bands), read like eval reads the RGB values: for
+  // a spectral table without a backing; its scale is then grey (scale.r is used).
+  void eval_bands(const Vec3& wo, const Vec3& wi, Spectrum& out) const;
 
   // The backing term alone (0 without a backing), for the tests.
   Rgb eval_backing(const Vec3& wo, const Vec3& wi) const;

@@ -99,11 +99,8 @@ class RenderScene {
 
   // The BSDF of a hit's material (per mesh, or per fiber of a curve set).
   const Bsdf& bsdf(const SurfaceHit& hit) const;
-  // A spectral render's BSDF of a hit's material for band group 'band_group' (core/spectrum.h;
-  // -1: the RGB one). Call check_spectral once first.
-  const Bsdf& bsdf(const SurfaceHit& hit, int band_group) const;
   // Whether a spectral render can draw this scene: weft::Error naming the description's file and
-  // the field of the first material without spectral values (bsdfs.h band_group_bsdf), or a
+  // the field of the first material without spectral values (bsdfs.h spectral_obstacle), or a
   // light whose colour is not grey (an RGB colour is not a spectrum; grey is one, the same at
   // every wavelength).
   void check_spectral() const;
@@ -138,7 +135,6 @@ class RenderScene {
   struct Geometry;
   // The query context for a ray that leaves fiber 'ignore_fiber' (kNoFiber: none).
   FiberQueryContext query_context(int64_t ignore_fiber) const;
-  uint32_t bsdf_index(const SurfaceHit& hit) const;
   RenderScene() = default;
   void set_lights(const Lights& lights);
   std::shared_ptr<const Geometry> geo_;
