@@ -218,22 +218,36 @@ inline FitResult fit_inner_model(
   const std::vector<FitParameter> given = parameters;
   FitResult first, last;
   int evaluations = 0;
-  double seconds = 0;
+  double seconds = 0, moved = 0, previous_move = 0;
+  std::vector<std::vector<double>> restart_optima;  // of the searches after the first
   for (int stage = 0;; ++stage) {
     std::vector<double> x;
     for (const auto& p : parameters) x.push_back(p.start);
     const TabulatedBsdfTable proposal = table_of(x);
     FitOptions o = options;
     o.max_evaluations = options.max_evaluations - evaluations;
+    // A restart refines where the last search ended: its simplex spans twice the last move (the
+    // re-centred proposal moves the optimum by about the estimate's noise), at least 0.02 of the
+    // box, not the first search's whole step.
+    if (stage > 0) o.initial_step = std::clamp(2 * moved, 0.02, options.initial_step);
     last = fit_inplane(model, parameters, curves_of(&proposal), measured, o);
     evaluations += last.evaluations;
     seconds += last.seconds;
     if (stage == 0) first = last;
-    double moved = 0;
+    if (stage > 0) {
+      restart_optima.emplace_back();
+      for (const auto& p : last.parameters) restart_optima.back().push_back(p.value);
+    }
+    previous_move = moved;
+    moved = 0;
     for (size_t k = 0; k < parameters.size(); ++k)
       moved = std::max(moved, std::abs(fit_unit(parameters[k], last.parameters[k].value) -
                                        fit_unit(parameters[k], x[k])));
-    const bool settled = last.converged && moved < 0.01;
+    // Settled: the search stayed within 1 % of its proposal's point, or (from the second restart
+    // on) moved no more than the restart before it: the moves no longer shrink, so what is left is
+    // the estimate's own noise (each proposal is another realization of the ray trace), which
+    // further restarts would only chase.
+    const bool settled = last.converged && (moved < 0.01 || (stage >= 2 && moved <= previous_move));
     // A restart needs the simplex and a first step (FitOptions::validate).
     const int least = 2 * static_cast<int>(parameters.size()) + 2;
     if (settled || options.max_evaluations - evaluations < least) {
@@ -242,7 +256,15 @@ inline FitResult fit_inner_model(
     }
     for (size_t k = 0; k < parameters.size(); ++k) parameters[k].start = last.parameters[k].value;
   }
-  for (size_t k = 0; k < given.size(); ++k) last.parameters[k].parameter = given[k];
+  for (size_t k = 0; k < given.size(); ++k) {
+    last.parameters[k].parameter = given[k];
+    const size_t n = restart_optima.size();
+    if (n < 2) continue;
+    double mean = 0, ss = 0;
+    for (const auto& o : restart_optima) mean += o[k] / static_cast<double>(n);
+    for (const auto& o : restart_optima) ss += (o[k] - mean) * (o[k] - mean);
+    last.parameters[k].sigma_restarts = std::sqrt(ss / static_cast<double>(n - 1));
+  }
   last.objective_start = first.objective_start;
   last.start_metrics = first.start_metrics;
   last.evaluations = evaluations;

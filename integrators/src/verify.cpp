@@ -1098,6 +1098,8 @@ std::string verify_metrics_json(const VerifyReport& r) {
              {"log_scale", p.parameter.log_scale},
              {"value", p.value},
              {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma) : nlohmann::json()},
+             {"sigma_restarts", std::isfinite(p.sigma_restarts) ? nlohmann::json(p.sigma_restarts)
+                                                                : nlohmann::json()},
              {"at_bound", p.at_bound}});
       nlohmann::json e = {{"parameters", ps},
                           {"inner_model", f.inner_model},
@@ -1190,7 +1192,7 @@ std::string verify_index_html(const VerifyReport& r,
          "<p>Objective: RMS of ln(model / measured), absolute, of the inner model; then the fitted "
          "parameters at the run's quality (the models marked fitted above).</p>\n<table><tr>"
          "<th>model</th><th>parameter</th><th>start</th><th>box</th><th>fitted</th><th>sigma</th>"
-         "</tr>\n";
+         "<th>sigma over restarts</th></tr>\n";
     for (const auto& f : r.fits)
       for (const auto& p : f.parameters)
         h << "<tr><td>" << html_escape(f.model) << "</td><td>" << html_escape(p.parameter.name)
@@ -1198,7 +1200,9 @@ std::string verify_index_html(const VerifyReport& r,
           << "</td><td>" << fmt(p.parameter.start, 4) << "</td><td>[" << fmt(p.parameter.lo, 4)
           << ", " << fmt(p.parameter.hi, 4) << "]</td><td>" << fmt(p.value, 4)
           << (p.at_bound ? " (at bound)" : "") << "</td><td>"
-          << (std::isfinite(p.sigma) ? fmt(p.sigma, 2) : std::string("&mdash;")) << "</td></tr>\n";
+          << (std::isfinite(p.sigma) ? fmt(p.sigma, 2) : std::string("&mdash;")) << "</td><td>"
+          << (std::isfinite(p.sigma_restarts) ? fmt(p.sigma_restarts, 2) : std::string("&mdash;"))
+          << "</td></tr>\n";
     h << "</table>\n<table><tr><th>model</th><th>inner RMS log, start</th><th>inner RMS log, "
          "fitted</th><th>evaluations</th><th>converged</th><th>seconds</th></tr>\n";
     for (const auto& f : r.fits)

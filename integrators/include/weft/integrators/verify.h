@@ -28,6 +28,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -216,6 +217,11 @@ struct FitParameterResult {
   double value = 0;
   double sigma = 0;       // one standard deviation (NaN where the Jacobian does not determine it)
   bool at_bound = false;  // within 1e-3 of the box's edge (a constrained optimum)
+  // The ray-trace inner model's restarts (fit_inner_model): the standard deviation of the optima
+  // of the searches after the first, each on its own proposal, i.e. another realization of the
+  // ray trace's noise (NaN with fewer than two). What sigma leaves out: the noise is correlated
+  // across the residuals, so it moves the optimum more than independent residuals would.
+  double sigma_restarts = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct FitResult {
