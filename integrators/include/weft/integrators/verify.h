@@ -387,9 +387,10 @@ inline constexpr const char* kVerifyWeaveRenderSetup =
 // measured BRDF (report.measured_nbrdf) in reflection; and where the report holds the sample at
 // fiber detail, the fibers with the computed and classic fiber tables in both configurations
 // (verify_weave_scene; stems render-weave-CONFIGURATION-MODEL). The tables are written into
-// 'folder' first (fabric-computed.exr, fabric-classic.exr, fiber-computed.exr, fiber-classic.exr,
-// RGB), where the renderer reads them as any scene's fabric_table or fiber_table; the images are
-// returned, not written.
+// 'folder' first (fabric-computed.exr, fabric-classic.exr, fiber-classic.exr in RGB;
+// fiber-computed.exr as the model has it, spectral, and rendered as a spectral render), where the
+// renderer reads them as any scene's fabric_table or fiber_table; the images are returned, not
+// written.
 struct VerifyReport;
 std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& folder,
                                                 const VerifyReport& report);
