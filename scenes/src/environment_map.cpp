@@ -194,6 +194,17 @@ Rgb EnvironmentMap::eval(const LightHit& hit) const {
   return hit.escaped ? radiance(hit.dir) : Rgb(0.0);
 }
 
+bool EnvironmentMap::grey() const {
+  const Rgb& s = data_->scale;
+  const std::vector<float>& v = data_->texels.rgb;
+  bool same = true;
+  for (size_t k = 0; same && k + 2 < v.size(); k += 3) {
+    const double r = v[k] * s.r, g = v[k + 1] * s.g, b = v[k + 2] * s.b;
+    same = r == g && g == b;
+  }
+  return same;
+}
+
 Rgb EnvironmentMap::integral() const {
   const EnvironmentTexels& t = data_->texels;
   Rgb sum(0.0);

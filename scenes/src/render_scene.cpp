@@ -607,7 +607,7 @@ void RenderScene::check_spectral() const {
           } else if constexpr (std::is_same_v<T, EnvironmentLight>) {
             if (!grey(l.radiance)) refuse("the environment's radiance is coloured");
           } else if constexpr (std::is_same_v<T, EnvironmentMap>) {
-            refuse("an environment map is an RGB image");
+            if (!l.grey()) refuse("an environment map's texels are coloured");
           }
         },
         light.variant());

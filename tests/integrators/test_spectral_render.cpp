@@ -84,27 +84,30 @@ SceneDescription enclosure(const json& material) {
   return parse_scene_description(j, ".", "enclosure.json");
 }
 
-// A unit quad of 'material' under parallel light at normal incidence, seen at 30 deg.
-SceneDescription patch(const json& material, const json& light_irradiance = 1.0) {
-  const json j = {{"objects",
-                   {{{"type", "quad"},
-                     {"name", "cloth"},
-                     {"material", "cloth"},
-                     {"center", {0, 0, 0}},
-                     {"normal", {0, 1, 0}},
-                     {"tangent", {1, 0, 0}},
-                     {"size", {1, 1}}}}},
-                  {"materials", {{"cloth", material}}},
-                  {"lights",
-                   {{{"type", "parallel"},
-                     {"irradiance", light_irradiance},
-                     {"zenith_deg", 0.0},
-                     {"azimuth_deg", 0.0}}}},
-                  {"camera",
-                   {{"type", "orthographic"},
-                    {"frame_object", "cloth"},
-                    {"zenith_deg", 30.0},
-                    {"azimuth_deg", 180.0}}}};
+// A unit quad of 'material' under parallel light at normal incidence, seen at 30 deg ('lights'
+// replaces the light when given).
+SceneDescription patch(const json& material, const json& light_irradiance = 1.0,
+                       const json& lights = nullptr) {
+  json j = {{"objects",
+             {{{"type", "quad"},
+               {"name", "cloth"},
+               {"material", "cloth"},
+               {"center", {0, 0, 0}},
+               {"normal", {0, 1, 0}},
+               {"tangent", {1, 0, 0}},
+               {"size", {1, 1}}}}},
+            {"materials", {{"cloth", material}}},
+            {"lights",
+             {{{"type", "parallel"},
+               {"irradiance", light_irradiance},
+               {"zenith_deg", 0.0},
+               {"azimuth_deg", 0.0}}}},
+            {"camera",
+             {{"type", "orthographic"},
+              {"frame_object", "cloth"},
+              {"zenith_deg", 30.0},
+              {"azimuth_deg", 180.0}}}};
+  if (!lights.is_null()) j["lights"] = lights;
   return parse_scene_description(j, ".", "patch.json");
 }
 
@@ -241,6 +244,20 @@ TEST(SpectralRender, RefusesMaterialsAndLightsWithoutASpectrum) {
   const std::string light = refusal(patch(spectral_table, {1.0, 0.9, 0.9}));
   EXPECT_NE(light.find("lights"), std::string::npos) << light;
   EXPECT_NE(light.find("parallel"), std::string::npos) << light;
+  // A CIE clear sky of a grey zenith radiance is grey everywhere; of a coloured one, refused.
+  for (const json& zenith : {json(1.0), json({1.0, 1.0, 1.2})}) {
+    const json sky = {{{"type", "sky"},
+                       {"zenith_radiance", zenith},
+                       {"sun_zenith_deg", 40.0},
+                       {"sun_azimuth_deg", 0.0},
+                       {"resolution", {32, 16}}}};
+    const std::string e = refusal(patch(spectral_table, 1.0, sky));
+    if (zenith.is_number()) {
+      EXPECT_EQ(e, "");
+    } else {
+      EXPECT_NE(e.find("environment map"), std::string::npos) << e;
+    }
+  }
   // The same scenes render in RGB.
   s.spectral = false;
   EXPECT_EQ(refusal(patch(spectral_table, {1.0, 0.9, 0.9})), "");

@@ -71,6 +71,9 @@ class EnvironmentMap {
   // Integral of the radiance over the sphere (W m^-2 per channel... radiance times sr), exact for
   // the piecewise-constant map; for tests.
   Rgb integral() const;
+  // Whether every texel times the scale has equal R, G and B (one colour at every wavelength, as
+  // a spectral render needs: a CIE sky of a grey zenith radiance is).
+  bool grey() const;
 
  private:
   struct Data {
