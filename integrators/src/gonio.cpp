@@ -158,7 +158,7 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
     if (!(std::abs(v) < 90)) throw Error(src, "view_zenith_deg", "views must lie in (-90, 90)");
   if (!(g.irradiance.r > 0 && g.irradiance.g > 0 && g.irradiance.b > 0))
     throw Error(src, "irradiance", "must be positive in every channel");
-  if (g.spectral && !(g.irradiance.r == g.irradiance.g && g.irradiance.g == g.irradiance.b))
+  if (g.spectral && !g.irradiance.is_grey())
     throw Error(src, "irradiance",
                 "a spectral sweep needs a grey irradiance (equal R, G and B: the same at every "
                 "wavelength)");

@@ -6,10 +6,6 @@
 namespace weft {
 namespace {
 
-bool grey(const Rgb& c) {
-  return c.r == c.g && c.g == c.b;
-}
-
 // The material's table when it is read per band (a spectral table), else null: a grey material.
 const TabulatedBsdf* band_table(const Bsdf& bsdf) {
   const auto* t = std::get_if<TabulatedBsdf>(&bsdf.variant());
@@ -23,18 +19,18 @@ std::string spectral_obstacle(const Bsdf& bsdf) {
       [&](const auto& b) -> std::string {
         using T = std::decay_t<decltype(b)>;
         if constexpr (std::is_same_v<T, LambertBsdf>) {
-          if (!grey(b.reflectance))
+          if (!b.reflectance.is_grey())
             return "a coloured lambert reflectance is RGB, not a spectrum (give it grey)";
         } else if constexpr (std::is_same_v<T, CookTorranceBsdf>) {
-          if (!grey(b.tint))
+          if (!b.tint.is_grey())
             return "a coloured cook_torrance tint is RGB, not a spectrum (give it grey)";
         } else if constexpr (std::is_same_v<T, ClassicFiberBsdf>) {
-          if (!grey(b.reflectance) || !grey(b.surface.tint))
+          if (!b.reflectance.is_grey() || !b.surface.tint.is_grey())
             return "a coloured classic_fiber reflectance is RGB, not a spectrum (give it grey)";
         } else if constexpr (std::is_same_v<T, TabulatedBsdf>) {
           if (!b.data || b.data->bands.empty())
             return "an RGB table has no spectral values (bake a spectral one)";
-          if (!grey(b.scale))
+          if (!b.scale.is_grey())
             return "a coloured tint on a spectral table is RGB, not a spectrum (give it grey)";
           if (b.backing) return "a table on a backing is rendered in RGB only";
         } else {

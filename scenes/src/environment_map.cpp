@@ -194,13 +194,12 @@ Rgb EnvironmentMap::eval(const LightHit& hit) const {
   return hit.escaped ? radiance(hit.dir) : Rgb(0.0);
 }
 
-bool EnvironmentMap::grey() const {
+bool EnvironmentMap::is_grey() const {
   const Rgb& s = data_->scale;
   const std::vector<float>& v = data_->texels.rgb;
   bool same = true;
   for (size_t k = 0; same && k + 2 < v.size(); k += 3) {
-    const double r = v[k] * s.r, g = v[k + 1] * s.g, b = v[k + 2] * s.b;
-    same = r == g && g == b;
+    same = Rgb(v[k] * s.r, v[k + 1] * s.g, v[k + 2] * s.b).is_grey();
   }
   return same;
 }

@@ -476,8 +476,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   geo->area_light = AreaLight(desc.meshes, emission);
   geo->source = desc.source;
   for (const AreaLight::Emission& e : emission)
-    geo->grey_emission =
-        geo->grey_emission && e.radiance.r == e.radiance.g && e.radiance.g == e.radiance.b;
+    geo->grey_emission = geo->grey_emission && e.radiance.is_grey();
   for (size_t i = 0; i < geo->meshes.size(); ++i)
     geo->meshes[i].emits = geo->area_light.emits(static_cast<uint32_t>(i));
   geo_ = std::move(geo);
@@ -588,7 +587,6 @@ void RenderScene::check_spectral() const {
   if (!geo_->spectral_why.empty())
     throw Error(geo_->source, geo_->spectral_field,
                 "a spectral render needs spectral values of every material: " + geo_->spectral_why);
-  auto grey = [](const Rgb& c) { return c.r == c.g && c.g == c.b; };
   auto refuse = [&](const std::string& what) {
     throw Error(geo_->source, "lights",
                 "a spectral render needs lights of one colour at every wavelength (grey: equal R, "
@@ -601,13 +599,13 @@ void RenderScene::check_spectral() const {
         [&](const auto& l) {
           using T = std::decay_t<decltype(l)>;
           if constexpr (std::is_same_v<T, DirectionalLight>) {
-            if (!grey(l.irradiance)) refuse("a parallel light's irradiance is coloured");
+            if (!l.irradiance.is_grey()) refuse("a parallel light's irradiance is coloured");
           } else if constexpr (std::is_same_v<T, PointLight>) {
-            if (!grey(l.intensity)) refuse("a point light's intensity is coloured");
+            if (!l.intensity.is_grey()) refuse("a point light's intensity is coloured");
           } else if constexpr (std::is_same_v<T, EnvironmentLight>) {
-            if (!grey(l.radiance)) refuse("the environment's radiance is coloured");
+            if (!l.radiance.is_grey()) refuse("the environment's radiance is coloured");
           } else if constexpr (std::is_same_v<T, EnvironmentMap>) {
-            if (!l.grey()) refuse("an environment map's texels are coloured");
+            if (!l.is_grey()) refuse("an environment map's texels are coloured");
           }
         },
         light.variant());

@@ -48,6 +48,8 @@ struct Rgb {
   constexpr double max_component() const { return r > g ? (r > b ? r : b) : (g > b ? g : b); }
   constexpr double average() const { return (r + g + b) / 3.0; }
   constexpr bool is_black() const { return r == 0 && g == 0 && b == 0; }
+  // Equal components: the one colour that is also a spectrum (the same value at every band).
+  constexpr bool is_grey() const { return r == g && g == b; }
   constexpr bool operator==(const Rgb&) const = default;
 };
 constexpr Rgb operator+(Rgb a, const Rgb& b) {

@@ -73,7 +73,7 @@ class EnvironmentMap {
   Rgb integral() const;
   // Whether every texel times the scale has equal R, G and B (one colour at every wavelength, as
   // a spectral render needs: a CIE sky of a grey zenith radiance is).
-  bool grey() const;
+  bool is_grey() const;
 
  private:
   struct Data {
