@@ -4,6 +4,7 @@
 #include <array>
 #include <charconv>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <memory>
 #include <span>
@@ -304,6 +305,32 @@ void fabric_raytrace_totals(FabricRaytraceResult& r) {
   r.relative_noise = all_signal2 > 0 ? std::sqrt(all_noise2 / all_signal2) : 0.0;
 }
 
+namespace {
+
+// A fiber sends out at most the light that hits it: a table's total albedo (the bake's exit
+// fraction) is at most 1. Above it, path weights grow from fiber to fiber, and the trace would run
+// for minutes before they overflow (a synthetic table of total albedo 1.9 did: tens of CPU
+// minutes), so it is refused before any work. The allowance is for a table's tabulation error:
+// the classic fiber at reflectance 1 (lossless, total albedo 1 by construction) tabulates to
+// at most kFiberAlbedoAllowance above 1 (test_fabric_raytrace.cpp).
+constexpr double kFiberAlbedoAllowance = 0.01;
+
+void check_fiber_energy(const TabulatedBsdfTable& t, const std::string& field) {
+  const std::vector<double> a = t.total_albedo();
+  for (size_t c = 0; c < a.size(); ++c)
+    if (!(a[c] <= 1 + kFiberAlbedoAllowance)) {
+      char v[32];
+      std::snprintf(v, sizeof v, "%.4g", a[c]);
+      throw Error("", field,
+                  std::string("the fiber table's total albedo is ") + v + " in channel " +
+                      std::to_string(c) +
+                      ": a fiber sends out at most the light that hits it (at most 1, the bake's "
+                      "exit fraction); bake it with weft bake fiber");
+    }
+}
+
+}  // namespace
+
 FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                                            const TabulatedBsdfTable& fiber,
                                            const FabricRaytraceOptions& o,
@@ -311,6 +338,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   o.validate();
   fiber.validate("");
   if (fiber.kind != "fiber") throw Error("", "fiber", "expected a fiber table, got " + fiber.kind);
+  check_fiber_energy(fiber, "fiber");
   const double px = sample.summary.period_x_mm * kMetresPerMm;
   const double pz = sample.summary.period_z_mm * kMetresPerMm;
   const double y0 = sample.summary.y_min_mm * kMetresPerMm;
@@ -327,6 +355,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
       throw Error("", "proposal",
                   "the proposal must be a fiber table of the traced table's resolution and "
                   "channels");
+    check_fiber_energy(*o.proposal, "proposal");
   }
   // With a proposal, paths are drawn from it and the choices that end or split a path are made on
   // the weights it gives (wp); the traced table's weights (w) follow the same path, each step

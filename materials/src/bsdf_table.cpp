@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <numbers>
 #include <numeric>
 #include <set>
 #include <utility>
@@ -233,6 +234,18 @@ TabulatedBsdfTable::DirectionalAlbedo TabulatedBsdfTable::directional_albedo_see
     auto& side = g.upper(wi) == g.upper(wo_bin) ? out.reflectance : out.transmittance;
     for (int c = 0; c < channels; ++c) side[c] += at(wi, wo_bin, c) * d[static_cast<size_t>(wi)];
   }
+  return out;
+}
+
+std::vector<double> TabulatedBsdfTable::total_albedo() const {
+  const DirectionGrid g = grid();
+  const auto d = g.cosine_weighted_areas();
+  std::vector<double> out(static_cast<size_t>(channels), 0.0);
+  for (int wi = 0; wi < g.bins(); ++wi)
+    for (int wo = 0; wo < g.bins(); ++wo)
+      for (int c = 0; c < channels; ++c)
+        out[static_cast<size_t>(c)] += at(wi, wo, c) * d[static_cast<size_t>(wi)] *
+                                       d[static_cast<size_t>(wo)] / std::numbers::pi;
   return out;
 }
 

@@ -156,6 +156,11 @@ struct TabulatedBsdfTable {
   // never transmitted, directional_albedo's transmittance is 0), while light from below passes
   // through the fiber to a view from above (this one's transmittance is 0.6-0.8 for red cotton).
   DirectionalAlbedo directional_albedo_seen_from(int wo_bin) const;
+  // The total albedo per channel, (1/pi) sum_i sum_o f[i][o] D_i D_o (D: the bins' cosine-weighted
+  // areas, core/direction_grid.h). For a fiber table it is the fraction of the light hitting the
+  // fiber that leaves it, at most 1: the bake's exit_fraction, which the bake states is the same
+  // sum (fiber_table_bake.h FiberBandSummary::energy_table).
+  std::vector<double> total_albedo() const;
 };
 
 }  // namespace weft
