@@ -165,8 +165,9 @@ TEST(TableBsdf, SpectralTablesReduceToRgbUnderD65) {
   t.resolution = 2;
   t.channels = kNumBands;
   t.values.assign(static_cast<size_t>(t.bins()) * t.bins() * kNumBands, 0.3f);
-  // A flat spectrum reduces to grey: D65 white maps to linear sRGB (1, 1, 1) (IEC 61966-2-1
-  // white point), so 0.3 per band -> 0.3 per channel, to the matrix's 4 printed digits.
+  // A flat spectrum reduces to grey: D65 white maps to linear sRGB (0.99942, 1.00036, 0.99878)
+  // (the IEC 61966-2-1 matrix's white against the 10 nm CIE and D65 tables, core/spectrum.h), so
+  // 0.3 per band -> 0.3 per channel within 3.7e-4.
   auto d = TabulatedBsdfData::prepare(t);
   EXPECT_EQ(d->clamped_components, 0u);
   const Rgb c = d->lookup(1, 2);

@@ -88,7 +88,9 @@ double linear_to_srgb_gamma(double linear);
 Hsv rgb_to_hsv(const Rgb& rgb);
 
 // Spectrum -> linear sRGB weights per band: rgb = sum_b w[b] * value[b], for rendering
-// spectral tables in an RGB renderer under D65 (white reflectance 1 -> rgb (1,1,1)).
+// spectral tables in an RGB renderer under D65. White reflectance 1 gives (0.99942, 1.00036,
+// 0.99878), not exactly (1, 1, 1): the IEC matrix's white is D65's chromaticity, not that of the
+// 10 nm CIE 1931 and D65 tables summed here (no white balance is applied).
 const std::array<Rgb, kNumBands>& srgb_band_weights_d65();
 
 // The one spectral -> RGB reduction of tabulated quantities (BSDF tables, albedos): linear sRGB
