@@ -37,9 +37,11 @@ struct VerifyCliOptions {
       "dye_scale,particle_fraction_scale,particle_radius_scale,roughness_alpha";
   int fit_evaluations = 100;
   std::string fit_inner = "raytrace";
+  std::string fit_method = "lm";
   std::string classic_albedo;
   std::string shard;  // --shard K/N
-  bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false;
+  bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false,
+       fit_method_given = false;
   uint64_t seed = 1;
   int threads = 0;
   bool quiet = false, json = false;
@@ -304,11 +306,18 @@ VerifyPlan plan(const VerifyCliOptions& o) {
     if (!o.shard.empty()) throw Error("", "--fit", "runs in one process, not with --shard");
     p.fit_names = parse_spec_fit_names(o.fit_params);
     (void)parse_fit_inner(o.fit_inner);
+    p.fit_options.method = parse_fit_method(o.fit_method);
     p.fit_options.max_evaluations = o.fit_evaluations;
     p.fit_options.validate(4);                       // the classic model always fits four
     (void)spec_fit_parameters(p.spec, p.fit_names);  // a spec without particles is refused here
-  } else if (o.fit_params_given || o.fit_evaluations_given) {
-    throw Error("", o.fit_params_given ? "--fit-params" : "--fit-evaluations", "only with --fit");
+  } else if (o.fit_params_given || o.fit_evaluations_given || o.fit_inner_given ||
+             o.fit_method_given) {
+    throw Error("",
+                o.fit_params_given        ? "--fit-params"
+                : o.fit_evaluations_given ? "--fit-evaluations"
+                : o.fit_inner_given       ? "--fit-inner"
+                                          : "--fit-method",
+                "only with --fit");
   }
   return p;
 }
@@ -569,6 +578,11 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                   "(the paper's summation table: cheaper, no light between fibers)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_inner_given = true; });
+  sub->add_option("--fit-method", o->fit_method,
+                  "the search: lm (Levenberg-Marquardt on the log residuals) or nelder-mead "
+                  "(derivative-free, slower from a distant start)")
+      ->capture_default_str()
+      ->each([o](const std::string&) { o->fit_method_given = true; });
   sub->add_option("--classic-albedo", o->classic_albedo,
                   "the classic baseline's diffuse colour R,G,B (linear sRGB reflectances); "
                   "default: the spec's volume albedo, or for a fiber table its total albedo "

@@ -201,8 +201,9 @@ inline std::vector<std::vector<Rgb>> classic_inner_curves(
 // from the proposal, so the proposal is then re-centred on the optimum and the search restarted
 // there, until a search converges without moving more than 1 % of any box (in the search's unit
 // cube) from its proposal's point, or the evaluations are spent (options.max_evaluations over
-// all stages; each stage's uncertainty adds its 2 p). The result: the last stage's optimum and
-// uncertainty, the first's start, the evaluations and seconds of all.
+// all stages; the uncertainty, computed once at the last stage's optimum with its proposal, adds
+// 2 p + 1). The result: the last stage's optimum and uncertainty, the first's start, the
+// evaluations and seconds of all.
 inline FitResult fit_inner_model(
     const std::string& model, std::vector<FitParameter> parameters,
     const std::function<TabulatedBsdfTable(const std::vector<double>&)>& table_of,
@@ -220,15 +221,18 @@ inline FitResult fit_inner_model(
   int evaluations = 0;
   double seconds = 0, moved = 0, previous_move = 0;
   std::vector<std::vector<double>> restart_optima;  // of the searches after the first
+  TabulatedBsdfTable proposal;
   for (int stage = 0;; ++stage) {
     std::vector<double> x;
     for (const auto& p : parameters) x.push_back(p.start);
-    const TabulatedBsdfTable proposal = table_of(x);
+    proposal = table_of(x);
     FitOptions o = options;
     o.max_evaluations = options.max_evaluations - evaluations;
+    o.uncertainty = false;  // the last stage's, once it is known to be the last (below)
     // A restart refines where the last search ended: its simplex spans twice the last move (the
     // re-centred proposal moves the optimum by about the estimate's noise), at least 0.02 of the
     // box, not the first search's whole step.
+    // (Nelder-Mead's; Levenberg-Marquardt takes its steps from the Jacobian.)
     if (stage > 0) o.initial_step = std::clamp(2 * moved, 0.02, options.initial_step);
     last = fit_inplane(model, parameters, curves_of(&proposal), measured, o);
     evaluations += last.evaluations;
@@ -269,6 +273,7 @@ inline FitResult fit_inner_model(
   last.start_metrics = first.start_metrics;
   last.evaluations = evaluations;
   last.seconds = seconds;
+  if (options.uncertainty) add_fit_uncertainty(last, curves_of(&proposal), measured, options);
   return last;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -669,26 +670,14 @@ TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistr
   return t;
 }
 
-std::vector<double> table_total_albedo(const TabulatedBsdfTable& t) {
-  const DirectionGrid g = t.grid();
-  const std::vector<double> d = g.cosine_weighted_areas();
-  std::vector<double> out(static_cast<size_t>(t.channels), 0.0);
-  for (int i = 0; i < g.bins(); ++i) {
-    const auto a = t.directional_albedo(i);
-    for (int c = 0; c < t.channels; ++c) out[c] += d[static_cast<size_t>(i)] * a.total(c) / kPi;
-  }
-  return out;
-}
-
 std::vector<double> classic_diffuse_from_fiber_table(const TabulatedBsdfTable& fiber,
                                                      const MicrofacetDistribution& d, double ior,
                                                      uint64_t seed, int threads) {
   // The lobe at a fixed fine resolution, not the table's: at R = 3 with 4 samples per cell pair
   // the tabulated lobe loses a fifth of its albedo (0.0587 for Beckmann 0.35, n 1.557); at R = 16
   // it is within 0.0002 of its value at R = 24 with 16 samples (0.0729).
-  const double lobe =
-      table_total_albedo(classic_fiber_table(Rgb(0.0), d, ior, 16, 4, seed, threads))[0];
-  std::vector<double> out = table_total_albedo(fiber);
+  const double lobe = classic_fiber_table(Rgb(0.0), d, ior, 16, 4, seed, threads).total_albedo()[0];
+  std::vector<double> out = fiber.total_albedo();
   for (double& v : out) v -= lobe;
   return out;
 }
@@ -825,7 +814,244 @@ bool invert(std::vector<std::vector<double>>& a) {
   return true;
 }
 
+// A search's outcome in the unit cube.
+struct FitSearch {
+  std::vector<double> u;
+  double objective_start = 0, objective = 0;
+  bool converged = false;
+};
+
+using ResidualsAt = std::function<std::vector<double>(const std::vector<double>&)>;
+
+std::vector<double> clamped(std::vector<double> u) {
+  for (double& x : u) x = std::clamp(x, 0.0, 1.0);
+  return u;
+}
+
+// Nelder-Mead (standard coefficients 1, 2, 0.5, 0.5) on the RMS of the residuals in the unit
+// cube; points are projected into the cube, so every evaluation is a valid parameter set.
+// 'at_start' runs right after the start's evaluation.
+FitSearch nelder_mead(const ResidualsAt& residuals_at, const std::vector<double>& u0,
+                      const FitOptions& o, const std::function<void()>& at_start) {
+  const size_t n = u0.size();
+  int evaluations = 0;
+  auto objective = [&](const std::vector<double>& u) {
+    ++evaluations;
+    return rms(residuals_at(u));
+  };
+  FitSearch out;
+  std::vector<std::vector<double>> simplex{u0};
+  for (size_t k = 0; k < n; ++k) {
+    auto u = u0;
+    u[k] += u[k] + o.initial_step <= 1 ? o.initial_step : -o.initial_step;
+    simplex.push_back(u);
+  }
+  std::vector<double> f;
+  for (const auto& u : simplex) {
+    f.push_back(objective(u));
+    if (f.size() == 1) at_start();
+  }
+  out.objective_start = f[0];
+  while (evaluations < o.max_evaluations) {
+    std::vector<size_t> order(n + 1);
+    for (size_t k = 0; k <= n; ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return f[a] < f[b]; });
+    std::vector<std::vector<double>> s2;
+    std::vector<double> f2;
+    for (size_t k : order) {
+      s2.push_back(simplex[k]);
+      f2.push_back(f[k]);
+    }
+    simplex = std::move(s2);
+    f = std::move(f2);
+    double size = 0;
+    for (size_t k = 1; k <= n; ++k)
+      for (size_t d = 0; d < n; ++d) size = std::max(size, std::abs(simplex[k][d] - simplex[0][d]));
+    if (f[n] - f[0] < o.tolerance && size < 1e-3) {
+      out.converged = true;
+      break;
+    }
+    std::vector<double> centroid(n, 0.0);
+    for (size_t k = 0; k < n; ++k)
+      for (size_t d = 0; d < n; ++d) centroid[d] += simplex[k][d] / static_cast<double>(n);
+    auto along = [&](double t) {
+      std::vector<double> u(n);
+      for (size_t d = 0; d < n; ++d) u[d] = centroid[d] + t * (simplex[n][d] - centroid[d]);
+      return clamped(u);
+    };
+    const auto ur = along(-1.0);
+    const double fr = objective(ur);
+    if (fr < f[0]) {
+      const auto ue = along(-2.0);
+      const double fe = objective(ue);
+      if (fe < fr) {
+        simplex[n] = ue;
+        f[n] = fe;
+      } else {
+        simplex[n] = ur;
+        f[n] = fr;
+      }
+    } else if (fr < f[n - 1]) {
+      simplex[n] = ur;
+      f[n] = fr;
+    } else {
+      const bool outside = fr < f[n];
+      const auto uc = along(outside ? -0.5 : 0.5);
+      const double fc = objective(uc);
+      if (fc < (outside ? fr : f[n])) {
+        simplex[n] = uc;
+        f[n] = fc;
+      } else {  // shrink towards the best point
+        for (size_t k = 1; k <= n; ++k) {
+          for (size_t d = 0; d < n; ++d)
+            simplex[k][d] = simplex[0][d] + 0.5 * (simplex[k][d] - simplex[0][d]);
+          f[k] = objective(simplex[k]);
+        }
+      }
+    }
+  }
+  size_t best = 0;
+  for (size_t k = 1; k <= n; ++k)
+    if (f[k] < f[best]) best = k;
+  out.u = simplex[best];
+  out.objective = f[best];
+  return out;
+}
+
+// Levenberg-Marquardt on the residuals in the unit cube (Marquardt's scaling by diag(J^T J),
+// Nielsen's update of the damping). The Jacobian is by one-sided differences towards the cube's
+// inside (n evaluations); a step is projected into the cube, and a parameter at its bound whose
+// gradient points outside is held there. Converged when an accepted step lowers the RMS by less
+// than the tolerance and the step's linear model predicted no more, or when no step of more than
+// 1e-3 of a box is left to try (the damping has shrunk it to nothing: no descent at this scale).
+FitSearch levenberg_marquardt(const ResidualsAt& residuals_at, const std::vector<double>& u0,
+                              const FitOptions& o, const std::function<void()>& at_start) {
+  const size_t n = u0.size();
+  int evaluations = 0;
+  auto eval = [&](const std::vector<double>& u) {
+    ++evaluations;
+    return residuals_at(u);
+  };
+  auto sum_sq = [](const std::vector<double>& r) {
+    double s = 0;
+    for (double x : r) s += x * x;
+    return s;
+  };
+  FitSearch out;
+  out.u = u0;
+  std::vector<double> r = eval(u0);
+  at_start();
+  const size_t m = r.size();
+  const double count = static_cast<double>(std::max<size_t>(m, 1));
+  double ssr = sum_sq(r);
+  out.objective_start = std::sqrt(ssr / count);
+  double lambda = -1, nu = 2;
+  while (evaluations + static_cast<int>(n) + 1 <= o.max_evaluations) {
+    std::vector<std::vector<double>> jac(n, std::vector<double>(m));
+    for (size_t k = 0; k < n; ++k) {
+      auto up = out.u;
+      const double h = out.u[k] + o.jacobian_step <= 1 ? o.jacobian_step : -o.jacobian_step;
+      up[k] += h;
+      const std::vector<double> rp = eval(up);
+      for (size_t i = 0; i < m; ++i) jac[k][i] = (rp[i] - r[i]) / h;
+    }
+    std::vector<std::vector<double>> a(n, std::vector<double>(n, 0.0));
+    std::vector<double> g(n, 0.0);  // J^T r: half the gradient of the SSR
+    for (size_t p = 0; p < n; ++p) {
+      for (size_t i = 0; i < m; ++i) g[p] += jac[p][i] * r[i];
+      for (size_t q = 0; q < n; ++q)
+        for (size_t i = 0; i < m; ++i) a[p][q] += jac[p][i] * jac[q][i];
+    }
+    double diag_max = 0;
+    for (size_t k = 0; k < n; ++k) diag_max = std::max(diag_max, a[k][k]);
+    if (!(diag_max > 0)) {  // the residuals do not move: nothing to descend
+      out.converged = true;
+      break;
+    }
+    if (lambda < 0) lambda = 1e-3 * diag_max;
+    bool stepped = false, stop = false;
+    while (!stepped && !stop) {
+      std::vector<size_t> free;
+      for (size_t k = 0; k < n; ++k)
+        if (!((out.u[k] <= 0 && g[k] > 0) || (out.u[k] >= 1 && g[k] < 0))) free.push_back(k);
+      std::vector<double> s(n, 0.0);
+      bool solved = !free.empty();
+      if (solved) {
+        std::vector<std::vector<double>> b(free.size(), std::vector<double>(free.size()));
+        for (size_t p = 0; p < free.size(); ++p)
+          for (size_t q = 0; q < free.size(); ++q)
+            b[p][q] = a[free[p]][free[q]] +
+                      (p == q ? lambda * std::max(a[free[p]][free[p]], 1e-9 * diag_max) : 0.0);
+        solved = invert(b);
+        if (solved) {
+          std::vector<double> un = out.u;
+          for (size_t p = 0; p < free.size(); ++p) {
+            double d = 0;
+            for (size_t q = 0; q < free.size(); ++q) d -= b[p][q] * g[free[q]];
+            un[free[p]] += d;
+          }
+          un = clamped(un);
+          for (size_t k = 0; k < n; ++k) s[k] = un[k] - out.u[k];
+        }
+      }
+      double longest = 0;
+      for (double x : s) longest = std::max(longest, std::abs(x));
+      if (!solved || longest < 1e-3) {
+        out.converged = true;
+        stop = true;
+        break;
+      }
+      if (evaluations + 1 > o.max_evaluations) {
+        stop = true;
+        break;
+      }
+      // The linear model's decrease of the SSR along the (projected) step: -(2 g.s + s.A s).
+      double predicted = 0;
+      for (size_t p = 0; p < n; ++p) {
+        predicted -= 2 * g[p] * s[p];
+        for (size_t q = 0; q < n; ++q) predicted -= s[p] * a[p][q] * s[q];
+      }
+      std::vector<double> un = out.u;
+      for (size_t k = 0; k < n; ++k) un[k] += s[k];
+      std::vector<double> rn = eval(un);
+      const double ssr_new = sum_sq(rn);
+      if (ssr_new < ssr) {
+        const double rho = predicted > 0 ? (ssr - ssr_new) / predicted : 0.0;
+        const double drop = std::sqrt(ssr / count) - std::sqrt(ssr_new / count);
+        const double drop_predicted =
+            std::sqrt(ssr / count) - std::sqrt(std::max(0.0, ssr - predicted) / count);
+        out.u = un;
+        r = std::move(rn);
+        ssr = ssr_new;
+        lambda *= std::max(1.0 / 3.0, 1 - std::pow(2 * rho - 1, 3));
+        nu = 2;
+        stepped = true;
+        if (drop < o.tolerance && drop_predicted < o.tolerance) {
+          out.converged = true;
+          stop = true;
+        }
+      } else {
+        lambda *= nu;
+        nu *= 2;
+      }
+    }
+    if (stop) break;
+  }
+  out.objective = std::sqrt(ssr / count);
+  return out;
+}
+
 }  // namespace
+
+FitMethod parse_fit_method(const std::string& name) {
+  if (name == "lm") return FitMethod::kLevenbergMarquardt;
+  if (name == "nelder-mead") return FitMethod::kNelderMead;
+  throw Error("", "--fit-method", "'" + name + "' is not lm or nelder-mead");
+}
+
+std::string fit_method_name(FitMethod method) {
+  return method == FitMethod::kNelderMead ? "nelder-mead" : "lm";
+}
 
 double fit_unit(const FitParameter& p, double x) {
   return p.log_scale ? (std::log(x) - std::log(p.lo)) / (std::log(p.hi) - std::log(p.lo))
@@ -864,95 +1090,50 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
     last = inplane(values_of(u));
     return fit_residuals(last, measured);
   };
-  auto objective = [&](const std::vector<double>& u) { return rms(residuals_at(u)); };
-
-  // Nelder-Mead (standard coefficients 1, 2, 0.5, 0.5) on the unit cube; points are projected
-  // into the cube, so every evaluation is a valid parameter set.
-  auto project = [](std::vector<double> u) {
-    for (double& x : u) x = std::clamp(x, 0.0, 1.0);
-    return u;
-  };
   std::vector<double> u0(n);
   for (size_t k = 0; k < n; ++k) u0[k] = fit_unit(params[k], params[k].start);
-  std::vector<std::vector<double>> simplex{u0};
+  const std::function<void()> at_start = [&] {
+    res.start_metrics = absolute_metrics(last, measured);
+  };
+  const FitSearch search = o.method == FitMethod::kNelderMead
+                               ? nelder_mead(residuals_at, u0, o, at_start)
+                               : levenberg_marquardt(residuals_at, u0, o, at_start);
+  res.method = fit_method_name(o.method);
+  res.objective_start = search.objective_start;
+  res.objective = search.objective;
+  res.converged = search.converged;
   for (size_t k = 0; k < n; ++k) {
-    auto u = u0;
-    u[k] += u[k] + o.initial_step <= 1 ? o.initial_step : -o.initial_step;
-    simplex.push_back(u);
+    FitParameterResult p;
+    p.parameter = params[k];
+    p.value = to_value(params[k], search.u[k]);
+    p.at_bound = search.u[k] < 1e-3 || search.u[k] > 1 - 1e-3;
+    p.sigma = std::nan("");
+    res.parameters.push_back(p);
   }
-  std::vector<double> f;
-  for (const auto& u : simplex) {
-    f.push_back(objective(u));
-    if (f.size() == 1) res.start_metrics = absolute_metrics(last, measured);
-  }
-  res.objective_start = f[0];
-  while (res.evaluations < o.max_evaluations) {
-    std::vector<size_t> order(n + 1);
-    for (size_t k = 0; k <= n; ++k) order[k] = k;
-    std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) { return f[a] < f[b]; });
-    std::vector<std::vector<double>> s2;
-    std::vector<double> f2;
-    for (size_t k : order) {
-      s2.push_back(simplex[k]);
-      f2.push_back(f[k]);
-    }
-    simplex = std::move(s2);
-    f = std::move(f2);
-    double size = 0;
-    for (size_t k = 1; k <= n; ++k)
-      for (size_t d = 0; d < n; ++d) size = std::max(size, std::abs(simplex[k][d] - simplex[0][d]));
-    if (f[n] - f[0] < o.tolerance && size < 1e-3) {
-      res.converged = true;
-      break;
-    }
-    std::vector<double> centroid(n, 0.0);
-    for (size_t k = 0; k < n; ++k)
-      for (size_t d = 0; d < n; ++d) centroid[d] += simplex[k][d] / static_cast<double>(n);
-    auto along = [&](double t) {
-      std::vector<double> u(n);
-      for (size_t d = 0; d < n; ++d) u[d] = centroid[d] + t * (simplex[n][d] - centroid[d]);
-      return project(u);
-    };
-    const auto ur = along(-1.0);
-    const double fr = objective(ur);
-    if (fr < f[0]) {
-      const auto ue = along(-2.0);
-      const double fe = objective(ue);
-      if (fe < fr) {
-        simplex[n] = ue;
-        f[n] = fe;
-      } else {
-        simplex[n] = ur;
-        f[n] = fr;
-      }
-    } else if (fr < f[n - 1]) {
-      simplex[n] = ur;
-      f[n] = fr;
-    } else {
-      const bool outside = fr < f[n];
-      const auto uc = along(outside ? -0.5 : 0.5);
-      const double fc = objective(uc);
-      if (fc < (outside ? fr : f[n])) {
-        simplex[n] = uc;
-        f[n] = fc;
-      } else {  // shrink towards the best point
-        for (size_t k = 1; k <= n; ++k) {
-          for (size_t d = 0; d < n; ++d)
-            simplex[k][d] = simplex[0][d] + 0.5 * (simplex[k][d] - simplex[0][d]);
-          f[k] = objective(simplex[k]);
-        }
-      }
-    }
-  }
-  size_t best = 0;
-  for (size_t k = 1; k <= n; ++k)
-    if (f[k] < f[best]) best = k;
-  const std::vector<double> ub = simplex[best];
-  res.objective = f[best];
+  res.seconds = seconds_since(t0);
+  if (o.uncertainty) add_fit_uncertainty(res, inplane, measured, o);
+  return res;
+}
+
+void add_fit_uncertainty(FitResult& res, const InplaneModel& inplane,
+                         const MeasuredInplane& measured, const FitOptions& o) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const size_t n = res.parameters.size();
+  std::vector<double> ub(n);
+  for (size_t k = 0; k < n; ++k)
+    ub[k] = std::clamp(fit_unit(res.parameters[k].parameter, res.parameters[k].value), 0.0, 1.0);
+  std::vector<std::vector<Rgb>> last;
+  auto residuals_at = [&](const std::vector<double>& u) {
+    ++res.evaluations;
+    std::vector<double> x(n);
+    for (size_t k = 0; k < n; ++k) x[k] = to_value(res.parameters[k].parameter, u[k]);
+    last = inplane(x);
+    return fit_residuals(last, measured);
+  };
   const std::vector<double> r0 = residuals_at(ub);
   res.fitted_metrics = absolute_metrics(last, measured);
 
-  // Uncertainty: J by central differences in u (one-sided at a bound), s^2 = SSR / (m - p).
+  // J by central differences in u (one-sided at a bound), s^2 = SSR / (m - p).
   const size_t m = r0.size();
   std::vector<std::vector<double>> jac(n);
   for (size_t k = 0; k < n; ++k) {
@@ -972,19 +1153,14 @@ FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>&
   const double s2 = m > n ? ssr / static_cast<double>(m - n) : std::nan("");
   const bool ok = invert(jtj);
   for (size_t k = 0; k < n; ++k) {
-    FitParameterResult p;
-    p.parameter = params[k];
-    p.value = to_value(params[k], ub[k]);
-    p.at_bound = ub[k] < 1e-3 || ub[k] > 1 - 1e-3;
+    FitParameterResult& p = res.parameters[k];
     // d value / d u converts the unit-cube standard deviation to the parameter's own units.
-    const double dxdu = params[k].log_scale
-                            ? p.value * (std::log(params[k].hi) - std::log(params[k].lo))
-                            : params[k].hi - params[k].lo;
+    const double dxdu = p.parameter.log_scale
+                            ? p.value * (std::log(p.parameter.hi) - std::log(p.parameter.lo))
+                            : p.parameter.hi - p.parameter.lo;
     p.sigma = ok && jtj[k][k] > 0 ? dxdu * std::sqrt(s2 * jtj[k][k]) : std::nan("");
-    res.parameters.push_back(p);
   }
-  res.seconds = seconds_since(t0);
-  return res;
+  res.seconds += seconds_since(t0);
 }
 
 // ---- Report files ---------------------------------------------------------------------------
@@ -1103,6 +1279,7 @@ std::string verify_metrics_json(const VerifyReport& r) {
              {"at_bound", p.at_bound}});
       nlohmann::json e = {{"parameters", ps},
                           {"inner_model", f.inner_model},
+                          {"method", f.method},
                           {"uncertainty", f.uncertainty},
                           {"objective", "rms_log, absolute, of the inner model"},
                           {"inner_rms_log_start", f.objective_start},
@@ -1203,12 +1380,14 @@ std::string verify_index_html(const VerifyReport& r,
           << (std::isfinite(p.sigma) ? fmt(p.sigma, 2) : std::string("&mdash;")) << "</td><td>"
           << (std::isfinite(p.sigma_restarts) ? fmt(p.sigma_restarts, 2) : std::string("&mdash;"))
           << "</td></tr>\n";
-    h << "</table>\n<table><tr><th>model</th><th>inner RMS log, start</th><th>inner RMS log, "
-         "fitted</th><th>evaluations</th><th>converged</th><th>seconds</th></tr>\n";
+    h << "</table>\n<table><tr><th>model</th><th>search</th><th>inner RMS log, "
+         "start</th><th>inner RMS log, fitted</th><th>evaluations</th><th>converged</th>"
+         "<th>seconds</th></tr>\n";
     for (const auto& f : r.fits)
-      h << "<tr><td>" << html_escape(f.model) << "</td><td>" << fmt(f.objective_start)
-        << "</td><td>" << fmt(f.objective) << "</td><td>" << f.evaluations << "</td><td>"
-        << (f.converged ? "yes" : "no") << "</td><td>" << fmt(f.seconds, 4) << "</td></tr>\n";
+      h << "<tr><td>" << html_escape(f.model) << "</td><td>" << html_escape(f.method) << "</td><td>"
+        << fmt(f.objective_start) << "</td><td>" << fmt(f.objective) << "</td><td>" << f.evaluations
+        << "</td><td>" << (f.converged ? "yes" : "no") << "</td><td>" << fmt(f.seconds, 4)
+        << "</td></tr>\n";
     h << "</table>\n<p>Inner models: ";
     for (const auto& f : r.fits)
       h << html_escape(f.model) << ": " << html_escape(f.inner_model) << ". ";

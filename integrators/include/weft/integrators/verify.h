@@ -204,11 +204,28 @@ double fit_unit(const FitParameter& p, double x);
 // parameter vector (in the parameters' own units).
 using InplaneModel = std::function<std::vector<std::vector<Rgb>>(const std::vector<double>&)>;
 
+// The search: Levenberg-Marquardt on the log residuals (the objective is a least-squares sum of
+// 945 smooth residuals in at most four parameters, so Gauss-Newton steps reach the optimum in a
+// few Jacobians), or Nelder-Mead on their RMS (no derivatives; slow from a distant start in four
+// dimensions, docs/verify.md "Optimizer").
+enum class FitMethod { kLevenbergMarquardt, kNelderMead };
+FitMethod parse_fit_method(const std::string& name);  // weft::Error naming "--fit-method"
+std::string fit_method_name(FitMethod method);        // "lm" or "nelder-mead"
+
 struct FitOptions {
-  int max_evaluations = 100;    // of the objective during the search (the uncertainty adds 2 p)
-  double tolerance = 1e-4;      // stop when the simplex's objective values span less than this
-  double initial_step = 0.15;   // simplex edge, as a fraction of each box
-  double jacobian_step = 0.02;  // central differences at the optimum, fraction of each box
+  FitMethod method = FitMethod::kLevenbergMarquardt;
+  int max_evaluations = 100;  // of the objective during the search (the uncertainty adds 2 p)
+  // Converged: Nelder-Mead when the simplex's objective values span less than this (and its edges
+  // are below 1e-3 of each box); Levenberg-Marquardt when a step lowers the objective by less than
+  // this and its model predicted no more, or when no step longer than 1e-3 of a box lowers it.
+  double tolerance = 1e-4;
+  double initial_step = 0.15;  // Nelder-Mead's simplex edge, as a fraction of each box
+  // Finite differences, fraction of each box: Levenberg-Marquardt's one-sided Jacobians during
+  // the search, and the central differences of the uncertainty at the optimum.
+  double jacobian_step = 0.02;
+  // The uncertainty at the optimum (add_fit_uncertainty: 2 p + 1 evaluations beyond the search);
+  // off for a search whose optimum only seeds another.
+  bool uncertainty = true;
   void validate(size_t parameters) const;  // weft::Error naming the option
 };
 
@@ -232,6 +249,7 @@ struct FitResult {
   CurveMetrics start_metrics, fitted_metrics;  // the inner model's absolute metrics
   int evaluations = 0;
   bool converged = false;  // the tolerance was met before max_evaluations
+  std::string method;      // fit_method_name of the search
   double seconds = 0;
   std::string uncertainty =
       "Gauss-Newton: covariance s^2 (J^T J)^-1 of the log residuals at the optimum, J by central "
@@ -244,12 +262,18 @@ struct FitResult {
 std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
                                   const MeasuredInplane& measured);
 
-// Bounded, deterministic Nelder-Mead on the RMS of fit_residuals (= rms_log, absolute), then the
-// uncertainty from the Jacobian at the optimum. weft::Error on more than four parameters, an empty
-// or reversed box, a start outside it, or bad options.
+// Bounded, deterministic minimization of the RMS of fit_residuals (= rms_log, absolute) by
+// options.method, then the uncertainty from the Jacobian at the optimum. weft::Error on more than
+// four parameters, an empty or reversed box, a start outside it, or bad options.
 FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>& parameters,
                       const InplaneModel& inplane, const MeasuredInplane& measured,
                       const FitOptions& options);
+
+// The fit's figures at its optimum (res.parameters' values): the inner model's metrics there and
+// each parameter's Gauss-Newton sigma (FitResult::uncertainty); adds its 2 p + 1 evaluations and
+// its seconds to res.
+void add_fit_uncertainty(FitResult& res, const InplaneModel& inplane,
+                         const MeasuredInplane& measured, const FitOptions& options);
 
 // The inner model the fit evaluates (docs/verify.md), both with fixed seeds at every evaluation
 // (common random numbers):
@@ -282,12 +306,6 @@ TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistr
                                        const ProgressCallback& progress = no_progress());
 
 // ---- A baked fiber table in place of a spec (weft verify --fiber TABLE) ------------------------
-
-// A table's total albedo per channel, (1/pi) sum_i sum_o f[i][o] D_i D_o (D: the bins'
-// cosine-weighted areas, core/direction_grid.h). For a fiber table it is the fraction of the light
-// hitting the fiber that leaves it: the bake's exit_fraction, which the bake states is the same
-// sum (fiber_table_bake.h FiberBandSummary::energy_table).
-std::vector<double> table_total_albedo(const TabulatedBsdfTable& table);
 
 // The classic fiber's diffuse colour from a fiber table alone, per channel of the table: the
 // table's total albedo minus that of the classic fiber's own Cook-Torrance lobe (diffuse colour 0,
