@@ -568,8 +568,8 @@ void add_verify_command(CLI::App& app, Commands& commands) {
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_params_given = true; });
   sub->add_option("--fit-evaluations", o->fit_evaluations,
-                  "objective evaluations per model's search, over all its restarts (each "
-                  "restart's uncertainty adds 2 per parameter)")
+                  "objective evaluations per model's search, over all its restarts (the "
+                  "uncertainty at the end adds 2 per parameter and 1)")
       ->capture_default_str()
       ->each([o](const std::string&) { o->fit_evaluations_given = true; });
   sub->add_option("--fit-inner", o->fit_inner,

@@ -214,7 +214,7 @@ std::string fit_method_name(FitMethod method);        // "lm" or "nelder-mead"
 
 struct FitOptions {
   FitMethod method = FitMethod::kLevenbergMarquardt;
-  int max_evaluations = 100;  // of the objective during the search (the uncertainty adds 2 p)
+  int max_evaluations = 100;  // of the objective during the search (the uncertainty adds 2 p + 1)
   // Converged: Nelder-Mead when the simplex's objective values span less than this (and its edges
   // are below 1e-3 of each box); Levenberg-Marquardt when a step lowers the objective by less than
   // this and its model predicted no more, or when no step longer than 1e-3 of a box lowers it.
