@@ -759,10 +759,14 @@ std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
 
 namespace {
 
-double rms(const std::vector<double>& r) {
+double sum_squares(const std::vector<double>& r) {
   double s = 0;
   for (double x : r) s += x * x;
-  return r.empty() ? 0.0 : std::sqrt(s / static_cast<double>(r.size()));
+  return s;
+}
+
+double rms(const std::vector<double>& r) {
+  return r.empty() ? 0.0 : std::sqrt(sum_squares(r) / static_cast<double>(r.size()));
 }
 
 // Unit-cube coordinate <-> the parameter's own value.
@@ -932,18 +936,13 @@ FitSearch levenberg_marquardt(const ResidualsAt& residuals_at, const std::vector
     ++evaluations;
     return residuals_at(u);
   };
-  auto sum_sq = [](const std::vector<double>& r) {
-    double s = 0;
-    for (double x : r) s += x * x;
-    return s;
-  };
   FitSearch out;
   out.u = u0;
   std::vector<double> r = eval(u0);
   at_start();
   const size_t m = r.size();
   const double count = static_cast<double>(std::max<size_t>(m, 1));
-  double ssr = sum_sq(r);
+  double ssr = sum_squares(r);
   out.objective_start = std::sqrt(ssr / count);
   double lambda = -1, nu = 2;
   while (evaluations + static_cast<int>(n) + 1 <= o.max_evaluations) {
@@ -1014,7 +1013,7 @@ FitSearch levenberg_marquardt(const ResidualsAt& residuals_at, const std::vector
       std::vector<double> un = out.u;
       for (size_t k = 0; k < n; ++k) un[k] += s[k];
       std::vector<double> rn = eval(un);
-      const double ssr_new = sum_sq(rn);
+      const double ssr_new = sum_squares(rn);
       if (ssr_new < ssr) {
         const double rho = predicted > 0 ? (ssr - ssr_new) / predicted : 0.0;
         const double drop = std::sqrt(ssr / count) - std::sqrt(ssr_new / count);
@@ -1148,8 +1147,7 @@ void add_fit_uncertainty(FitResult& res, const InplaneModel& inplane,
   for (size_t a = 0; a < n; ++a)
     for (size_t b = 0; b < n; ++b)
       for (size_t i = 0; i < m; ++i) jtj[a][b] += jac[a][i] * jac[b][i];
-  double ssr = 0;
-  for (double x : r0) ssr += x * x;
+  const double ssr = sum_squares(r0);
   const double s2 = m > n ? ssr / static_cast<double>(m - n) : std::nan("");
   const bool ok = invert(jtj);
   for (size_t k = 0; k < n; ++k) {
