@@ -1,4 +1,4 @@
-// Fabric tables by summation (materials/fabric/fabric_summation.h): the paper's summation, the
+// Fabric tables by summation (fabric/fabric_summation.h): the paper's summation, the
 // baseline, and the visible-layer summation on the orientations the bundled red-cotton sample
 // shows at fiber detail (as `weft bake fabric --method summation-visible --detail fiber` uses
 // them), R = 4, 8 direction pairs per cell pair, one thread. The fiber table is a smooth RGB
@@ -9,8 +9,8 @@
 #include <vector>
 
 #include "weft/core/math.h"
-#include "weft/integrators/fabric_raytrace.h"
-#include "weft/materials/fabric/fabric_summation.h"
+#include "weft/fabric/fabric_raytrace.h"
+#include "weft/fabric/fabric_summation.h"
 #include "weft/scenes/weave.h"
 
 namespace {

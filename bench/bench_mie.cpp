@@ -5,8 +5,8 @@
 #include <cmath>
 #include <vector>
 
-#include "weft/materials/fabric/medium.h"
-#include "weft/materials/fabric/mie.h"
+#include "weft/fiber/medium.h"
+#include "weft/fiber/mie.h"
 
 static void BM_MieEfficiencies(benchmark::State& state) {
   const double x = static_cast<double>(state.range(0));

@@ -4,8 +4,8 @@
 // meaningful), and the 1 -> 2 thread speed-up of a fixed-size batch.
 #include <benchmark/benchmark.h>
 
-#include "weft/materials/fabric/bssrdf.h"
-#include "weft/materials/fabric/transport_cylinder.h"
+#include "weft/fiber/bssrdf.h"
+#include "weft/fiber/transport_cylinder.h"
 
 namespace {
 

@@ -42,7 +42,7 @@ cmake --build "$build" -j "${WEFT_JOBS:-2}" --target "${harnesses[@]}"
 seeds() {
   case "$1" in
     fuzz_scene_description) ls scenes/examples/*.json ;;
-    fuzz_fiber_spec) ls materials/fabric/presets/*.json ;;
+    fuzz_fiber_spec) ls fiber/presets/*.json ;;
     fuzz_weave_options) ls tests/fuzz/seeds/weave/*.json ;;
     fuzz_table_exr) ls tests/fuzz/seeds/table/*.exr ;;
     fuzz_wif) ls scenes/data/wif/*.wif ;;

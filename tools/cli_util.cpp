@@ -188,18 +188,6 @@ CLI::Validator seed_validator() {
       "SEED");
 }
 
-std::optional<double> finite_number(const std::string& text) {
-  size_t used = 0;
-  double v = 0;
-  try {
-    v = std::stod(text, &used);
-  } catch (...) {
-    return std::nullopt;
-  }
-  if (used != text.size() || !std::isfinite(v)) return std::nullopt;
-  return v;
-}
-
 void validate_output_paths(const std::vector<std::string>& outputs,
                            const std::vector<std::string>& inputs) {
   std::vector<NamedPath> out, in;

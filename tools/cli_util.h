@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/params.h"
 #include "weft/core/progress.h"
 
 namespace weft {
@@ -78,8 +79,6 @@ std::string format_seconds(double seconds);
 // octal 8. main.cpp adds it to every --seed option.
 CLI::Validator seed_validator();
 
-// The finite number that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
-std::optional<double> finite_number(const std::string& text);
 
 // Checks a command's output paths before any work: each names a file in an existing directory,
 // no two name the same file and none names one of the inputs (compared by canonical path, so

@@ -9,10 +9,10 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "job_part.h"
+#include "weft/core/job_part.h"
 #include "weft/core/error.h"
-#include "weft/materials/fabric/fiber_spec.h"
-#include "weft/materials/fabric/fiber_table_bake.h"
+#include "weft/fiber/fiber_spec.h"
+#include "weft/fiber/fiber_table_bake.h"
 
 namespace weft::cli {
 
@@ -71,7 +71,7 @@ int report_fiber_bake(const FiberTableBakeResult& r, const FiberSpec& spec,
   return r.cancelled ? 130 : 0;
 }
 
-// What fixes a fiber bake's bits: a shard's identity (job_part.h).
+// What fixes a fiber bake's bits: a shard's identity (core/job_part.h).
 JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
                        const FiberTableBakeOptions& o, Shard shard) {
   JobPart p;

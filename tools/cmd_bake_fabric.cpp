@@ -9,11 +9,11 @@
 #include <optional>
 
 #include "commands.h"
-#include "fabric_parts.h"
+#include "weft/fabric/fabric_parts.h"
 #include "weft/core/error.h"
-#include "weft/integrators/fabric_raytrace.h"
-#include "weft/materials/fabric/bake_cache.h"
-#include "weft/materials/fabric/fabric_summation.h"
+#include "weft/fabric/fabric_raytrace.h"
+#include "weft/fiber/bake_cache.h"
+#include "weft/fabric/fabric_summation.h"
 #include "weft/scenes/weave.h"
 
 namespace weft::cli {
@@ -234,5 +234,23 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   sub->add_flag("--quiet", o->quiet, "no progress bar");
   commands.push_back({sub, [o] { return run(*o); }});
 }
+
+int merge_fabric_bake(const JobPart& all, const std::string& output, bool json) {
+  FabricRaytraceResult r = assemble_fabric_job(all, all.job.at("resolution").get<int>());
+  TabulatedBsdfTable& t = r.table;
+  t.metadata["sample"] = all.job.at("sample").get<std::string>();
+  t.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;  // as bake fabric writes
+  t.write_exr(output);
+  nlohmann::json j = {{"output", output}, {"method", "raytrace"}, {"parts_merged", true}};
+  j.update(fabric_table_summary(t));
+  j.update(raytrace_summary(r));
+  if (json)
+    std::cout << j.dump(2) << "\n";
+  else
+    std::printf("%s: ray-traced fabric table, R = %d, merged; relative noise %.4g\n",
+                output.c_str(), t.resolution, r.relative_noise);
+  return 0;
+}
+
 
 }  // namespace weft::cli

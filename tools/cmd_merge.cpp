@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "commands.h"
-#include "job_part.h"
+#include "weft/core/job_part.h"
 #include "weft/core/error.h"
 
 namespace weft::cli {

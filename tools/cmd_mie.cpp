@@ -11,8 +11,8 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/spectrum.h"
-#include "weft/materials/fabric/medium.h"
-#include "weft/materials/fabric/mie.h"
+#include "weft/fiber/medium.h"
+#include "weft/fiber/mie.h"
 
 namespace weft::cli {
 namespace {

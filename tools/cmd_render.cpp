@@ -11,7 +11,7 @@
 #include "weft/core/error.h"
 #include "weft/core/progress.h"
 #include "weft/integrators/render_job.h"
-#include "weft/materials/fabric/bake_cache.h"
+#include "weft/fiber/bake_cache.h"
 #include "weft/scenes/description.h"
 
 namespace weft::cli {

@@ -10,7 +10,7 @@
 #include "commands.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
-#include "weft/materials/fabric/transport_slab.h"
+#include "weft/fiber/transport_slab.h"
 
 namespace weft::cli {
 namespace {

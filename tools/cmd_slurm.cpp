@@ -16,7 +16,7 @@
 #include "commands.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
-#include "weft/integrators/verify.h"
+#include "weft/verify/verify.h"
 
 namespace weft::cli {
 namespace {

@@ -8,12 +8,12 @@
 #include <sstream>
 
 #include "commands.h"
-#include "job_part.h"
+#include "weft/core/job_part.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
 #include "weft/integrators/gonio.h"
-#include "weft/materials/fabric/bake_cache.h"
+#include "weft/fiber/bake_cache.h"
 #include "weft/scenes/description.h"
 
 namespace weft::cli {

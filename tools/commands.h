@@ -1,6 +1,7 @@
 #pragma once
 // Every subcommand registers itself here; main.cpp calls each add_* once.
 #include "cli_util.h"
+#include "weft/core/job_part.h"
 
 namespace weft::cli {
 
@@ -19,5 +20,12 @@ AddCommand add_verify_command;  // cmd_verify.cpp
 
 // The subcommands of "bench" (cmd_bench.cpp makes the group).
 AddCommand add_bench_bake_command, add_bench_render_command;
+
+// Each command's merge (in its cmd_*.cpp): writes 'output' from all units of its job and prints
+// the command's summary. Returns the exit code.
+int merge_fiber_bake(const JobPart& all, const std::string& output, bool json);
+int merge_fabric_bake(const JobPart& all, const std::string& output, bool json);
+int merge_sweep(const JobPart& all, const std::string& output, bool json);
+int merge_verify(const JobPart& all, const std::string& output, bool json);
 
 }  // namespace weft::cli

@@ -112,6 +112,18 @@ void check_json_depth(std::string_view text, const std::string& file) {
   }
 }
 
+std::optional<double> finite_number(const std::string& text) {
+  size_t used = 0;
+  double v = 0;
+  try {
+    v = std::stod(text, &used);
+  } catch (...) {
+    return std::nullopt;
+  }
+  if (used == 0 || used != text.size() || !std::isfinite(v)) return std::nullopt;
+  return v;
+}
+
 nlohmann::json parse_json(std::string_view text, const std::string& file) {
   check_json_depth(text, file);
   nlohmann::json root;

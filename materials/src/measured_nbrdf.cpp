@@ -6,6 +6,7 @@
 #include <system_error>
 
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 #include "weft/core/install_paths.h"
 #include "weft/core/math.h"
 
@@ -60,17 +61,11 @@ NbrdfNetwork NbrdfNetwork::load(const std::filesystem::path& path) {
         throw Error(
             file, b.name,
             "ends after " + std::to_string(i) + " of " + std::to_string(count) + " numbers");
-      size_t used = 0;
-      double v = 0;
-      try {
-        v = std::stod(token, &used);
-      } catch (const std::exception&) {
-        used = 0;
-      }
-      if (used != token.size() || !std::isfinite(v))
+      const auto v = finite_number(token);
+      if (!v)
         throw Error(file, std::string(b.name) + "[" + std::to_string(i) + "]",
                     "\"" + token + "\" is not a finite number");
-      b.dst[i] = v;
+      b.dst[i] = *v;
     }
   }
   std::string extra;

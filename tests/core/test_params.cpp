@@ -155,7 +155,7 @@ TEST(ParamReader, StringsChoicesBooleansAndVectors) {
                "must be an array of 3 numbers");
 }
 
-// Issue 10, "Bad input": deeply nested JSON segfaulted (unbounded recursion). The depth is bounded
+// Bad input: deeply nested JSON segfaulted (unbounded recursion). The depth is bounded
 // before the parser sees the text; the error names the file and where the limit was passed.
 TEST(ParseJson, DeeplyNestedJsonIsRefusedBeforeParsing) {
   const std::string deep(100000, '[');  // the hostile input of the issue: 10^5 open arrays
@@ -173,7 +173,7 @@ TEST(ParseJson, DeeplyNestedJsonIsRefusedBeforeParsing) {
   EXPECT_EQ(parse_json(in_string, "s.json")["a"].get<std::string>().size(), 1001u);
 }
 
-// Issue 10: `1e400` in a scene was an "internal error" (nlohmann's out_of_range escaped); it is a
+// Bad input: `1e400` in a scene was an "internal error" (nlohmann's out_of_range escaped); it is a
 // clear error naming the file and the JSON path of the number.
 TEST(ParseJson, NumberOutOfRangeNamesFileAndField) {
   const std::string text = R"({"lights": [{"type": "parallel"}, {"irradiance": 1e400}]})";

@@ -11,7 +11,8 @@ TEST(Spectrum, BandsCover390To710) {
 }
 
 TEST(Spectrum, CmfBandSumMatchesCieTotal) {
-  // shared/data/README.md (from the CIE dataset): sum of ybar over 360-830 nm at 1 nm = 106.8569.
+  // core/data/cie/README.md (the CIE 1931 2 deg dataset): sum of ybar over 360-830 nm at 1 nm =
+  // 106.8569.
   // The bands cover 385-715 nm; ybar outside that range adds less than 0.05.
   double sum = 0;
   for (const auto& c : cie_cmf_bands()) sum += c.y * kBandStepNm;

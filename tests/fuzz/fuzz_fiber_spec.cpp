@@ -1,7 +1,7 @@
 // Fiber spec JSON (`weft bake fiber SPEC`): parse and hash as the bake cache does.
 #include "fuzz_input.h"
 #include "weft/core/error.h"
-#include "weft/materials/fabric/fiber_spec.h"
+#include "weft/fiber/fiber_spec.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

@@ -2,7 +2,7 @@
 // materials/data/measured/*/inplane.csv), seeded with the bundled ones.
 #include "fuzz_input.h"
 #include "weft/core/error.h"
-#include "weft/integrators/verify.h"
+#include "weft/verify/verify.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   try {

@@ -19,7 +19,7 @@
 #include "weft/core/math.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/materials/bsdf_table.h"
-#include "weft/materials/fabric/fabric_summation.h"
+#include "weft/fabric/fabric_summation.h"
 #include "weft/scenes/car_seat.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"

@@ -1,4 +1,4 @@
-// The render controls users expect (issue 9): a crop window holds the same pixels as the whole
+// The render controls users expect: a crop window holds the same pixels as the whole
 // render, a time limit stops after whole passes, albedo and normal passes leave the image alone,
 // and a render's EXR carries its metadata and is the same bytes on every run.
 #include <gtest/gtest.h>

@@ -208,7 +208,7 @@ TEST(TableBsdf, SamplingFollowsAPeakedLobeWithinCells) {
   // A glossy reflection lobe (about 0.3 rad wide) tabulated at R = 8, where a table cell spans
   // about 0.4 rad. A density flat over each table cell gave weights f cos / pdf up to 8.9 times
   // the albedo here (measured with that sampling, same seed): the few large weights that speckle
-  // indirect light (issue 9). With the density following the interpolated f cos on 4 x 4 fine
+  // indirect light. With the density following the interpolated f cos on 4 x 4 fine
   // cells per table cell the largest is 4.4 times the albedo (measured); the bound is 6.
   const Bsdf b = bsdf_of(table_of(8, [](const Vec3& wo, const Vec3& wi) {
     if (wo.z <= 0 || wi.z <= 0) return Rgb(0.0);

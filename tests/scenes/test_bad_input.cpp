@@ -1,4 +1,4 @@
-// Issue 10, "Bad input", in the scene library: sizes counted before anything is allocated.
+// Bad input in the scene library: sizes counted before anything is allocated.
 #include <gtest/gtest.h>
 
 #include <string>

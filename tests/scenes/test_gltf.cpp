@@ -228,7 +228,7 @@ TEST(Gltf, DeepNodeChainLoadsWithoutRecursion) {
 }
 
 TEST(Gltf, NodeWithSeveralParentsIsAnErrorNamingTheNodes) {
-  // The instanced DAG of issue 10: 6 levels of 20 nodes, each node listing all 20 of the next
+  // An instanced DAG that once exploded: 6 levels of 20 nodes, each node listing all 20 of the next
   // level as children (20^6 paths: it hung). glTF requires trees (glTF 2.0, section 3.5.3).
   const auto dir = weft::testing::fresh_test_dir();
   nlohmann::json doc = triangle_doc();
@@ -404,7 +404,7 @@ TEST(Gltf, GlbVersionOneAndGltfOneAreRefused) {
 }
 
 TEST(Gltf, DeeplyNestedJsonIsRefusedBeforeTinygltfParsesIt) {
-  // Found by fuzzing (issue 10): 10^5 nested arrays in 'extras' overflowed tinygltf's recursive
+  // Found by fuzzing: 10^5 nested arrays in 'extras' overflowed tinygltf's recursive
   // parser (segfault). Both containers: a .gltf and the JSON chunk of a GLB.
   const auto dir = weft::testing::fresh_test_dir();
   const int n = 100000;

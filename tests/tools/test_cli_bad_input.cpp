@@ -1,4 +1,4 @@
-// Issue 10, "Bad input" and the memory and work budget: each case a hostile user tried, run
+// Bad input and the memory and work budget: each case a hostile user tried, run
 // through the weft program. Every one ends with a clear error naming the file or option and the
 // field, a non-zero exit, and no output written.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// weft render's controls as a user meets them (issue 9): -D overrides, --camera, --crop,
+// weft render's controls as a user meets them: -D overrides, --camera, --crop,
 // --exposure, --time-limit, --aov, EXR metadata and bit-identical files, progress in a log.
 #include <gtest/gtest.h>
 #include <sys/wait.h>

@@ -13,11 +13,11 @@
 #include <sstream>
 #include <string>
 
-#include "../../tools/verify_fit.h"  // the fit's inner models, header-only (the command's own)
+#include "weft/verify/fit_models.h"  // the fit's inner models, header-only (the command's own)
 #include "cli_run.h"
 #include "test_util.h"
-#include "weft/materials/fabric/fiber_spec.h"
-#include "weft/materials/fabric/fiber_table_bake.h"
+#include "weft/fiber/fiber_spec.h"
+#include "weft/fiber/fiber_table_bake.h"
 
 namespace fs = std::filesystem;
 using weft::testing::fresh_test_dir;
@@ -129,7 +129,7 @@ TEST(CliVerify, DraftWritesTheWholeReport) {
   const weft::Rgb rt = patch["render-transmission-computed"];
   EXPECT_EQ(rt.g / rt.r > rr.g / rr.r, ct.g / ct.r > cr.g / cr.r);
   EXPECT_EQ(rt.b / rt.r > rr.b / rr.r, ct.b / ct.r > cr.b / cr.r);
-  EXPECT_GT(rt.g / rt.r, rr.g / rr.r);  // the paper's "purple to dark red" (issue 8)
+  EXPECT_GT(rt.g / rt.r, rr.g / rr.r);  // the paper's "purple to dark red" (its Table 1)
   // The fiber-level renders: the fibers of the sample with each model's fiber table, both
   // configurations, beside the others and linked the same way.
   for (const char* stem : {"render-weave-reflection-computed", "render-weave-transmission-computed",

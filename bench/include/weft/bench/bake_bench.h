@@ -10,8 +10,8 @@
 #include <span>
 #include <vector>
 
-#include "weft/materials/fabric/fiber_spec.h"
-#include "weft/materials/fabric/fiber_table_bake.h"
+#include "weft/fiber/fiber_spec.h"
+#include "weft/fiber/fiber_table_bake.h"
 
 namespace weft {
 

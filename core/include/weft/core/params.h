@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <string_view>
@@ -33,6 +34,10 @@ void check_json_depth(std::string_view text, const std::string& file);
 // file and, where it is known, the JSON path of the value (e.g. a number out of the range of a
 // double: "scene.json: field 'lights[0].irradiance': number 1e400 is out of range").
 nlohmann::json parse_json(std::string_view text, const std::string& file);
+
+// The one strict parser of a number in text (options, CSV cells, weight files): the finite number
+// that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
+std::optional<double> finite_number(const std::string& text);
 
 class ParamReader {
  public:

@@ -27,6 +27,9 @@ struct Rgb {
   constexpr Rgb() = default;
   constexpr Rgb(double r_, double g_, double b_) : r(r_), g(g_), b(b_) {}
   constexpr explicit Rgb(double v) : r(v), g(v), b(v) {}
+  // Channel k: 0 = r, 1 = g, 2 = b (loops over channels).
+  constexpr double operator[](int k) const { return k == 0 ? r : (k == 1 ? g : b); }
+  constexpr double& operator[](int k) { return k == 0 ? r : (k == 1 ? g : b); }
   constexpr Rgb& operator+=(const Rgb& o) {
     r += o.r;
     g += o.g;

@@ -1,0 +1,244 @@
+#include "weft/core/job_part.h"
+
+#include <bit>
+#include <cstring>
+#include <fstream>
+#include <set>
+
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
+#include "weft/core/hash.h"
+#include "weft/core/params.h"
+
+namespace weft {
+namespace {
+
+constexpr const char* kMagic = "WEFT-PART 1";
+// A header is a few kilobytes; a bound keeps a corrupt file from asking for gigabytes.
+constexpr size_t kMaxHeaderBytes = size_t{1} << 24;
+
+static_assert(std::endian::native == std::endian::little, "part files are little-endian");
+
+}  // namespace
+
+Shard parse_shard(const std::string& text, const std::string& option_name) {
+  const auto slash = text.find('/');
+  auto whole_number = [&](const std::string& s) -> uint64_t {
+    if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos)
+      throw Error("", option_name, "'" + text + "' is not K/N (0 <= K < N)");
+    return std::stoull(s);
+  };
+  if (slash == std::string::npos) throw Error("", option_name, "'" + text + "' is not K/N");
+  const uint64_t k = whole_number(text.substr(0, slash)), n = whole_number(text.substr(slash + 1));
+  if (n < 1 || k >= n || n > 100000)
+    throw Error("", option_name, "'" + text + "' needs 0 <= K < N <= 100000");
+  return {static_cast<uint32_t>(k), static_cast<uint32_t>(n)};
+}
+
+UnitRange shard_units(uint64_t units, Shard s) {
+  return {units * s.index / s.count, units * (s.index + 1) / s.count};
+}
+
+bool JobPart::same_job(const JobPart& o) const {
+  return command == o.command && job == o.job && units_total == o.units_total &&
+         shard.count == o.shard.count;
+}
+
+void push_u64(std::vector<double>& v, uint64_t x) {
+  v.push_back(std::bit_cast<double>(x));
+}
+uint64_t as_u64(double d) {
+  return std::bit_cast<uint64_t>(d);
+}
+
+void write_job_part(const std::filesystem::path& path, const JobPart& p) {
+  nlohmann::json units = nlohmann::json::array(), sizes = nlohmann::json::array();
+  for (const auto& [u, v] : p.units) units.push_back(u), sizes.push_back(v.size());
+  const nlohmann::json header = {{"command", p.command},
+                                 {"job", p.job},
+                                 {"units_total", p.units_total},
+                                 {"shard", p.shard.index},
+                                 {"shards", p.shard.count},
+                                 {"checkpoint", p.checkpoint},
+                                 {"extra", p.extra},
+                                 {"units", units},
+                                 {"unit_doubles", sizes}};
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out << kMagic << "\n" << header.dump() << "\n";
+    for (const auto& [u, v] : p.units)
+      out.write(reinterpret_cast<const char*>(v.data()),
+                static_cast<std::streamsize>(v.size() * sizeof(double)));
+    out.close();
+    if (!out) throw Error(path.string(), "", "write failed");
+  });
+}
+
+JobPart read_job_part(const std::filesystem::path& path) {
+  const std::string file = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(file, "", "cannot open");
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  if (ec) throw Error(file, "", "cannot read its size");
+  std::string magic;
+  std::getline(in, magic);
+  if (magic != kMagic)
+    throw Error(file, "", "not a weft part or checkpoint (no '" + std::string(kMagic) + "' line)");
+  std::string line;
+  line.reserve(4096);
+  char c;
+  while (in.get(c) && c != '\n') {
+    line.push_back(c);
+    if (line.size() > kMaxHeaderBytes) throw Error(file, "header", "longer than 16 MiB");
+  }
+  if (!in) throw Error(file, "header", "truncated");
+  JobPart p;
+  try {
+    const auto h = parse_json(line, file);
+    p.command = h.at("command").get<std::string>();
+    p.job = h.at("job");
+    p.units_total = h.at("units_total").get<uint64_t>();
+    p.shard = {h.at("shard").get<uint32_t>(), h.at("shards").get<uint32_t>()};
+    p.checkpoint = h.at("checkpoint").get<bool>();
+    p.extra = h.at("extra");
+    const auto units = h.at("units").get<std::vector<uint64_t>>();
+    const auto sizes = h.at("unit_doubles").get<std::vector<uint64_t>>();
+    if (units.size() != sizes.size()) throw Error(file, "units", "does not match unit_doubles");
+    if (p.shard.count < 1 || p.shard.index >= p.shard.count)
+      throw Error(file, "shard", "must lie in [0, shards)");
+    uint64_t doubles = 0;
+    for (size_t i = 0; i < units.size(); ++i) {
+      if (units[i] >= p.units_total) throw Error(file, "units", "a unit beyond units_total");
+      if (sizes[i] > size / sizeof(double))
+        throw Error(file, "unit_doubles", "larger than the file");
+      doubles += sizes[i];
+    }
+    const uint64_t payload_at = static_cast<uint64_t>(in.tellg());
+    if (doubles > size / sizeof(double) || payload_at + doubles * sizeof(double) != size)
+      throw Error(file, "", "truncated or padded: the payload does not match its header");
+    for (size_t i = 0; i < units.size(); ++i) {
+      std::vector<double> v(sizes[i]);
+      in.read(reinterpret_cast<char*>(v.data()), static_cast<std::streamsize>(sizes[i] * 8));
+      if (!p.units.emplace(units[i], std::move(v)).second)
+        throw Error(file, "units", "unit " + std::to_string(units[i]) + " appears twice");
+    }
+    if (!in) throw Error(file, "", "truncated payload");
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(file, "header", e.what());
+  }
+  return p;
+}
+
+nlohmann::json input_file_hashes(const std::vector<std::filesystem::path>& files) {
+  nlohmann::json out = nlohmann::json::object();
+  std::vector<char> buf(size_t{1} << 20);
+  for (const auto& f : files) {
+    std::ifstream in(f, std::ios::binary);
+    if (!in) throw Error(f.string(), "", "cannot read this input to identify the job");
+    uint64_t h = kFnv1a64Basis;
+    while (in) {
+      in.read(buf.data(), static_cast<std::streamsize>(buf.size()));
+      h = fnv1a64(reinterpret_cast<const unsigned char*>(buf.data()),
+                  static_cast<size_t>(in.gcount()), h);
+    }
+    if (in.bad()) throw Error(f.string(), "", "read failed while identifying the job");
+    out[f.string()] = hex64(h);
+  }
+  return out;
+}
+
+std::string job_difference(const JobPart& then, const JobPart& now) {
+  if (then.command != now.command)
+    return "it is of `weft " + then.command + "`, not `weft " + now.command + "`";
+  const auto& a = then.job;
+  const auto& b = now.job;
+  if (a.contains("inputs") && b.contains("inputs") && a["inputs"] != b["inputs"]) {
+    for (const auto& [file, hash] : b["inputs"].items())
+      if (a["inputs"].contains(file) && a["inputs"][file] != hash)
+        return "the content of " + file + " differs";
+    return "the job reads other input files (" + b["inputs"].dump() + " against " +
+           a["inputs"].dump() + ")";
+  }
+  for (const auto& [key, value] : b.items())
+    if (!a.contains(key) || a[key] != value) return "setting '" + key + "' differs";
+  for (const auto& [key, value] : a.items())
+    if (!b.contains(key)) return "setting '" + key + "' differs";
+  if (then.units_total != now.units_total) return "the number of units differs";
+  if (then.shard.count != now.shard.count) return "the shard count differs";
+  return "";
+}
+
+std::filesystem::path checkpoint_path(const std::filesystem::path& output) {
+  const auto name = "." + output.filename().string() + ".weft-checkpoint";
+  return output.has_parent_path() ? output.parent_path() / name : std::filesystem::path(name);
+}
+
+std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
+                                       bool resume) {
+  const auto path = checkpoint_path(output);
+  if (!resume || !std::filesystem::exists(path)) return std::nullopt;
+  JobPart p;
+  try {
+    p = read_job_part(path);
+  } catch (const Error&) {
+    // Written atomically, so a bad checkpoint was damaged afterwards: start over.
+    std::fprintf(stderr, "weft: warning: %s is unreadable; starting afresh\n", path.c_str());
+    return std::nullopt;
+  }
+  if (!p.checkpoint || !p.same_job(job) || p.shard.index != job.shard.index) {
+    std::string why = job_difference(p, job);
+    if (why.empty()) why = p.checkpoint ? "the shard differs" : "it is not a checkpoint";
+    throw Error(
+        path.string(), "",
+        "is the checkpoint of another job (" + why + "): remove it or run without --resume");
+  }
+  return p;
+}
+
+JobPart merge_job_parts(const std::vector<std::filesystem::path>& paths) {
+  if (paths.empty()) throw Error("", "parts", "no parts given");
+  JobPart all;
+  std::map<uint64_t, std::string> owner;
+  std::set<uint32_t> shards_seen;
+  for (size_t i = 0; i < paths.size(); ++i) {
+    JobPart p = read_job_part(paths[i]);
+    const std::string file = paths[i].string();
+    if (p.checkpoint)
+      throw Error(file, "", "is a checkpoint of an unfinished run, not a finished part");
+    if (i == 0) {
+      all.command = p.command, all.job = p.job, all.units_total = p.units_total;
+      all.shard = {0, p.shard.count};
+      all.extra = p.extra;
+    } else if (!p.same_job(all)) {
+      throw Error(
+          file, "job",
+          "belongs to another job than " + paths[0].string() + " (" + job_difference(all, p) + ")");
+    }
+    if (!shards_seen.insert(p.shard.index).second)
+      throw Error(file, "shard",
+                  "shard " + std::to_string(p.shard.index) + "/" + std::to_string(p.shard.count) +
+                      " is given twice");
+    const UnitRange r = shard_units(p.units_total, p.shard);
+    if (p.units.size() != r.last - r.first)
+      throw Error(file, "units", "the part does not hold every unit of its shard");
+    for (auto& [u, v] : p.units) {
+      if (u < r.first || u >= r.last)
+        throw Error(file, "units", "unit " + std::to_string(u) + " is not of its shard");
+      if (const auto it = owner.find(u); it != owner.end())
+        throw Error(file, "units", "unit " + std::to_string(u) + " is also in " + it->second);
+      owner.emplace(u, file);
+      all.units.emplace(u, std::move(v));
+    }
+  }
+  std::string missing;
+  for (uint32_t k = 0; k < all.shard.count; ++k)
+    if (!shards_seen.count(k) && shard_units(all.units_total, {k, all.shard.count}).last >
+                                     shard_units(all.units_total, {k, all.shard.count}).first)
+      missing +=
+          (missing.empty() ? "" : ", ") + std::to_string(k) + "/" + std::to_string(all.shard.count);
+  if (!missing.empty()) throw Error("", "parts", "incomplete: missing shard " + missing);
+  return all;
+}
+
+}  // namespace weft

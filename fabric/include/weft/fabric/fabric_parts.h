@@ -1,0 +1,42 @@
+#pragma once
+// The fiber-level ray trace in pieces (`weft bake fabric --method raytrace --shard/--resume`,
+// `weft merge`): parts of incident bins, checkpoints, and the table assembled from them.
+#include <optional>
+#include <string>
+
+#include "weft/core/job_part.h"
+#include "weft/fabric/fabric_raytrace.h"
+
+namespace weft {
+
+// The ray tracer's splits and roulette kills in the table's metadata (whole runs and merges).
+void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t roulette_kills);
+
+// With --shard K/N: traces the shard's incident bins and writes them as a part to 'output'
+// (returns nothing). 'inputs' (input_file_hashes of the weave options and draft) joins the job's
+// identity. With --resume: checkpoints every finished piece beside 'output' and starts
+// from a checkpoint left there; a whole table is returned for the caller to write. A cancelled
+// run returns nothing with exit code 130.
+std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
+    const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
+    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard,
+    bool resume, const ProgressCallback& progress, int* exit_code);
+
+// The unit of incident bin 'bin' of a ray trace (its row of the table, its books and noise, every
+// value with its exact bits); the channels of such a unit for a table of 'bins' bins; and the
+// whole result (table, books, noise summed as raytrace_fabric_table sums them) from the units
+// [first_unit, first_unit + bins) of all its bins. weft::Error naming a missing or malformed unit.
+void encode_fabric_bin(const FabricRaytraceResult& result, uint64_t bin, std::vector<double>& unit);
+int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins);
+// The whole table (with the pieces' metadata and particle counts) of a merged job of every bin.
+FabricRaytraceResult assemble_fabric_job(const JobPart& all, int resolution);
+FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<double>>& units,
+                                          uint64_t first_unit, uint64_t bins, int resolution,
+                                          int channels);
+
+// What `bake fabric --json` and `merge --json` print of a ray trace (books, counts, noise) and of a
+// fabric table (resolution, sample, albedo at normal incidence): one list of keys for both.
+nlohmann::json raytrace_summary(const FabricRaytraceResult& result);
+nlohmann::json fabric_table_summary(const TabulatedBsdfTable& table);
+
+}  // namespace weft

@@ -1,0 +1,147 @@
+#pragma once
+// The ray-traced fabric BSDF, the reference the summations (fabric/fabric_summation.h)
+// are measured against: a virtual gonioreflectometer on one repeat of a woven sample with periodic
+// boundaries. For every incident bin a parallel beam (directions spread over the bin) falls on the
+// tile from above or from below; each light particle is followed through the sample with the fiber
+// table at every hit until it leaves the cloth's slab, and its exit direction is binned: the
+// exits of all particles, reflected and transmitted, are the fabric table (cosine-weighted cell
+// averages, materials/bsdf_table.h).
+//
+// The fiber table is the BSDF of a whole fiber (docs/fiber-bsdf.md): the radiance leaving a point
+// B for light entering anywhere on the fiber. A renderer shades a fiber point with it and lets
+// light from behind B pass through B's own fiber. Traced forwards, a particle whose line meets a
+// fiber therefore lights both points where that line crosses the fiber's surface: where it enters
+// (B') and where it would leave (B''); it is re-emitted from one of them (chosen in proportion to
+// the table's albedo there, weighted to stay unbiased) into a direction drawn from the table's cell
+// averages at that point, both for the channel the particle follows (ChannelSampling). The cloth is
+// periodic: the geometry is the repeat and its eight neighbours, and a particle crossing a side of
+// the repeat re-enters through the opposite side.
+//
+// At yarn detail the tubes take the fibers' part: light a tube sends into itself leaves it through
+// its far side (as light leaves a fiber through the fiber), and the table's frame at a tube point
+// is its facet's (normal and the yarn's tangent), so that the transport is reciprocal.
+//
+// Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
+// is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
+#include <cstdint>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/scenes/weave.h"
+
+namespace weft {
+
+// How a particle's path is drawn when the fiber table's channels differ. spectral_mis: each
+// particle follows one hero channel, chosen uniformly, and every channel is weighted by the balance
+// heuristic over the channels' path densities (one-sample MIS over channels, as Wilkie et al. 2014
+// do over wavelengths); Russian roulette on the largest channel weight. Every channel's paths are
+// then drawn about as often as it needs, so the channels' relative noises are alike. mean: the
+// channels' mean steers the path and the roulette (the estimator before spectral MIS, kept to
+// compare with: in a strongly coloured fabric the dominant channel's weights grow along multiply
+// scattered paths and it is far noisier than the others).
+enum class ChannelSampling { spectral_mis, mean };
+// The names the command line and the table's metadata use: "hero" (spectral_mis) and "mean".
+const char* channel_sampling_name(ChannelSampling s);
+
+// The estimator's revision, raised whenever a change alters its results for the same options: it
+// is part of a sharded or resumed run's identity (parts of another revision are refused, not
+// merged) and of the table's metadata. 2: the scene passes rays through fibers they are inside
+// (a fiber's continuation across the repeat's sides), before which particles leaving a fiber near
+// the side were passed through that cap by a rule of the estimator's own and scattered by any
+// other fiber met from inside.
+inline constexpr int kFabricRaytraceRevision = 2;
+
+struct FabricRaytraceOptions {
+  int resolution = 8;                  // of the fabric table (DirectionGrid R)
+  uint64_t particles_per_bin = 20000;  // per incident bin
+  uint64_t seed = 1;
+  int threads = 0;                   // 0 = all cores; results do not depend on it
+  int max_scatterings = 1000;        // beyond it a particle's weight is booked as lost
+  double roulette_threshold = 0.05;  // Russian roulette below this weight (see ChannelSampling)
+  // A particle whose largest channel weight exceeds this splits into copies (not with mean).
+  double split_threshold = 1.0;
+  // The most copies one particle's splits make in all. Splitting is optional (any count keeps the
+  // estimate unbiased), so the cap changes only the noise; it bounds a particle's work where
+  // weights grow at every event (a table whose line albedo stays above 1 makes copies grow
+  // geometrically). A particle at the cap keeps its weight, so a low cap leaves a heavy tail:
+  // at 64, 0.013 % of the particles carried half of red's largest contributions on red cotton
+  // (docs/PERFORMANCE.md); at 1024 none reached it, at the same cost.
+  int max_copies_per_particle = 1024;
+  ChannelSampling channel_sampling = ChannelSampling::spectral_mis;
+  // Trace only incident bins [first_bin, first_bin + bin_count) (0: all), for a table split over
+  // processes: their rows have the bits of a whole run's, the other rows are zero.
+  int first_bin = 0, bin_count = 0;
+  // Optional: draw the paths from this fiber table (same resolution and channels) and weight each
+  // step by f / f_proposal of the fiber table traced (likelihood-ratio reweighting). Every choice
+  // (B' or B'', exit cell and direction, roulette, splitting) then depends on the proposal alone,
+  // so at a fixed seed the particles keep their paths when the fiber table changes and the result
+  // is a smooth function of it: weft verify --fit's inner model (docs/verify.md). Unbiased where
+  // the proposal is nonzero wherever the table is; the noise grows as the two tables differ. Null:
+  // the fiber table itself (the default estimator, bit for bit).
+  const TabulatedBsdfTable* proposal = nullptr;
+
+  void validate() const;  // weft::Error naming the field
+};
+
+// What one incident bin's particles booked: the totals of FabricRaytraceResult are sums of these
+// in bin order (fabric_raytrace_totals), so a table traced in pieces (first_bin, bin_count) and
+// put together has the whole run's books and noise bit for bit.
+struct FabricBinBooks {
+  double launched = 0, exited = 0, absorbed = 0, lost = 0, roulette_net = 0;  // power
+  uint64_t particles = 0, scatterings = 0, wraps = 0, splits = 0, roulette_kills = 0;
+  uint64_t inside_hits = 0, tube_passes = 0;
+  // Per channel, over the bin's row of the table: sum of se^2 D_i D_o and of f^2 D_i D_o (the
+  // relative noise's numerator and denominator, D the cosine-weighted areas).
+  std::vector<double> noise2, signal2;
+  void add(const FabricBinBooks& other);  // the power and counts (not noise2, signal2)
+};
+
+struct FabricRaytraceResult {
+  TabulatedBsdfTable table;  // kind "fabric", the fiber table's channels
+  // Energy books, as fractions of the power that fell on the cloth (mean over channels): exited +
+  // absorbed + lost + roulette_net = 1 to rounding. absorbed is what the fibers' tables keep
+  // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
+  double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
+  uint64_t particles = 0, scatterings = 0, wraps = 0;
+  // Copies made by splitting, and particles (or copies) ended by Russian roulette, in all and
+  // per incident bin (what a bin's particles did depends only on (seed, bin), like its row).
+  uint64_t splits = 0, roulette_kills = 0;
+  std::vector<uint64_t> splits_per_bin, roulette_kills_per_bin;
+  // Fiber detail: hits on a fiber that the particle's line only grazes from inside (taken alone,
+  // without their B''); the scene passes a ray through any fiber it is inside (RenderScene), so
+  // none are expected but at ties of rounding.
+  uint64_t inside_hits = 0;
+  // Yarn detail: particles that a tube sent into itself and that left it through its far side.
+  uint64_t tube_passes = 0;
+  // Standard error of the table relative to its values, weighted like weft compare's rel_rms
+  // (by D_i D_o, channels summed): what two independent runs would differ by, over sqrt(2).
+  double relative_noise = 0;
+  std::vector<double> relative_noise_per_channel;  // the same, channel by channel
+  std::vector<float> standard_error;               // per value of the table (cell pair and channel)
+  std::vector<FabricBinBooks> bin_books;  // per incident bin (zero outside the bins traced)
+  bool cancelled = false;
+};
+
+// The totals above (energy books, counts, relative noise) from bin_books, summed in bin order.
+void fabric_raytrace_totals(FabricRaytraceResult& result);
+
+// A lower bound on the CPU time of one particle of the ray trace, seconds: PERFORMANCE.md gives
+// about 0.8 M particles/s at fiber detail and 1.2 M/s on yarn tubes on 2 threads (1.7 us per
+// particle per core on tubes); a particle that meets no fiber is cheaper, so 0.25 us. A front end
+// estimates a ray trace's time with it before starting.
+inline constexpr double kMinSecondsPerFabricParticle = 0.25e-6;
+
+// The fiber directions seen at the cloth's surface, for the summations: the unit tangents (cloth
+// frame) at the first hits of a rays_per_side x rays_per_side grid of rays along the normal over
+// one repeat, from above (views on the cloth's face) or from below. Each stands for an equal share
+// of the cloth's area.
+std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_above,
+                                         int rays_per_side = 64);
+
+FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
+                                           const TabulatedBsdfTable& fiber,
+                                           const FabricRaytraceOptions& options,
+                                           const ProgressCallback& progress = no_progress());
+
+}  // namespace weft

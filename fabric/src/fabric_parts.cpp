@@ -1,0 +1,200 @@
+// The ray-traced fabric table in pieces: a shard of its incident bins (`weft bake fabric --method
+// raytrace --shard K/N`) written as a part, checkpoints of finished bins (`--resume`), and the
+// merge of the parts. Each incident bin's row of the table depends only on (seed, bin): a piece
+// holds the rows a whole run computes, bit for bit.
+#include "weft/fabric/fabric_parts.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "weft/core/error.h"
+
+namespace weft {
+namespace {
+
+JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
+                   const nlohmann::json& inputs, const FabricRaytraceOptions& r, Shard shard) {
+  JobPart p;
+  p.command = "bake fabric";
+  p.job = {{"method", "raytrace"},
+           {"estimator_revision", kFabricRaytraceRevision},
+           {"inputs", inputs},
+           {"fiber_checksum", fiber.checksum()},
+           {"sample", sample.summary.source + " (" + sample.summary.detail + ")"},
+           {"resolution", r.resolution},
+           {"particles_per_bin", r.particles_per_bin},
+           {"seed", r.seed},
+           {"max_scatterings", r.max_scatterings},
+           {"roulette_threshold", r.roulette_threshold},
+           {"estimator", channel_sampling_name(r.channel_sampling)},
+           {"split_threshold", r.split_threshold},
+           {"max_copies_per_particle", r.max_copies_per_particle},
+           {"program_version", WEFT_VERSION}};
+  p.units_total = static_cast<uint64_t>(DirectionGrid{r.resolution}.bins());
+  p.shard = shard;
+  return p;
+}
+
+// A bin's unit: its row of the table, then its books (FabricBinBooks: the power as doubles, the
+// counts as raw 64-bit values, noise2 and signal2 per channel).
+constexpr size_t kBookValues = 5 + 7;
+
+}  // namespace
+
+void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t roulette_kills) {
+  t.metadata["splits"] = std::to_string(splits);
+  t.metadata["roulette_kills"] = std::to_string(roulette_kills);
+}
+
+FabricRaytraceResult assemble_fabric_job(const JobPart& all, int resolution) {
+  FabricRaytraceResult r = assemble_fabric_bins(all.units, 0, all.units_total, resolution,
+                                                all.extra.at("channels").get<int>());
+  r.table.metadata = all.extra.at("metadata").get<std::map<std::string, std::string>>();
+  record_particle_counts(r.table, r.splits, r.roulette_kills);
+  return r;
+}
+
+void encode_fabric_bin(const FabricRaytraceResult& res, uint64_t a, std::vector<double>& v) {
+  const size_t row = res.bin_books.size() * static_cast<size_t>(res.table.channels);
+  v.assign(res.table.values.begin() + static_cast<std::ptrdiff_t>(a * row),
+           res.table.values.begin() + static_cast<std::ptrdiff_t>((a + 1) * row));
+  const FabricBinBooks& b = res.bin_books.at(a);
+  for (double x : {b.launched, b.exited, b.absorbed, b.lost, b.roulette_net}) v.push_back(x);
+  for (uint64_t x : {b.particles, b.scatterings, b.wraps, b.splits, b.inside_hits, b.roulette_kills,
+                     b.tube_passes})
+    push_u64(v, x);
+  v.insert(v.end(), b.noise2.begin(), b.noise2.end());
+  v.insert(v.end(), b.signal2.begin(), b.signal2.end());
+}
+
+int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins) {
+  const size_t n = unit.size();
+  if (n < kBookValues || (n - kBookValues) % (bins + 2) != 0 || n == kBookValues)
+    throw Error("", "units", "not the record of an incident bin of a ray-traced table");
+  return static_cast<int>((n - kBookValues) / (bins + 2));
+}
+
+FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<double>>& units,
+                                          uint64_t first_unit, uint64_t bins, int resolution,
+                                          int channels) {
+  FabricRaytraceResult r;
+  TabulatedBsdfTable& t = r.table;
+  t.resolution = resolution;
+  t.kind = "fabric";
+  t.channels = channels;
+  const size_t nc = static_cast<size_t>(channels), row = bins * nc;
+  t.values.assign(bins * row, 0.0f);
+  r.bin_books.resize(bins);
+  for (uint64_t a = 0; a < bins; ++a) {
+    const auto it = units.find(first_unit + a);
+    if (it == units.end())
+      throw Error("", "units", "incident bin " + std::to_string(a) + " is missing");
+    const std::vector<double>& v = it->second;
+    if (v.size() != row + kBookValues + 2 * nc)
+      throw Error("", "units", "a bin's record of another size");
+    for (size_t k = 0; k < row; ++k) t.values[a * row + k] = static_cast<float>(v[k]);
+    FabricBinBooks& b = r.bin_books[a];
+    const double* x = v.data() + row;
+    b.launched = x[0], b.exited = x[1], b.absorbed = x[2], b.lost = x[3], b.roulette_net = x[4];
+    b.particles = as_u64(x[5]), b.scatterings = as_u64(x[6]), b.wraps = as_u64(x[7]);
+    b.splits = as_u64(x[8]), b.inside_hits = as_u64(x[9]);
+    b.roulette_kills = as_u64(x[10]), b.tube_passes = as_u64(x[11]);
+    b.noise2.assign(x + kBookValues, x + kBookValues + nc);
+    b.signal2.assign(x + kBookValues + nc, x + kBookValues + 2 * nc);
+  }
+  t.validate("");
+  fabric_raytrace_totals(r);
+  return r;
+}
+
+std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
+    const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
+    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
+    bool resume, const ProgressCallback& progress, int* exit_code) {
+  *exit_code = 0;
+  const Shard shard = shard_text.empty() ? Shard{} : parse_shard(shard_text, "--shard");
+  JobPart job = fabric_job(fiber, sample, inputs, r, shard);
+  const UnitRange range = shard_units(job.units_total, shard);
+  JobPart done = job;
+  if (const auto cp = load_checkpoint(output, job, resume)) done = *cp;
+  done.checkpoint = true;
+  // Pieces of about an eighth of the range between checkpoints; the whole range without them.
+  const uint64_t step = resume ? std::max<uint64_t>(1, (range.last - range.first + 7) / 8)
+                               : std::max<uint64_t>(1, range.last - range.first);
+  for (uint64_t a = range.first; a < range.last;) {
+    if (done.units.count(a)) {
+      ++a;
+      continue;
+    }
+    uint64_t b = a;
+    while (b < range.last && b - a < step && !done.units.count(b)) ++b;
+    FabricRaytraceOptions piece = r;
+    piece.first_bin = static_cast<int>(a);
+    piece.bin_count = static_cast<int>(b - a);
+    const FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, piece, progress);
+    if (res.cancelled) {
+      std::fprintf(stderr, "\nweft: bake cancelled; %s\n",
+                   resume ? "--resume continues from the last checkpoint" : "nothing was written");
+      *exit_code = 130;
+      return std::nullopt;
+    }
+    for (uint64_t u = a; u < b; ++u) encode_fabric_bin(res, u, done.units[u]);
+    done.extra = {{"channels", res.table.channels}, {"metadata", res.table.metadata}};
+    if (resume) write_job_part(checkpoint_path(output), done);
+    a = b;
+  }
+  if (done.extra.empty() || !done.extra.contains("metadata")) {
+    // Every bin came from the checkpoint, or the shard has none: the metadata of an empty piece.
+    FabricRaytraceOptions none = r;
+    none.first_bin = 0;
+    none.bin_count = 1;
+    none.particles_per_bin = 1;
+    const auto t = raytrace_fabric_table(sample, fiber, none, no_progress());
+    auto md = t.table.metadata;
+    md["particles_per_bin"] = std::to_string(r.particles_per_bin);
+    done.extra = {{"channels", t.table.channels}, {"metadata", md}};
+  }
+  done.checkpoint = false;
+  if (!shard.whole()) {
+    write_job_part(output, done);
+    std::filesystem::remove(checkpoint_path(output));
+    std::printf("incident bins %llu..%llu (shard %u/%u) -> %s\n",
+                static_cast<unsigned long long>(range.first),
+                static_cast<unsigned long long>(range.last), shard.index, shard.count,
+                output.c_str());
+    return std::nullopt;
+  }
+  std::filesystem::remove(checkpoint_path(output));
+  return assemble_fabric_job(done, r.resolution);
+}
+
+nlohmann::json raytrace_summary(const FabricRaytraceResult& res) {
+  return {{"particles", res.particles},
+          {"scatterings", res.scatterings},
+          {"splits", res.splits},
+          {"roulette_kills", res.roulette_kills},
+          {"exited", res.exited},
+          {"absorbed", res.absorbed},
+          {"lost", res.lost},
+          {"roulette_net", res.roulette_net},
+          {"relative_noise", res.relative_noise},
+          {"relative_noise_per_channel", res.relative_noise_per_channel}};
+}
+
+nlohmann::json fabric_table_summary(const TabulatedBsdfTable& table) {
+  // Light arriving along the normal, where it goes; and what a view along the normal gathers
+  // under uniform light (they differ for a non-reciprocal table, fabric_summation.h).
+  const auto normal = table.directional_albedo(table.grid().bin_of({0, 0, 1}));
+  const auto view = table.directional_albedo_seen_from(table.grid().bin_of({0, 0, 1}));
+  return {{"resolution", table.resolution},
+          {"sample", table.metadata.at("sample")},
+          {"reflectance_normal_incidence", normal.reflectance},
+          {"transmittance_normal_incidence", normal.transmittance},
+          {"reflectance_normal_view", view.reflectance},
+          {"transmittance_normal_view", view.transmittance}};
+}
+
+}  // namespace weft

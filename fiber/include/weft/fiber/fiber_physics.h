@@ -1,0 +1,106 @@
+#pragma once
+// One band of a fiber as the bakers see it: the rough surface seen from outside and the interior
+// (its cylinder, index and photon transport), and the one routine by which light enters it. Both
+// the direct route and the BSSRDF (fiber_bake.h, bssrdf.h) launch every photon through
+// enter_fiber, so they share geometry, boundary and books by construction.
+//
+// Frames (docs/fiber-bsdf.md): the fiber's axis is the world x axis (transport.h); the surface
+// point at angle phi has the frame CylinderGeometry::cylinder_frame(phi), local (x, y, z) =
+// (axis t, binormal b, outward normal n).
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "weft/core/rng.h"
+#include "weft/core/vec.h"
+#include "weft/fiber/fiber_spec.h"
+#include "weft/fiber/medium.h"
+#include "weft/fiber/rough_dielectric.h"
+#include "weft/fiber/transport.h"
+#include "weft/materials/microfacet.h"
+
+namespace weft {
+
+// Receives each photon leaving the fiber (interior exits as the transport reports them; the
+// surface lobe's reflection at the entry point).
+using ExitSink = std::function<void(const ExitEvent&)>;
+
+// The rough surface seen from outside, in the local frame of the hit point (z = normal).
+struct FiberSurfaceModel {
+  // Samples the surface-reflected direction for light from 'w_light' (z > 0): returns false if
+  // none; else sets the reflected direction and its weight f * cos / pdf.
+  std::function<bool(const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out, double* weight)>
+      sample;
+  // Directional albedo of the surface lobe for light at cos theta (its complement enters).
+  std::function<double(double cos_theta)> albedo;
+};
+
+// The inside of the fiber: its cylinder (radius, index outside), the index inside, and a tracer
+// for a photon just refracted in at surface point p (world frame) travelling along unit d with
+// weight w. The tracer reports exits to the sink and returns its books (exited, absorbed,
+// roulette, lost, scatterings; launched = w).
+struct FiberInterior {
+  CylinderGeometry geometry{1, 1};
+  double n_inside = 1;
+  std::function<PhotonTally(const Vec3& p, const Vec3& d, double w, Rng& rng, const ExitSink& sink)>
+      trace;
+
+  // Photon transport in the homogeneous medium of 'transport' (geometry and index from it).
+  static FiberInterior transport(std::shared_ptr<const CylinderTransport> transport);
+};
+
+struct FiberBandPhysics {
+  FiberSurfaceModel surface;
+  FiberInterior interior;
+  // A rough dielectric boundary (the spec's "rough-dielectric"): when set, entry is one draw of
+  // its microsurface walk (reflected: the surface part; refracted: the volume part) and 'surface'
+  // is unused; the interior's transport exits through the same interface.
+  std::shared_ptr<const RoughDielectricInterface> boundary;
+
+  // Throws weft::Error naming the field (n_inside, surface, trace).
+  void validate() const;
+};
+
+// A smooth dielectric boundary both ways (Fresnel reflection at entry, sampled as the mirror
+// direction; smooth Fresnel at exits): the setting of the paper's BSSRDF and of the transport
+// engine's own launch_external.
+FiberBandPhysics smooth_fiber_physics(const TransportMedium& medium, double radius,
+                                      double n_outside, TransportOptions options = {});
+
+// Directional albedo of a Cook-Torrance lobe at cos theta, tabulated at nodes uniform in
+// sqrt(cos theta) (dense at grazing angles) and interpolated linearly; computed by a
+// deterministic stratified quadrature of the sample weights.
+class SurfaceAlbedoTable {
+ public:
+  SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes = 129,
+                     int samples_per_side = 64);
+  double operator()(double cos_theta) const;
+
+ private:
+  std::vector<double> albedo_;
+};
+
+// One band of a spec. Boundary "smooth": the Cook-Torrance surface lobe at the band's host index,
+// the rough boundary both ways (light leaving the fiber is transmitted with 1 - the lobe's albedo
+// at the outside angle, as on entry, which keeps the fiber reciprocal). Boundary
+// "rough-dielectric": the rough dielectric interface of the spec's roughness at the band's host
+// index, both ways. Then cylinder transport in the band's medium. 'albedo' (smooth only) may be
+// shared between bands of equal host index; null computes it. 'mode': how the interior's transport
+// treats absorption (transport.h).
+FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& band,
+                                    uint64_t max_events_per_photon = 10'000'000,
+                                    std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr,
+                                    WeightMode mode = WeightMode::implicit_capture);
+
+// Light from world direction 'omega' (towards the light) meets the fiber at surface angle phi
+// (axial position 0) with flux weight w0. The surface lobe's sampled reflection goes to
+// 'surface_exits' (may be empty; booked as specular and specular_excess either way); the rest,
+// 1 - albedo, enters refracted at the smooth normal and is traced, its exits going to
+// 'interior_exits' (required: Error if empty). With a rough dielectric boundary the photon either
+// reflects off it (to 'surface_exits', booked as specular) or enters refracted by it, whole. Adds
+// one launched photon to 'books'. Deterministic given rng.
+void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
+                 const ExitSink& surface_exits, const ExitSink& interior_exits, PhotonTally& books);
+
+}  // namespace weft

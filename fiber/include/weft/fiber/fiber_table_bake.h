@@ -1,0 +1,115 @@
+#pragma once
+// Bakes a fiber spec into a fiber BSDF table: Mie medium per band -> photon transport in the
+// cylinder -> cosine-weighted cell averages (docs/fiber-bsdf.md) plus the Cook-Torrance surface
+// lobe, for every band, stored as a spectral (33 bands) or RGB table.
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/fiber/fiber_bake.h"
+#include "weft/fiber/fiber_physics.h"
+#include "weft/fiber/fiber_spec.h"
+#include "weft/fiber/medium.h"
+
+namespace weft {
+
+enum class FiberBakeRoute { kDirect, kBssrdf };
+
+// Upper bound on photons per band that any front end accepts (about a day of work per band).
+inline constexpr uint64_t kMaxPhotonsPerBand = uint64_t{1} << 40;
+
+// The defaults here are the only ones: `weft bake fiber` and the bake cache start from them.
+struct FiberTableBakeOptions {
+  int resolution = 8;  // R x R equal-area bins per direction
+  uint64_t photons_per_band = 200000;
+  uint64_t seed = 1;
+  int threads = 0;       // 0 = all cores; results do not depend on it
+  bool spectral = true;  // 33 bands, else linear sRGB (D65) from the 33 bands
+  FiberBakeRoute route = FiberBakeRoute::kDirect;
+  uint64_t max_events_per_photon = 10'000'000;  // beyond it the weight is reported as lost
+  // How the fiber's interior treats absorption (transport.h). absorption_weight makes the table a
+  // smooth function of the absorption at a fixed seed (paths do not depend on it): weft verify
+  // --fit's inner bake (docs/verify.md). Both are unbiased; the default keeps its bits.
+  WeightMode weight_mode = WeightMode::implicit_capture;
+  // Photons are traced in this many passes over all bands; an interrupted bake keeps every
+  // finished pass (results depend on it, not on threads).
+  uint64_t passes = 8;
+};
+
+struct FiberBandSummary {
+  int band = 0;
+  double wavelength_nm = 0;
+  double mu_s_per_um = 0, mu_a_per_um = 0, g = 0;
+  double surface_fraction = 0;  // reflected by the surface lobe (of the light hitting the fiber)
+  double exit_fraction = 0;     // everything that leaves: surface + volume
+  double absorbed_fraction = 0;
+  double lost_fraction = 0;
+  double roulette_net = 0;             // Russian roulette's net removal (mean zero)
+  double surface_sampling_excess = 0;  // sampled minus tabulated surface albedo (mean zero)
+  double energy_balance = 0;           // exit + absorbed + roulette + lost - excess: 1 to rounding
+  double energy_table = 0;  // table energy sum / pi: equals exit_fraction (white furnace)
+  uint64_t photons = 0;
+  uint64_t scattering_events = 0;
+};
+
+struct FiberTableBakeResult {
+  TabulatedBsdfTable table;
+  std::vector<FiberBandSummary> bands;
+  uint64_t photons = 0;
+  uint64_t scattering_events = 0;
+  double rgb_negative_clipped = 0;  // largest negative RGB value set to 0 (out of sRGB gamut)
+  bool cancelled = false;           // the table then holds the passes finished (metadata "photons")
+};
+
+// The most memory bake_fiber_table holds at once, bytes: per band a running sum and the cell
+// averages over all (cells x cells) direction pairs, as doubles, and the finished table (about
+// 2.3 GB at R = 32 in RGB). A front end compares it with its budget before baking.
+double fiber_table_bake_bytes(const FiberTableBakeOptions& options);
+// A lower bound on the CPU time of a photon, seconds: a fiber without particles (no scattering
+// events) took 0.41x the time per photon of red-cotton here, whose full bake PERFORMANCE.md gives
+// as 1.2 us per photon per core; so 0.5 us. Denser media take longer.
+inline constexpr double kMinSecondsPerPhoton = 0.5e-6;
+
+FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
+                                      const ProgressCallback& progress = no_progress());
+
+// The pieces of bake_fiber_table, for bakes split over processes (shards of bands) or resumed
+// from a checkpoint. A band's running sums after some passes: continuing from them gives the same
+// bits as a bake that never stopped, and the table depends on nothing else.
+struct FiberBandState {
+  double mu_s_per_um = 0, mu_a_per_um = 0, g = 0;  // the medium's band (for the summary)
+  std::vector<double> weighted_sum;  // photon-weighted sum over passes of the cell sums
+  double surface = 0, exit = 0, absorbed = 0, roulette = 0, lost = 0, excess = 0, energy = 0;
+  uint64_t photons = 0, events = 0;
+  uint64_t passes_done = 0;
+};
+
+struct FiberBandWork {
+  int first_band = 0, last_band = kNumBands;  // the bands to trace: [first, last)
+  // Where to continue from: one state per band of the range (empty: from the start).
+  std::vector<FiberBandState> start;
+  // Called after every pass finished by all bands of the range (a checkpoint).
+  std::function<void(const std::vector<FiberBandState>&)> on_pass;
+};
+
+struct FiberBandsResult {
+  std::vector<FiberBandState> bands;  // one per band of the range
+  uint64_t passes = 0;                // passes of a finished bake (options.passes, clamped)
+  bool cancelled = false;
+};
+
+// Photon transport for a range of bands over every pass (Mie medium first: Ctrl-C is honoured
+// there too, as a weft::Error "cancelled" when nothing was traced yet).
+FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOptions& options,
+                                   const FiberBandWork& work,
+                                   const ProgressCallback& progress = no_progress());
+
+// The table and summary from the states of all kNumBands bands.
+FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
+                                        const std::vector<FiberBandState>& bands, bool cancelled);
+
+}  // namespace weft

@@ -1,0 +1,229 @@
+#include "weft/fiber/fiber_table_bake.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "weft/core/error.h"
+#include "weft/core/spectrum.h"
+#include "weft/fiber/fiber_bake.h"
+#include "weft/fiber/medium.h"
+
+namespace weft {
+
+namespace {
+
+void validate(const FiberTableBakeOptions& o) {
+  if (o.resolution < 2 || o.resolution > TabulatedBsdfTable::kMaxResolution)
+    throw Error("", "resolution",
+                "must lie in [2, " + std::to_string(TabulatedBsdfTable::kMaxResolution) + "]");
+  if (o.photons_per_band == 0) throw Error("", "photons", "must be positive");
+  if (o.max_events_per_photon == 0) throw Error("", "max_events_per_photon", "must be positive");
+  if (o.weight_mode != WeightMode::implicit_capture &&
+      o.weight_mode != WeightMode::absorption_weight)
+    throw Error("", "weight_mode", "must be implicit_capture or absorption_weight");
+}
+
+}  // namespace
+
+double fiber_table_bake_bytes(const FiberTableBakeOptions& o) {
+  const double cells = DirectionGrid{std::clamp(o.resolution, 1, 1 << 12)}.bins();
+  const double pairs = cells * cells;
+  const int channels = o.spectral ? kNumBands : 3;
+  // weighted_sum and band_f for every band, one band's table and mean_sum in flight, the table.
+  return pairs *
+         (2.0 * kNumBands * sizeof(double) + 2.0 * sizeof(double) + channels * sizeof(float));
+}
+
+FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOptions& o,
+                                   const FiberBandWork& work, const ProgressCallback& progress) {
+  validate(o);
+  if (work.first_band < 0 || work.last_band > kNumBands || work.first_band >= work.last_band)
+    throw Error("", "bands", "band range must lie in [0, " + std::to_string(kNumBands) + ")");
+  const int nb = work.last_band - work.first_band;
+  if (!work.start.empty() && work.start.size() != static_cast<size_t>(nb))
+    throw Error("", "bands", "a resumed bake needs one state per band");
+  std::vector<int> band_ids;
+  for (int b = work.first_band; b < work.last_band; ++b) band_ids.push_back(b);
+  MediumOptions medium_options;
+  medium_options.threads = o.threads;
+  const FiberMedium medium = build_fiber_medium(spec, band_ids, medium_options, progress);
+
+  const int R = o.resolution;
+  const size_t cells = static_cast<size_t>(DirectionGrid{R}.bins());
+  // Photons are traced in passes over all bands, so an interrupted bake still has every band,
+  // each with the photons of the passes it finished (the table records how many).
+  const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
+  FiberBandsResult result;
+  result.passes = passes;
+  std::vector<FiberBandState>& states = result.bands;
+  states = work.start.empty() ? std::vector<FiberBandState>(nb) : work.start;
+  std::vector<FiberBandPhysics> physics(nb);
+  std::map<double, std::shared_ptr<const SurfaceAlbedoTable>> albedo_by_ior;
+  for (int i = 0; i < nb; ++i) {
+    const MediumBand& mb = medium.bands[i];
+    auto& albedo = albedo_by_ior[mb.host_n];
+    if (!albedo && spec.boundary == FiberBoundary::kSmooth)
+      albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
+                                                          spec.roughness_alpha, mb.host_n);
+    physics[i] = fiber_band_physics(spec, mb, o.max_events_per_photon, albedo, o.weight_mode);
+    FiberBandState& st = states[i];
+    st.mu_s_per_um = mb.mu_s_per_um, st.mu_a_per_um = mb.mu_a_per_um, st.g = mb.g;
+    if (work.start.empty()) st.weighted_sum.assign(cells * cells, 0.0);
+    if (st.weighted_sum.size() != cells * cells || st.passes_done > passes)
+      throw Error("", "bands", "a resumed state does not fit this bake's resolution or passes");
+  }
+
+  const uint64_t total_units = o.photons_per_band * static_cast<uint64_t>(nb);
+  uint64_t units_done = 0;
+  for (const auto& st : states) units_done += st.photons;
+  bool stop_requested = false;
+  uint64_t first_pass = passes;
+  for (const auto& st : states) first_pass = std::min(first_pass, st.passes_done);
+  for (uint64_t pass = first_pass; pass < passes && !result.cancelled; ++pass) {
+    const uint64_t first = o.photons_per_band * pass / passes;
+    const uint64_t count = o.photons_per_band * (pass + 1) / passes - first;
+    for (int i = 0; i < nb && !result.cancelled; ++i) {
+      FiberBandState& st = states[i];
+      if (st.passes_done > pass) continue;
+      const int band = work.first_band + i;
+      FiberBakeSettings settings;
+      settings.resolution = R;
+      settings.photons = count;
+      // Disjoint random streams per (seed, pass, band).
+      settings.seed = mix64(mix64(o.seed) ^ (pass * kNumBands + static_cast<uint64_t>(band)));
+      settings.threads = o.threads;
+      const uint64_t base = units_done;
+      // A stop request may arrive after a band's last task: remember it for the loops here.
+      ProgressCallback band_progress = [&](const ProgressUpdate& u) {
+        if (progress && !progress({"photons", base + u.done, total_units})) stop_requested = true;
+        return !stop_requested;
+      };
+      const FiberBandTable t =
+          o.route == FiberBakeRoute::kDirect
+              ? bake_fiber_band_direct(physics[i], settings, band_progress)
+              : bake_fiber_band_bssrdf(physics[i], settings, BssrdfRouteSettings{}, band_progress);
+      const double n = static_cast<double>(t.photons);
+      for (size_t k = 0; k < st.weighted_sum.size(); ++k)
+        st.weighted_sum[k] += t.weighted_sum[k] * n;
+      st.surface += t.surface_fraction * n;
+      st.exit += t.exit_fraction * n;
+      st.lost += t.lost_fraction * n;
+      st.absorbed += t.absorbed_fraction * n;
+      st.roulette += t.roulette_net * n;
+      st.excess += t.surface_sampling_excess * n;
+      st.energy += fiber_table_energy(t) / kPi * n;
+      st.photons += t.photons;
+      st.events += t.scattering_events;
+      units_done += t.photons;
+      result.cancelled = t.cancelled || stop_requested;
+      if (!result.cancelled) st.passes_done = pass + 1;
+    }
+    if (!result.cancelled && work.on_pass) work.on_pass(states);
+  }
+  return result;
+}
+
+FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
+                                      const ProgressCallback& progress) {
+  const FiberBandsResult r = trace_fiber_bands(spec, o, FiberBandWork{}, progress);
+  return finish_fiber_table(spec, o, r.bands, r.cancelled);
+}
+
+FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
+                                        const std::vector<FiberBandState>& states, bool cancelled) {
+  validate(o);
+  if (states.size() != static_cast<size_t>(kNumBands))
+    throw Error("", "bands",
+                "a table needs the states of all " + std::to_string(kNumBands) + " bands");
+  const int R = o.resolution;
+  const size_t cells = static_cast<size_t>(DirectionGrid{R}.bins());
+  const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
+  FiberTableBakeResult result;
+  result.cancelled = cancelled;
+  std::vector<std::vector<double>> band_f(kNumBands);
+  for (int band = 0; band < kNumBands; ++band) {
+    const FiberBandState& st = states[band];
+    if (st.weighted_sum.size() != cells * cells)
+      throw Error("", "bands", "band " + std::to_string(band) + " has another resolution");
+    result.photons += st.photons;
+    result.scattering_events += st.events;
+    FiberBandSummary s;
+    s.band = band;
+    s.wavelength_nm = band_wavelength_nm(band);
+    s.mu_s_per_um = st.mu_s_per_um;
+    s.mu_a_per_um = st.mu_a_per_um;
+    s.g = st.g;
+    s.photons = st.photons;
+    s.scattering_events = st.events;
+    if (st.photons > 0) {
+      const double inv = 1.0 / static_cast<double>(st.photons);
+      s.surface_fraction = st.surface * inv;
+      s.exit_fraction = st.exit * inv;
+      s.lost_fraction = st.lost * inv;
+      s.absorbed_fraction = st.absorbed * inv;
+      s.roulette_net = st.roulette * inv;
+      s.surface_sampling_excess = st.excess * inv;
+      s.energy_balance = s.exit_fraction + s.absorbed_fraction + s.roulette_net + s.lost_fraction -
+                         s.surface_sampling_excess;
+      s.energy_table = st.energy * inv;
+      // The photon-weighted mean of the passes' sums, then cell averages.
+      std::vector<double> mean_sum(st.weighted_sum.size());
+      for (size_t k = 0; k < mean_sum.size(); ++k) mean_sum[k] = st.weighted_sum[k] * inv;
+      band_f[band] = TabulatedBsdfTable::averages_from_weighted_sums(R, mean_sum);
+    }
+    result.bands.push_back(s);
+  }
+  uint64_t min_photons = states[0].photons;
+  for (const auto& st : states) min_photons = std::min(min_photons, st.photons);
+  if (min_photons == 0) {
+    throw Error("", "photons",
+                "interrupted before every band had photons: no table written (let the first of " +
+                    std::to_string(passes) + " passes finish)");
+  }
+
+  TabulatedBsdfTable& table = result.table;
+  table.resolution = R;
+  table.kind = "fiber";
+  table.channels = o.spectral ? kNumBands : 3;
+  table.values.assign(cells * cells * table.channels, 0.0f);
+  GamutClip gamut;
+  for (size_t k = 0; k < cells * cells; ++k) {
+    if (o.spectral) {
+      for (int b = 0; b < kNumBands; ++b)
+        table.values[k * kNumBands + b] = static_cast<float>(band_f[b][k]);
+    } else {
+      Rgb rgb = bands_to_linear_srgb([&](int b) { return band_f[b][k]; });
+      gamut.clip(rgb);
+      table.values[k * 3 + 0] = static_cast<float>(rgb.r);
+      table.values[k * 3 + 1] = static_cast<float>(rgb.g);
+      table.values[k * 3 + 2] = static_cast<float>(rgb.b);
+    }
+  }
+  result.rgb_negative_clipped = gamut.largest;
+  table.metadata = {
+      {"spec_hash", fiber_spec_hash_hex(spec)},
+      {"spec_name", spec.name},
+      {"photons", std::to_string(min_photons)},
+      {"photons_requested", std::to_string(o.photons_per_band)},
+      {"interrupted", result.cancelled ? "yes" : "no"},
+      {"seed", std::to_string(o.seed)},
+      {"route", o.route == FiberBakeRoute::kDirect ? "direct" : "bssrdf"},
+      {"fiber_radius_um", std::to_string(spec.fiber_radius_um)},
+      {"roughness", std::string(microfacet_model_name(spec.roughness_distribution)) + " alpha " +
+                        std::to_string(spec.roughness_alpha)},
+      {"definition",
+       "f = L_o / (E |cos theta_i|); cosine-weighted cell averages (docs/fiber-bsdf.md)"},
+  };
+  // Only when not the default, so tables of the paper's model keep their header.
+  if (spec.boundary != FiberBoundary::kSmooth)
+    table.metadata["boundary"] = fiber_boundary_name(spec.boundary);
+  if (!o.spectral)
+    table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
+  table.validate("");
+  return result;
+}
+
+}  // namespace weft
