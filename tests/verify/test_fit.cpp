@@ -1,0 +1,119 @@
+// The fit (verify/fit.h) on an analytic model whose log residuals are linear in its parameters,
+// ln x (a log-scale box) and y (a linear box), plus a fixed pattern orthogonal to both: the
+// least-squares optimum, its residual sum and its Gauss-Newton sigmas follow in closed form.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "test_util.h"
+#include "weft/verify/fit.h"
+
+using weft::testing::error_of;
+
+namespace weft {
+namespace {
+
+constexpr double kX = 0.35, kY = 0.6;  // the optimum
+
+MeasuredInplane synthetic_measurement() {
+  MeasuredInplane m;
+  m.file = "synthetic";
+  m.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.3), Rgb(0.25)}});
+  m.curves.push_back({40, {-30, 0, 30}, {Rgb(0.1), Rgb(0.15), Rgb(0.4)}});
+  return m;
+}
+
+// The pattern: 0.01 (1, -2, 1) over the views times (1, 2, 3) over the channels; it sums to zero
+// and is orthogonal to the views' (-1, 0, 1), so it moves neither parameter.
+double pattern(size_t view, int channel) {
+  return 0.01 * (view == 1 ? -2.0 : 1.0) * (channel + 1);
+}
+
+// ln(model / measured) = ln(x / kX) + (y - kY) v / 30 + pattern.
+InplaneModel linear_in_log(const MeasuredInplane& m) {
+  return [&m](const std::vector<double>& p) {
+    std::vector<std::vector<Rgb>> out;
+    for (const auto& c : m.curves) {
+      auto& curve = out.emplace_back();
+      for (size_t v = 0; v < c.view_deg.size(); ++v) {
+        Rgb b;
+        for (int k = 0; k < 3; ++k)
+          b[k] = c.beta[v][k] *
+                 std::exp(std::log(p[0] / kX) + (p[1] - kY) * c.view_deg[v] / 30 + pattern(v, k));
+        curve.push_back(b);
+      }
+    }
+    return out;
+  };
+}
+
+const std::vector<FitParameter> kParameters = {{"x", "", 0.05, 1, 0.1, true},
+                                               {"y", "", 0, 1, 0.2, false}};
+
+TEST(VerifyFit, LevenbergMarquardtFindsTheOptimumAndItsSigmas) {
+  const MeasuredInplane m = synthetic_measurement();
+  FitOptions o;
+  const FitResult r = fit_inplane("computed", kParameters, linear_in_log(m), m, o);
+  EXPECT_EQ(r.method, "lm");
+  EXPECT_TRUE(r.converged);
+  ASSERT_EQ(r.parameters.size(), 2u);
+  EXPECT_NEAR(r.parameters[0].value, kX, 1e-6);
+  EXPECT_NEAR(r.parameters[1].value, kY, 1e-6);
+  EXPECT_FALSE(r.parameters[0].at_bound);
+  // 18 residuals (2 incidences, 3 views, 3 channels); at the optimum they are the pattern:
+  // SSR = 2 (1 + 4 + 1)(1 + 4 + 9) 1e-4, s^2 = SSR / (18 - 2). The design's columns, 1 and v / 30,
+  // are orthogonal (18 and 12 as their squared norms), so Var ln x = s^2 / 18, Var y = s^2 / 12,
+  // and sigma x = x sigma ln x.
+  const double ssr = 2 * 6 * 14 * 1e-4, s2 = ssr / 16;
+  EXPECT_NEAR(r.objective, std::sqrt(ssr / 18), 1e-7);
+  EXPECT_NEAR(r.fitted_metrics.rms_log, std::sqrt(ssr / 18), 1e-7);
+  EXPECT_NEAR(r.parameters[0].sigma, kX * std::sqrt(s2 / 18), 1e-7);
+  EXPECT_NEAR(r.parameters[1].sigma, std::sqrt(s2 / 12), 1e-7);
+  // The start's figures: ln(0.1 / 0.35) and (0.2 - 0.6) v / 30 added to the pattern.
+  EXPECT_GT(r.objective_start, 1.0);
+  EXPECT_NEAR(r.start_metrics.rms_log, r.objective_start, 1e-12);
+  // The uncertainty's 2 p + 1 evaluations come after the search's.
+  EXPECT_LE(r.evaluations, o.max_evaluations + 5);
+}
+
+TEST(VerifyFit, NelderMeadFindsTheOptimum) {
+  const MeasuredInplane m = synthetic_measurement();
+  FitOptions o;
+  o.method = FitMethod::kNelderMead;
+  o.max_evaluations = 400;
+  const FitResult r = fit_inplane("classic", kParameters, linear_in_log(m), m, o);
+  EXPECT_EQ(r.method, "nelder-mead");
+  EXPECT_TRUE(r.converged);
+  // Converged: edges below 1e-3 of each box (ln x spans ln 20 = 3.0).
+  EXPECT_NEAR(std::log(r.parameters[0].value / kX), 0.0, 5e-3);
+  EXPECT_NEAR(r.parameters[1].value, kY, 2e-3);
+}
+
+TEST(VerifyFit, ResidualsAreTheLogRatiosWhereTheMeasurementIsPositive) {
+  MeasuredInplane m;
+  m.file = "m.csv";
+  m.curves.push_back({0, {0, 30}, {Rgb(0.5, 0.0, 0.5), Rgb(0.4)}});
+  const std::vector<std::vector<Rgb>> model = {{Rgb(1.0, 1.0, 0.0), Rgb(0.4)}};
+  const std::vector<double> r = fit_residuals(model, m);
+  ASSERT_EQ(r.size(), 5u);  // the measured zero is left out
+  EXPECT_DOUBLE_EQ(r[0], std::log(2.0));
+  EXPECT_DOUBLE_EQ(r[1], std::log(1e-6));  // a model zero is the penalty
+  EXPECT_DOUBLE_EQ(r[2], 0.0);
+  EXPECT_NE(error_of([&] { fit_residuals({}, m); }).find("incidences"), std::string::npos);
+}
+
+TEST(VerifyFit, OptionsNameTheirField) {
+  FitOptions o;
+  o.max_evaluations = 5;
+  EXPECT_NE(error_of([&] { o.validate(2); }).find("--fit-evaluations"), std::string::npos);
+  o = {};
+  o.jacobian_step = 0.5;
+  EXPECT_NE(error_of([&] { o.validate(2); }).find("jacobian_step"), std::string::npos);
+  EXPECT_EQ(parse_fit_method("nelder-mead"), FitMethod::kNelderMead);
+  EXPECT_NE(error_of([] { parse_fit_method("bfgs"); }).find("--fit-method"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace weft

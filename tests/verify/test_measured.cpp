@@ -1,0 +1,65 @@
+// The measured-table reader (verify/measured.h): the bundled table's values and the errors of
+// bad tables.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+
+#include "test_util.h"
+#include "weft/core/atomic_file.h"
+#include "weft/verify/measured.h"
+
+namespace fs = std::filesystem;
+using weft::testing::error_of;
+using weft::testing::fresh_test_dir;
+
+namespace weft {
+namespace {
+
+TEST(VerifyMeasured, BundledTableHasNineIncidencesAndThePapersSign) {
+  const MeasuredInplane m = read_measured_inplane(bundled_measured_inplane());
+  ASSERT_EQ(m.curves.size(), 9u);
+  const std::vector<double> want = {0, 10, 20, 30, 40, 45, 50, 60, 70};
+  for (size_t i = 0; i < want.size(); ++i) {
+    EXPECT_EQ(m.curves[i].theta_i_deg, want[i]);
+    EXPECT_EQ(m.curves[i].view_deg.size(), 35u);  // -85..85 in 5 deg steps
+  }
+  // Rows of materials/data/measured/merl-red-fabric/inplane.csv: "0,0,...,0.280098,..." and
+  // "30,-30,...,0.257877,..." (theta_o = -30 is the mirror side there, view +30 here).
+  const auto& c0 = m.curves[0];
+  const size_t v0 = std::find(c0.view_deg.begin(), c0.view_deg.end(), 0.0) - c0.view_deg.begin();
+  EXPECT_DOUBLE_EQ(c0.beta[v0].r, 0.280098);
+  const auto& c30 = m.curves[3];
+  const size_t v30 =
+      std::find(c30.view_deg.begin(), c30.view_deg.end(), 30.0) - c30.view_deg.begin();
+  EXPECT_DOUBLE_EQ(c30.beta[v30].r, 0.257877);
+  EXPECT_DOUBLE_EQ(c30.beta[v30].b, 0.0255022);
+}
+
+TEST(VerifyMeasured, BadTablesNameFileAndField) {
+  const fs::path dir = fresh_test_dir();
+  const std::string head = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n";
+  struct Case {
+    std::string text, part;
+  } cases[] = {
+      {"theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_B\n0,0,1,1\n", "nbrdf_beta_G"},
+      {head + "0,0,1,x,1\n", "line 2 nbrdf_beta_G"},
+      {head + "0,0,1,1,1\n0,0,1,1,1\n", "duplicate"},
+      {head + "0,0,1,-1,1\n", "line 2 nbrdf_beta_G"},
+      {head + "95,0,1,1,1\n", "theta_i_deg"},
+      {head + "0,0,1,1\n", "line 2"},
+      {head, "no data rows"},
+  };
+  for (const auto& c : cases) {
+    const fs::path p = dir / "bad.csv";
+    write_text_atomically(p, c.text);
+    const std::string e = error_of([&] { read_measured_inplane(p); });
+    EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+    EXPECT_NE(e.find(c.part), std::string::npos) << c.text << " -> " << e;
+  }
+  EXPECT_NE(error_of([&] { read_measured_inplane(dir / "missing.csv"); }).find("missing.csv"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace weft

@@ -1,0 +1,69 @@
+// The report folder (verify/report.h): written whole or not at all, never over something else.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "test_util.h"
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
+#include "weft/verify/report.h"
+
+namespace fs = std::filesystem;
+using weft::testing::error_of;
+using weft::testing::fresh_test_dir;
+
+namespace weft {
+namespace {
+
+VerifyReport tiny_report() {
+  VerifyReport r;
+  r.measured.file = "m.csv";
+  r.measured.curves.push_back(MeasuredCurve{0, {0, 30}, {Rgb(0.5), Rgb(0.4)}});
+  ModelCurves m;
+  m.key = m.label = "classic";
+  m.beta = {{Rgb(1.0), Rgb(0.8)}};
+  m.beta_err = {{Rgb(0.1), Rgb(0.1)}};
+  m.normalization = Rgb(0.5);
+  m.absolute.push_back({});
+  m.normalized.push_back({});
+  r.models.push_back(m);
+  return r;
+}
+
+TEST(VerifyReportFiles, AllOrNone) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path out = dir / "report";
+  // A failing plot leaves nothing, not even a staging folder.
+  EXPECT_THROW(write_verify_report(out, tiny_report(),
+                                   [](const fs::path&) { throw Error("plot", "", "failed"); }),
+               Error);
+  EXPECT_FALSE(fs::exists(out));
+  for (const auto& e : fs::directory_iterator(dir)) ADD_FAILURE() << "left behind: " << e.path();
+  // A good run writes every file; a second run replaces it.
+  for (int k = 0; k < 2; ++k) {
+    write_verify_report(out, tiny_report(),
+                        [](const fs::path& s) { write_text_atomically(s / "p.png", "PNG"); });
+    for (const char* f : {"inplane.csv", "metrics.json", "index.html", "p.png"})
+      EXPECT_TRUE(fs::exists(out / f)) << f;
+  }
+  std::ifstream csv(out / "inplane.csv");
+  std::stringstream ss;
+  ss << csv.rdbuf();
+  // The classic row at view 30: beta 0.8, err 0.1, normalized 0.4 with factor 0.5.
+  EXPECT_NE(ss.str().find("0,30,classic,R,0.8,0.1,0.4,0.5"), std::string::npos) << ss.str();
+  // A folder holding something else is refused and left alone.
+  const fs::path other = dir / "other";
+  fs::create_directory(other);
+  write_text_atomically(other / "keep.txt", "x");
+  EXPECT_NE(error_of([&] {
+              write_verify_report(other, tiny_report(), [](const fs::path&) {});
+            }).find("refusing"),
+            std::string::npos);
+  EXPECT_TRUE(fs::exists(other / "keep.txt"));
+  EXPECT_FALSE(fs::exists(other / "metrics.json"));
+}
+
+}  // namespace
+}  // namespace weft

@@ -1,0 +1,69 @@
+// The run (verify/run.h): the same bits at any thread count, the classic colour from the volume
+// albedo, and the measurement's normal point.
+#include <gtest/gtest.h>
+
+#include "constant_table.h"
+#include "test_util.h"
+#include "weft/materials/registry.h"
+#include "weft/verify/report.h"
+#include "weft/verify/run.h"
+
+using weft::testing::constant_table;
+using weft::testing::error_of;
+
+namespace weft {
+namespace {
+
+TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
+  WeaveOptions w;
+  w.detail = "fiber";
+  const WovenSample sample = make_woven_sample(overlay(red_cotton_weave_options(), w));
+  VerifySettings s = verify_settings(VerifyQuality::kDraft);
+  s.resolution = 2;
+  s.particles_per_bin = 200;
+  s.batches = 2;
+  s.summation_samples = 2;
+  s.azimuths = 3;
+  VerifyInputs in;
+  in.fiber = constant_table(2, kNumBands, 0.2);
+  in.volume_albedo.fill(0.6);
+  in.classic_distribution = {MicrofacetModel::kBeckmann, 0.35};
+  in.classic_ior = 1.557;
+  MeasuredInplane m;
+  m.file = "synthetic";
+  m.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  m.curves.push_back({30, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  std::string first;
+  for (int threads : {1, 2}) {
+    s.threads = threads;
+    VerifyReport r = run_verify(sample, in, m, s);
+    ASSERT_FALSE(r.cancelled);
+    ASSERT_EQ(r.models.size(), 2u);  // ray trace and classic (no summation given)
+    // A flat volume albedo of 0.6 is grey 0.6 in linear sRGB.
+    EXPECT_NEAR(r.classic_reflectance.r, 0.6, 2e-3);
+    EXPECT_NEAR(r.classic_reflectance.b, 0.6, 2e-3);
+    ASSERT_GE(r.colours.size(), 2u);
+    // Per curve (incidence, channel): their points add up to the incidence's.
+    for (const auto& mc : r.models)
+      for (size_t i = 0; i < m.curves.size(); ++i) {
+        size_t points = 0;
+        for (const auto& c : mc.normalized_channel[i]) points += c.points + c.excluded;
+        EXPECT_EQ(points, mc.normalized[i].points + mc.normalized[i].excluded);
+        EXPECT_EQ(points, 3u * m.curves[i].view_deg.size());
+      }
+    EXPECT_EQ(r.colours[0].name, "computed fabric, reflection");
+    r.seconds.clear();
+    r.settings.threads = 0;
+    const std::string csv = verify_inplane_csv(r) + verify_metrics_json(r);
+    if (threads == 1)
+      first = csv;
+    else
+      EXPECT_EQ(csv, first);
+  }
+  // The measurement must hold normal incidence and view.
+  m.curves.erase(m.curves.begin());
+  EXPECT_NE(error_of([&] { run_verify(sample, in, m, s); }).find("theta_i_deg"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace weft

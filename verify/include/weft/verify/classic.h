@@ -1,0 +1,40 @@
+#pragma once
+// The classic baseline: a Lambert + Cook-Torrance fiber (materials/classic_fiber.h), tabulated as
+// a fiber table so that it is ray-traced on the same sample as the computed fiber, and what it
+// takes from a baked fiber table given in place of a spec (weft verify --fiber TABLE).
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/core/spectrum.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/materials/microfacet.h"
+
+namespace weft {
+
+// The classic fiber (Lambert + Cook-Torrance, outer hemisphere only: opaque) as a fiber table.
+TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
+                                       double ior, int resolution, int samples, uint64_t seed,
+                                       int threads,
+                                       const ProgressCallback& progress = no_progress());
+
+// The classic fiber's diffuse colour from a fiber table alone, per channel of the table: the
+// table's total albedo minus that of the classic fiber's own Cook-Torrance lobe (diffuse colour 0,
+// tabulated by classic_fiber_table at R = 16, 4 samples per cell pair), so that the classic fiber
+// sends out as much light in all as the table's fiber. For a table baked from a spec this stands
+// for the volume albedo exit_fraction - surface_fraction: the lobe's albedo and the bake's surface
+// fraction are those of the same rough surface (docs/verify.md gives the figures). Channels may
+// come out negative (a table darker than its surface alone); the caller decides.
+std::vector<double> classic_diffuse_from_fiber_table(const TabulatedBsdfTable& fiber,
+                                                     const MicrofacetDistribution& d, double ior,
+                                                     uint64_t seed, int threads);
+
+// The fiber surface's roughness that a fiber table's header states ("roughness": "beckmann alpha
+// 0.350000", as weft bake fiber writes it); nullopt when the header has none; weft::Error naming
+// 'file' and "roughness" when it is malformed or out of (0, 1].
+std::optional<MicrofacetDistribution> fiber_table_roughness(const TabulatedBsdfTable& table,
+                                                            const std::string& file);
+
+}  // namespace weft

@@ -1,0 +1,123 @@
+#pragma once
+// Fitting a model's fiber to the measurement (docs/verify.md "Fit"): at most four physical
+// parameters, the same budget for both models, searched in the unit cube of their boxes by
+// core/optimize.h on the log residuals of the in-plane curves.
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "weft/core/optimize.h"
+#include "weft/core/spectrum.h"
+#include "weft/verify/measured.h"
+#include "weft/verify/metrics.h"
+#include "weft/verify/settings.h"
+
+namespace weft {
+
+// One fitted parameter: its box [lo, hi] and start; 'log_scale' searches ln(x) (for scales that
+// span decades). The optimizer works in the unit cube u in [0, 1] of each box.
+struct FitParameter {
+  std::string name, unit;
+  double lo = 0, hi = 1, start = 0.5;
+  bool log_scale = false;
+};
+
+// A parameter's value as its coordinate in the optimizer's unit cube (ln x where log_scale).
+double fit_unit(const FitParameter& p, double x);
+
+// The model being fitted: the in-plane beta [incidence][view] of the measurement's views for a
+// parameter vector (in the parameters' own units).
+using InplaneModel = std::function<std::vector<std::vector<Rgb>>(const std::vector<double>&)>;
+
+// The search: Levenberg-Marquardt on the log residuals (the objective is a least-squares sum of
+// 945 smooth residuals in at most four parameters, so Gauss-Newton steps reach the optimum in a
+// few Jacobians), or Nelder-Mead on their RMS (no derivatives; slow from a distant start in four
+// dimensions, docs/verify.md "Optimizer").
+enum class FitMethod { kLevenbergMarquardt, kNelderMead };
+FitMethod parse_fit_method(const std::string& name);  // weft::Error naming "--fit-method"
+std::string fit_method_name(FitMethod method);        // "lm" or "nelder-mead"
+
+// The search's options (core/optimize.h; its steps are fractions of each box): max_evaluations
+// counts the objective's evaluations during the search (the uncertainty adds 2 p + 1);
+// jacobian_step also sets the central differences of the uncertainty at the optimum.
+struct FitOptions : OptimizeOptions {
+  FitMethod method = FitMethod::kLevenbergMarquardt;
+  // The uncertainty at the optimum (add_fit_uncertainty: 2 p + 1 evaluations beyond the search);
+  // off for a search whose optimum only seeds another.
+  bool uncertainty = true;
+  void validate(size_t parameters) const;  // weft::Error naming the option
+};
+
+struct FitParameterResult {
+  FitParameter parameter;
+  double value = 0;
+  double sigma = 0;       // one standard deviation (NaN where the Jacobian does not determine it)
+  bool at_bound = false;  // within 1e-3 of the box's edge (a constrained optimum)
+  // The ray-trace inner model's restarts (fit_inner_model): the standard deviation of the optima
+  // of the searches after the first, each on its own proposal, i.e. another realization of the
+  // ray trace's noise (NaN with fewer than two). What sigma leaves out: the noise is correlated
+  // across the residuals, so it moves the optimum more than independent residuals would.
+  double sigma_restarts = std::numeric_limits<double>::quiet_NaN();
+};
+
+struct FitResult {
+  std::string model;        // "computed" or "classic"
+  std::string inner_model;  // what the objective evaluated (docs/verify.md)
+  std::vector<FitParameterResult> parameters;
+  double objective_start = 0, objective = 0;   // rms_log, absolute, of the inner model
+  CurveMetrics start_metrics, fitted_metrics;  // the inner model's absolute metrics
+  int evaluations = 0;
+  bool converged = false;  // the tolerance was met before max_evaluations
+  std::string method;      // fit_method_name of the search
+  double seconds = 0;
+  std::string uncertainty =
+      "Gauss-Newton: covariance s^2 (J^T J)^-1 of the log residuals at the optimum, J by central "
+      "differences, s^2 = SSR / (n - p); treats the residuals as independent";
+};
+
+// The residuals the fit minimizes: ln(model / measured) at every view, incidence and channel
+// where the measurement is positive (the points of rms_log); a model value <= 0 counts as
+// ln(1e-6), a penalty, so the vector's length does not depend on the parameters.
+std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
+                                  const MeasuredInplane& measured);
+
+// Bounded, deterministic minimization of the RMS of fit_residuals (= rms_log, absolute) by
+// options.method, then the uncertainty from the Jacobian at the optimum. weft::Error on more than
+// four parameters, an empty or reversed box, a start outside it, or bad options.
+FitResult fit_inplane(const std::string& model, const std::vector<FitParameter>& parameters,
+                      const InplaneModel& inplane, const MeasuredInplane& measured,
+                      const FitOptions& options);
+
+// The fit's figures at its optimum (res.parameters' values): the inner model's metrics there and
+// each parameter's Gauss-Newton sigma (FitResult::uncertainty); adds its 2 p + 1 evaluations and
+// its seconds to res.
+void add_fit_uncertainty(FitResult& res, const InplaneModel& inplane,
+                         const MeasuredInplane& measured, const FitOptions& options);
+
+// The inner model the fit evaluates (docs/verify.md), both with fixed seeds at every evaluation
+// (common random numbers):
+//   kRaytrace: the run's own pipeline (RGB fiber bake, then the fiber-level ray trace) with few
+//     photons and particles; the bake treats absorption as a weight and the ray trace draws its
+//     paths from a proposal table re-centred on the optimum (verify/fit_models.h), so that the
+//     objective is smooth in the parameters at the fixed seed;
+//   kSummation: the paper's summation table of the same bake; smooth and about 20 times cheaper,
+//     but without light travelling between fibers, so its optimum is not the ray trace's.
+enum class FitInner { kRaytrace, kSummation };
+FitInner parse_fit_inner(const std::string& name);  // weft::Error naming "--fit-inner"
+std::string fit_inner_name(FitInner inner);
+
+struct FitInnerSettings {
+  FitInner inner = FitInner::kRaytrace;
+  int resolution = 6;
+  uint64_t fiber_photons_per_band = 5000;
+  uint64_t particles_per_bin = 2000;  // kRaytrace: one ray trace
+  int summation_samples = 4;          // the summation's and the classic fiber table's
+  uint64_t seed = 1;
+  int azimuths = 24;
+  int threads = 0;
+};
+FitInnerSettings fit_inner_settings(const VerifySettings& settings);
+
+}  // namespace weft

@@ -1,0 +1,32 @@
+#pragma once
+// The report of a verification (docs/verify.md "Report"): its files as text, and the folder that
+// holds them, written whole or not at all.
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "weft/verify/run.h"
+
+namespace weft {
+
+// The report's files, as text: the long-form curves CSV and metrics JSON (stable keys,
+// docs/verify.md), and the offline HTML page embedding the given images (file name -> bytes).
+std::string verify_inplane_csv(const VerifyReport& report);
+std::string verify_metrics_json(const VerifyReport& report);
+std::string verify_index_html(const VerifyReport& report,
+                              const std::vector<std::pair<std::string, std::string>>& images);
+
+// Writes DIR whole or not at all: the renders (render_verify_samples: fabric-*.exr, render-*.exr
+// and .png), inplane.csv and metrics.json into a staging folder beside DIR, then draw(staging)
+// (the plots: inplane-*.png and .svg files it writes there), then index.html embedding the plots
+// and linking the renders by relative path, then the staging folder replaces DIR. DIR must not
+// exist, be empty, or hold an earlier report (its metrics.json has "report": "weft verify");
+// anything else is refused (weft::Error naming DIR) and left alone. The check write_verify_report
+// makes first, for callers to make before the work.
+void check_verify_output(const std::filesystem::path& dir);
+void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
+                         const std::function<void(const std::filesystem::path& staging)>& draw);
+
+}  // namespace weft

@@ -1,0 +1,32 @@
+#include "weft/verify/colour.h"
+
+#include "weft/core/error.h"
+
+namespace weft {
+
+ColourEntry colour_of_spectrum(const std::string& name, const Spectrum& s,
+                               const std::string& note) {
+  ColourEntry e;
+  e.name = name;
+  e.spectrum = s;
+  e.note = note;
+  e.linear_srgb = xyz_to_linear_srgb(reflectance_to_xyz_d65(s));
+  Rgb c = e.linear_srgb;
+  GamutClip().clip(c);
+  e.hsv = rgb_to_hsv(c);
+  return e;
+}
+
+FabricSpectra normal_incidence_spectra(const TabulatedBsdfTable& t) {
+  if (t.channels != kNumBands)
+    throw Error("", "channels", "the colour table needs a spectral (33-band) fabric table");
+  const auto a = t.directional_albedo(t.grid().bin_of({0, 0, 1}));
+  FabricSpectra s;
+  for (int b = 0; b < kNumBands; ++b) {
+    s.reflectance[b] = a.reflectance[b];
+    s.transmittance[b] = a.transmittance[b];
+  }
+  return s;
+}
+
+}  // namespace weft

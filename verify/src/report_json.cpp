@@ -1,0 +1,194 @@
+// metrics.json of the report (docs/verify.md gives its keys).
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "weft/verify/report.h"
+
+namespace weft {
+namespace {
+
+nlohmann::json metrics_json(const CurveMetrics& m) {
+  return {{"rms_log", m.rms_log},
+          {"rms_rel", m.rms_rel},
+          {"points", m.points},
+          {"excluded", m.excluded}};
+}
+
+nlohmann::json rgb_json(const Rgb& c) {
+  return nlohmann::json::array({c.r, c.g, c.b});
+}
+
+nlohmann::json settings_json(const VerifySettings& s) {
+  return {{"quality", quality_name(s.quality)},
+          {"resolution", s.resolution},
+          {"fiber_photons_per_band", s.fiber_photons_per_band},
+          {"particles_per_bin", s.particles_per_bin},
+          {"batches", s.batches},
+          {"summation_samples", s.summation_samples},
+          {"azimuths", s.azimuths},
+          {"render_size", s.render_size},
+          {"render_spp", s.render_spp},
+          {"weave_render_size", s.weave_render_size},
+          {"weave_render_spp", s.weave_render_spp},
+          {"threads", s.threads}};
+}
+
+// Per model: its metrics overall, per incidence and per incidence and channel.
+nlohmann::json models_json(const VerifyReport& r) {
+  nlohmann::json models = nlohmann::json::object();
+  for (const auto& m : r.models) {
+    nlohmann::json per = nlohmann::json::array();
+    for (size_t i = 0; i < r.measured.curves.size(); ++i) {
+      nlohmann::json channels = nlohmann::json::object();
+      if (i < m.absolute_channel.size())
+        for (int k = 0; k < 3; ++k)
+          channels[std::string(1, "RGB"[k])] = {
+              {"absolute", metrics_json(m.absolute_channel[i][k])},
+              {"normalized", metrics_json(m.normalized_channel[i][k])}};
+      per.push_back({{"theta_i_deg", r.measured.curves[i].theta_i_deg},
+                     {"absolute", metrics_json(m.absolute[i])},
+                     {"normalized", metrics_json(m.normalized[i])},
+                     {"channels", channels}});
+    }
+    models[m.key] = {{"label", m.label},
+                     {"normalization_factor", rgb_json(m.normalization)},
+                     {"absolute", metrics_json(m.absolute_overall)},
+                     {"normalized", metrics_json(m.normalized_overall)},
+                     {"per_incidence", per}};
+  }
+  return models;
+}
+
+// The headline figures at the top level: computed is the fiber-level ray trace.
+void add_headline_figures(nlohmann::json& j, const std::vector<ModelCurves>& models) {
+  for (const auto& m : models) {
+    if (m.key == "computed_raytrace") {
+      j["computed_rms_log"] = m.normalized_overall.rms_log;
+      j["computed_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["computed_rms_rel"] = m.normalized_overall.rms_rel;
+      j["computed_rms_rel_absolute"] = m.absolute_overall.rms_rel;
+    }
+    if (m.key == "computed_raytrace_fitted") {
+      j["computed_fitted_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["computed_fitted_rms_log"] = m.normalized_overall.rms_log;
+    }
+    if (m.key == "classic_fitted") {
+      j["classic_fitted_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["classic_fitted_rms_log"] = m.normalized_overall.rms_log;
+    }
+    if (m.key == "classic") {
+      j["classic_rms_log"] = m.normalized_overall.rms_log;
+      j["classic_rms_log_absolute"] = m.absolute_overall.rms_log;
+      j["classic_rms_rel"] = m.normalized_overall.rms_rel;
+      j["classic_rms_rel_absolute"] = m.absolute_overall.rms_rel;
+    }
+  }
+}
+
+nlohmann::json fit_parameters_json(const FitResult& f) {
+  nlohmann::json ps = nlohmann::json::array();
+  for (const auto& p : f.parameters)
+    ps.push_back(
+        {{"name", p.parameter.name},
+         {"unit", p.parameter.unit},
+         {"start", p.parameter.start},
+         {"lo", p.parameter.lo},
+         {"hi", p.parameter.hi},
+         {"log_scale", p.parameter.log_scale},
+         {"value", p.value},
+         {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma) : nlohmann::json()},
+         {"sigma_restarts",
+          std::isfinite(p.sigma_restarts) ? nlohmann::json(p.sigma_restarts) : nlohmann::json()},
+         {"at_bound", p.at_bound}});
+  return ps;
+}
+
+// One fit: its parameters, its search, and the fitted model at the run's quality.
+nlohmann::json fit_json(const FitResult& f, const std::vector<ModelCurves>& models) {
+  nlohmann::json e = {{"parameters", fit_parameters_json(f)},
+                      {"inner_model", f.inner_model},
+                      {"method", f.method},
+                      {"uncertainty", f.uncertainty},
+                      {"objective", "rms_log, absolute, of the inner model"},
+                      {"inner_rms_log_start", f.objective_start},
+                      {"inner_rms_log_fitted", f.objective},
+                      {"inner_start", metrics_json(f.start_metrics)},
+                      {"inner_fitted", metrics_json(f.fitted_metrics)},
+                      {"evaluations", f.evaluations},
+                      {"converged", f.converged},
+                      {"seconds", f.seconds}};
+  // The fitted parameters at the run's quality (the same ray trace as the unfitted curves).
+  const std::string key = f.model == "computed" ? "computed_raytrace_fitted" : f.model + "_fitted";
+  for (const auto& m : models)
+    if (m.key == key)
+      e["at_run_quality"] = {{"model", key},
+                             {"absolute", metrics_json(m.absolute_overall)},
+                             {"normalized", metrics_json(m.normalized_overall)}};
+  return e;
+}
+
+nlohmann::json colours_json(const std::vector<ColourEntry>& entries) {
+  nlohmann::json colours = nlohmann::json::array();
+  for (const auto& c : entries) {
+    nlohmann::json e = {{"name", c.name}, {"hsv", {c.hsv.h, c.hsv.s, c.hsv.v}}, {"note", c.note}};
+    if (std::isfinite(c.linear_srgb.r)) e["linear_srgb"] = rgb_json(c.linear_srgb);
+    if (c.spectrum) e["spectrum"] = *c.spectrum;
+    colours.push_back(e);
+  }
+  return colours;
+}
+
+nlohmann::json renders_json(const std::vector<VerifyRender>& images) {
+  nlohmann::json renders = nlohmann::json::array();
+  for (const auto& v : images) {
+    nlohmann::json e = {{"kind", v.kind},
+                        {"model", v.model},
+                        {"configuration", v.configuration},
+                        {"exr", v.stem + ".exr"},
+                        {"png", v.stem + ".png"},
+                        {"caption", v.caption},
+                        {"mean_linear_srgb", rgb_json(v.mean)}};
+    if (v.kind == "patch") e["patch_radiance_linear_srgb"] = rgb_json(v.patch_radiance);
+    renders.push_back(e);
+  }
+  return renders;
+}
+
+}  // namespace
+
+std::string verify_metrics_json(const VerifyReport& r) {
+  nlohmann::json j;
+  j["report"] = "weft verify";
+  j["measured"] = r.measured.file;
+  j["fiber"] = r.fiber_name;
+  j["sample"] = r.sample_name;
+  const VerifySettings& s = r.settings;
+  j["settings"] = settings_json(s);
+  j["seed"] = s.seed;
+  j["seconds"] = r.seconds;
+  j["normalization"] =
+      "paper (section 4): per model and channel, beta scaled so that beta at normal incidence and "
+      "view equals the measured one";
+  j["metrics"] =
+      "rms_log: RMS of ln(model / measured); rms_rel: RMS of (model - measured) / "
+      "measured; over every view, incidence and channel where both are positive";
+  j["models"] = models_json(r);
+  add_headline_figures(j, r.models);
+  if (!r.fits.empty()) {
+    nlohmann::json fit = nlohmann::json::object();
+    for (const auto& f : r.fits) fit[f.model] = fit_json(f, r.models);
+    j["fit"] = fit;
+  }
+  j["colour_table"] = colours_json(r.colours);
+  j["renders"] = renders_json(r.renders);
+  j["render_setup"] = kVerifyRenderSetup;
+  j["weave_render_setup"] = kVerifyWeaveRenderSetup;
+  j["classic_reflectance_linear_srgb"] = rgb_json(r.classic_reflectance);
+  j["classic_reflectance_clipped_components"] = r.classic_clip.components;
+  j["classic_source"] = r.classic_source;
+  j["fabric_table_gamut_clipped_components"] = r.fabric_table_gamut_clipped;
+  j["raytrace_relative_noise"] = r.raytrace_relative_noise;
+  return j.dump(2) + "\n";
+}
+
+}  // namespace weft
