@@ -42,6 +42,7 @@
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/integrators/image.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/classic_fiber.h"
 #include "weft/materials/microfacet.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/weave.h"
@@ -299,12 +300,6 @@ struct FitInnerSettings {
   int threads = 0;
 };
 FitInnerSettings fit_inner_settings(const VerifySettings& settings);
-
-// The classic fiber (Lambert + Cook-Torrance, outer hemisphere only: opaque) as a fiber table.
-TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
-                                       double ior, int resolution, int samples, uint64_t seed,
-                                       int threads,
-                                       const ProgressCallback& progress = no_progress());
 
 // ---- A baked fiber table in place of a spec (weft verify --fiber TABLE) ------------------------
 
