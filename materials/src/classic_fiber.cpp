@@ -102,4 +102,23 @@ std::optional<BsdfSample> ClassicFiberBsdf::sample(const Vec3& wo, Vec2 u, doubl
   return BsdfSample{wi, eval(wo, wi) * (std::abs(wi.z) / p), p, false};
 }
 
+TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
+                                       double ior, int resolution, int samples, uint64_t seed,
+                                       int threads, const ProgressCallback& progress) {
+  const ClassicFiberBsdf classic = ClassicFiberBsdf::create(diffuse, d, ior);
+  // Outside the fiber only: the ray trace lights the far crossing point from inside, where an
+  // opaque classic fiber reflects nothing.
+  TabulatedBsdfTable t = TabulatedBsdfTable::from_function(
+      resolution, 3,
+      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const Rgb f = wo.z > 0 && wi.z > 0 ? classic.eval(wo, wi) : Rgb();
+        v[0] = f.r;
+        v[1] = f.g;
+        v[2] = f.b;
+      },
+      samples, seed, threads, progress);
+  t.kind = "fiber";
+  return t;
+}
+
 }  // namespace weft

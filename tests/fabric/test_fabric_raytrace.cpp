@@ -10,7 +10,7 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/fabric/fabric_raytrace.h"
-#include "weft/verify/verify.h"
+#include "weft/materials/classic_fiber.h"
 #include "weft/materials/table_compare.h"
 #include "weft/scenes/weave.h"
 

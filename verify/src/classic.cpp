@@ -3,28 +3,8 @@
 #include <sstream>
 
 #include "weft/core/error.h"
-#include "weft/materials/classic_fiber.h"
 
 namespace weft {
-
-TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
-                                       double ior, int resolution, int samples, uint64_t seed,
-                                       int threads, const ProgressCallback& progress) {
-  const ClassicFiberBsdf classic = ClassicFiberBsdf::create(diffuse, d, ior);
-  // Outside the fiber only: the ray trace lights the far crossing point from inside, where an
-  // opaque classic fiber reflects nothing.
-  TabulatedBsdfTable t = TabulatedBsdfTable::from_function(
-      resolution, 3,
-      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        const Rgb f = wo.z > 0 && wi.z > 0 ? classic.eval(wo, wi) : Rgb();
-        v[0] = f.r;
-        v[1] = f.g;
-        v[2] = f.b;
-      },
-      samples, seed, threads, progress);
-  t.kind = "fiber";
-  return t;
-}
 
 std::vector<double> classic_diffuse_from_fiber_table(const TabulatedBsdfTable& fiber,
                                                      const MicrofacetDistribution& d, double ior,

@@ -8,7 +8,7 @@
 #include "common.h"
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
-#include "weft/verify/classic.h"
+#include "weft/materials/classic_fiber.h"
 #include "weft/verify/inplane.h"
 
 namespace weft {

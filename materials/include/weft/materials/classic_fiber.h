@@ -21,6 +21,8 @@
 #include <memory>
 #include <optional>
 
+#include "weft/core/progress.h"
+#include "weft/materials/bsdf_table.h"
 #include "weft/materials/cook_torrance.h"
 
 namespace weft {
@@ -51,5 +53,13 @@ struct ClassicFiberBsdf {
   // Probability of choosing the surface lobe at wo (mirrored to the upper side).
   double surface_lobe_probability(const Vec3& wo_upper) const;
 };
+
+// The classic fiber (outer hemisphere only: opaque) as a fiber table of R = 'resolution', 3
+// channels, 'samples' direction pairs per cell pair (TabulatedBsdfTable::from_function): what the
+// fabric ray trace and the summations read in place of a baked fiber table.
+TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
+                                       double ior, int resolution, int samples, uint64_t seed,
+                                       int threads,
+                                       const ProgressCallback& progress = no_progress());
 
 }  // namespace weft

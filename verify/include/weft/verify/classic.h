@@ -1,24 +1,18 @@
 #pragma once
-// The classic baseline: a Lambert + Cook-Torrance fiber (materials/classic_fiber.h), tabulated as
-// a fiber table so that it is ray-traced on the same sample as the computed fiber, and what it
-// takes from a baked fiber table given in place of a spec (weft verify --fiber TABLE).
+// The classic baseline's fiber from a baked fiber table given in place of a spec (weft verify
+// --fiber TABLE): its diffuse colour and its roughness. The classic fiber itself and its fiber
+// table are materials/classic_fiber.h's.
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "weft/core/progress.h"
 #include "weft/core/spectrum.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/classic_fiber.h"
 #include "weft/materials/microfacet.h"
 
 namespace weft {
-
-// The classic fiber (Lambert + Cook-Torrance, outer hemisphere only: opaque) as a fiber table.
-TabulatedBsdfTable classic_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
-                                       double ior, int resolution, int samples, uint64_t seed,
-                                       int threads,
-                                       const ProgressCallback& progress = no_progress());
 
 // The classic fiber's diffuse colour from a fiber table alone, per channel of the table: the
 // table's total albedo minus that of the classic fiber's own Cook-Torrance lobe (diffuse colour 0,

@@ -10,7 +10,7 @@
 #include "weft/verify/metrics.h"   // the metrics, absolute and normalized
 #include "weft/verify/colour.h"    // the colour table
 #include "weft/verify/settings.h"  // the quality levels
-#include "weft/verify/classic.h"   // the classic baseline's fiber table
+#include "weft/verify/classic.h"   // the classic fiber from a baked fiber table
 #include "weft/verify/fit.h"       // the fit of a model's fiber
 #include "weft/verify/render.h"    // the renders of the sample
 #include "weft/verify/run.h"       // the run
