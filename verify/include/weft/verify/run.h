@@ -2,11 +2,11 @@
 // The run of a verification (docs/verify.md): for every incidence of the measured in-plane table,
 // beta = pi f in the plane of incidence of
 //   * the computed fabric: fabric tables of the woven sample made from the fiber table, by the
-//     fiber-level ray trace (fabric/fabric_raytrace.h) and by the paper's summation (made by
-//     the caller: the summation lives in the fiber physics, which this library does not link);
-//   * the classic baseline: a Lambert + Cook-Torrance fiber (verify/classic.h) whose diffuse
-//     colour is the fiber's volume albedo, tabulated as a fiber table and ray-traced on the same
-//     sample, so the two differ only in the fiber's BSDF;
+//     fiber-level ray trace (fabric/fabric_raytrace.h) and by the paper's summation
+//     (fabric/fabric_summation.h, made by the caller);
+//   * the classic baseline: a Lambert + Cook-Torrance fiber (materials/classic_fiber.h) whose
+//     diffuse colour is the fiber's volume albedo, tabulated as a fiber table and ray-traced on the
+//     same sample, so the two differ only in the fiber's BSDF;
 //   * the measurement;
 // and the metrics that compare them, and the fabric's colour (paper's Table 1).
 #include <array>
@@ -33,7 +33,7 @@
 
 namespace weft {
 
-// What the caller brings: the fiber physics' results (this library does not link them).
+// What the caller brings: the fiber physics' results (the fiber bake) and the summation table.
 struct VerifyInputs {
   TabulatedBsdfTable fiber;  // fiber table (spectral for the colour table, or RGB)
   // The fiber's volume albedo per band (albedo minus the surface part): the classic model's
