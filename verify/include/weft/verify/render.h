@@ -47,9 +47,15 @@ inline constexpr const char* kVerifyRenderSetup =
     "radiance times 1 (a white Lambertian patch would be white), clipped to [0, 1], sRGB transfer "
     "curve, no other tone mapping; EXR: linear sRGB radiance.";
 
-// The renders' scene description (in memory): the patch named "cloth" bound to 'material'.
-nlohmann::json verify_render_scene(const nlohmann::json& material, bool transmission,
-                                   const VerifySettings& settings);
+// The patch render's scene, built in memory (verify_render.cpp): a flat 1 m square of cloth, the
+// object and material "cloth" bound to 'material' (its relative paths resolve against
+// 'base_dir'), lit by a parallel light of irradiance kVerifyRenderIrradiance at normal incidence
+// from the viewer's side or from behind ('transmission'), seen by an orthographic camera
+// kVerifyRenderViewZenithDeg from the normal that frames the patch, with the render settings
+// (render_size, render_spp, seed).
+SceneDescription verify_render_scene(const nlohmann::json& material, bool transmission,
+                                     const VerifySettings& settings,
+                                     const std::filesystem::path& base_dir);
 
 // The fiber-level renders (docs/verify.md "Renders"): the woven sample's fibers, as Embree round
 // curves, every fiber with the model's fiber table, shaded by the renderer as any scene's fibers
