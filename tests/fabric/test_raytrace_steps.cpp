@@ -3,6 +3,8 @@
 // the tally of an exit, Russian roulette and splitting.
 #include <gtest/gtest.h>
 
+#include "flat_sheet.h"
+
 #include <cmath>
 #include <vector>
 
@@ -16,29 +18,14 @@ using namespace weft::raytrace;
 
 namespace {
 
+using weft::testing::flat_sheet;
+
 // A repeat of 1 x 0.5 mm, 0.2 mm thick, centred on the origin.
 RepeatSlab small_slab() {
   RepeatSlab s;
   s.px = 1e-3, s.pz = 0.5e-3;
   s.x0 = -0.5 * s.px, s.z0 = -0.5 * s.pz;
   s.y0 = -0.1e-3, s.y1 = 0.1e-3;
-  return s;
-}
-
-// A flat sheet (a quad facing +y) filling one repeat of period 1 x 1 mm, 0.1 mm thick slab.
-WovenSample flat_sheet() {
-  WovenSample s;
-  TriangleMesh m;
-  m.material = "warp";
-  const float h = 0.5e-3f;
-  m.positions = {-h, 0, -h, h, 0, -h, h, 0, h, -h, 0, h};
-  m.normals = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
-  m.tangents = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1};
-  m.indices = {0, 2, 1, 0, 3, 2};  // counter-clockwise seen from +y
-  s.meshes.push_back(m);
-  s.summary.period_x_mm = s.summary.period_z_mm = 1;
-  s.summary.y_min_mm = -0.05;
-  s.summary.y_max_mm = 0.05;
   return s;
 }
 
