@@ -3,11 +3,11 @@
 #include <fstream>
 #include <sstream>
 
-#include "primitives.h"
 #include "weft/core/error.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
 #include "weft/core/params.h"
+#include "weft/scenes/primitives.h"
 
 namespace weft {
 namespace {
@@ -207,13 +207,13 @@ void parse_object(ParamReader f, SceneDescription& d) {
     }
     if (length(cross(n, t)) < 1e-6)
       throw Error(f.file(), f.field("tangent"), "is parallel to the normal");
-    m = detail::make_quad(c, n, t, w, h);
+    m = make_quad(c, n, t, w, h);
   } else if (type == "sphere") {
     const Vec3 c = f.vec3("center");
     const double r = f.number("radius", 1e-30, 1e30);
     const int sub = static_cast<int>(f.integer("subdivisions", 3, 0, 7));
     const bool inward = f.boolean("inward", false);
-    m = detail::make_sphere(c, r, sub, inward);
+    m = make_sphere(c, r, sub, inward);
     // Flat facets (no vertex normals) make shading and geometry agree exactly (furnace tests).
     if (!f.boolean("smooth", true)) m.normals.clear();
   } else if (type == "fiber") {

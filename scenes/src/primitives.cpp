@@ -1,4 +1,4 @@
-#include "primitives.h"
+#include "weft/scenes/primitives.h"
 
 #include <array>
 #include <cmath>
@@ -7,7 +7,7 @@
 
 #include "weft/core/frame.h"
 
-namespace weft::detail {
+namespace weft {
 
 namespace {
 void push(std::vector<float>& v, const Vec3& p) {
@@ -82,4 +82,4 @@ TriangleMesh make_sphere(const Vec3& center, double radius, int subdivisions, bo
   return m;
 }
 
-}  // namespace weft::detail
+}  // namespace weft

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "flat_sheet.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -17,6 +18,8 @@
 using namespace weft;
 
 namespace {
+
+using weft::testing::flat_sheet;
 
 // A fiber table given per point: f(wo, wi) in every channel.
 template <class F>
@@ -35,25 +38,6 @@ TabulatedBsdfTable fiber_table3(int resolution, F f) {
   auto t = TabulatedBsdfTable::from_function(resolution, 3, f, 2, 1);
   t.kind = "fiber";
   return t;
-}
-
-// A flat sheet (a quad facing +y) filling one repeat of period 1 x 1 mm, 0.1 mm thick slab.
-WovenSample flat_sheet() {
-  WovenSample s;
-  TriangleMesh m;
-  m.material = "warp";
-  const float h = 0.5e-3f;
-  m.positions = {-h, 0, -h, h, 0, -h, h, 0, h, -h, 0, h};
-  m.normals = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
-  m.tangents = {1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1, 1, 0, 0, 1};
-  m.indices = {0, 2, 1, 0, 3, 2};  // counter-clockwise seen from +y
-  s.meshes.push_back(m);
-  s.summary.period_x_mm = s.summary.period_z_mm = 1;
-  s.summary.y_min_mm = -0.05;
-  s.summary.y_max_mm = 0.05;
-  s.summary.source = "flat sheet";
-  s.summary.detail = "yarn";
-  return s;
 }
 
 FabricRaytraceOptions options(int resolution, uint64_t particles_per_bin) {

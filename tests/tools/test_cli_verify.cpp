@@ -1,7 +1,8 @@
 // weft verify as a user meets it: a draft run writes the whole report folder; a bad measured
-// table is refused naming the file and the column, exit code 2, nothing written. And --fit: the
-// fit recovers parameters from a synthetic measurement that its own inner model made; bad fit
-// options are refused before any work.
+// table is refused naming the file and the column, exit code 2, nothing written; bad fit options
+// are refused before any work; a baked fiber table in place of a spec; the estimate and the
+// long-work rule; shards and their merge; Slurm scripts. (The fit's library:
+// tests/verify/test_fit_models.cpp.)
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -13,11 +14,11 @@
 #include <sstream>
 #include <string>
 
-#include "weft/verify/fit_models.h"  // the fit's inner models, header-only (the command's own)
 #include "cli_run.h"
 #include "test_util.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
+#include "weft/verify/verify.h"
 
 namespace fs = std::filesystem;
 using weft::testing::fresh_test_dir;
@@ -157,211 +158,8 @@ TEST(CliVerify, DraftWritesTheWholeReport) {
   EXPECT_TRUE(fs::exists(other / "notes.txt"));
 }
 
-namespace {
-
-// The bundled measurement's geometry (its incidences and views), with beta replaced by a model's.
-weft::MeasuredInplane synthetic(const std::vector<std::vector<weft::Rgb>>& beta) {
-  weft::MeasuredInplane m = weft::read_measured_inplane(
-      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
-  m.file = "synthetic";
-  for (size_t i = 0; i < m.curves.size(); ++i) m.curves[i].beta = beta[i];
-  return m;
-}
-
-// The command's sample: the bundled poplin at fiber detail.
-weft::WovenSample verify_sample() {
-  weft::WeaveOptions given;
-  given.detail = "fiber";
-  return weft::make_woven_sample(weft::overlay(weft::WeaveOptions{}, given));
-}
-
-}  // namespace
-
-// The computed model: a red-cotton fiber with its dye 1.8 times as strong and roughness 0.22
-// makes the measurement (the fit's own inner model, so a perfect fit exists); the fit starts from
-// the spec (1, 0.35) and must land on the chosen values, converged within 60 evaluations, with
-// each search. Tolerances: 3 % in the dye scale and 0.01 in roughness, well outside the
-// searches' own reach (1e-3 of each box) and below the distance of the start (ln 1.8 = 0.59,
-// 0.13). Measured (2026-12-02): Levenberg-Marquardt converged after 21 evaluations (dye 1.7990,
-// roughness 0.2203, rms_log 0.0012); Nelder-Mead had not converged after 60 (1.7993, 0.2199,
-// 0.0004).
-TEST(CliVerify, FitRecoversKnownFiberParametersFromASyntheticMeasurement) {
-  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
-  weft::VerifySettings s = weft::verify_settings(weft::VerifyQuality::kDraft);
-  weft::FitInnerSettings inner = weft::fit_inner_settings(s);
-  // The smooth inner model, with the test's budget (the command uses 5000 photons).
-  inner.inner = weft::FitInner::kSummation;
-  inner.fiber_photons_per_band = 2000;
-  const weft::WovenSample sample = verify_sample();
-  const std::vector<std::string> names = {"dye_scale", "roughness_alpha"};
-  const std::vector<double> truth = {1.8, 0.22};
-  weft::MeasuredInplane geometry = weft::read_measured_inplane(
-      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
-  const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
-      weft::apply_spec_fit(spec, names, truth), sample, inner, geometry));
-  for (const auto method : {weft::FitMethod::kLevenbergMarquardt, weft::FitMethod::kNelderMead}) {
-    weft::FitOptions options;
-    options.method = method;
-    options.max_evaluations = 60;
-    const weft::FitResult r = weft::fit_inplane(
-        "computed", weft::spec_fit_parameters(spec, names),
-        [&](const std::vector<double>& x) {
-          return weft::computed_inner_curves(weft::apply_spec_fit(spec, names, x), sample, inner,
-                                             measured);
-        },
-        measured, options);
-    const std::string name = weft::fit_method_name(method);
-    ASSERT_EQ(r.parameters.size(), 2u);
-    EXPECT_EQ(r.method, name);
-    EXPECT_GT(r.objective_start, 0.2);  // the start is far from the truth
-    EXPECT_NEAR(std::log(r.parameters[0].value / truth[0]), 0.0, 0.03)
-        << name << " " << r.parameters[0].value;
-    EXPECT_NEAR(r.parameters[1].value, truth[1], 0.01) << name;
-    EXPECT_LT(r.objective, 0.02) << name;
-    for (const auto& p : r.parameters) {
-      EXPECT_FALSE(p.at_bound) << name << " " << p.parameter.name;
-      EXPECT_TRUE(std::isfinite(p.sigma) && p.sigma > 0) << name << " " << p.parameter.name;
-    }
-    // The search, a Nelder-Mead shrink's overrun (p), the optimum again and the Jacobian (2 p).
-    EXPECT_LE(r.evaluations, options.max_evaluations + 2 + 1 + 2 * 2) << name;
-    if (method == weft::FitMethod::kLevenbergMarquardt) {
-      EXPECT_TRUE(r.converged);
-      EXPECT_LE(r.evaluations, options.max_evaluations + 1 + 2 * 2);  // never past its budget
-    }
-  }
-}
-
-// The fit's objective is smooth in dye_scale at its fixed seed: its inner bake keeps the photons'
-// paths when the dye changes (absorption as a weight, transport.h), and its ray trace draws its
-// paths from a fixed proposal table (FabricRaytraceOptions::proposal; the fit's is the table of
-// its start, here dye 1), so the inner models' rms_log along dye 1.00, 1.01, ..., 1.04 (red-cotton,
-// the bundled measurement, the command's inner settings at draft) have second differences below
-// 1e-4 (summation) and 3e-4 (ray trace), curvatures below 1 and 3 per unit dye squared at h = 0.01
-// (measured 4.5e-5 and 1.1e-4, docs/verify.md). Before, the same steps gave second differences of
-// 2.5e-3 to 8.6e-3 (summation) and 1.7e-2 to 1.9e-2 (ray trace): the noise of the bake and of the
-// paths, 25 and 60 times over the bounds.
-TEST(CliVerify, FitInnerObjectiveIsSmoothInDyeAtAFixedSeed) {
-  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
-  weft::FitInnerSettings inner =
-      weft::fit_inner_settings(weft::verify_settings(weft::VerifyQuality::kDraft));
-  inner.threads = 2;
-  const weft::WovenSample sample = verify_sample();
-  const weft::MeasuredInplane measured = weft::read_measured_inplane(
-      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
-  const weft::TabulatedBsdfTable proposal = weft::computed_inner_fiber_table(spec, inner);
-  for (const auto& [model, bound] :
-       {std::pair{weft::FitInner::kSummation, 1e-4}, std::pair{weft::FitInner::kRaytrace, 3e-4}}) {
-    inner.inner = model;
-    std::vector<double> j;
-    for (int k = 0; k < 5; ++k) {
-      const weft::FiberSpec dyed = weft::apply_spec_fit(spec, {"dye_scale"}, {1 + 0.01 * k});
-      const auto r = weft::fit_residuals(
-          weft::inner_fabric_curves(sample, weft::computed_inner_fiber_table(dyed, inner), inner,
-                                    measured, &proposal),
-          measured);
-      double ss = 0;
-      for (double v : r) ss += v * v;
-      j.push_back(std::sqrt(ss / r.size()));
-    }
-    const std::string name = weft::fit_inner_name(model);
-    for (size_t k = 0; k + 2 < j.size(); ++k)
-      EXPECT_LT(std::abs(j[k + 2] - 2 * j[k + 1] + j[k]), bound) << name << " " << k;
-    EXPECT_GT(std::abs(j[4] - j[0]), 1e-3) << name;  // and the objective does move with the dye
-  }
-}
-
-// The ray-trace inner model's search with its proposal re-centred (fit_inner_model): the dye 1.8
-// from the ray-trace inner model's own curves (traced directly at the truth), at a test's budget
-// (R = 3, 1000 photons per band, 300 particles per incident bin) and the default 100 evaluations.
-// The first search's proposal is the start's table (dye 1); the restarts move the proposal to the
-// optimum, and the search ends settled there. The fitted curves follow other paths than the
-// measurement's (their proposal's), so the optimum can only be as good as the ray trace's noise:
-// its objective is below that of the truth traced with another seed (the noise floor), and the dye
-// within 10 % (the summation's test above, without that noise, asks 3 %). Measured with the seeds
-// of measurement and fit 1, 2, 3, 4 (2026-12-02, estimator revision 2, Levenberg-Marquardt): dye
-// -0.3, -1.8, -4.6, +2.8 %, settled after 37, 18, 37, 27 evaluations (the uncertainty's 3
-// included). Each proposal is another realization of the ray trace, and the restarts' optima
-// wander by several times the Gauss-Newton sigma: sigma_restarts reports that spread (seed 1:
-// 0.057 for 0.011). With Nelder-Mead (its restarts from a simplex twice the last move) the same
-// seeds gave +6.3, -0.2, -1.1, +4.1 % after 57, 42, 59, 59 evaluations; before restarts stopped
-// once their moves stopped shrinking, seed 3 went 1.79, 1.58, 1.78, 1.64, 1.68 in 93 evaluations.
-TEST(CliVerify, RaytraceFitRecentresItsProposalAndConverges) {
-  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
-  weft::FitInnerSettings inner =
-      weft::fit_inner_settings(weft::verify_settings(weft::VerifyQuality::kDraft));
-  inner.inner = weft::FitInner::kRaytrace;
-  inner.resolution = 3;
-  inner.fiber_photons_per_band = 1000;
-  inner.particles_per_bin = 300;
-  inner.threads = 2;
-  const weft::WovenSample sample = verify_sample();
-  const std::vector<std::string> names = {"dye_scale"};
-  weft::MeasuredInplane geometry = weft::read_measured_inplane(
-      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
-  const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
-      weft::apply_spec_fit(spec, names, {1.8}), sample, inner, geometry));
-  const weft::FitOptions options;  // the defaults, as weft verify --fit uses them
-  const weft::FitResult r = weft::fit_inner_model(
-      "computed", weft::spec_fit_parameters(spec, names),
-      [&](const std::vector<double>& x) {
-        return weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), inner);
-      },
-      sample, inner, measured, options);
-  ASSERT_EQ(r.parameters.size(), 1u);
-  EXPECT_TRUE(r.converged);
-  EXPECT_GT(r.objective_start, 0.2);  // the first search's start, far from the truth
-  EXPECT_NEAR(std::log(r.parameters[0].value / 1.8), 0.0, 0.1) << r.parameters[0].value;
-  weft::FitInnerSettings other = inner;
-  other.seed = 2;
-  const auto floor =
-      weft::fit_residuals(weft::computed_inner_curves(weft::apply_spec_fit(spec, names, {1.8}),
-                                                      sample, other, measured),
-                          measured);
-  double ss = 0;
-  for (double v : floor) ss += v * v;
-  EXPECT_LT(r.objective, std::sqrt(ss / floor.size()));
-  EXPECT_EQ(r.parameters[0].parameter.start, 1.0);  // the given start, not a restart's
-  EXPECT_LE(r.evaluations, options.max_evaluations + 2);
-  // Two restarts or more: their spread is reported beside the Gauss-Newton sigma.
-  EXPECT_TRUE(std::isfinite(r.parameters[0].sigma_restarts));
-  EXPECT_GT(r.parameters[0].sigma_restarts, 0);
-}
-
-// The classic model's four (diffuse colour per channel, roughness) from its own synthetic
-// measurement, from the start the command uses for red-cotton (its volume albedo, 0.35), within
-// the command's default budget of 100 evaluations: converged. Measured (2026-12-02):
-// Levenberg-Marquardt converged after 35 evaluations (0.3001, 0.0500, 0.0301, 0.5999; rms_log
-// 0.0005); Nelder-Mead had not converged after 100 (0.3000, 0.0500, 0.0300, 0.6007; 0.0008) and
-// this test gave it 150.
-TEST(CliVerify, FitRecoversKnownClassicParametersFromASyntheticMeasurement) {
-  weft::VerifySettings s = weft::verify_settings(weft::VerifyQuality::kDraft);
-  weft::FitInnerSettings inner = weft::fit_inner_settings(s);
-  inner.inner = weft::FitInner::kSummation;
-  const weft::WovenSample sample = verify_sample();
-  weft::MeasuredInplane geometry = weft::read_measured_inplane(
-      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
-  const weft::MicrofacetModel model = weft::MicrofacetModel::kBeckmann;
-  const double ior = 1.557;
-  const std::vector<double> truth = {0.3, 0.05, 0.03, 0.6};
-  const weft::MeasuredInplane measured = synthetic(weft::classic_inner_curves(
-      weft::Rgb(truth[0], truth[1], truth[2]), {model, truth[3]}, ior, sample, inner, geometry));
-  const weft::FitOptions options;  // the defaults: Levenberg-Marquardt, 100 evaluations
-  const weft::FitResult r = weft::fit_inplane(
-      "classic", weft::classic_fit_parameters(weft::Rgb(0.849, 0.147, 0.209), 0.35),
-      [&](const std::vector<double>& x) {
-        return weft::classic_inner_curves(weft::Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, sample,
-                                          inner, measured);
-      },
-      measured, options);
-  ASSERT_EQ(r.parameters.size(), 4u);
-  for (size_t k = 0; k < 3; ++k)
-    EXPECT_NEAR(std::log(r.parameters[k].value / truth[k]), 0.0, 0.03)
-        << r.parameters[k].parameter.name << " " << r.parameters[k].value;
-  EXPECT_NEAR(r.parameters[3].value, truth[3], 0.02);
-  EXPECT_LT(r.objective, 0.02);
-  EXPECT_TRUE(r.converged);
-}
-
+// Bad fit options are refused before any work, naming the option, exit 2, nothing written (the
+// library's own refusals: tests/verify/test_fit_models.cpp).
 TEST(CliVerify, BadFitOptionsAreRefusedBeforeAnyWork) {
   const fs::path dir = fresh_test_dir();
   const fs::path out = dir / "report";
@@ -393,24 +191,6 @@ TEST(CliVerify, BadFitOptionsAreRefusedBeforeAnyWork) {
     EXPECT_NE(r.err.find(c.words), std::string::npos) << c.args << ": " << r.err;
     EXPECT_FALSE(fs::exists(out)) << c.args;
   }
-  // The library refuses a fifth parameter and a start outside the box, naming them.
-  const weft::MeasuredInplane m = weft::read_measured_inplane(
-      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
-  const weft::InplaneModel never =
-      [](const std::vector<double>&) -> std::vector<std::vector<weft::Rgb>> {
-    ADD_FAILURE() << "the model ran";
-    return {};
-  };
-  std::vector<weft::FitParameter> five(5, {"a", "", 0.1, 1, 0.5, false});
-  EXPECT_NE(weft::testing::error_of([&] {
-              weft::fit_inplane("x", five, never, m, {});
-            }).find("between one and four"),
-            std::string::npos);
-  const std::vector<weft::FitParameter> outside = {{"roughness_alpha", "", 0.05, 1, 1.5, false}};
-  EXPECT_NE(weft::testing::error_of([&] {
-              weft::fit_inplane("x", outside, never, m, {});
-            }).find("roughness_alpha"),
-            std::string::npos);
 }
 
 namespace {

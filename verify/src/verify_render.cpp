@@ -1,6 +1,6 @@
 // The renders of weft verify's report (paper's Figs. 8-9): a flat patch of cloth with each model's
 // fabric table, lit from the viewer's side and from behind, through the one renderer (a scene
-// description in memory, RenderScene, render) as `weft render` would draw it.
+// description built in memory, RenderScene, render) as `weft render` would draw it.
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -11,39 +11,53 @@
 #include "weft/core/math.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/integrators/render_settings.h"
-#include "weft/verify/verify.h"
+#include "weft/scenes/camera.h"
 #include "weft/scenes/description.h"
+#include "weft/scenes/primitives.h"
 #include "weft/scenes/render_scene.h"
+#include "weft/verify/render_scene.h"
+#include "weft/verify/verify.h"
 
 namespace weft {
 
-nlohmann::json verify_render_scene(const nlohmann::json& material, bool transmission,
-                                   const VerifySettings& s) {
-  using nlohmann::json;
+namespace {
+
+// A model's material as a description's binding under 'key'.
+MaterialBinding binding_of(const nlohmann::json& material, const std::string& key) {
+  MaterialBinding b;
+  b.type = material.at("type").get<std::string>();
+  b.params = material.value("params", nlohmann::json::object());
+  b.field = "materials." + key;
+  return b;
+}
+
+}  // namespace
+
+SceneDescription verify_render_scene(const nlohmann::json& material, bool transmission,
+                                     const VerifySettings& s,
+                                     const std::filesystem::path& base_dir) {
+  SceneDescription d;
+  d.source = std::string("verify render ") + (transmission ? "transmission" : "reflection");
+  d.base_dir = base_dir;
   // glTF's Y up (the description's default frame): the patch lies in the x-z plane, its tangent
   // (the warp, the tables' x axis) along x.
-  return json{{"objects", json::array({{{"type", "quad"},
-                                        {"name", "cloth"},
-                                        {"material", "cloth"},
-                                        {"center", {0, 0, 0}},
-                                        {"normal", {0, 1, 0}},
-                                        {"tangent", {1, 0, 0}},
-                                        {"size", {1, 1}}}})},
-              {"materials", {{"cloth", material}}},
-              {"lights", json::array({{{"type", "parallel"},
-                                       {"irradiance", kVerifyRenderIrradiance},
-                                       {"zenith_deg", transmission ? 180.0 : 0.0},
-                                       {"azimuth_deg", 0.0}}})},
-              {"camera",
-               {{"type", "orthographic"},
-                {"frame_object", "cloth"},
-                {"zenith_deg", kVerifyRenderViewZenithDeg},
-                {"azimuth_deg", 180.0}}},
-              {"render",
-               {{"width", s.render_size},
-                {"height", s.render_size},
-                {"spp", s.render_spp},
-                {"seed", s.seed}}}};
+  TriangleMesh cloth = make_quad({0, 0, 0}, {0, 1, 0}, {1, 0, 0}, 1, 1);
+  cloth.material = "cloth";
+  cloth.names = {"cloth"};
+  d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(cloth)));
+  d.materials["cloth"] = binding_of(material, "cloth");
+  DirectionalLight light;
+  light.irradiance = Rgb(kVerifyRenderIrradiance);
+  light.to_light = d.frame.direction(deg_to_rad(transmission ? 180.0 : 0.0), deg_to_rad(0.0));
+  d.lights.directional.push_back(light);
+  // The camera frames the patch from zenith kVerifyRenderViewZenithDeg, azimuth 180 deg.
+  d.camera = frame_box_orthographic(
+      d.object_bounds("cloth"),
+      d.frame.direction(deg_to_rad(kVerifyRenderViewZenithDeg), deg_to_rad(180.0)),
+      d.frame.tangent);
+  d.render = nlohmann::json{
+      {"width", s.render_size}, {"height", s.render_size}, {"spp", s.render_spp}, {"seed", s.seed}};
+  return d;
 }
 
 VerifyWeaveFrame verify_weave_frame(const WeaveSummary& sample, int size) {
@@ -88,13 +102,7 @@ SceneDescription verify_weave_scene(const WovenSample& sample, const nlohmann::j
   // or inline objects, and the fibers are the tiled sample's.
   SceneDescription d = tiled_woven_description(sample, f.copies_x, f.copies_z, source);
   d.base_dir = base_dir;
-  for (const char* key : {"warp", "weft"}) {
-    MaterialBinding b;
-    b.type = material.at("type").get<std::string>();
-    b.params = material.value("params", nlohmann::json::object());
-    b.field = std::string("materials.") + key;
-    d.materials[key] = b;
-  }
+  for (const char* key : {"warp", "weft"}) d.materials[key] = binding_of(material, key);
   // glTF's frame (weave.h): the cloth's normal is +y, the warp +x. The light as the patch's.
   DirectionalLight light;
   light.to_light = {0, transmission ? -1.0 : 1.0, 0};
@@ -150,8 +158,9 @@ VerifyRender render_one(const std::filesystem::path& folder, const nlohmann::jso
   v.model = model;
   v.configuration = config;
   v.stem = "render-" + config + "-" + model;
-  v.image = render_description(
-      parse_scene_description(verify_render_scene(material, transmission, s), folder, source), s);
+  SceneDescription desc = verify_render_scene(material, transmission, s, folder);
+  desc.source = source;
+  v.image = render_description(desc, s);
   // The central half of the film lies inside the patch (the film is the patch's projection).
   const int w = v.image.width, h = v.image.height;
   v.patch_radiance = mean_of(v.image, w / 4, w - w / 4, h / 4, h - h / 4);

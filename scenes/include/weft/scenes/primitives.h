@@ -1,8 +1,9 @@
 #pragma once
-// Built-in primitives for inline test geometry (the bundled examples use glTF files).
+// Built-in primitives: the inline objects of a scene description (description.h) and the scenes
+// that code builds in memory (the bundled examples use glTF files).
 #include "weft/scenes/mesh.h"
 
-namespace weft::detail {
+namespace weft {
 
 // A w x h rectangle centred at 'center' facing 'normal', its first side along 'tangent'.
 TriangleMesh make_quad(const Vec3& center, const Vec3& normal, const Vec3& tangent, double w,
@@ -10,4 +11,4 @@ TriangleMesh make_quad(const Vec3& center, const Vec3& normal, const Vec3& tange
 // An icosphere (subdivided icosahedron, vertices on the sphere) facing outwards, or inwards.
 TriangleMesh make_sphere(const Vec3& center, double radius, int subdivisions, bool inward);
 
-}  // namespace weft::detail
+}  // namespace weft

@@ -1,0 +1,66 @@
+#include "weft/fabric/fiber_sampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+namespace weft {
+namespace {
+
+// A bound of |cos theta| over cell b (for rejection): its largest value on a lattice that includes
+// the edges, a little enlarged; the pole's cell reaches 1.
+double max_cos_in(const DirectionGrid& grid, int b) {
+  double m = 0;
+  for (int i = 0; i <= 16; ++i)
+    for (int j = 0; j <= 16; ++j)
+      m = std::max(
+          m, std::abs(DirectionGrid::to_direction(grid.chart_point(b, i / 16.0, j / 16.0)).z));
+  return std::min(1.0, 1.02 * m + 1e-6);
+}
+
+}  // namespace
+
+FiberSampler::FiberSampler(const TabulatedBsdfTable& t) : table(&t), grid(t.grid()) {
+  const int bins = grid.bins(), nc = t.channels;
+  strategies = nc + 1;
+  areas = grid.cosine_weighted_areas();
+  max_cos.resize(bins);
+  for (int b = 0; b < bins; ++b) max_cos[b] = max_cos_in(grid, b);
+  albedo.assign(static_cast<size_t>(bins) * strategies, 0.0);
+  rows.resize(static_cast<size_t>(bins) * strategies);
+  std::vector<double> w(static_cast<size_t>(strategies) * bins);
+  for (int i = 0; i < bins; ++i) {
+    for (int o = 0; o < bins; ++o) {
+      double mean = 0;
+      for (int c = 0; c < nc; ++c) {
+        const double f = t.at(i, o, c);
+        w[static_cast<size_t>(c) * bins + o] = f * areas[o];
+        mean += f;
+      }
+      w[static_cast<size_t>(nc) * bins + o] = mean / nc * areas[o];
+    }
+    for (int s = 0; s < strategies; ++s) {
+      const std::span<const double> ws(w.data() + static_cast<size_t>(s) * bins, bins);
+      for (double x : ws) albedo[static_cast<size_t>(i) * strategies + s] += x;
+      rows[static_cast<size_t>(i) * strategies + s] = Distribution1D(ws);
+    }
+  }
+}
+
+double FiberSampler::value(int i, int o, int s) const {
+  const int nc = table->channels;
+  if (s < nc) return table->at(i, o, s);
+  double mean = 0;
+  for (int c = 0; c < nc; ++c) mean += table->at(i, o, c);
+  return mean / nc;
+}
+
+Vec3 FiberSampler::cosine_direction_in(int b, Rng& rng) const {
+  for (int tries = 0; tries < 1000; ++tries) {
+    const Vec3 d = DirectionGrid::to_direction(grid.chart_point(b, rng.uniform(), rng.uniform()));
+    if (rng.uniform() * max_cos[b] <= std::abs(d.z)) return d;
+  }
+  return grid.bin_center(b);  // a cell of vanishing cosine mass: never drawn in practice
+}
+
+}  // namespace weft

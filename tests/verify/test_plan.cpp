@@ -1,0 +1,133 @@
+// weft verify's request and plan (verify/plan.h): the request's defaults are the library's, the
+// plan reads and checks the inputs before any work, a sharded job's request comes back from its
+// parts, and the estimate grows with the fit.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "test_util.h"
+#include "weft/verify/plan.h"
+
+namespace fs = std::filesystem;
+using weft::testing::error_of;
+
+namespace weft {
+namespace {
+
+TEST(VerifyPlan, RequestDefaultsAreTheLibrarys) {
+  const VerifyRequest r;
+  EXPECT_EQ(r.fiber, "red-cotton");
+  EXPECT_EQ(r.quality, "default");
+  EXPECT_EQ(parse_verify_quality(r.quality), VerifySettings{}.quality);
+  EXPECT_EQ(r.seed, VerifySettings{}.seed);
+  EXPECT_EQ(r.threads, 0);
+  EXPECT_EQ(r.fit_params,
+            "dye_scale,particle_fraction_scale,particle_radius_scale,roughness_alpha");
+  EXPECT_EQ(r.fit_evaluations, FitOptions{}.max_evaluations);
+  EXPECT_EQ(parse_fit_inner(r.fit_inner), FitInner::kRaytrace);
+  EXPECT_EQ(parse_fit_method(r.fit_method), FitMethod::kLevenbergMarquardt);
+}
+
+TEST(VerifyPlan, ReadsTheInputsOfADraftRun) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.seed = 7;
+  r.threads = 2;
+  const VerifyPlan p = plan_verify(r);
+  EXPECT_EQ(p.settings.quality, VerifyQuality::kDraft);
+  EXPECT_EQ(p.settings.seed, 7u);
+  EXPECT_EQ(p.settings.threads, 2);
+  EXPECT_EQ(p.measured_path, bundled_measured_inplane());
+  EXPECT_EQ(p.measured.curves.size(), 9u);
+  EXPECT_EQ(p.spec.name, "red-cotton");
+  EXPECT_FALSE(p.fiber_table);
+  EXPECT_FALSE(p.shard);
+  EXPECT_EQ(p.weave.detail, "fiber");  // the fiber-level reference
+  EXPECT_TRUE(p.fit_names.empty());
+}
+
+TEST(VerifyPlan, BadRequestsAreRefusedNamingTheOption) {
+  struct Case {
+    std::function<void(VerifyRequest&)> set;
+    std::string words;
+  };
+  const std::vector<Case> cases = {
+      {[](VerifyRequest& r) { r.fit_params_given = true; },
+       "field '--fit-params': only with --fit"},
+      {[](VerifyRequest& r) { r.fit_method_given = true; },
+       "field '--fit-method': only with --fit"},
+      {[](VerifyRequest& r) { r.fit = true, r.shard = "0/2"; }, "not with --shard"},
+      {[](VerifyRequest& r) { r.fit = true, r.fit_params = "dye_scale,hue"; },
+       "'hue' is not one of"},
+      {[](VerifyRequest& r) { r.pattern = "plain", r.wif = "x.wif"; }, "--wif"},
+      {[](VerifyRequest& r) { r.classic_albedo = "0.3,0.2"; }, "--classic-albedo"},
+      {[](VerifyRequest& r) { r.shard = "3/2"; }, "--shard"},
+      {[](VerifyRequest& r) { r.fiber = "no-such-fiber"; }, "no-such-fiber"}};
+  for (const auto& c : cases) {
+    VerifyRequest r;
+    r.quality = "draft";
+    c.set(r);
+    const std::string e = error_of([&] { plan_verify(r); });
+    EXPECT_NE(e.find(c.words), std::string::npos) << c.words << ": " << e;
+  }
+}
+
+TEST(VerifyPlan, ClassicAlbedoIsThreeReflectances) {
+  const Rgb c = parse_classic_albedo("0.3,0.05,1");
+  EXPECT_EQ(c.r, 0.3);
+  EXPECT_EQ(c.g, 0.05);
+  EXPECT_EQ(c.b, 1.0);
+  for (const char* bad :
+       {"0.3,0.2", "0.3,0.2,0.1,0", "0.3,x,0.1", "-0.1,0,0", "1.5,0,0", "nan,0,0"})
+    EXPECT_NE(error_of([&] { parse_classic_albedo(bad); }).find("--classic-albedo"),
+              std::string::npos)
+        << bad;
+}
+
+// A shard's job names its options; the merge's request, made from them, plans the same job.
+TEST(VerifyPlan, AJobsRequestPlansTheSameJob) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.seed = 5;
+  r.threads = 3;
+  r.pattern = "twill:2/1";
+  r.shard = "1/4";
+  r.output = "part-1.part";
+  const VerifyPlan p = plan_verify(r);
+  ASSERT_TRUE(p.shard);
+  const JobPart job = verify_job(p, *p.shard);
+  EXPECT_EQ(job.command, "verify");
+  EXPECT_EQ(job.shard.index, 1u);
+  EXPECT_EQ(job.shard.count, 4u);
+  EXPECT_EQ(job.units_total, verify_traces(p.settings).size() *
+                                 uint64_t(2 * p.settings.resolution * p.settings.resolution));
+  const VerifyRequest again = verify_job_request(job, "report");
+  EXPECT_EQ(again.output, "report");
+  EXPECT_EQ(again.threads, 3);
+  EXPECT_EQ(again.pattern, "twill:2/1");
+  EXPECT_TRUE(again.shard.empty());
+  EXPECT_EQ(job_difference(job, verify_job(plan_verify(again), job.shard)), "");
+}
+
+TEST(VerifyPlan, EstimateGrowsWithTheFit) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.threads = 2;
+  const VerifyPlan p = plan_verify(r);
+  const VerifyEstimate e = estimate_verify(p);
+  EXPECT_EQ(e.cores, 2u);
+  EXPECT_GT(e.photons, 0);  // the spec is baked
+  EXPECT_GT(e.particles, 0);
+  EXPECT_GT(e.typical, e.least);
+  const VerifyEstimate fit = estimate_verify(p.settings, true, true, 100, 4);
+  EXPECT_GT(fit.photons, e.photons);
+  EXPECT_GT(fit.particles, e.particles);
+  // A baked table is not baked again.
+  EXPECT_EQ(estimate_verify(p.settings, false, false, 0, 0).photons, 0);
+}
+
+}  // namespace
+}  // namespace weft

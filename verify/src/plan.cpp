@@ -1,0 +1,276 @@
+// weft verify's plan: the request's inputs read and checked, the time estimate, the sharded job's
+// identity, and the classic baseline of a baked fiber table (plan.h).
+#include "weft/verify/plan.h"
+
+#include <algorithm>
+#include <sstream>
+#include <thread>
+
+#include "weft/core/direction_grid.h"
+#include "weft/core/error.h"
+#include "weft/core/params.h"
+#include "weft/materials/cook_torrance.h"
+
+namespace weft {
+
+namespace {
+
+// A baked fiber table (--fiber TABLE): read and validated (read_exr names the file and the field at
+// fault), and of kind "fiber".
+TabulatedBsdfTable read_fiber_table(const std::string& file) {
+  TabulatedBsdfTable t;
+  try {
+    t = TabulatedBsdfTable::read_exr(file);
+  } catch (const Error& e) {
+    throw Error("", "--fiber", std::string("not a usable fiber table: ") + e.what());
+  }
+  if (t.kind != "fiber")
+    throw Error(file, "--fiber",
+                "holds a " + t.kind + " table; verify needs a fiber table (weft bake fiber)");
+  return t;
+}
+
+// The woven sample: the options file's, with the pattern or draft given over it, at fiber detail
+// (the fiber-level reference).
+WeaveOptions plan_weave(const VerifyRequest& o) {
+  if (!o.pattern.empty() && !o.wif.empty())
+    throw Error("", "--wif", "give either --pattern or --wif, not both");
+  WeaveOptions given;
+  if (!o.pattern.empty()) given.pattern = o.pattern;
+  if (!o.wif.empty()) given.wif = o.wif;
+  given.detail = "fiber";
+  const WeaveOptions base = o.weave.empty() ? WeaveOptions{} : read_weave_options(o.weave);
+  return overlay(base, given);
+}
+
+// The fit's options, checked with the spec before any work; without the fit, none may be given.
+void plan_fit(const VerifyRequest& o, VerifyPlan& p) {
+  if (o.fit) {
+    if (!o.shard.empty()) throw Error("", "--fit", "runs in one process, not with --shard");
+    p.fit_names = parse_spec_fit_names(o.fit_params);
+    p.fit_inner = parse_fit_inner(o.fit_inner);
+    p.fit_options.method = parse_fit_method(o.fit_method);
+    p.fit_options.max_evaluations = o.fit_evaluations;
+    p.fit_options.validate(4);                       // the classic model always fits four
+    (void)spec_fit_parameters(p.spec, p.fit_names);  // a spec without particles is refused here
+  } else if (o.fit_params_given || o.fit_evaluations_given || o.fit_inner_given ||
+             o.fit_method_given) {
+    throw Error("",
+                o.fit_params_given        ? "--fit-params"
+                : o.fit_evaluations_given ? "--fit-evaluations"
+                : o.fit_inner_given       ? "--fit-inner"
+                                          : "--fit-method",
+                "only with --fit");
+  }
+}
+
+}  // namespace
+
+VerifyPlan plan_verify(const VerifyRequest& o) {
+  VerifyPlan p;
+  p.request = o;
+  const VerifyQuality q = parse_verify_quality(o.quality);
+  p.settings = verify_settings(q);
+  p.settings.seed = o.seed;
+  p.settings.threads = o.threads;
+  p.measured_path =
+      o.measured.empty() ? bundled_measured_inplane() : std::filesystem::path(o.measured);
+  p.measured = read_measured_inplane(p.measured_path);
+  // The fiber names a spec or preset, or (.exr) a baked fiber table, whose resolution the run
+  // takes.
+  if (std::filesystem::path(o.fiber).extension() == ".exr") {
+    p.fiber_table = read_fiber_table(o.fiber);
+    if (o.fit)
+      throw Error(o.fiber, "--fit",
+                  "the fit changes the fiber spec's parameters, and a baked table has no spec: "
+                  "give a spec or preset");
+    p.settings.resolution = p.fiber_table->resolution;
+  } else {
+    p.spec = load_fiber_spec(o.fiber);
+  }
+  if (!o.classic_albedo.empty()) p.classic_albedo = parse_classic_albedo(o.classic_albedo);
+  p.weave = plan_weave(o);
+  plan_fit(o, p);
+  if (!o.shard.empty()) p.shard = parse_shard(o.shard, "--shard");
+  return p;
+}
+
+Rgb parse_classic_albedo(const std::string& text) {
+  std::vector<double> v;
+  std::stringstream in(text);
+  std::string part;
+  while (std::getline(in, part, ',')) {
+    const auto x = finite_number(part);
+    if (!x || *x < 0 || *x > 1)
+      throw Error("", "--classic-albedo",
+                  "'" + text + "' is not three reflectances R,G,B in [0, 1] (linear sRGB)");
+    v.push_back(*x);
+  }
+  if (v.size() != 3)
+    throw Error("", "--classic-albedo",
+                "'" + text + "' is not three reflectances R,G,B in [0, 1] (linear sRGB)");
+  return {v[0], v[1], v[2]};
+}
+
+// ---- The time ------------------------------------------------------------------------------
+
+namespace {
+
+// Measured (docs/verify.md "Time"): red-cotton's full bake, 1.2 us per photon per core
+// (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default quality, computed
+// and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so 18 us per
+// particle; the plots and the rest, about 10 s of CPU whatever the quality.
+constexpr double kTypicalSecondsPerPhoton = 1.2e-6;
+constexpr double kTypicalSecondsPerParticle = 18e-6;
+constexpr double kTypicalFixedSeconds = 10;
+// The fiber-level renders (docs/verify.md "Renders"): 23 s of CPU at default quality for the four
+// renders' 3.64 M camera samples on the bundled poplin, so 6.5 us per sample; counted here on a
+// square film of weave_render_size (an upper bound: the film is whole repeats, one side shorter).
+constexpr double kTypicalSecondsPerWeaveSample = 6.5e-6;
+constexpr int kWeaveRenders = 4;  // computed and classic, reflection and transmission
+constexpr double kLeastSecondsPerParticle = 1.25e-6;
+
+}  // namespace
+
+VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
+                               size_t fit_params) {
+  VerifyEstimate e;
+  e.cores = std::max(1u, s.threads > 0 ? unsigned(s.threads) : std::thread::hardware_concurrency());
+  const double bins = 2.0 * s.resolution * s.resolution;
+  const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
+  // Computed and classic, each 'particles_per_bin' per incident bin over all batches.
+  const double run_particles = 2.0 * double(s.particles_per_bin) * bins;
+  e.photons = run_photons;
+  e.particles = run_particles;
+  if (fit) {
+    const FitInnerSettings inner = fit_inner_settings(s);
+    const double inner_bins = 2.0 * inner.resolution * inner.resolution;
+    // Per model: the search, the optimum again and the Jacobian (2 per parameter; the classic
+    // model has 4).
+    const double computed_evals = fit_evaluations + 1 + 2.0 * double(fit_params);
+    const double classic_evals = fit_evaluations + 1 + 8.0;
+    e.photons += computed_evals * double(inner.fiber_photons_per_band) * kNumBands + run_photons;
+    e.particles += (computed_evals + classic_evals) * double(inner.particles_per_bin) * inner_bins +
+                   run_particles;
+  }
+  const double weave_samples =
+      double(kWeaveRenders) * s.weave_render_size * s.weave_render_size * s.weave_render_spp;
+  e.typical = e.photons * kTypicalSecondsPerPhoton + e.particles * kTypicalSecondsPerParticle +
+              weave_samples * kTypicalSecondsPerWeaveSample + kTypicalFixedSeconds;
+  e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
+  return e;
+}
+
+VerifyEstimate estimate_verify(const VerifyPlan& p) {
+  return estimate_verify(p.settings, !p.fiber_table, p.request.fit, p.fit_options.max_evaluations,
+                         p.fit_names.size());
+}
+
+// ---- The sharded job -------------------------------------------------------------------------
+
+JobPart verify_job(const VerifyPlan& p, Shard shard) {
+  const VerifyRequest& o = p.request;
+  std::vector<std::filesystem::path> files{p.measured_path};
+  std::error_code ec;
+  for (const std::string& f : {o.weave, o.wif, o.fiber})
+    if (!f.empty() && std::filesystem::is_regular_file(f, ec)) files.emplace_back(f);
+  JobPart job;
+  job.command = "verify";
+  job.job = {{"options",
+              {{"fiber", o.fiber},
+               {"measured", o.measured},
+               {"weave", o.weave},
+               {"pattern", o.pattern},
+               {"wif", o.wif},
+               {"quality", o.quality},
+               {"seed", o.seed}}},
+             {"inputs", input_file_hashes(files)},
+             {"spec_hash", p.fiber_table ? p.fiber_table->checksum() : fiber_spec_hash_hex(p.spec)},
+             {"program_version", WEFT_VERSION}};
+  job.units_total = verify_traces(p.settings).size() * DirectionGrid{p.settings.resolution}.bins();
+  job.shard = shard;
+  job.extra = {{"threads", o.threads}};  // reported in metrics.json; results do not depend on it
+  return job;
+}
+
+VerifyRequest verify_job_request(const JobPart& all, const std::string& output) {
+  VerifyRequest o;
+  const auto& opt = all.job.at("options");
+  o.fiber = opt.at("fiber").get<std::string>();
+  o.measured = opt.at("measured").get<std::string>();
+  o.weave = opt.at("weave").get<std::string>();
+  o.pattern = opt.at("pattern").get<std::string>();
+  o.wif = opt.at("wif").get<std::string>();
+  o.quality = opt.at("quality").get<std::string>();
+  o.seed = opt.at("seed").get<uint64_t>();
+  o.threads = all.extra.value("threads", 0);
+  o.output = output;
+  return o;
+}
+
+// ---- The classic baseline of a baked table ----------------------------------------------------
+
+namespace {
+
+// The classic fiber's index: the header's preset's at 550 nm when the preset has the header's
+// spec hash, else cotton's; and where it came from, for the report.
+std::pair<double, std::string> classic_ior_of(const TabulatedBsdfTable& t) {
+  std::pair<double, std::string> ior = {
+      kCottonIor, "cotton's index " + std::to_string(kCottonIor).substr(0, 5) +
+                      " (the header names no preset with its spec hash)"};
+  const auto name = t.metadata.find("spec_name"), hash = t.metadata.find("spec_hash");
+  if (name == t.metadata.end() || hash == t.metadata.end()) return ior;
+  const auto presets = fiber_preset_names();
+  if (std::find(presets.begin(), presets.end(), name->second) == presets.end()) return ior;
+  const FiberSpec spec = parse_fiber_spec(fiber_preset_json(name->second), name->second);
+  if (fiber_spec_hash_hex(spec) == hash->second)
+    ior = {spec.host_n[kNumBands / 2],  // 550 nm
+           "the index at 550 nm of preset " + name->second + " (the header's spec name and hash)"};
+  return ior;
+}
+
+}  // namespace
+
+void classic_from_table(const std::string& file, const TabulatedBsdfTable& t,
+                        const std::optional<Rgb>& albedo, const VerifySettings& s,
+                        VerifyInputs& in) {
+  const auto rough = fiber_table_roughness(t, file);
+  if (!rough)
+    throw Error(file, "roughness",
+                "the table's header does not state the fiber's surface roughness (weft bake "
+                "fiber writes it), which the classic baseline needs: bake the table with weft "
+                "bake fiber, or give a fiber spec or preset");
+  in.classic_distribution = *rough;
+  const auto [ior, ior_source] = classic_ior_of(t);
+  in.classic_ior = ior;
+  if (albedo) {
+    in.classic_diffuse = albedo;
+    in.classic_source = "--classic-albedo; the table header's roughness; " + ior_source;
+    return;
+  }
+  const std::vector<double> diffuse =
+      classic_diffuse_from_fiber_table(t, *rough, in.classic_ior, s.seed, s.threads);
+  Rgb rgb;
+  if (t.channels == kNumBands) {
+    for (int b = 0; b < kNumBands; ++b) in.volume_albedo[b] = diffuse[b];
+    rgb = bands_to_linear_srgb([&](int b) { return diffuse[b]; });
+  } else {
+    rgb = Rgb(diffuse[0], diffuse[1], diffuse[2]);
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double v = rgb[k];
+    if (!(v >= 0 && v <= 1))
+      throw Error(file, "--classic-albedo",
+                  "the classic baseline's diffuse colour from the table (its total albedo minus "
+                  "the Cook-Torrance lobe's) is " +
+                      std::to_string(v) + " in channel " + "RGB"[k] +
+                      ", not a reflectance in [0, 1]: give --classic-albedo R,G,B");
+  }
+  if (t.channels != kNumBands) in.classic_diffuse = rgb;
+  in.classic_source =
+      "the fiber table: its total albedo minus the classic Cook-Torrance lobe's, per " +
+      std::string(t.channels == kNumBands ? "band" : "channel") +
+      "; the table header's roughness; " + ior_source;
+}
+
+}  // namespace weft
