@@ -24,10 +24,7 @@
 
 using namespace weft;
 using nlohmann::json;
-using weft::testing::expect_furnace_sphere_radiance;
-using weft::testing::fresh_test_dir;
-using weft::testing::sample_mean;
-using weft::testing::SampleMean;
+using namespace weft::testing;
 namespace fs = std::filesystem;
 
 namespace {

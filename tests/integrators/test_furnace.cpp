@@ -18,10 +18,7 @@
 
 using namespace weft;
 using nlohmann::json;
-using weft::testing::expect_furnace_sphere_radiance;
-using weft::testing::mode_name;
-using weft::testing::sample_mean;
-using weft::testing::SampleMean;
+using namespace weft::testing;
 
 namespace {
 
