@@ -173,6 +173,48 @@ std::vector<cd> mie_log_derivatives(cd z, int n_max) {
   return out;
 }
 
+namespace {
+
+// psi_n(x) for n = 0..nstop (x < 1) from the downward ratio recurrence, normalized by
+// psi_0 = sin x: the upward one cancels there.
+std::vector<double> psi_downward(double x, int nstop) {
+  std::vector<double> psi(nstop + 1, 0.0);
+  const int top = nstop + 20;
+  double ratio = (2.0 * top + 3) / x;  // psi_top / psi_{top+1}, leading order
+  std::vector<double> ratios(nstop + 1, 0.0);
+  for (int n = top; n >= 1; --n) {
+    ratio = (2.0 * n + 1) / x - 1.0 / ratio;  // psi_{n-1} / psi_n
+    if (n <= nstop) ratios[n] = ratio;
+  }
+  psi[0] = std::sin(x);
+  for (int n = 1; n <= nstop; ++n) psi[n] = psi[n - 1] / ratios[n];
+  return psi;
+}
+
+// Adds term n (coefficients a_n, b_n) to the amplitudes r.s1, r.s2 at every mu. Angular
+// functions (BH eq. 4.47): pi_n = (2n-1)/(n-1) mu pi_{n-1} - n/(n-1) pi_{n-2},
+// tau_n = n mu pi_n - (n+1) pi_{n-1}. On entry pi_n[] holds pi_{n-1}, pi_nm1[] pi_{n-2}; on
+// return pi_n and pi_{n-1}.
+void add_amplitude_terms(int n, cd a, cd b, std::span<const double> mu, std::vector<double>& pi_nm1,
+                         std::vector<double>& pi_n, MieResult& r) {
+  const double dn_d = static_cast<double>(n);
+  const double w = 2 * dn_d + 1;
+  const double fn = w / (dn_d * (dn_d + 1));
+  const double c1 = n > 1 ? (2 * dn_d - 1) / (dn_d - 1) : 0.0;
+  const double c2 = n > 1 ? dn_d / (dn_d - 1) : 0.0;
+  for (size_t i = 0; i < mu.size(); ++i) {
+    const double p_nm1 = n > 1 ? pi_n[i] : 0.0;
+    const double p_n = n > 1 ? c1 * mu[i] * p_nm1 - c2 * pi_nm1[i] : 1.0;
+    const double tau = dn_d * mu[i] * p_n - (dn_d + 1) * p_nm1;
+    r.s1[i] += fn * (a * p_n + b * tau);
+    r.s2[i] += fn * (a * tau + b * p_n);
+    pi_nm1[i] = p_nm1;
+    pi_n[i] = p_n;
+  }
+}
+
+}  // namespace
+
 MieResult mie_sphere(cd m, double x, std::span<const double> mu) {
   validate_index_and_size(m, x);
   validate_mu(mu);
@@ -197,19 +239,7 @@ MieResult mie_sphere(cd m, double x, std::span<const double> mu) {
   const bool series = use_small_sphere_series(m, x);  // then nstop == 2
   const SmallNumerators small = series ? small_sphere_numerators(m, x) : SmallNumerators{};
   const bool small_x = x < 1;
-  std::vector<double> psi_small;
-  if (small_x) {
-    psi_small.assign(nstop + 1, 0.0);
-    const int top = nstop + 20;
-    double ratio = (2.0 * top + 3) / x;  // psi_top / psi_{top+1}, leading order
-    std::vector<double> ratios(nstop + 1, 0.0);
-    for (int n = top; n >= 1; --n) {
-      ratio = (2.0 * n + 1) / x - 1.0 / ratio;  // psi_{n-1} / psi_n
-      if (n <= nstop) ratios[n] = ratio;
-    }
-    psi_small[0] = std::sin(x);
-    for (int n = 1; n <= nstop; ++n) psi_small[n] = psi_small[n - 1] / ratios[n];
-  }
+  const std::vector<double> psi_small = small_x ? psi_downward(x, nstop) : std::vector<double>{};
 
   double psi_nm2 = std::cos(x), psi_nm1 = std::sin(x);
   double chi_nm2 = -std::sin(x), chi_nm1 = std::cos(x);
@@ -245,22 +275,7 @@ MieResult mie_sphere(cd m, double x, std::span<const double> mu) {
           (dn_d - 1) * (dn_d + 1) / dn_d * (a_prev * std::conj(a) + b_prev * std::conj(b)).real();
     sum_g += w / (dn_d * (dn_d + 1)) * (a * std::conj(b)).real();
 
-    if (na > 0) {
-      const double fn = w / (dn_d * (dn_d + 1));
-      // Angular functions (BH eq. 4.47): pi_n = (2n-1)/(n-1) mu pi_{n-1} - n/(n-1) pi_{n-2},
-      // tau_n = n mu pi_n - (n+1) pi_{n-1}. On entry pi_n[] holds pi_{n-1}, pi_nm1[] pi_{n-2}.
-      const double c1 = n > 1 ? (2 * dn_d - 1) / (dn_d - 1) : 0.0;
-      const double c2 = n > 1 ? dn_d / (dn_d - 1) : 0.0;
-      for (size_t i = 0; i < na; ++i) {
-        const double p_nm1 = n > 1 ? pi_n[i] : 0.0;
-        const double p_n = n > 1 ? c1 * mu[i] * p_nm1 - c2 * pi_nm1[i] : 1.0;
-        const double tau = dn_d * mu[i] * p_n - (dn_d + 1) * p_nm1;
-        r.s1[i] += fn * (a * p_n + b * tau);
-        r.s2[i] += fn * (a * tau + b * p_n);
-        pi_nm1[i] = p_nm1;
-        pi_n[i] = p_n;
-      }
-    }
+    if (na > 0) add_amplitude_terms(n, a, b, mu, pi_nm1, pi_n, r);
 
     a_prev = a;
     b_prev = b;

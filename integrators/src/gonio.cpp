@@ -147,10 +147,9 @@ void normalize_gonio(GonioResult& res, const GonioSettings& g) {
   for (auto& row : res.rows) row.beta_norm = row.beta * *res.normalization;
 }
 
-GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
-                      const ProgressCallback& progress, const FiberTableResolver& fiber_tables,
-                      const std::function<void(const GonioResult&)>& on_unit) {
-  const std::string src = desc.source;
+namespace {
+
+void check_gonio_settings(const std::string& src, const GonioSettings& g) {
   if (!(g.light_zenith_deg >= 0 && g.light_zenith_deg < 90))
     throw Error(src, "light_zenith_deg", "must lie in [0, 90)");
   if (g.view_zenith_deg.empty()) throw Error(src, "view_zenith_deg", "no view directions");
@@ -164,52 +163,42 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
                 "wavelength)");
   if (g.width < 1 || g.height < 1 || g.spp < 1)
     throw Error(src, "sweep", "width, height and spp must be positive");
+}
 
-  const std::vector<uint8_t> sel = desc.select_object(g.sample);
-  const Bounds3 box = desc.object_bounds(g.sample);
-  const double phi_v = g.view_azimuth_deg.value_or(g.light_azimuth_deg);
+// The instrument's light: parallel, from the given direction; the scene's own lights and
+// environment are not part of the instrument.
+Lights instrument_light(const SceneDescription& desc, const GonioSettings& g, double zenith_deg,
+                        double azimuth_deg) {
+  Lights l;
+  l.directional.push_back(
+      {desc.frame.direction(deg_to_rad(zenith_deg), deg_to_rad(azimuth_deg)), g.irradiance});
+  return l;
+}
 
-  auto light_set = [&](double zenith_deg, double azimuth_deg) {
-    Lights l;  // the scene's own lights and environment are not part of the instrument
-    l.directional.push_back(
-        {desc.frame.direction(deg_to_rad(zenith_deg), deg_to_rad(azimuth_deg)), g.irradiance});
-    return l;
-  };
-  const RenderScene sample_scene =
-      RenderScene(desc,
-                  [&] {
-                    RenderSceneOptions o;
-                    o.material_progress = progress;
-                    o.fiber_tables = fiber_tables;
-                    return o;
-                  }())
-          .with_lights(light_set(g.light_zenith_deg, g.light_azimuth_deg));
-  std::optional<RenderScene> white_scene;
-  if (g.white_check) {
-    RenderSceneOptions opt;
-    opt.override_shapes = sel;
-    MaterialBinding white;
-    white.type = "lambert";
-    white.params = {{"reflectance", 1.0}};
-    white.field = "white reference";
-    opt.override_binding = white;
-    white_scene =
-        RenderScene(desc, opt).with_lights(light_set(g.light_zenith_deg, g.light_azimuth_deg));
-  }
+// The scene with the sample's shapes ('sel') made a white Lambertian reflector.
+RenderScene white_reference_scene(const SceneDescription& desc, const std::vector<uint8_t>& sel) {
+  RenderSceneOptions opt;
+  opt.override_shapes = sel;
+  MaterialBinding white;
+  white.type = "lambert";
+  white.params = {{"reflectance", 1.0}};
+  white.field = "white reference";
+  opt.override_binding = white;
+  return RenderScene(desc, opt);
+}
 
-  // Normalization needs beta at normal incidence and view; reuse a row when the sweep has it.
-  const size_t views = g.view_zenith_deg.size();
-  const bool need_normal_render = needs_normal_render(g);
+// Which units of the sweep (gonio_unit_count) to run: g.units, or all.
+std::vector<bool> wanted_units(const GonioSettings& g, const std::string& src) {
   std::vector<bool> wanted(gonio_unit_count(g), !g.units.has_value());
   if (g.units)
     for (size_t u : *g.units) {
       if (u >= wanted.size()) throw Error(src, "units", "a unit beyond the sweep's");
       wanted[u] = true;
     }
-  const int per_view = g.white_check ? 2 : 1;
-  uint64_t renders = 0;
-  for (size_t u = 0; u < wanted.size(); ++u)
-    if (wanted[u]) renders += u < views ? per_view : 1;
+  return wanted;
+}
+
+RenderSettings view_render_settings(const GonioSettings& g) {
   RenderSettings rs;
   rs.width = g.width;
   rs.height = g.height;
@@ -219,69 +208,132 @@ GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
   rs.seed = g.seed;
   rs.threads = g.threads;
   rs.spectral = g.spectral;
-  uint64_t renders_done = 0;
+  return rs;
+}
 
+// Renders the sweep's views one after another, reporting progress over all of them and adding
+// each render's rays and dropped samples to the result.
+class ViewRenderer {
+ public:
+  // The views of 'wanted' units of the sample 'sel' framed by 'box'.
+  ViewRenderer(const SceneDescription& desc, const GonioSettings& g,
+               const std::vector<uint8_t>& sel, const Bounds3& box, const std::vector<bool>& wanted,
+               const ProgressCallback& progress, GonioResult& res)
+      : desc_(desc),
+        g_(g),
+        sel_(sel),
+        progress_(progress),
+        res_(res),
+        box_(box),
+        rs_(view_render_settings(g)) {
+    const size_t views = g.view_zenith_deg.size();
+    const int per_view = g.white_check ? 2 : 1;
+    for (size_t u = 0; u < wanted.size(); ++u)
+      if (wanted[u]) renders_ += u < views ? per_view : 1;
+  }
+
+  // The sample's measure and its beta (mean radiance / l_white) seen from (zen, azi); nullopt
+  // when cancelled.
+  std::optional<std::pair<ViewMeasure, Rgb>> operator()(const RenderScene& scene, double zen,
+                                                        double azi, const Rgb& l_white) {
+    const Vec3 towards_viewer = gonio_view_direction(desc_.frame, zen, azi);
+    // Film "up" follows the sample normal except near normal view.
+    const Vec3 up_hint = std::abs(zen) > 5 ? desc_.frame.normal : desc_.frame.tangent;
+    const Camera cam = frame_box_orthographic(box_, towards_viewer, up_hint);
+    // Every view is the same number of samples (u.total) long.
+    const MaskedRender r = render_masked(scene, cam, rs_, sel_, [&](const ProgressUpdate& u) {
+      return progress_({"sweep", renders_done_ * u.total + u.done, renders_ * u.total, u.unit});
+    });
+    ++renders_done_;
+    res_.rays += r.render.rays;
+    res_.nonfinite_samples += r.render.nonfinite_samples;
+    if (r.render.cancelled) return std::nullopt;
+    const ViewMeasure m = measure(r, g_.spp);  // NaN when the sample is not seen at all
+    return std::make_pair(m, divide(m.mean, l_white));
+  }
+
+ private:
+  const SceneDescription& desc_;
+  const GonioSettings& g_;
+  const std::vector<uint8_t>& sel_;
+  const ProgressCallback& progress_;
+  GonioResult& res_;
+  const Bounds3 box_;
+  const RenderSettings rs_;
+  uint64_t renders_ = 0, renders_done_ = 0;
+};
+
+// The row of view v at azimuth phi_v, with its white reference when 'white' is given; nullopt
+// when cancelled.
+std::optional<GonioRow> view_row(ViewRenderer& render_view, const GonioSettings& g, size_t v,
+                                 double phi_v, const RenderScene& sample, const RenderScene* white,
+                                 const Rgb& l_white) {
+  const double zen = g.view_zenith_deg[v];
+  GonioRow row;
+  row.view = v;
+  row.view_zenith_deg = zen;
+  row.view_azimuth_deg = phi_v;
+  const auto s = render_view(sample, zen, phi_v, l_white);
+  if (!s) return std::nullopt;
+  const auto& [m, beta] = *s;
+  row.sum = m.sum;
+  row.footprint_px = m.footprint;
+  row.beta = beta;
+  row.beta_err_rgb = {std::sqrt(m.var_mean.r) / l_white.r, std::sqrt(m.var_mean.g) / l_white.g,
+                      std::sqrt(m.var_mean.b) / l_white.b};
+  // Channel mean: channels of one sample are strongly correlated, so bound the error of the
+  // mean by the mean of the errors (exact for perfectly correlated channels).
+  row.beta_err = row.beta_err_rgb.average();
+  if (white) {
+    const auto w = render_view(*white, zen, phi_v, l_white);
+    if (!w) return std::nullopt;
+    row.white = w->second;
+  }
+  return row;
+}
+
+}  // namespace
+
+GonioResult run_gonio(const SceneDescription& desc, const GonioSettings& g,
+                      const ProgressCallback& progress, const FiberTableResolver& fiber_tables,
+                      const std::function<void(const GonioResult&)>& on_unit) {
+  const std::string src = desc.source;
+  check_gonio_settings(src, g);
+  const std::vector<uint8_t> sel = desc.select_object(g.sample);
+  const Bounds3 box = desc.object_bounds(g.sample);
+  const double phi_v = g.view_azimuth_deg.value_or(g.light_azimuth_deg);
+  const Lights light = instrument_light(desc, g, g.light_zenith_deg, g.light_azimuth_deg);
+  RenderSceneOptions sample_options;
+  sample_options.material_progress = progress;
+  sample_options.fiber_tables = fiber_tables;
+  const RenderScene sample_scene = RenderScene(desc, sample_options).with_lights(light);
+  std::optional<RenderScene> white_scene;
+  if (g.white_check) white_scene = white_reference_scene(desc, sel).with_lights(light);
+
+  // Normalization needs beta at normal incidence and view; reuse a row when the sweep has it.
+  const size_t views = g.view_zenith_deg.size();
+  const std::vector<bool> wanted = wanted_units(g, src);
   GonioResult res;
+  ViewRenderer render_view(desc, g, sel, box, wanted, progress, res);
   res.light_zenith_deg = g.light_zenith_deg;
   res.light_azimuth_deg = g.light_azimuth_deg;
   const double cos_i = std::cos(deg_to_rad(g.light_zenith_deg));
   res.l_white = g.irradiance * (cos_i * kInvPi);
 
-  // Renders one view; returns nullopt when cancelled.
-  auto render_view = [&](const RenderScene& scene, double zen, double azi,
-                         const Rgb& l_white) -> std::optional<std::pair<ViewMeasure, Rgb>> {
-    const Vec3 towards_viewer = gonio_view_direction(desc.frame, zen, azi);
-    // Film "up" follows the sample normal except near normal view.
-    const Vec3 up_hint = std::abs(zen) > 5 ? desc.frame.normal : desc.frame.tangent;
-    const Camera cam = frame_box_orthographic(box, towards_viewer, up_hint);
-    // Every view is the same number of samples (u.total) long.
-    const MaskedRender r = render_masked(scene, cam, rs, sel, [&](const ProgressUpdate& u) {
-      return progress({"sweep", renders_done * u.total + u.done, renders * u.total, u.unit});
-    });
-    ++renders_done;
-    res.rays += r.render.rays;
-    res.nonfinite_samples += r.render.nonfinite_samples;
-    if (r.render.cancelled) return std::nullopt;
-    const ViewMeasure m = measure(r, g.spp);  // NaN when the sample is not seen at all
-    return std::make_pair(m, divide(m.mean, l_white));
-  };
-
   for (size_t v = 0; v < views; ++v) {
     if (!wanted[v]) continue;
-    const double zen = g.view_zenith_deg[v];
-    GonioRow row;
-    row.view = v;
-    row.view_zenith_deg = zen;
-    row.view_azimuth_deg = phi_v;
-    const auto s = render_view(sample_scene, zen, phi_v, res.l_white);
-    if (!s) {
+    const auto row = view_row(render_view, g, v, phi_v, sample_scene,
+                              white_scene ? &*white_scene : nullptr, res.l_white);
+    if (!row) {
       res.cancelled = true;
       return res;
     }
-    const auto& [m, beta] = *s;
-    row.sum = m.sum;
-    row.footprint_px = m.footprint;
-    row.beta = beta;
-    row.beta_err_rgb = {std::sqrt(m.var_mean.r) / res.l_white.r,
-                        std::sqrt(m.var_mean.g) / res.l_white.g,
-                        std::sqrt(m.var_mean.b) / res.l_white.b};
-    // Channel mean: channels of one sample are strongly correlated, so bound the error of the
-    // mean by the mean of the errors (exact for perfectly correlated channels).
-    row.beta_err = row.beta_err_rgb.average();
-    if (white_scene) {
-      const auto w = render_view(*white_scene, zen, phi_v, res.l_white);
-      if (!w) {
-        res.cancelled = true;
-        return res;
-      }
-      row.white = w->second;
-    }
-    res.rows.push_back(row);
+    res.rows.push_back(*row);
     if (on_unit) on_unit(res);
   }
 
-  if (need_normal_render && wanted[views]) {
-    const RenderScene normal_scene = sample_scene.with_lights(light_set(0, 0));
+  if (needs_normal_render(g) && wanted[views]) {
+    const RenderScene normal_scene = sample_scene.with_lights(instrument_light(desc, g, 0, 0));
     const Rgb l_white00 = g.irradiance * kInvPi;
     const auto s = render_view(normal_scene, 0, 0, l_white00);
     if (!s) {

@@ -85,287 +85,381 @@ struct BandShading {
   }
 };
 
+// A shading point of a path: the hit, its BSDF and the direction back along the path.
+struct PathVertex {
+  const SurfaceHit& hit;
+  const Bsdf& bsdf;
+  Vec3 wo;       // towards the previous vertex, in the shading frame
+  double wo_ng;  // the same direction in the world, dotted with the facet normal
+
+  // Shading normals differ from the facets: a direction the BSDF treats as reflection may lie
+  // behind the facet (or the reverse for transmission). Such directions would leak light
+  // through the surface, so they carry none (Veach 1997, section 5.3). A fiber has no such
+  // surface to leak through: it is shaded as a whole, light from any side of B included.
+  bool consistent(const Vec3& wi_world, const Vec3& wi_local) const {
+    return hit.on_fiber() || (wo_ng * dot(wi_world, hit.ng) > 0) == (wo.z * wi_local.z > 0);
+  }
+};
+
+// One path from the camera: its radiance so far (L) and throughput (beta).
 template <class Shading>
-Rgb trace(const RenderScene& scene, const Ray& camera_ray, const RenderSettings& settings, Rng& rng,
-          RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
+class PathTrace {
+ public:
   using Color = typename Shading::Color;
-  auto occluded = [&](const Vec3& o, const Vec3& d, double tmax, int64_t ignore_fiber) {
-    ++rays.shadow;
-    if (on_ray) (*on_ray)({o, d, tmax}, true);
-    return scene.occluded(o, d, tmax, ignore_fiber);
-  };
-  const bool use_mis = settings.sampling == LightSampling::mis;
-  const bool nee_area = settings.sampling != LightSampling::bsdf_only;
-  Color L(0.0), beta(1.0);
-  Ray ray = camera_ray;
-  bool specular = true;  // camera rays and delta bounces are not covered by next-event estimation
-  double prev_pdf = 0;
-  if (first_mesh) *first_mesh = -1;
-  // Rays that leave a fiber pass through it (its own fiber never occludes a point of it).
-  int64_t ignore_fiber = kNoFiber;
+
+  PathTrace(const RenderScene& scene, const RenderSettings& settings, Rng& rng, RayCounts& rays,
+            const RayObserver* on_ray)
+      : scene_(scene), settings_(settings), rng_(rng), rays_(rays), on_ray_(on_ray) {}
+
+  Rgb run(const Ray& camera_ray, int64_t* first_mesh) {
+    ray_ = camera_ray;
+    if (first_mesh) *first_mesh = -1;
+    for (int depth = 0;; ++depth) {
+      SurfaceHit hit;
+      if (on_ray_) (*on_ray_)(ray_, false);
+      const bool found = scene_.intersect(ray_, &hit, ignore_fiber_);
+      if (!found) {
+        const LightHit escaped = LightHit::escaped_along(ray_.d);
+        for (const Light& light : scene_.lights()) add_found_light(light, escaped);
+        break;
+      }
+      if (depth == 0 && first_mesh) *first_mesh = hit.shape;
+      const Vec3 wo_world = -ray_.d;
+      if (const Light* light = scene_.surface_light(hit.shape))
+        add_found_light(*light, LightHit::on_surface(ray_.d, hit.shape, hit.prim, hit.ng, hit.t));
+      if (depth >= settings_.max_depth) break;
+
+      const PathVertex v{hit, scene_.bsdf(hit), hit.shading.to_local(wo_world),
+                         dot(wo_world, hit.ng)};
+      sample_lights(v);
+      if (!extend(v, depth)) break;
+    }
+    return Shading::to_rgb(L_);
+  }
+
+ private:
+  bool occluded(const Vec3& o, const Vec3& d, double tmax, int64_t ignore_fiber) {
+    ++rays_.shadow;
+    if (on_ray_) (*on_ray_)({o, d, tmax}, true);
+    return scene_.occluded(o, d, tmax, ignore_fiber);
+  }
   // Shadow ray from just off the surface (on the target's side) to just short of the target.
-  auto occluded_between = [&](const SurfaceHit& h, const Vec3& target) {
+  bool occluded_between(const SurfaceHit& h, const Vec3& target) {
     const Vec3 o = h.spawn_origin(target - h.p);
     const Vec3 to = target - o;
     const double d = length(to);
     return d > 0 && occluded(o, to / d, d * (1 - 1e-5), h.fiber);
-  };
+  }
   // Radiance from a light that the last BSDF sample found, weighted against next-event estimation
   // of the same light.
-  auto add_found_light = [&](const Light& light, const LightHit& at) {
+  void add_found_light(const Light& light, const LightHit& at) {
     const Rgb Le = light.eval(at);
     if (Le.is_black()) return;
     double w = 1;
-    if (!specular) w = use_mis ? power_heuristic(prev_pdf, light.pdf(at)) : (nee_area ? 0.0 : 1.0);
-    L += beta * Shading::light(Le) * w;
-  };
+    if (!specular_)
+      w = use_mis_ ? power_heuristic(prev_pdf_, light.pdf(at)) : (nee_area_ ? 0.0 : 1.0);
+    L_ += beta_ * Shading::light(Le) * w;
+  }
 
-  for (int depth = 0;; ++depth) {
-    SurfaceHit hit;
-    if (on_ray) (*on_ray)(ray, false);
-    const bool found = scene.intersect(ray, &hit, ignore_fiber);
-    if (!found) {
-      const LightHit escaped = LightHit::escaped_along(ray.d);
-      for (const Light& light : scene.lights()) add_found_light(light, escaped);
-      break;
-    }
-    if (depth == 0 && first_mesh) *first_mesh = hit.shape;
-    const Vec3 wo_world = -ray.d;
-    if (const Light* light = scene.surface_light(hit.shape))
-      add_found_light(*light, LightHit::on_surface(ray.d, hit.shape, hit.prim, hit.ng, hit.t));
-    if (depth >= settings.max_depth) break;
-
-    const Bsdf& bsdf = scene.bsdf(hit);
-    const Frame& frame = hit.shading;
-    const Vec3 wo = frame.to_local(wo_world);
-    // Shading normals differ from the facets: a direction the BSDF treats as reflection may lie
-    // behind the facet (or the reverse for transmission). Such directions would leak light
-    // through the surface, so they carry none (Veach 1997, section 5.3). A fiber has no such
-    // surface to leak through: it is shaded as a whole, light from any side of B included.
-    const double wo_ng = dot(wo_world, hit.ng);
-    auto consistent = [&](const Vec3& wi_world, const Vec3& wi_local) {
-      return hit.on_fiber() || (wo_ng * dot(wi_world, hit.ng) > 0) == (wo.z * wi_local.z > 0);
-    };
-
-    // Next-event estimation: one sample of every light; area lights and the environment weighted
-    // against BSDF sampling (lights.h states what a sample holds).
-    for (const Light& light : scene.lights()) {
+  // Next-event estimation: one sample of every light; area lights and the environment weighted
+  // against BSDF sampling (lights.h states what a sample holds).
+  void sample_lights(const PathVertex& v) {
+    const SurfaceHit& hit = v.hit;
+    for (const Light& light : scene_.lights()) {
       const bool delta = light.is_delta();
-      if (!delta && !nee_area) continue;
-      const std::optional<LightSample> ls = light.sample(hit.p, rng);
+      if (!delta && !nee_area_) continue;
+      const std::optional<LightSample> ls = light.sample(hit.p, rng_);
       if (!ls) continue;
-      const Vec3 wi = frame.to_local(ls->wi);
+      const Vec3 wi = hit.shading.to_local(ls->wi);
       // Shadow terminator (Hanika 2021, render_scene.h SurfaceHit::lift_front): on a low-poly
       // mesh with vertex normals, the shading normal sees lights that the flat facet has behind
       // it, or that a neighbouring facet hides, and Veach's rule (consistent) then blackens whole
       // facets along the terminator. For reflection, the shadow ray starts instead on the smooth
       // surface the vertex normals describe, above the facet, and decides alone: light that the
       // facet really hides still meets it there, so nothing leaks through.
-      const Vec3 lift = wo_ng >= 0 ? hit.lift_front : hit.lift_back;
-      const bool lifted = !hit.on_fiber() && wo.z * wi.z > 0 && !(lift == Vec3{});
-      const bool agrees = consistent(ls->wi, wi);
+      const Vec3 lift = v.wo_ng >= 0 ? hit.lift_front : hit.lift_back;
+      const bool lifted = !hit.on_fiber() && v.wo.z * wi.z > 0 && !(lift == Vec3{});
+      const bool agrees = v.consistent(ls->wi, wi);
       if (!lifted && !agrees) continue;
-      const Color f = Shading::f(bsdf, wo, wi);
+      const Color f = Shading::f(v.bsdf, v.wo, wi);
       if (f.is_black()) continue;
       // BSDF sampling stops at directions the facet disagrees on, so there this is the only
       // strategy and takes the whole weight.
       const double w =
-          delta || !use_mis || !agrees ? 1.0 : power_heuristic(ls->pdf, bsdf.pdf(wo, wi));
+          delta || !use_mis_ || !agrees ? 1.0 : power_heuristic(ls->pdf, v.bsdf.pdf(v.wo, wi));
       bool blocked;
-      if (lifted) {
-        // Off the lifted point on the viewer's side of the facet.
-        const Vec3 o = hit.p + lift + hit.ng * (wo_ng >= 0 ? hit.offset : -hit.offset);
-        if (ls->at_infinity) {
-          blocked = occluded(o, ls->wi, 1e300, hit.fiber);
-        } else {
-          const Vec3 to = ls->p_light - o;
-          const double d = length(to);
-          blocked = !(d > 0) || occluded(o, to / d, d * (1 - 1e-5), hit.fiber);
-        }
-      } else {
-        blocked = ls->at_infinity ? occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300, hit.fiber)
-                                  : occluded_between(hit, ls->p_light);
-      }
+      if (lifted)
+        blocked = blocked_from_lift(v, lift, *ls);
+      else if (ls->at_infinity)
+        blocked = occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300, hit.fiber);
+      else
+        blocked = occluded_between(hit, ls->p_light);
       if (!blocked)
-        L += beta * f * Shading::light(ls->L) * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
-    }
-
-    // Continue the path by sampling the BSDF.
-    const double u_lobe = rng.uniform();
-    const Vec2 u{rng.uniform(), rng.uniform()};
-    const auto bs = bsdf.sample(wo, u, u_lobe);
-    if (!bs || bs->weight.is_black() || !(bs->pdf > 0 || bs->is_delta)) break;
-    const Vec3 wi = normalize(frame.to_world(bs->wi));
-    if (!consistent(wi, bs->wi)) break;
-    const Color weight = Shading::weight(bsdf, wo, *bs);
-    if (weight.is_black()) break;
-    beta *= weight;
-    specular = bs->is_delta;
-    prev_pdf = bs->pdf;
-    ray = {hit.spawn_origin(wi), wi};
-    ignore_fiber = hit.fiber;
-    ++rays.bounce;
-    if (depth + 1 >= settings.rr_depth) {
-      const double q = std::min(0.95, beta.max_component());
-      if (!(rng.uniform() < q)) break;
-      beta = beta / q;
+        L_ += beta_ * f * Shading::light(ls->L) * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
     }
   }
-  return Shading::to_rgb(L);
-}
+  // Whether the light sample is hidden from the lifted point, off it on the viewer's side of the
+  // facet.
+  bool blocked_from_lift(const PathVertex& v, const Vec3& lift, const LightSample& ls) {
+    const SurfaceHit& hit = v.hit;
+    const Vec3 o = hit.p + lift + hit.ng * (v.wo_ng >= 0 ? hit.offset : -hit.offset);
+    if (ls.at_infinity) return occluded(o, ls.wi, 1e300, hit.fiber);
+    const Vec3 to = ls.p_light - o;
+    const double d = length(to);
+    return !(d > 0) || occluded(o, to / d, d * (1 - 1e-5), hit.fiber);
+  }
+
+  // Continues the path by sampling the BSDF (and Russian roulette); false: the path ends.
+  bool extend(const PathVertex& v, int depth) {
+    const double u_lobe = rng_.uniform();
+    const Vec2 u{rng_.uniform(), rng_.uniform()};
+    const auto bs = v.bsdf.sample(v.wo, u, u_lobe);
+    if (!bs || bs->weight.is_black() || !(bs->pdf > 0 || bs->is_delta)) return false;
+    const Vec3 wi = normalize(v.hit.shading.to_world(bs->wi));
+    if (!v.consistent(wi, bs->wi)) return false;
+    const Color weight = Shading::weight(v.bsdf, v.wo, *bs);
+    if (weight.is_black()) return false;
+    beta_ *= weight;
+    specular_ = bs->is_delta;
+    prev_pdf_ = bs->pdf;
+    ray_ = {v.hit.spawn_origin(wi), wi};
+    ignore_fiber_ = v.hit.fiber;
+    ++rays_.bounce;
+    if (depth + 1 >= settings_.rr_depth) {
+      const double q = std::min(0.95, beta_.max_component());
+      if (!(rng_.uniform() < q)) return false;
+      beta_ = beta_ / q;
+    }
+    return true;
+  }
+
+  const RenderScene& scene_;
+  const RenderSettings& settings_;
+  Rng& rng_;
+  RayCounts& rays_;
+  const RayObserver* on_ray_;
+  const bool use_mis_ = settings_.sampling == LightSampling::mis;
+  const bool nee_area_ = settings_.sampling != LightSampling::bsdf_only;
+  Color L_ = Color(0.0), beta_ = Color(1.0);
+  Ray ray_;
+  bool specular_ = true;  // camera rays and delta bounces are not covered by next-event estimation
+  double prev_pdf_ = 0;
+  // Rays that leave a fiber pass through it (its own fiber never occludes a point of it).
+  int64_t ignore_fiber_ = kNoFiber;
+};
 
 }  // namespace
 
 Rgb trace_path(const RenderScene& scene, const Ray& ray, const RenderSettings& settings, Rng& rng,
                RayCounts& rays, int64_t* first_mesh, const RayObserver* on_ray) {
-  return settings.spectral ? trace<BandShading>(scene, ray, settings, rng, rays, first_mesh, on_ray)
-                           : trace<RgbShading>(scene, ray, settings, rng, rays, first_mesh, on_ray);
+  return settings.spectral
+             ? PathTrace<BandShading>(scene, settings, rng, rays, on_ray).run(ray, first_mesh)
+             : PathTrace<RgbShading>(scene, settings, rng, rays, on_ray).run(ray, first_mesh);
 }
 
-RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
-                    const ProgressCallback& progress, const RenderObservers& observers) {
+namespace {
+
+void check_render_settings(const RenderSettings& s) {
   if (s.width < 1 || s.height < 1 || s.spp < 1 || s.tile_size < 1 || s.max_depth < 0 ||
       s.rr_depth < 0)
     throw Error("", "render", "width, height, spp and tile size must be positive");
   if (!(s.time_limit_s >= 0) || !std::isfinite(s.time_limit_s))
     throw Error("", "render.time_limit_s", "must be a finite number of seconds >= 0");
-  const PixelWindow win = s.crop.value_or(PixelWindow{0, s.width, 0, s.height});
-  check_crop(win, s.width, s.height, "", "render.crop");
-  if (s.spectral) scene.check_spectral();
-  RenderResult out;
-  const int ww = win.width(), wh = win.height();
-  const size_t npx = size_t(ww) * wh;
-  auto film_image = [&] {
-    Image im(ww, wh);
-    im.x0 = win.x0, im.y0 = win.y0, im.film_width = s.width, im.film_height = s.height;
-    return im;
-  };
-  out.image = film_image();
-  const bool aov = s.aov_albedo || s.aov_normal;
-  if (s.aov_albedo) out.albedo = film_image();
-  if (s.aov_normal) out.normal = film_image();
-  const RayObserver* on_ray = observers.on_ray ? &observers.on_ray : nullptr;
-  const int tx = (ww + s.tile_size - 1) / s.tile_size, ty = (wh + s.tile_size - 1) / s.tile_size;
-  const uint64_t tiles = uint64_t(tx) * ty;
-  std::vector<RayCounts> tile_rays(tiles);
-  std::vector<uint64_t> tile_nonfinite(tiles, 0);
-  std::atomic<bool> cancel{false};
-  std::atomic<uint64_t> done{0};
-  const uint64_t total = uint64_t(npx) * s.spp;
-  std::mutex progress_mutex;
-  const double aspect = double(s.width) / s.height;
+}
 
-  // Per-pixel sums of radiance, albedo and normal, in sample order.
-  struct Sums {
-    double L[3] = {0, 0, 0}, albedo[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
-  };
+// Per-pixel sums of radiance, albedo and normal, in sample order.
+struct PixelSums {
+  double L[3] = {0, 0, 0}, albedo[3] = {0, 0, 0}, normal[3] = {0, 0, 0};
+};
+
+// The render of a window of the film, tile by tile in parallel, in passes of samples per pixel.
+// Each sample has its own random stream (seed, pixel, sample index), so the image does not
+// depend on the tiles, threads or passes.
+class WindowRender {
+ public:
+  WindowRender(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
+               const ProgressCallback& progress, const RenderObservers& observers,
+               const PixelWindow& win)
+      : scene_(scene),
+        camera_(camera),
+        s_(s),
+        progress_(progress),
+        observers_(observers),
+        win_(win),
+        ww_(win.width()),
+        wh_(win.height()),
+        npx_(size_t(ww_) * wh_),
+        tx_((ww_ + s.tile_size - 1) / s.tile_size),
+        ty_((wh_ + s.tile_size - 1) / s.tile_size),
+        tiles_(uint64_t(tx_) * ty_),
+        tile_rays_(tiles_),
+        tile_nonfinite_(tiles_, 0),
+        total_(uint64_t(npx_) * s.spp) {
+    out_.image = film_image();
+    if (s.aov_albedo) out_.albedo = film_image();
+    if (s.aov_normal) out_.normal = film_image();
+  }
+
+  // Every sample of every pixel in one pass.
+  void render_all() {
+    pass(0, s_.spp, nullptr);
+    out_.spp_done = s_.spp;
+  }
+  // One sample per pixel a pass until the time limit, so that the image is always a whole
+  // number of samples per pixel; the sums are kept between passes (72 bytes a pixel).
+  void render_timed() {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<PixelSums> sums(npx_);
+    int n = 0;
+    while (n < s_.spp && !cancel_.load()) {
+      pass(n, n + 1, &sums);
+      if (cancel_.load()) break;
+      ++n;
+      const double elapsed =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      if (elapsed >= s_.time_limit_s) break;
+    }
+    out_.spp_done = n;
+    if (n > 0)
+      for (size_t i = 0; i < npx_; ++i) store(i, sums[i], 1.0 / n);
+  }
+  RenderResult finish() {
+    for (uint64_t t = 0; t < tiles_; ++t) {
+      out_.rays += tile_rays_[t];
+      out_.nonfinite_samples += tile_nonfinite_[t];
+    }
+    out_.cancelled = cancel_.load();
+    return std::move(out_);
+  }
+
+ private:
+  Image film_image() const {
+    Image im(ww_, wh_);
+    im.x0 = win_.x0, im.y0 = win_.y0, im.film_width = s_.width, im.film_height = s_.height;
+    return im;
+  }
+
+  // Samples [k0, k1) of every pixel of the window, tile by tile; 'sums' holds the running sums
+  // when the render goes in several passes (null: one pass, stored as it ends).
+  void pass(int k0, int k1, std::vector<PixelSums>* sums) {
+    parallel_for(tiles_, s_.threads, [&](uint64_t tile) {
+      if (cancel_.load(std::memory_order_relaxed)) return;
+      const int x0 = int(tile % tx_) * s_.tile_size, y0 = int(tile / tx_) * s_.tile_size;
+      const int x1 = std::min(x0 + s_.tile_size, ww_), y1 = std::min(y0 + s_.tile_size, wh_);
+      RayCounts rays;
+      for (int y = y0; y < y1; ++y) {
+        // A cancelled render is discarded anyway: stop within a row, not a whole tile.
+        if (cancel_.load(std::memory_order_relaxed)) return;
+        for (int x = x0; x < x1; ++x) {
+          const size_t i = size_t(y) * ww_ + x;
+          if (sums) {
+            sample_pixel(win_.x0 + x, win_.y0 + y, k0, k1, (*sums)[i], rays, tile_nonfinite_[tile]);
+          } else {
+            PixelSums acc;
+            sample_pixel(win_.x0 + x, win_.y0 + y, k0, k1, acc, rays, tile_nonfinite_[tile]);
+            store(i, acc, 1.0 / s_.spp);
+          }
+        }
+      }
+      tile_rays_[tile] += rays;
+      const uint64_t d = done_.fetch_add(uint64_t(x1 - x0) * (y1 - y0) * (k1 - k0)) +
+                         uint64_t(x1 - x0) * (y1 - y0) * (k1 - k0);
+      std::lock_guard lock(progress_mutex_);
+      if (!cancel_.load() && !progress_({"render", d, total_, "samples"})) cancel_.store(true);
+    });
+  }
+
   // Samples [k0, k1) of film pixel (x, y), added to 'acc'.
-  auto sample_pixel = [&](int x, int y, int k0, int k1, Sums& acc, RayCounts& rays,
-                          uint64_t& nonfinite) {
-    const uint64_t pixel = uint64_t(y) * s.width + x;
+  void sample_pixel(int x, int y, int k0, int k1, PixelSums& acc, RayCounts& rays,
+                    uint64_t& nonfinite) const {
+    const uint64_t pixel = uint64_t(y) * s_.width + x;
     for (int k = k0; k < k1; ++k) {
-      Rng rng(s.seed, pixel, uint64_t(k));
-      const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
-      const Ray ray = camera.generate_ray(fx, fy, aspect);
+      Rng rng(s_.seed, pixel, uint64_t(k));
+      const double fx = (x + rng.uniform()) / s_.width, fy = (y + rng.uniform()) / s_.height;
+      const Ray ray = camera_.generate_ray(fx, fy, aspect_);
       ++rays.camera;
       int64_t first = -1;
-      Rgb L = trace_path(scene, ray, s, rng, rays, &first, on_ray);
+      Rgb L = trace_path(scene_, ray, s_, rng, rays, &first, on_ray_);
       if (!finite(L)) {
         ++nonfinite;
         L = Rgb(0.0);
       }
       acc.L[0] += L.r, acc.L[1] += L.g, acc.L[2] += L.b;
-      if (observers.on_sample) observers.on_sample(pixel, first, L);
-      if (aov) {
-        // Its own stream (the sample index with the top bit set, never a render sample), so
-        // asking for passes leaves the image's bits alone.
-        Rng aov_rng(s.seed, pixel, uint64_t(k) | (uint64_t(1) << 63));
-        SurfaceHit hit;
-        if (!scene.intersect(ray, &hit, kNoFiber)) continue;
-        const Vec3 wo_world = -ray.d;
-        if (s.aov_normal) {
-          const Vec3 n = dot(hit.shading.n, wo_world) < 0 ? -hit.shading.n : hit.shading.n;
-          acc.normal[0] += n.x, acc.normal[1] += n.y, acc.normal[2] += n.z;
-        }
-        if (s.aov_albedo) {
-          const Vec3 wo = hit.shading.to_local(wo_world);
-          const double u_lobe = aov_rng.uniform();
-          const Vec2 u{aov_rng.uniform(), aov_rng.uniform()};
-          const Bsdf& bsdf = scene.bsdf(hit);
-          const auto bs = bsdf.sample(wo, u, u_lobe);
-          if (bs && finite(bs->weight)) {
-            const Rgb a =
-                s.spectral ? BandShading::to_rgb(BandShading::weight(bsdf, wo, *bs)) : bs->weight;
-            acc.albedo[0] += a.r, acc.albedo[1] += a.g, acc.albedo[2] += a.b;
-          }
-        }
-      }
+      if (observers_.on_sample) observers_.on_sample(pixel, first, L);
+      if (aov_) add_aovs(ray, pixel, k, acc);
     }
-  };
-  auto store = [&](size_t i, const Sums& acc, double inv_n) {
-    for (int c = 0; c < 3; ++c) {
-      out.image.rgb[3 * i + c] = static_cast<float>(acc.L[c] * inv_n);
-      if (s.aov_albedo) out.albedo.rgb[3 * i + c] = static_cast<float>(acc.albedo[c] * inv_n);
-      if (s.aov_normal) out.normal.rgb[3 * i + c] = static_cast<float>(acc.normal[c] * inv_n);
-    }
-  };
-  // Samples [k0, k1) of every pixel of the window, tile by tile; 'sums' holds the running sums
-  // when the render goes in several passes (null: one pass, stored as it ends).
-  auto pass = [&](int k0, int k1, std::vector<Sums>* sums) {
-    parallel_for(tiles, s.threads, [&](uint64_t tile) {
-      if (cancel.load(std::memory_order_relaxed)) return;
-      const int x0 = int(tile % tx) * s.tile_size, y0 = int(tile / tx) * s.tile_size;
-      const int x1 = std::min(x0 + s.tile_size, ww), y1 = std::min(y0 + s.tile_size, wh);
-      RayCounts rays;
-      for (int y = y0; y < y1; ++y) {
-        // A cancelled render is discarded anyway: stop within a row, not a whole tile.
-        if (cancel.load(std::memory_order_relaxed)) return;
-        for (int x = x0; x < x1; ++x) {
-          const size_t i = size_t(y) * ww + x;
-          if (sums) {
-            sample_pixel(win.x0 + x, win.y0 + y, k0, k1, (*sums)[i], rays, tile_nonfinite[tile]);
-          } else {
-            Sums acc;
-            sample_pixel(win.x0 + x, win.y0 + y, k0, k1, acc, rays, tile_nonfinite[tile]);
-            store(i, acc, 1.0 / s.spp);
-          }
-        }
-      }
-      tile_rays[tile] += rays;
-      const uint64_t d = done.fetch_add(uint64_t(x1 - x0) * (y1 - y0) * (k1 - k0)) +
-                         uint64_t(x1 - x0) * (y1 - y0) * (k1 - k0);
-      std::lock_guard lock(progress_mutex);
-      if (!cancel.load() && !progress({"render", d, total, "samples"})) cancel.store(true);
-    });
-  };
+  }
 
-  if (s.time_limit_s == 0) {
-    pass(0, s.spp, nullptr);
-    out.spp_done = s.spp;
-  } else {
-    // One sample per pixel a pass, so that the image is always a whole number of samples per
-    // pixel; the sums are kept between passes (72 bytes a pixel).
-    const auto start = std::chrono::steady_clock::now();
-    std::vector<Sums> sums(npx);
-    int n = 0;
-    while (n < s.spp && !cancel.load()) {
-      pass(n, n + 1, &sums);
-      if (cancel.load()) break;
-      ++n;
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      if (elapsed >= s.time_limit_s) break;
+  // The albedo and normal passes of sample k of a pixel, whose camera ray is 'ray'.
+  void add_aovs(const Ray& ray, uint64_t pixel, int k, PixelSums& acc) const {
+    // Its own stream (the sample index with the top bit set, never a render sample), so
+    // asking for passes leaves the image's bits alone.
+    Rng aov_rng(s_.seed, pixel, uint64_t(k) | (uint64_t(1) << 63));
+    SurfaceHit hit;
+    if (!scene_.intersect(ray, &hit, kNoFiber)) return;
+    const Vec3 wo_world = -ray.d;
+    if (s_.aov_normal) {
+      const Vec3 n = dot(hit.shading.n, wo_world) < 0 ? -hit.shading.n : hit.shading.n;
+      acc.normal[0] += n.x, acc.normal[1] += n.y, acc.normal[2] += n.z;
     }
-    out.spp_done = n;
-    if (n > 0)
-      for (size_t i = 0; i < npx; ++i) store(i, sums[i], 1.0 / n);
+    if (s_.aov_albedo) {
+      const Vec3 wo = hit.shading.to_local(wo_world);
+      const double u_lobe = aov_rng.uniform();
+      const Vec2 u{aov_rng.uniform(), aov_rng.uniform()};
+      const Bsdf& bsdf = scene_.bsdf(hit);
+      const auto bs = bsdf.sample(wo, u, u_lobe);
+      if (bs && finite(bs->weight)) {
+        const Rgb a =
+            s_.spectral ? BandShading::to_rgb(BandShading::weight(bsdf, wo, *bs)) : bs->weight;
+        acc.albedo[0] += a.r, acc.albedo[1] += a.g, acc.albedo[2] += a.b;
+      }
+    }
   }
-  for (uint64_t t = 0; t < tiles; ++t) {
-    out.rays += tile_rays[t];
-    out.nonfinite_samples += tile_nonfinite[t];
+
+  void store(size_t i, const PixelSums& acc, double inv_n) {
+    for (int c = 0; c < 3; ++c) {
+      out_.image.rgb[3 * i + c] = static_cast<float>(acc.L[c] * inv_n);
+      if (s_.aov_albedo) out_.albedo.rgb[3 * i + c] = static_cast<float>(acc.albedo[c] * inv_n);
+      if (s_.aov_normal) out_.normal.rgb[3 * i + c] = static_cast<float>(acc.normal[c] * inv_n);
+    }
   }
-  out.cancelled = cancel.load();
-  return out;
+
+  const RenderScene& scene_;
+  const Camera& camera_;
+  const RenderSettings& s_;
+  const ProgressCallback& progress_;
+  const RenderObservers& observers_;
+  const PixelWindow win_;
+  const int ww_, wh_;
+  const size_t npx_;
+  const int tx_, ty_;
+  const uint64_t tiles_;
+  const bool aov_ = s_.aov_albedo || s_.aov_normal;
+  const RayObserver* const on_ray_ = observers_.on_ray ? &observers_.on_ray : nullptr;
+  const double aspect_ = double(s_.width) / s_.height;
+  RenderResult out_;
+  std::vector<RayCounts> tile_rays_;
+  std::vector<uint64_t> tile_nonfinite_;
+  const uint64_t total_;
+  std::atomic<bool> cancel_{false};
+  std::atomic<uint64_t> done_{0};
+  std::mutex progress_mutex_;
+};
+
+}  // namespace
+
+RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
+                    const ProgressCallback& progress, const RenderObservers& observers) {
+  check_render_settings(s);
+  const PixelWindow win = s.crop.value_or(PixelWindow{0, s.width, 0, s.height});
+  check_crop(win, s.width, s.height, "", "render.crop");
+  if (s.spectral) scene.check_spectral();
+  WindowRender film(scene, camera, s, progress, observers, win);
+  if (s.time_limit_s == 0)
+    film.render_all();
+  else
+    film.render_timed();
+  return film.finish();
 }
 
 }  // namespace weft

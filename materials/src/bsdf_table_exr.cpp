@@ -125,6 +125,133 @@ void check_exr_header(const std::filesystem::path& path, const std::string& file
   }
 }
 
+// The file must exist and begin with OpenEXR's magic number.
+void check_exr_magic(const std::filesystem::path& path, const std::string& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) throw Error(file, "", "no such table file");
+  std::ifstream in(path, std::ios::binary);
+  char magic[4] = {};
+  in.read(magic, 4);
+  if (!in || !Imf::isImfMagic(magic)) throw Error(file, "", "not an OpenEXR file");
+}
+
+int int_attribute(const Imf::Header& h, const std::string& file, const char* name) {
+  const auto* a = h.findTypedAttribute<Imf::IntAttribute>(name);
+  if (!a) throw Error(file, name, "missing int attribute");
+  return a->value();
+}
+
+std::string string_attribute(const Imf::Header& h, const std::string& file, const char* name) {
+  const auto* a = h.findTypedAttribute<Imf::StringAttribute>(name);
+  if (!a) throw Error(file, name, "missing string attribute");
+  return a->value();
+}
+
+// The table's format from the header: version, parameterization, units, kind, resolution and
+// bands (returned, as the file spells them).
+std::string read_table_format(const Imf::Header& h, const std::string& file,
+                              TabulatedBsdfTable& table) {
+  using T = TabulatedBsdfTable;
+  auto string_attr = [&](const char* name) { return string_attribute(h, file, name); };
+  const int version = int_attribute(h, file, "weft_format_version");
+  if (version == 1 || version == 2)
+    throw Error(file, "weft_format_version",
+                "is " + std::to_string(version) +
+                    ": an octahedral-grid table whose bins straddle the horizon; re-bake it with "
+                    "this version (format " +
+                    std::to_string(T::kFormatVersion) + ")");
+  if (version != T::kFormatVersion)
+    throw Error(file, "weft_format_version",
+                "is " + std::to_string(version) + "; this program reads version " +
+                    std::to_string(T::kFormatVersion));
+  if (string_attr("parameterization") != T::kParameterization)
+    throw Error(file, "parameterization",
+                "is \"" + string_attr("parameterization") + "\", expected \"" +
+                    T::kParameterization + "\"");
+  if (string_attr("units") != T::kUnits)
+    throw Error(file, "units", "is \"" + string_attr("units") + "\", expected \"1/sr\"");
+  table.kind = string_attr("kind");
+  if (table.kind != "fiber" && table.kind != "fabric")
+    throw Error(file, "kind", "must be \"fiber\" or \"fabric\", got \"" + table.kind + "\"");
+  table.resolution = int_attribute(h, file, "resolution");
+  if (table.resolution < 1 || table.resolution > T::kMaxResolution)
+    throw Error(file, "resolution",
+                "must lie in [1, " + std::to_string(T::kMaxResolution) + "], got " +
+                    std::to_string(table.resolution));
+  const std::string bands = string_attr("bands");
+  if (bands == "rgb") {
+    table.channels = 3;
+  } else if (bands == T::kSpectralBands) {
+    table.channels = kNumBands;
+  } else {
+    throw Error(file, "bands", "must be \"rgb\" or \"390:710:10\", got \"" + bands + "\"");
+  }
+  return bands;
+}
+
+// The data window must be the table's, and the file large enough to hold its pixels.
+void check_pixel_size(const Imf::Header& h, const std::filesystem::path& path,
+                      const std::string& file, const TabulatedBsdfTable& table,
+                      const std::string& bands) {
+  const int n = table.bins();
+  const Imath::Box2i dw = h.dataWindow();
+  if (dw.min.x != 0 || dw.min.y != 0 || dw.max.x != n - 1 || dw.max.y != n - 1)
+    throw Error(file, "dataWindow",
+                "must be " + std::to_string(n) + " x " + std::to_string(n) +
+                    " pixels from (0, 0) for resolution " + std::to_string(table.resolution));
+  // The pixels must be in the file before their buffer is allocated: write_exr compresses with
+  // ZIP, and deflate expands at most 1032:1 (zlib's technical details), so a 3 KB file cannot
+  // hold a 553 MB table (R = 32, 33 bands).
+  const double pixel_bytes = double(n) * n * table.channels * sizeof(float);
+  std::error_code size_ec;
+  const double file_bytes = double(std::filesystem::file_size(path, size_ec));
+  if (pixel_bytes > 1032.0 * file_bytes + 65536)
+    throw Error(file, "resolution",
+                std::to_string(table.resolution) + " and bands " + bands + " need " +
+                    std::to_string(static_cast<uint64_t>(pixel_bytes)) +
+                    " bytes of pixels, more than a file of " +
+                    std::to_string(static_cast<uint64_t>(file_bytes)) +
+                    " bytes can hold (truncated?)");
+}
+
+// The file's channels must be exactly 'names', each 32-bit FLOAT.
+void check_channels(const Imf::Header& h, const std::string& file,
+                    const std::vector<std::string>& names, const std::string& bands) {
+  const std::set<std::string> wanted(names.begin(), names.end());
+  std::set<std::string> present;
+  for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
+    const std::string name = it.name();
+    if (!wanted.count(name))
+      throw Error(file, "channels", "unexpected channel \"" + name + "\" for bands " + bands);
+    if (it.channel().type != Imf::FLOAT)
+      throw Error(file, "channels", "channel \"" + name + "\" is not 32-bit FLOAT");
+    present.insert(name);
+  }
+  for (const auto& name : names)
+    if (!present.count(name)) throw Error(file, "channels", "missing channel \"" + name + "\"");
+}
+
+// The pixels of channels 'names' into table.values, checked against the stored checksum.
+void read_table_pixels(Imf::InputFile& in, const std::string& file,
+                       const std::vector<std::string>& names, TabulatedBsdfTable& table) {
+  const int n = table.bins();
+  table.values.assign(static_cast<size_t>(n) * n * table.channels, 0.0f);
+  Imf::FrameBuffer fb;
+  const size_t x_stride = sizeof(float) * static_cast<size_t>(table.channels);
+  const size_t y_stride = x_stride * static_cast<size_t>(n);
+  char* base = reinterpret_cast<char*>(table.values.data());
+  for (int c = 0; c < table.channels; ++c)
+    fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + sizeof(float) * c, x_stride, y_stride));
+  const std::string stored_checksum = string_attribute(in.header(), file, "values_fnv1a64");
+  in.setFrameBuffer(fb);
+  if (!in.isComplete()) throw Error(file, "", "truncated: pixel data incomplete");
+  in.readPixels(0, n - 1);
+  if (table.checksum() != stored_checksum)
+    throw Error(file, "values_fnv1a64",
+                "pixel data is corrupt (checksum " + table.checksum() + " does not match " +
+                    stored_checksum + ")");
+}
+
 }  // namespace
 
 void TabulatedBsdfTable::check_output_path(const std::filesystem::path& path,
@@ -180,114 +307,18 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
 
 TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& path) {
   const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw Error(file, "", "no such table file");
-  {
-    std::ifstream in(path, std::ios::binary);
-    char magic[4] = {};
-    in.read(magic, 4);
-    if (!in || !Imf::isImfMagic(magic)) throw Error(file, "", "not an OpenEXR file");
-  }
+  check_exr_magic(path, file);
   check_exr_header(path, file);
 
   TabulatedBsdfTable table;
   try {
     Imf::InputFile in(file.c_str());
     const Imf::Header& h = in.header();
-    auto int_attr = [&](const char* name) {
-      const auto* a = h.findTypedAttribute<Imf::IntAttribute>(name);
-      if (!a) throw Error(file, name, "missing int attribute");
-      return a->value();
-    };
-    auto string_attr = [&](const char* name) {
-      const auto* a = h.findTypedAttribute<Imf::StringAttribute>(name);
-      if (!a) throw Error(file, name, "missing string attribute");
-      return a->value();
-    };
-
-    const int version = int_attr("weft_format_version");
-    if (version == 1 || version == 2)
-      throw Error(file, "weft_format_version",
-                  "is " + std::to_string(version) +
-                      ": an octahedral-grid table whose bins straddle the horizon; re-bake it with "
-                      "this version (format " +
-                      std::to_string(kFormatVersion) + ")");
-    if (version != kFormatVersion)
-      throw Error(file, "weft_format_version",
-                  "is " + std::to_string(version) + "; this program reads version " +
-                      std::to_string(kFormatVersion));
-    if (string_attr("parameterization") != kParameterization)
-      throw Error(
-          file, "parameterization",
-          "is \"" + string_attr("parameterization") + "\", expected \"" + kParameterization + "\"");
-    if (string_attr("units") != kUnits)
-      throw Error(file, "units", "is \"" + string_attr("units") + "\", expected \"1/sr\"");
-    table.kind = string_attr("kind");
-    if (table.kind != "fiber" && table.kind != "fabric")
-      throw Error(file, "kind", "must be \"fiber\" or \"fabric\", got \"" + table.kind + "\"");
-    table.resolution = int_attr("resolution");
-    if (table.resolution < 1 || table.resolution > kMaxResolution)
-      throw Error(file, "resolution",
-                  "must lie in [1, " + std::to_string(kMaxResolution) + "], got " +
-                      std::to_string(table.resolution));
-    const std::string bands = string_attr("bands");
-    if (bands == "rgb") {
-      table.channels = 3;
-    } else if (bands == kSpectralBands) {
-      table.channels = kNumBands;
-    } else {
-      throw Error(file, "bands", "must be \"rgb\" or \"390:710:10\", got \"" + bands + "\"");
-    }
-
-    const int n = table.bins();
-    const Imath::Box2i dw = h.dataWindow();
-    if (dw.min.x != 0 || dw.min.y != 0 || dw.max.x != n - 1 || dw.max.y != n - 1)
-      throw Error(file, "dataWindow",
-                  "must be " + std::to_string(n) + " x " + std::to_string(n) +
-                      " pixels from (0, 0) for resolution " + std::to_string(table.resolution));
-    // The pixels must be in the file before their buffer is allocated: write_exr compresses with
-    // ZIP, and deflate expands at most 1032:1 (zlib's technical details), so a 3 KB file cannot
-    // hold a 553 MB table (R = 32, 33 bands).
-    const double pixel_bytes = double(n) * n * table.channels * sizeof(float);
-    std::error_code size_ec;
-    const double file_bytes = double(std::filesystem::file_size(path, size_ec));
-    if (pixel_bytes > 1032.0 * file_bytes + 65536)
-      throw Error(file, "resolution",
-                  std::to_string(table.resolution) + " and bands " + bands + " need " +
-                      std::to_string(static_cast<uint64_t>(pixel_bytes)) +
-                      " bytes of pixels, more than a file of " +
-                      std::to_string(static_cast<uint64_t>(file_bytes)) +
-                      " bytes can hold (truncated?)");
-
+    const std::string bands = read_table_format(h, file, table);
+    check_pixel_size(h, path, file, table, bands);
     const std::vector<std::string> names = table.channel_names();
-    const std::set<std::string> wanted(names.begin(), names.end());
-    std::set<std::string> present;
-    for (auto it = h.channels().begin(); it != h.channels().end(); ++it) {
-      const std::string name = it.name();
-      if (!wanted.count(name))
-        throw Error(file, "channels", "unexpected channel \"" + name + "\" for bands " + bands);
-      if (it.channel().type != Imf::FLOAT)
-        throw Error(file, "channels", "channel \"" + name + "\" is not 32-bit FLOAT");
-      present.insert(name);
-    }
-    for (const auto& name : names)
-      if (!present.count(name)) throw Error(file, "channels", "missing channel \"" + name + "\"");
-
-    table.values.assign(static_cast<size_t>(n) * n * table.channels, 0.0f);
-    Imf::FrameBuffer fb;
-    const size_t x_stride = sizeof(float) * static_cast<size_t>(table.channels);
-    const size_t y_stride = x_stride * static_cast<size_t>(n);
-    char* base = reinterpret_cast<char*>(table.values.data());
-    for (int c = 0; c < table.channels; ++c)
-      fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + sizeof(float) * c, x_stride, y_stride));
-    const std::string stored_checksum = string_attr("values_fnv1a64");
-    in.setFrameBuffer(fb);
-    if (!in.isComplete()) throw Error(file, "", "truncated: pixel data incomplete");
-    in.readPixels(0, n - 1);
-    if (table.checksum() != stored_checksum)
-      throw Error(file, "values_fnv1a64",
-                  "pixel data is corrupt (checksum " + table.checksum() + " does not match " +
-                      stored_checksum + ")");
+    check_channels(h, file, names, bands);
+    read_table_pixels(in, file, names, table);
 
     for (auto it = h.begin(); it != h.end(); ++it) {
       const std::string name = it.name();
@@ -295,10 +326,10 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
       if (const auto* s = dynamic_cast<const Imf::StringAttribute*>(&it.attribute()))
         table.metadata[name] = s->value();
     }
-    if (string_attr("cell_average") != kCellAverage)
+    if (string_attribute(h, file, "cell_average") != kCellAverage)
       throw Error(file, "cell_average",
-                  "is \"" + string_attr("cell_average") + "\"; this program reads \"" +
-                      kCellAverage + "\" cell averages");
+                  "is \"" + string_attribute(h, file, "cell_average") +
+                      "\"; this program reads \"" + kCellAverage + "\" cell averages");
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {

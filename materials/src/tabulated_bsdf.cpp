@@ -92,19 +92,17 @@ TableBacking TableBacking::make(const TabulatedBsdfData& data, const Rgb& scale,
   return b;
 }
 
-std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
-    const TabulatedBsdfTable& table) {
-  table.validate("");
-  auto data = std::make_shared<TabulatedBsdfData>();
-  const DirectionGrid grid = table.grid();
-  const int n = grid.bins(), r = grid.resolution;
-  const size_t cells = static_cast<size_t>(n) * static_cast<size_t>(n);
-  data->grid = grid;
-  data->kind = table.kind;
-  data->metadata = table.metadata;
-  data->rgb.resize(cells * 3);
+namespace {
 
-  // RGB, and the channel mean m that drives sampling.
+// Index of the cell pair (wi, wo) in an n x n table.
+size_t cell_at(int n, int wi, int wo) {
+  return static_cast<size_t>(wi) * n + static_cast<size_t>(wo);
+}
+
+// The table's RGB into data.rgb (spectral tables reduced and gamut-clipped, their bands kept);
+// returns the channel mean m per cell, which drives sampling.
+std::vector<float> reduce_to_rgb(const TabulatedBsdfTable& table, TabulatedBsdfData& data) {
+  const size_t cells = data.rgb.size() / 3;
   std::vector<float> mean(cells);
   GamutClip gamut;
   for (size_t cell = 0; cell < cells; ++cell) {
@@ -116,107 +114,153 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
       c = bands_to_linear_srgb([v](int b) { return v[b]; });
       gamut.clip(c);
     }
-    data->rgb[cell * 3] = static_cast<float>(c.r);
-    data->rgb[cell * 3 + 1] = static_cast<float>(c.g);
-    data->rgb[cell * 3 + 2] = static_cast<float>(c.b);
+    data.rgb[cell * 3] = static_cast<float>(c.r);
+    data.rgb[cell * 3 + 1] = static_cast<float>(c.g);
+    data.rgb[cell * 3 + 2] = static_cast<float>(c.b);
     mean[cell] = static_cast<float>(c.average());
   }
-  data->clamped_components = gamut.components;
-  if (table.channels == kNumBands) data->bands = table.values;
+  data.clamped_components = gamut.components;
+  if (table.channels == kNumBands) data.bands = table.values;
+  return mean;
+}
 
-  // m3: mean of m over the 3 x 3 neighbourhoods of the wi bin and of the wo bin (separably).
+// m3: the mean of m over the 3 x 3 neighbourhoods of the wi bin and of the wo bin (separably).
+std::vector<float> neighbourhood_means(const DirectionGrid& grid, const std::vector<float>& mean) {
+  const int n = grid.bins();
   std::vector<std::array<int, 9>> nbr(n);
   for (int b = 0; b < n; ++b) nbr[b] = neighbourhood(grid, b);
-  std::vector<float> tmp(cells), blur(cells);
-  auto at = [n](int wi, int wo) { return static_cast<size_t>(wi) * n + static_cast<size_t>(wo); };
+  std::vector<float> tmp(mean.size()), blur(mean.size());
   for (int wi = 0; wi < n; ++wi)
     for (int wo = 0; wo < n; ++wo) {
       double s = 0;
-      for (int k : nbr[wi]) s += mean[at(k, wo)];
-      tmp[at(wi, wo)] = static_cast<float>(s / 9);
+      for (int k : nbr[wi]) s += mean[cell_at(n, k, wo)];
+      tmp[cell_at(n, wi, wo)] = static_cast<float>(s / 9);
     }
   for (int wi = 0; wi < n; ++wi)
     for (int wo = 0; wo < n; ++wo) {
       double s = 0;
-      for (int k : nbr[wo]) s += tmp[at(wi, k)];
-      blur[at(wi, wo)] = static_cast<float>(s / 9);
+      for (int k : nbr[wo]) s += tmp[cell_at(n, wi, k)];
+      blur[cell_at(n, wi, wo)] = static_cast<float>(s / 9);
     }
+  return blur;
+}
+
+// The fine grid: each table cell split k x k, so the density follows the interpolated f cos
+// within a cell instead of being flat over it (a flat cell density against a peaked, bilinearly
+// interpolated f gave a few samples large weights: speckle on indirect light).
+struct FineGrid {
+  int k = 1, fr = 0, fn = 0;   // cells per table cell side; resolution; bins
+  std::vector<double> cos;     // mean |cos theta| over each fine cell
+  std::vector<Vec3> dir;       // each fine cell's centre
+  std::vector<int> coarse_of;  // the table cell each fine cell lies in
+};
+FineGrid fine_grid(int r) {
+  FineGrid f;
+  f.k = subdivision_for(r);
+  f.fr = f.k * r;
+  const DirectionGrid fine{f.fr};
+  f.fn = fine.bins();
+  f.cos = fine.cosine_weighted_areas();
+  for (double& c : f.cos) c /= fine.bin_solid_angle();
+  f.dir.resize(f.fn);
+  f.coarse_of.resize(f.fn);
+  for (int s = 0; s < f.fn; ++s) {
+    f.dir[s] = fine.bin_center(s);
+    const int x = s % f.fr, row = s / f.fr;
+    f.coarse_of[s] = (row / f.k) * r + x / f.k;
+  }
+  return f;
+}
+
+// The directional albedos of the interpolated table per wo bin, and its diffuse ones.
+void add_albedos(TabulatedBsdfData& data) {
+  const DirectionGrid& grid = data.grid;
+  const int n = grid.bins();
+  const std::vector<double> hw = hemisphere_weights(grid);
+  data.same_side.assign(n, Rgb(0.0));
+  data.other_side.assign(n, Rgb(0.0));
+  for (int wo = 0; wo < n; ++wo)
+    for (int wi = 0; wi < n; ++wi) {
+      const Rgb f = data.lookup(wi, wo) * hw[wi];
+      (grid.upper(wi) == grid.upper(wo) ? data.same_side : data.other_side)[wo] += f;
+    }
+  for (int wo = 0; wo < n; ++wo) {
+    if (grid.upper(wo))
+      data.diffuse_transmittance += data.other_side[wo] * (hw[wo] * kInvPi);
+    else
+      data.underside_diffuse_albedo += data.same_side[wo] * (hw[wo] * kInvPi);
+  }
+}
+
+// The sampling density over fine wi cells for wo bin 'wo': a share kSamplingCoverage flat over
+// each table cell, the rest following the interpolated f cos.
+Distribution2D wi_sampling(const DirectionGrid& grid, int wo, const std::vector<float>& mean,
+                           const std::vector<float>& blur, const std::vector<double>& cos_avg,
+                           const FineGrid& fine) {
+  const int n = grid.bins(), fn = fine.fn, k = fine.k;
+  // Coverage: per table cell, cos_avg * (m + m3) / 2, which is > 0 wherever the interpolated f
+  // can be for any wo in this bin.
+  std::vector<double> cell(n);
+  double cell_sum = 0;
+  for (int wi = 0; wi < n; ++wi) {
+    cell[wi] = cos_avg[wi] * 0.5 *
+               (static_cast<double>(mean[cell_at(n, wi, wo)]) + blur[cell_at(n, wi, wo)]);
+    cell_sum += cell[wi];
+  }
+  // Shape: the interpolated channel mean times |cos| at the centre of each fine cell, averaged
+  // over wo at the 2 x 2 quarter points of its bin (eval interpolates over wo too).
+  std::array<Vec3, 4> wo_at;
+  for (int q = 0; q < 4; ++q)
+    wo_at[q] = DirectionGrid::to_direction(
+        grid.chart_point(wo, 0.25 + 0.5 * (q % 2), 0.25 + 0.5 * (q / 2)));
+  std::vector<double> shape(fn);
+  double shape_sum = 0;
+  for (int s = 0; s < fn; ++s) {
+    double v = 0;
+    for (const Vec3& o_dir : wo_at)
+      for_each_interpolated_cell(grid, o_dir, fine.dir[s],
+                                 [&](int i, int o, double w) { v += mean[cell_at(n, i, o)] * w; });
+    shape[s] = std::max(0.0, v) * fine.cos[s];
+    shape_sum += shape[s];
+  }
+  std::vector<double> w(fn, 0.0);
+  if (cell_sum > 0) {
+    const double a = shape_sum > 0 ? kSamplingCoverage : 1.0;
+    for (int s = 0; s < fn; ++s) {
+      w[s] = a * cell[fine.coarse_of[s]] / (cell_sum * k * k);
+      if (shape_sum > 0) w[s] += (1 - a) * shape[s] / shape_sum;
+    }
+  }
+  return Distribution2D(w, static_cast<size_t>(fine.fr), static_cast<size_t>(2 * fine.fr));
+}
+
+}  // namespace
+
+std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
+    const TabulatedBsdfTable& table) {
+  table.validate("");
+  auto data = std::make_shared<TabulatedBsdfData>();
+  const DirectionGrid grid = table.grid();
+  const int n = grid.bins();
+  const size_t cells = static_cast<size_t>(n) * static_cast<size_t>(n);
+  data->grid = grid;
+  data->kind = table.kind;
+  data->metadata = table.metadata;
+  data->rgb.resize(cells * 3);
+  const std::vector<float> mean = reduce_to_rgb(table, *data);
+  const std::vector<float> blur = neighbourhood_means(grid, mean);
 
   // Mean |cos theta| over each cell.
   std::vector<double> cos_avg = grid.cosine_weighted_areas();
   for (double& c : cos_avg) c /= grid.bin_solid_angle();
-
-  // The fine grid: each table cell split k x k, so the density follows the interpolated f cos
-  // within a cell instead of being flat over it (a flat cell density against a peaked, bilinearly
-  // interpolated f gave a few samples large weights: speckle on indirect light).
-  const int k = subdivision_for(r), fr = k * r;
-  const DirectionGrid fine{fr};
-  const int fn = fine.bins();
-  std::vector<double> fine_cos = fine.cosine_weighted_areas();
-  for (double& c : fine_cos) c /= fine.bin_solid_angle();
-  std::vector<Vec3> fine_dir(fn);
-  std::vector<int> coarse_of(fn);
-  for (int s = 0; s < fn; ++s) {
-    fine_dir[s] = fine.bin_center(s);
-    const int x = s % fr, row = s / fr;
-    coarse_of[s] = (row / k) * r + x / k;
-  }
-  data->sampling_subdivision = k;
-
-  // The directional albedos of the interpolated table per wo bin, and its diffuse ones.
-  {
-    const std::vector<double> hw = hemisphere_weights(grid);
-    data->same_side.assign(n, Rgb(0.0));
-    data->other_side.assign(n, Rgb(0.0));
-    for (int wo = 0; wo < n; ++wo)
-      for (int wi = 0; wi < n; ++wi) {
-        const Rgb f = data->lookup(wi, wo) * hw[wi];
-        (grid.upper(wi) == grid.upper(wo) ? data->same_side : data->other_side)[wo] += f;
-      }
-    for (int wo = 0; wo < n; ++wo) {
-      if (grid.upper(wo))
-        data->diffuse_transmittance += data->other_side[wo] * (hw[wo] * kInvPi);
-      else
-        data->underside_diffuse_albedo += data->same_side[wo] * (hw[wo] * kInvPi);
-    }
-  }
+  const FineGrid fine = fine_grid(grid.resolution);
+  data->sampling_subdivision = fine.k;
+  add_albedos(*data);
 
   data->sampling.resize(n);
   parallel_for(static_cast<uint64_t>(n), 0, [&](uint64_t task) {
     const int wo = static_cast<int>(task);
-    // Coverage: per table cell, cos_avg * (m + m3) / 2, which is > 0 wherever the interpolated f
-    // can be for any wo in this bin.
-    std::vector<double> cell(n);
-    double cell_sum = 0;
-    for (int wi = 0; wi < n; ++wi) {
-      cell[wi] = cos_avg[wi] * 0.5 * (static_cast<double>(mean[at(wi, wo)]) + blur[at(wi, wo)]);
-      cell_sum += cell[wi];
-    }
-    // Shape: the interpolated channel mean times |cos| at the centre of each fine cell, averaged
-    // over wo at the 2 x 2 quarter points of its bin (eval interpolates over wo too).
-    std::array<Vec3, 4> wo_at;
-    for (int q = 0; q < 4; ++q)
-      wo_at[q] = DirectionGrid::to_direction(
-          grid.chart_point(wo, 0.25 + 0.5 * (q % 2), 0.25 + 0.5 * (q / 2)));
-    std::vector<double> shape(fn);
-    double shape_sum = 0;
-    for (int s = 0; s < fn; ++s) {
-      double v = 0;
-      for (const Vec3& o_dir : wo_at)
-        for_each_interpolated_cell(grid, o_dir, fine_dir[s],
-                                   [&](int i, int o, double w) { v += mean[at(i, o)] * w; });
-      shape[s] = std::max(0.0, v) * fine_cos[s];
-      shape_sum += shape[s];
-    }
-    std::vector<double> w(fn, 0.0);
-    if (cell_sum > 0) {
-      const double a = shape_sum > 0 ? kSamplingCoverage : 1.0;
-      for (int s = 0; s < fn; ++s) {
-        w[s] = a * cell[coarse_of[s]] / (cell_sum * k * k);
-        if (shape_sum > 0) w[s] += (1 - a) * shape[s] / shape_sum;
-      }
-    }
-    data->sampling[wo] = Distribution2D(w, static_cast<size_t>(fr), static_cast<size_t>(2 * fr));
+    data->sampling[wo] = wi_sampling(grid, wo, mean, blur, cos_avg, fine);
   });
   return data;
 }

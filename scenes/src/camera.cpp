@@ -1,8 +1,8 @@
 #include "weft/scenes/camera.h"
 
 #include <cmath>
-#include <cstdio>
 
+#include "message_format.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 
@@ -23,21 +23,18 @@ bool within(const Vec3& v, double bound) {
 }
 
 std::string format_vec(const Vec3& v) {
-  char buf[96];
-  std::snprintf(buf, sizeof buf, "(%.6g, %.6g, %.6g)", v.x, v.y, v.z);
-  return buf;
+  return detail::format_triple(v.x, v.y, v.z);
 }
-
-std::string format_number(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", x);
-  return buf;
-}
+using detail::format_number;
 
 }  // namespace
 
+bool in_traceable_range(const Vec3& p) {
+  return within(p, kMaxCameraCoordinate_m);
+}
+
 void Camera::validate(const std::string& file, const std::string& field) const {
-  if (!within(position, kMaxCameraCoordinate_m))
+  if (!in_traceable_range(position))
     throw Error(file, field,
                 "camera position " + format_vec(position) + " is not finite or beyond " +
                     format_number(kMaxCameraCoordinate_m) + " m");
@@ -56,7 +53,7 @@ void Camera::validate(const std::string& file, const std::string& field) const {
 }
 
 Camera Camera::look_at(Type type, const Vec3& position, const Vec3& target, const Vec3& up_hint) {
-  if (!within(position, kMaxCameraCoordinate_m))
+  if (!in_traceable_range(position))
     throw Error("camera position " + format_vec(position) + " is not finite or beyond " +
                 format_number(kMaxCameraCoordinate_m) + " m");
   if (!within(target, 1e300) || !within(up_hint, 1e300))

@@ -47,13 +47,6 @@ Rigid translate(const Vec3& t) {
   return r;
 }
 
-double comp(const Vec3& v, int k) {
-  return k == 0 ? v.x : (k == 1 ? v.y : v.z);
-}
-void set_comp(Vec3& v, int k, double x) {
-  (k == 0 ? v.x : (k == 1 ? v.y : v.z)) = x;
-}
-
 // Smooth normals: area-weighted face normals summed over vertices with the same position, so
 // that duplicated vertices along UV seams (cube edges, the tube's closing ring) share a normal.
 void smooth_normals(TriangleMesh& m) {
@@ -104,17 +97,15 @@ struct BoxSpec {
 TriangleMesh rounded_box(const BoxSpec& b, double cell_m) {
   const Vec3 inner = b.half - Vec3(b.radius, b.radius, b.radius);
   std::array<int, 3> n{};
-  for (int k = 0; k < 3; ++k) n[k] = std::max(2, int(std::ceil(2 * comp(b.half, k) / cell_m)));
+  for (int k = 0; k < 3; ++k) n[k] = std::max(2, int(std::ceil(2 * b.half[k] / cell_m)));
   auto lattice = [&](const std::array<int, 3>& i) {
     Vec3 s;
-    for (int k = 0; k < 3; ++k)
-      set_comp(s, k, -comp(b.half, k) + 2 * comp(b.half, k) * double(i[k]) / n[k]);
+    for (int k = 0; k < 3; ++k) s[k] = -b.half[k] + 2 * b.half[k] * double(i[k]) / n[k];
     return s;
   };
   auto position = [&](const Vec3& s) {
     Vec3 c;
-    for (int k = 0; k < 3; ++k)
-      set_comp(c, k, std::clamp(comp(s, k), -comp(inner, k), comp(inner, k)));
+    for (int k = 0; k < 3; ++k) c[k] = std::clamp(s[k], -inner[k], inner[k]);
     const Vec3 d = s - c;
     const double len = length(d);
     const Vec3 p = len > 0 ? c + d * (b.radius / len) : s;
@@ -133,7 +124,7 @@ TriangleMesh rounded_box(const BoxSpec& b, double cell_m) {
           idx[a] = i, idx[c] = j;
           const Vec3 s = lattice(idx);
           const int v_axis = 3 - k - u_axis;
-          push(m, position(s), comp(s, u_axis), comp(s, v_axis));
+          push(m, position(s), s[u_axis], s[v_axis]);
         }
       const uint32_t row = static_cast<uint32_t>(n[a] + 1);
       for (int j = 0; j < n[c]; ++j)
@@ -225,6 +216,120 @@ CarSeatPart part(const std::string& name, const std::string& material, TriangleM
   return {name, std::move(m), warp};
 }
 
+// The rounding radius of the seat's upholstered panels.
+constexpr double kPanelRounding = 0.035;
+
+// Piping along the middle of a panel's rounded edge around its face at height 'face' above the
+// box's centre: a rounded rectangle in the plane y = that middle, half extents a, b less the inset
+// of the edge's middle.
+std::vector<Vec3> piping_path(double a, double b, double face, double cell) {
+  const double r = kPanelRounding, inset = r * (1 - std::cos(kPi / 4));
+  const double y0 = face - r * (1 - std::sin(kPi / 4));
+  return rounded_rect_xz(a - inset, b - inset, 0.03, y0, cell);
+}
+
+// Seat cushion: centre panel pillowed on top with two seams along z, rising towards the front
+// (thigh support), tilted 5 degrees front up, between two bolsters. Shifts of y by functions of
+// (x, z), and of y by a factor 1 + g(x, z) / hy > 0 on the top half, keep the map injective.
+void add_cushion(CarSeat& seat, const CarSeatOptions& o, double cell, double pipe_r) {
+  const Vec3 ch{0.19, 0.05, 0.23};
+  const Deform cushion = [ch](const Vec3& p) {
+    const double top = std::max(0.0, p.y / ch.y);
+    const double pillow = 0.018 * dome(p.x / ch.x) * dome(p.z / ch.z);
+    const double seams = 0.007 * (groove(p.x, -0.07, 0.006) + groove(p.x, 0.07, 0.006));
+    const double rise = 0.012 * (p.z / ch.z + 1) * 0.5;
+    return Vec3{p.x, p.y + (pillow - seams) * top + rise, p.z};
+  };
+  const Rigid cushion_place = translate({0, 0.30, 0.03}).then_after(rot_x(-5));
+  seat.parts.push_back(part("cushion_centre", "centre",
+                            rounded_box({ch, kPanelRounding, 2, cushion, cushion_place}, cell),
+                            cushion_place.rotate({0, 0, 1})));
+  for (int side : {-1, 1}) {
+    const Vec3 bh{0.05, 0.07, 0.24};
+    const Rigid place =
+        cushion_place.then_after(translate({side * 0.235, 0.03, 0}).then_after(rot_z(side * 10.0)));
+    seat.parts.push_back(part(side < 0 ? "cushion_bolster_left" : "cushion_bolster_right",
+                              "bolster", rounded_box({bh, 0.045, 2, nullptr, place}, cell),
+                              place.rotate({0, 0, 1})));
+  }
+  // Piping on the centre panel's top edge.
+  seat.parts.push_back(part("cushion_piping", "piping",
+                            closed_tube(piping_path(ch.x, ch.z, ch.y, cell), {0, 1, 0}, pipe_r,
+                                        o.piping_sides, cushion, cushion_place),
+                            {}));
+}
+
+// The backrest's hinge above the cushion's rear (it is tilted 18 degrees back about it) and its
+// centre panel's half extents; the headrest stands on it.
+Rigid backrest_hinge() {
+  return translate({0, 0.33, -0.24}).then_after(rot_x(-18));
+}
+constexpr Vec3 kBackrestHalf{0.19, 0.29, 0.045};
+
+// Backrest: built upright (height along y, front +z) from its bottom edge, wrapped towards the
+// occupant at the sides, with a lumbar bulge and a pillowed front with two horizontal seams;
+// then tilted back about its hinge, between two bolsters.
+void add_backrest(CarSeat& seat, const CarSeatOptions& o, double cell, double pipe_r) {
+  const Vec3 bh = kBackrestHalf;
+  const Deform back = [bh](const Vec3& p) {
+    const double front = std::max(0.0, p.z / bh.z);
+    const double pillow = 0.015 * dome(p.x / bh.x) * dome((p.y - bh.y) / bh.y);
+    const double seams =
+        0.006 * (groove(p.y, bh.y - 0.09, 0.006) + groove(p.y, bh.y + 0.11, 0.006));
+    const double wrap = 0.9 * p.x * p.x;  // sides come 3 cm forward
+    const double lumbar = 0.02 * groove(p.y, 0.15, 0.08);
+    return Vec3{p.x, p.y, p.z + (pillow - seams) * front + wrap + lumbar};
+  };
+  const Rigid hinge = backrest_hinge();
+  const Rigid back_place = hinge.then_after(translate({0, bh.y, 0}));
+  // 'back' measures y from the bottom edge; the box is built around its centre.
+  const Deform back_local = [back, bh](const Vec3& p) {
+    const Vec3 q = back({p.x, p.y + bh.y, p.z});
+    return Vec3{q.x, q.y - bh.y, q.z};
+  };
+  seat.parts.push_back(part("backrest_centre", "centre",
+                            rounded_box({bh, kPanelRounding, 1, back_local, back_place}, cell),
+                            back_place.rotate({0, 1, 0})));
+  for (int side : {-1, 1}) {
+    const Vec3 sh{0.05, 0.28, 0.065};
+    const Rigid place =
+        hinge.then_after(translate({side * 0.235, sh.y, 0.03}).then_after(rot_y(-side * 12.0)));
+    seat.parts.push_back(part(side < 0 ? "backrest_bolster_left" : "backrest_bolster_right",
+                              "bolster", rounded_box({sh, 0.045, 1, nullptr, place}, cell),
+                              place.rotate({0, 1, 0})));
+  }
+  // Piping around the front face: the path in the box's (x, z, y) plane is the cushion's
+  // rounded rectangle turned so that its plane faces +z.
+  auto path = piping_path(bh.x, bh.y, bh.z, cell);
+  for (Vec3& p : path) p = {p.x, -p.z, p.y};  // (x, y0, z) -> (x, -z, y0): plane z = y0
+  seat.parts.push_back(
+      part("backrest_piping", "piping",
+           closed_tube(path, {0, 0, 1}, pipe_r, o.piping_sides, back_local, back_place), {}));
+}
+
+// Headrest above the backrest on two posts, pillowed at the front; its warp runs across (x).
+void add_headrest(CarSeat& seat, double cell) {
+  const Vec3 hh{0.13, 0.095, 0.055};
+  const Deform head = [hh](const Vec3& p) {
+    const double front = std::max(0.0, p.z / hh.z);
+    return Vec3{p.x, p.y, p.z + 0.012 * dome(p.x / hh.x) * dome(p.y / hh.y) * front};
+  };
+  const Rigid hinge = backrest_hinge();
+  const Vec3 bh = kBackrestHalf;
+  const Rigid head_place = hinge.then_after(translate({0, 2 * bh.y + 0.07 + hh.y, 0.0}));
+  seat.parts.push_back(part("headrest", "headrest",
+                            rounded_box({hh, 0.045, 0, head, head_place}, cell),
+                            head_place.rotate({1, 0, 0})));
+  for (int side : {-1, 1}) {
+    const Vec3 ph{0.006, 0.065, 0.006};
+    const Rigid place = hinge.then_after(translate({side * 0.07, 2 * bh.y + 0.04, 0}));
+    // A rod with rounded ends: the rounding radius just under the rod's half width.
+    seat.parts.push_back(part(side < 0 ? "headrest_post_left" : "headrest_post_right", "post",
+                              rounded_box({ph, 0.0059, 1, nullptr, place}, std::min(cell, 0.003)),
+                              place.rotate({0, 1, 0})));
+  }
+}
+
 }  // namespace
 
 void CarSeatOptions::validate() const {
@@ -250,108 +355,14 @@ CarSeat make_car_seat(const CarSeatOptions& o) {
   o.validate();
   const double cell = o.cell_mm * 1e-3, pipe_r = o.piping_radius_mm * 1e-3;
   CarSeat seat;
-
-  // Seat cushion: centre panel pillowed on top with two seams along z, rising towards the front
-  // (thigh support), tilted 5 degrees front up. Shifts of y by functions of (x, z), and of y by a
-  // factor 1 + g(x, z) / hy > 0 on the top half, keep the map injective.
-  const Vec3 ch{0.19, 0.05, 0.23};
-  const Deform cushion = [ch](const Vec3& p) {
-    const double top = std::max(0.0, p.y / ch.y);
-    const double pillow = 0.018 * dome(p.x / ch.x) * dome(p.z / ch.z);
-    const double seams = 0.007 * (groove(p.x, -0.07, 0.006) + groove(p.x, 0.07, 0.006));
-    const double rise = 0.012 * (p.z / ch.z + 1) * 0.5;
-    return Vec3{p.x, p.y + (pillow - seams) * top + rise, p.z};
-  };
-  const Rigid cushion_place = translate({0, 0.30, 0.03}).then_after(rot_x(-5));
-  seat.parts.push_back(part("cushion_centre", "centre",
-                            rounded_box({ch, 0.035, 2, cushion, cushion_place}, cell),
-                            cushion_place.rotate({0, 0, 1})));
-  for (int side : {-1, 1}) {
-    const Vec3 bh{0.05, 0.07, 0.24};
-    const Rigid place =
-        cushion_place.then_after(translate({side * 0.235, 0.03, 0}).then_after(rot_z(side * 10.0)));
-    seat.parts.push_back(part(side < 0 ? "cushion_bolster_left" : "cushion_bolster_right",
-                              "bolster", rounded_box({bh, 0.045, 2, nullptr, place}, cell),
-                              place.rotate({0, 0, 1})));
-  }
-  {
-    // Piping on the centre panel's top edge: the middle of its rounded edge.
-    const double r = 0.035, inset = r * (1 - std::cos(kPi / 4));
-    const double y0 = ch.y - r * (1 - std::sin(kPi / 4));
-    const auto path = rounded_rect_xz(ch.x - inset, ch.z - inset, 0.03, y0, cell);
-    seat.parts.push_back(
-        part("cushion_piping", "piping",
-             closed_tube(path, {0, 1, 0}, pipe_r, o.piping_sides, cushion, cushion_place), {}));
-  }
-
-  // Backrest: built upright (height along y, front +z) from its bottom edge, wrapped towards the
-  // occupant at the sides, with a lumbar bulge and a pillowed front with two horizontal seams;
-  // then tilted 18 degrees back about its hinge above the cushion's rear.
-  const Vec3 bh{0.19, 0.29, 0.045};
-  const Deform back = [bh](const Vec3& p) {
-    const double front = std::max(0.0, p.z / bh.z);
-    const double pillow = 0.015 * dome(p.x / bh.x) * dome((p.y - bh.y) / bh.y);
-    const double seams =
-        0.006 * (groove(p.y, bh.y - 0.09, 0.006) + groove(p.y, bh.y + 0.11, 0.006));
-    const double wrap = 0.9 * p.x * p.x;  // sides come 3 cm forward
-    const double lumbar = 0.02 * groove(p.y, 0.15, 0.08);
-    return Vec3{p.x, p.y, p.z + (pillow - seams) * front + wrap + lumbar};
-  };
-  const Rigid hinge = translate({0, 0.33, -0.24}).then_after(rot_x(-18));
-  const Rigid back_place = hinge.then_after(translate({0, bh.y, 0}));
-  // 'back' measures y from the bottom edge; the box is built around its centre.
-  const Deform back_local = [back, bh](const Vec3& p) {
-    const Vec3 q = back({p.x, p.y + bh.y, p.z});
-    return Vec3{q.x, q.y - bh.y, q.z};
-  };
-  seat.parts.push_back(part("backrest_centre", "centre",
-                            rounded_box({bh, 0.035, 1, back_local, back_place}, cell),
-                            back_place.rotate({0, 1, 0})));
-  for (int side : {-1, 1}) {
-    const Vec3 sh{0.05, 0.28, 0.065};
-    const Rigid place =
-        hinge.then_after(translate({side * 0.235, sh.y, 0.03}).then_after(rot_y(-side * 12.0)));
-    seat.parts.push_back(part(side < 0 ? "backrest_bolster_left" : "backrest_bolster_right",
-                              "bolster", rounded_box({sh, 0.045, 1, nullptr, place}, cell),
-                              place.rotate({0, 1, 0})));
-  }
-  {
-    // Piping around the front face: the path in the box's (x, z, y) plane is the cushion's
-    // rounded rectangle turned so that its plane faces +z.
-    const double r = 0.035, inset = r * (1 - std::cos(kPi / 4));
-    const double z0 = bh.z - r * (1 - std::sin(kPi / 4));
-    auto path = rounded_rect_xz(bh.x - inset, bh.y - inset, 0.03, z0, cell);
-    for (Vec3& p : path) p = {p.x, -p.z, p.y};  // (x, y0, z) -> (x, -z, y0): plane z = y0
-    seat.parts.push_back(
-        part("backrest_piping", "piping",
-             closed_tube(path, {0, 0, 1}, pipe_r, o.piping_sides, back_local, back_place), {}));
-  }
-
-  // Headrest above the backrest on two posts, pillowed at the front; its warp runs across (x).
-  const Vec3 hh{0.13, 0.095, 0.055};
-  const Deform head = [hh](const Vec3& p) {
-    const double front = std::max(0.0, p.z / hh.z);
-    return Vec3{p.x, p.y, p.z + 0.012 * dome(p.x / hh.x) * dome(p.y / hh.y) * front};
-  };
-  const Rigid head_place = hinge.then_after(translate({0, 2 * bh.y + 0.07 + hh.y, 0.0}));
-  seat.parts.push_back(part("headrest", "headrest",
-                            rounded_box({hh, 0.045, 0, head, head_place}, cell),
-                            head_place.rotate({1, 0, 0})));
-  for (int side : {-1, 1}) {
-    const Vec3 ph{0.006, 0.065, 0.006};
-    const Rigid place = hinge.then_after(translate({side * 0.07, 2 * bh.y + 0.04, 0}));
-    // A rod with rounded ends: the rounding radius just under the rod's half width.
-    seat.parts.push_back(part(side < 0 ? "headrest_post_left" : "headrest_post_right", "post",
-                              rounded_box({ph, 0.0059, 1, nullptr, place}, std::min(cell, 0.003)),
-                              place.rotate({0, 1, 0})));
-  }
+  add_cushion(seat, o, cell, pipe_r);
+  add_backrest(seat, o, cell, pipe_r);
+  add_headrest(seat, cell);
   // The frame under the cushion, down to the floor (y = 0), so the seat stands on the ground.
-  {
-    const Vec3 fh{0.2, 0.125, 0.21};
-    const Rigid place = translate({0, fh.y + 0.002, 0.0});
-    seat.parts.push_back(
-        part("base", "base", rounded_box({fh, 0.02, 2, nullptr, place}, 2 * cell), {}));
-  }
+  const Vec3 fh{0.2, 0.125, 0.21};
+  const Rigid place = translate({0, fh.y + 0.002, 0.0});
+  seat.parts.push_back(
+      part("base", "base", rounded_box({fh, 0.02, 2, nullptr, place}, 2 * cell), {}));
   return seat;
 }
 

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
+#include "message_format.h"
 #include "weft/core/distribution.h"
 #include "weft/core/math.h"
 
@@ -177,15 +177,8 @@ Rgb AreaLight::eval(const LightHit& hit) const {
 }
 
 std::vector<std::string> describe_lights(const Lights& lights) {
-  auto num = [](double x) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.6g", x);
-    return std::string(buf);
-  };
-  auto vec = [&](const Vec3& v) {
-    return "(" + num(v.x) + ", " + num(v.y) + ", " + num(v.z) + ")";
-  };
-  auto rgb = [&](const Rgb& c) { return "(" + num(c.r) + ", " + num(c.g) + ", " + num(c.b) + ")"; };
+  auto vec = [](const Vec3& v) { return detail::format_triple(v.x, v.y, v.z); };
+  auto rgb = [](const Rgb& c) { return detail::format_triple(c.r, c.g, c.b); };
   std::vector<std::string> out;
   for (const auto& d : lights.directional)
     out.push_back("parallel towards " + vec(d.to_light) + ": irradiance " + rgb(d.irradiance) +

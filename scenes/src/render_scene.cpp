@@ -268,218 +268,260 @@ void curve_hit(const FiberSegment& s, double t, const Ray& ray, SurfaceHit* hit)
 
 }  // namespace
 
-RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions& options) {
-  auto geo = std::make_shared<Geometry>();
-  EmbreeErrors& errors = geo->errors;
-  geo->device = rtcNewDevice(nullptr);
-  if (!geo->device) throw Error(desc.source, "", "cannot create the Embree device");
-  rtcSetDeviceErrorFunction(geo->device, on_embree_error, &errors);
-  geo->scene = rtcNewScene(geo->device);
-  rtcSetSceneFlags(geo->scene, RTC_SCENE_FLAG_ROBUST);  // watertight: no leaks along shared edges
-  rtcSetSceneBuildQuality(geo->scene, RTC_BUILD_QUALITY_HIGH);
+// Builds a RenderScene's Geometry from a description, one step per method (a member of
+// RenderScene, so it may name the private Geometry).
+class RenderScene::Builder {
+ public:
+  // The Embree device and scene; checks the override mask.
+  Builder(const SceneDescription& desc, const RenderSceneOptions& options);
+  void add_meshes();      // geometry ID = mesh index
+  void add_curve_sets();  // after the meshes: their fibers' shape IDs follow the meshes'
+  void instance_curve_scene();
+  std::shared_ptr<const Geometry> finish();
+
+ private:
+  // One BSDF per binding, created once and shared by every shape that uses it.
+  uint32_t bsdf_index(const MaterialBinding& b);
+  // The binding of material 'key' on 'shape': the options' override where its mask says so.
+  const MaterialBinding& binding(size_t shape, const std::string& key) const;
+  // An Embree triangle geometry holding a copy of the mesh's vertices and triangles.
+  RTCGeometry triangle_geometry(const TriangleMesh& m) const;
+  void start_curve_sets();  // the fiber geometry, checks and the curve scene
+  void add_curve_set(size_t k);
+  RTCGeometry tube_geometry(CurveRecord& rec);
+  RTCGeometry round_curve_geometry(CurveRecord& rec, size_t k);
+  [[noreturn]] void allocation_failed(RTCGeometry g) const;
+
+  const SceneDescription& desc_;
+  const RenderSceneOptions& options_;
+  std::shared_ptr<Geometry> geo_ = std::make_shared<Geometry>();
+  std::map<const MaterialBinding*, uint32_t> bsdf_of_;
+  std::shared_ptr<TableCache> cache_;
+  std::vector<AreaLight::Emission> emission_;  // per mesh
+  bool tubes_ = false;                         // the fibers are triangle tubes
+};
+
+RenderScene::Builder::Builder(const SceneDescription& desc, const RenderSceneOptions& options)
+    : desc_(desc), options_(options) {
+  geo_->device = rtcNewDevice(nullptr);
+  if (!geo_->device) throw Error(desc.source, "", "cannot create the Embree device");
+  rtcSetDeviceErrorFunction(geo_->device, on_embree_error, &geo_->errors);
+  geo_->scene = rtcNewScene(geo_->device);
+  rtcSetSceneFlags(geo_->scene, RTC_SCENE_FLAG_ROBUST);  // watertight: no leaks along shared edges
+  rtcSetSceneBuildQuality(geo_->scene, RTC_BUILD_QUALITY_HIGH);
 
   if (!options.override_shapes.empty() && options.override_shapes.size() != desc.shape_count())
     throw Error(desc.source, "", "override mask does not match the shape count");
-  // One BSDF per binding, created once and shared by every mesh that uses it.
-  std::map<const MaterialBinding*, uint32_t> bsdf_of;
-  const auto cache = options.table_cache ? options.table_cache : std::make_shared<TableCache>();
-  auto bsdf_index = [&](const MaterialBinding& b) {
-    const auto it = bsdf_of.find(&b);
-    if (it != bsdf_of.end()) return it->second;
-    MaterialContext ctx;
-    ctx.base_dir = desc.base_dir;
-    ctx.source_file = desc.source;
-    ctx.field_prefix = b.field.empty() ? "materials" : b.field + ".params";
-    ctx.cache = cache;
-    ctx.progress = options.material_progress;
-    ctx.fiber_tables = options.fiber_tables;
-    geo->bsdfs.push_back(make_bsdf(b.type, b.params, ctx));
-    const auto id = static_cast<uint32_t>(geo->bsdfs.size() - 1);
-    if (geo->spectral_why.empty()) {
-      geo->spectral_why = spectral_obstacle(geo->bsdfs.back());
-      if (!geo->spectral_why.empty()) geo->spectral_field = b.field.empty() ? "materials" : b.field;
-    }
-    bsdf_of[&b] = id;
-    return id;
-  };
-  auto overridden = [&](size_t shape) {
-    const bool o = !options.override_shapes.empty() && options.override_shapes[shape];
-    if (o && !options.override_binding) throw Error(desc.source, "", "override without a binding");
-    return o;
-  };
+  cache_ = options.table_cache ? options.table_cache : std::make_shared<TableCache>();
+}
 
-  std::vector<AreaLight::Emission> emission;
-  for (size_t i = 0; i < desc.meshes.size(); ++i) {
-    const auto& mesh = desc.meshes[i];
-    const MaterialBinding& b =
-        overridden(i) ? *options.override_binding : desc.binding_for(mesh->material);
+uint32_t RenderScene::Builder::bsdf_index(const MaterialBinding& b) {
+  const auto it = bsdf_of_.find(&b);
+  if (it != bsdf_of_.end()) return it->second;
+  MaterialContext ctx;
+  ctx.base_dir = desc_.base_dir;
+  ctx.source_file = desc_.source;
+  ctx.field_prefix = b.field.empty() ? "materials" : b.field + ".params";
+  ctx.cache = cache_;
+  ctx.progress = options_.material_progress;
+  ctx.fiber_tables = options_.fiber_tables;
+  geo_->bsdfs.push_back(make_bsdf(b.type, b.params, ctx));
+  const auto id = static_cast<uint32_t>(geo_->bsdfs.size() - 1);
+  if (geo_->spectral_why.empty()) {
+    geo_->spectral_why = spectral_obstacle(geo_->bsdfs.back());
+    if (!geo_->spectral_why.empty()) geo_->spectral_field = b.field.empty() ? "materials" : b.field;
+  }
+  bsdf_of_[&b] = id;
+  return id;
+}
+
+const MaterialBinding& RenderScene::Builder::binding(size_t shape, const std::string& key) const {
+  const bool o = !options_.override_shapes.empty() && options_.override_shapes[shape];
+  if (o && !options_.override_binding) throw Error(desc_.source, "", "override without a binding");
+  return o ? *options_.override_binding : desc_.binding_for(key);
+}
+
+void RenderScene::Builder::allocation_failed(RTCGeometry g) const {
+  rtcReleaseGeometry(g);
+  throw Error(desc_.source, "", "Embree could not allocate buffers: " + geo_->errors.message);
+}
+
+RTCGeometry RenderScene::Builder::triangle_geometry(const TriangleMesh& m) const {
+  RTCGeometry g = rtcNewGeometry(geo_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+      g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertex_count()));
+  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+      g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), m.triangle_count()));
+  if (!vb || !ib) allocation_failed(g);
+  std::memcpy(vb, m.positions.data(), m.positions.size() * sizeof(float));
+  std::memcpy(ib, m.indices.data(), m.indices.size() * sizeof(uint32_t));
+  return g;
+}
+
+void RenderScene::Builder::add_meshes() {
+  for (size_t i = 0; i < desc_.meshes.size(); ++i) {
+    const auto& mesh = desc_.meshes[i];
+    const MaterialBinding& b = binding(i, mesh->material);
     Geometry::MeshRecord rec;
     rec.mesh = mesh;
     rec.bsdf = bsdf_index(b);
-    const auto info = desc.gltf_materials.find(mesh->material);
+    const auto info = desc_.gltf_materials.find(mesh->material);
     const GltfMaterialInfo gl =
-        info != desc.gltf_materials.end() ? info->second : GltfMaterialInfo{};
-    emission.push_back({b.emission ? *b.emission : gl.emission,
-                        b.double_sided ? *b.double_sided : gl.double_sided});
-    geo->meshes.push_back(rec);
-    geo->bounds.expand(mesh->bounds());
+        info != desc_.gltf_materials.end() ? info->second : GltfMaterialInfo{};
+    emission_.push_back({b.emission ? *b.emission : gl.emission,
+                         b.double_sided ? *b.double_sided : gl.double_sided});
+    geo_->meshes.push_back(rec);
+    geo_->bounds.expand(mesh->bounds());
     // Geometry IDs equal mesh indices; an empty mesh simply has no Embree geometry.
     if (mesh->vertex_count() == 0 || mesh->triangle_count() == 0) continue;
 
-    RTCGeometry g = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-        g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), mesh->vertex_count()));
-    auto* ib = static_cast<uint32_t*>(
-        rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t),
-                                mesh->triangle_count()));
-    if (!vb || !ib) {
-      rtcReleaseGeometry(g);
-      throw Error(desc.source, "", "Embree could not allocate buffers: " + errors.message);
-    }
-    if (mesh->vertex_count())
-      std::memcpy(vb, mesh->positions.data(), mesh->positions.size() * sizeof(float));
-    if (mesh->triangle_count())
-      std::memcpy(ib, mesh->indices.data(), mesh->indices.size() * sizeof(uint32_t));
+    RTCGeometry g = triangle_geometry(*mesh);
     rtcCommitGeometry(g);
-    rtcAttachGeometryByID(geo->scene, g, static_cast<unsigned>(i));
+    rtcAttachGeometryByID(geo_->scene, g, static_cast<unsigned>(i));
     rtcReleaseGeometry(g);
-    geo->triangles += mesh->triangle_count();
+    geo_->triangles += mesh->triangle_count();
   }
+}
 
-  // Fibers: one Embree geometry per curve set, with the filter that ignores the query's fiber.
-  // Tubes take the shape's ID in the scene; round curves ID k in the instanced curve scene.
-  geo->fiber_geometry = options.fiber_geometry.value_or(desc.fiber_geometry);
-  const bool tubes = geo->fiber_geometry.type == FiberGeometry::Type::tubes;
-  if (!desc.curves.empty() &&
-      rtcGetDeviceProperty(geo->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0)
-    throw Error(desc.source, "curves",
+void RenderScene::Builder::start_curve_sets() {
+  geo_->fiber_geometry = options_.fiber_geometry.value_or(desc_.fiber_geometry);
+  tubes_ = geo_->fiber_geometry.type == FiberGeometry::Type::tubes;
+  if (!desc_.curves.empty() &&
+      rtcGetDeviceProperty(geo_->device, RTC_DEVICE_PROPERTY_FILTER_FUNCTION_SUPPORTED) == 0)
+    throw Error(desc_.source, "curves",
                 "this Embree is built without filter functions, which fibers need");
-  for (size_t k = 0; k < desc.curves.size(); ++k)
-    desc.curves[k]->validate(desc.source, "curves[" + std::to_string(k) + "]");
-  geo->curve_sets.reserve(desc.curves.size());
-  if (!tubes && !desc.curves.empty()) {
-    // The scale that makes the mean fiber radius about 1.
-    double sum = 0;
-    size_t n = 0;
-    for (const auto& c : desc.curves)
-      for (size_t i = 0; i < c->point_count(); ++i) sum += c->radius(i), ++n;
-    if (n > 0) geo->curve_scale = std::ldexp(1.0, std::clamp(-std::ilogb(sum / n), -100, 100));
-    geo->curve_scene = rtcNewScene(geo->device);
-    rtcSetSceneFlags(geo->curve_scene, RTC_SCENE_FLAG_ROBUST);
-    rtcSetSceneBuildQuality(geo->curve_scene, RTC_BUILD_QUALITY_HIGH);
-  }
-  for (size_t k = 0; k < desc.curves.size(); ++k) {
-    const size_t shape = desc.meshes.size() + k;
-    const auto& curves = desc.curves[k];
-    CurveRecord& rec = geo->curve_sets.emplace_back();
-    rec.curves = curves;
-    rec.scale = tubes ? 1.0 : geo->curve_scale;
-    rec.segments = index_segments(*curves);
-    rec.first_fiber = geo->fibers;
-    geo->fibers += static_cast<int64_t>(curves->curve_count());
-    for (const std::string& key : curves->yarn_material) {
-      const MaterialBinding& b =
-          overridden(shape) ? *options.override_binding : desc.binding_for(key);
-      if (b.emission && !b.emission->is_black())
-        throw Error(desc.source, b.field.empty() ? "materials" : b.field + ".emission",
-                    "fibers do not emit light: bind emission to meshes only");
-      rec.yarn_bsdf.push_back(bsdf_index(b));
-    }
-    geo->bounds.expand(curves->bounds());
-    if (curves->curve_count() == 0) continue;
+  for (size_t k = 0; k < desc_.curves.size(); ++k)
+    desc_.curves[k]->validate(desc_.source, "curves[" + std::to_string(k) + "]");
+  geo_->curve_sets.reserve(desc_.curves.size());
+  if (tubes_ || desc_.curves.empty()) return;
+  // The scale that makes the mean fiber radius about 1.
+  double sum = 0;
+  size_t n = 0;
+  for (const auto& c : desc_.curves)
+    for (size_t i = 0; i < c->point_count(); ++i) sum += c->radius(i), ++n;
+  if (n > 0) geo_->curve_scale = std::ldexp(1.0, std::clamp(-std::ilogb(sum / n), -100, 100));
+  geo_->curve_scene = rtcNewScene(geo_->device);
+  rtcSetSceneFlags(geo_->curve_scene, RTC_SCENE_FLAG_ROBUST);
+  rtcSetSceneBuildQuality(geo_->curve_scene, RTC_BUILD_QUALITY_HIGH);
+}
 
-    RTCGeometry g = nullptr;
-    bool allocated = true;
-    if (tubes) {
-      auto t =
-          std::make_shared<FiberTubes>(make_fiber_tubes(*curves, geo->fiber_geometry.tube_sides));
-      rec.prim_curve.resize(t->triangle_segment.size());
-      for (size_t i = 0; i < t->triangle_segment.size(); ++i)
-        rec.prim_curve[i] = rec.segments.curve[t->triangle_segment[i]];
-      const TriangleMesh& m = t->mesh;
-      g = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_TRIANGLE);
-      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
-          g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertex_count()));
-      auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), m.triangle_count()));
-      allocated = vb && ib;
-      if (allocated) {
-        std::memcpy(vb, m.positions.data(), m.positions.size() * sizeof(float));
-        std::memcpy(ib, m.indices.data(), m.indices.size() * sizeof(uint32_t));
-      }
-      geo->triangles += m.triangle_count();
-      rec.tubes = std::move(t);
-    } else {
-      rec.prim_curve = rec.segments.curve;
-      const size_t nseg = rec.segments.first_point.size();
-      g = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
-      auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0,
-                                                             RTC_FORMAT_FLOAT4, 4 * sizeof(float),
-                                                             curves->point_count()));
-      auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-          g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(uint32_t), nseg));
-      // Neighbour flags: a fiber's inner joints attach, only its two ends are closed by spheres.
-      auto* fb = static_cast<uint8_t*>(
-          rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR, 1, nseg));
-      allocated = vb && ib && fb;
-      if (allocated) {
-        const auto scale = static_cast<float>(geo->curve_scale);
-        bool in_range = true;
-        for (size_t i = 0; i < curves->points.size(); ++i) {
-          vb[i] = curves->points[i] * scale;  // exact: a power of two
-          in_range = in_range && std::abs(vb[i]) < 1e37f;
-        }
-        if (!in_range) {
-          rtcReleaseGeometry(g);
-          throw Error(desc.source, "curves[" + std::to_string(k) + "]",
-                      "fiber coordinates too large for their radii");
-        }
-        std::memcpy(ib, rec.segments.first_point.data(), nseg * sizeof(uint32_t));
-        for (size_t s = 0; s < nseg; ++s) {
-          const uint32_t c = rec.segments.curve[s], first = curves->curve_first[c];
-          const uint32_t last = first + curves->curve_points[c] - 2;  // its last segment's start
-          const uint32_t at = rec.segments.first_point[s];
-          fb[s] = static_cast<uint8_t>((at > first ? RTC_CURVE_FLAG_NEIGHBOR_LEFT : 0) |
-                                       (at < last ? RTC_CURVE_FLAG_NEIGHBOR_RIGHT : 0));
-        }
-      }
-      geo->curve_segments += nseg;
-    }
-    if (!allocated) {
-      rtcReleaseGeometry(g);
-      throw Error(desc.source, "", "Embree could not allocate buffers: " + errors.message);
-    }
-    rtcSetGeometryUserData(g, &rec);
-    rtcSetGeometryIntersectFilterFunction(g, fiber_filter);
-    rtcSetGeometryOccludedFilterFunction(g, fiber_filter);
-    rtcCommitGeometry(g);
-    // Tubes: shape IDs in the scene; round curves: set k in the curve scene.
-    if (tubes)
-      rtcAttachGeometryByID(geo->scene, g, static_cast<unsigned>(shape));
-    else
-      rtcAttachGeometryByID(geo->curve_scene, g, static_cast<unsigned>(k));
+// Fibers: one Embree geometry per curve set, with the filter that ignores the query's fiber.
+void RenderScene::Builder::add_curve_sets() {
+  start_curve_sets();
+  for (size_t k = 0; k < desc_.curves.size(); ++k) add_curve_set(k);
+}
+
+void RenderScene::Builder::add_curve_set(size_t k) {
+  const size_t shape = desc_.meshes.size() + k;
+  const auto& curves = desc_.curves[k];
+  CurveRecord& rec = geo_->curve_sets.emplace_back();
+  rec.curves = curves;
+  rec.scale = tubes_ ? 1.0 : geo_->curve_scale;
+  rec.segments = index_segments(*curves);
+  rec.first_fiber = geo_->fibers;
+  geo_->fibers += static_cast<int64_t>(curves->curve_count());
+  for (const std::string& key : curves->yarn_material) {
+    const MaterialBinding& b = binding(shape, key);
+    if (b.emission && !b.emission->is_black())
+      throw Error(desc_.source, b.field.empty() ? "materials" : b.field + ".emission",
+                  "fibers do not emit light: bind emission to meshes only");
+    rec.yarn_bsdf.push_back(bsdf_index(b));
+  }
+  geo_->bounds.expand(curves->bounds());
+  if (curves->curve_count() == 0) return;
+
+  RTCGeometry g = tubes_ ? tube_geometry(rec) : round_curve_geometry(rec, k);
+  rtcSetGeometryUserData(g, &rec);
+  rtcSetGeometryIntersectFilterFunction(g, fiber_filter);
+  rtcSetGeometryOccludedFilterFunction(g, fiber_filter);
+  rtcCommitGeometry(g);
+  // Tubes take the shape's ID in the scene; round curves ID k in the instanced curve scene.
+  if (tubes_)
+    rtcAttachGeometryByID(geo_->scene, g, static_cast<unsigned>(shape));
+  else
+    rtcAttachGeometryByID(geo_->curve_scene, g, static_cast<unsigned>(k));
+  rtcReleaseGeometry(g);
+}
+
+RTCGeometry RenderScene::Builder::tube_geometry(CurveRecord& rec) {
+  auto t =
+      std::make_shared<FiberTubes>(make_fiber_tubes(*rec.curves, geo_->fiber_geometry.tube_sides));
+  rec.prim_curve.resize(t->triangle_segment.size());
+  for (size_t i = 0; i < t->triangle_segment.size(); ++i)
+    rec.prim_curve[i] = rec.segments.curve[t->triangle_segment[i]];
+  RTCGeometry g = triangle_geometry(t->mesh);
+  geo_->triangles += t->mesh.triangle_count();
+  rec.tubes = std::move(t);
+  return g;
+}
+
+RTCGeometry RenderScene::Builder::round_curve_geometry(CurveRecord& rec, size_t k) {
+  const FiberCurves& curves = *rec.curves;
+  rec.prim_curve = rec.segments.curve;
+  const size_t nseg = rec.segments.first_point.size();
+  RTCGeometry g = rtcNewGeometry(geo_->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+  auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
+      g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4, 4 * sizeof(float), curves.point_count()));
+  auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
+      g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT, sizeof(uint32_t), nseg));
+  // Neighbour flags: a fiber's inner joints attach, only its two ends are closed by spheres.
+  auto* fb = static_cast<uint8_t*>(
+      rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR, 1, nseg));
+  if (!(vb && ib && fb)) allocation_failed(g);
+  const auto scale = static_cast<float>(geo_->curve_scale);
+  bool in_range = true;
+  for (size_t i = 0; i < curves.points.size(); ++i) {
+    vb[i] = curves.points[i] * scale;  // exact: a power of two
+    in_range = in_range && std::abs(vb[i]) < 1e37f;
+  }
+  if (!in_range) {
     rtcReleaseGeometry(g);
+    throw Error(desc_.source, "curves[" + std::to_string(k) + "]",
+                "fiber coordinates too large for their radii");
   }
-  if (geo->curve_scene) {
-    rtcCommitScene(geo->curve_scene);
-    RTCGeometry inst = rtcNewGeometry(geo->device, RTC_GEOMETRY_TYPE_INSTANCE);
-    rtcSetGeometryInstancedScene(inst, geo->curve_scene);
-    const auto inv = static_cast<float>(1 / geo->curve_scale);
-    const float xfm[12] = {inv, 0, 0, 0, inv, 0, 0, 0, inv, 0, 0, 0};  // 3 x 4, column-major
-    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
-    rtcCommitGeometry(inst);
-    rtcAttachGeometryByID(geo->scene, inst, static_cast<unsigned>(desc.shape_count()));
-    rtcReleaseGeometry(inst);
+  std::memcpy(ib, rec.segments.first_point.data(), nseg * sizeof(uint32_t));
+  for (size_t s = 0; s < nseg; ++s) {
+    const uint32_t c = rec.segments.curve[s], first = curves.curve_first[c];
+    const uint32_t last = first + curves.curve_points[c] - 2;  // its last segment's start
+    const uint32_t at = rec.segments.first_point[s];
+    fb[s] = static_cast<uint8_t>((at > first ? RTC_CURVE_FLAG_NEIGHBOR_LEFT : 0) |
+                                 (at < last ? RTC_CURVE_FLAG_NEIGHBOR_RIGHT : 0));
   }
-  rtcCommitScene(geo->scene);
-  if (!errors.message.empty()) throw Error(desc.source, "", errors.message);
-  geo->area_light = AreaLight(desc.meshes, emission);
-  geo->source = desc.source;
-  for (const AreaLight::Emission& e : emission)
-    geo->grey_emission = geo->grey_emission && e.radiance.is_grey();
-  for (size_t i = 0; i < geo->meshes.size(); ++i)
-    geo->meshes[i].emits = geo->area_light.emits(static_cast<uint32_t>(i));
-  geo_ = std::move(geo);
+  geo_->curve_segments += nseg;
+  return g;
+}
+
+void RenderScene::Builder::instance_curve_scene() {
+  if (!geo_->curve_scene) return;
+  rtcCommitScene(geo_->curve_scene);
+  RTCGeometry inst = rtcNewGeometry(geo_->device, RTC_GEOMETRY_TYPE_INSTANCE);
+  rtcSetGeometryInstancedScene(inst, geo_->curve_scene);
+  const auto inv = static_cast<float>(1 / geo_->curve_scale);
+  const float xfm[12] = {inv, 0, 0, 0, inv, 0, 0, 0, inv, 0, 0, 0};  // 3 x 4, column-major
+  rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+  rtcCommitGeometry(inst);
+  rtcAttachGeometryByID(geo_->scene, inst, static_cast<unsigned>(desc_.shape_count()));
+  rtcReleaseGeometry(inst);
+}
+
+std::shared_ptr<const RenderScene::Geometry> RenderScene::Builder::finish() {
+  rtcCommitScene(geo_->scene);
+  if (!geo_->errors.message.empty()) throw Error(desc_.source, "", geo_->errors.message);
+  geo_->area_light = AreaLight(desc_.meshes, emission_);
+  geo_->source = desc_.source;
+  for (const AreaLight::Emission& e : emission_)
+    geo_->grey_emission = geo_->grey_emission && e.radiance.is_grey();
+  for (size_t i = 0; i < geo_->meshes.size(); ++i)
+    geo_->meshes[i].emits = geo_->area_light.emits(static_cast<uint32_t>(i));
+  return std::move(geo_);
+}
+
+RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions& options) {
+  Builder b(desc, options);
+  b.add_meshes();
+  b.add_curve_sets();
+  b.instance_curve_scene();
+  geo_ = b.finish();
   set_lights(desc.lights);
 }
 

@@ -108,8 +108,8 @@ struct Resolved {
   Interlacing repeat;
 };
 
-Resolved resolve(const WeaveOptions& o) {
-  Resolved r;
+// The detail, repeat counts and tessellation, checked; the tessellation goes to r.layout.
+void resolve_detail(const WeaveOptions& o, Resolved& r) {
   r.detail = o.detail.value_or("yarn");
   if (r.detail != "yarn" && r.detail != "fiber")
     bad("detail", "must be yarn or fiber, got '" + r.detail + "'");
@@ -123,79 +123,99 @@ Resolved resolve(const WeaveOptions& o) {
   if (segments_per_crossing < 2 || segments_per_crossing > 1024)
     bad("segments-per-crossing", "must lie in [2, 1024]");
   if (sides < 4 || sides > 1024) bad("sides", "must lie in [4, 1024]");
-  if (o.wif && o.pattern) bad("wif", "give either a pattern or a WIF draft, not both");
-  const bool from_wif = o.wif.has_value();
+  r.layout.segments_per_crossing = segments_per_crossing;
+  r.layout.sides = sides;
+}
+
+// The sizes of the repeat's threads, each way.
+struct ThreadSizes {
   std::vector<ThreadSize> warp, weft;
+};
+
+// The repeat, its threads' sizes and colours from the WIF draft o.wif. A thread's thickness is
+// its drawn width (clamped to its spacing so neighbours do not overlap); its height follows the
+// red-cotton flattening unless given.
+ThreadSizes wif_threads(const WeaveOptions& o, Resolved& r) {
+  const WifDraft d = read_wif(*o.wif);
+  r.repeat = d.interlacing();
+  r.source = *o.wif;
+  ThreadSizes sized;
+  auto sizes = [&](const std::vector<WifThread>& threads, const std::string& dir,
+                   const std::optional<double>& sp, const std::optional<double>& wd,
+                   const std::optional<double>& th, double def_sp, double def_w, double flat,
+                   std::vector<ThreadSize>& out, std::vector<std::array<double, 3>>& rgb) {
+    for (const WifThread& t : threads) {
+      const std::string where = *o.wif + ", " + dir + " thread " + std::to_string(out.size() + 1);
+      ThreadSize s;
+      s.spacing_mm = check_length(sp, t.spacing_mm > 0 ? t.spacing_mm : def_sp, dir + "-spacing-mm",
+                                  0, 100, where);
+      const double drawn = t.thickness_mm > 0 ? std::min(t.thickness_mm, s.spacing_mm)
+                                              : std::min(def_w, s.spacing_mm);
+      s.width_mm = check_length(wd, drawn, dir + "-width-mm", 0, 100, where);
+      s.thickness_mm = check_length(th, s.width_mm * flat, dir + "-thickness-mm", 0, 100, where);
+      out.push_back(s);
+      rgb.push_back(t.rgb);
+    }
+  };
   const double warp_flat = kRedWarpThickness / kRedWarpWidth,
                weft_flat = kRedWeftThickness / kRedWeftWidth;
-  if (from_wif) {
-    const WifDraft d = read_wif(*o.wif);
-    r.repeat = d.interlacing();
-    r.source = *o.wif;
-    // WIF sizes: a thread's thickness is its drawn width (clamped to its spacing so neighbours
-    // do not overlap); its height follows the red-cotton flattening unless given.
-    auto sizes = [&](const std::vector<WifThread>& threads, const std::string& dir,
-                     const std::optional<double>& sp, const std::optional<double>& wd,
-                     const std::optional<double>& th, double def_sp, double def_w, double flat,
-                     std::vector<ThreadSize>& out, std::vector<std::array<double, 3>>& rgb) {
-      for (const WifThread& t : threads) {
-        const std::string where = *o.wif + ", " + dir + " thread " + std::to_string(out.size() + 1);
-        ThreadSize s;
-        s.spacing_mm = check_length(sp, t.spacing_mm > 0 ? t.spacing_mm : def_sp,
-                                    dir + "-spacing-mm", 0, 100, where);
-        const double drawn = t.thickness_mm > 0 ? std::min(t.thickness_mm, s.spacing_mm)
-                                                : std::min(def_w, s.spacing_mm);
-        s.width_mm = check_length(wd, drawn, dir + "-width-mm", 0, 100, where);
-        s.thickness_mm = check_length(th, s.width_mm * flat, dir + "-thickness-mm", 0, 100, where);
-        out.push_back(s);
-        rgb.push_back(t.rgb);
-      }
-    };
-    sizes(d.warp, "warp", o.warp_spacing_mm, o.warp_width_mm, o.warp_thickness_mm, kRedWarpSpacing,
-          kRedWarpWidth, warp_flat, warp, r.warp_rgb);
-    sizes(d.weft, "weft", o.weft_spacing_mm, o.weft_width_mm, o.weft_thickness_mm, kRedWeftSpacing,
-          kRedWeftWidth, weft_flat, weft, r.weft_rgb);
-  } else {
-    r.repeat = parse_weave_pattern(o.pattern.value_or("plain"), "pattern");
-    r.source = o.pattern.value_or("plain");
-    ThreadSize w, f;
-    w.spacing_mm = check_length(o.warp_spacing_mm, kRedWarpSpacing, "warp-spacing-mm", 0, 100);
-    f.spacing_mm = check_length(o.weft_spacing_mm, kRedWeftSpacing, "weft-spacing-mm", 0, 100);
-    w.width_mm = check_length(o.warp_width_mm, kRedWarpWidth, "warp-width-mm", 0, 100);
-    f.width_mm = check_length(o.weft_width_mm, kRedWeftWidth, "weft-width-mm", 0, 100);
-    w.thickness_mm =
-        check_length(o.warp_thickness_mm, kRedWarpThickness, "warp-thickness-mm", 0, 100);
-    f.thickness_mm =
-        check_length(o.weft_thickness_mm, kRedWeftThickness, "weft-thickness-mm", 0, 100);
-    warp.assign(r.repeat.warps, w);
-    weft.assign(r.repeat.wefts, f);
-  }
-  // A yarn wider than its spacing would overlap its neighbours; the same check each way.
-  auto check_widths = [](const std::vector<ThreadSize>& threads, const std::string& field,
-                         const std::string& thread_name) {
-    for (size_t k = 0; k < threads.size(); ++k)
-      if (threads[k].width_mm > threads[k].spacing_mm * (1 + 1e-12))
-        bad(field, thread_name + " " + std::to_string(k + 1) + " is wider (" +
-                       ParamReader::fmt(threads[k].width_mm) + " mm) than its spacing (" +
-                       ParamReader::fmt(threads[k].spacing_mm) +
-                       " mm): neighbouring yarns would overlap");
-  };
-  check_widths(warp, "warp-width-mm", "warp");
-  check_widths(weft, "weft-width-mm", "pick");
-  // A WIF draft's threads have no crimp data: balanced unless given.
-  double share = o.warp_crimp_share.value_or(from_wif ? -1.0 : kRedWarpCrimpShare);
-  if (!std::isfinite(share) || share > 1) bad("warp-crimp-share", "must be <= 1 (< 0: balanced)");
+  sizes(d.warp, "warp", o.warp_spacing_mm, o.warp_width_mm, o.warp_thickness_mm, kRedWarpSpacing,
+        kRedWarpWidth, warp_flat, sized.warp, r.warp_rgb);
+  sizes(d.weft, "weft", o.weft_spacing_mm, o.weft_width_mm, o.weft_thickness_mm, kRedWeftSpacing,
+        kRedWeftWidth, weft_flat, sized.weft, r.weft_rgb);
+  return sized;
+}
 
-  // Sizes of the sample, estimated before anything is allocated.
-  const double nwarp = double(r.repeat.warps) * r.repeats_z,
-               nweft = double(r.repeat.wefts) * r.repeats_x;
-  const double segs = double(segments_per_crossing) * nwarp * nweft * 2;  // along all yarns
+// The repeat of the named pattern; every thread of a direction has the options' size.
+ThreadSizes pattern_threads(const WeaveOptions& o, Resolved& r) {
+  r.repeat = parse_weave_pattern(o.pattern.value_or("plain"), "pattern");
+  r.source = o.pattern.value_or("plain");
+  ThreadSize w, f;
+  w.spacing_mm = check_length(o.warp_spacing_mm, kRedWarpSpacing, "warp-spacing-mm", 0, 100);
+  f.spacing_mm = check_length(o.weft_spacing_mm, kRedWeftSpacing, "weft-spacing-mm", 0, 100);
+  w.width_mm = check_length(o.warp_width_mm, kRedWarpWidth, "warp-width-mm", 0, 100);
+  f.width_mm = check_length(o.weft_width_mm, kRedWeftWidth, "weft-width-mm", 0, 100);
+  w.thickness_mm =
+      check_length(o.warp_thickness_mm, kRedWarpThickness, "warp-thickness-mm", 0, 100);
+  f.thickness_mm =
+      check_length(o.weft_thickness_mm, kRedWeftThickness, "weft-thickness-mm", 0, 100);
+  ThreadSizes out;
+  out.warp.assign(r.repeat.warps, w);
+  out.weft.assign(r.repeat.wefts, f);
+  return out;
+}
+
+// A yarn wider than its spacing would overlap its neighbours; the same check each way.
+void check_widths(const std::vector<ThreadSize>& threads, const std::string& field,
+                  const std::string& thread_name) {
+  for (size_t k = 0; k < threads.size(); ++k)
+    if (threads[k].width_mm > threads[k].spacing_mm * (1 + 1e-12))
+      bad(field, thread_name + " " + std::to_string(k + 1) + " is wider (" +
+                     ParamReader::fmt(threads[k].width_mm) + " mm) than its spacing (" +
+                     ParamReader::fmt(threads[k].spacing_mm) +
+                     " mm): neighbouring yarns would overlap");
+}
+
+// The tile's warps (along z) and picks (along x): the repeat's times the repeat counts.
+double tile_warps(const Resolved& r) {
+  return double(r.repeat.warps) * r.repeats_z;
+}
+double tile_wefts(const Resolved& r) {
+  return double(r.repeat.wefts) * r.repeats_x;
+}
+
+// The yarn tubes' triangles, estimated before anything is allocated.
+void check_triangle_count(const Resolved& r) {
+  // Segments along all yarns.
+  const double segs = double(r.layout.segments_per_crossing) * tile_warps(r) * tile_wefts(r) * 2;
+  const int sides = r.layout.sides;
   if (!r.fiber_detail && segs * sides * 2 > kMaxTriangles)
     bad("repeats", "the sample would have " + ParamReader::fmt(segs * sides * 2) +
                        " triangles (limit 5e7): fewer repeats, sides or segments");
+}
 
-  // Fiber settings.
-  detail::FiberSettings& fs = r.fibers;
+detail::FiberSettings fiber_settings(const WeaveOptions& o) {
+  detail::FiberSettings fs;
   fs.radius_mm =
       check_length(o.fiber_radius_um, kRedFiberRadiusUm, "fiber-radius-um", 0.01, 1000) * 1e-3;
   fs.plies = o.plies.value_or(1);
@@ -223,31 +243,55 @@ Resolved resolve(const WeaveOptions& o) {
   if (!(std::isfinite(fs.ply_twist_per_mm) && std::abs(fs.ply_twist_per_mm) <= 100))
     bad("ply-twist-per-mm", "must be finite and at most 100 turns per mm in magnitude");
   if (o.ply_twist_per_mm && fs.plies == 1) bad("ply-twist-per-mm", "needs --plies 2 or more");
-  if (r.fiber_detail) {
-    // Fibers per yarn from the packing unless given; estimate the points.
-    double points = 0;
-    auto count = [&](const std::vector<ThreadSize>& ts, double yarns_per_thread, double along) {
-      for (const ThreadSize& s : ts) {
-        const double area = 2 * s.width_mm * s.thickness_mm / kPi;  // lens
-        const double n = fs.fibers_per_yarn > 0
-                             ? fs.fibers_per_yarn
-                             : std::max(1.0, std::round(fs.packing * area /
-                                                        (kPi * fs.radius_mm * fs.radius_mm)));
-        points += n * yarns_per_thread * (along * segments_per_crossing + 1);
-      }
-    };
-    count(warp, r.repeats_z, nweft);
-    count(weft, r.repeats_x, nwarp);
-    if (points > kMaxCurvePoints)
-      bad(fs.fibers_per_yarn > 0 ? "fibers-per-yarn" : "packing",
-          "the sample would have " + ParamReader::fmt(points) +
-              " curve points (limit 3e7): fewer repeats, fibers or segments");
-  }
+  return fs;
+}
 
-  // Layout of the tile.
+// The fibers' curve points, estimated (fibers per yarn from the packing unless given) before
+// anything is allocated.
+void check_curve_point_count(const Resolved& r, const ThreadSizes& t) {
+  const detail::FiberSettings& fs = r.fibers;
+  const int segments_per_crossing = r.layout.segments_per_crossing;
+  double points = 0;
+  auto count = [&](const std::vector<ThreadSize>& ts, double yarns_per_thread, double along) {
+    for (const ThreadSize& s : ts) {
+      const double area = 2 * s.width_mm * s.thickness_mm / kPi;  // lens
+      const double n =
+          fs.fibers_per_yarn > 0
+              ? fs.fibers_per_yarn
+              : std::max(1.0, std::round(fs.packing * area / (kPi * fs.radius_mm * fs.radius_mm)));
+      points += n * yarns_per_thread * (along * segments_per_crossing + 1);
+    }
+  };
+  count(t.warp, r.repeats_z, tile_wefts(r));
+  count(t.weft, r.repeats_x, tile_warps(r));
+  if (points > kMaxCurvePoints)
+    bad(fs.fibers_per_yarn > 0 ? "fibers-per-yarn" : "packing",
+        "the sample would have " + ParamReader::fmt(points) +
+            " curve points (limit 3e7): fewer repeats, fibers or segments");
+}
+
+// Centres of 'count' threads cycling through the repeat's sizes, laid side by side and centred
+// on zero; 'period' is their total spacing. Warps lie along z, picks along x.
+std::vector<double> thread_centres(const std::vector<ThreadSize>& sizes, int repeat, int count,
+                                   double& period) {
+  std::vector<double> c(count);
+  double acc = 0;
+  for (int k = 0; k < count; ++k) {
+    const double sp = sizes[k % repeat].spacing_mm;
+    c[k] = acc + 0.5 * sp;
+    acc += sp;
+  }
+  period = acc;
+  for (double& v : c) v -= 0.5 * period;
+  return c;
+}
+
+// The tile's interlacing, thread centres and yarn centre lines, with the warps' share 'share' of
+// each crossing's crimp (< 0: balanced).
+void lay_out(Resolved& r, const ThreadSizes& t, double share) {
+  const std::vector<ThreadSize>&warp = t.warp, &weft = t.weft;
+  const double nwarp = tile_warps(r), nweft = tile_wefts(r);
   Layout& L = r.layout;
-  L.segments_per_crossing = segments_per_crossing;
-  L.sides = sides;
   L.tile.warps = static_cast<int>(nwarp);
   L.tile.wefts = static_cast<int>(nweft);
   L.tile.warp_over.resize(static_cast<size_t>(nwarp * nweft));
@@ -255,22 +299,8 @@ Resolved resolve(const WeaveOptions& o) {
     for (int i = 0; i < L.tile.warps; ++i)
       L.tile.warp_over[static_cast<size_t>(j) * L.tile.warps + i] =
           r.repeat.over(i % r.repeat.warps, j % r.repeat.wefts);
-  // Centres of 'count' threads cycling through the repeat's sizes, laid side by side and centred
-  // on zero; 'period' is their total spacing. Warps lie along z, picks along x.
-  auto centres = [](const std::vector<ThreadSize>& sizes, int repeat, int count, double& period) {
-    std::vector<double> c(count);
-    double acc = 0;
-    for (int k = 0; k < count; ++k) {
-      const double sp = sizes[k % repeat].spacing_mm;
-      c[k] = acc + 0.5 * sp;
-      acc += sp;
-    }
-    period = acc;
-    for (double& v : c) v -= 0.5 * period;
-    return c;
-  };
-  const std::vector<double> zc = centres(warp, r.repeat.warps, L.tile.warps, L.period_z);
-  const std::vector<double> xc = centres(weft, r.repeat.wefts, L.tile.wefts, L.period_x);
+  const std::vector<double> zc = thread_centres(warp, r.repeat.warps, L.tile.warps, L.period_z);
+  const std::vector<double> xc = thread_centres(weft, r.repeat.wefts, L.tile.wefts, L.period_x);
   const bool balanced = share < 0;
   L.warp_crimp_share = share;
   auto warp_height = [&](int i, int j) {
@@ -305,6 +335,23 @@ Resolved resolve(const WeaveOptions& o) {
     }
   }
   if (balanced) L.warp_crimp_share = -1;
+}
+
+Resolved resolve(const WeaveOptions& o) {
+  Resolved r;
+  resolve_detail(o, r);
+  if (o.wif && o.pattern) bad("wif", "give either a pattern or a WIF draft, not both");
+  const bool from_wif = o.wif.has_value();
+  const ThreadSizes threads = from_wif ? wif_threads(o, r) : pattern_threads(o, r);
+  check_widths(threads.warp, "warp-width-mm", "warp");
+  check_widths(threads.weft, "weft-width-mm", "pick");
+  // A WIF draft's threads have no crimp data: balanced unless given.
+  const double share = o.warp_crimp_share.value_or(from_wif ? -1.0 : kRedWarpCrimpShare);
+  if (!std::isfinite(share) || share > 1) bad("warp-crimp-share", "must be <= 1 (< 0: balanced)");
+  check_triangle_count(r);
+  r.fibers = fiber_settings(o);
+  if (r.fiber_detail) check_curve_point_count(r, threads);
+  lay_out(r, threads, share);
   return r;
 }
 

@@ -17,9 +17,9 @@
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
 #include "weft/core/sphere_mapping.h"
-#include "weft/materials/cook_torrance.h"
 #include "weft/fiber/bake_cache.h"
 #include "weft/fiber/fiber_table_bake.h"
+#include "weft/materials/cook_torrance.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/tabulated_bsdf.h"
 
@@ -84,6 +84,26 @@ int count_outliers(const std::vector<double>& a, const std::vector<double>& sa,
   return n;
 }
 
+// The direct and the BSSRDF route's cell statistics over 5 bakes each of band physics 'ph' at
+// R = 3 (18 x 18 cells), the BSSRDF route at its default grid.
+struct RouteStats {
+  CellStats direct, bssrdf;
+};
+RouteStats bake_both_routes(const FiberBandPhysics& ph) {
+  FiberBakeSettings s = weft::testing::bake_settings(3, 60000, 2);
+  const int k = 5;
+  RouteStats r;
+  r.direct = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed;
+    return bake_fiber_band_direct(ph, s, nullptr);
+  });
+  r.bssrdf = cell_stats(k, [&](uint64_t seed) {
+    s.seed = seed + 100;
+    return bake_fiber_band_bssrdf(ph, s, BssrdfRouteSettings{}, nullptr);
+  });
+  return r;
+}
+
 }  // namespace
 
 TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
@@ -143,16 +163,7 @@ TEST(FiberTableBake, DirectAndBssrdfRoutesAgreeWithinStatisticalError) {
   const FiberSpec spec = test_spec(20, 0.10, 0.01);
   const MediumBand mb = compute_medium_band(spec, 16);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
-  FiberBakeSettings s = weft::testing::bake_settings(3, 60000, 2);
-  const int k = 5;
-  const CellStats direct = cell_stats(k, [&](uint64_t seed) {
-    s.seed = seed;
-    return bake_fiber_band_direct(ph, s, nullptr);
-  });
-  const CellStats bssrdf = cell_stats(k, [&](uint64_t seed) {
-    s.seed = seed + 100;
-    return bake_fiber_band_bssrdf(ph, s, BssrdfRouteSettings{}, nullptr);
-  });
+  const auto [direct, bssrdf] = bake_both_routes(ph);
   // 324 cells; at 4.5 standard errors a false alarm has probability 324 * 7e-6 = 0.002, but the
   // standard errors themselves come from 5 bakes (t with 8 dof): allow one outlier cell.
   EXPECT_LE(count_outliers(direct.mean, direct.se, bssrdf.mean, bssrdf.se, 4.5), 1);
@@ -739,15 +750,6 @@ TEST(FiberTableBake, RoughDielectricBoundaryDirectAndBssrdfRoutesAgree) {
   const FiberSpec spec = rough_dielectric(test_spec(20, 0.10, 0.01));
   const MediumBand mb = compute_medium_band(spec, 16);
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
-  FiberBakeSettings s = weft::testing::bake_settings(3, 60000, 2);
-  const int k = 5;
-  const CellStats direct = cell_stats(k, [&](uint64_t seed) {
-    s.seed = seed;
-    return bake_fiber_band_direct(ph, s, nullptr);
-  });
-  const CellStats bssrdf = cell_stats(k, [&](uint64_t seed) {
-    s.seed = seed + 100;
-    return bake_fiber_band_bssrdf(ph, s, BssrdfRouteSettings{}, nullptr);
-  });
+  const auto [direct, bssrdf] = bake_both_routes(ph);
   EXPECT_LE(count_outliers(direct.mean, direct.se, bssrdf.mean, bssrdf.se, 4.5), 1);
 }

@@ -16,10 +16,11 @@
 #include <filesystem>
 #include <fstream>
 
+#include "test_util.h"
 #include "weft/core/math.h"
+#include "weft/fabric/fabric_summation.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/materials/bsdf_table.h"
-#include "weft/fabric/fabric_summation.h"
 #include "weft/scenes/car_seat.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
@@ -30,14 +31,6 @@ namespace fs = std::filesystem;
 namespace {
 const fs::path kSeatDir = fs::path(WEFT_SOURCE_DIR) / "scenes/examples/car-seat";
 const char* const kFabricKeys[] = {"centre", "bolster", "piping", "headrest"};
-
-fs::path test_dir() {
-  const fs::path dir =
-      fs::temp_directory_path() /
-      (std::string("weft-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::create_directories(dir);
-  return dir;
-}
 
 // The bundled description with a coarse seat written next to it in a temporary folder.
 nlohmann::json seat_description(const fs::path& dir) {
@@ -54,6 +47,17 @@ void bind_fabric(nlohmann::json& j, const nlohmann::json& binding) {
   for (const char* key : kFabricKeys) j["materials"][key] = binding;
 }
 
+// The fiber table 'fiber' summed into a fabric table (R = 4) by the paper's formula, written to
+// 'file'.
+fs::path write_summed(TabulatedBsdfTable fiber, const fs::path& file) {
+  fiber.kind = "fiber";
+  FabricSummationOptions o;
+  o.resolution = 4;
+  o.samples_per_cell = 2;
+  sum_fabric_table(fiber, o).write_exr(file);
+  return file;
+}
+
 // A red-tinted Lambert fiber table summed into a fabric table by the paper's formula.
 fs::path summed_fabric_table(const fs::path& dir) {
   auto fiber = TabulatedBsdfTable::from_function(
@@ -64,13 +68,7 @@ fs::path summed_fabric_table(const fs::path& dir) {
         v[1] = v[2] = lit ? 0.1 * kInvPi : 0.0;
       },
       2, 1);
-  fiber.kind = "fiber";
-  FabricSummationOptions o;
-  o.resolution = 4;
-  o.samples_per_cell = 2;
-  const fs::path file = dir / "fabric.exr";
-  sum_fabric_table(fiber, o).write_exr(file);
-  return file;
+  return write_summed(std::move(fiber), dir / "fabric.exr");
 }
 
 // A red fiber table that also transmits (like the baked red-cotton one, which transmits more
@@ -85,13 +83,7 @@ fs::path summed_transmitting_fabric_table(const fs::path& dir) {
         v[1] = v[2] = (lit ? 0.04 : through ? 0.1 : 0.0) * kInvPi;
       },
       2, 1);
-  fiber.kind = "fiber";
-  FabricSummationOptions o;
-  o.resolution = 4;
-  o.samples_per_cell = 2;
-  const fs::path file = dir / "fabric-transmitting.exr";
-  sum_fabric_table(fiber, o).write_exr(file);
-  return file;
+  return write_summed(std::move(fiber), dir / "fabric-transmitting.exr");
 }
 
 // Per pixel: the mesh every sample's camera ray met first, or -2 when they differ (-1: none).
@@ -116,7 +108,7 @@ Classified render_classified(const SceneDescription& d, const RenderSettings& s)
 }  // namespace
 
 TEST(CarSeatScene, BundledDescriptionLoadsAndRendersFinite) {
-  const fs::path dir = test_dir();
+  const fs::path dir = weft::testing::fresh_test_dir();
   const SceneDescription d = parse_scene_description(seat_description(dir), kSeatDir, "seat.json");
   ASSERT_TRUE(d.camera);
   EXPECT_EQ(d.lights.directional.size(), 1u);
@@ -136,7 +128,7 @@ TEST(CarSeatScene, BundledDescriptionLoadsAndRendersFinite) {
 }
 
 TEST(CarSeatScene, ThreeVariantsDifferOnTheFabricAndNowhereElse) {
-  const fs::path dir = test_dir();
+  const fs::path dir = weft::testing::fresh_test_dir();
   nlohmann::json base = seat_description(dir);
   nlohmann::json measured = base, table = base, classic = base;  // bundled: measured_nbrdf
   bind_fabric(
@@ -187,7 +179,7 @@ TEST(CarSeatScene, ThreeVariantsDifferOnTheFabricAndNowhereElse) {
 }
 
 TEST(CarSeatScene, ComputedFabricOnAFoamBackingIsBrighterAndFinite) {
-  const fs::path dir = test_dir();
+  const fs::path dir = weft::testing::fresh_test_dir();
   const std::string table = summed_transmitting_fabric_table(dir).string();
   nlohmann::json bare = seat_description(dir), backed = bare;
   bind_fabric(bare, {{"type", "fabric_table"}, {"params", {{"file", table}}}});
@@ -229,7 +221,7 @@ TEST(CarSeatScene, ComputedFabricOnAFoamBackingIsBrighterAndFinite) {
 }
 
 TEST(CarSeatScene, LambertFabricTableRendersTheLambertImage) {
-  const fs::path dir = test_dir();
+  const fs::path dir = weft::testing::fresh_test_dir();
   const Rgb rho{0.6, 0.25, 0.15};
   auto lam_table = TabulatedBsdfTable::from_function(
       8, 3,

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "furnace_sphere.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -23,19 +24,10 @@
 
 using namespace weft;
 using nlohmann::json;
-using weft::testing::sample_mean;
-using weft::testing::SampleMean;
+using namespace weft::testing;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path test_dir() {
-  const fs::path dir =
-      fs::temp_directory_path() /
-      (std::string("weft-") + ::testing::UnitTest::GetInstance()->current_test_info()->name());
-  fs::create_directories(dir);
-  return dir;
-}
 
 // A 16 x 8 map: a smooth gradient plus one bright texel (a "sun") at column 5, row 2.
 EnvironmentTexels varied_map() {
@@ -81,7 +73,7 @@ TEST(EnvironmentMap, SamplePdfAndEvalAgreeAndEstimateTheIntegral) {
         if (std::abs(map.pdf(hit) - s->pdf) > 1e-6 * s->pdf) ++pdf_mismatch;
         EXPECT_EQ(map.eval(hit), s->L);
       }
-      const double L = c == 0 ? s->L.r : (c == 1 ? s->L.g : s->L.b);
+      const double L = s->L[c];
       return L / s->pdf;
     }));
   }
@@ -122,7 +114,7 @@ TEST(EnvironmentMap, AnglesAreTheDescriptionsZenithAndAzimuth) {
 }
 
 TEST(EnvironmentMap, FurnaceSphereInAConstantMapHasRadianceAlbedo) {
-  const fs::path dir = test_dir();
+  const fs::path dir = fresh_test_dir();
   Image img(8, 4);
   std::fill(img.rgb.begin(), img.rgb.end(), 1.0f);
   write_exr(dir / "white.exr", img);
@@ -140,34 +132,11 @@ TEST(EnvironmentMap, FurnaceSphereInAConstantMapHasRadianceAlbedo) {
       {"lights", {{{"type", "environment"}, {"file", "white.exr"}}}}};
   const SceneDescription d = parse_scene_description(j, dir, "furnace.json");
   ASSERT_EQ(d.lights.environment_maps.size(), 1u);
-  const RenderScene scene(d);
-  const Vec3 eye{0, 0, 3};
-  for (LightSampling mode :
-       {LightSampling::mis, LightSampling::lights_only, LightSampling::bsdf_only}) {
-    RenderSettings s;
-    s.max_depth = 64;
-    s.sampling = mode;
-    s.seed = 7;
-    RayCounts rays;
-    int missed = 0;
-    const SampleMean e = sample_mean(40000, [&](int i) {
-      Rng rng(s.seed, uint64_t(i));
-      const double r = 0.95 * std::sqrt(rng.uniform()), phi = 2 * kPi * rng.uniform();
-      const Vec3 target{r * std::cos(phi), r * std::sin(phi), 0};
-      int64_t first = -1;
-      const double v =
-          trace_path(scene, {eye, normalize(target - eye)}, s, rng, rays, &first).average();
-      missed += first != 0;
-      return v;
-    });
-    ASSERT_EQ(missed, 0);
-    EXPECT_LT(e.std_error, 0.01 * albedo);
-    EXPECT_NEAR(e.mean, albedo, 4 * e.std_error + 1e-12) << int(mode);
-  }
+  expect_furnace_sphere_radiance(RenderScene(d), {0, 0, 3}, albedo);
 }
 
 TEST(EnvironmentMap, BadInputNamesTheField) {
-  const fs::path dir = test_dir();
+  const fs::path dir = fresh_test_dir();
   Image black(4, 2);
   write_exr(dir / "black.exr", black);
   auto error_of = [&](const json& light) {

@@ -10,6 +10,7 @@
 
 #include <cmath>
 
+#include "furnace_sphere.h"
 #include "test_util.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
@@ -17,8 +18,7 @@
 
 using namespace weft;
 using nlohmann::json;
-using weft::testing::sample_mean;
-using weft::testing::SampleMean;
+using namespace weft::testing;
 
 namespace {
 
@@ -57,45 +57,11 @@ SceneDescription emitting_enclosure(double albedo, double emission) {
   return parse_scene_description(j, ".", "enclosure.json");
 }
 
-const char* mode_name(LightSampling m) {
-  return m == LightSampling::mis           ? "mis"
-         : m == LightSampling::lights_only ? "lights_only"
-                                           : "bsdf_only";
-}
-
 }  // namespace
 
 TEST(Furnace, SphereInUniformEnvironmentHasRadianceAlbedo) {
-  // Camera looking at the sphere so that the film sees both sphere and environment.
-  const Camera cam = Camera::look_at(Camera::Type::perspective, {0, 0, 3}, {0, 0, 0}, {0, 1, 0});
-  for (double albedo : {1.0, 0.5}) {
-    const RenderScene scene(sphere_in_environment(albedo));
-    for (LightSampling mode :
-         {LightSampling::mis, LightSampling::lights_only, LightSampling::bsdf_only}) {
-      SCOPED_TRACE(std::string(mode_name(mode)) + " albedo " + std::to_string(albedo));
-      RenderSettings s;
-      s.max_depth = 64;
-      s.sampling = mode;
-      s.seed = 7;
-      // Only rays that hit the sphere: aim at points on the sphere's silhouette disc.
-      RayCounts rays;
-      int missed = 0;
-      const SampleMean e = sample_mean(40000, [&](int i) {
-        Rng rng(s.seed, uint64_t(i));
-        const double r = 0.95 * std::sqrt(rng.uniform()), phi = 2 * M_PI * rng.uniform();
-        const Vec3 target{r * std::cos(phi), r * std::sin(phi), 0};
-        int64_t first = -1;
-        const double v = trace_path(scene, {cam.position, normalize(target - cam.position)}, s, rng,
-                                    rays, &first)
-                             .average();
-        missed += first != 0;
-        return v;
-      });
-      ASSERT_EQ(missed, 0);
-      EXPECT_LT(e.std_error, 0.01 * albedo);  // the check below must be able to fail
-      EXPECT_NEAR(e.mean, albedo, 4 * e.std_error + 1e-12);
-    }
-  }
+  for (double albedo : {1.0, 0.5})
+    expect_furnace_sphere_radiance(RenderScene(sphere_in_environment(albedo)), {0, 0, 3}, albedo);
 }
 
 TEST(Furnace, EnvironmentSeenDirectlyIsExact) {

@@ -203,7 +203,7 @@ TEST(SpectralRender, EmittingEnclosureReachesLeOverOneMinusAlbedoInEveryBand) {
       for (size_t i = c; i < r.image.rgb.size(); i += 3)
         var += (r.image.rgb[i] - m) * (r.image.rgb[i] - m);
       const double se = std::sqrt(var / (n - 1) / n);
-      const double w = c == 0 ? want.r : c == 1 ? want.g : want.b;
+      const double w = want[c];
       EXPECT_LT(se, 0.02 * std::abs(w)) << c;  // the check below can fail
       EXPECT_NEAR(m, w, 4 * se) << c;
     }

@@ -9,6 +9,7 @@
 #include <limits>
 
 #include "chi2.h"
+#include "rgb_table.h"
 #include "table_context.h"
 #include "weft/core/error.h"
 #include "weft/core/rng.h"
@@ -23,13 +24,7 @@ namespace {
 
 TabulatedBsdfTable table_of(int resolution, const std::function<Rgb(const Vec3&, const Vec3&)>& f,
                             int spp = 4) {
-  auto t = TabulatedBsdfTable::from_function(
-      resolution, 3,
-      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        const Rgb c = f(wo, wi);
-        v[0] = c.r, v[1] = c.g, v[2] = c.b;
-      },
-      spp, 1);
+  auto t = rgb_table(resolution, f, spp);
   t.kind = "fabric";
   return t;
 }
@@ -88,6 +83,23 @@ Rgb albedo_by_quadrature(const Bsdf& b, const Vec3& wo) {
   return sum;
 }
 
+// The table's reflection (wi above) and transmission (wi below) albedos at wo, by the midpoint
+// rule on 768 x 768 equal-area points of the sphere.
+struct SideAlbedos {
+  Rgb refl, trans;
+};
+SideAlbedos albedos_by_side(const TabulatedBsdf& b, const Vec3& wo) {
+  SideAlbedos s;
+  const int m = 768;
+  const double area = 4 * kPi / (double(m) * m);
+  for (int j = 0; j < m; ++j)
+    for (int i = 0; i < m; ++i) {
+      const Vec3 wi = equal_area_square_to_sphere({(i + 0.5) / m, (j + 0.5) / m});
+      (wi.z > 0 ? s.refl : s.trans) += b.eval(wo, wi) * (std::abs(wi.z) * area);
+    }
+  return s;
+}
+
 const Vec3 kUpperWos[] = {spherical_direction(0.05, 0.2), spherical_direction(0.7, 2.0),
                           spherical_direction(1.2, -1.0), spherical_direction(1.5, 0.7)};
 
@@ -116,14 +128,7 @@ TEST(TableBacking, AlbedosAreTheIntegralsOfTheInterpolatedTable) {
   const auto t = table_of(8, lumpy);
   const TabulatedBsdf bare{TabulatedBsdfData::prepare(t), Rgb(1.0)};
   for (const Vec3& wo : kUpperWos) {
-    Rgb refl, trans;
-    const int m = 768;
-    const double area = 4 * kPi / (double(m) * m);
-    for (int j = 0; j < m; ++j)
-      for (int i = 0; i < m; ++i) {
-        const Vec3 wi = equal_area_square_to_sphere({(i + 0.5) / m, (j + 0.5) / m});
-        (wi.z > 0 ? refl : trans) += bare.eval(wo, wi) * (std::abs(wi.z) * area);
-      }
+    const auto [refl, trans] = albedos_by_side(bare, wo);
     const Rgb same = bare.data->interpolate(bare.data->same_side, wo);
     const Rgb other = bare.data->interpolate(bare.data->other_side, wo);
     EXPECT_NEAR(same.r, refl.r, 1e-3 * refl.r) << wo;
@@ -165,20 +170,12 @@ TEST(TableBacking, LumpySheetMatchesTheClosedFormByQuadrature) {
   uint64_t seed = 99;
   for (const Vec3& wo : kUpperWos) {
     const Rgb q = albedo_by_quadrature(b, wo);
-    Rgb refl, trans;
-    const int m = 768;
-    const double area = 4 * kPi / (double(m) * m);
-    for (int j = 0; j < m; ++j)
-      for (int i = 0; i < m; ++i) {
-        const Vec3 wi = equal_area_square_to_sphere({(i + 0.5) / m, (j + 0.5) / m});
-        (wi.z > 0 ? refl : trans) += bare.eval(wo, wi) * (std::abs(wi.z) * area);
-      }
+    const auto [refl, trans] = albedos_by_side(bare, wo);
     for (int c = 0; c < 3; ++c) {
-      const double rb = c == 0 ? rho.r : c == 1 ? rho.g : rho.b;
-      const auto get = [c](const Rgb& v) { return c == 0 ? v.r : c == 1 ? v.g : v.b; };
-      const double expect = get(refl) + rb / (1 - rb * get(b.data->underside_diffuse_albedo)) *
-                                            get(trans) * get(b.data->diffuse_transmittance);
-      EXPECT_NEAR(get(q), expect, 2e-3 * expect) << "channel " << c << " wo " << wo;
+      const double rb = rho[c];
+      const double expect = refl[c] + rb / (1 - rb * b.data->underside_diffuse_albedo[c]) *
+                                          trans[c] * b.data->diffuse_transmittance[c];
+      EXPECT_NEAR(q[c], expect, 2e-3 * expect) << "channel " << c << " wo " << wo;
     }
     const auto mc = estimate_albedo(b, wo, 40000, seed++);
     EXPECT_NEAR(mc.mean.r, q.r, 4 * mc.standard_error.r + 1e-3 * q.r) << wo;

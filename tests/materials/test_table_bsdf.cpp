@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "chi2.h"
+#include "rgb_table.h"
 #include "weft/core/error.h"
 #include "weft/core/rng.h"
 #include "weft/core/spectrum.h"
@@ -18,17 +19,6 @@ using namespace weft::testing;
 namespace fs = std::filesystem;
 
 namespace {
-
-TabulatedBsdfTable table_of(int resolution, const std::function<Rgb(const Vec3&, const Vec3&)>& f,
-                            int spp = 16) {
-  return TabulatedBsdfTable::from_function(
-      resolution, 3,
-      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        const Rgb c = f(wo, wi);
-        v[0] = c.r, v[1] = c.g, v[2] = c.b;
-      },
-      spp, 1);
-}
 
 Bsdf bsdf_of(const TabulatedBsdfTable& t, Rgb scale = Rgb(1.0)) {
   return TabulatedBsdf{TabulatedBsdfData::prepare(t), scale};
@@ -59,7 +49,7 @@ const Vec3 kWos[] = {spherical_direction(0.1, 0.2), spherical_direction(0.9, 2.0
 TEST(TableBsdf, LosslessTwoSidedDiffuserPassesTheWhiteFurnace) {
   // f = 1 / (2 pi) on the whole sphere scatters everything (half reflected, half transmitted):
   // int f |cos| dw = 1 exactly, and a table holds it exactly, so only Monte Carlo noise remains.
-  const Bsdf b = bsdf_of(table_of(8, [](const Vec3&, const Vec3&) { return Rgb(0.5 * kInvPi); }));
+  const Bsdf b = bsdf_of(rgb_table(8, [](const Vec3&, const Vec3&) { return Rgb(0.5 * kInvPi); }));
   uint64_t seed = 1;
   for (double theta : {0.0, 0.7, 1.45, 1.5707, 2.2, 3.1}) {
     const auto a = estimate_albedo(b, spherical_direction(theta, 0.4), 100000, seed++);
@@ -75,7 +65,7 @@ TEST(TableBsdf, LambertOneTablePassesTheWhiteFurnaceAwayFromTheEquator) {
   // and the unlit side, which costs the interpolated table ~1e-3 of albedo at R = 16 (falling as
   // 1/R^2: measured 3e-3 at R = 8); wo cells that straddle the equator themselves (theta_o > ~75
   // deg at R = 16) are excluded, since their cell average is half-lit by construction.
-  const Bsdf b = bsdf_of(table_of(
+  const Bsdf b = bsdf_of(rgb_table(
       16, [](const Vec3& wo, const Vec3& wi) { return LambertBsdf{Rgb(1.0)}.eval(wo, wi); }));
   uint64_t seed = 10;
   for (double theta_deg : {0.0, 20.0, 45.0, 60.0, 70.0, 120.0, 170.0}) {
@@ -88,7 +78,7 @@ TEST(TableBsdf, LambertOneTablePassesTheWhiteFurnaceAwayFromTheEquator) {
 }
 
 TEST(TableBsdf, EvalAtBinCentresReturnsTheTable) {
-  const auto t = table_of(6, lumpy, 4);
+  const auto t = rgb_table(6, lumpy, 4);
   const Bsdf b = bsdf_of(t);
   const DirectionGrid g = t.grid();
   for (int wi = 0; wi < g.bins(); wi += 5)
@@ -108,7 +98,7 @@ Rgb sparse(const Vec3& wo, const Vec3& wi) {
 TEST(TableBsdf, SampleWeightAndPdfAreConsistent) {
   Rng rng(4);
   for (const Bsdf& b :
-       {bsdf_of(table_of(8, lumpy, 4), Rgb(0.9, 0.8, 0.7)), bsdf_of(table_of(8, sparse, 4))}) {
+       {bsdf_of(rgb_table(8, lumpy, 4), Rgb(0.9, 0.8, 0.7)), bsdf_of(rgb_table(8, sparse, 4))}) {
     for (const Vec3& wo : kWos) {
       for (int i = 0; i < 2000; ++i) {
         const auto s = b.sample(wo, {rng.uniform(), rng.uniform()}, rng.uniform());
@@ -129,7 +119,7 @@ TEST(TableBsdf, SampleWeightAndPdfAreConsistent) {
 TEST(TableBsdf, PdfCoversWhereverInterpolationReaches) {
   // Bilinear eval is positive next to non-zero cells, also inside cells whose own value is 0;
   // the pdf must be positive there too or that light could never be sampled.
-  const auto t = table_of(8, sparse, 4);
+  const auto t = rgb_table(8, sparse, 4);
   const Bsdf b = bsdf_of(t);
   const DirectionGrid g = t.grid();
   Rng rng(8);
@@ -145,7 +135,7 @@ TEST(TableBsdf, PdfCoversWhereverInterpolationReaches) {
 }
 
 TEST(TableBsdf, ScaleMultipliesValueNotDensity) {
-  const auto t = table_of(4, lumpy, 4);
+  const auto t = rgb_table(4, lumpy, 4);
   const Bsdf one = bsdf_of(t), half = bsdf_of(t, Rgb(0.5, 0.25, 1.0));
   const Vec3 wo = kWos[1], wi = spherical_direction(0.6, 1.0);
   EXPECT_DOUBLE_EQ(half.eval(wo, wi).r, 0.5 * one.eval(wo, wi).r);
@@ -154,7 +144,7 @@ TEST(TableBsdf, ScaleMultipliesValueNotDensity) {
 }
 
 TEST(TableBsdf, AllZeroColumnSamplesNothing) {
-  const Bsdf b = bsdf_of(table_of(
+  const Bsdf b = bsdf_of(rgb_table(
       4, [](const Vec3&, const Vec3&) { return Rgb(0.0); }, 1));
   EXPECT_FALSE(b.sample(kWos[0], {0.3, 0.3}, 0.5).has_value());
   EXPECT_EQ(b.pdf(kWos[0], kWos[1]), 0.0);
@@ -188,7 +178,7 @@ TEST(TableCache, LoadsEachFileOnceUnderAnySpelling) {
   const fs::path dir = fs::path(WEFT_BINARY_DIR) / "test_table_tmp" / "cache";
   fs::remove_all(dir);
   fs::create_directories(dir / "sub");
-  table_of(4, lumpy, 1).write_exr(dir / "t.exr");
+  rgb_table(4, lumpy, 1).write_exr(dir / "t.exr");
   TableCache cache;
   const auto a = cache.tabulated(dir / "t.exr");
   const auto b = cache.tabulated(dir / "sub" / ".." / "t.exr");
@@ -210,7 +200,7 @@ TEST(TableBsdf, SamplingFollowsAPeakedLobeWithinCells) {
   // the albedo here (measured with that sampling, same seed): the few large weights that speckle
   // indirect light. With the density following the interpolated f cos on 4 x 4 fine
   // cells per table cell the largest is 4.4 times the albedo (measured); the bound is 6.
-  const Bsdf b = bsdf_of(table_of(8, [](const Vec3& wo, const Vec3& wi) {
+  const Bsdf b = bsdf_of(rgb_table(8, [](const Vec3& wo, const Vec3& wi) {
     if (wo.z <= 0 || wi.z <= 0) return Rgb(0.0);
     const Vec3 m{-wo.x, -wo.y, wo.z};
     return Rgb(3 * std::exp(-10 * length_squared(wi - m)));

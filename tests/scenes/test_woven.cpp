@@ -14,6 +14,7 @@
 #include <set>
 
 #include "mesh_checks.h"
+#include "swapped_weave.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
@@ -424,10 +425,7 @@ TEST(Woven, PlainWeaveTurnedBy90DegreesSwapsWarpAndWeft) {
   a.warp_crimp_share = -1;  // balanced crimp is the one that is symmetric in warp and weft
   a.warp_spacing_mm = 0.30, a.warp_width_mm = 0.26, a.warp_thickness_mm = 0.09;
   a.weft_spacing_mm = 0.40, a.weft_width_mm = 0.30, a.weft_thickness_mm = 0.12;
-  WeaveOptions b = a;
-  std::swap(b.warp_spacing_mm, b.weft_spacing_mm);
-  std::swap(b.warp_width_mm, b.weft_width_mm);
-  std::swap(b.warp_thickness_mm, b.weft_thickness_mm);
+  const WeaveOptions b = weft::testing::with_warp_and_weft_swapped(a);
   const WovenSample sa = make_woven_sample(a), sb = make_woven_sample(b);
   EXPECT_NEAR(sa.summary.period_x_mm, sb.summary.period_z_mm, 1e-12);
   EXPECT_NEAR(sa.summary.period_z_mm, sb.summary.period_x_mm, 1e-12);

@@ -15,6 +15,7 @@
 
 namespace fs = std::filesystem;
 using weft::testing::fresh_test_dir;
+using weft::testing::slurp;
 
 namespace {
 
@@ -215,13 +216,7 @@ TEST(CliBadInput, ExrAttributeClaimingMoreThanTheFileIsRefusedBeforeReading) {
   const fs::path dir = fresh_test_dir();
   ASSERT_EQ(run("table bake lambert -R 2 -o t.exr --quiet", dir).exit_code, 0);
   // Make the "units" string attribute claim 1.9 GB (OpenEXR allocated that before its error).
-  std::string bytes;
-  {
-    std::ifstream in(dir / "t.exr", std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    bytes = ss.str();
-  }
+  std::string bytes = slurp(dir / "t.exr");
   ASSERT_LT(bytes.size(), 4096u);
   const std::string key = std::string("units") + '\0' + "string" + '\0';
   const size_t at = bytes.find(key);
@@ -240,13 +235,7 @@ TEST(CliBadInput, ExrAttributeClaimingMoreThanTheFileIsRefusedBeforeReading) {
 TEST(CliBadInput, ExrTableClaimingMorePixelsThanTheFileHoldsIsRefused) {
   const fs::path dir = fresh_test_dir();
   ASSERT_EQ(run("table bake lambert -R 2 -o t.exr --quiet", dir).exit_code, 0);
-  std::string bytes;
-  {
-    std::ifstream in(dir / "t.exr", std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    bytes = ss.str();
-  }
+  std::string bytes = slurp(dir / "t.exr");
   auto set_int = [&](const std::string& key, size_t offset, int32_t v) {
     const size_t at = bytes.find(key);
     ASSERT_NE(at, std::string::npos) << key;

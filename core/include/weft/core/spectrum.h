@@ -5,6 +5,8 @@
 #include <array>
 #include <cstddef>
 
+#include "weft/core/componentwise.h"
+
 namespace weft {
 
 inline constexpr int kNumBands = 33;
@@ -55,21 +57,10 @@ struct Rgb {
   constexpr bool is_grey() const { return r == g && g == b; }
   constexpr bool operator==(const Rgb&) const = default;
 };
-constexpr Rgb operator+(Rgb a, const Rgb& b) {
-  return a += b;
-}
-constexpr Rgb operator*(Rgb a, const Rgb& b) {
-  return a *= b;
-}
-constexpr Rgb operator*(Rgb a, double s) {
-  return a *= s;
-}
-constexpr Rgb operator*(double s, Rgb a) {
-  return a *= s;
-}
-constexpr Rgb operator/(Rgb a, double s) {
-  return a *= (1.0 / s);
-}
+// a + b, a * b (per channel), c * s, s * c and c / s (componentwise.h).
+template <>
+inline constexpr bool kComponentWise<Rgb> = true;
+
 struct Hsv {
   double h = 0, s = 0, v = 0;  // each in [0, 1]
 };

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <ostream>
 
+#include "weft/core/componentwise.h"
+
 namespace weft {
 
 struct Vec3 {
@@ -36,21 +38,10 @@ struct Vec3 {
   constexpr bool operator==(const Vec3&) const = default;
 };
 
-constexpr Vec3 operator+(Vec3 a, const Vec3& b) {
-  return a += b;
-}
-constexpr Vec3 operator-(Vec3 a, const Vec3& b) {
-  return a -= b;
-}
-constexpr Vec3 operator*(Vec3 a, double s) {
-  return a *= s;
-}
-constexpr Vec3 operator*(double s, Vec3 a) {
-  return a *= s;
-}
-constexpr Vec3 operator/(Vec3 a, double s) {
-  return a *= (1.0 / s);
-}
+// a + b, a - b, v * s, s * v and v / s (componentwise.h).
+template <>
+inline constexpr bool kComponentWise<Vec3> = true;
+
 constexpr Vec3 mul(const Vec3& a, const Vec3& b) {
   return {a.x * b.x, a.y * b.y, a.z * b.z};
 }

@@ -11,6 +11,9 @@ namespace weft {
 // refuses ray origins beyond about 1.8e18; far below that, at 1e15 m (6.7 astronomical units) a
 // float's spacing is 6.7e7 m, so nothing a camera there sees can be resolved anyway.
 inline constexpr double kMaxCameraCoordinate_m = 1e15;
+// Whether p is finite and within kMaxCameraCoordinate_m of the origin on every axis: a point
+// Embree can trace from (a camera's position, a loaded vertex or light).
+bool in_traceable_range(const Vec3& p);
 
 struct Ray {
   Vec3 o, d;  // origin, unit direction

@@ -133,6 +133,7 @@ class RenderScene {
 
  private:
   struct Geometry;
+  class Builder;  // makes the Geometry (render_scene.cpp)
   // The query context for a ray that leaves fiber 'ignore_fiber' (kNoFiber: none).
   FiberQueryContext query_context(int64_t ignore_fiber) const;
   RenderScene() = default;
