@@ -123,6 +123,9 @@ struct Tracer {
   bool mis = false, window = false, proposal = false;
   // The particles traced are [first_item, last_item); particle k is of incident bin k / per_bin.
   uint64_t per_bin = 0, first_item = 0, last_item = 0;
+  // Yarn detail: the line albedos of the table traced and of the proposal (weigh_as_round_fiber).
+  const LineAlbedo* tube = nullptr;
+  const LineAlbedo* tube_proposal = nullptr;
 };
 
 // A particle's life from its launch: where its exits and books go, the strategies its path and
@@ -158,6 +161,8 @@ bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Pa
   }
   const FiberPoint& pt = x.pts[draw->point];
   books.absorbed += weigh_scatter(t.fs, t.fiber, life.st, pt.bin, draw->exit_bin, s_sum, s);
+  if (!h.on_fiber() && t.tube)
+    books.absorbed += weigh_as_round_fiber(*t.tube, t.tube_proposal, x, s.d, s);
   leave_fiber(pt.hit, draw->wo_local, s);
   ++books.scatterings;
   if (++s.events >= t.o.max_scatterings) {
@@ -428,8 +433,14 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   // the weights it gives (wp); the traced table's weights (w) follow the same path, each step
   // multiplied by its f over the proposal's.
   const FiberSampler fs(o.proposal ? *o.proposal : fiber);
-  const Tracer t =
+  Tracer t =
       tracer_for(scene, slab, static_cast<int64_t>(sample.fibers.curve_count()), fs, fiber, o);
+  // Yarn tubes stand for round fibers: they return the tables' line albedos.
+  std::optional<LineAlbedo> tube, tube_proposal;
+  if (!sample.meshes.empty()) {
+    t.tube = &tube.emplace(fiber);
+    if (o.proposal) t.tube_proposal = &tube_proposal.emplace(*o.proposal);
+  }
   const int bins = t.grid.bins(), nc = t.nc;
   CellSums sums{std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0),
                 std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0)};

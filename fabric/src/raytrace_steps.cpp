@@ -247,6 +247,23 @@ double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, co
   return (before - after) / nc;
 }
 
+double weigh_as_round_fiber(const LineAlbedo& traced, const LineAlbedo* proposal,
+                            const Crossings& x, const Vec3& d, Particle& s) {
+  const double axial = dot(d, x.pts[0].hit.shading.s);
+  auto scale = [&](const LineAlbedo& table, std::vector<double>& w) {
+    for (size_t c = 0; c < w.size(); ++c) {
+      const int ch = static_cast<int>(c);
+      double s_sum = 0;
+      for (int q = 0; q < x.count; ++q) s_sum += table.point(x.pts[q].bin, ch);
+      if (s_sum > 0) w[c] *= table.line(axial, ch) / s_sum;
+    }
+  };
+  const double before = mean_weight(s.w);
+  scale(traced, s.w);
+  if (proposal && !s.wp.empty()) scale(*proposal, s.wp);
+  return before - mean_weight(s.w);
+}
+
 void leave_fiber(const SurfaceHit& hit, const Vec3& wo_local, Particle& s) {
   s.d = normalize(hit.shading.to_world(wo_local));
   s.p = hit.spawn_origin(s.d);

@@ -1,6 +1,6 @@
 // The steps of a particle's life in the fiber-level ray trace (fabric/raytrace_steps.h), one by
-// one: launch, flight and the periodic wrap, the tube pass, crossings, scattering and its weights,
-// the tally of an exit, Russian roulette and splitting.
+// one: launch, flight and the periodic wrap, the tube pass, crossings, scattering and its weights
+// (a yarn tube's by the line albedo), the tally of an exit, Russian roulette and splitting.
 #include <gtest/gtest.h>
 
 #include "flat_sheet.h"
@@ -10,6 +10,7 @@
 
 #include "weft/core/math.h"
 #include "weft/fabric/fiber_sampler.h"
+#include "weft/fabric/line_albedo.h"
 #include "weft/fabric/raytrace_steps.h"
 #include "weft/scenes/weave.h"
 
@@ -352,6 +353,76 @@ TEST(RaytraceSteps, UnderAProposalTheTracedWeightsFollowItsPathsTimesTheRatio) {
     EXPECT_NEAR(s.wp[c], fs.albedo_of(4, c), 1e-6);
     EXPECT_NEAR(s.w[c], 0.5 * s.wp[c], 1e-7);
   }
+}
+
+TEST(RaytraceSteps, LineAlbedoOfATableThatSeesOnlyTheHemisphereIsItsTwoSidesAlbedos) {
+  // A' depends only on which side of the point the light comes from: every line returns
+  // A(front) + A(behind), whatever its direction.
+  const auto t = cell_table([](int i, int, int c) { return (i < 4 ? 0.1 : 0.04) * (1 + c); });
+  const LineAlbedo line(t);
+  const int front = 0, behind = 4;  // bins above and below the point's horizon
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(line.point(front, c), t.directional_albedo(front).total(c), 1e-12);
+    const double expected = line.point(front, c) + line.point(behind, c);
+    for (double axial : {-1.0, -0.7, 0.0, 0.3, 0.99, 1.0})
+      EXPECT_NEAR(line.line(axial, c), expected, 1e-12 * expected) << axial << " " << c;
+  }
+}
+
+TEST(RaytraceSteps, LineAlbedoUnderIsotropicLightIsTheTablesTotalAlbedo) {
+  // Isotropic light brings each direction's lines in proportion to the fiber's projected width
+  // sqrt(1 - s^2) (s the axial cosine, uniform over the sphere); every point of the fiber then
+  // receives light from all directions (from behind through the fiber), so the fiber sends out
+  // (1 / pi) sum_i A_i D_i of it: the total albedo. A table with no symmetry, whose A' + A''
+  // varies along the lines.
+  const auto t =
+      cell_table([](int i, int o, int c) { return 0.02 + 0.03 * ((i * 5 + o * 3 + c) % 7); });
+  const LineAlbedo line(t);
+  const std::vector<double> total = t.total_albedo();
+  for (int c = 0; c < 3; ++c) {
+    double sum = 0, width = 0;
+    const int steps = 4096;
+    for (int k = 0; k < steps; ++k) {
+      const double s = -1 + (k + 0.5) * 2.0 / steps, w = std::sqrt(1 - s * s);
+      sum += w * line.line(s, c);
+      width += w;
+    }
+    // The midpoint rules over u and s, of functions constant within the table's bins: 5e-6.
+    EXPECT_NEAR(sum / width, total[c], 1e-4 * total[c]) << c;
+  }
+}
+
+TEST(RaytraceSteps, ATubeCrossingReturnsTheLineAlbedo) {
+  // After scattering at a tube's crossing, channel c's weight is scaled by L_c / S_c: the
+  // crossing returns L_c of the light on average, where its facets returned S_c = A_c' + A_c''.
+  // A channel that no facet returns stays as it is (nothing of it leaves there).
+  const auto traced =
+      cell_table([](int i, int, int c) { return c == 2 ? 0.0 : 0.05 * (1 + i % 3); });
+  const auto proposal = cell_table([](int i, int, int) { return 0.04 + 0.01 * (i % 2); });
+  const LineAlbedo line(traced), line_p(proposal);
+  Crossings x;
+  x.count = 2;
+  x.pts[0].bin = 1, x.pts[1].bin = 6;
+  const Vec3 axis = normalize(Vec3{1, 0.2, 0});
+  x.pts[0].hit.shading = Frame::from_normal_tangent({0, 0, 1}, axis);
+  const Vec3 d = normalize(Vec3{0.3, -0.2, -1});
+  const double axial = dot(d, x.pts[0].hit.shading.s);
+  Particle s;
+  s.w = {0.8, 0.6, 0.4};
+  s.wp = {0.5, 0.5, 0.5};
+  const double absorbed = weigh_as_round_fiber(line, &line_p, x, d, s);
+  double lost = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double w0 = c == 0 ? 0.8 : c == 1 ? 0.6 : 0.4;
+    const double s_c = line.point(1, c) + line.point(6, c);
+    const double expected = s_c > 0 ? w0 * line.line(axial, c) / s_c : w0;
+    EXPECT_NEAR(s.w[c], expected, 1e-12) << c;
+    lost += w0 - s.w[c];
+    const double sp = line_p.point(1, c) + line_p.point(6, c);
+    EXPECT_NEAR(s.wp[c], 0.5 * line_p.line(axial, c) / sp, 1e-12) << c;
+  }
+  EXPECT_EQ(s.w[2], 0.4);
+  EXPECT_NEAR(absorbed, lost / 3, 1e-12);
 }
 
 TEST(RaytraceSteps, LeavingAFiberStartsTheNewLineThere) {

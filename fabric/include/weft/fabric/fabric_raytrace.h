@@ -18,8 +18,10 @@
 // the repeat re-enters through the opposite side.
 //
 // At yarn detail the tubes take the fibers' part: light a tube sends into itself leaves it through
-// its far side (as light leaves a fiber through the fiber), and the table's frame at a tube point
-// is its facet's (normal and the yarn's tangent), so that the transport is reciprocal.
+// its far side (as light leaves a fiber through the fiber), the table's frame at a tube point is
+// its facet's (normal and the yarn's tangent), so that the transport is reciprocal, and a tube
+// crossing returns what a round fiber returns for light along its line, averaged over where lines
+// cross the fiber (line_albedo.h): the table conserves energy only so averaged.
 //
 // Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
@@ -49,8 +51,11 @@ const char* channel_sampling_name(ChannelSampling s);
 // merged) and of the table's metadata. 2: the scene passes rays through fibers they are inside
 // (a fiber's continuation across the repeat's sides), before which particles leaving a fiber near
 // the side were passed through that cap by a rule of the estimator's own and scattered by any
-// other fiber met from inside.
-inline constexpr int kFabricRaytraceRevision = 2;
+// other fiber met from inside. 3: a yarn tube's crossing returns the fiber table's line albedo
+// (what a round fiber returns, averaged over where lines cross it), before which it returned
+// A' + A'' at its facets: 1.2 of the light at normal incidence for a nearly lossless white-cotton
+// fiber. Fiber-detail results are unchanged.
+inline constexpr int kFabricRaytraceRevision = 3;
 
 struct FabricRaytraceOptions {
   int resolution = 8;                  // of the fabric table (DirectionGrid R)

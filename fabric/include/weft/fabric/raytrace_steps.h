@@ -6,7 +6,8 @@
 //               repeat, where it re-enters through the opposite side (the periodic wrap);
 //   crossings   a line that meets a fiber lights B' and B'', where it enters and would leave it;
 //   scattering  the hero strategy picks B' or B'' and an exit direction from the fiber table, and
-//               the path's weights become f over the strategies' mean probability (MIS);
+//               the path's weights become f over the strategies' mean probability (MIS); a yarn
+//               tube's crossing returns the line albedo of the fiber it stands for;
 //   tally       a particle leaving the slab adds its weights to its (incident, outgoing) cell;
 //   roulette and splitting  keep the weights in a window (below: roulette; above: copies).
 // Frames: world is the woven sample's (glTF, y up, metres), cloth the fabric table's (z = +y).
@@ -23,6 +24,7 @@
 #include "weft/core/rng.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fiber_sampler.h"
+#include "weft/fabric/line_albedo.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 
@@ -163,6 +165,18 @@ std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies
 // densities kept relative to their mean. Returns the power the step absorbed (channels' mean).
 double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, const Strategies& st,
                      int bin, int exit_bin, std::span<const double> s_sum, Particle& s);
+// A yarn tube stands for a round fiber: the weights after scattering at the tube's crossing x of
+// the line along d are scaled per channel by L_c / S_c, L the table's line albedo for d
+// (line_albedo.h, axial cosine with the yarn's tangent at x.pts[0]) and S_c the albedos summed
+// over x's points (unchanged where S_c is 0: nothing of c leaves there), so that the crossing
+// returns what the fiber returns on average. The tube's facets keep choosing where and in which
+// direction the light leaves, but their A' + A'' is not the fiber's: light along the normal meets
+// both faces of the flattened section head-on, as only lines through a round fiber's axis do,
+// where a clear fiber's A' + A'' is 2 to 3 (docs/fabric-bsdf.md). The proposal's weights (wp)
+// are scaled by its own L / S. Returns the power this absorbed (channels' mean; negative where it
+// adds).
+double weigh_as_round_fiber(const LineAlbedo& traced, const LineAlbedo* proposal,
+                            const Crossings& x, const Vec3& d, Particle& s);
 // The particle leaves fiber point 'hit' along wo_local (its frame): the new line, the fiber to
 // pass through, and whether it was sent into its own yarn tube.
 void leave_fiber(const SurfaceHit& hit, const Vec3& wo_local, Particle& s);
