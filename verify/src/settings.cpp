@@ -18,44 +18,40 @@ std::string quality_name(VerifyQuality q) {
 }
 
 VerifySettings verify_settings(VerifyQuality q) {
-  VerifySettings s;
-  s.quality = q;
-  switch (q) {
-    case VerifyQuality::kDraft:
-      s.resolution = 6;
-      s.fiber_photons_per_band = 20000;
-      s.particles_per_bin = 4000;
-      s.batches = 2;
-      s.summation_samples = 4;
-      s.render_size = 64;
-      s.render_spp = 2;
-      s.weave_render_size = 128;
-      s.weave_render_spp = 4;
-      break;
-    case VerifyQuality::kDefault:
-      s.resolution = 8;
-      s.fiber_photons_per_band = 200000;  // FiberTableBakeOptions{}'s
-      s.particles_per_bin = 64000;
-      s.batches = 4;
-      s.summation_samples = 8;
-      s.render_size = 128;
-      s.render_spp = 4;
-      s.weave_render_size = 256;
-      s.weave_render_spp = 16;
-      break;
-    case VerifyQuality::kPublication:
-      s.resolution = 12;
-      s.fiber_photons_per_band = 1000000;
-      s.particles_per_bin = 256000;
-      s.batches = 8;
-      s.summation_samples = 16;
-      s.render_size = 384;
-      s.render_spp = 64;
-      s.weave_render_size = 512;
-      s.weave_render_spp = 32;
-      break;
-  }
-  return s;
+  // The default's photons are FiberTableBakeOptions{}'s; what a row omits keeps its default.
+  static const VerifySettings kDraft{.quality = VerifyQuality::kDraft,
+                                     .resolution = 6,
+                                     .fiber_photons_per_band = 20000,
+                                     .particles_per_bin = 4000,
+                                     .batches = 2,
+                                     .summation_samples = 4,
+                                     .render_size = 64,
+                                     .render_spp = 2,
+                                     .weave_render_size = 128,
+                                     .weave_render_spp = 4};
+  static const VerifySettings kDefault{.quality = VerifyQuality::kDefault,
+                                       .resolution = 8,
+                                       .fiber_photons_per_band = 200000,
+                                       .particles_per_bin = 64000,
+                                       .batches = 4,
+                                       .summation_samples = 8,
+                                       .render_size = 128,
+                                       .render_spp = 4,
+                                       .weave_render_size = 256,
+                                       .weave_render_spp = 16};
+  static const VerifySettings kPublication{.quality = VerifyQuality::kPublication,
+                                           .resolution = 12,
+                                           .fiber_photons_per_band = 1000000,
+                                           .particles_per_bin = 256000,
+                                           .batches = 8,
+                                           .summation_samples = 16,
+                                           .render_size = 384,
+                                           .render_spp = 64,
+                                           .weave_render_size = 512,
+                                           .weave_render_spp = 32};
+  return q == VerifyQuality::kDraft     ? kDraft
+         : q == VerifyQuality::kDefault ? kDefault
+                                        : kPublication;
 }
 
 }  // namespace weft
