@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "plot_util.h"
 #include "weft/verify/plan.h"
+#include "weft/verify/report.h"
 #include "weft/verify/whole_run.h"
 
 namespace weft::cli {
@@ -42,10 +43,42 @@ void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
                   kVerifyLeastRates);
 }
 
-// The metrics of each model against the measurement, and the fits.
+// "0.308 +- 0.005 [0.29..0.35]": a figure, its seed standard error, its range over the fits.
+std::string figure_text(const FigureSamples& f) {
+  char b[96];
+  std::snprintf(b, sizeof b, "%.3f +- %.3f", f.value(), f.seed_se());
+  std::string t = b;
+  if (f.mean.size() > 1) {
+    std::snprintf(b, sizeof b, " [%.2f..%.2f]", f.fit_min(), f.fit_max());
+    t += b;
+  }
+  return t;
+}
+
+// The verdict, then the headline figures of each model with their uncertainty.
+void print_verdict(const VerifyReport& report) {
+  const std::vector<Verdict> verdicts = verify_verdicts(report);
+  std::printf("  verdict:\n");
+  for (int f = 0; f < 3; ++f) {
+    std::printf("   %s\n", figure_label(static_cast<FigureKind>(f)).c_str());
+    for (const Verdict& v : verdicts)
+      if (v.figure == kFigureKeys[f]) std::printf("    - %s\n", v.text.c_str());
+  }
+  std::printf("  %-36s %-28s %-28s %-28s\n", "RMS log (+- seed SE [over fits])", "shape",
+              "paper's one-point", "absolute");
+  for (const auto& m : report.models)
+    if (!m.figures.fits.empty())
+      std::printf("  %-36s %-28s %-28s %-28s\n", m.label.c_str(),
+                  figure_text(m.figures.figure[kShapeFigure]).c_str(),
+                  figure_text(m.figures.figure[kPaperFigure]).c_str(),
+                  figure_text(m.figures.figure[kAbsoluteFigure]).c_str());
+}
+
+// The verdict and the figures, the metrics of each model against the measurement, and the fits.
 void print_summary(const VerifyPlan& p, const VerifyReport& report, double seconds) {
   std::printf("%s: %zu incidences, quality %s, %.1f s\n", p.request.output.c_str(),
               p.measured.curves.size(), p.request.quality.c_str(), seconds);
+  print_verdict(report);
   std::printf("  %-36s %10s %10s %10s %10s\n", "RMS vs measured", "log norm", "rel norm", "log abs",
               "rel abs");
   for (const std::string key : {"computed_raytrace", "computed_summation", "classic",

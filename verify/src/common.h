@@ -1,7 +1,8 @@
 #pragma once
-// Two small helpers that several of verify/src's files share (private to the library).
+// Small helpers that several of verify/src's files share (private to the library).
 #include <chrono>
 #include <cstdio>
+#include <sstream>
 #include <string>
 
 namespace weft {
@@ -16,5 +17,33 @@ inline std::string fmt(double v, int digits = 3) {
 inline double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+// Text made safe for an HTML page.
+inline std::string html_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '<':
+        o += "&lt;";
+        break;
+      case '>':
+        o += "&gt;";
+        break;
+      case '&':
+        o += "&amp;";
+        break;
+      case '"':
+        o += "&quot;";
+        break;
+      default:
+        o.push_back(c);
+    }
+  }
+  return o;
+}
+
+struct VerifyReport;
+// The page's verdict section, which leads it (report_html_verdict.cpp).
+void html_verdict(std::ostringstream& h, const VerifyReport& r);
 
 }  // namespace weft

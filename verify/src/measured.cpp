@@ -4,9 +4,12 @@
 #include <array>
 #include <fstream>
 #include <map>
+#include <optional>
+#include <utility>
 
 #include "weft/core/error.h"
 #include "weft/core/install_paths.h"
+#include "weft/core/math.h"
 #include "weft/core/params.h"
 
 #ifndef WEFT_DATA_DIR
@@ -36,6 +39,96 @@ double parse_number(const std::string& text, const std::string& file, const std:
   throw Error(file, field, "'" + text + "' is not a finite number");
 }
 
+// The columns of a table: the angles and the reference fit (required), and the other fits whose
+// three columns are all there (a fit with some of them is an error).
+struct Columns {
+  size_t theta_i = 0, theta_o = 0;
+  std::vector<std::string> fit_names;         // "nbrdf" first
+  std::vector<std::array<size_t, 3>> fit_at;  // [fit] -> R, G, B column
+  std::vector<double> fit_scale;              // beta per unit of the column (1 or pi)
+  std::vector<std::array<std::string, 3>> fit_columns;
+};
+
+Columns find_columns(const std::vector<std::string>& header, const std::string& file) {
+  const auto find = [&](const std::string& name) -> std::optional<size_t> {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end()) return std::nullopt;
+    return static_cast<size_t>(it - header.begin());
+  };
+  const auto need = [&](const std::string& name) {
+    if (const auto k = find(name)) return *k;
+    throw Error(file, name, "missing column");
+  };
+  Columns c;
+  c.theta_i = need("theta_i_deg");
+  c.theta_o = need("theta_o_deg");
+  // The reference is beta itself; the other fits give f_r (1/sr), so beta = pi f_r.
+  const std::array<std::pair<std::string, double>, 3> fits = {
+      {{"nbrdf_beta_", 1.0}, {"sgd_fr_", kPi}, {"abc_fr_", kPi}}};
+  for (const auto& [prefix, scale] : fits) {
+    std::array<std::string, 3> names;
+    std::array<std::optional<size_t>, 3> at;
+    int present = 0;
+    for (int k = 0; k < 3; ++k) {
+      names[k] = prefix + "RGB"[k];
+      at[k] = find(names[k]);
+      present += at[k].has_value();
+    }
+    if (present == 0 && prefix != "nbrdf_beta_") continue;
+    for (int k = 0; k < 3; ++k)
+      if (!at[k]) throw Error(file, names[k], "missing column");
+    c.fit_names.push_back(prefix.substr(0, prefix.find('_')));
+    c.fit_at.push_back({*at[0], *at[1], *at[2]});
+    c.fit_scale.push_back(scale);
+    c.fit_columns.push_back(names);
+  }
+  return c;
+}
+
+// The table's rows: theta_i -> view (paper's sign) -> beta of every fit.
+using Rows = std::map<double, std::map<double, std::vector<Rgb>>>;
+
+void read_row(const std::vector<std::string>& f, const Columns& col, const std::string& file,
+              const std::string& where, Rows& rows) {
+  const double ti = parse_number(f[col.theta_i], file, where + " theta_i_deg");
+  const double to = parse_number(f[col.theta_o], file, where + " theta_o_deg");
+  if (ti < 0 || ti >= 90) throw Error(file, where + " theta_i_deg", "must lie in [0, 90)");
+  if (to <= -90 || to >= 90) throw Error(file, where + " theta_o_deg", "must lie in (-90, 90)");
+  std::vector<Rgb> betas;
+  for (size_t j = 0; j < col.fit_at.size(); ++j) {
+    Rgb b;
+    for (int k = 0; k < 3; ++k) {
+      const std::string field = where + " " + col.fit_columns[j][k];
+      const double v = parse_number(f[col.fit_at[j][k]], file, field);
+      if (v < 0) throw Error(file, field, "a radiance coefficient is >= 0");
+      b[k] = v * col.fit_scale[j];
+    }
+    betas.push_back(b);
+  }
+  // The table's theta_o is negative on the mirror side, the paper's view positive (0.0 - x:
+  // no negative zero).
+  if (!rows[ti].emplace(0.0 - to, std::move(betas)).second)
+    throw Error(file, where, "duplicate row for this (theta_i_deg, theta_o_deg)");
+}
+
+MeasuredInplane measured_from_rows(const Rows& rows, const Columns& col, const std::string& file) {
+  MeasuredInplane m;
+  m.file = file;
+  for (size_t j = 1; j < col.fit_names.size(); ++j) m.other_fits.push_back({col.fit_names[j], {}});
+  for (const auto& [ti, views] : rows) {
+    MeasuredCurve c;
+    c.theta_i_deg = ti;
+    for (auto& f : m.other_fits) f.beta.emplace_back();
+    for (const auto& [v, b] : views) {
+      c.view_deg.push_back(v);
+      c.beta.push_back(b[0]);
+      for (size_t j = 1; j < b.size(); ++j) m.other_fits[j - 1].beta.back().push_back(b[j]);
+    }
+    m.curves.push_back(std::move(c));
+  }
+  return m;
+}
+
 }  // namespace
 
 MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
@@ -52,15 +145,8 @@ MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
     break;
   }
   if (header.empty()) throw Error(file, "", "no header line (empty table)");
-  const std::vector<std::string> needed = {"theta_i_deg", "theta_o_deg", "nbrdf_beta_R",
-                                           "nbrdf_beta_G", "nbrdf_beta_B"};
-  std::array<size_t, 5> col{};
-  for (size_t k = 0; k < needed.size(); ++k) {
-    const auto it = std::find(header.begin(), header.end(), needed[k]);
-    if (it == header.end()) throw Error(file, needed[k], "missing column");
-    col[k] = static_cast<size_t>(it - header.begin());
-  }
-  std::map<double, std::map<double, Rgb>> rows;  // theta_i -> view (paper's sign) -> beta
+  const Columns col = find_columns(header, file);
+  Rows rows;
   while (std::getline(in, line)) {
     ++line_no;
     if (line.empty() || line == "\r") continue;
@@ -70,32 +156,18 @@ MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
       throw Error(file, where,
                   std::to_string(f.size()) + " fields where the header has " +
                       std::to_string(header.size()));
-    std::array<double, 5> v{};
-    for (size_t k = 0; k < 5; ++k) v[k] = parse_number(f[col[k]], file, where + " " + needed[k]);
-    if (v[0] < 0 || v[0] >= 90) throw Error(file, where + " theta_i_deg", "must lie in [0, 90)");
-    if (v[1] <= -90 || v[1] >= 90)
-      throw Error(file, where + " theta_o_deg", "must lie in (-90, 90)");
-    for (size_t k = 2; k < 5; ++k)
-      if (v[k] < 0) throw Error(file, where + " " + needed[k], "a radiance coefficient is >= 0");
-    // The table's theta_o is negative on the mirror side, the paper's view positive (0.0 - x:
-    // no negative zero).
-    auto& curve = rows[v[0]];
-    if (!curve.emplace(0.0 - v[1], Rgb(v[2], v[3], v[4])).second)
-      throw Error(file, where, "duplicate row for this (theta_i_deg, theta_o_deg)");
+    read_row(f, col, file, where, rows);
   }
   if (rows.empty()) throw Error(file, "", "no data rows");
-  MeasuredInplane m;
-  m.file = file;
-  for (const auto& [ti, views] : rows) {
-    MeasuredCurve c;
-    c.theta_i_deg = ti;
-    for (const auto& [v, b] : views) {
-      c.view_deg.push_back(v);
-      c.beta.push_back(b);
-    }
-    m.curves.push_back(std::move(c));
-  }
-  return m;
+  return measured_from_rows(rows, col, file);
+}
+
+std::vector<MeasuredFit> measured_fits(const MeasuredInplane& m) {
+  std::vector<MeasuredFit> out(1);
+  out[0].name = "nbrdf";
+  for (const auto& c : m.curves) out[0].beta.push_back(c.beta);
+  out.insert(out.end(), m.other_fits.begin(), m.other_fits.end());
+  return out;
 }
 
 std::filesystem::path bundled_measured_inplane() {

@@ -11,29 +11,6 @@
 namespace weft {
 namespace {
 
-std::string html_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o.push_back(c);
-    }
-  }
-  return o;
-}
-
 // The page's head and what was compared.
 void html_head(std::ostringstream& h, const VerifyReport& r) {
   h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>weft verify</title>\n"
@@ -48,7 +25,7 @@ void html_head(std::ostringstream& h, const VerifyReport& r) {
 
 // The metrics of every model, overall and per incidence (the table is left open).
 void html_metrics(std::ostringstream& h, const VerifyReport& r) {
-  h << "<h2>Metrics (over every view, incidence and channel)</h2>\n<table><tr><th>model</th>"
+  h << "<h2>All metrics (over every view, incidence and channel)</h2>\n<table><tr><th>model</th>"
        "<th>RMS log ratio, normalized</th><th>RMS relative, normalized</th><th>RMS log ratio, "
        "absolute</th><th>RMS relative, absolute</th><th>normalization factor (R, G, B)</th>"
        "<th>points (excluded)</th></tr>\n";
@@ -219,6 +196,7 @@ std::string verify_index_html(const VerifyReport& r,
                               const std::vector<std::pair<std::string, std::string>>& images) {
   std::ostringstream h;
   html_head(h, r);
+  html_verdict(h, r);
   html_metrics(h, r);
   html_fits(h, r);
   html_curves(h, images);

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "common.h"
 #include "weft/verify/report.h"
 
 namespace weft {
@@ -33,6 +34,53 @@ nlohmann::json settings_json(const VerifySettings& s) {
           {"threads", s.threads}};
 }
 
+// A number, or null where it is not defined.
+nlohmann::json number_json(double v) {
+  return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
+}
+
+nlohmann::json shape_json(const ShapeFigure& s, const MeasuredInplane& measured) {
+  nlohmann::json per = nlohmann::json::array();
+  for (size_t i = 0; i < s.rms_log_incidence.size(); ++i)
+    per.push_back({{"theta_i_deg", measured.curves[i].theta_i_deg},
+                   {"rms_log", number_json(s.rms_log_incidence[i])}});
+  nlohmann::json channels = nlohmann::json::object();
+  for (int k = 0; k < 3; ++k)
+    channels[std::string(1, "RGB"[k])] = number_json(s.rms_log_channel[k]);
+  return {{"rms_log", number_json(s.rms_log)},
+          {"gain", {number_json(s.gain.r), number_json(s.gain.g), number_json(s.gain.b)}},
+          {"max_view_deg", kShapeMaxViewDeg},
+          {"points", s.points},
+          {"rms_log_channel", channels},
+          {"per_incidence", per},
+          {"rms_log_beyond_max_view", number_json(s.rms_log_grazing)},
+          {"points_beyond_max_view", s.grazing_points},
+          {"excluded", s.excluded}};
+}
+
+// A figure with its uncertainty: the seed's (batches) and the measurement's (its fits).
+nlohmann::json figure_json(const FigureSamples& f, const std::vector<std::string>& fits) {
+  nlohmann::json per_fit = nlohmann::json::object(), per_batch = nlohmann::json::array();
+  for (size_t k = 0; k < fits.size(); ++k) per_fit[fits[k]] = number_json(f.mean[k]);
+  if (!f.batch.empty())
+    for (double v : f.batch[0]) per_batch.push_back(number_json(v));
+  return {{"value", number_json(f.value())},
+          {"batches", per_batch.size()},
+          {"per_batch", per_batch},
+          {"seed_sd", number_json(f.seed_sd())},
+          {"seed_se", number_json(f.seed_se())},
+          {"per_fit", per_fit},
+          {"fit_min", number_json(f.fit_min())},
+          {"fit_max", number_json(f.fit_max())}};
+}
+
+nlohmann::json uncertainty_json(const ModelFigures& f) {
+  nlohmann::json u = {{"fits", f.fits}};
+  if (f.fits.empty()) return u;
+  for (int k = 0; k < 3; ++k) u[kFigureKeys[k]] = figure_json(f.figure[k], f.fits);
+  return u;
+}
+
 // Per model: its metrics overall, per incidence and per incidence and channel.
 nlohmann::json models_json(const VerifyReport& r) {
   nlohmann::json models = nlohmann::json::object();
@@ -54,13 +102,29 @@ nlohmann::json models_json(const VerifyReport& r) {
                      {"normalization_factor", rgb_json(m.normalization)},
                      {"absolute", metrics_json(m.absolute_overall)},
                      {"normalized", metrics_json(m.normalized_overall)},
-                     {"per_incidence", per}};
+                     {"per_incidence", per},
+                     {"uncertainty", uncertainty_json(m.figures)}};
+    if (!m.figures.fits.empty()) models[m.key]["shape"] = shape_json(m.figures.shape, r.measured);
   }
   return models;
 }
 
 // The headline figures at the top level: computed is the fiber-level ray trace.
 void add_headline_figures(nlohmann::json& j, const std::vector<ModelCurves>& models) {
+  const std::pair<const char*, const char*> shape_keys[] = {
+      {"computed_raytrace", "computed"},
+      {"computed_summation", "summation"},
+      {"classic", "classic"},
+      {"computed_raytrace_fitted", "computed_fitted"},
+      {"classic_fitted", "classic_fitted"}};
+  for (const auto& m : models)
+    for (const auto& [key, name] : shape_keys)
+      if (m.key == key && !m.figures.fits.empty()) {
+        const ShapeFigure& s = m.figures.shape;
+        j[std::string(name) + "_shape_rms_log"] = number_json(s.rms_log);
+        j[std::string(name) + "_shape_gain"] = {number_json(s.gain.r), number_json(s.gain.g),
+                                                number_json(s.gain.b)};
+      }
   for (const auto& m : models) {
     if (m.key == "computed_raytrace") {
       j["computed_rms_log"] = m.normalized_overall.rms_log;
@@ -127,6 +191,34 @@ nlohmann::json fit_json(const FitResult& f, const std::vector<ModelCurves>& mode
   return e;
 }
 
+nlohmann::json verdict_json(const VerifyReport& r) {
+  nlohmann::json v = {
+      {"rule",
+       "a is closer when its figure is below b's; resolved when the difference a - b has "
+       "one sign against every fit of the measurement and for every batch, and exceeds " +
+           fmt(kVerdictSeedErrors, 2) +
+           " seed standard errors (paired batch differences) against every fit"}};
+  for (const char* key : kFigureKeys) v[key] = nlohmann::json::array();
+  for (const Verdict& d : verify_verdicts(r)) {
+    nlohmann::json per_fit = nlohmann::json::array();
+    for (double x : d.difference_per_fit) per_fit.push_back(number_json(x));
+    v[d.figure].push_back({{"a", d.a},
+                           {"b", d.b},
+                           {"a_value", number_json(d.a_value)},
+                           {"b_value", number_json(d.b_value)},
+                           {"difference", number_json(d.difference)},
+                           {"difference_seed_se", number_json(d.difference_seed_se)},
+                           {"difference_per_fit", per_fit},
+                           {"same_sign_fits", d.same_sign_fits},
+                           {"same_sign_batches", d.same_sign_batches},
+                           {"exceeds_seed", d.exceeds_seed},
+                           {"resolved", d.resolved},
+                           {"closer", d.resolved ? nlohmann::json(d.closer) : nlohmann::json()},
+                           {"text", d.text}});
+  }
+  return v;
+}
+
 nlohmann::json colours_json(const std::vector<ColourEntry>& entries) {
   nlohmann::json colours = nlohmann::json::array();
   for (const auto& c : entries) {
@@ -172,8 +264,20 @@ std::string verify_metrics_json(const VerifyReport& r) {
   j["metrics"] =
       "rms_log: RMS of ln(model / measured); rms_rel: RMS of (model - measured) / "
       "measured; over every view, incidence and channel where both are positive";
+  j["shape"] =
+      "per model and channel one gain, ln g = mean of ln(measured / model) over the points where "
+      "both are positive and |view| <= " +
+      fmt(kShapeMaxViewDeg, 3) +
+      " deg; rms_log of g model against measured over those points (the views beyond: "
+      "rms_log_beyond_max_view, the same gains)";
+  j["uncertainty"] =
+      "per figure: seed_sd, the standard deviation of the figure over the ray trace's batches "
+      "(each an independent seed), and seed_se = seed_sd / sqrt(batches), the standard error of "
+      "the figure of their mean (shown after +-); per_fit, the figure against each fit of the "
+      "measurement (fit_min..fit_max: the measurement's own spread)";
   j["models"] = models_json(r);
   add_headline_figures(j, r.models);
+  j["verdict"] = verdict_json(r);
   if (!r.fits.empty()) {
     nlohmann::json fit = nlohmann::json::object();
     for (const auto& f : r.fits) fit[f.model] = fit_json(f, r.models);

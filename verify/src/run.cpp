@@ -22,8 +22,9 @@ uint64_t batch_seed(uint64_t seed, const std::string& model, int k) {
 // Ray-traced fabric table of 'fiber' in 'batches' independent runs: the curves of their mean and
 // the standard error of that mean from their spread (what the error bars show).
 struct TracedCurves {
-  std::vector<std::vector<Rgb>> beta, err;
-  TabulatedBsdfTable mean;  // the fiber table's channels
+  InplaneCurves beta, err;
+  std::vector<InplaneCurves> batches;  // each batch's curves
+  TabulatedBsdfTable mean;             // the fiber table's channels
   double relative_noise = 0;
   bool cancelled = false;
 };
@@ -43,7 +44,7 @@ TracedCurves trace_curves(const WovenSample& sample, const TabulatedBsdfTable& f
                           const VerifyTraced* traced) {
   TracedCurves out;
   const size_t n_inc = measured.curves.size();
-  std::vector<std::vector<std::vector<Rgb>>> per_batch;  // [batch][incidence][view]
+  std::vector<InplaneCurves>& per_batch = out.batches;
   std::vector<double> sum;
   double noise2 = 0;
   for (int k = 0; k < s.batches; ++k) {
@@ -104,20 +105,23 @@ TracedCurves trace_curves(const WovenSample& sample, const TabulatedBsdfTable& f
   return out;
 }
 
-ModelCurves model_curves(std::string key, std::string label, std::vector<std::vector<Rgb>> beta,
-                         std::vector<std::vector<Rgb>> err) {
+ModelCurves model_curves(std::string key, std::string label, InplaneCurves beta, InplaneCurves err,
+                         std::vector<InplaneCurves> batches = {}) {
   ModelCurves m;
   m.key = std::move(key);
   m.label = std::move(label);
   m.beta = std::move(beta);
   m.beta_err = std::move(err);
+  m.batch_beta = std::move(batches);
   return m;
 }
 
 void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& normal_curve,
            size_t normal_view) {
-  const Rgb model0 = m.beta[&normal_curve - meas.curves.data()][normal_view];
+  const size_t normal_incidence = static_cast<size_t>(&normal_curve - meas.curves.data());
+  const Rgb model0 = m.beta[normal_incidence][normal_view];
   m.normalization = paper_normalization(model0, normal_curve.beta[normal_view], m.label);
+  m.figures = model_figures(m.beta, m.batch_beta, meas, {normal_incidence, normal_view});
   MetricsAccumulator abs_all, norm_all;
   for (size_t i = 0; i < meas.curves.size(); ++i) {
     MetricsAccumulator a, n;
@@ -184,7 +188,7 @@ void add_computed_raytrace(VerifyReport& rep, const TracedCurves& computed, cons
     rep.fabric_table_gamut_clipped = clip.components;
   }
   rep.models.push_back(model_curves("computed_raytrace", "computed (fiber-level ray trace)",
-                                    computed.beta, computed.err));
+                                    computed.beta, computed.err, computed.batches));
   rep.computed_fabric = computed.mean;
   rep.computed_fiber = in.fiber;
   if (sample.fibers.curve_count() > 0) rep.sample = std::make_shared<const WovenSample>(sample);
@@ -321,7 +325,7 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   }
   rep.seconds["raytrace_classic"] = seconds_since(t0);
   rep.models.push_back(
-      model_curves("classic", "classic (Lambert + Cook-Torrance)", cl.beta, cl.err));
+      model_curves("classic", "classic (Lambert + Cook-Torrance)", cl.beta, cl.err, cl.batches));
   rep.classic_fabric = std::move(cl.mean);
   rep.classic_fiber = classic.table;
   rep.measured_nbrdf = measured_network(measured);

@@ -15,17 +15,34 @@ struct MeasuredCurve {
   std::vector<Rgb> beta;
 };
 
+// In-plane curves, per incidence, at every view of the measured table: [incidence][view].
+using InplaneCurves = std::vector<std::vector<Rgb>>;
+
+// One fit of the measurement: its name and its beta at every (incidence, view) of the table.
+struct MeasuredFit {
+  std::string name;
+  InplaneCurves beta;
+};
+
 struct MeasuredInplane {
   std::string file;
-  std::vector<MeasuredCurve> curves;  // by increasing theta_i
+  std::vector<MeasuredCurve> curves;  // by increasing theta_i; beta: the reference fit, "nbrdf"
+  // Other fits of the same measurement, where the table has them (beta = pi f_r of its sgd_fr_*
+  // and abc_fr_* columns): what the measurement's own spread is judged by.
+  std::vector<MeasuredFit> other_fits;
 };
+
+// Every fit of the measurement: the reference ("nbrdf", MeasuredCurve::beta) first, then the
+// others.
+std::vector<MeasuredFit> measured_fits(const MeasuredInplane& measured);
 
 // Reads a table in the format of materials/data/measured/*/inplane.csv: optional comment lines
 // starting with '#' or '"#', a header naming at least theta_i_deg, theta_o_deg, nbrdf_beta_R,
 // nbrdf_beta_G, nbrdf_beta_B, and one row per (theta_i, theta_o) with theta_o < 0 on the mirror
-// side (that table's convention; flipped here). weft::Error naming the file and the column (or
-// line) on a missing file or column, a non-number, a negative or non-finite beta, an angle out of
-// range, or a duplicate row.
+// side (that table's convention; flipped here). The optional columns sgd_fr_R/G/B and
+// abc_fr_R/G/B (each fit all three or none) are kept as other_fits. weft::Error naming the file and
+// the column (or line) on a missing file or column, a non-number, a negative or non-finite beta, an
+// angle out of range, or a duplicate row.
 MeasuredInplane read_measured_inplane(const std::filesystem::path& path);
 
 // The bundled MERL red fabric (materials/data/measured/merl-red-fabric/inplane.csv), found in the

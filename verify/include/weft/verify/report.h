@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "weft/verify/run.h"
+#include "weft/verify/verdict.h"
 
 namespace weft {
 
@@ -17,6 +18,13 @@ std::string verify_inplane_csv(const VerifyReport& report);
 std::string verify_metrics_json(const VerifyReport& report);
 std::string verify_index_html(const VerifyReport& report,
                               const std::vector<std::pair<std::string, std::string>>& images);
+
+// The report's verdicts (verify/verdict.h), figure by figure (kFigureKeys' order): the computed
+// ray trace against the classic model, the paper's summation against the classic model, and the
+// fitted ray trace against the fitted classic model, each where both are in the report.
+std::vector<Verdict> verify_verdicts(const VerifyReport& report);
+// A model's name in the verdict's words ("computed (ray trace)", "classic, fitted").
+std::string verdict_model_name(const std::string& key);
 
 // Writes DIR whole or not at all: the renders (render_verify_samples: fabric-*.exr, render-*.exr
 // and .png), inplane.csv and metrics.json into a staging folder beside DIR, then draw(staging)

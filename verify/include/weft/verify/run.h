@@ -25,6 +25,7 @@
 #include "weft/materials/microfacet.h"
 #include "weft/scenes/weave.h"
 #include "weft/verify/colour.h"
+#include "weft/verify/figures.h"
 #include "weft/verify/fit.h"
 #include "weft/verify/measured.h"
 #include "weft/verify/metrics.h"
@@ -56,8 +57,13 @@ struct VerifyInputs {
 // error (zero where the model is deterministic).
 struct ModelCurves {
   std::string key, label;
-  std::vector<std::vector<Rgb>> beta, beta_err;  // [incidence][view]
-  Rgb normalization{1.0};                        // paper's, per channel
+  InplaneCurves beta, beta_err;
+  // Each ray-trace batch's curves (beta is their mean); empty where the model is deterministic.
+  std::vector<InplaneCurves> batch_beta;
+  // The headline figures (shape, paper's, absolute) with their spread over the batches and over
+  // the measurement's fits.
+  ModelFigures figures;
+  Rgb normalization{1.0};  // paper's, per channel
   // [incidence] then overall ("all" last): absolute and normalized metrics, channels together.
   std::vector<CurveMetrics> absolute, normalized;
   // [incidence][channel]: each curve (one incidence, one channel) on its own.

@@ -8,6 +8,8 @@
 #include "weft/verify/measured.h"  // the measurement
 #include "weft/verify/inplane.h"   // a table's beta in the plane of incidence
 #include "weft/verify/metrics.h"   // the metrics, absolute and normalized
+#include "weft/verify/figures.h"   // the headline figures: shape, paper's, absolute
+#include "weft/verify/verdict.h"   // which model is closer, and whether that is resolved
 #include "weft/verify/colour.h"    // the colour table
 #include "weft/verify/settings.h"  // the quality levels
 #include "weft/verify/classic.h"   // the classic fiber from a baked fiber table

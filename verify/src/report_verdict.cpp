@@ -1,0 +1,43 @@
+// The report's verdicts: which models are compared, and their names in words.
+#include <algorithm>
+
+#include "weft/verify/report.h"
+
+namespace weft {
+
+std::string verdict_model_name(const std::string& key) {
+  const std::string fitted = "_fitted";
+  const bool is_fitted = key.size() > fitted.size() &&
+                         key.compare(key.size() - fitted.size(), fitted.size(), fitted) == 0;
+  const std::string base = is_fitted ? key.substr(0, key.size() - fitted.size()) : key;
+  std::string name = base;
+  if (base == "computed_raytrace") name = "computed model (ray trace)";
+  if (base == "computed_summation") name = "computed model (paper's summation)";
+  if (base == "classic") name = "classic model";
+  return std::string("the ") + (is_fitted ? "fitted " : "") + name;
+}
+
+std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
+  const auto find = [&](const std::string& key) -> const ModelCurves* {
+    const auto it = std::find_if(r.models.begin(), r.models.end(),
+                                 [&](const ModelCurves& m) { return m.key == key; });
+    return it == r.models.end() ? nullptr : &*it;
+  };
+  const std::pair<const char*, const char*> pairs[] = {
+      {"computed_raytrace", "classic"},
+      {"computed_summation", "classic"},
+      {"computed_raytrace_fitted", "classic_fitted"}};
+  std::vector<Verdict> out;
+  for (int f = 0; f < 3; ++f)
+    for (const auto& [ka, kb] : pairs) {
+      const ModelCurves* a = find(ka);
+      const ModelCurves* b = find(kb);
+      if (!a || !b || a->figures.fits.empty() || b->figures.fits.empty()) continue;
+      const auto kind = static_cast<FigureKind>(f);
+      out.push_back(compare_figure(kind, ka, verdict_model_name(ka), a->figures.figure[f], kb,
+                                   verdict_model_name(kb), b->figures.figure[f]));
+    }
+  return out;
+}
+
+}  // namespace weft
