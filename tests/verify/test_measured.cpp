@@ -7,6 +7,7 @@
 
 #include "test_util.h"
 #include "weft/core/atomic_file.h"
+#include "weft/core/math.h"
 #include "weft/verify/measured.h"
 
 namespace fs = std::filesystem;
@@ -34,6 +35,51 @@ TEST(VerifyMeasured, BundledTableHasNineIncidencesAndThePapersSign) {
       std::find(c30.view_deg.begin(), c30.view_deg.end(), 30.0) - c30.view_deg.begin();
   EXPECT_DOUBLE_EQ(c30.beta[v30].r, 0.257877);
   EXPECT_DOUBLE_EQ(c30.beta[v30].b, 0.0255022);
+  // The table's two other fits, as beta = pi f_r: its row "0,-85,...", sgd_fr_R 0.0678578 and
+  // abc_fr_B 0.00365227 (theta_o = -85 is view +85 here, the last of incidence 0).
+  ASSERT_EQ(m.other_fits.size(), 2u);
+  EXPECT_EQ(m.other_fits[0].name, "sgd");
+  EXPECT_EQ(m.other_fits[1].name, "abc");
+  ASSERT_EQ(m.other_fits[0].beta.size(), 9u);
+  ASSERT_EQ(m.other_fits[0].beta[0].size(), 35u);
+  EXPECT_EQ(c0.view_deg.back(), 85.0);
+  EXPECT_DOUBLE_EQ(m.other_fits[0].beta[0].back().r, kPi * 0.0678578);
+  EXPECT_DOUBLE_EQ(m.other_fits[1].beta[0].back().b, kPi * 0.00365227);
+  const std::vector<MeasuredFit> fits = measured_fits(m);
+  ASSERT_EQ(fits.size(), 3u);
+  EXPECT_EQ(fits[0].name, "nbrdf");
+  EXPECT_DOUBLE_EQ(fits[0].beta[0][v0].r, 0.280098);
+}
+
+TEST(VerifyMeasured, OtherFitsAreOptionalButWholeAndChecked) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path p = dir / "fits.csv";
+  // Without them: the reference only.
+  write_text_atomically(
+      p, "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n0,0,1,1,1\n");
+  EXPECT_TRUE(read_measured_inplane(p).other_fits.empty());
+  // One fit's columns, in any order among the others: f_r times pi.
+  write_text_atomically(p,
+                        "abc_fr_B,theta_i_deg,theta_o_deg,abc_fr_G,nbrdf_beta_R,nbrdf_beta_G,"
+                        "nbrdf_beta_B,abc_fr_R\n0.5,0,0,0.25,1,1,1,2\n");
+  const MeasuredInplane m = read_measured_inplane(p);
+  ASSERT_EQ(m.other_fits.size(), 1u);
+  EXPECT_EQ(m.other_fits[0].name, "abc");
+  EXPECT_DOUBLE_EQ(m.other_fits[0].beta[0][0].r, 2 * kPi);
+  EXPECT_DOUBLE_EQ(m.other_fits[0].beta[0][0].g, 0.25 * kPi);
+  EXPECT_DOUBLE_EQ(m.other_fits[0].beta[0][0].b, 0.5 * kPi);
+  // A fit with some of its columns, a non-number and a negative value: the file and the field.
+  const std::string head = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B";
+  const std::pair<std::string, std::string> cases[] = {
+      {head + ",sgd_fr_R,sgd_fr_B\n0,0,1,1,1,1,1\n", "sgd_fr_G"},
+      {head + ",sgd_fr_R,sgd_fr_G,sgd_fr_B\n0,0,1,1,1,1,x,1\n", "line 2 sgd_fr_G"},
+      {head + ",sgd_fr_R,sgd_fr_G,sgd_fr_B\n0,0,1,1,1,1,1,-1\n", "line 2 sgd_fr_B"}};
+  for (const auto& [text, part] : cases) {
+    write_text_atomically(p, text);
+    const std::string e = error_of([&] { read_measured_inplane(p); });
+    EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+    EXPECT_NE(e.find(part), std::string::npos) << text << " -> " << e;
+  }
 }
 
 TEST(VerifyMeasured, BadTablesNameFileAndField) {

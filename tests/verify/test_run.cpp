@@ -51,6 +51,14 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
         EXPECT_EQ(points, mc.normalized[i].points + mc.normalized[i].excluded);
         EXPECT_EQ(points, 3u * m.curves[i].view_deg.size());
       }
+    // Both ray-traced models keep each batch's curves and score them: one figure per batch.
+    for (const auto& mc : r.models) {
+      ASSERT_EQ(mc.batch_beta.size(), 2u) << mc.key;
+      EXPECT_EQ(mc.figures.fits, std::vector<std::string>{"nbrdf"});
+      EXPECT_EQ(mc.figures.figure[kShapeFigure].batch.at(0).size(), 2u);
+      EXPECT_EQ(mc.figures.shape.rms_log,
+                shape_figure(mc.beta, measured_fits(m)[0].beta, m).rms_log);
+    }
     EXPECT_EQ(r.colours[0].name, "computed fabric, reflection");
     r.seconds.clear();
     r.settings.threads = 0;
