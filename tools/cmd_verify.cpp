@@ -60,12 +60,17 @@ void print_verdict(const VerifyReport& report) {
   const std::vector<Verdict> verdicts = verify_verdicts(report);
   std::printf("  verdict:\n");
   for (int f = 0; f < 3; ++f) {
-    std::printf("   %s\n", figure_label(static_cast<FigureKind>(f)).c_str());
+    const std::string note =
+        f == kAbsoluteFigure ? not_comparable_note(report.measured.colour_space) : "";
+    std::printf("   %s%s\n", figure_label(static_cast<FigureKind>(f)).c_str(),
+                note.empty() ? "" : (" -- " + note).c_str());
     for (const Verdict& v : verdicts)
       if (v.figure == kFigureKeys[f]) std::printf("    - %s\n", v.text.c_str());
   }
-  std::printf("  %-36s %-28s %-28s %-28s\n", "RMS log (+- seed SE [over fits])", "shape",
-              "paper's one-point", "absolute");
+  std::printf(
+      "  %-36s %-28s %-28s %-28s\n", "RMS log (+- seed SE [over fits])", "shape",
+      "paper's one-point",
+      absolute_comparable(report.measured.colour_space) ? "absolute" : "absolute (not comparable)");
   for (const auto& m : report.models)
     if (!m.figures.fits.empty())
       std::printf("  %-36s %-28s %-28s %-28s\n", m.label.c_str(),
@@ -158,6 +163,10 @@ void add_verify_command(CLI::App& app, Commands& commands) {
   sub->add_option("--measured", r.measured,
                   "measured in-plane table (format of materials/data/measured/*/inplane.csv; "
                   "default: the bundled MERL red fabric)");
+  sub->add_option("--colour-space", r.colour_space,
+                  "the measured table's RGB space, over its '# colour_space:' line: srgb (linear "
+                  "sRGB, as the models) or camera (absolute figures then not comparable)")
+      ->check(CLI::IsMember({"srgb", "camera"}));
   sub->add_option("--fiber", r.fiber,
                   "fiber spec (.json) or preset, or a baked fiber table (.exr, weft bake fiber)")
       ->capture_default_str();

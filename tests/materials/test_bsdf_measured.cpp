@@ -34,8 +34,9 @@ std::vector<InplaneRow> read_inplane(const fs::path& file) {
   std::ifstream in(file);
   std::vector<InplaneRow> rows;
   std::string line;
-  std::getline(in, line);  // comment
-  std::getline(in, line);  // header
+  // Comment lines ('#' or '"#': the description, the colour space), then the header.
+  while (std::getline(in, line) && (line.rfind('#', 0) == 0 || line.rfind("\"#", 0) == 0)) {
+  }
   while (std::getline(in, line)) {
     std::stringstream ss(line);
     std::vector<double> v;

@@ -16,9 +16,9 @@ TEST(VerifyColour, WhiteAndGreyAreNeutral) {
   Spectrum s;
   s.fill(0.5);
   const ColourEntry e = colour_of_spectrum("grey", s, "");
-  EXPECT_NEAR(e.linear_srgb.r, 0.5, 2e-3);  // D65 white -> sRGB white (spectrum.h)
-  EXPECT_NEAR(e.linear_srgb.g, 0.5, 2e-3);
-  EXPECT_NEAR(e.linear_srgb.b, 0.5, 2e-3);
+  EXPECT_NEAR(e.rgb.r, 0.5, 2e-3);  // D65 white -> sRGB white (spectrum.h)
+  EXPECT_NEAR(e.rgb.g, 0.5, 2e-3);
+  EXPECT_NEAR(e.rgb.b, 0.5, 2e-3);
   EXPECT_LT(e.hsv.s, 0.01);
   // A spectral constant table converts to equal RGB channels.
   const TabulatedBsdfTable rgb = table_to_rgb(constant_table(2, kNumBands, 1.0));

@@ -51,6 +51,32 @@ TEST(VerifyMeasured, BundledTableHasNineIncidencesAndThePapersSign) {
   EXPECT_DOUBLE_EQ(fits[0].beta[0][v0].r, 0.280098);
 }
 
+TEST(VerifyMeasured, ColourSpaceFromItsCommentLine) {
+  // The bundled MERL tables are camera RGB (materials/data/measured/README.md).
+  EXPECT_EQ(read_measured_inplane(bundled_measured_inplane()).colour_space,
+            MeasuredColourSpace::kCamera);
+  const fs::path dir = fresh_test_dir();
+  const fs::path p = dir / "space.csv";
+  const std::string table =
+      "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n0,0,1,1,1\n";
+  // Absent: unknown. Quoted as a spreadsheet writes it, with CRLF: read.
+  write_text_atomically(p, "# a table\n" + table);
+  EXPECT_EQ(read_measured_inplane(p).colour_space, MeasuredColourSpace::kUnknown);
+  write_text_atomically(p, "\"# a table\"\r\n\"# colour_space: srgb\"\r\n" + table);
+  EXPECT_EQ(read_measured_inplane(p).colour_space, MeasuredColourSpace::kSrgb);
+  // A bad value, or two lines: the file and the field.
+  for (const std::string head : {"# colour_space: xyz\n", "# colour_space:\n",
+                                 "# colour_space: srgb\n# colour_space: camera\n"}) {
+    write_text_atomically(p, head + table);
+    const std::string e = error_of([&] { read_measured_inplane(p); });
+    EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+    EXPECT_NE(e.find("colour_space"), std::string::npos) << head << " -> " << e;
+  }
+  EXPECT_NE(
+      error_of([] { parse_colour_space("sRGB", "", "--colour-space"); }).find("--colour-space"),
+      std::string::npos);
+}
+
 TEST(VerifyMeasured, OtherFitsAreOptionalButWholeAndChecked) {
   const fs::path dir = fresh_test_dir();
   const fs::path p = dir / "fits.csv";

@@ -3,6 +3,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "test_util.h"
@@ -63,6 +64,43 @@ TEST(VerifyReportFiles, AllOrNone) {
             std::string::npos);
   EXPECT_TRUE(fs::exists(other / "keep.txt"));
   EXPECT_FALSE(fs::exists(other / "metrics.json"));
+}
+
+// Against camera (or unknown) RGB the absolute figures and the measurement's colour are marked
+// not comparable in metrics.json and on the page; the shape and the paper's figures are not.
+TEST(VerifyReportFiles, CameraRgbMarksAbsoluteFiguresNotComparable) {
+  for (const auto space :
+       {MeasuredColourSpace::kCamera, MeasuredColourSpace::kUnknown, MeasuredColourSpace::kSrgb}) {
+    VerifyReport r = tiny_report();
+    r.measured.colour_space = space;
+    // Two models (the classic above and a computed one half as bright), scored.
+    ModelCurves c = r.models[0];
+    c.key = "computed_raytrace";
+    c.beta = {{Rgb(0.5), Rgb(0.4)}};
+    r.models.push_back(c);
+    for (auto& m : r.models) m.figures = model_figures(m.beta, {}, r.measured, {0, 0});
+    ColourEntry e;
+    e.name = "measured";
+    e.rgb = Rgb(0.5);
+    e.comparable = absolute_comparable(space);
+    r.colours.push_back(e);
+    const auto j = nlohmann::json::parse(verify_metrics_json(r));
+    const bool srgb = space == MeasuredColourSpace::kSrgb;
+    EXPECT_EQ(j.at("colour_space"), colour_space_name(space));
+    EXPECT_EQ(j.at("absolute_comparable"), srgb);
+    const auto& u = j.at("models").at("computed_raytrace").at("uncertainty");
+    EXPECT_EQ(u.at("absolute").at("comparable"), srgb);
+    EXPECT_EQ(u.at("shape").at("comparable"), true);
+    EXPECT_EQ(u.at("paper_normalized").at("comparable"), true);
+    ASSERT_EQ(j.at("verdict").at("absolute").size(), 1u);
+    EXPECT_EQ(j.at("verdict").at("absolute")[0].at("comparable"), srgb);
+    EXPECT_EQ(j.at("verdict").at("shape")[0].at("comparable"), true);
+    EXPECT_EQ(j.at("colour_table")[0].at("comparable"), srgb);
+    const std::string html = verify_index_html(r, {});
+    EXPECT_EQ(html.find("not comparable") != std::string::npos, !srgb);
+    // The verdict leads the page, above the plots.
+    EXPECT_LT(html.find("<h2>Verdict</h2>"), html.find("<h2>In-plane curves</h2>"));
+  }
 }
 
 }  // namespace

@@ -10,8 +10,8 @@ ColourEntry colour_of_spectrum(const std::string& name, const Spectrum& s,
   e.name = name;
   e.spectrum = s;
   e.note = note;
-  e.linear_srgb = xyz_to_linear_srgb(reflectance_to_xyz_d65(s));
-  Rgb c = e.linear_srgb;
+  e.rgb = xyz_to_linear_srgb(reflectance_to_xyz_d65(s));
+  Rgb c = e.rgb;
   GamutClip().clip(c);
   e.hsv = rgb_to_hsv(c);
   return e;

@@ -39,6 +39,21 @@ double parse_number(const std::string& text, const std::string& file, const std:
   throw Error(file, field, "'" + text + "' is not a finite number");
 }
 
+// A comment line's colour space, where it states one ("# colour_space: camera", quoted or not).
+std::optional<MeasuredColourSpace> comment_colour_space(std::string line, const std::string& file) {
+  const auto trim = [](std::string& t, const char* chars) {
+    t.erase(0, t.find_first_not_of(chars));
+    const size_t end = t.find_last_not_of(chars);
+    t.erase(end == std::string::npos ? 0 : end + 1);
+  };
+  trim(line, "\"# \t\r");
+  const std::string key = "colour_space:";
+  if (line.rfind(key, 0) != 0) return std::nullopt;
+  std::string value = line.substr(key.size());
+  trim(value, "\" \t\r");
+  return parse_colour_space(value, file, "colour_space");
+}
+
 // The columns of a table: the angles and the reference fit (required), and the other fits whose
 // three columns are all there (a fit with some of them is an error).
 struct Columns {
@@ -138,9 +153,16 @@ MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
   std::string line;
   std::vector<std::string> header;
   size_t line_no = 0;
+  std::optional<MeasuredColourSpace> space;
   while (std::getline(in, line)) {
     ++line_no;
-    if (line.empty() || line[0] == '#' || line.rfind("\"#", 0) == 0) continue;
+    if (line.empty() || line[0] == '#' || line.rfind("\"#", 0) == 0) {
+      if (const auto c = comment_colour_space(line, file)) {
+        if (space) throw Error(file, "colour_space", "given on two comment lines");
+        space = c;
+      }
+      continue;
+    }
     header = split_csv(line);
     break;
   }
@@ -159,7 +181,36 @@ MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
     read_row(f, col, file, where, rows);
   }
   if (rows.empty()) throw Error(file, "", "no data rows");
-  return measured_from_rows(rows, col, file);
+  MeasuredInplane m = measured_from_rows(rows, col, file);
+  m.colour_space = space.value_or(MeasuredColourSpace::kUnknown);
+  return m;
+}
+
+std::string colour_space_name(MeasuredColourSpace c) {
+  switch (c) {
+    case MeasuredColourSpace::kCamera:
+      return "camera";
+    case MeasuredColourSpace::kSrgb:
+      return "srgb";
+    case MeasuredColourSpace::kUnknown:
+      break;
+  }
+  return "unknown";
+}
+
+MeasuredColourSpace parse_colour_space(const std::string& text, const std::string& file,
+                                       const std::string& field) {
+  if (text == "camera") return MeasuredColourSpace::kCamera;
+  if (text == "srgb") return MeasuredColourSpace::kSrgb;
+  throw Error(file, field, "'" + text + "' is not a colour space: camera or srgb");
+}
+
+std::string not_comparable_note(MeasuredColourSpace c) {
+  if (absolute_comparable(c)) return "";
+  return c == MeasuredColourSpace::kCamera
+             ? "not comparable: the measurement is in camera RGB, the models in linear sRGB"
+             : "not comparable: the measurement's RGB space is unknown, the models are in linear "
+               "sRGB";
 }
 
 std::vector<MeasuredFit> measured_fits(const MeasuredInplane& m) {

@@ -76,6 +76,8 @@ VerifyPlan plan_verify(const VerifyRequest& o) {
   p.measured_path =
       o.measured.empty() ? bundled_measured_inplane() : std::filesystem::path(o.measured);
   p.measured = read_measured_inplane(p.measured_path);
+  if (!o.colour_space.empty())
+    p.measured.colour_space = parse_colour_space(o.colour_space, "", "--colour-space");
   // The fiber names a spec or preset, or (.exr) a baked fiber table, whose resolution the run
   // takes.
   if (std::filesystem::path(o.fiber).extension() == ".exr") {
@@ -179,6 +181,7 @@ JobPart verify_job(const VerifyPlan& p, Shard shard) {
   job.job = {{"options",
               {{"fiber", o.fiber},
                {"measured", o.measured},
+               {"colour_space", o.colour_space},
                {"weave", o.weave},
                {"pattern", o.pattern},
                {"wif", o.wif},
@@ -198,6 +201,7 @@ VerifyRequest verify_job_request(const JobPart& all, const std::string& output) 
   const auto& opt = all.job.at("options");
   o.fiber = opt.at("fiber").get<std::string>();
   o.measured = opt.at("measured").get<std::string>();
+  o.colour_space = opt.value("colour_space", "");
   o.weave = opt.at("weave").get<std::string>();
   o.pattern = opt.at("pattern").get<std::string>();
   o.wif = opt.at("wif").get<std::string>();

@@ -27,7 +27,11 @@ void html_head(std::ostringstream& h, const VerifyReport& r) {
 void html_metrics(std::ostringstream& h, const VerifyReport& r) {
   h << "<h2>All metrics (over every view, incidence and channel)</h2>\n<table><tr><th>model</th>"
        "<th>RMS log ratio, normalized</th><th>RMS relative, normalized</th><th>RMS log ratio, "
-       "absolute</th><th>RMS relative, absolute</th><th>normalization factor (R, G, B)</th>"
+       "absolute"
+    << (absolute_comparable(r.measured.colour_space) ? "" : " (not comparable)")
+    << "</th><th>RMS relative, absolute"
+    << (absolute_comparable(r.measured.colour_space) ? "" : " (not comparable)")
+    << "</th><th>normalization factor (R, G, B)</th>"
        "<th>points (excluded)</th></tr>\n";
   for (const auto& m : r.models)
     h << "<tr><td>" << html_escape(m.label) << "</td><td>" << fmt(m.normalized_overall.rms_log)
@@ -153,15 +157,16 @@ std::string swatch_style(const Hsv& hsv) {
 
 // The colour table (paper's Table 1) and the classic diffuse colour.
 void html_colours(std::ostringstream& h, const VerifyReport& r) {
-  h << "<h2>Colour (paper's Table 1): CIE 1931, D65</h2>\n<table><tr><th>what</th><th>linear "
-       "sRGB</th><th>H</th><th>S</th><th>V</th><th></th><th>note</th></tr>\n";
+  h << "<h2>Colour (paper's Table 1): CIE 1931, D65</h2>\n<table><tr><th>what</th><th>RGB</th>"
+       "<th>RGB space</th><th>H</th><th>S</th><th>V</th><th></th><th>note</th></tr>\n";
   for (const auto& c : r.colours) {
     h << "<tr><td>" << html_escape(c.name) << "</td><td>";
-    if (std::isfinite(c.linear_srgb.r))
-      h << fmt(c.linear_srgb.r) << ", " << fmt(c.linear_srgb.g) << ", " << fmt(c.linear_srgb.b);
+    if (std::isfinite(c.rgb.r))
+      h << fmt(c.rgb.r) << ", " << fmt(c.rgb.g) << ", " << fmt(c.rgb.b);
     else
       h << "&mdash;";
-    h << "</td><td>" << fmt(c.hsv.h) << "</td><td>" << fmt(c.hsv.s) << "</td><td>" << fmt(c.hsv.v)
+    h << "</td><td>" << html_escape(c.colour_space) << (c.comparable ? "" : " (not comparable)")
+      << "</td><td>" << fmt(c.hsv.h) << "</td><td>" << fmt(c.hsv.s) << "</td><td>" << fmt(c.hsv.v)
       << "</td><td style=\"" << swatch_style(c.hsv) << "\"></td><td>" << html_escape(c.note)
       << "</td></tr>\n";
   }

@@ -19,7 +19,8 @@ void figures_table(std::ostringstream& h, const VerifyReport& r) {
   h << "<table><tr><th>model</th><th>shape, RMS log (|view| &le; " << fmt(kShapeMaxViewDeg)
     << "&deg;)</th><th>shape beyond " << fmt(kShapeMaxViewDeg)
     << "&deg; (same gains)</th><th>shape gains (R, G, B)</th><th>paper's one-point "
-       "normalization, RMS log</th><th>absolute, RMS log</th></tr>\n";
+       "normalization, RMS log</th><th>absolute, RMS log"
+    << (absolute_comparable(r.measured.colour_space) ? "" : " (not comparable)") << "</th></tr>\n";
   for (const auto& m : r.models) {
     if (m.figures.fits.empty()) continue;
     const ShapeFigure& s = m.figures.shape;
@@ -38,7 +39,12 @@ void html_verdict(std::ostringstream& h, const VerifyReport& r) {
   const std::vector<Verdict> verdicts = verify_verdicts(r);
   h << "<h2>Verdict</h2>\n";
   for (int f = 0; f < 3; ++f) {
-    h << "<p><b>" << html_escape(figure_label(static_cast<FigureKind>(f))) << "</b></p>\n<ul>";
+    const bool shown_apart = f == kAbsoluteFigure && !absolute_comparable(r.measured.colour_space);
+    h << "<p><b>" << html_escape(figure_label(static_cast<FigureKind>(f))) << "</b>"
+      << (shown_apart ? " &mdash; <b>" + html_escape(not_comparable_note(r.measured.colour_space)) +
+                            "</b> (shown for what it is)"
+                      : "")
+      << "</p>\n<ul>";
     for (const Verdict& v : verdicts)
       if (v.figure == kFigureKeys[f]) h << "<li>" << html_escape(v.text) << "</li>";
     h << "</ul>\n";

@@ -59,7 +59,8 @@ nlohmann::json shape_json(const ShapeFigure& s, const MeasuredInplane& measured)
 }
 
 // A figure with its uncertainty: the seed's (batches) and the measurement's (its fits).
-nlohmann::json figure_json(const FigureSamples& f, const std::vector<std::string>& fits) {
+nlohmann::json figure_json(const FigureSamples& f, const std::vector<std::string>& fits,
+                           bool comparable) {
   nlohmann::json per_fit = nlohmann::json::object(), per_batch = nlohmann::json::array();
   for (size_t k = 0; k < fits.size(); ++k) per_fit[fits[k]] = number_json(f.mean[k]);
   if (!f.batch.empty())
@@ -71,13 +72,16 @@ nlohmann::json figure_json(const FigureSamples& f, const std::vector<std::string
           {"seed_se", number_json(f.seed_se())},
           {"per_fit", per_fit},
           {"fit_min", number_json(f.fit_min())},
-          {"fit_max", number_json(f.fit_max())}};
+          {"fit_max", number_json(f.fit_max())},
+          {"comparable", comparable}};
 }
 
-nlohmann::json uncertainty_json(const ModelFigures& f) {
+nlohmann::json uncertainty_json(const ModelFigures& f, MeasuredColourSpace space) {
   nlohmann::json u = {{"fits", f.fits}};
   if (f.fits.empty()) return u;
-  for (int k = 0; k < 3; ++k) u[kFigureKeys[k]] = figure_json(f.figure[k], f.fits);
+  for (int k = 0; k < 3; ++k)
+    u[kFigureKeys[k]] =
+        figure_json(f.figure[k], f.fits, k != kAbsoluteFigure || absolute_comparable(space));
   return u;
 }
 
@@ -103,7 +107,7 @@ nlohmann::json models_json(const VerifyReport& r) {
                      {"absolute", metrics_json(m.absolute_overall)},
                      {"normalized", metrics_json(m.normalized_overall)},
                      {"per_incidence", per},
-                     {"uncertainty", uncertainty_json(m.figures)}};
+                     {"uncertainty", uncertainty_json(m.figures, r.measured.colour_space)}};
     if (!m.figures.fits.empty()) models[m.key]["shape"] = shape_json(m.figures.shape, r.measured);
   }
   return models;
@@ -213,6 +217,7 @@ nlohmann::json verdict_json(const VerifyReport& r) {
                            {"same_sign_batches", d.same_sign_batches},
                            {"exceeds_seed", d.exceeds_seed},
                            {"resolved", d.resolved},
+                           {"comparable", d.comparable},
                            {"closer", d.resolved ? nlohmann::json(d.closer) : nlohmann::json()},
                            {"text", d.text}});
   }
@@ -223,7 +228,14 @@ nlohmann::json colours_json(const std::vector<ColourEntry>& entries) {
   nlohmann::json colours = nlohmann::json::array();
   for (const auto& c : entries) {
     nlohmann::json e = {{"name", c.name}, {"hsv", {c.hsv.h, c.hsv.s, c.hsv.v}}, {"note", c.note}};
-    if (std::isfinite(c.linear_srgb.r)) e["linear_srgb"] = rgb_json(c.linear_srgb);
+    if (std::isfinite(c.rgb.r)) {
+      if (c.colour_space == "linear sRGB")
+        e["linear_srgb"] = rgb_json(c.rgb);
+      else
+        e["rgb"] = rgb_json(c.rgb);
+    }
+    e["colour_space"] = c.colour_space;
+    e["comparable"] = c.comparable;
     if (c.spectrum) e["spectrum"] = *c.spectrum;
     colours.push_back(e);
   }
@@ -252,6 +264,15 @@ std::string verify_metrics_json(const VerifyReport& r) {
   nlohmann::json j;
   j["report"] = "weft verify";
   j["measured"] = r.measured.file;
+  // The measurement's RGB space, and whether the figures that include the colour's level (the
+  // absolute ones, the colour table's absolute colour) compare with the models' linear sRGB.
+  j["colour_space"] = colour_space_name(r.measured.colour_space);
+  j["absolute_comparable"] = absolute_comparable(r.measured.colour_space);
+  if (!absolute_comparable(r.measured.colour_space))
+    j["absolute_note"] =
+        not_comparable_note(r.measured.colour_space) +
+        "; the shape and the paper's normalized figures stay comparable (per-channel "
+        "gains absorb the diagonal part of a change of RGB space)";
   j["fiber"] = r.fiber_name;
   j["sample"] = r.sample_name;
   const VerifySettings& s = r.settings;

@@ -34,8 +34,13 @@ std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
       const ModelCurves* b = find(kb);
       if (!a || !b || a->figures.fits.empty() || b->figures.fits.empty()) continue;
       const auto kind = static_cast<FigureKind>(f);
-      out.push_back(compare_figure(kind, ka, verdict_model_name(ka), a->figures.figure[f], kb,
-                                   verdict_model_name(kb), b->figures.figure[f]));
+      Verdict v = compare_figure(kind, ka, verdict_model_name(ka), a->figures.figure[f], kb,
+                                 verdict_model_name(kb), b->figures.figure[f]);
+      if (kind == kAbsoluteFigure && !absolute_comparable(r.measured.colour_space)) {
+        v.comparable = false;
+        v.text += " [" + not_comparable_note(r.measured.colour_space) + "]";
+      }
+      out.push_back(std::move(v));
     }
   return out;
 }

@@ -216,9 +216,11 @@ std::filesystem::path measured_network(const MeasuredInplane& measured) {
 }
 
 // The colour table (paper's Table 1): the spectral ray-traced fabric at normal incidence, the
-// summation's and the classic colour's spectra, the paper's figure and the measurement's.
+// summation's and the classic colour's spectra, the measurement's (the reference, in its own RGB
+// space) and the paper's figure for its fabric.
 std::vector<ColourEntry> colour_table(const TabulatedBsdfTable& computed, const VerifyInputs& in,
-                                      const Rgb& measured_at_normal) {
+                                      const Rgb& measured_at_normal,
+                                      MeasuredColourSpace measured_space) {
   std::vector<ColourEntry> out;
   if (computed.channels == kNumBands) {
     const FabricSpectra sp = normal_incidence_spectra(computed);
@@ -238,18 +240,26 @@ std::vector<ColourEntry> colour_table(const TabulatedBsdfTable& computed, const 
                                        in.volume_albedo,
                                        "before clipping to [0, 1]; " + in.classic_source));
   }
+  ColourEntry measured;
+  measured.name = "measured (this table), normal incidence and view: the reference";
+  measured.rgb = measured_at_normal;
+  measured.hsv = rgb_to_hsv(measured.rgb);
+  measured.comparable = absolute_comparable(measured_space);
+  measured.colour_space = measured_space == MeasuredColourSpace::kSrgb     ? "linear sRGB"
+                          : measured_space == MeasuredColourSpace::kCamera ? "camera RGB"
+                                                                           : "RGB of unknown space";
+  measured.note = "beta at normal incidence and view, in the measurement's own RGB space" +
+                  (measured.comparable ? std::string()
+                                       : "; " + not_comparable_note(measured_space) +
+                                             " (hue only roughly comparable)");
+  out.push_back(measured);
   ColourEntry paper;
   paper.name = "real fabric (paper, Table 1)";
   paper.hsv = {0.98, 0.99, 0.8};
-  paper.linear_srgb = {std::nan(""), std::nan(""), std::nan("")};
-  paper.note = "Voloboy et al. 2010, Table 1 (HSV only)";
+  paper.rgb = {std::nan(""), std::nan(""), std::nan("")};
+  paper.colour_space = "HSV only";
+  paper.note = "Voloboy et al. 2010, Table 1: the paper's own red fabric, not this measurement";
   out.push_back(paper);
-  ColourEntry merl;
-  merl.name = "measured (this table), normal incidence and view";
-  merl.linear_srgb = measured_at_normal;
-  merl.hsv = rgb_to_hsv(merl.linear_srgb);
-  merl.note = "camera RGB of the measurement's database, not sRGB: hue only roughly comparable";
-  out.push_back(merl);
   return out;
 }
 
@@ -331,7 +341,8 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   rep.measured_nbrdf = measured_network(measured);
 
   for (auto& m : rep.models) score(m, measured, *normal.curve, normal.view);
-  rep.colours = colour_table(computed.mean, in, normal.curve->beta[normal.view]);
+  rep.colours =
+      colour_table(computed.mean, in, normal.curve->beta[normal.view], measured.colour_space);
   rep.seconds["verify_library"] = seconds_since(t_all);
   return rep;
 }

@@ -11,8 +11,14 @@ namespace weft {
 struct ColourEntry {
   std::string name;
   std::optional<Spectrum> spectrum;  // absent for entries given as RGB or HSV
-  Rgb linear_srgb;                   // D65, unclipped (negative = out of gamut)
-  Hsv hsv;                           // of the linear sRGB with negative components set to 0
+  // In 'colour_space': linear sRGB (D65, unclipped: negative = out of gamut) for Weft's own; a
+  // measurement's in its own RGB space.
+  Rgb rgb;
+  std::string colour_space = "linear sRGB";
+  Hsv hsv;  // of the RGB with negative components set to 0
+  // Whether its absolute colour compares with the models' linear sRGB (a measurement in camera
+  // RGB or an unknown space does not).
+  bool comparable = true;
   std::string note;
 };
 

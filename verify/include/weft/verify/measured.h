@@ -24,8 +24,26 @@ struct MeasuredFit {
   InplaneCurves beta;
 };
 
+// The RGB space of a measured table's values: its comment line "# colour_space: camera" or
+// "# colour_space: srgb" (linear sRGB); unknown without one.
+enum class MeasuredColourSpace { kUnknown, kCamera, kSrgb };
+std::string colour_space_name(MeasuredColourSpace c);  // "unknown", "camera", "srgb"
+// "camera" or "srgb"; weft::Error naming 'file' and 'field' otherwise.
+MeasuredColourSpace parse_colour_space(const std::string& text, const std::string& file,
+                                       const std::string& field);
+// Whether a figure that includes the colour's level (absolute) compares with the models' linear
+// sRGB: only a measurement in linear sRGB. Per-channel gains (the shape, the paper's
+// normalization) absorb the diagonal part of a change of RGB space, so those stay comparable.
+inline bool absolute_comparable(MeasuredColourSpace c) {
+  return c == MeasuredColourSpace::kSrgb;
+}
+// Why not, in words ("not comparable: the measurement is in camera RGB, the models in linear
+// sRGB"); empty when comparable.
+std::string not_comparable_note(MeasuredColourSpace c);
+
 struct MeasuredInplane {
   std::string file;
+  MeasuredColourSpace colour_space = MeasuredColourSpace::kUnknown;
   std::vector<MeasuredCurve> curves;  // by increasing theta_i; beta: the reference fit, "nbrdf"
   // Other fits of the same measurement, where the table has them (beta = pi f_r of its sgd_fr_*
   // and abc_fr_* columns): what the measurement's own spread is judged by.
@@ -37,12 +55,12 @@ struct MeasuredInplane {
 std::vector<MeasuredFit> measured_fits(const MeasuredInplane& measured);
 
 // Reads a table in the format of materials/data/measured/*/inplane.csv: optional comment lines
-// starting with '#' or '"#', a header naming at least theta_i_deg, theta_o_deg, nbrdf_beta_R,
-// nbrdf_beta_G, nbrdf_beta_B, and one row per (theta_i, theta_o) with theta_o < 0 on the mirror
-// side (that table's convention; flipped here). The optional columns sgd_fr_R/G/B and
-// abc_fr_R/G/B (each fit all three or none) are kept as other_fits. weft::Error naming the file and
-// the column (or line) on a missing file or column, a non-number, a negative or non-finite beta, an
-// angle out of range, or a duplicate row.
+// starting with '#' or '"#' (one of them may be "# colour_space: camera|srgb"), a header naming at
+// least theta_i_deg, theta_o_deg, nbrdf_beta_R, nbrdf_beta_G, nbrdf_beta_B, and one row per
+// (theta_i, theta_o) with theta_o < 0 on the mirror side (that table's convention; flipped here).
+// The optional columns sgd_fr_R/G/B and abc_fr_R/G/B (each fit all three or none) are kept as
+// other_fits. weft::Error naming the file and the column (or line) on a missing file or column, a
+// non-number, a negative or non-finite beta, an angle out of range, or a duplicate row.
 MeasuredInplane read_measured_inplane(const std::filesystem::path& path);
 
 // The bundled MERL red fabric (materials/data/measured/merl-red-fabric/inplane.csv), found in the

@@ -19,7 +19,8 @@ namespace weft {
 
 // What a user asks of weft verify. Paths are as given; empty strings are options not given.
 struct VerifyRequest {
-  std::string measured;              // measured in-plane table (empty: the bundled MERL red fabric)
+  std::string measured;      // measured in-plane table (empty: the bundled MERL red fabric)
+  std::string colour_space;  // the table's RGB space, "srgb" or "camera" (empty: its comment line)
   std::string fiber = "red-cotton";  // fiber spec (.json) or preset, or a baked fiber table (.exr)
   std::string weave;                 // woven sample options (.json; empty: the bundled poplin)
   std::string pattern, wif;          // weave pattern or WIF draft over the sample's (one of them)

@@ -25,6 +25,9 @@ struct Verdict {
   std::vector<double> difference_per_fit;
   bool same_sign_fits = false, same_sign_batches = false, exceeds_seed = false;
   bool resolved = false;
+  // False for a figure that includes the colour's level against a measurement not in linear sRGB
+  // (measured.h absolute_comparable): shown, labelled, and no verdict on it is meant.
+  bool comparable = true;
   std::string closer;  // the closer model's key when resolved, else empty
   std::string text;    // in words, one sentence
 };
