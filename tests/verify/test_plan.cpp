@@ -47,6 +47,10 @@ TEST(VerifyPlan, ReadsTheInputsOfADraftRun) {
   EXPECT_FALSE(p.shard);
   EXPECT_EQ(p.weave.detail, "fiber");  // the fiber-level reference
   EXPECT_TRUE(p.fit_names.empty());
+  // The bundled table's colour space, from its comment line; --colour-space over it.
+  EXPECT_EQ(p.measured.colour_space, MeasuredColourSpace::kCamera);
+  r.colour_space = "srgb";
+  EXPECT_EQ(plan_verify(r).measured.colour_space, MeasuredColourSpace::kSrgb);
 }
 
 TEST(VerifyPlan, BadRequestsAreRefusedNamingTheOption) {
@@ -65,6 +69,7 @@ TEST(VerifyPlan, BadRequestsAreRefusedNamingTheOption) {
       {[](VerifyRequest& r) { r.pattern = "plain", r.wif = "x.wif"; }, "--wif"},
       {[](VerifyRequest& r) { r.classic_albedo = "0.3,0.2"; }, "--classic-albedo"},
       {[](VerifyRequest& r) { r.shard = "3/2"; }, "--shard"},
+      {[](VerifyRequest& r) { r.colour_space = "xyz"; }, "field '--colour-space'"},
       {[](VerifyRequest& r) { r.fiber = "no-such-fiber"; }, "no-such-fiber"}};
   for (const auto& c : cases) {
     VerifyRequest r;
@@ -94,6 +99,7 @@ TEST(VerifyPlan, AJobsRequestPlansTheSameJob) {
   r.seed = 5;
   r.threads = 3;
   r.pattern = "twill:2/1";
+  r.colour_space = "srgb";
   r.shard = "1/4";
   r.output = "part-1.part";
   const VerifyPlan p = plan_verify(r);
@@ -108,6 +114,7 @@ TEST(VerifyPlan, AJobsRequestPlansTheSameJob) {
   EXPECT_EQ(again.output, "report");
   EXPECT_EQ(again.threads, 3);
   EXPECT_EQ(again.pattern, "twill:2/1");
+  EXPECT_EQ(again.colour_space, "srgb");
   EXPECT_TRUE(again.shard.empty());
   EXPECT_EQ(job_difference(job, verify_job(plan_verify(again), job.shard)), "");
 }
