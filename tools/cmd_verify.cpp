@@ -11,8 +11,11 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "plot_util.h"
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
 #include "weft/verify/plan.h"
 #include "weft/verify/report.h"
+#include "weft/verify/suite.h"
 #include "weft/verify/whole_run.h"
 
 namespace weft::cli {
@@ -21,6 +24,10 @@ namespace {
 struct VerifyCliOptions {
   VerifyRequest request;
   bool quiet = false, json = false;
+  bool suite = false;      // every fabric of a suite file
+  std::string suite_file;  // empty: the bundled suite
+  // Options given that a suite's fabrics set themselves.
+  std::vector<std::string> per_fabric_given;
 };
 
 double since(std::chrono::steady_clock::time_point t0) {
@@ -105,18 +112,10 @@ void print_summary(const VerifyPlan& p, const VerifyReport& report, double secon
   }
 }
 
-// The whole run, a shard of it, or the merge of a sharded one ('all': every unit of its ray
-// traces).
-int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
-  const auto t_all = std::chrono::steady_clock::now();
-  const VerifyRequest& r = o.request;
-  const VerifyPlan p = plan_verify(r);
-  if (p.shard) {
-    validate_output_paths({r.output}, {p.measured_path.string(), r.weave, r.wif, r.fiber});
-  } else {
-    check_verify_output(r.output);
-    if (!all) check_verify_time(o, p);  // a merge's ray traces are done
-  }
+// The run of a checked plan, with the progress bar and the plots.
+VerifyOutcome run_checked(const VerifyCliOptions& o, const VerifyPlan& p,
+                          std::chrono::steady_clock::time_point t_all, const JobPart* all) {
+  const VerifyRequest& r = p.request;
   VerifyHooks hooks;
   hooks.progress = progress_bar(o.quiet);
   hooks.interrupted = interrupted;
@@ -130,7 +129,22 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
         r.output);
   };
   hooks.started = t_all;
-  const VerifyOutcome out = run_verify_plan(p, hooks, all);
+  return run_verify_plan(p, hooks, all);
+}
+
+// The whole run, a shard of it, or the merge of a sharded one ('all': every unit of its ray
+// traces).
+int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
+  const auto t_all = std::chrono::steady_clock::now();
+  const VerifyRequest& r = o.request;
+  const VerifyPlan p = plan_verify(r);
+  if (p.shard) {
+    validate_output_paths({r.output}, {p.measured_path.string(), r.weave, r.wif, r.fiber});
+  } else {
+    check_verify_output(r.output);
+    if (!all) check_verify_time(o, p);  // a merge's ray traces are done
+  }
+  const VerifyOutcome out = run_checked(o, p, t_all, all);
   if (out.cancelled) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
     return 130;
@@ -147,6 +161,69 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
     print_summary(p, out.report, since(t_all));
   }
   return 0;
+}
+
+// Every fabric of a suite: all planned (inputs read and checked) and the whole suite's time
+// checked before any work; then one report each, then the suite's page.
+int run_suite(const VerifyCliOptions& o) {
+  const auto t_all = std::chrono::steady_clock::now();
+  if (!o.per_fabric_given.empty())
+    throw Error("", o.per_fabric_given.front(),
+                "is set per fabric by the suite file; not with --suite");
+  const VerifyRequest& base = o.request;
+  const VerifySuite suite = read_verify_suite(
+      o.suite_file.empty() ? bundled_verify_suite() : std::filesystem::path(o.suite_file));
+  check_suite_output(base.output);
+  std::vector<VerifyPlan> plans;
+  VerifyEstimate total;
+  for (const SuiteFabric& f : suite.fabrics) {
+    plans.push_back(plan_verify(suite_request(f, base, base.output)));
+    const VerifyEstimate e = estimate_verify(plans.back());
+    total.typical += e.typical;
+    total.least += e.least;
+    total.cores = e.cores;
+  }
+  if (!o.quiet)
+    std::fprintf(stderr,
+                 "weft verify --suite: %zu fabrics of %s, quality %s: about %s on %u cores\n",
+                 plans.size(), suite.file.string().c_str(), base.quality.c_str(),
+                 format_seconds(total.typical / total.cores).c_str(), total.cores);
+  check_long_work(total.least, 1.0, base.threads, "", "--quality",
+                  "weft verify --suite at quality " + base.quality, kVerifyLeastRates);
+  std::filesystem::create_directories(base.output);
+  std::vector<SuiteRow> rows;
+  bool failed = false;
+  for (size_t k = 0; k < plans.size(); ++k) {
+    SuiteRow row{suite.fabrics[k], nullptr, ""};
+    if (!o.quiet)
+      std::fprintf(stderr, "weft verify --suite: fabric %zu of %zu, %s\n", k + 1, plans.size(),
+                   row.fabric.name.c_str());
+    try {
+      const VerifyOutcome out = run_checked(o, plans[k], std::chrono::steady_clock::now(), nullptr);
+      if (out.cancelled) {
+        std::fprintf(stderr,
+                     "\nweft: verify --suite cancelled; the finished fabrics' reports "
+                     "stay, the suite's page was not written\n");
+        return 130;
+      }
+      row.metrics = nlohmann::json::parse(verify_metrics_json(out.report));
+    } catch (const Error& e) {
+      row.error = e.what();
+      failed = true;
+      std::fprintf(stderr, "weft: %s: %s\n", row.fabric.name.c_str(), e.what());
+    }
+    rows.push_back(std::move(row));
+  }
+  write_text_atomically(std::filesystem::path(base.output) / "suite.json",
+                        verify_suite_json(suite, rows));
+  write_text_atomically(std::filesystem::path(base.output) / "index.html",
+                        verify_suite_html(suite, rows));
+  if (o.json)
+    std::cout << verify_suite_json(suite, rows);
+  else
+    std::printf("%s: %zu fabrics, quality %s, %.1f s\n%s", base.output.c_str(), rows.size(),
+                base.quality.c_str(), since(t_all), verify_suite_text(rows).c_str());
+  return failed ? 1 : 0;
 }
 
 }  // namespace
@@ -211,7 +288,18 @@ void add_verify_command(CLI::App& app, Commands& commands) {
   sub->add_option("--shard", r.shard,
                   "K/N: run only shard K of N of the ray traces (their incident bins) into a part "
                   "file -o PART; `weft merge` makes the report folder from all parts");
-  commands.push_back({sub, [o] { return run(*o); }});
+  sub->add_flag("--suite", o->suite,
+                "every bundled measurement with its sample's description (verify/data/suite.json): "
+                "a report per fabric in -o DIR and one page over them (index.html, suite.json)");
+  sub->add_option("--suite-file", o->suite_file, "a suite file in place of the bundled one")
+      ->each([o](const std::string&) { o->suite = true; });
+  commands.push_back({sub, [o, sub] {
+                        if (!o->suite) return run(*o);
+                        for (const char* name : {"--measured", "--fiber", "--weave", "--pattern",
+                                                 "--wif", "--shard", "--fit", "--classic-albedo"})
+                          if (sub->count(name) > 0) o->per_fabric_given.push_back(name);
+                        return run_suite(*o);
+                      }});
 }
 
 int merge_verify(const JobPart& all, const std::string& output, bool json) {

@@ -6,9 +6,9 @@
 #include <system_error>
 
 #include "weft/core/error.h"
-#include "weft/core/params.h"
 #include "weft/core/install_paths.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
 
 #ifndef WEFT_DATA_DIR
 #define WEFT_DATA_DIR ""
@@ -103,8 +103,16 @@ Rgb NbrdfNetwork::eval_upper(const Vec3& wo, const Vec3& wi) const {
   return {out[0], out[1], out[2]};
 }
 
+// The folders of materials/data/measured (listed there in samples.json, made by make_inplane.py).
 std::vector<std::string> measured_nbrdf_names() {
-  return {"merl-red-fabric", "merl-white-fabric"};
+  return {"merl-red-fabric",           "merl-white-fabric",       "merl-red-fabric2",
+          "merl-white-fabric2",        "merl-blue-fabric",        "merl-green-fabric",
+          "merl-pink-fabric",          "merl-pink-fabric2",       "merl-pink-felt",
+          "merl-beige-fabric",         "merl-black-fabric",       "merl-light-brown-fabric",
+          "merl-dark-specular-fabric", "rgl-acrylic-felt-green",  "rgl-acrylic-felt-orange",
+          "rgl-acrylic-felt-pink",     "rgl-acrylic-felt-purple", "rgl-acrylic-felt-white",
+          "rgl-acrylic-felt-yellow",   "rgl-satin-blue",          "rgl-satin-gold",
+          "rgl-satin-purple",          "rgl-satin-rosaline",      "rgl-satin-white"};
 }
 
 std::filesystem::path find_measured_nbrdf(const std::string& name) {

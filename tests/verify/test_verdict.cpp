@@ -39,6 +39,10 @@ TEST(VerifyVerdict, ResolvedWhenEveryFitAndBatchAgreeAndTheDifferenceExceedsTheS
                                    "computed_raytrace", "the computed model", a);
   EXPECT_TRUE(w.resolved);
   EXPECT_EQ(w.closer, "computed_raytrace");
+  // The closer model's figure comes first in the words.
+  EXPECT_NE(w.text.find("the computed model is closer than the classic model (0.3 vs 0.6"),
+            std::string::npos)
+      << w.text;
 }
 
 TEST(VerifyVerdict, NotResolvedWhenTheMeasurementsFitsDisagreeOnTheSign) {

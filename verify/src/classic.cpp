@@ -18,6 +18,10 @@ std::vector<double> classic_diffuse_from_fiber_table(const TabulatedBsdfTable& f
   return out;
 }
 
+double classic_entering_fraction(const MicrofacetDistribution& d, double ior) {
+  return 1 - ClassicFiberBsdf::create(Rgb(0.0), d, ior).surface_albedo->average;
+}
+
 std::optional<MicrofacetDistribution> fiber_table_roughness(const TabulatedBsdfTable& t,
                                                             const std::string& file) {
   const auto it = t.metadata.find("roughness");

@@ -261,18 +261,22 @@ void classic_from_table(const std::string& file, const TabulatedBsdfTable& t,
   } else {
     rgb = Rgb(diffuse[0], diffuse[1], diffuse[2]);
   }
+  // As a reflectance of the light that gets past the lobe (classic.h).
+  const double entering = classic_entering_fraction(*rough, in.classic_ior);
   for (int k = 0; k < 3; ++k) {
+    rgb[k] /= entering;
     const double v = rgb[k];
     if (!(v >= 0 && v <= 1))
       throw Error(file, "--classic-albedo",
                   "the classic baseline's diffuse colour from the table (its total albedo minus "
-                  "the Cook-Torrance lobe's) is " +
+                  "the Cook-Torrance lobe's, over what the lobe leaves) is " +
                       std::to_string(v) + " in channel " + "RGB"[k] +
                       ", not a reflectance in [0, 1]: give --classic-albedo R,G,B");
   }
   if (t.channels != kNumBands) in.classic_diffuse = rgb;
   in.classic_source =
-      "the fiber table: its total albedo minus the classic Cook-Torrance lobe's, per " +
+      "the fiber table: its total albedo minus the classic Cook-Torrance lobe's, over what the "
+      "lobe leaves, per " +
       std::string(t.channels == kNumBands ? "band" : "channel") +
       "; the table header's roughness; " + ior_source;
 }

@@ -9,6 +9,7 @@
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
 #include "weft/materials/classic_fiber.h"
+#include "weft/verify/classic.h"
 #include "weft/verify/inplane.h"
 
 namespace weft {
@@ -235,10 +236,13 @@ std::vector<ColourEntry> colour_table(const TabulatedBsdfTable& computed, const 
       out.push_back(colour_of_spectrum("paper's summation, reflection", ss.reflectance,
                                        "the summation transmits nothing"));
     }
-    if (!in.classic_diffuse)
-      out.push_back(colour_of_spectrum("fiber volume albedo (classic diffuse colour)",
-                                       in.volume_albedo,
-                                       "before clipping to [0, 1]; " + in.classic_source));
+    if (!in.classic_diffuse) {
+      const double entering = classic_entering_fraction(in.classic_distribution, in.classic_ior);
+      Spectrum diffuse = in.volume_albedo;
+      for (double& v : diffuse) v /= entering;
+      out.push_back(colour_of_spectrum("classic diffuse colour (fiber volume albedo / (1 - E))",
+                                       diffuse, "before clipping to [0, 1]; " + in.classic_source));
+    }
   }
   ColourEntry measured;
   measured.name = "measured (this table), normal incidence and view: the reference";
@@ -275,9 +279,12 @@ std::vector<VerifyTrace> verify_traces(const VerifySettings& s) {
 ClassicFiber verify_classic_fiber(const VerifyInputs& in, const VerifySettings& s,
                                   const ProgressCallback& progress) {
   ClassicFiber c;
-  // The fiber's volume albedo as a reflectance: components outside [0, 1] are removed (and
-  // reported).
-  Rgb refl = bands_to_linear_srgb([&](int b) { return in.volume_albedo[b]; });
+  // The fiber's volume albedo is a share of all the light hitting the fiber; the classic fiber's
+  // reflectance is the albedo of the light that gets past its surface lobe, so it is the volume
+  // albedo divided by what the lobe leaves (classic.h). Components outside [0, 1] are removed
+  // (and reported).
+  const double entering = classic_entering_fraction(in.classic_distribution, in.classic_ior);
+  Rgb refl = bands_to_linear_srgb([&](int b) { return in.volume_albedo[b] / entering; });
   c.clip.clip(refl);
   for (double* v : {&refl.r, &refl.g, &refl.b})
     if (*v > 1) {

@@ -27,7 +27,10 @@ int sign(double x) {
 
 std::string verdict_text(const Verdict& v, FigureKind figure, const std::string& a_name,
                          const std::string& b_name) {
-  const std::string values = fmt(v.a_value, 2) + " vs " + fmt(v.b_value, 2) + " RMS log";
+  // The closer model's figure first when resolved; else in the pair's order.
+  const bool b_first = v.resolved && v.closer == v.b;
+  const std::string values = fmt(b_first ? v.b_value : v.a_value, 2) + " vs " +
+                             fmt(b_first ? v.a_value : v.b_value, 2) + " RMS log";
   const std::string seed =
       fmt(std::abs(v.difference), 2) + " +- " + fmt(v.difference_seed_se, 1) + " seed";
   double lo = v.difference_per_fit.at(0), hi = lo;
@@ -50,9 +53,9 @@ std::string verdict_text(const Verdict& v, FigureKind figure, const std::string&
   else
     why = "the sign differs between batches";
   return figure_name(figure) + ", " + a_name + " vs " + b_name + ": not resolved (" + values +
-         ", difference a - b " + fmt(v.difference, 2) + " +- " + fmt(v.difference_seed_se, 1) +
-         " seed, " + fmt(lo, 2) + ".." + fmt(hi, 2) + " against the " + fits +
-         " of the measurement; " + why + ")";
+         ", difference (first minus second) " + fmt(v.difference, 2) + " +- " +
+         fmt(v.difference_seed_se, 1) + " seed, " + fmt(lo, 2) + ".." + fmt(hi, 2) +
+         " against the " + fits + " of the measurement; " + why + ")";
 }
 
 }  // namespace

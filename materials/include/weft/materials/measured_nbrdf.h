@@ -1,11 +1,12 @@
 #pragma once
-// Measured fabric BRDFs from MERL (Matusik et al. 2003) through their neural fits (Sztrajman,
-// Rainer, Ritschel, Weyrich, "Neural BRDF Representation and Importance Sampling", CGF 2021):
-// a 6-21-21-3 MLP
+// Measured fabric BRDFs from MERL (Matusik et al. 2003) and RGL (Dupuy & Jakob 2018) through
+// their neural fits (Sztrajman, Rainer, Ritschel, Weyrich, "Neural BRDF Representation and
+// Importance Sampling", CGF 2021): a 6-21-21-3 MLP
 //   f_r = max(exp(W3^T relu(W2^T relu(W1^T x + b1) + b2) + b3) - 1, 0)   [1/sr, per RGB channel]
 // with x = (sin theta_h, 0, cos theta_h, d_x, d_y, d_z): Rusinkiewicz half/difference coordinates,
 // h = normalize(wi + wo), d = R_y(-theta_h) R_z(-phi_h) wi, wi towards the light.
-// Colours are MERL's camera RGB, not sRGB (see materials/data/measured/README.md).
+// Colours are MERL's camera RGB (merl-*) or linear sRGB (rgl-*), as each folder's inplane.csv
+// states (materials/data/measured/README.md).
 // The measurement is reflection only: f = 0 when wo and wi lie on opposite sides; for wo.z < 0
 // both directions are mirrored (the back side is the same material), like the other reflectors.
 // Sampling is cosine-weighted on wo's side.
@@ -37,7 +38,7 @@ struct NbrdfNetwork {
   Rgb eval_upper(const Vec3& wo, const Vec3& wi) const;
 };
 
-// Bundled measured materials ("merl-red-fabric", "merl-white-fabric").
+// Bundled measured materials: the folders of materials/data/measured ("merl-red-fabric", ...).
 std::vector<std::string> measured_nbrdf_names();
 // The weights file of a bundled material: looked up in the data folder compiled in
 // (WEFT_DATA_DIR = materials/data of the source tree) and then relative to the executable

@@ -48,7 +48,8 @@ struct VerifyInputs {
   std::string fiber_name, sample_name;
   // Where the classic model's colour, roughness and index came from (for the report).
   std::string classic_source =
-      "the fiber spec: volume albedo of the bake, the spec's roughness "
+      "the fiber spec: volume albedo of the bake over the share past the classic lobe, the "
+      "spec's roughness "
       "and index at 550 nm";
   std::map<std::string, double> seconds;  // timings of the caller's steps (fiber bake, ...)
 };

@@ -1,0 +1,116 @@
+// weft verify --suite (verify/suite.h): the suite file is read and checked field by field, every
+// bundled fabric plans, a fabric's request carries its own inputs, and the summary reads each
+// report's figures back (a failed fabric is a row that says why).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "test_util.h"
+#include "weft/verify/suite.h"
+
+namespace fs = std::filesystem;
+using weft::testing::error_of;
+using weft::testing::fresh_test_dir;
+
+namespace weft {
+namespace {
+
+void write(const fs::path& p, const std::string& text) {
+  std::ofstream(p) << text;
+}
+
+// A suite file in 'dir' with one fabric whose fields are 'fabric' (JSON members), and a measured
+// file beside it.
+fs::path suite_with(const fs::path& dir, const std::string& fabric) {
+  write(dir / "m.csv", "theta_i_deg,theta_o_deg\n");
+  const fs::path f = dir / "suite.json";
+  write(f, "{\"title\": \"t\", \"fabrics\": [{" + fabric + "}]}");
+  return f;
+}
+
+TEST(VerifySuite, EveryBundledFabricPlans) {
+  const VerifySuite s = read_verify_suite(bundled_verify_suite());
+  ASSERT_GE(s.fabrics.size(), 2u);
+  VerifyRequest base;
+  base.quality = "draft";
+  for (const SuiteFabric& f : s.fabrics) {
+    EXPECT_FALSE(f.known.empty()) << f.name;
+    const VerifyRequest r = suite_request(f, base, "/tmp/out");
+    EXPECT_EQ(r.output, "/tmp/out/" + f.name);
+    EXPECT_EQ(r.quality, "draft");
+    EXPECT_EQ(r.measured, f.measured);
+    const VerifyPlan p = plan_verify(r);  // inputs read and checked
+    EXPECT_FALSE(p.measured.curves.empty()) << f.name;
+  }
+}
+
+TEST(VerifySuite, FieldsAreCheckedAndNamed) {
+  const fs::path dir = fresh_test_dir();
+  const std::string ok = R"("name": "a", "measured": "m.csv", "fiber": "red-cotton", "known": "k")";
+  const VerifySuite s = read_verify_suite(suite_with(dir, ok));
+  ASSERT_EQ(s.fabrics.size(), 1u);
+  EXPECT_EQ(fs::path(s.fabrics[0].measured), (dir / "m.csv").lexically_normal());
+  EXPECT_EQ(s.fabrics[0].fiber, "red-cotton");  // a preset: no such file
+
+  const auto error = [&](const std::string& fabric) {
+    return error_of([&] { read_verify_suite(suite_with(dir, fabric)); });
+  };
+  EXPECT_NE(error(ok + R"(, "colour": "red")").find("colour"), std::string::npos);
+  EXPECT_NE(error(R"("name": "../x", "measured": "m.csv", "fiber": "f", "known": "k")")
+                .find("fabrics[0].name"),
+            std::string::npos);
+  EXPECT_NE(error(R"("name": "a", "measured": "none.csv", "fiber": "f", "known": "k")")
+                .find("fabrics[0].measured"),
+            std::string::npos);
+  EXPECT_NE(error(ok + R"(, "colour_space": "xyz")").find("fabrics[0].colour_space"),
+            std::string::npos);
+  EXPECT_NE(error(R"("name": "a", "measured": "m.csv", "fiber": "f")").find("known"),
+            std::string::npos);
+  write(dir / "twice.json", "{\"title\": \"t\", \"fabrics\": [{" + ok + "}, {" + ok + "}]}");
+  EXPECT_NE(error_of([&] { read_verify_suite(dir / "twice.json"); }).find("fabrics[1].name"),
+            std::string::npos);
+  write(dir / "empty.json", R"({"title": "t", "fabrics": []})");
+  EXPECT_NE(error_of([&] { read_verify_suite(dir / "empty.json"); }).find("fabrics"),
+            std::string::npos);
+  EXPECT_NE(error_of([&] { read_verify_suite(dir / "missing.json"); }).find("missing.json"),
+            std::string::npos);
+}
+
+TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
+  VerifySuite s;
+  s.title = "two";
+  SuiteRow good{{"good", "m.csv", "red-cotton", "", "", "", "camera", "a red cloth"}, {}, ""};
+  good.metrics = nlohmann::json::parse(R"({"models": {"computed_raytrace":
+      {"shape": {"rms_log": 0.31}, "normalized": {"rms_log": 0.73}, "absolute": {"rms_log": 0.55}},
+      "classic": {"shape": {"rms_log": 0.66}, "normalized": {"rms_log": 0.75},
+                  "absolute": {"rms_log": 1.5}}}})");
+  SuiteRow bad{{"bad", "m.csv", "red-cotton", "", "", "", "", "k"}, nullptr, "the sample fails"};
+  const auto j = nlohmann::json::parse(verify_suite_json(s, {good, bad}));
+  EXPECT_EQ(j.at("report"), "weft verify suite");
+  const auto& g = j.at("fabrics")[0].at("models");
+  EXPECT_DOUBLE_EQ(g.at("computed_raytrace").at("shape_rms_log").get<double>(), 0.31);
+  EXPECT_DOUBLE_EQ(g.at("classic").at("absolute_rms_log").get<double>(), 1.5);
+  EXPECT_FALSE(g.contains("computed_summation"));  // not in that report
+  EXPECT_EQ(j.at("fabrics")[1].at("error"), "the sample fails");
+  const std::string html = verify_suite_html(s, {good, bad});
+  EXPECT_NE(html.find("good/index.html"), std::string::npos);
+  EXPECT_NE(html.find("failed: the sample fails"), std::string::npos);
+  EXPECT_NE(html.find("0.310"), std::string::npos);
+}
+
+TEST(VerifySuite, OutputIsNewEmptyOrAnEarlierSuite) {
+  const fs::path dir = fresh_test_dir();
+  check_suite_output(dir / "new");
+  check_suite_output(dir);  // empty
+  write(dir / "suite.json", R"({"report": "weft verify suite"})");
+  check_suite_output(dir);
+  write(dir / "suite.json", R"({"report": "something else"})");
+  EXPECT_NE(error_of([&] { check_suite_output(dir); }).find("-o"), std::string::npos);
+  EXPECT_NE(error_of([&] { check_suite_output(dir / "suite.json"); }).find("not a directory"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace weft
