@@ -168,6 +168,7 @@ void add_weave_command(CLI::App& app, Commands& commands) {
          else
            std::printf("%zu curves, %zu segments; closest fibers %.2f um apart\n", s.curves,
                        s.curve_segments, s.min_fiber_distance_um);
+         for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
          if (!s.floating_warps.empty() || !s.floating_wefts.empty())
            std::printf("note: %zu warp and %zu weft threads never interlace (floating threads)\n",
                        s.floating_warps.size(), s.floating_wefts.size());

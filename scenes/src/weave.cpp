@@ -226,6 +226,7 @@ detail::FiberSettings fiber_settings(const WeaveOptions& o) {
   if (o.fibers_per_yarn && o.packing)
     bad("packing", "give either --fibers-per-yarn or --packing, not both");
   fs.packing = o.packing.value_or(kRedPacking);
+  fs.densest_if_needed = !o.packing && !o.fibers_per_yarn;
   if (!(std::isfinite(fs.packing) && fs.packing > 0 && fs.packing < 0.9069))
     bad("packing", "must lie in (0, 0.9069) (0.9069: hexagonal packing of equal circles)");
   if (o.twist_per_mm && o.twist_angle_deg)
@@ -502,6 +503,25 @@ void append_legacy_yarn(TriangleMesh& m, const WeaveParams& p, const Vec3& along
   });
 }
 
+void add_once(std::vector<std::string>& notes, const std::string& note) {
+  if (std::find(notes.begin(), notes.end(), note) == notes.end()) notes.push_back(note);
+}
+
+// A note per thread size whose section took the densest packing it admits instead of the
+// default one (sizes that came out alike, once).
+std::vector<std::string> packing_notes(const WeaveSummary& s) {
+  std::vector<std::string> notes;
+  for (const bool warp : {true, false})
+    for (const FiberLayoutInfo& f : warp ? s.warp_fibers : s.weft_fibers)
+      if (f.default_packing > 0)
+        add_once(notes, std::string(warp ? "warp" : "weft") + ": the default packing " +
+                            ParamReader::fmt(f.default_packing) +
+                            " does not fit; the densest packing that fits, " +
+                            ParamReader::fmt(std::round(f.packing * 1000) / 1000) + " (" +
+                            std::to_string(f.fibers) + " fibers per yarn), was taken");
+  return notes;
+}
+
 nlohmann::json summary_object(const WeaveSummary& s) {
   auto fibers = [](const std::vector<FiberLayoutInfo>& v) {
     auto a = nlohmann::json::array();
@@ -533,6 +553,7 @@ nlohmann::json summary_object(const WeaveSummary& s) {
     j["min_fiber_distance_um"] = s.min_fiber_distance_um;
     j["fiber_sections"] = s.fiber_sections;
   }
+  if (!s.notes.empty()) j["notes"] = s.notes;
   return j;
 }
 
@@ -715,6 +736,7 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
               " um apart, less than twice the fiber radius; use fewer fibers, less twist or "
               "more segments per crossing");
     out.fibers.names = {"patch"};
+    s.notes = packing_notes(s);
     const FiberCurves& f = out.fibers;
     s.curves = f.curve_count();
     s.curve_points = f.point_count();

@@ -51,6 +51,9 @@ struct FiberSettings {
   double radius_mm = 0;
   int fibers_per_yarn = 0;  // 0: from packing
   double packing = 0;
+  // Neither packing nor fibers per yarn given: where 'packing' (the default) does not fit a
+  // section, that section takes the most fibers that do (the densest packing it admits).
+  bool densest_if_needed = false;
   int plies = 1;
   double twist_per_mm = 0;     // signed, Z > 0
   double twist_angle_deg = 0;  // used when twist_per_mm is not given (then > 0)

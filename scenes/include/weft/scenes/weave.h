@@ -76,8 +76,12 @@ struct WeaveOptions {
   std::optional<int> sides;                  // around a yarn tube
   // Fiber detail.
   std::optional<double> fiber_radius_um;
-  std::optional<int> fibers_per_yarn;  // per yarn section; unset: from the packing fraction
-  std::optional<double> packing;       // fiber area / yarn section area
+  // Per yarn section; unset: from the packing fraction. With neither given, each section takes the
+  // default packing (red cotton's 0.55) where it fits and the densest packing it admits where not
+  // (FiberLayoutInfo::default_packing, WeaveSummary::notes); a value given that does not fit is
+  // an error naming it.
+  std::optional<int> fibers_per_yarn;
+  std::optional<double> packing;  // fiber area / yarn section area
   std::optional<int> plies;
   std::optional<double> twist_per_mm;      // fibers about their ply (or yarn) axis, Z > 0
   std::optional<double> twist_angle_deg;   // alternative: surface helix angle of the fibers
@@ -105,6 +109,9 @@ struct FiberLayoutInfo {
   double packing = 0;          // fiber area / section area
   double twist_per_mm = 0;     // effective (rounded so the sample stays periodic), outer ring
   double twist_angle_deg = 0;  // surface helix angle relative to the yarn axis
+  // > 0 where the default packing (this value) did not fit and the section took the densest
+  // packing that does (neither --packing nor --fibers-per-yarn given); 0: the packing asked for.
+  double default_packing = 0;
 };
 
 struct WeaveSummary {
@@ -122,7 +129,9 @@ struct WeaveSummary {
   std::vector<FiberLayoutInfo> warp_fibers, weft_fibers;  // per distinct thread size
   double min_fiber_distance_um = 0;                       // measured (fiber detail), centre lines
   std::string fiber_sections;  // "perpendicular" or "vertical" (fiber detail; see the top)
-  double seconds = 0;          // generation time
+  // What the generator chose for the user, one sentence each (the densest packing that fits).
+  std::vector<std::string> notes;
+  double seconds = 0;  // generation time
 };
 
 struct WovenSample {
