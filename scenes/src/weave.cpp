@@ -338,7 +338,23 @@ void lay_out(Resolved& r, const ThreadSizes& t, double share) {
   if (balanced) L.warp_crimp_share = -1;
 }
 
+// The nonwoven mat's options have no meaning for a woven sample.
+void check_no_nonwoven_options(const WeaveOptions& o) {
+  const std::pair<bool, const char*> given[] = {
+      {o.areal_density_gsm.has_value(), "areal-density-gsm"},
+      {o.thickness_mm.has_value(), "thickness-mm"},
+      {o.solidity.has_value(), "solidity"},
+      {o.inclination_sd_deg.has_value(), "inclination-sd-deg"},
+      {o.fiber_length_mm.has_value(), "fiber-length-mm"},
+      {o.tile_mm.has_value(), "tile-mm"},
+      {o.fiber_density_g_cm3.has_value(), "fiber-density-g-cm3"},
+      {o.seed.has_value(), "seed"}};
+  for (const auto& [set, field] : given)
+    if (set) bad(field, std::string("only with --pattern ") + kNonwovenPattern);
+}
+
 Resolved resolve(const WeaveOptions& o) {
+  check_no_nonwoven_options(o);
   Resolved r;
   resolve_detail(o, r);
   if (o.wif && o.pattern) bad("wif", "give either a pattern or a WIF draft, not both");
@@ -554,6 +570,19 @@ nlohmann::json summary_object(const WeaveSummary& s) {
     j["fiber_sections"] = s.fiber_sections;
   }
   if (!s.notes.empty()) j["notes"] = s.notes;
+  if (s.nonwoven) {
+    const NonwovenSummary& n = *s.nonwoven;
+    j["nonwoven"] = {{"areal_density_gsm", n.areal_density_gsm},
+                     {"thickness_mm", n.thickness_mm},
+                     {"solidity", n.solidity},
+                     {"fiber_length_mm", n.fiber_length_mm},
+                     {"fiber_density_g_cm3", n.fiber_density_g_cm3},
+                     {"inclination_sd_deg", n.inclination_sd_deg},
+                     {"fibers", n.fibers},
+                     {"attempts", n.attempts},
+                     {"seed", n.seed}};
+    j["min_fiber_distance_um"] = s.min_fiber_distance_um;
+  }
   return j;
 }
 
@@ -602,6 +631,12 @@ WeaveOptions overlay(WeaveOptions base, const WeaveOptions& g) {
   take(base.packing, g.packing), take(base.plies, g.plies);
   take(base.twist_per_mm, g.twist_per_mm), take(base.twist_angle_deg, g.twist_angle_deg);
   take(base.ply_twist_per_mm, g.ply_twist_per_mm);
+  if (g.thickness_mm) base.solidity.reset();
+  if (g.solidity) base.thickness_mm.reset();
+  take(base.areal_density_gsm, g.areal_density_gsm), take(base.thickness_mm, g.thickness_mm);
+  take(base.solidity, g.solidity), take(base.inclination_sd_deg, g.inclination_sd_deg);
+  take(base.fiber_length_mm, g.fiber_length_mm), take(base.tile_mm, g.tile_mm);
+  take(base.fiber_density_g_cm3, g.fiber_density_g_cm3), take(base.seed, g.seed);
   return base;
 }
 
@@ -645,6 +680,15 @@ WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& bas
   num("twist-per-mm", o.twist_per_mm);
   num("twist-angle-deg", o.twist_angle_deg);
   num("ply-twist-per-mm", o.ply_twist_per_mm);
+  num("areal-density-gsm", o.areal_density_gsm);
+  num("thickness-mm", o.thickness_mm);
+  num("solidity", o.solidity);
+  if (o.thickness_mm) r.reject_unused("solidity", "give thickness-mm or solidity, not both");
+  num("inclination-sd-deg", o.inclination_sd_deg);
+  num("fiber-length-mm", o.fiber_length_mm);
+  num("tile-mm", o.tile_mm);
+  num("fiber-density-g-cm3", o.fiber_density_g_cm3);
+  if (r.has("seed")) o.seed = static_cast<uint64_t>(r.integer("seed", 0, int64_t(1) << 53));
   r.finish();
   return o;
 }
@@ -660,6 +704,7 @@ WeaveOptions read_weave_options(const std::filesystem::path& json_file) {
 }
 
 WovenSample make_woven_sample(const WeaveOptions& options) {
+  if (options.pattern == kNonwovenPattern) return make_nonwoven_sample(options);
   const auto t0 = std::chrono::steady_clock::now();
   Resolved r = resolve(options);
   const Layout& L = r.layout;

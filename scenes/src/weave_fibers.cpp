@@ -502,7 +502,7 @@ void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& ou
 }  // namespace weft::detail
 
 namespace weft {
-namespace {
+namespace detail {
 
 // Closest points of segments p0-p1 and q0-q1 (Ericson, Real-Time Collision Detection, 5.1.9).
 double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
@@ -532,7 +532,9 @@ double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Ve
   return length((p0 + d1 * s) - (q0 + d2 * t));
 }
 
-}  // namespace
+}  // namespace detail
+
+using detail::segment_distance;
 
 namespace {
 
@@ -639,10 +641,17 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
   // along one fiber, not two fibers.
   const std::vector<int64_t> next = continuations(fibers, period_x, period_z);
   const long near = static_cast<long>(std::ceil(cutoff / std::max(min_segment, 1e-15))) + 1;
+  // b lies fewer than 'near' segments after a along a's fiber (through the curves continuing it;
+  // a nonwoven fiber cut at a corner of the tile continues through a short middle piece).
   auto along_joint = [&](const Seg& a, const Seg& b) {
-    if (next[a.curve] != b.curve) return false;
-    const long from_end = static_cast<long>(fibers.curve_points[a.curve]) - 2 - a.index;
-    return from_end + static_cast<long>(b.index) < near;
+    long gap = static_cast<long>(fibers.curve_points[a.curve]) - 2 - a.index;
+    int64_t c = next[a.curve];
+    for (int step = 0; c >= 0 && gap < near && step < 8; ++step) {
+      if (c == b.curve) return gap + static_cast<long>(b.index) < near;
+      gap += static_cast<long>(fibers.curve_points[c]) - 1;
+      c = next[c];
+    }
+    return false;
   };
   // The nearest periodic image (round(d / period) periods; most pairs need none).
   auto image = [](double d, double period) {

@@ -69,6 +69,9 @@ struct FiberSettings {
 void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& out,
                   std::vector<FiberLayoutInfo>& warp_info, std::vector<FiberLayoutInfo>& weft_info);
 
+// Distance between the segments p0-p1 and q0-q1 (any units).
+double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
+
 // A glTF document and its one binary buffer, shared by the legacy patch and woven samples.
 struct GltfDocument {
   nlohmann::json doc;
