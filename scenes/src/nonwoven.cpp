@@ -46,7 +46,7 @@ double in_range(const std::optional<double>& v, double fallback, const std::stri
 
 struct Mat {
   double gsm = 0, tile = 0, thickness = 0, radius = 0, length = 0, density = 0;  // mm, g/cm3
-  double inclination_sd = 0;                                                     // radians
+  double inclination_sd_deg = 0, inclination_sd = 0;                             // degrees, radians
   uint64_t seed = 0;
   int fibers = 0;
 };
@@ -91,8 +91,9 @@ Mat resolve_mat(const WeaveOptions& o) {
   m.tile = in_range(o.tile_mm, kFeltTileMm, "tile-mm", 0, 20);
   m.length = in_range(o.fiber_length_mm, kFeltFiberLengthMm, "fiber-length-mm", 4 * m.radius,
                       0.5 * m.tile, false);
-  m.inclination_sd = deg_to_rad(
-      in_range(o.inclination_sd_deg, kFeltInclinationSdDeg, "inclination-sd-deg", 0, 45, false));
+  m.inclination_sd_deg =
+      in_range(o.inclination_sd_deg, kFeltInclinationSdDeg, "inclination-sd-deg", 0, 45, false);
+  m.inclination_sd = deg_to_rad(m.inclination_sd_deg);
   m.seed = o.seed.value_or(kFeltSeed);
   // Areal density g/m^2 over density g/cm^3 is a thickness in um: gsm / rho x 1e-3 mm.
   const double solid_mm = m.gsm / m.density * 1e-3;
@@ -309,7 +310,7 @@ void summarise(const Mat& m, int attempts, WovenSample& s) {
   n.solidity = volume_m3 / (tile_m * tile_m * m.thickness * kMetresPerMm);
   n.fiber_length_mm = m.length;
   n.fiber_density_g_cm3 = m.density;
-  n.inclination_sd_deg = rad_to_deg(m.inclination_sd);
+  n.inclination_sd_deg = m.inclination_sd_deg;
   n.fibers = m.fibers;
   n.attempts = attempts;
   n.seed = m.seed;
