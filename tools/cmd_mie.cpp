@@ -249,9 +249,7 @@ void add_medium_command(CLI::App& app, Commands& commands) {
   auto o = std::make_shared<MediumCliOptions>();
   auto* sub = app.add_subcommand(
       "medium", "Per-band mu_s, mu_a, albedo and g of a fiber spec file or preset");
-  sub->add_option("spec", o->spec,
-                  "spec file, or a preset: red-cotton, white-cotton, polyester-delustered")
-      ->required();
+  sub->add_option("spec", o->spec, "spec file, or a preset (docs/presets.md)")->required();
   sub->add_option("--wavelengths-nm", o->wavelengths,
                   "band centres a:b:step or a,b,c (default all)");
   sub->add_option("--threads", o->threads, "threads (0 = all cores)");

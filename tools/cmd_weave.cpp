@@ -105,6 +105,19 @@ void add_weave_command(CLI::App& app, Commands& commands) {
   sub->add_option("--twist-angle-deg", o->w.twist_angle_deg,
                   "fiber twist as the outer fibers' helix angle, degrees");
   sub->add_option("--ply-twist-per-mm", o->w.ply_twist_per_mm, "ply twist, turns per mm (S < 0)");
+  // Nonwoven mats (--pattern nonwoven, docs/weave.md).
+  sub->add_option("--areal-density-gsm", o->w.areal_density_gsm, "nonwoven: mass per area, g/m^2");
+  sub->add_option("--thickness-mm", o->w.thickness_mm, "nonwoven: mat thickness, mm");
+  sub->add_option("--solidity", o->w.solidity,
+                  "nonwoven: fiber volume / mat volume (instead of --thickness-mm)");
+  sub->add_option("--inclination-sd-deg", o->w.inclination_sd_deg,
+                  "nonwoven: standard deviation of the fibers' angle out of the plane, degrees");
+  sub->add_option("--fiber-length-mm", o->w.fiber_length_mm,
+                  "nonwoven: length of each straight fiber, at most half the tile");
+  sub->add_option("--tile-mm", o->w.tile_mm, "nonwoven: side of the square periodic tile, mm");
+  sub->add_option("--fiber-density-g-cm3", o->w.fiber_density_g_cm3,
+                  "nonwoven: density of the fiber material, g/cm^3");
+  sub->add_option("--seed", o->w.seed, "nonwoven: random seed (same seed, same fibers)");
   // Shared with the legacy patch: segments around each yarn tube.
   auto* sides = sub->add_option("--sides", o->w.sides, "segments around each yarn tube");
   // The legacy open-mesh patch.
@@ -151,6 +164,8 @@ void add_weave_command(CLI::App& app, Commands& commands) {
                 "--packing or --fibers-per-yarn");
          one_of(given.twist_per_mm.has_value(), given.twist_angle_deg.has_value(),
                 "twist-angle-deg", "--twist-per-mm or --twist-angle-deg");
+         one_of(given.thickness_mm.has_value(), given.solidity.has_value(), "solidity",
+                "--thickness-mm or --solidity");
          const WeaveOptions base =
              o->sample.empty() ? WeaveOptions{} : read_weave_options(o->sample);
          const WovenSample sample = make_woven_sample(overlay(base, given));
@@ -168,6 +183,13 @@ void add_weave_command(CLI::App& app, Commands& commands) {
          else
            std::printf("%zu curves, %zu segments; closest fibers %.2f um apart\n", s.curves,
                        s.curve_segments, s.min_fiber_distance_um);
+         if (s.nonwoven)
+           std::printf(
+               "  nonwoven: %d fibers (%d placements drawn), %.1f g/m^2, %.3f mm thick, "
+               "solidity %.3f\n",
+               s.nonwoven->fibers, s.nonwoven->attempts, s.nonwoven->areal_density_gsm,
+               s.nonwoven->thickness_mm, s.nonwoven->solidity);
+         for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
          if (!s.floating_warps.empty() || !s.floating_wefts.empty())
            std::printf("note: %zu warp and %zu weft threads never interlace (floating threads)\n",
                        s.floating_warps.size(), s.floating_wefts.size());

@@ -183,6 +183,8 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
       p.choice("boundary", "smooth", {"smooth", "rough-dielectric"}) == "rough-dielectric"
           ? FiberBoundary::kRoughDielectric
           : FiberBoundary::kSmooth;
+  if (p.has("density_g_cm3"))
+    spec.density_g_cm3 = p.number("density_g_cm3", kMinFiberDensityGcm3, kMaxFiberDensityGcm3);
   p.finish();
   if (total_fraction > kMaxVolumeFraction)
     throw Error(

@@ -226,6 +226,7 @@ detail::FiberSettings fiber_settings(const WeaveOptions& o) {
   if (o.fibers_per_yarn && o.packing)
     bad("packing", "give either --fibers-per-yarn or --packing, not both");
   fs.packing = o.packing.value_or(kRedPacking);
+  fs.densest_if_needed = !o.packing && !o.fibers_per_yarn;
   if (!(std::isfinite(fs.packing) && fs.packing > 0 && fs.packing < 0.9069))
     bad("packing", "must lie in (0, 0.9069) (0.9069: hexagonal packing of equal circles)");
   if (o.twist_per_mm && o.twist_angle_deg)
@@ -337,7 +338,23 @@ void lay_out(Resolved& r, const ThreadSizes& t, double share) {
   if (balanced) L.warp_crimp_share = -1;
 }
 
+// The nonwoven mat's options have no meaning for a woven sample.
+void check_no_nonwoven_options(const WeaveOptions& o) {
+  const std::pair<bool, const char*> given[] = {
+      {o.areal_density_gsm.has_value(), "areal-density-gsm"},
+      {o.thickness_mm.has_value(), "thickness-mm"},
+      {o.solidity.has_value(), "solidity"},
+      {o.inclination_sd_deg.has_value(), "inclination-sd-deg"},
+      {o.fiber_length_mm.has_value(), "fiber-length-mm"},
+      {o.tile_mm.has_value(), "tile-mm"},
+      {o.fiber_density_g_cm3.has_value(), "fiber-density-g-cm3"},
+      {o.seed.has_value(), "seed"}};
+  for (const auto& [set, field] : given)
+    if (set) bad(field, std::string("only with --pattern ") + kNonwovenPattern);
+}
+
 Resolved resolve(const WeaveOptions& o) {
+  check_no_nonwoven_options(o);
   Resolved r;
   resolve_detail(o, r);
   if (o.wif && o.pattern) bad("wif", "give either a pattern or a WIF draft, not both");
@@ -502,6 +519,25 @@ void append_legacy_yarn(TriangleMesh& m, const WeaveParams& p, const Vec3& along
   });
 }
 
+void add_once(std::vector<std::string>& notes, const std::string& note) {
+  if (std::find(notes.begin(), notes.end(), note) == notes.end()) notes.push_back(note);
+}
+
+// A note per thread size whose section took the densest packing it admits instead of the
+// default one (sizes that came out alike, once).
+std::vector<std::string> packing_notes(const WeaveSummary& s) {
+  std::vector<std::string> notes;
+  for (const bool warp : {true, false})
+    for (const FiberLayoutInfo& f : warp ? s.warp_fibers : s.weft_fibers)
+      if (f.default_packing > 0)
+        add_once(notes, std::string(warp ? "warp" : "weft") + ": the default packing " +
+                            ParamReader::fmt(f.default_packing) +
+                            " does not fit; the densest packing that fits, " +
+                            ParamReader::fmt(std::round(f.packing * 1000) / 1000) + " (" +
+                            std::to_string(f.fibers) + " fibers per yarn), was taken");
+  return notes;
+}
+
 nlohmann::json summary_object(const WeaveSummary& s) {
   auto fibers = [](const std::vector<FiberLayoutInfo>& v) {
     auto a = nlohmann::json::array();
@@ -532,6 +568,20 @@ nlohmann::json summary_object(const WeaveSummary& s) {
     j["fibers"] = {{"warp", fibers(s.warp_fibers)}, {"weft", fibers(s.weft_fibers)}};
     j["min_fiber_distance_um"] = s.min_fiber_distance_um;
     j["fiber_sections"] = s.fiber_sections;
+  }
+  if (!s.notes.empty()) j["notes"] = s.notes;
+  if (s.nonwoven) {
+    const NonwovenSummary& n = *s.nonwoven;
+    j["nonwoven"] = {{"areal_density_gsm", n.areal_density_gsm},
+                     {"thickness_mm", n.thickness_mm},
+                     {"solidity", n.solidity},
+                     {"fiber_length_mm", n.fiber_length_mm},
+                     {"fiber_density_g_cm3", n.fiber_density_g_cm3},
+                     {"inclination_sd_deg", n.inclination_sd_deg},
+                     {"fibers", n.fibers},
+                     {"attempts", n.attempts},
+                     {"seed", n.seed}};
+    j["min_fiber_distance_um"] = s.min_fiber_distance_um;
   }
   return j;
 }
@@ -581,6 +631,12 @@ WeaveOptions overlay(WeaveOptions base, const WeaveOptions& g) {
   take(base.packing, g.packing), take(base.plies, g.plies);
   take(base.twist_per_mm, g.twist_per_mm), take(base.twist_angle_deg, g.twist_angle_deg);
   take(base.ply_twist_per_mm, g.ply_twist_per_mm);
+  if (g.thickness_mm) base.solidity.reset();
+  if (g.solidity) base.thickness_mm.reset();
+  take(base.areal_density_gsm, g.areal_density_gsm), take(base.thickness_mm, g.thickness_mm);
+  take(base.solidity, g.solidity), take(base.inclination_sd_deg, g.inclination_sd_deg);
+  take(base.fiber_length_mm, g.fiber_length_mm), take(base.tile_mm, g.tile_mm);
+  take(base.fiber_density_g_cm3, g.fiber_density_g_cm3), take(base.seed, g.seed);
   return base;
 }
 
@@ -624,6 +680,15 @@ WeaveOptions read_weave_options(ParamReader& r, const std::filesystem::path& bas
   num("twist-per-mm", o.twist_per_mm);
   num("twist-angle-deg", o.twist_angle_deg);
   num("ply-twist-per-mm", o.ply_twist_per_mm);
+  num("areal-density-gsm", o.areal_density_gsm);
+  num("thickness-mm", o.thickness_mm);
+  num("solidity", o.solidity);
+  if (o.thickness_mm) r.reject_unused("solidity", "give thickness-mm or solidity, not both");
+  num("inclination-sd-deg", o.inclination_sd_deg);
+  num("fiber-length-mm", o.fiber_length_mm);
+  num("tile-mm", o.tile_mm);
+  num("fiber-density-g-cm3", o.fiber_density_g_cm3);
+  if (r.has("seed")) o.seed = static_cast<uint64_t>(r.integer("seed", 0, int64_t(1) << 53));
   r.finish();
   return o;
 }
@@ -639,6 +704,7 @@ WeaveOptions read_weave_options(const std::filesystem::path& json_file) {
 }
 
 WovenSample make_woven_sample(const WeaveOptions& options) {
+  if (options.pattern == kNonwovenPattern) return make_nonwoven_sample(options);
   const auto t0 = std::chrono::steady_clock::now();
   Resolved r = resolve(options);
   const Layout& L = r.layout;
@@ -715,6 +781,7 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
               " um apart, less than twice the fiber radius; use fewer fibers, less twist or "
               "more segments per crossing");
     out.fibers.names = {"patch"};
+    s.notes = packing_notes(s);
     const FiberCurves& f = out.fibers;
     s.curves = f.curve_count();
     s.curve_points = f.point_count();

@@ -395,11 +395,21 @@ Bundle make_bundle(double w, double t, double slope, double period, const FiberS
     return std::tan(deg_to_rad(fs.twist_angle_deg)) / std::max(outer_perimeter, 1e-9);
   };
   int capacity = 0;
+  // Fibers in 'section' (per ply); with neither packing nor count given, the most that fit where
+  // the default packing's count does not.
+  auto fill = [&](const Poly& section, int wanted) {
+    b.rings = fit_rings(section, inset, q, wanted, min_area, &capacity);
+    if (b.rings.empty() && fs.densest_if_needed && capacity >= 1) {
+      b.info.default_packing = fs.packing;
+      wanted = capacity;
+      b.rings = fit_rings(section, inset, q, wanted, min_area, &capacity);
+    }
+    return wanted;
+  };
   if (fs.plies == 1) {
     const auto outer = inset_ring(lens, inset, q.two_r, min_area);
     q.rate = twist_rate(outer ? outer->per : 0);
-    b.rings = fit_rings(lens, inset, q, count, min_area, &capacity);
-    b.fibers = count;
+    b.fibers = fill(lens, count);
   } else {
     // Largest ply radius for which 'plies' discs on a ring inset by their radius never overlap.
     double lo = 0, hi = 0.5 * std::min(w, t);
@@ -424,9 +434,8 @@ Bundle make_bundle(double w, double t, double slope, double period, const FiberS
     const Poly disc = circle_polygon(lo);
     q.carry = std::abs(b.ply_rate) * b.ply_ring.per;
     q.rate = twist_rate(2 * kPi * std::max(lo - inset, 0.0));
-    b.rings = fit_rings(disc, inset, q, per_ply, min_area, &capacity);
+    b.fibers = fill(disc, per_ply) * fs.plies;
     capacity *= fs.plies;
-    b.fibers = per_ply * fs.plies;
   }
   if (b.rings.empty())
     throw Error("", field,
@@ -493,7 +502,7 @@ void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& ou
 }  // namespace weft::detail
 
 namespace weft {
-namespace {
+namespace detail {
 
 // Closest points of segments p0-p1 and q0-q1 (Ericson, Real-Time Collision Detection, 5.1.9).
 double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1) {
@@ -523,60 +532,24 @@ double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Ve
   return length((p0 + d1 * s) - (q0 + d2 * t));
 }
 
-}  // namespace
+}  // namespace detail
 
-double min_fiber_distance(const FiberCurves& fibers, double period_x, double period_z,
-                          double cutoff) {
-  struct Seg {
-    Vec3 a, b, lo, hi;
-    uint32_t curve;
-  };
-  std::vector<Seg> segs;
-  segs.reserve(fibers.segment_count());
-  double ylo = 1e300, yhi = -1e300;
-  for (size_t c = 0; c < fibers.curve_count(); ++c)
-    for (uint32_t k = 0; k + 1 < fibers.curve_points[c]; ++k) {
-      const Vec3 a = fibers.point(fibers.curve_first[c] + k),
-                 b = fibers.point(fibers.curve_first[c] + k + 1);
-      Seg s{a, b, {}, {}, static_cast<uint32_t>(c)};
-      for (int i = 0; i < 3; ++i) {
-        s.lo[i] = std::min(a[i], b[i]) - 0.5 * cutoff;
-        s.hi[i] = std::max(a[i], b[i]) + 0.5 * cutoff;
-      }
-      ylo = std::min(ylo, s.lo.y);
-      yhi = std::max(yhi, s.hi.y);
-      segs.push_back(s);
-    }
-  if (segs.empty()) return cutoff;
-  // Cells at least 'cutoff' wide; x and z wrap with the period.
-  auto cells_along = [&](double extent) {
-    return std::clamp(static_cast<int>(extent / cutoff), 1, 512);
-  };
-  const int nx = cells_along(period_x), nz = cells_along(period_z),
-            ny = cells_along(std::max(yhi - ylo, cutoff));
-  const double cx = period_x / nx, cz = period_z / nz, cy = std::max(yhi - ylo, cutoff) / ny;
-  auto wrap = [](long i, int n) { return static_cast<int>(((i % n) + n) % n); };
-  std::vector<std::vector<uint32_t>> cells(static_cast<size_t>(nx) * ny * nz);
-  for (uint32_t i = 0; i < segs.size(); ++i) {
-    const Seg& s = segs[i];
-    const long x0 = std::lround(std::floor((s.lo.x + 0.5 * period_x) / cx)),
-               x1 = std::lround(std::floor((s.hi.x + 0.5 * period_x) / cx));
-    const long z0 = std::lround(std::floor((s.lo.z + 0.5 * period_z) / cz)),
-               z1 = std::lround(std::floor((s.hi.z + 0.5 * period_z) / cz));
-    const long y0 = std::lround(std::floor((s.lo.y - ylo) / cy)),
-               y1 = std::lround(std::floor((s.hi.y - ylo) / cy));
-    for (long x = x0; x <= std::min(x1, x0 + nx - 1); ++x)
-      for (long z = z0; z <= std::min(z1, z0 + nz - 1); ++z)
-        for (long yy = std::max(0L, y0); yy <= std::min<long>(y1, ny - 1); ++yy)
-          cells[(static_cast<size_t>(wrap(x, nx)) * ny + yy) * nz + wrap(z, nz)].push_back(i);
-  }
-  // A fiber that leaves through a side continues as the curve that starts at the same point
-  // on the opposite side: next[c] is that curve. Segments of such a joined pair within the cutoff
-  // of the joint are neighbours along one fiber, not two fibers.
+using detail::segment_distance;
+
+namespace {
+
+struct Seg {
+  Vec3 a, b, lo, hi;  // ends; box grown by cutoff / 2
+  uint32_t curve;
+  uint32_t index;  // within its curve
+};
+
+// For each curve, the curve that continues it across a side of the sample (-1: none): a fiber
+// that leaves through a side continues as the curve of its yarn that starts where it ends, a
+// period away.
+std::vector<int64_t> continuations(const FiberCurves& fibers, double period_x, double period_z) {
   const double joined = 1e-9;  // float storage of points a period apart
   std::vector<int64_t> next(fibers.curve_count(), -1);
-  double min_segment = 1e300;
-  // A fiber continues within its own yarn: compare ends and starts yarn by yarn.
   std::map<uint32_t, std::vector<uint32_t>> by_yarn;
   for (size_t c = 0; c < fibers.curve_count(); ++c)
     by_yarn[fibers.curve_yarn[c]].push_back(static_cast<uint32_t>(c));
@@ -590,35 +563,134 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
         if (length(d) < joined) next[c] = c2;
       }
     }
+  return next;
+}
+
+// A uniform grid, periodic in x and z, of cells at least 'size' wide; each segment lies in the one
+// cell of its midpoint, so two segments whose midpoints (nearest periodic images) are less than
+// 'size' apart along every axis lie in the same or neighbouring cells.
+struct SegmentGrid {
+  int n[3] = {1, 1, 1};
+  double lo[3] = {0, 0, 0}, cell[3] = {1, 1, 1};
+  std::vector<Seg> segs;             // sorted by cell
+  std::vector<uint64_t> cell_start;  // cells + 1 offsets into 'segs'
+  std::vector<uint64_t> keys;        // occupied cells, ascending
+
+  int index(int axis, double v) const {
+    const long i = std::lround(std::floor((v - lo[axis]) / cell[axis]));
+    if (axis == 1) return static_cast<int>(std::clamp<long>(i, 0, n[1] - 1));
+    return static_cast<int>(((i % n[axis]) + n[axis]) % n[axis]);
+  }
+  uint64_t key(int x, int y, int z) const {
+    return (static_cast<uint64_t>(x) * n[1] + y) * n[2] + z;
+  }
+};
+
+SegmentGrid grid_of(std::vector<Seg> segs, const double extent[3], double ylo, double size) {
+  SegmentGrid g;
+  for (int a = 0; a < 3; ++a) {
+    g.n[a] = static_cast<int>(std::clamp(std::floor(extent[a] / size), 1.0, double(1 << 20)));
+    g.cell[a] = extent[a] / g.n[a];
+  }
+  g.lo[0] = -0.5 * extent[0], g.lo[1] = ylo, g.lo[2] = -0.5 * extent[2];
+  std::vector<std::pair<uint64_t, uint32_t>> by_cell(segs.size());
+  for (uint32_t i = 0; i < segs.size(); ++i) {
+    const Vec3 m = 0.5 * (segs[i].a + segs[i].b);
+    by_cell[i] = {g.key(g.index(0, m.x), g.index(1, m.y), g.index(2, m.z)), i};
+  }
+  std::sort(by_cell.begin(), by_cell.end());
+  for (size_t k = 0; k < by_cell.size(); ++k) {
+    if (k == 0 || by_cell[k].first != by_cell[k - 1].first) {
+      g.keys.push_back(by_cell[k].first);
+      g.cell_start.push_back(k);
+    }
+    g.segs.push_back(segs[by_cell[k].second]);
+  }
+  g.cell_start.push_back(by_cell.size());
+  return g;
+}
+
+}  // namespace
+
+double min_fiber_distance(const FiberCurves& fibers, double period_x, double period_z,
+                          double cutoff) {
+  std::vector<Seg> segs;
+  segs.reserve(fibers.segment_count());
+  double ylo = 1e300, yhi = -1e300, longest = 0;
+  for (size_t c = 0; c < fibers.curve_count(); ++c)
+    for (uint32_t k = 0; k + 1 < fibers.curve_points[c]; ++k) {
+      const Vec3 a = fibers.point(fibers.curve_first[c] + k),
+                 b = fibers.point(fibers.curve_first[c] + k + 1);
+      Seg s{a, b, {}, {}, static_cast<uint32_t>(c), k};
+      for (int i = 0; i < 3; ++i) {
+        s.lo[i] = std::min(a[i], b[i]) - 0.5 * cutoff;
+        s.hi[i] = std::max(a[i], b[i]) + 0.5 * cutoff;
+        longest = std::max(longest, std::abs(b[i] - a[i]));
+      }
+      ylo = std::min(ylo, s.lo.y);
+      yhi = std::max(yhi, s.hi.y);
+      segs.push_back(s);
+    }
+  if (segs.empty()) return cutoff;
+  // Grown boxes that overlap have midpoints at most cutoff + the longest extent apart per axis.
+  const double extent[3] = {period_x, std::max(yhi - ylo, cutoff), period_z};
+  double min_segment = 1e300;
   for (const Seg& s : segs) min_segment = std::min(min_segment, length(s.b - s.a));
+  const SegmentGrid g = grid_of(std::move(segs), extent, ylo, cutoff + longest);
+  // Segments of a fiber and its continuation within the cutoff of their joint are neighbours
+  // along one fiber, not two fibers.
+  const std::vector<int64_t> next = continuations(fibers, period_x, period_z);
   const long near = static_cast<long>(std::ceil(cutoff / std::max(min_segment, 1e-15))) + 1;
-  // Index of each segment within its curve.
-  std::vector<uint32_t> index(segs.size());
-  for (size_t i = 1; i < segs.size(); ++i)
-    index[i] = segs[i].curve == segs[i - 1].curve ? index[i - 1] + 1 : 0;
-  auto along_joint = [&](uint32_t sa, uint32_t sb) {
-    const Seg &a = segs[sa], &b = segs[sb];
-    if (next[a.curve] != b.curve) return false;
-    const long from_end = static_cast<long>(fibers.curve_points[a.curve]) - 2 - index[sa];
-    return from_end + static_cast<long>(index[sb]) < near;
+  // b lies fewer than 'near' segments after a along a's fiber (through the curves continuing it;
+  // a nonwoven fiber cut at a corner of the tile continues through a short middle piece).
+  auto along_joint = [&](const Seg& a, const Seg& b) {
+    long gap = static_cast<long>(fibers.curve_points[a.curve]) - 2 - a.index;
+    int64_t c = next[a.curve];
+    for (int step = 0; c >= 0 && gap < near && step < 8; ++step) {
+      if (c == b.curve) return gap + static_cast<long>(b.index) < near;
+      gap += static_cast<long>(fibers.curve_points[c]) - 1;
+      c = next[c];
+    }
+    return false;
+  };
+  // The nearest periodic image (round(d / period) periods; most pairs need none).
+  auto image = [](double d, double period) {
+    return std::abs(d) < 0.5 * period ? 0.0 : period * std::round(d / period);
+  };
+  auto pair_distance = [&](const Seg& a, const Seg& b) {
+    if (a.curve == b.curve) return cutoff;
+    // The periodic image of b nearest to a; boxes grown by cutoff / 2 that miss each other hold
+    // no pair within the cutoff.
+    const Vec3 shift{image(0.5 * (a.a.x + a.b.x - b.a.x - b.b.x), period_x), 0,
+                     image(0.5 * (a.a.z + a.b.z - b.a.z - b.b.z), period_z)};
+    for (int i = 0; i < 3; ++i)
+      if (a.hi[i] < b.lo[i] + shift[i] || b.hi[i] + shift[i] < a.lo[i]) return cutoff;
+    if (along_joint(a, b) || along_joint(b, a)) return cutoff;
+    return segment_distance(a.a, a.b, b.a + shift, b.b + shift);
   };
   double best = cutoff;
-  for (const auto& cell : cells)
-    for (size_t u = 0; u < cell.size(); ++u)
-      for (size_t v = u + 1; v < cell.size(); ++v) {
-        const Seg &a = segs[cell[u]], &b = segs[cell[v]];
-        if (a.curve == b.curve) continue;
-        // The periodic image of b nearest to a; boxes grown by cutoff / 2 that miss each other
-        // hold no pair within the cutoff.
-        const Vec3 ca = 0.5 * (a.a + a.b), cb = 0.5 * (b.a + b.b);
-        const Vec3 shift{period_x * std::round((ca.x - cb.x) / period_x), 0,
-                         period_z * std::round((ca.z - cb.z) / period_z)};
-        bool apart = false;
-        for (int i = 0; i < 3 && !apart; ++i)
-          apart = a.hi[i] < b.lo[i] + shift[i] || b.hi[i] + shift[i] < a.lo[i];
-        if (apart || along_joint(cell[u], cell[v]) || along_joint(cell[v], cell[u])) continue;
-        best = std::min(best, segment_distance(a.a, a.b, b.a + shift, b.b + shift));
-      }
+  std::vector<uint64_t> seen;
+  for (size_t k = 0; k < g.keys.size(); ++k) {
+    const uint64_t key = g.keys[k];
+    const int cz = static_cast<int>(key % g.n[2]), cy = static_cast<int>(key / g.n[2] % g.n[1]),
+              cx = static_cast<int>(key / g.n[2] / g.n[1]);
+    seen.clear();  // a neighbour met twice through the wrap of a short period is done once
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz) {
+          const int y = cy + dy;
+          if (y < 0 || y >= g.n[1]) continue;
+          const uint64_t other = g.key((cx + dx + g.n[0]) % g.n[0], y, (cz + dz + g.n[2]) % g.n[2]);
+          if (other < key || std::find(seen.begin(), seen.end(), other) != seen.end()) continue;
+          seen.push_back(other);
+          const auto it = std::lower_bound(g.keys.begin(), g.keys.end(), other);
+          if (it == g.keys.end() || *it != other) continue;
+          const size_t o = static_cast<size_t>(it - g.keys.begin());
+          for (uint64_t i = g.cell_start[k]; i < g.cell_start[k + 1]; ++i)
+            for (uint64_t j = other == key ? i + 1 : g.cell_start[o]; j < g.cell_start[o + 1]; ++j)
+              best = std::min(best, pair_distance(g.segs[i], g.segs[j]));
+        }
+  }
   return best;
 }
 

@@ -51,6 +51,9 @@ struct FiberSettings {
   double radius_mm = 0;
   int fibers_per_yarn = 0;  // 0: from packing
   double packing = 0;
+  // Neither packing nor fibers per yarn given: where 'packing' (the default) does not fit a
+  // section, that section takes the most fibers that do (the densest packing it admits).
+  bool densest_if_needed = false;
   int plies = 1;
   double twist_per_mm = 0;     // signed, Z > 0
   double twist_angle_deg = 0;  // used when twist_per_mm is not given (then > 0)
@@ -65,6 +68,9 @@ struct FiberSettings {
 // Fills 'out' with the fibers of every yarn; per distinct yarn section the layout info.
 void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& out,
                   std::vector<FiberLayoutInfo>& warp_info, std::vector<FiberLayoutInfo>& weft_info);
+
+// Distance between the segments p0-p1 and q0-q1 (any units).
+double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
 
 // A glTF document and its one binary buffer, shared by the legacy patch and woven samples.
 struct GltfDocument {

@@ -144,8 +144,8 @@ TEST(FiberSpec, LoadsFilesAndPresetsAndReportsMissingOnes) {
     EXPECT_NE(what.find("red-cotton"), std::string::npos) << what;  // lists the presets
   }
   const auto names = fiber_preset_names();
-  EXPECT_EQ(names,
-            (std::vector<std::string>{"red-cotton", "white-cotton", "polyester-delustered"}));
+  EXPECT_EQ(names, (std::vector<std::string>{"red-cotton", "white-cotton", "polyester-delustered",
+                                             "polyester-filament", "silk", "acrylic"}));
   for (const auto& n : names) EXPECT_EQ(load_fiber_spec(n).name, n);
   EXPECT_THROW(fiber_preset_json("blue-silk"), Error);
 }
@@ -216,4 +216,22 @@ TEST(FiberSpec, BoundaryOptionDefaultsToSmoothAndKeepsOldHashes) {
   expect_error(edit("\"name\": \"test\",", "\"name\": \"test\", \"boundary\": \"rough\","),
                {"boundary", "rough-dielectric", "smooth"});
   expect_error(edit("\"name\": \"test\",", "\"name\": \"test\", \"boundary\": 3,"), {"boundary"});
+}
+
+TEST(FiberSpec, DensityIsOptionalCheckedAndNotHashed) {
+  const FiberSpec without = parse_fiber_spec(kMinimal, "spec.json");
+  EXPECT_EQ(without.density_g_cm3, 0);  // not given
+  const FiberSpec with = parse_fiber_spec(
+      edit("\"fiber_radius_um\": 5,", "\"fiber_radius_um\": 5, \"density_g_cm3\": 1.38,"),
+      "spec.json");
+  EXPECT_EQ(with.density_g_cm3, 1.38);
+  // No optics depend on it: the hash (and so the bake cache) is the same.
+  EXPECT_EQ(fiber_spec_hash(with), fiber_spec_hash(without));
+  expect_error(edit("\"fiber_radius_um\": 5,", "\"fiber_radius_um\": 5, \"density_g_cm3\": 0,"),
+               {"density_g_cm3"});
+  // The presets the nonwoven and filament samples use carry their cited densities
+  // (docs/presets.md): PET 1.38, silk fibroin 1.35, acrylic 1.17 g/cm3.
+  EXPECT_EQ(load_fiber_spec("polyester-filament").density_g_cm3, 1.38);
+  EXPECT_EQ(load_fiber_spec("silk").density_g_cm3, 1.35);
+  EXPECT_EQ(load_fiber_spec("acrylic").density_g_cm3, 1.17);
 }

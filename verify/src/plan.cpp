@@ -92,6 +92,13 @@ VerifyPlan plan_verify(const VerifyRequest& o) {
   }
   if (!o.classic_albedo.empty()) p.classic_albedo = parse_classic_albedo(o.classic_albedo);
   p.weave = plan_weave(o);
+  // A nonwoven mat is made of the fiber itself: its radius and density, unless the options give
+  // them (a woven sample keeps its own fiber radius, as before).
+  if (p.weave.pattern == kNonwovenPattern && !p.fiber_table) {
+    if (!p.weave.fiber_radius_um) p.weave.fiber_radius_um = p.spec.fiber_radius_um;
+    if (!p.weave.fiber_density_g_cm3 && p.spec.density_g_cm3 > 0)
+      p.weave.fiber_density_g_cm3 = p.spec.density_g_cm3;
+  }
   plan_fit(o, p);
   if (!o.shard.empty()) p.shard = parse_shard(o.shard, "--shard");
   return p;

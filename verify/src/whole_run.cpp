@@ -55,6 +55,16 @@ bool fiber_inputs(const VerifyPlan& p, VerifyInputs& in, const VerifyHooks& hook
   return true;
 }
 
+// The sample as the report names it, with what the generator chose (the densest packing that
+// fits) and what does not apply to it.
+std::string sample_name(const WeaveSummary& s) {
+  std::string name = s.source + " (" + s.detail + ")";
+  for (const std::string& note : s.notes) name += "; " + note;
+  if (s.nonwoven)
+    name += "; the paper's summation is not applicable to a nonwoven (no warp and weft): not run";
+  return name;
+}
+
 // A shard's units of the ray traces into a part file at the request's output.
 VerifyOutcome run_shard(const VerifyPlan& p, const WovenSample& sample, const VerifyInputs& in,
                         const JobPart& job, const VerifyHooks& hooks) {
@@ -108,10 +118,14 @@ VerifyOutcome run_report(const VerifyPlan& p, const WovenSample& sample, VerifyI
   const VerifySettings& s = p.settings;
   VerifyOutcome out;
   auto t0 = std::chrono::steady_clock::now();
-  in.summation = sum_fabric_table(
-      in.fiber, verify_summation_options(s.resolution, s.summation_samples, s.seed, s.threads),
-      hooks.progress);
-  in.seconds["summation"] = seconds_since(t0);
+  // The paper's summation averages a warp and a weft fiber: a nonwoven mat has neither (the
+  // report then has no summation model; its sample line says why).
+  if (!sample.summary.nonwoven) {
+    in.summation = sum_fabric_table(
+        in.fiber, verify_summation_options(s.resolution, s.summation_samples, s.seed, s.threads),
+        hooks.progress);
+    in.seconds["summation"] = seconds_since(t0);
+  }
   const std::optional<VerifyTraced> traced =
       all ? std::optional<VerifyTraced>(traced_from_parts(*all, s)) : std::nullopt;
   out.report = run_verify(sample, in, p.measured, s, hooks.progress, traced ? &*traced : nullptr);
@@ -144,7 +158,9 @@ VerifyOutcome run_verify_plan(const VerifyPlan& p, const VerifyHooks& hooks, con
   in.fiber_name = p.request.fiber;
   const auto t0 = std::chrono::steady_clock::now();
   const WovenSample sample = make_woven_sample(p.weave);
-  in.sample_name = sample.summary.source + " (" + sample.summary.detail + ")";
+  in.sample_name = sample_name(sample.summary);
+  if (sample.summary.nonwoven || !sample.summary.notes.empty())
+    hooks.note("weft: sample: " + in.sample_name + "\n");
   in.seconds["woven_sample"] = seconds_since(t0);
   if (!fiber_inputs(p, in, hooks)) {
     VerifyOutcome cancelled;

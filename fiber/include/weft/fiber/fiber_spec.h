@@ -13,6 +13,8 @@
 //                "size": {"distribution": "monodisperse", "radius_um": 0.3} |
 //                        {"distribution": "lognormal", "median_radius_um": 0.3, "sigma": 0.5}}],
 //   "boundary": "smooth" | "rough-dielectric" (optional, default "smooth"),
+//   "density_g_cm3": 1.38 (optional, not hashed: the fibre material's density, which the
+//                    nonwoven generator turns an areal density into fibre length with),
 //   "notes": "free text" (optional, not hashed)
 // }
 // boundary: "smooth" is the paper's model, a Cook-Torrance surface lobe whose complement is
@@ -55,7 +57,11 @@ struct FiberSpec {
   Spectrum host_absorption_per_um{};  // absorption coefficient of the host (dye), >= 0
   std::vector<ParticleSpecies> species;
   FiberBoundary boundary = FiberBoundary::kSmooth;
+  double density_g_cm3 = 0;  // 0: not given (no optics depend on it)
 };
+
+// Textile fibre materials: polypropylene 0.91 to glass 2.6 g/cm3; 0.5-25 leaves room for metals.
+inline constexpr double kMinFiberDensityGcm3 = 0.5, kMaxFiberDensityGcm3 = 25;
 
 inline constexpr double kMaxVolumeFraction = 0.74;  // close packing of equal spheres
 
@@ -84,7 +90,7 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
 // Errors: missing file (naming it and listing the presets), invalid JSON, invalid fields.
 FiberSpec load_fiber_spec(const std::string& path_or_preset);
 
-// Bundled presets ("red-cotton", "white-cotton", "polyester-delustered"), compiled in.
+// Bundled presets (fiber/presets/*.json, docs/presets.md), compiled in.
 std::vector<std::string> fiber_preset_names();
 // The preset's JSON text; throws weft::Error listing the valid names for an unknown one.
 const std::string& fiber_preset_json(const std::string& name);

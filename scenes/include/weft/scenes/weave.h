@@ -48,6 +48,7 @@
 
 #include "weft/scenes/curves.h"
 #include "weft/scenes/mesh.h"
+#include "weft/scenes/nonwoven.h"
 #include "weft/scenes/weave_pattern.h"
 
 namespace weft {
@@ -76,12 +77,25 @@ struct WeaveOptions {
   std::optional<int> sides;                  // around a yarn tube
   // Fiber detail.
   std::optional<double> fiber_radius_um;
-  std::optional<int> fibers_per_yarn;  // per yarn section; unset: from the packing fraction
-  std::optional<double> packing;       // fiber area / yarn section area
+  // Per yarn section; unset: from the packing fraction. With neither given, each section takes the
+  // default packing (red cotton's 0.55) where it fits and the densest packing it admits where not
+  // (FiberLayoutInfo::default_packing, WeaveSummary::notes); a value given that does not fit is
+  // an error naming it.
+  std::optional<int> fibers_per_yarn;
+  std::optional<double> packing;  // fiber area / yarn section area
   std::optional<int> plies;
   std::optional<double> twist_per_mm;      // fibers about their ply (or yarn) axis, Z > 0
   std::optional<double> twist_angle_deg;   // alternative: surface helix angle of the fibers
   std::optional<double> ply_twist_per_mm;  // plies about the yarn axis (plies > 1), S < 0
+  // Nonwoven mats (pattern "nonwoven", nonwoven.h): only with that pattern.
+  std::optional<double> areal_density_gsm;   // g/m^2
+  std::optional<double> thickness_mm;        // of the mat; or:
+  std::optional<double> solidity;            // fiber volume / mat volume (sets the thickness)
+  std::optional<double> inclination_sd_deg;  // of the fibers out of the cloth plane
+  std::optional<double> fiber_length_mm;     // each fiber straight, at most half the tile
+  std::optional<double> tile_mm;             // side of the square tile (the period)
+  std::optional<double> fiber_density_g_cm3;
+  std::optional<uint64_t> seed;
 };
 
 // Reads a sample description (a JSON object whose keys are the `weft weave` option names without
@@ -92,7 +106,8 @@ WeaveOptions read_weave_options(const std::filesystem::path& json_file);
 // The bundled red-cotton sample's options, every value set (the defaults of `weft weave`).
 WeaveOptions red_cotton_weave_options();
 // 'base' with every field that 'given' sets replaced; setting one of a pair of alternatives
-// (pattern / wif, fibers-per-yarn / packing, twist-per-mm / twist-angle-deg) clears the other.
+// (pattern / wif, fibers-per-yarn / packing, twist-per-mm / twist-angle-deg, thickness-mm /
+// solidity) clears the other.
 WeaveOptions overlay(WeaveOptions base, const WeaveOptions& given);
 
 // Sizes of one thread, millimetres.
@@ -105,6 +120,9 @@ struct FiberLayoutInfo {
   double packing = 0;          // fiber area / section area
   double twist_per_mm = 0;     // effective (rounded so the sample stays periodic), outer ring
   double twist_angle_deg = 0;  // surface helix angle relative to the yarn axis
+  // > 0 where the default packing (this value) did not fit and the section took the densest
+  // packing that does (neither --packing nor --fibers-per-yarn given); 0: the packing asked for.
+  double default_packing = 0;
 };
 
 struct WeaveSummary {
@@ -122,7 +140,10 @@ struct WeaveSummary {
   std::vector<FiberLayoutInfo> warp_fibers, weft_fibers;  // per distinct thread size
   double min_fiber_distance_um = 0;                       // measured (fiber detail), centre lines
   std::string fiber_sections;  // "perpendicular" or "vertical" (fiber detail; see the top)
-  double seconds = 0;          // generation time
+  // What the generator chose for the user, one sentence each (the densest packing that fits).
+  std::vector<std::string> notes;
+  std::optional<NonwovenSummary> nonwoven;  // a nonwoven mat's parameters and counts
+  double seconds = 0;                       // generation time
 };
 
 struct WovenSample {
