@@ -119,6 +119,36 @@ SizeDistribution parse_size(ParamReader p, double fiber_radius_um) {
   return d;
 }
 
+// host.dyes: the recipe, each dye bundled and named once. The spec's density_g_cm3 must be
+// read first: a recipe needs it.
+void parse_dyes(ParamReader& host, FiberSpec& spec) {
+  const std::string& file = host.file();
+  if (!host.has("dyes")) return;
+  if (spec.density_g_cm3 <= 0)
+    throw Error(file, "density_g_cm3",
+                "is required with a dye recipe (host.dyes): it turns percent on the weight of "
+                "fibre into mol/L");
+  const json& dyes = host.at("dyes");
+  const std::string path = host.field("dyes");
+  if (!dyes.is_array() || dyes.empty()) throw Error(file, path, "must be a non-empty array");
+  if (dyes.size() > static_cast<size_t>(kMaxDyeComponents))
+    throw Error(file, path,
+                "lists " + std::to_string(dyes.size()) + " dyes, more than " +
+                    std::to_string(kMaxDyeComponents));
+  for (size_t i = 0; i < dyes.size(); ++i) {
+    ParamReader d(dyes[i], file, path + "[" + std::to_string(i) + "]");
+    DyeComponent c;
+    c.dye = d.string("dye");
+    (void)bundled_dye(c.dye, file, d.field("dye"));
+    for (const auto& other : spec.dyes)
+      if (other.dye == c.dye) throw Error(file, d.field("dye"), "'" + c.dye + "' is listed twice");
+    c.concentration_owf_percent = d.number("concentration_owf_percent", 0, kMaxDyeOwfPercent);
+    c.uptake_fraction = d.number("uptake_fraction", 1.0, 1e-300, 1.0);
+    d.finish();
+    spec.dyes.push_back(c);
+  }
+}
+
 json spectrum_json(const Spectrum& s) {
   return json(std::vector<double>(s.begin(), s.end()));
 }
@@ -142,6 +172,8 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
   spec.roughness_alpha = rough.number("alpha", 1e-300, 1.0);
   rough.finish();
 
+  if (p.has("density_g_cm3"))
+    spec.density_g_cm3 = p.number("density_g_cm3", kMinFiberDensityGcm3, kMaxFiberDensityGcm3);
   ParamReader host = p.object("host");
   spec.host_n = spectral(host, "n");
   require_range(spec.host_n, host, "n", kMinHostIndex, false, "refractive index", kMaxHostIndex);
@@ -156,6 +188,7 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
     require_range(mm, host, "absorption_per_mm", 0.0, false, "absorption");
     for (int b = 0; b < kNumBands; ++b) spec.host_absorption_per_um[b] = mm[b] * 1e-3;
   }
+  parse_dyes(host, spec);
   host.finish();
 
   const json& species = p.at("species");
@@ -183,14 +216,19 @@ FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file
       p.choice("boundary", "smooth", {"smooth", "rough-dielectric"}) == "rough-dielectric"
           ? FiberBoundary::kRoughDielectric
           : FiberBoundary::kSmooth;
-  if (p.has("density_g_cm3"))
-    spec.density_g_cm3 = p.number("density_g_cm3", kMinFiberDensityGcm3, kMaxFiberDensityGcm3);
   p.finish();
   if (total_fraction > kMaxVolumeFraction)
     throw Error(
         file, "species",
         "volume fractions add up to " + fmt(total_fraction) + ", above " + fmt(kMaxVolumeFraction));
   return spec;
+}
+
+Spectrum host_total_absorption_per_um(const FiberSpec& spec) {
+  Spectrum total = spec.host_absorption_per_um;
+  const Spectrum dyes = recipe_absorption_per_um(spec.dyes, spec.density_g_cm3);
+  for (int b = 0; b < kNumBands; ++b) total[b] += dyes[b];
+  return total;
 }
 
 const char* fiber_boundary_name(FiberBoundary boundary) {
@@ -260,6 +298,17 @@ std::string canonical_json(const FiberSpec& spec) {
                        {"size", size}});
   }
   j["species"] = species;
+  // Written only with a recipe, so specs without one keep their hashes. The resolved molar
+  // absorption is hashed too: a change of a bundled dye's data changes the hash.
+  if (!spec.dyes.empty()) {
+    json dyes = json::array();
+    for (const auto& c : spec.dyes)
+      dyes.push_back({{"dye", c.dye},
+                      {"mol_per_L", dye_mol_per_L(c, spec.density_g_cm3)},
+                      {"epsilon_per_M_per_cm",
+                       spectrum_json(bundled_dye(c.dye, "", "dye").epsilon_per_M_per_cm)}});
+    j["host"]["dyes"] = dyes;
+  }
   // Written only when not the default, so specs from before the option keep their hashes (and
   // their cached tables).
   if (spec.boundary != FiberBoundary::kSmooth) j["boundary"] = fiber_boundary_name(spec.boundary);

@@ -30,7 +30,7 @@ MediumBand compute_medium_band(const FiberSpec& spec, int band, const MediumOpti
     const SizeQuadrature q = size_quadrature(s.size, options.lognormal_nodes);
     for (double r : q.radius_um) x_max = std::max(x_max, wavenumber * r);
   }
-  out.mu_a_host_per_um = (1 - total_fraction) * spec.host_absorption_per_um[band];
+  out.mu_a_host_per_um = (1 - total_fraction) * host_total_absorption_per_um(spec)[band];
 
   std::vector<double> mu;  // increasing, -1 .. 1, without duplicates from cos near 0 and pi
   if (x_max > 0) {

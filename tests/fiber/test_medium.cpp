@@ -114,11 +114,15 @@ TEST(FiberMedium, PresetPhaseTablesReproduceMieAsymmetry) {
       EXPECT_NEAR(sum / n, b.g, 1e-3) << name << " " << b.wavelength_nm;
     }
   }
-  // The dye makes red cotton absorb in the green, not in the red; white cotton is lossless.
+  // The dye makes red cotton absorb in the green far more than in the red; white cotton is
+  // lossless. Its recipe (docs/presets.md: Congo red, a broad band whose tail reaches 670 nm)
+  // gives albedos of 0.15 at 530 nm and 0.79 at 670 nm.
   const FiberMedium red = build_fiber_medium(load_fiber_spec("red-cotton"));
   const FiberMedium white = build_fiber_medium(load_fiber_spec("white-cotton"));
   EXPECT_LT(red.bands[14].albedo, 0.5);   // 530 nm
-  EXPECT_GT(red.bands[28].albedo, 0.95);  // 670 nm
+  EXPECT_GT(red.bands[28].albedo, 0.75);  // 670 nm
+  EXPECT_GT(red.bands[28].mu_s_per_um / red.bands[28].mu_a_per_um,
+            10 * red.bands[14].mu_s_per_um / red.bands[14].mu_a_per_um);
   for (const auto& b : white.bands) EXPECT_EQ(b.mu_a_per_um, 0.0);
 }
 

@@ -19,6 +19,39 @@ void require_species(const FiberSpec& spec, const std::string& name) {
     throw Error(spec.name, "--fit-params", "'" + name + "': the spec has no particle species");
 }
 
+// The recipe's component 'index', with a concentration to scale.
+const DyeComponent& require_dye(const FiberSpec& spec, size_t index, const std::string& name) {
+  if (index >= spec.dyes.size())
+    throw Error(
+        spec.name, "--fit-params",
+        "'" + name + "': the spec's dye recipe has " + std::to_string(spec.dyes.size()) + " dyes");
+  const DyeComponent& c = spec.dyes[index];
+  if (!(c.concentration_owf_percent > 0))
+    throw Error(spec.name, "--fit-params",
+                "'" + name + "': dye '" + c.dye + "' has no concentration to scale");
+  return c;
+}
+
+// dyeK_concentration, K = 0 .. kMaxDyeComponents - 1: the recipe's K-th concentration itself
+// (% owf), over a decade each way within the spec's bounds. Named on request only (not among the
+// default parameters: a spec without a recipe has none).
+const std::vector<SpecFitRule>& dye_concentration_rules() {
+  using Box = SpecFitRule::Box;
+  static const std::vector<SpecFitRule> rules = [] {
+    std::vector<SpecFitRule> r;
+    for (size_t k = 0; k < static_cast<size_t>(kMaxDyeComponents); ++k)
+      r.push_back(
+          {"dye" + std::to_string(k) + "_concentration", "% owf",
+           [k](const FiberSpec& spec, const std::string& name) {
+             const double c = require_dye(spec, k, name).concentration_owf_percent;
+             return Box{c / 10, std::min(10 * c, kMaxDyeOwfPercent), c, true};
+           },
+           [k](FiberSpec& spec, double v) { spec.dyes.at(k).concentration_owf_percent = v; }});
+    return r;
+  }();
+  return rules;
+}
+
 }  // namespace
 
 const std::vector<SpecFitRule>& spec_fit_rules() {
@@ -28,8 +61,10 @@ const std::vector<SpecFitRule>& spec_fit_rules() {
        [](const FiberSpec&, const std::string&) {
          return Box{0.1, 10, 1, true};
        },
+       // The absorption as given and the recipe's concentrations alike.
        [](FiberSpec& spec, double v) {
          for (double& a : spec.host_absorption_per_um) a *= v;
+         for (auto& c : spec.dyes) c.concentration_owf_percent *= v;
        }},
       {"particle_fraction_scale", "x spec's volume fractions",
        [](const FiberSpec& spec, const std::string& name) {
@@ -64,7 +99,12 @@ const std::vector<SpecFitRule>& spec_fit_rules() {
 const SpecFitRule& spec_fit_rule(const std::string& name) {
   for (const auto& r : spec_fit_rules())
     if (r.name == name) return r;
-  throw Error("", "--fit-params", "'" + name + "' is not one of " + spec_fit_parameter_list(", "));
+  for (const auto& r : dye_concentration_rules())
+    if (r.name == name) return r;
+  throw Error("", "--fit-params",
+              "'" + name + "' is not one of " + spec_fit_parameter_list(", ") +
+                  " or dyeK_concentration (K = 0.." + std::to_string(kMaxDyeComponents - 1) +
+                  ", the recipe's K-th dye)");
 }
 
 const std::vector<std::string>& spec_fit_parameter_names() {

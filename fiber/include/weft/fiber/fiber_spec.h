@@ -8,20 +8,27 @@
 //   "name": "red-cotton",
 //   "fiber_radius_um": 8.0,
 //   "roughness": {"distribution": "beckmann" | "ggx", "alpha": 0.35},
-//   "host": {"n": SPECTRAL, "absorption_per_um": SPECTRAL | "absorption_per_mm": SPECTRAL},
+//   "host": {"n": SPECTRAL, "absorption_per_um": SPECTRAL | "absorption_per_mm": SPECTRAL,
+//            "dyes": [{"dye": "congo-red", "concentration_owf_percent": 2.0,
+//                      "uptake_fraction": 0.8}]},
 //   "species": [{"name": "air voids", "n": SPECTRAL, "k": SPECTRAL, "volume_fraction": 0.02,
 //                "size": {"distribution": "monodisperse", "radius_um": 0.3} |
 //                        {"distribution": "lognormal", "median_radius_um": 0.3, "sigma": 0.5}}],
 //   "boundary": "smooth" | "rough-dielectric" (optional, default "smooth"),
-//   "density_g_cm3": 1.38 (optional, not hashed: the fibre material's density, which the
-//                    nonwoven generator turns an areal density into fibre length with),
+//   "density_g_cm3": 1.38 (the fibre material's density: required with a dye recipe, which it
+//                    turns from percent on weight into mol/L; otherwise optional, and the
+//                    nonwoven generator turns an areal density into fibre length with it;
+//                    hashed only through the recipe's mol/L),
 //   "notes": "free text" (optional, not hashed)
 // }
 // boundary: "smooth" is the paper's model, a Cook-Torrance surface lobe whose complement is
 // refracted at the smooth normal (and leaves with it); "rough-dielectric" makes the roughness a
 // rough dielectric interface both ways, whose reflection is the surface part and whose refraction
 // feeds the volume (rough_dielectric.h, docs/fiber-bsdf.md).
-// host.absorption_* is optional (no dye: zero); species may be empty. SPECTRAL is one of
+// host.absorption_* is optional (zero when absent); species may be empty. host.dyes is an optional
+// dye recipe (dye.h: bundled dyes, percent on the weight of fibre, uptake_fraction optional,
+// default 1) whose Beer-Lambert absorption adds to host.absorption_*.
+// SPECTRAL is one of
 //   - a number (the same in every band),
 //   - an array of 33 numbers, one per band 390, 400, ..., 710 nm,
 //   - {"points": [[wavelength_nm, value], ...]}: linearly interpolated, wavelengths strictly
@@ -31,6 +38,7 @@
 #include <vector>
 
 #include "weft/core/spectrum.h"
+#include "weft/fiber/dye.h"
 #include "weft/fiber/mie.h"
 #include "weft/materials/microfacet.h"
 
@@ -54,10 +62,11 @@ struct FiberSpec {
   MicrofacetModel roughness_distribution = MicrofacetModel::kBeckmann;
   double roughness_alpha = 0;         // in (0, 1]
   Spectrum host_n{};                  // real refractive index of the fibre material
-  Spectrum host_absorption_per_um{};  // absorption coefficient of the host (dye), >= 0
+  Spectrum host_absorption_per_um{};  // absorption of the host as given, >= 0 (dyes not included)
+  std::vector<DyeComponent> dyes;     // the dye recipe (empty: none)
   std::vector<ParticleSpecies> species;
   FiberBoundary boundary = FiberBoundary::kSmooth;
-  double density_g_cm3 = 0;  // 0: not given (no optics depend on it)
+  double density_g_cm3 = 0;  // 0: not given (then there are no dyes)
 };
 
 // Textile fibre materials: polypropylene 0.91 to glass 2.6 g/cm3; 0.5-25 leaves room for metals.
@@ -84,6 +93,9 @@ inline constexpr int kMaxSpecies = 16;
 // most this share of the fibre radius.
 inline constexpr double kMaxParticleShareOfFiberRadius = 0.5;
 
+// The host's absorption coefficient per um: host_absorption_per_um plus the dye recipe's.
+Spectrum host_total_absorption_per_um(const FiberSpec& spec);
+
 // Parses a spec from JSON text; 'file' names the source in error messages.
 FiberSpec parse_fiber_spec(const std::string& json_text, const std::string& file);
 // Loads a spec from a file path, or from a bundled preset by name when no such file exists.
@@ -96,7 +108,8 @@ std::vector<std::string> fiber_preset_names();
 const std::string& fiber_preset_json(const std::string& name);
 
 // Canonical JSON of the parsed spec (sorted keys, spectra resolved to 33 band values, shortest
-// round-trip numbers); the name and notes are left out, so two specs with the same physics hash
+// round-trip numbers; a recipe's dyes by name, mol/L and molar absorption per band); the name and
+// notes are left out, so two specs with the same physics hash
 // alike however they were written.
 std::string canonical_json(const FiberSpec& spec);
 // FNV-1a 64 of canonical_json(spec), and the same as 16 lower-case hex digits.

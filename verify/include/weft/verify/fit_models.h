@@ -27,8 +27,9 @@ struct SpecFitRule {
   std::function<void(FiberSpec& spec, double value)> apply;
 };
 
-// The table every function below reads: dye_scale, particle_fraction_scale,
-// particle_radius_scale, roughness_alpha.
+// The table of the default parameters: dye_scale, particle_fraction_scale,
+// particle_radius_scale, roughness_alpha. spec_fit_rule also knows dyeK_concentration (K = 0 ..
+// kMaxDyeComponents - 1, the recipe's K-th concentration in % owf), named on request only.
 const std::vector<SpecFitRule>& spec_fit_rules();
 // The rule of that name; weft::Error naming "--fit-params" and the known names otherwise.
 const SpecFitRule& spec_fit_rule(const std::string& name);
