@@ -8,6 +8,7 @@ void add_bench_command(CLI::App& app, Commands& commands) {
   bench->require_subcommand(1);
   add_bench_bake_command(*bench, commands);
   add_bench_render_command(*bench, commands);
+  add_bench_flatten_command(*bench, commands);
 }
 
 }  // namespace weft::cli

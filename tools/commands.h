@@ -19,7 +19,7 @@ AddCommand add_bake_fabric_command;
 AddCommand add_verify_command;  // cmd_verify.cpp
 
 // The subcommands of "bench" (cmd_bench.cpp makes the group).
-AddCommand add_bench_bake_command, add_bench_render_command;
+AddCommand add_bench_bake_command, add_bench_render_command, add_bench_flatten_command;
 
 // Each command's merge (in its cmd_*.cpp): writes 'output' from all units of its job and prints
 // the command's summary. Returns the exit code.

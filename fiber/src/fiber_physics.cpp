@@ -82,50 +82,56 @@ double SurfaceAlbedoTable::operator()(double cos_theta) const {
   return (1 - t) * albedo_[i] + t * albedo_[i + 1];
 }
 
+TransportMedium fiber_band_medium(const MediumBand& mb) {
+  return TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase};
+}
+
+TransportOptions fiber_band_transport_options(const FiberBandPhysics& fiber,
+                                              uint64_t max_events_per_photon, WeightMode mode) {
+  TransportOptions topt;
+  topt.max_events = max_events_per_photon;
+  topt.mode = mode;
+  if (const auto boundary = fiber.boundary) {
+    topt.boundary_scatter = [boundary](const Vec3& d, Rng& rng) {
+      const RoughDielectricScatter s = boundary->scatter(d, rng);
+      return BoundaryScatter{s.direction, s.lost};
+    };
+    return topt;
+  }
+  if (!fiber.surface.albedo) throw Error("", "surface", "the surface model needs an albedo");
+  topt.exit_reflectance = fiber.surface.albedo;
+  return topt;
+}
+
 FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
                                     uint64_t max_events_per_photon,
                                     std::shared_ptr<const SurfaceAlbedoTable> albedo,
                                     WeightMode mode) {
   FiberBandPhysics ph;
   if (spec.boundary == FiberBoundary::kRoughDielectric) {
-    auto boundary = std::make_shared<const RoughDielectricInterface>(
+    ph.boundary = std::make_shared<const RoughDielectricInterface>(
         spec.roughness_distribution, spec.roughness_alpha, 1.0, mb.host_n);
-    ph.boundary = boundary;
-    TransportOptions topt;
-    topt.max_events = max_events_per_photon;
-    topt.mode = mode;
-    topt.boundary_scatter = [boundary](const Vec3& d, Rng& rng) {
-      const RoughDielectricScatter s = boundary->scatter(d, rng);
-      return BoundaryScatter{s.direction, s.lost};
+  } else {
+    auto ct = std::make_shared<const CookTorranceBsdf>(
+        CookTorranceBsdf{{spec.roughness_distribution, spec.roughness_alpha}, mb.host_n, Rgb(1.0)});
+    if (!albedo)
+      albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
+                                                          spec.roughness_alpha, mb.host_n);
+    ph.surface.sample = [ct](const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out,
+                             double* weight) {
+      // Cook-Torrance is reciprocal: sampling the view direction given the light one uses the
+      // same routine with the roles swapped; the weight is f cos(out) / pdf.
+      const auto smp = ct->sample(w_light, u, u_lobe);
+      if (!smp || !(smp->wi.z > 0)) return false;
+      *w_out = smp->wi;
+      *weight = smp->weight.r;
+      return true;
     };
-    ph.interior = FiberInterior::transport(std::make_shared<const CylinderTransport>(
-        CylinderGeometry(spec.fiber_radius_um, 1.0),
-        TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt));
-    return ph;
+    ph.surface.albedo = [albedo](double c) { return (*albedo)(c); };
   }
-  auto ct = std::make_shared<const CookTorranceBsdf>(
-      CookTorranceBsdf{{spec.roughness_distribution, spec.roughness_alpha}, mb.host_n, Rgb(1.0)});
-  if (!albedo)
-    albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
-                                                        spec.roughness_alpha, mb.host_n);
-  ph.surface.sample = [ct](const Vec3& w_light, Vec2 u, double u_lobe, Vec3* w_out,
-                           double* weight) {
-    // Cook-Torrance is reciprocal: sampling the view direction given the light one uses the same
-    // routine with the roles swapped; the weight is f cos(out) / pdf.
-    const auto smp = ct->sample(w_light, u, u_lobe);
-    if (!smp || !(smp->wi.z > 0)) return false;
-    *w_out = smp->wi;
-    *weight = smp->weight.r;
-    return true;
-  };
-  ph.surface.albedo = [albedo](double c) { return (*albedo)(c); };
-  TransportOptions topt;
-  topt.max_events = max_events_per_photon;
-  topt.mode = mode;
-  topt.exit_reflectance = [albedo](double cos_outside) { return (*albedo)(cos_outside); };
   ph.interior = FiberInterior::transport(std::make_shared<const CylinderTransport>(
-      CylinderGeometry(spec.fiber_radius_um, 1.0),
-      TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase}, topt));
+      CylinderGeometry(spec.fiber_radius_um, 1.0), fiber_band_medium(mb),
+      fiber_band_transport_options(ph, max_events_per_photon, mode)));
   return ph;
 }
 

@@ -93,6 +93,14 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& ban
                                     std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr,
                                     WeightMode mode = WeightMode::implicit_capture);
 
+// The interior's medium of one band, and the transport options that make light leave a fiber
+// through the same boundary it entered by (the rough dielectric both ways, or the surface lobe's
+// complement as the exit transmittance): fiber_band_physics builds its cylinder from them, and
+// fiber cross-sections other than the round one (fiber_layer.h) build theirs the same way.
+TransportMedium fiber_band_medium(const MediumBand& band);
+TransportOptions fiber_band_transport_options(const FiberBandPhysics& fiber,
+                                              uint64_t max_events_per_photon, WeightMode mode);
+
 // Light from world direction 'omega' (towards the light) meets the fiber at surface angle phi
 // (axial position 0) with flux weight w0. The surface lobe's sampled reflection goes to
 // 'surface_exits' (may be empty; booked as specular and specular_excess either way); the rest,
