@@ -2,11 +2,13 @@
 // Shared pieces of the command-line front end: the subcommand registry, the progress bar on
 // stderr, and Ctrl-C handling that asks long work to stop cleanly.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "weft/core/atomic_file.h"
 #include "weft/core/params.h"
 #include "weft/core/progress.h"
 
@@ -80,12 +82,28 @@ std::string format_seconds(double seconds);
 CLI::Validator seed_validator();
 
 
-// Checks a command's output paths before any work: each names a file in an existing directory,
-// no two name the same file and none names one of the inputs (compared by canonical path, so
-// "./x" and "x" or a symbolic link are the same file). Inputs that are not files (a preset name)
-// are ignored. weft::Error naming the output otherwise.
-void validate_output_paths(const std::vector<std::string>& outputs,
-                           const std::vector<std::string>& inputs);
+// THE output guard: every command checks its outputs here before any work. Each output names a
+// file in an existing directory, no two outputs name the same file, and none is any file the job
+// reads: compared by identity (same device and inode, so a symbolic or hard link to an input is
+// that input), a not-yet-existing output by its resolved folder and name. An output inside an
+// input folder (the bake cache) is refused too. 'folders' are outputs replaced whole (verify's
+// report folder, weft slurm's script folder): refused when they hold any input. Inputs that are
+// not files (a preset name) are ignored. weft::Error naming the output and the input otherwise.
+void validate_output_paths(const std::vector<NamedPath>& outputs,
+                           const std::vector<NamedPath>& inputs,
+                           const std::vector<NamedPath>& folders = {});
+// Every input validate_output_paths was given in this process, oldest first: weft slurm checks its
+// scripts against the inputs of the command it wraps after checking that command (check_only).
+const std::vector<NamedPath>& guarded_inputs();
+
+// Every file a render or sweep of the description reads: the description, its glTF files and
+// buffers and environment maps, and what its materials name (tables, measured networks, fiber
+// specs; a preset name is no file). Relative names resolve as registry.cpp and bake_cache.cpp
+// resolve them.
+std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
+                                                     const SceneDescription& d);
+// The same named for the output guard, with the scene's fiber-table bake cache folder.
+std::vector<NamedPath> scene_inputs(const std::string& scene, const SceneDescription& d);
 
 // Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers; at most
 // max_count of them (a range's count is checked before the list is built), no empty items.

@@ -93,12 +93,16 @@ int run(const BakeFabricOptions& o) {
                 "splitting is the ray tracer's: it needs --method raytrace");
   const FabricRaytraceOptions r =
       o.method == "raytrace" ? raytrace_options(o) : FabricRaytraceOptions{};
+  // The WIF draft a weave options file names is read too.
+  const std::string weave_wif = o.weave.empty() ? "" : read_weave_options(o.weave).wif.value_or("");
+  validate_output_paths({{o.output, "--output"}, {checkpoint_path(o.output), "checkpoint"}},
+                        {{o.fiber, "fiber table or spec"},
+                         {o.weave, "weave options"},
+                         {o.wif, "WIF draft"},
+                         {weave_wif, "WIF draft"},
+                         {".weft-cache", "fiber-table bake cache"}});
   if (std::filesystem::path(o.output).extension() != ".exr" && o.shard.empty())
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
-  const auto dir = std::filesystem::absolute(o.output).parent_path();
-  if (!std::filesystem::is_directory(dir))
-    throw Error(o.output, "", "output directory does not exist");
-  validate_output_paths({o.output}, {o.fiber, o.weave, o.wif});
   if (o.method == "raytrace") {
     const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
     const UnitRange r =

@@ -25,12 +25,8 @@ nlohmann::json to_json(const TableDifference& d) {
 }
 
 int run_compare(const CompareCliOptions& o) {
-  for (const auto& out : {o.plot, o.csv})
-    if (!out.empty()) {
-      const auto dir = std::filesystem::absolute(out).parent_path();
-      if (!std::filesystem::is_directory(dir))
-        throw Error(out, "", "output directory does not exist");
-    }
+  validate_output_paths({{o.plot, "--plot"}, {o.csv, "--csv"}},
+                        {{o.a, "table A"}, {o.b, "table B"}});
   const auto a = TabulatedBsdfTable::read_exr(o.a);
   const auto b = TabulatedBsdfTable::read_exr(o.b);
   const TableComparison c = compare_tables(a, b, o.compare);

@@ -138,6 +138,12 @@ void add_render_command(CLI::App& app, Commands& commands) {
            check_crop(*job.settings.crop, job.settings.width, job.settings.height, "", "--crop");
          }
          job.settings.threads = o->threads;
+         std::vector<NamedPath> outputs = {{job.exr, "--output"}};
+         if (job.png) outputs.push_back({*job.png, "--preview"});
+         if (job.mask) outputs.push_back({*job.mask, "--mask"});
+         if (job.albedo) outputs.push_back({*job.albedo, "--aov albedo"});
+         if (job.normal) outputs.push_back({*job.normal, "--aov normal"});
+         validate_output_paths(outputs, scene_inputs(o->scene, desc));
          check_memory(render_bytes(job.settings.width, job.settings.height, job.png.has_value(),
                                    job.mask.has_value()),
                       o->scene, "width x height",

@@ -102,7 +102,7 @@ void add_slurm_command(CLI::App& app, Commands& commands) {
          if (verify)
            check_verify_output(out_abs);
          else
-           validate_output_paths({out_abs.string()}, {});
+           validate_output_paths({{out_abs, "--output"}}, {});
          const fs::path dir = out_abs.string() + ".slurm";
          const std::string weft = self_path();
          const std::string name = "weft-" + out_abs.filename().string();

@@ -27,31 +27,6 @@ Rgb rgb_of(const nlohmann::json& j) {
   return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
 }
 
-// Every file a sweep of the description reads: the description, its glTF files and buffers and
-// environment maps, and what its materials name (tables, measured networks, fiber specs; a preset
-// name is no file, and its content is the program's). Relative names resolve as registry.cpp
-// and bake_cache.cpp resolve them.
-std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
-                                                     const SceneDescription& d) {
-  std::vector<std::filesystem::path> files{scene};
-  files.insert(files.end(), d.files.begin(), d.files.end());
-  auto add = [&](const MaterialBinding& b) {
-    for (const char* key : {"file", "spec"}) {
-      if (!b.params.contains(key) || !b.params[key].is_string()) continue;
-      std::filesystem::path f = b.params[key].get<std::string>();
-      std::error_code ec;
-      if (f.is_relative() &&
-          (std::string(key) == "file" || std::filesystem::exists(d.base_dir / f, ec)))
-        f = d.base_dir / f;
-      // A missing table is the renderer's error to report, with its field.
-      if (std::filesystem::is_regular_file(f, ec)) files.push_back(f);
-    }
-  };
-  for (const auto& [key, b] : d.materials) add(b);
-  if (d.default_material) add(*d.default_material);
-  return files;
-}
-
 // What fixes a sweep's bits: the content of every file it reads and every setting but threads.
 JobPart sweep_job(const std::string& scene, const SceneDescription& desc, const GonioSettings& g,
                   Shard shard) {
@@ -255,7 +230,9 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          if (o->resolution) g.width = g.height = o->resolution;
          if (seed->count()) g.seed = o->seed;
          g.threads = o->threads;
-         validate_output_paths({o->output}, {o->scene});
+         validate_output_paths(
+             {{o->output, "--output"}, {checkpoint_path(o->output), "checkpoint"}},
+             scene_inputs(o->scene, desc));
          const Shard shard = o->shard.empty() ? Shard{} : parse_shard(o->shard, "--shard");
          const JobPart job = sweep_job(o->scene, desc, g, shard);
          const UnitRange range = shard_units(job.units_total, shard);
