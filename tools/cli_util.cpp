@@ -39,6 +39,7 @@ bool interrupted() {
 }
 
 ProgressCallback progress_bar(bool quiet) {
+  if (run_limits().check_only) throw WorkWouldStart{};
   install_interrupt_handler();
   using Clock = std::chrono::steady_clock;
   struct State {
@@ -144,6 +145,7 @@ std::string format_seconds(double s) {
 void check_memory(double bytes, const std::string& file, const std::string& field,
                   const std::string& what) {
   const RunLimits& l = run_limits();
+  if (l.check_only && !(l.max_memory_bytes > 0)) return;
   const double budget = l.max_memory_bytes > 0 ? l.max_memory_bytes : available_memory_bytes();
   if (budget > 0 && bytes > budget)
     throw Error(file, field,

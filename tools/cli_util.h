@@ -31,7 +31,7 @@ using Commands = std::vector<Command>;
 // on a terminal one line redrawn in place, elsewhere (a log, a pipe) a plain line every 10 s and
 // at the end of each stage. It returns false once the user
 // pressed Ctrl-C, so the library stops at the next task boundary and keeps what it has.
-ProgressCallback progress_bar(bool quiet);
+ProgressCallback progress_bar(bool quiet);  // throws WorkWouldStart when check_only
 // Installs the SIGINT handler used by progress_bar (idempotent).
 void install_interrupt_handler();
 bool interrupted();
@@ -51,7 +51,12 @@ int report_render_outcome(const RenderOutcome& r, const std::string& what);
 struct RunLimits {
   double max_memory_bytes = 0;  // 0: available_memory_bytes()
   bool yes_long = false;
+  // weft slurm's check of the command it wraps: every check the command makes, then progress_bar
+  // throws WorkWouldStart where the work would start. The memory available here is not the
+  // cluster's, so only an explicit --max-memory-gb is checked.
+  bool check_only = false;
 };
+struct WorkWouldStart {};
 RunLimits& run_limits();
 // MemAvailable from /proc/meminfo (what can be allocated without swapping), else free pages.
 double available_memory_bytes();
@@ -80,7 +85,6 @@ std::string format_seconds(double seconds);
 // A seed is a plain decimal number below 2^64: CLI11 would read "-5" as 2^64 - 5 and "010" as
 // octal 8. main.cpp adds it to every --seed option.
 CLI::Validator seed_validator();
-
 
 // THE output guard: every command checks its outputs here before any work. Each output names a
 // file in an existing directory, no two outputs name the same file, and none is any file the job

@@ -251,3 +251,72 @@ TEST(CliBadInput, ExrTableClaimingMorePixelsThanTheFileHoldsIsRefused) {
                {"big.exr", "field 'resolution'", "50331648 bytes of pixels", "can hold"},
                dir / "none");
 }
+
+// weft slurm writes batch scripts that run on a cluster: no value of the user's may add a line to
+// them (a newline in --time wrote an #SBATCH line of the user's choosing), Slurm's values are
+// checked against its syntax, and the wrapped command is checked by the same parser and checks
+// as running it, before any script is written (no OUTPUT.slurm folder is left).
+TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
+  const fs::path dir = fresh_test_dir();
+  fs::copy_file(kPlane, dir / "plane.json");
+  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
+  const std::string sweep = " sweep plane.json -o s.csv";
+  struct Case {
+    std::string options;
+    const char* option;  // named in the error
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--time '1:00:00\n#SBATCH --mem=1'", "--time"},
+           {"--time 'one hour'", "--time"},
+           {"--time 1:00:00:00", "--time"},
+           {"--partition 'cpu gpu'", "--partition"},
+           {"--partition 'cpu\n#SBATCH --x'", "--partition"},
+           {"--account 'a;b'", "--account"},
+       }) {
+    for (const char* dry : {"", " --dry-run"}) {
+      const CliRun r = run("slurm --shards 2" + std::string(dry) + " " + c.options + sweep, dir);
+      expect_error(r, {c.option}, dir / "s.csv.slurm");
+      EXPECT_EQ(r.out.find("#SBATCH"), std::string::npos) << r.out;
+    }
+  }
+  // A newline in the wrapped command's output path, in any of its arguments.
+  expect_error(run("slurm --shards 2 sweep plane.json -o 's\n.csv'", dir), {"'-o'"},
+               dir / "s\n.csv.slurm");
+  expect_error(run("slurm --shards 2 sweep plane.json --sample 'a\nb' -o s.csv", dir),
+               {"--sample", "control character"}, dir / "s.csv.slurm");
+  // Valid values go into the scripts as given (Slurm's time formats, a partition list).
+  const CliRun ok = run(
+      "slurm --shards 2 --dry-run --time 2-12 --partition cpu,long --account lab_1" + sweep, dir);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  for (const char* line :
+       {"#SBATCH --time=2-12\n", "#SBATCH --partition=cpu,long\n", "#SBATCH --account=lab_1\n"})
+    EXPECT_NE(ok.out.find(line), std::string::npos) << line << ok.out;
+  EXPECT_FALSE(fs::exists(dir / "s.csv.slurm"));
+}
+
+TEST(CliBadInput, SlurmChecksTheWrappedCommandBeforeWritingScripts) {
+  const fs::path dir = fresh_test_dir();
+  fs::copy_file(kPlane, dir / "plane.json");
+  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
+  // Refused by the wrapped command's own parser, its own checks and the output guard.
+  expect_error(run("slurm --shards 2 bake fiber red-cotton --photons -5 -o t.exr", dir),
+               {"--photons"}, dir / "t.exr.slurm");
+  expect_error(run("slurm --shards 2 bake fiber nonesuch -o t.exr", dir), {"nonesuch"},
+               dir / "t.exr.slurm");
+  // A summation cannot be sharded: only the ray trace can.
+  expect_error(run("slurm --shards 2 bake fabric -R 2 -o t.exr", dir), {"--method raytrace"},
+               dir / "t.exr.slurm");
+  expect_error(run("slurm --shards 2 sweep plane.json -o lambert-plane.gltf", dir),
+               {"lambert-plane.gltf", "refusing to overwrite"}, dir / "lambert-plane.gltf.slurm");
+  expect_error(run("slurm --shards 2 sweep plane.json --spp 0 -o s.csv", dir), {"--spp"},
+               dir / "s.csv.slurm");
+  // Work that a shard would refuse without --yes-long.
+  expect_error(run("slurm --shards 2 bake fiber red-cotton --photons 1000000000000 -o t.exr", dir),
+               {"--photons", "--yes-long"}, dir / "t.exr.slurm");
+  // The scene's files are untouched and nothing was written beside them.
+  EXPECT_EQ(slurp(dir / "plane.json"), slurp(kPlane));
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir))
+    files += e.path().filename() != "stdout" && e.path().filename() != "stderr";
+  EXPECT_EQ(files, 2u);
+}
