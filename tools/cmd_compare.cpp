@@ -33,13 +33,22 @@ int run_compare(const CompareCliOptions& o) {
   const std::string curves = in_plane_csv(c, a.channel_names());
   if (!o.csv.empty()) write_text_atomically(o.csv, curves);
   if (!o.plot.empty()) {
-    const auto tmp = std::filesystem::temp_directory_path() / "weft-compare-curves.csv";
+    // The curves for the plot script under a name of this run's own (atomic_file.h), so that
+    // runs at once never read each other's; removed however the plot ends.
+    const auto tmp =
+        temporary_sibling(std::filesystem::temp_directory_path() / "weft-compare-curves.csv");
+    struct Remove {
+      std::filesystem::path path;
+      ~Remove() {
+        std::error_code ec;
+        std::filesystem::remove(path, ec);
+      }
+    } remove{tmp};
     write_text_atomically(tmp, curves);
     run_plot_script("plot_compare.py",
                     {tmp.string(), o.plot, std::filesystem::path(o.a).filename().string(),
                      std::filesystem::path(o.b).filename().string()},
                     o.plot);
-    std::filesystem::remove(tmp);
   }
   if (o.json) {
     std::cout << nlohmann::json{{"a", o.a},

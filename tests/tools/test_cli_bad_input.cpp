@@ -274,7 +274,8 @@ TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
            {"--account 'a;b'", "--account"},
        }) {
     for (const char* dry : {"", " --dry-run"}) {
-      const CliRun r = run("slurm --shards 2" + std::string(dry) + " " + c.options + sweep, dir);
+      const std::string args = std::string("slurm --shards 2") + dry + " " + c.options + sweep;
+      const CliRun r = run(args, dir);
       expect_error(r, {c.option}, dir / "s.csv.slurm");
       EXPECT_EQ(r.out.find("#SBATCH"), std::string::npos) << r.out;
     }

@@ -4,6 +4,7 @@
 // a message naming both, the input's bytes unchanged and nothing left behind in the folder.
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -146,4 +147,41 @@ TEST(OutputGuard, VerifyRefusesAReportFolderHoldingItsMeasurement) {
                 dir / "report" / "m.csv");
   expect_refused(dir, "verify --quiet --quality draft --measured report/m.csv -o report", "report",
                  "report/m.csv");
+}
+
+// Concurrent `weft compare --plot` runs shared one temporary file name for their curves (15 of 20
+// plots showed another run's curves). Each run's plot, drawn with others running at once, is
+// byte for byte the plot it draws alone, and no temporary stays behind in TMPDIR.
+TEST(OutputGuard, ConcurrentComparePlotsDrawTheirOwnCurves) {
+  const fs::path dir = fresh_test_dir();
+  fs::create_directory(dir / "tmp");
+  for (const char* r : {"0.2", "0.4", "0.6", "0.8"})
+    ASSERT_EQ(
+        run(std::string("table bake lambert -R 2 --spp 1 --quiet --params '{\"reflectance\": ") +
+                r + "}' -o t" + r + ".exr",
+            dir)
+            .exit_code,
+        0);
+  const std::vector<std::string> pairs = {"t0.2.exr t0.4.exr", "t0.4.exr t0.6.exr",
+                                          "t0.6.exr t0.8.exr", "t0.2.exr t0.8.exr"};
+  const std::string env = "export TMPDIR='" + (dir / "tmp").string() + "'; ";
+  for (size_t i = 0; i < pairs.size(); ++i)
+    ASSERT_EQ(
+        run("compare " + pairs[i] + " --plot alone" + std::to_string(i) + ".png", dir).exit_code,
+        0);
+  std::string together;
+  for (size_t i = 0; i < pairs.size(); ++i)
+    together += "'" + std::string(WEFT_EXE) + "' compare " + pairs[i] + " --plot together" +
+                std::to_string(i) + ".png >/dev/null & ";
+  ASSERT_EQ(std::system(("cd '" + dir.string() + "' && " + env + together + "wait").c_str()), 0);
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const std::string n = std::to_string(i);
+    const std::string alone = slurp(dir / ("alone" + n + ".png"));
+    ASSERT_FALSE(alone.empty());
+    EXPECT_EQ(slurp(dir / ("together" + n + ".png")), alone) << pairs[i];
+    if (i) {
+      EXPECT_NE(alone, slurp(dir / "alone0.png")) << "the pairs must plot differently";
+    }
+  }
+  EXPECT_TRUE(fs::is_empty(dir / "tmp"));
 }
