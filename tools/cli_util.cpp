@@ -223,6 +223,23 @@ std::vector<NamedPath>& guarded_inputs_list() {
 
 }  // namespace
 
+CLI::Validator finite_range(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {
+        const auto v = finite_number(s);
+        if (!v || *v < lo || *v > hi)
+          return "must be a finite number in [" + ParamReader::fmt(lo) + ", " +
+                 ParamReader::fmt(hi) + "], got '" + s + "'";
+        return "";
+      },
+      "NUMBER in [" + ParamReader::fmt(lo) + ", " + ParamReader::fmt(hi) + "]");
+}
+
+CLI::Validator non_empty() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string { return s.empty() ? "must not be empty" : ""; }, "");
+}
+
 void validate_output_paths(const std::vector<NamedPath>& outputs,
                            const std::vector<NamedPath>& inputs,
                            const std::vector<NamedPath>& folders) {

@@ -86,6 +86,15 @@ std::string format_seconds(double seconds);
 // octal 8. main.cpp adds it to every --seed option.
 CLI::Validator seed_validator();
 
+// A number option in [lo, hi], read by finite_number (params.h): CLI11's Range lets "nan" through
+// (every comparison with NaN is false), and "inf" past an open bound. Every floating-point option
+// takes this check.
+CLI::Validator finite_range(double lo, double hi);
+// A string option given as "" (--camera '') is refused rather than read as not given.
+CLI::Validator non_empty();
+// The floor of --max-memory-gb: below it no command can run (the memory budget, RunLimits).
+inline constexpr double kMinMemoryGb = 0.05;
+
 // THE output guard: every command checks its outputs here before any work. Each output names a
 // file in an existing directory, no two outputs name the same file, and none is any file the job
 // reads: compared by identity (same device and inode, so a symbolic or hard link to an input is

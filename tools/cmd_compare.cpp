@@ -87,7 +87,7 @@ void add_compare_command(CLI::App& app, Commands& commands) {
   sub->add_option("--csv", o->csv, "in-plane curves as CSV");
   sub->add_option("--significant", o->compare.significant,
                   "max_rel counts cells at least this fraction of A's mean value")
-      ->check(CLI::Range(0.0, 1e6))
+      ->check(finite_range(0.0, 1e6))
       ->capture_default_str();
   commands.push_back({sub, [o] { return run_compare(*o); }});
 }

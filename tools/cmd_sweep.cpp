@@ -173,22 +173,25 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_option("scene", o->scene, "scene description (.json)")->required();
   sub->add_option("-o,--output", o->output, "CSV output")->required();
   auto* lz = sub->add_option("--light-zenith-deg", o->light_zenith, "light zenith")
-                 ->check(CLI::Range(0.0, 89.9));
+                 ->check(finite_range(0.0, 89.9));
   auto* la = sub->add_option("--light-azimuth-deg", o->light_azimuth, "light azimuth")
-                 ->check(CLI::Range(-360.0, 360.0));
+                 ->check(finite_range(-360.0, 360.0));
   sub->add_option("--view-zenith-deg", o->views,
-                  "view zeniths: a:b:step, a list a,b,c or one value");
+                  "view zeniths: a:b:step, a list a,b,c or one value")
+      ->check(non_empty());
   auto* va = sub->add_option("--view-azimuth-deg", o->view_azimuth,
                              "azimuth of the view plane (default: the light's)")
-                 ->check(CLI::Range(-360.0, 360.0));
+                 ->check(finite_range(-360.0, 360.0));
   sub->add_option("--sample", o->sample,
-                  "object to measure (glTF node or mesh name; default: the scene's)");
+                  "object to measure (glTF node or mesh name; default: the scene's)")
+      ->check(non_empty());
   auto* irr =
       sub->add_option("--irradiance", o->irradiance, "irradiance E of the parallel light, W/m^2")
-          ->check(CLI::Range(1e-12, 1e12));
+          ->check(finite_range(1e-12, 1e12));
   sub->add_option(
-      "--normalize-to", o->normalize_to,
-      "scale beta so that beta(normal incidence, normal view) equals this (value or r,g,b)");
+         "--normalize-to", o->normalize_to,
+         "scale beta so that beta(normal incidence, normal view) equals this (value or r,g,b)")
+      ->check(non_empty());
   sub->add_flag("--no-white-check", o->no_white, "skip rendering the white Lambert reference");
   sub->add_option("--spp", o->spp, "samples per pixel")->check(CLI::Range(1, 1 << 20));
   sub->add_option("--resolution", o->resolution, "pixels per side of each view")
@@ -196,7 +199,8 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
   auto* seed = sub->add_option("--seed", o->seed, "random seed");
   sub->add_option("--shard", o->shard,
-                  "K/N: render only shard K of N (views) into a part file for `weft merge`");
+                  "K/N: render only shard K of N (views) into a part file for `weft merge`")
+      ->check(non_empty());
   sub->add_flag("--resume", o->resume,
                 "checkpoint every finished view beside the output and continue from a "
                 "checkpoint an earlier run of this sweep left there");

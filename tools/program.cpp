@@ -27,7 +27,7 @@ std::unique_ptr<Program> make_program() {
   app.add_option("--max-memory-gb", p->max_memory_gb,
                  "memory budget, GB (default: the memory available at start); work estimated "
                  "to need more is refused before it starts")
-      ->check(CLI::Range(1e-3, 1e6));
+      ->check(finite_range(kMinMemoryGb, 1e6));
   app.add_flag("--yes-long", p->yes_long, "run work estimated to take more than an hour");
   // In the order `weft --help` lists them.
   for (AddCommand* add :

@@ -149,9 +149,10 @@ TEST(CliBadInput, LongBakesNeedConfirmation) {
   // 1e12 photons per band: 33e12 photons at >= 0.5 us each is years on any machine here.
   const CliRun r = run("bake fiber red-cotton --photons 1000000000000 -o t.exr", dir);
   expect_error(r, {"--photons", "would take at least", "--yes-long"}, dir / "t.exr");
-  // --yes-long passes that check (after the subcommand too); the memory budget then refuses.
-  expect_error(run("bake fiber red-cotton --photons 1000000000000 -o t.exr --yes-long "
-                   "--max-memory-gb 0.001",
+  // --yes-long passes that check (after the subcommand too); the memory budget then refuses (at
+  // its floor of 0.05 GB, cli_util.h kMinMemoryGb, a bake at resolution 16 needs 178 MB).
+  expect_error(run("bake fiber red-cotton --photons 1000000000000 --resolution 16 -o t.exr "
+                   "--yes-long --max-memory-gb 0.05",
                    dir),
                {"--resolution", "needs about", "allowed by --max-memory-gb"}, dir / "t.exr");
 }
@@ -320,4 +321,47 @@ TEST(CliBadInput, SlurmChecksTheWrappedCommandBeforeWritingScripts) {
   for (const auto& e : fs::directory_iterator(dir))
     files += e.path().filename() != "stdout" && e.path().filename() != "stderr";
   EXPECT_EQ(files, 2u);
+}
+
+// Numbers that were accepted and then misread: NaN passed CLI11's Range checks (every comparison
+// with NaN is false) and disabled the memory budget or the time limit, an empty --camera read as
+// not given, 0 raytrace samples as the default and 2^32 + 1 summation samples wrapped to 1. Each
+// is refused naming the option, before any work (no output).
+TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(run("table bake lambert -R 2 --spp 1 -o a.exr --quiet", dir).exit_code, 0);
+  const std::string render = "render '" + kPlane + "' -o out.exr --quiet ";
+  const std::string sweep = "sweep '" + kPlane + "' -o out.exr --quiet ";
+  struct Case {
+    std::string args;
+    const char* option;
+  };
+  for (const Case& c : std::vector<Case>{
+           {render + "--time-limit nan", "--time-limit"},
+           {render + "--time-limit inf", "--time-limit"},
+           {render + "--exposure nan", "--exposure"},
+           {render + "--camera ''", "--camera"},
+           {render + "--preview ''", "--preview"},
+           {std::string("--max-memory-gb nan ") + render, "--max-memory-gb"},
+           {std::string("--max-memory-gb 0.001 ") + render, "--max-memory-gb"},
+           {render + "--max-memory-gb inf", "--max-memory-gb"},
+           {sweep + "--light-zenith-deg nan", "--light-zenith-deg"},
+           {sweep + "--irradiance nan", "--irradiance"},
+           {sweep + "--view-azimuth-deg nan", "--view-azimuth-deg"},
+           {sweep + "--sample ''", "--sample"},
+           {"compare a.exr a.exr --significant nan --csv out.exr", "--significant"},
+           {"bake fabric --method raytrace -R 2 --samples 0 -o out.exr", "--samples"},
+           {"bake fabric -R 2 --samples 4294967297 -o out.exr", "--samples"},
+           {"bake fabric -R 2 --samples 0 -o out.exr", "--samples"},
+           {"bench bake --target nan", "--target"},
+       }) {
+    const CliRun r = run(c.args, dir);
+    EXPECT_NE(r.exit_code, 0) << c.args;
+    EXPECT_NE(r.err.find(c.option), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out.exr")) << c.args;
+  }
+  // In range the same options still run (the floor of the budget is 0.05 GB).
+  EXPECT_EQ(
+      run("--max-memory-gb 0.05 table bake lambert -R 2 --spp 1 -o out.exr --quiet", dir).exit_code,
+      0);
 }
