@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
@@ -268,6 +269,23 @@ void validate_output_paths(const std::vector<NamedPath>& outputs,
       if (!folder.path.empty() && inside(in.path, folder.path)) refuse(folder, in, "holds");
   // Each in an existing directory, not a directory, no two the same file.
   check_output_paths(outputs, {});
+}
+
+std::vector<NamedPath> json_named_files(const nlohmann::json& j, const std::string& what) {
+  std::vector<NamedPath> out;
+  auto add = [&](const nlohmann::json& v) {
+    for (auto& f : json_named_files(v, what)) out.push_back(std::move(f));
+  };
+  if (j.is_string()) {
+    const std::string& s = j.get_ref<const std::string&>();
+    std::error_code ec;
+    if (!s.empty() && s.size() < 4096 && fs::exists(s, ec)) out.push_back({s, what});
+  } else if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) add(it.key()), add(it.value());
+  } else if (j.is_array()) {
+    for (const auto& v : j) add(v);
+  }
+  return out;
 }
 
 const std::vector<NamedPath>& guarded_inputs() {

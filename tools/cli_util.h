@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
@@ -108,6 +109,10 @@ void validate_output_paths(const std::vector<NamedPath>& outputs,
 // Every input validate_output_paths was given in this process, oldest first: weft slurm checks its
 // scripts against the inputs of the command it wraps after checking that command (check_only).
 const std::vector<NamedPath>& guarded_inputs();
+
+// Every string in 'j' (values and keys, at any depth) that names an existing file or folder,
+// named 'what' for the output guard: the files a part's job or a material's parameters name.
+std::vector<NamedPath> json_named_files(const nlohmann::json& j, const std::string& what);
 
 // Every file a render or sweep of the description reads: the description, its glTF files and
 // buffers and environment maps, and what its materials name (tables, measured networks, fiber

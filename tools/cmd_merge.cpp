@@ -1,8 +1,6 @@
 // weft merge: the parts of a sharded bake or sweep (`--shard K/N`) -> the output the unsharded run
 // writes, bit for bit. The parts must be of one job, disjoint and together complete.
 #include <filesystem>
-#include <functional>
-#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
@@ -11,34 +9,6 @@
 #include "weft/core/job_part.h"
 
 namespace weft::cli {
-namespace {
-
-// What the merge and its shards read: the parts, and every file the job names (the sweep's and
-// the ray trace's hashed inputs by their names, the fiber spec file, verify's options).
-std::vector<NamedPath> merge_inputs(const std::vector<std::string>& parts, const JobPart& all) {
-  std::vector<NamedPath> out;
-  for (const auto& p : parts) out.push_back({p, "part file"});
-  std::function<void(const nlohmann::json&)> add = [&](const nlohmann::json& j) {
-    if (j.is_string()) {
-      const std::string s = j.get<std::string>();
-      std::error_code ec;
-      if (!s.empty() && s.size() < 4096 && std::filesystem::exists(s, ec))
-        out.push_back({s, "job's input"});
-    }
-    for (auto it = j.begin(); j.is_object() && it != j.end(); ++it) {
-      add(nlohmann::json(it.key()));
-      add(it.value());
-    }
-    for (const auto& v : j)
-      if (j.is_array()) add(v);
-  };
-  add(all.job);
-  add(all.extra);
-  return out;
-}
-
-}  // namespace
-
 void add_merge_command(CLI::App& app, Commands& commands) {
   struct Options {
     std::vector<std::string> parts;
@@ -60,7 +30,12 @@ void add_merge_command(CLI::App& app, Commands& commands) {
          const JobPart all =
              merge_job_parts(std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
          // A verify report is a folder, replaced whole.
-         const std::vector<NamedPath> inputs = merge_inputs(o->parts, all);
+         // The parts, and every file the job names (the sweep's and the ray trace's hashed
+         // inputs, the fiber spec file, verify's options): what the shards read.
+         std::vector<NamedPath> inputs;
+         for (const auto& p : o->parts) inputs.push_back({p, "part file"});
+         for (const auto* j : {&all.job, &all.extra})
+           for (auto& f : json_named_files(*j, "job's input")) inputs.push_back(std::move(f));
          if (all.command == "verify")
            validate_output_paths({}, inputs, {{o->output, "--output"}});
          else

@@ -283,11 +283,12 @@ TEST(CliRender, ProgressInALogIsPlainLinesWithUnits) {
 // second: 10 s allows for a loaded machine. Nothing is written, exit 130.
 TEST(CliRender, CtrlCStopsALargeTileAtOnce) {
   const fs::path dir = fresh_test_dir();
-  const std::string cmd = "cd '" + dir.string() + "'; '" + std::string(WEFT_EXE) + "' render '" +
-                          (kExamples / "lambert-plane.json").string() +
-                          "' --width 16 --height 16 --spp 1048576 -o out.exr --quiet 2>err & "
-                          "pid=$!; sleep 1; t0=$(date +%s%N); kill -INT $pid; wait $pid; "
-                          "echo $? $(( ($(date +%s%N) - t0) / 1000000 )) > result";
+  std::string cmd = "cd '";
+  cmd += dir.string() + "'; '" + WEFT_EXE + "' render '" +
+         (kExamples / "lambert-plane.json").string() +
+         "' --width 16 --height 16 --spp 1048576 -o out.exr --quiet 2>err & "
+         "pid=$!; sleep 1; t0=$(date +%s%N); kill -INT $pid; wait $pid; "
+         "echo $? $(( ($(date +%s%N) - t0) / 1000000 )) > result";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   std::istringstream in(slurp(dir / "result"));
   int code = -1;

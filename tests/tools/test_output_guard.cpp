@@ -136,6 +136,9 @@ TEST(OutputGuard, WeaveAndCompareRefuseTheirInputs) {
   ASSERT_EQ(run("table bake lambert -R 2 --spp 2 -o b.exr --quiet", dir).exit_code, 0);
   expect_refused(dir, "compare a.exr b.exr --csv a.exr", "a.exr", "a.exr");
   expect_refused(dir, "compare a.exr b.exr --plot b.exr", "b.exr", "b.exr");
+  // table bake of a table material: the table its parameters name is an input.
+  expect_refused(dir, "table bake fiber_table -R 2 --params '{\"file\": \"a.exr\"}' -o a.exr",
+                 "a.exr", "a.exr");
 }
 
 TEST(OutputGuard, VerifyRefusesAReportFolderHoldingItsMeasurement) {
