@@ -25,8 +25,8 @@ std::unique_ptr<Program> make_program() {
   // made after this pass options they do not know up to here.
   app.fallthrough();
   app.add_option("--max-memory-gb", p->max_memory_gb,
-                 "memory budget, GB (default: the memory available at start); work estimated "
-                 "to need more is refused before it starts")
+                 "memory budget, GB, at least 0.05 (default: the memory available at start); "
+                 "work estimated to need more is refused before it starts")
       ->check(finite_range(kMinMemoryGb, 1e6));
   app.add_flag("--yes-long", p->yes_long, "run work estimated to take more than an hour");
   // In the order `weft --help` lists them.
