@@ -185,17 +185,19 @@ int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
   const std::string name = "weft-" + out_abs.filename().string();
   const int n = o.shards;
   auto part = [&](int k) { return dir / ("part-" + std::to_string(k) + ".part"); };
-  // The first shard's command line, as the array script runs it for task 0.
-  std::vector<std::string> first = args;
-  first[output_at] = part(0).string();
-  first.insert(first.end(), {"--shard", "0/" + std::to_string(n)});
-  if (!verify) first.push_back("--resume");
-  first.push_back("--quiet");
+  // The last shard's command line, as the array script runs it for task N-1: the last shard
+  // always has work (shard_units), so its check ends where the work would start and writes
+  // nothing.
+  std::vector<std::string> last = args;
+  last[output_at] = part(n - 1).string();
+  last.insert(last.end(), {"--shard", std::to_string(n - 1) + "/" + std::to_string(n)});
+  if (!verify) last.push_back("--resume");
+  last.push_back("--quiet");
   ScriptFolder folder(dir);
-  // The first shard's command, checked as it will run; then the scripts, the parts and
+  // That shard's command, checked as it will run; then the scripts, the parts and
   // the output against every file it reads.
   const size_t seen = guarded_inputs().size();
-  check_wrapped_command(first);
+  check_wrapped_command(last);
   const std::vector<NamedPath> inputs(guarded_inputs().begin() + seen, guarded_inputs().end());
   std::vector<NamedPath> outputs = {{dir / "array.sh", "array script"},
                                     {dir / "merge.sh", "merge script"}};

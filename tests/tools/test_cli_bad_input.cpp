@@ -294,6 +294,13 @@ TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
        {"#SBATCH --time=2-12\n", "#SBATCH --partition=cpu,long\n", "#SBATCH --account=lab_1\n"})
     EXPECT_NE(ok.out.find(line), std::string::npos) << line << ok.out;
   EXPECT_FALSE(fs::exists(dir / "s.csv.slurm"));
+  // More shards than the sweep's 16 units (15 views and the normal-incidence reference): the
+  // check runs the last shard, which has work, and writes no part of its own.
+  const CliRun many = run(std::string("slurm --shards 40 --dry-run") + sweep, dir);
+  ASSERT_EQ(many.exit_code, 0) << many.err;
+  EXPECT_EQ(many.out.find("views "), std::string::npos) << many.out;
+  EXPECT_FALSE(fs::exists(dir / "s.csv.slurm"));
+  EXPECT_FALSE(fs::exists(dir / "s.csv"));
 }
 
 TEST(CliBadInput, SlurmChecksTheWrappedCommandBeforeWritingScripts) {
