@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <sstream>
 #include <thread>
 
@@ -39,6 +40,7 @@ bool interrupted() {
 }
 
 ProgressCallback progress_bar(bool quiet) {
+  if (run_limits().check_only) throw WorkWouldStart{};
   install_interrupt_handler();
   using Clock = std::chrono::steady_clock;
   struct State {
@@ -144,6 +146,7 @@ std::string format_seconds(double s) {
 void check_memory(double bytes, const std::string& file, const std::string& field,
                   const std::string& what) {
   const RunLimits& l = run_limits();
+  if (l.check_only && !(l.max_memory_bytes > 0)) return;
   const double budget = l.max_memory_bytes > 0 ? l.max_memory_bytes : available_memory_bytes();
   if (budget > 0 && bytes > budget)
     throw Error(file, field,
@@ -188,12 +191,135 @@ CLI::Validator seed_validator() {
       "SEED");
 }
 
-void validate_output_paths(const std::vector<std::string>& outputs,
-                           const std::vector<std::string>& inputs) {
-  std::vector<NamedPath> out, in;
-  for (const auto& p : outputs) out.push_back({p, "output"});
-  for (const auto& p : inputs) in.push_back({p, "input"});
-  check_output_paths(out, in);
+namespace {
+
+namespace fs = std::filesystem;
+
+// The path as the file system resolves it: symbolic links followed; a path not there yet as its
+// resolved folder and its name.
+fs::path resolved(const fs::path& p) {
+  std::error_code ec;
+  const fs::path c = fs::weakly_canonical(fs::absolute(p, ec), ec);
+  return ec ? fs::absolute(p).lexically_normal() : c;
+}
+
+// 'p' is 'folder' or lies inside it, once both are resolved.
+bool inside(const fs::path& p, const fs::path& folder) {
+  const fs::path rel = resolved(p).lexically_relative(resolved(folder));
+  return !rel.empty() && *rel.begin() != "..";
+}
+
+// 'out' is the existing file 'in' (same device and inode, through any link) or will be written
+// where 'in' lies.
+bool same_file(const fs::path& out, const fs::path& in) {
+  std::error_code ec;
+  if (fs::exists(out, ec) && fs::equivalent(out, in, ec) && !ec) return true;
+  return resolved(out) == resolved(in);
+}
+
+std::vector<NamedPath>& guarded_inputs_list() {
+  static std::vector<NamedPath> inputs;
+  return inputs;
+}
+
+}  // namespace
+
+CLI::Validator finite_range(double lo, double hi) {
+  return CLI::Validator(
+      [lo, hi](std::string& s) -> std::string {
+        const auto v = finite_number(s);
+        if (!v || *v < lo || *v > hi)
+          return "must be a finite number in [" + ParamReader::fmt(lo) + ", " +
+                 ParamReader::fmt(hi) + "], got '" + s + "'";
+        return "";
+      },
+      "NUMBER in [" + ParamReader::fmt(lo) + ", " + ParamReader::fmt(hi) + "]");
+}
+
+CLI::Validator non_empty() {
+  return CLI::Validator(
+      [](std::string& s) -> std::string { return s.empty() ? "must not be empty" : ""; }, "");
+}
+
+void validate_output_paths(const std::vector<NamedPath>& outputs,
+                           const std::vector<NamedPath>& inputs,
+                           const std::vector<NamedPath>& folders) {
+  auto& seen = guarded_inputs_list();
+  seen.insert(seen.end(), inputs.begin(), inputs.end());
+  std::vector<NamedPath> present;  // inputs that are files or folders here (not preset names)
+  for (const auto& in : inputs) {
+    std::error_code ec;
+    if (!in.path.empty() && fs::exists(in.path, ec)) present.push_back(in);
+  }
+  auto refuse = [](const NamedPath& out, const NamedPath& in, const std::string& how) {
+    throw Error(out.path.string(), out.what,
+                how + " the " + in.what + " '" + in.path.string() + "': refusing to " +
+                    (how == "holds" ? "replace it" : "overwrite it"));
+  };
+  for (const auto& out : outputs) {
+    if (out.path.empty()) continue;
+    for (const auto& in : present) {
+      std::error_code ec;
+      if (same_file(out.path, in.path)) refuse(out, in, "is also");
+      if (fs::is_directory(in.path, ec) && inside(out.path, in.path)) refuse(out, in, "lies in");
+    }
+  }
+  for (const auto& folder : folders)
+    for (const auto& in : present)
+      if (!folder.path.empty() && inside(in.path, folder.path)) refuse(folder, in, "holds");
+  // Each in an existing directory, not a directory, no two the same file.
+  check_output_paths(outputs, {});
+}
+
+std::vector<NamedPath> json_named_files(const nlohmann::json& j, const std::string& what) {
+  std::vector<NamedPath> out;
+  auto add = [&](const nlohmann::json& v) {
+    for (auto& f : json_named_files(v, what)) out.push_back(std::move(f));
+  };
+  if (j.is_string()) {
+    const std::string& s = j.get_ref<const std::string&>();
+    std::error_code ec;
+    if (!s.empty() && s.size() < 4096 && fs::exists(s, ec)) out.push_back({s, what});
+  } else if (j.is_object()) {
+    for (auto it = j.begin(); it != j.end(); ++it) add(it.key()), add(it.value());
+  } else if (j.is_array()) {
+    for (const auto& v : j) add(v);
+  }
+  return out;
+}
+
+const std::vector<NamedPath>& guarded_inputs() {
+  return guarded_inputs_list();
+}
+
+std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
+                                                     const SceneDescription& d) {
+  std::vector<std::filesystem::path> files{scene};
+  files.insert(files.end(), d.files.begin(), d.files.end());
+  auto add = [&](const MaterialBinding& b) {
+    for (const char* key : {"file", "spec"}) {
+      if (!b.params.contains(key) || !b.params[key].is_string()) continue;
+      std::filesystem::path f = b.params[key].get<std::string>();
+      std::error_code ec;
+      if (f.is_relative() &&
+          (std::string(key) == "file" || std::filesystem::exists(d.base_dir / f, ec)))
+        f = d.base_dir / f;
+      // A missing table is the renderer's error to report, with its field.
+      if (std::filesystem::is_regular_file(f, ec)) files.push_back(f);
+    }
+  };
+  for (const auto& [key, b] : d.materials) add(b);
+  if (d.default_material) add(*d.default_material);
+  return files;
+}
+
+std::vector<NamedPath> scene_inputs(const std::string& scene, const SceneDescription& d) {
+  std::vector<NamedPath> out;
+  for (const auto& f : scene_input_files(scene, d))
+    out.push_back({f, out.empty() ? "scene description" : "scene's input"});
+  // Where fiber_table_resolver keeps the tables it bakes for the scene (bake_cache.h).
+  out.push_back({d.base_dir / ".weft-cache", "fiber-table bake cache"});
+  return out;
 }
 
 std::vector<double> parse_range(const std::string& text, const std::string& option_name,

@@ -2,11 +2,14 @@
 // Shared pieces of the command-line front end: the subcommand registry, the progress bar on
 // stderr, and Ctrl-C handling that asks long work to stop cleanly.
 #include <CLI/CLI.hpp>
+#include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "weft/core/atomic_file.h"
 #include "weft/core/params.h"
 #include "weft/core/progress.h"
 
@@ -29,7 +32,7 @@ using Commands = std::vector<Command>;
 // on a terminal one line redrawn in place, elsewhere (a log, a pipe) a plain line every 10 s and
 // at the end of each stage. It returns false once the user
 // pressed Ctrl-C, so the library stops at the next task boundary and keeps what it has.
-ProgressCallback progress_bar(bool quiet);
+ProgressCallback progress_bar(bool quiet);  // throws WorkWouldStart when check_only
 // Installs the SIGINT handler used by progress_bar (idempotent).
 void install_interrupt_handler();
 bool interrupted();
@@ -49,7 +52,12 @@ int report_render_outcome(const RenderOutcome& r, const std::string& what);
 struct RunLimits {
   double max_memory_bytes = 0;  // 0: available_memory_bytes()
   bool yes_long = false;
+  // weft slurm's check of the command it wraps: every check the command makes, then progress_bar
+  // throws WorkWouldStart where the work would start. The memory available here is not the
+  // cluster's, so only an explicit --max-memory-gb is checked.
+  bool check_only = false;
 };
+struct WorkWouldStart {};
 RunLimits& run_limits();
 // MemAvailable from /proc/meminfo (what can be allocated without swapping), else free pages.
 double available_memory_bytes();
@@ -79,13 +87,41 @@ std::string format_seconds(double seconds);
 // octal 8. main.cpp adds it to every --seed option.
 CLI::Validator seed_validator();
 
+// A number option in [lo, hi], read by finite_number (params.h): CLI11's Range lets "nan" through
+// (every comparison with NaN is false), and "inf" past an open bound. Every floating-point option
+// takes this check.
+CLI::Validator finite_range(double lo, double hi);
+// A string option given as "" (--camera '') is refused rather than read as not given.
+CLI::Validator non_empty();
+// The floor of --max-memory-gb: below it no command can run (the memory budget, RunLimits).
+inline constexpr double kMinMemoryGb = 0.05;
 
-// Checks a command's output paths before any work: each names a file in an existing directory,
-// no two name the same file and none names one of the inputs (compared by canonical path, so
-// "./x" and "x" or a symbolic link are the same file). Inputs that are not files (a preset name)
-// are ignored. weft::Error naming the output otherwise.
-void validate_output_paths(const std::vector<std::string>& outputs,
-                           const std::vector<std::string>& inputs);
+// THE output guard: every command checks its outputs here before any work. Each output names a
+// file in an existing directory, no two outputs name the same file, and none is any file the job
+// reads: compared by identity (same device and inode, so a symbolic or hard link to an input is
+// that input), a not-yet-existing output by its resolved folder and name. An output inside an
+// input folder (the bake cache) is refused too. 'folders' are outputs replaced whole (verify's
+// report folder, weft slurm's script folder): refused when they hold any input. Inputs that are
+// not files (a preset name) are ignored. weft::Error naming the output and the input otherwise.
+void validate_output_paths(const std::vector<NamedPath>& outputs,
+                           const std::vector<NamedPath>& inputs,
+                           const std::vector<NamedPath>& folders = {});
+// Every input validate_output_paths was given in this process, oldest first: weft slurm checks its
+// scripts against the inputs of the command it wraps after checking that command (check_only).
+const std::vector<NamedPath>& guarded_inputs();
+
+// Every string in 'j' (values and keys, at any depth) that names an existing file or folder,
+// named 'what' for the output guard: the files a part's job or a material's parameters name.
+std::vector<NamedPath> json_named_files(const nlohmann::json& j, const std::string& what);
+
+// Every file a render or sweep of the description reads: the description, its glTF files and
+// buffers and environment maps, and what its materials name (tables, measured networks, fiber
+// specs; a preset name is no file). Relative names resolve as registry.cpp and bake_cache.cpp
+// resolve them.
+std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
+                                                     const SceneDescription& d);
+// The same named for the output guard, with the scene's fiber-table bake cache folder.
+std::vector<NamedPath> scene_inputs(const std::string& scene, const SceneDescription& d);
 
 // Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers; at most
 // max_count of them (a range's count is checked before the list is built), no empty items.

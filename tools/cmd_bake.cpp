@@ -219,7 +219,9 @@ void add_bake_command(CLI::App& app, Commands& commands) {
 
   commands.push_back(
       {fiber, [opt] {
-         validate_output_paths({opt->output}, {opt->spec});
+         validate_output_paths(
+             {{opt->output, "--output"}, {checkpoint_path(opt->output), "checkpoint"}},
+             {{opt->spec, "fiber spec"}});
          // A shard writes a part file for `weft merge`, not a table.
          if (opt->shard.empty()) TabulatedBsdfTable::check_output_path(opt->output, "--output");
          const FiberSpec spec = load_fiber_spec(opt->spec);

@@ -19,11 +19,15 @@
 namespace weft::cli {
 namespace {
 
+// The summations' direction pairs per cell pair at most (fabric_summation.cpp checks the same).
+constexpr uint64_t kMaxSummationSamples = 4096;
+
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
   std::string detail = "yarn", shard, estimator;  // estimator: "" = hero
   int resolution = 8, threads = 0;
-  uint64_t samples = 0, seed = 1;
+  std::optional<uint64_t> samples;  // the method's default unless given
+  uint64_t seed = 1;
   std::optional<double> split_threshold;  // the library's default unless given
   bool json = false, quiet = false, resume = false;
 };
@@ -63,7 +67,7 @@ std::vector<FiberOrientation> orientations(const std::vector<Vec3>& tangents) {
 FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
   FabricRaytraceOptions r;
   r.resolution = o.resolution;
-  if (o.samples) r.particles_per_bin = o.samples;
+  if (o.samples) r.particles_per_bin = *o.samples;
   r.seed = o.seed;
   r.threads = o.threads;
   r.channel_sampling =
@@ -88,22 +92,31 @@ int run(const BakeFabricOptions& o) {
     throw Error("", "--shard", "--shard and --resume need --method raytrace");
   if (o.method != "raytrace" && !o.estimator.empty())
     throw Error("", "--estimator", "the estimator is the ray tracer's: it needs --method raytrace");
+  // Checked before narrowing to the summation's int: 2^32 + 1 wrapped to 1.
+  if (o.method != "raytrace" && o.samples && *o.samples > kMaxSummationSamples)
+    throw Error("", "--samples",
+                "a summation takes 1 to " + std::to_string(kMaxSummationSamples) +
+                    " direction pairs per cell pair, got " + std::to_string(*o.samples));
   if (o.method != "raytrace" && o.split_threshold)
     throw Error("", "--split-threshold",
                 "splitting is the ray tracer's: it needs --method raytrace");
   const FabricRaytraceOptions r =
       o.method == "raytrace" ? raytrace_options(o) : FabricRaytraceOptions{};
+  // The WIF draft a weave options file names is read too.
+  const std::string weave_wif = o.weave.empty() ? "" : read_weave_options(o.weave).wif.value_or("");
+  validate_output_paths({{o.output, "--output"}, {checkpoint_path(o.output), "checkpoint"}},
+                        {{o.fiber, "fiber table or spec"},
+                         {o.weave, "weave options"},
+                         {o.wif, "WIF draft"},
+                         {weave_wif, "WIF draft"},
+                         {".weft-cache", "fiber-table bake cache"}});
   if (std::filesystem::path(o.output).extension() != ".exr" && o.shard.empty())
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
-  const auto dir = std::filesystem::absolute(o.output).parent_path();
-  if (!std::filesystem::is_directory(dir))
-    throw Error(o.output, "", "output directory does not exist");
-  validate_output_paths({o.output}, {o.fiber, o.weave, o.wif});
   if (o.method == "raytrace") {
     const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
     const UnitRange r =
         shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"));
-    const uint64_t per_bin = o.samples ? o.samples : FabricRaytraceOptions{}.particles_per_bin;
+    const uint64_t per_bin = o.samples.value_or(FabricRaytraceOptions{}.particles_per_bin);
     check_long_work(double(r.last - r.first) * double(per_bin), kMinSecondsPerFabricParticle,
                     o.threads, "", "--samples",
                     "a ray trace of " + std::to_string(r.last - r.first) + " incident bins x " +
@@ -146,7 +159,7 @@ int run(const BakeFabricOptions& o) {
     FabricSummationOptions s;
     s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
     s.resolution = o.resolution;
-    if (o.samples) s.samples_per_cell = static_cast<int>(o.samples);
+    if (o.samples) s.samples_per_cell = static_cast<int>(*o.samples);  // checked in run()
     s.seed = o.seed;
     s.threads = o.threads;
     if (s.method == FabricSummation::kVisible) {
@@ -208,9 +221,11 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   sub->add_option("-R,--resolution", o->resolution, "fabric table bins per hemisphere side")
       ->check(CLI::Range(1, TabulatedBsdfTable::kMaxResolution))
       ->capture_default_str();
-  sub->add_option(
-      "--samples", o->samples,
-      "summations: direction pairs per cell pair; raytrace: particles per incident bin");
+  sub->add_option("--samples", o->samples,
+                  "summations: direction pairs per cell pair (1 to " +
+                      std::to_string(kMaxSummationSamples) +
+                      "); raytrace: particles per incident bin (1 to 2^36)")
+      ->check(CLI::Range(uint64_t{1}, uint64_t{1} << 36));
   sub->add_option(
          "--estimator", o->estimator,
          "raytrace: hero (one channel steers each path, MIS over channels, roulette on the "

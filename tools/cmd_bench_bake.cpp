@@ -32,7 +32,7 @@ void add_bench_bake_command(CLI::App& bench, Commands& commands) {
       ->check(CLI::Range(2, 64))
       ->capture_default_str();
   cmd->add_option("--target", opt->bench.target, "relative RMS error to extrapolate to")
-      ->check(CLI::Range(1e-6, 1.0))
+      ->check(finite_range(1e-6, 1.0))
       ->capture_default_str();
   cmd->add_option("--threads", opt->bench.threads, "threads (0 = all cores)")
       ->check(CLI::Range(0, 1024))

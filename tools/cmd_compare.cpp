@@ -25,25 +25,30 @@ nlohmann::json to_json(const TableDifference& d) {
 }
 
 int run_compare(const CompareCliOptions& o) {
-  for (const auto& out : {o.plot, o.csv})
-    if (!out.empty()) {
-      const auto dir = std::filesystem::absolute(out).parent_path();
-      if (!std::filesystem::is_directory(dir))
-        throw Error(out, "", "output directory does not exist");
-    }
+  validate_output_paths({{o.plot, "--plot"}, {o.csv, "--csv"}},
+                        {{o.a, "table A"}, {o.b, "table B"}});
   const auto a = TabulatedBsdfTable::read_exr(o.a);
   const auto b = TabulatedBsdfTable::read_exr(o.b);
   const TableComparison c = compare_tables(a, b, o.compare);
   const std::string curves = in_plane_csv(c, a.channel_names());
   if (!o.csv.empty()) write_text_atomically(o.csv, curves);
   if (!o.plot.empty()) {
-    const auto tmp = std::filesystem::temp_directory_path() / "weft-compare-curves.csv";
+    // The curves for the plot script under a name of this run's own (atomic_file.h), so that
+    // runs at once never read each other's; removed however the plot ends.
+    const auto tmp =
+        temporary_sibling(std::filesystem::temp_directory_path() / "weft-compare-curves.csv");
+    struct Remove {
+      std::filesystem::path path;
+      ~Remove() {
+        std::error_code ec;
+        std::filesystem::remove(path, ec);
+      }
+    } remove{tmp};
     write_text_atomically(tmp, curves);
     run_plot_script("plot_compare.py",
                     {tmp.string(), o.plot, std::filesystem::path(o.a).filename().string(),
                      std::filesystem::path(o.b).filename().string()},
                     o.plot);
-    std::filesystem::remove(tmp);
   }
   if (o.json) {
     std::cout << nlohmann::json{{"a", o.a},
@@ -82,7 +87,7 @@ void add_compare_command(CLI::App& app, Commands& commands) {
   sub->add_option("--csv", o->csv, "in-plane curves as CSV");
   sub->add_option("--significant", o->compare.significant,
                   "max_rel counts cells at least this fraction of A's mean value")
-      ->check(CLI::Range(0.0, 1e6))
+      ->check(finite_range(0.0, 1e6))
       ->capture_default_str();
   commands.push_back({sub, [o] { return run_compare(*o); }});
 }

@@ -1,14 +1,14 @@
 // weft merge: the parts of a sharded bake or sweep (`--shard K/N`) -> the output the unsharded run
 // writes, bit for bit. The parts must be of one job, disjoint and together complete.
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include "commands.h"
-#include "weft/core/job_part.h"
 #include "weft/core/error.h"
+#include "weft/core/job_part.h"
 
 namespace weft::cli {
-
 void add_merge_command(CLI::App& app, Commands& commands) {
   struct Options {
     std::vector<std::string> parts;
@@ -29,8 +29,17 @@ void add_merge_command(CLI::App& app, Commands& commands) {
       {sub, [o] {
          const JobPart all =
              merge_job_parts(std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
-         // A verify report is a folder, checked as verify checks it (check_verify_output).
-         if (all.command != "verify") validate_output_paths({o->output}, o->parts);
+         // A verify report is a folder, replaced whole.
+         // The parts, and every file the job names (the sweep's and the ray trace's hashed
+         // inputs, the fiber spec file, verify's options): what the shards read.
+         std::vector<NamedPath> inputs;
+         for (const auto& p : o->parts) inputs.push_back({p, "part file"});
+         for (const auto* j : {&all.job, &all.extra})
+           for (auto& f : json_named_files(*j, "job's input")) inputs.push_back(std::move(f));
+         if (all.command == "verify")
+           validate_output_paths({}, inputs, {{o->output, "--output"}});
+         else
+           validate_output_paths({{o->output, "--output"}}, inputs);
          if (all.command == "verify") return merge_verify(all, o->output, o->json);
          if (all.command == "bake fiber") return merge_fiber_bake(all, o->output, o->json);
          if (all.command == "bake fabric") return merge_fabric_bake(all, o->output, o->json);

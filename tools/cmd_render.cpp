@@ -62,24 +62,29 @@ void add_render_command(CLI::App& app, Commands& commands) {
                   "render.spp=64); repeatable, docs/scenes.md")
       ->allow_extra_args(false);
   sub->add_option("--camera", o->camera,
-                  "glTF camera by name or index (0, 1, ...) instead of the description's");
+                  "glTF camera by name or index (0, 1, ...) instead of the description's")
+      ->check(non_empty());
   sub->add_option("--crop", o->crop,
                   "x0,x1,y0,y1: render only pixels x0 <= x < x1, y0 <= y < y1 (same pixels as "
-                  "the whole render; the EXR's data window)");
-  sub->add_option("--preview", o->preview, "sRGB PNG preview (.png)");
+                  "the whole render; the EXR's data window)")
+      ->check(non_empty());
+  sub->add_option("--preview", o->preview, "sRGB PNG preview (.png)")->check(non_empty());
   sub->add_option("--exposure", o->exposure_ev,
                   "preview exposure in stops: the PNG shows linear values x 2^EV, clipped to "
                   "[0, 1], sRGB-encoded (no other tone mapping; the EXR is unchanged)")
-      ->check(CLI::Range(-64.0, 64.0));
+      ->check(finite_range(-64.0, 64.0));
   sub->add_option("--time-limit", o->time_limit_s,
                   "seconds: stop after the whole pass (1 sample per pixel) that ends past it and "
                   "write the mean of the passes done (weft:spp in the EXR)")
-      ->check(CLI::Range(1e-9, 1e9));
+      ->check(finite_range(1e-9, 1e9));
   sub->add_option("--aov", o->aov,
                   "albedo,normal: extra passes of the first surface seen, written to "
-                  "OUTPUT.albedo.exr and OUTPUT.normal.exr");
-  sub->add_option("--mask", o->mask, "coverage of --mask-object per pixel (.exr)");
-  sub->add_option("--mask-object", o->mask_object, "object (glTF node or mesh name) for --mask");
+                  "OUTPUT.albedo.exr and OUTPUT.normal.exr")
+      ->check(non_empty());
+  sub->add_option("--mask", o->mask, "coverage of --mask-object per pixel (.exr)")
+      ->check(non_empty());
+  sub->add_option("--mask-object", o->mask_object, "object (glTF node or mesh name) for --mask")
+      ->check(non_empty());
   sub->add_option("--spp", o->spp, "samples per pixel (default: the scene's)")
       ->check(CLI::Range(1, 1 << 20));
   sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
@@ -138,6 +143,12 @@ void add_render_command(CLI::App& app, Commands& commands) {
            check_crop(*job.settings.crop, job.settings.width, job.settings.height, "", "--crop");
          }
          job.settings.threads = o->threads;
+         std::vector<NamedPath> outputs = {{job.exr, "--output"}};
+         if (job.png) outputs.push_back({*job.png, "--preview"});
+         if (job.mask) outputs.push_back({*job.mask, "--mask"});
+         if (job.albedo) outputs.push_back({*job.albedo, "--aov albedo"});
+         if (job.normal) outputs.push_back({*job.normal, "--aov normal"});
+         validate_output_paths(outputs, scene_inputs(o->scene, desc));
          check_memory(render_bytes(job.settings.width, job.settings.height, job.png.has_value(),
                                    job.mask.has_value()),
                       o->scene, "width x height",

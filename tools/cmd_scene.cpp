@@ -17,6 +17,7 @@ struct SceneOptions {
 };
 
 int run_car_seat(const SceneOptions& o) {
+  validate_output_paths({{o.output, "--output"}}, {});
   const CarSeat seat = make_car_seat(o.seat);
   write_car_seat_gltf(o.output, seat, o.seat);
   if (o.json) {

@@ -27,31 +27,6 @@ Rgb rgb_of(const nlohmann::json& j) {
   return {j.at(0).get<double>(), j.at(1).get<double>(), j.at(2).get<double>()};
 }
 
-// Every file a sweep of the description reads: the description, its glTF files and buffers and
-// environment maps, and what its materials name (tables, measured networks, fiber specs; a preset
-// name is no file, and its content is the program's). Relative names resolve as registry.cpp
-// and bake_cache.cpp resolve them.
-std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
-                                                     const SceneDescription& d) {
-  std::vector<std::filesystem::path> files{scene};
-  files.insert(files.end(), d.files.begin(), d.files.end());
-  auto add = [&](const MaterialBinding& b) {
-    for (const char* key : {"file", "spec"}) {
-      if (!b.params.contains(key) || !b.params[key].is_string()) continue;
-      std::filesystem::path f = b.params[key].get<std::string>();
-      std::error_code ec;
-      if (f.is_relative() &&
-          (std::string(key) == "file" || std::filesystem::exists(d.base_dir / f, ec)))
-        f = d.base_dir / f;
-      // A missing table is the renderer's error to report, with its field.
-      if (std::filesystem::is_regular_file(f, ec)) files.push_back(f);
-    }
-  };
-  for (const auto& [key, b] : d.materials) add(b);
-  if (d.default_material) add(*d.default_material);
-  return files;
-}
-
 // What fixes a sweep's bits: the content of every file it reads and every setting but threads.
 JobPart sweep_job(const std::string& scene, const SceneDescription& desc, const GonioSettings& g,
                   Shard shard) {
@@ -198,22 +173,25 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_option("scene", o->scene, "scene description (.json)")->required();
   sub->add_option("-o,--output", o->output, "CSV output")->required();
   auto* lz = sub->add_option("--light-zenith-deg", o->light_zenith, "light zenith")
-                 ->check(CLI::Range(0.0, 89.9));
+                 ->check(finite_range(0.0, 89.9));
   auto* la = sub->add_option("--light-azimuth-deg", o->light_azimuth, "light azimuth")
-                 ->check(CLI::Range(-360.0, 360.0));
+                 ->check(finite_range(-360.0, 360.0));
   sub->add_option("--view-zenith-deg", o->views,
-                  "view zeniths: a:b:step, a list a,b,c or one value");
+                  "view zeniths: a:b:step, a list a,b,c or one value")
+      ->check(non_empty());
   auto* va = sub->add_option("--view-azimuth-deg", o->view_azimuth,
                              "azimuth of the view plane (default: the light's)")
-                 ->check(CLI::Range(-360.0, 360.0));
+                 ->check(finite_range(-360.0, 360.0));
   sub->add_option("--sample", o->sample,
-                  "object to measure (glTF node or mesh name; default: the scene's)");
+                  "object to measure (glTF node or mesh name; default: the scene's)")
+      ->check(non_empty());
   auto* irr =
       sub->add_option("--irradiance", o->irradiance, "irradiance E of the parallel light, W/m^2")
-          ->check(CLI::Range(1e-12, 1e12));
+          ->check(finite_range(1e-12, 1e12));
   sub->add_option(
-      "--normalize-to", o->normalize_to,
-      "scale beta so that beta(normal incidence, normal view) equals this (value or r,g,b)");
+         "--normalize-to", o->normalize_to,
+         "scale beta so that beta(normal incidence, normal view) equals this (value or r,g,b)")
+      ->check(non_empty());
   sub->add_flag("--no-white-check", o->no_white, "skip rendering the white Lambert reference");
   sub->add_option("--spp", o->spp, "samples per pixel")->check(CLI::Range(1, 1 << 20));
   sub->add_option("--resolution", o->resolution, "pixels per side of each view")
@@ -221,7 +199,8 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
   auto* seed = sub->add_option("--seed", o->seed, "random seed");
   sub->add_option("--shard", o->shard,
-                  "K/N: render only shard K of N (views) into a part file for `weft merge`");
+                  "K/N: render only shard K of N (views) into a part file for `weft merge`")
+      ->check(non_empty());
   sub->add_flag("--resume", o->resume,
                 "checkpoint every finished view beside the output and continue from a "
                 "checkpoint an earlier run of this sweep left there");
@@ -255,7 +234,9 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          if (o->resolution) g.width = g.height = o->resolution;
          if (seed->count()) g.seed = o->seed;
          g.threads = o->threads;
-         validate_output_paths({o->output}, {o->scene});
+         validate_output_paths(
+             {{o->output, "--output"}, {checkpoint_path(o->output), "checkpoint"}},
+             scene_inputs(o->scene, desc));
          const Shard shard = o->shard.empty() ? Shard{} : parse_shard(o->shard, "--shard");
          const JobPart job = sweep_job(o->scene, desc, g, shard);
          const UnitRange range = shard_units(job.units_total, shard);

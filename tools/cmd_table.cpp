@@ -63,7 +63,9 @@ struct BakeOptions {
 
 int run_bake(const BakeOptions& o) {
   const nlohmann::json params = parse_json(o.params, "--params");
-  // Fail before the work, not after it.
+  // Fail before the work, not after it; the files the parameters name (a table, a measured
+  // network) are inputs.
+  validate_output_paths({{o.output, "--output"}}, json_named_files(params, "--params file"));
   TabulatedBsdfTable::check_output_path(o.output, "--output");
   MaterialContext ctx;
   ctx.field_prefix = "--params";

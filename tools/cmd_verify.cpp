@@ -138,9 +138,14 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
   const auto t_all = std::chrono::steady_clock::now();
   const VerifyRequest& r = o.request;
   const VerifyPlan p = plan_verify(r);
+  const std::vector<NamedPath> inputs = {{p.measured_path, "measured CSV"},
+                                         {r.weave, "weave options"},
+                                         {r.wif, "WIF draft"},
+                                         {r.fiber, "fiber table or spec"}};
   if (p.shard) {
-    validate_output_paths({r.output}, {p.measured_path.string(), r.weave, r.wif, r.fiber});
+    validate_output_paths({{r.output, "-o"}}, inputs);
   } else {
+    validate_output_paths({}, inputs, {{r.output, "-o"}});
     check_verify_output(r.output);
     if (!all) check_verify_time(o, p);  // a merge's ray traces are done
   }

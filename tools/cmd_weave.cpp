@@ -40,6 +40,7 @@ int run_legacy(const CLI::App& sub, WeaveParams p, const WeaveOptions& w, bool s
       throw Error("", std::string(name).substr(2),
                   "cannot be combined with the legacy open-mesh options (--yarns, "
                   "--yarn-radius-mm, --spacing-mm, --segments, --amplitude-mm)");
+  validate_output_paths({{output, "--output"}}, {});
   p.pattern = w.pattern.value_or("plain");
   if (sides_given) p.sides = *w.sides;
   const auto meshes = make_weave(p);
@@ -168,7 +169,11 @@ void add_weave_command(CLI::App& app, Commands& commands) {
                 "--thickness-mm or --solidity");
          const WeaveOptions base =
              o->sample.empty() ? WeaveOptions{} : read_weave_options(o->sample);
-         const WovenSample sample = make_woven_sample(overlay(base, given));
+         const WeaveOptions options = overlay(base, given);
+         validate_output_paths(
+             {{o->output, "--output"}},
+             {{o->sample, "sample description"}, {options.wif.value_or(""), "WIF draft"}});
+         const WovenSample sample = make_woven_sample(options);
          write_woven(o->output, sample);
          const WeaveSummary& s = sample.summary;
          if (o->json) {

@@ -1,5 +1,7 @@
 #pragma once
 // Every subcommand registers itself here; main.cpp calls each add_* once.
+#include <memory>
+
 #include "cli_util.h"
 #include "weft/core/job_part.h"
 
@@ -20,6 +22,19 @@ AddCommand add_verify_command;  // cmd_verify.cpp
 
 // The subcommands of "bench" (cmd_bench.cpp makes the group).
 AddCommand add_bench_bake_command, add_bench_render_command, add_bench_flatten_command;
+
+// The weft program: global options (--max-memory-gb, --yes-long) and every subcommand
+// (program.cpp). main() parses and runs one; weft slurm parses the command it wraps with another.
+struct Program {
+  CLI::App app{"Weft: physically based fabric appearance pipeline and renderer", "weft"};
+  Commands commands;
+  double max_memory_gb = 0;  // 0: the memory available
+  bool yes_long = false;
+};
+std::unique_ptr<Program> make_program();
+// Sets run_limits() from the global options and runs the subcommand the parse chose: its exit
+// code. weft::Error and other exceptions propagate.
+int run_program(const Program& p);
 
 // Each command's merge (in its cmd_*.cpp): writes 'output' from all units of its job and prints
 // the command's summary. Returns the exit code.

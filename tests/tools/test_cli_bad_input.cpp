@@ -149,9 +149,10 @@ TEST(CliBadInput, LongBakesNeedConfirmation) {
   // 1e12 photons per band: 33e12 photons at >= 0.5 us each is years on any machine here.
   const CliRun r = run("bake fiber red-cotton --photons 1000000000000 -o t.exr", dir);
   expect_error(r, {"--photons", "would take at least", "--yes-long"}, dir / "t.exr");
-  // --yes-long passes that check (after the subcommand too); the memory budget then refuses.
-  expect_error(run("bake fiber red-cotton --photons 1000000000000 -o t.exr --yes-long "
-                   "--max-memory-gb 0.001",
+  // --yes-long passes that check (after the subcommand too); the memory budget then refuses (at
+  // its floor of 0.05 GB, cli_util.h kMinMemoryGb, a bake at resolution 16 needs 178 MB).
+  expect_error(run("bake fiber red-cotton --photons 1000000000000 --resolution 16 -o t.exr "
+                   "--yes-long --max-memory-gb 0.05",
                    dir),
                {"--resolution", "needs about", "allowed by --max-memory-gb"}, dir / "t.exr");
 }
@@ -250,4 +251,124 @@ TEST(CliBadInput, ExrTableClaimingMorePixelsThanTheFileHoldsIsRefused) {
   expect_error(run("table info big.exr", dir),
                {"big.exr", "field 'resolution'", "50331648 bytes of pixels", "can hold"},
                dir / "none");
+}
+
+// weft slurm writes batch scripts that run on a cluster: no value of the user's may add a line to
+// them (a newline in --time wrote an #SBATCH line of the user's choosing), Slurm's values are
+// checked against its syntax, and the wrapped command is checked by the same parser and checks
+// as running it, before any script is written (no OUTPUT.slurm folder is left).
+TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
+  const fs::path dir = fresh_test_dir();
+  fs::copy_file(kPlane, dir / "plane.json");
+  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
+  const std::string sweep = " sweep plane.json -o s.csv";
+  struct Case {
+    std::string options;
+    const char* option;  // named in the error
+  };
+  for (const Case& c : std::vector<Case>{
+           {"--time '1:00:00\n#SBATCH --mem=1'", "--time"},
+           {"--time 'one hour'", "--time"},
+           {"--time 1:00:00:00", "--time"},
+           {"--partition 'cpu gpu'", "--partition"},
+           {"--partition 'cpu\n#SBATCH --x'", "--partition"},
+           {"--account 'a;b'", "--account"},
+       }) {
+    for (const char* dry : {"", " --dry-run"}) {
+      const std::string args = std::string("slurm --shards 2") + dry + " " + c.options + sweep;
+      const CliRun r = run(args, dir);
+      expect_error(r, {c.option}, dir / "s.csv.slurm");
+      EXPECT_EQ(r.out.find("#SBATCH"), std::string::npos) << r.out;
+    }
+  }
+  // A newline in the wrapped command's output path, in any of its arguments.
+  expect_error(run("slurm --shards 2 sweep plane.json -o 's\n.csv'", dir), {"'-o'"},
+               dir / "s\n.csv.slurm");
+  expect_error(run("slurm --shards 2 sweep plane.json --sample 'a\nb' -o s.csv", dir),
+               {"--sample", "control character"}, dir / "s.csv.slurm");
+  // Valid values go into the scripts as given (Slurm's time formats, a partition list).
+  const CliRun ok = run(
+      "slurm --shards 2 --dry-run --time 2-12 --partition cpu,long --account lab_1" + sweep, dir);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  for (const char* line :
+       {"#SBATCH --time=2-12\n", "#SBATCH --partition=cpu,long\n", "#SBATCH --account=lab_1\n"})
+    EXPECT_NE(ok.out.find(line), std::string::npos) << line << ok.out;
+  EXPECT_FALSE(fs::exists(dir / "s.csv.slurm"));
+  // More shards than the sweep's 16 units (15 views and the normal-incidence reference): the
+  // check runs the last shard, which has work, and writes no part of its own.
+  const CliRun many = run(std::string("slurm --shards 40 --dry-run") + sweep, dir);
+  ASSERT_EQ(many.exit_code, 0) << many.err;
+  EXPECT_EQ(many.out.find("views "), std::string::npos) << many.out;
+  EXPECT_FALSE(fs::exists(dir / "s.csv.slurm"));
+  EXPECT_FALSE(fs::exists(dir / "s.csv"));
+}
+
+TEST(CliBadInput, SlurmChecksTheWrappedCommandBeforeWritingScripts) {
+  const fs::path dir = fresh_test_dir();
+  fs::copy_file(kPlane, dir / "plane.json");
+  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
+  // Refused by the wrapped command's own parser, its own checks and the output guard.
+  expect_error(run("slurm --shards 2 bake fiber red-cotton --photons -5 -o t.exr", dir),
+               {"--photons"}, dir / "t.exr.slurm");
+  expect_error(run("slurm --shards 2 bake fiber nonesuch -o t.exr", dir), {"nonesuch"},
+               dir / "t.exr.slurm");
+  // A summation cannot be sharded: only the ray trace can.
+  expect_error(run("slurm --shards 2 bake fabric -R 2 -o t.exr", dir), {"--method raytrace"},
+               dir / "t.exr.slurm");
+  expect_error(run("slurm --shards 2 sweep plane.json -o lambert-plane.gltf", dir),
+               {"lambert-plane.gltf", "refusing to overwrite"}, dir / "lambert-plane.gltf.slurm");
+  expect_error(run("slurm --shards 2 sweep plane.json --spp 0 -o s.csv", dir), {"--spp"},
+               dir / "s.csv.slurm");
+  // Work that a shard would refuse without --yes-long.
+  expect_error(run("slurm --shards 2 bake fiber red-cotton --photons 1000000000000 -o t.exr", dir),
+               {"--photons", "--yes-long"}, dir / "t.exr.slurm");
+  // The scene's files are untouched and nothing was written beside them.
+  EXPECT_EQ(slurp(dir / "plane.json"), slurp(kPlane));
+  size_t files = 0;
+  for (const auto& e : fs::directory_iterator(dir))
+    files += e.path().filename() != "stdout" && e.path().filename() != "stderr";
+  EXPECT_EQ(files, 2u);
+}
+
+// Numbers that were accepted and then misread: NaN passed CLI11's Range checks (every comparison
+// with NaN is false) and disabled the memory budget or the time limit, an empty --camera read as
+// not given, 0 raytrace samples as the default and 2^32 + 1 summation samples wrapped to 1. Each
+// is refused naming the option, before any work (no output).
+TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(run("table bake lambert -R 2 --spp 1 -o a.exr --quiet", dir).exit_code, 0);
+  const std::string render = "render '" + kPlane + "' -o out.exr --quiet ";
+  const std::string sweep = "sweep '" + kPlane + "' -o out.exr --quiet ";
+  struct Case {
+    std::string args;
+    const char* option;
+  };
+  for (const Case& c : std::vector<Case>{
+           {render + "--time-limit nan", "--time-limit"},
+           {render + "--time-limit inf", "--time-limit"},
+           {render + "--exposure nan", "--exposure"},
+           {render + "--camera ''", "--camera"},
+           {render + "--preview ''", "--preview"},
+           {std::string("--max-memory-gb nan ") + render, "--max-memory-gb"},
+           {std::string("--max-memory-gb 0.001 ") + render, "--max-memory-gb"},
+           {render + "--max-memory-gb inf", "--max-memory-gb"},
+           {sweep + "--light-zenith-deg nan", "--light-zenith-deg"},
+           {sweep + "--irradiance nan", "--irradiance"},
+           {sweep + "--view-azimuth-deg nan", "--view-azimuth-deg"},
+           {sweep + "--sample ''", "--sample"},
+           {"compare a.exr a.exr --significant nan --csv out.exr", "--significant"},
+           {"bake fabric --method raytrace -R 2 --samples 0 -o out.exr", "--samples"},
+           {"bake fabric -R 2 --samples 4294967297 -o out.exr", "--samples"},
+           {"bake fabric -R 2 --samples 0 -o out.exr", "--samples"},
+           {"bench bake --target nan", "--target"},
+       }) {
+    const CliRun r = run(c.args, dir);
+    EXPECT_NE(r.exit_code, 0) << c.args;
+    EXPECT_NE(r.err.find(c.option), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(dir / "out.exr")) << c.args;
+  }
+  // In range the same options still run (the floor of the budget is 0.05 GB).
+  EXPECT_EQ(
+      run("--max-memory-gb 0.05 table bake lambert -R 2 --spp 1 -o out.exr --quiet", dir).exit_code,
+      0);
 }

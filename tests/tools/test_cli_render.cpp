@@ -276,3 +276,26 @@ TEST(CliRender, ProgressInALogIsPlainLinesWithUnits) {
   EXPECT_TRUE(contains(r.err, "rays/s")) << r.err;  // the summary
   EXPECT_TRUE(contains(r.err, "2 of 2 samples per pixel")) << r.err;
 }
+
+// Ctrl-C was seen only where a tile ended: a 16 x 16 render at 2^20 samples per pixel is one
+// tile, and stopped about 110 s after the signal. The renderer asks the progress callback every
+// 4096 samples of a thread (path_tracer.cpp kPollSamples), so it stops within a fraction of a
+// second: 10 s allows for a loaded machine. Nothing is written, exit 130.
+TEST(CliRender, CtrlCStopsALargeTileAtOnce) {
+  const fs::path dir = fresh_test_dir();
+  std::string cmd = "cd '";
+  cmd += dir.string() + "'; '" + WEFT_EXE + "' render '" +
+         (kExamples / "lambert-plane.json").string() +
+         "' --width 16 --height 16 --spp 1048576 -o out.exr --quiet 2>err & "
+         "pid=$!; sleep 1; t0=$(date +%s%N); kill -INT $pid; wait $pid; "
+         "echo $? $(( ($(date +%s%N) - t0) / 1000000 )) > result";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  std::istringstream in(slurp(dir / "result"));
+  int code = -1;
+  long ms = -1;
+  in >> code >> ms;
+  EXPECT_EQ(code, 130) << slurp(dir / "err");
+  EXPECT_GE(ms, 0);
+  EXPECT_LT(ms, 10000) << "ms from the signal to the exit";
+  EXPECT_FALSE(fs::exists(dir / "out.exr"));
+}
