@@ -82,22 +82,44 @@ TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
   VerifySuite s;
   s.title = "two";
   SuiteRow good{{"good", "m.csv", "red-cotton", "", "", "", "camera", "a red cloth"}, {}, ""};
-  good.metrics = nlohmann::json::parse(R"({"models": {"computed_raytrace":
-      {"shape": {"rms_log": 0.31}, "normalized": {"rms_log": 0.73}, "absolute": {"rms_log": 0.55}},
+  // The keys a report writes (docs/verify.md): figures per model with their uncertainty, and
+  // the verdict per figure.
+  good.metrics = nlohmann::json::parse(R"({"absolute_comparable": false, "models": {
+      "computed_raytrace": {"shape": {"rms_log": 0.31}, "normalized": {"rms_log": 0.73},
+          "absolute": {"rms_log": 0.55},
+          "uncertainty": {"shape": {"seed_se": 0.004, "fit_min": 0.28, "fit_max": 0.39}}},
       "classic": {"shape": {"rms_log": 0.66}, "normalized": {"rms_log": 0.75},
-                  "absolute": {"rms_log": 1.5}}}})");
+                  "absolute": {"rms_log": 1.5}}},
+      "verdict": {"shape": [{"a": "computed_raytrace", "b": "classic", "resolved": true,
+                             "closer": "computed_raytrace", "text": "Shape: computed wins"}],
+                  "absolute": [{"a": "computed_raytrace", "b": "classic", "resolved": false,
+                                "text": "Absolute: not resolved"}]}})");
   SuiteRow bad{{"bad", "m.csv", "red-cotton", "", "", "", "", "k"}, nullptr, "the sample fails"};
   const auto j = nlohmann::json::parse(verify_suite_json(s, {good, bad}));
   EXPECT_EQ(j.at("report"), "weft verify suite");
   const auto& g = j.at("fabrics")[0].at("models");
   EXPECT_DOUBLE_EQ(g.at("computed_raytrace").at("shape_rms_log").get<double>(), 0.31);
   EXPECT_DOUBLE_EQ(g.at("classic").at("absolute_rms_log").get<double>(), 1.5);
-  EXPECT_FALSE(g.contains("computed_summation"));  // not in that report
+  EXPECT_DOUBLE_EQ(g.at("computed_raytrace").at("shape_seed_se").get<double>(), 0.004);
+  EXPECT_DOUBLE_EQ(g.at("computed_raytrace").at("shape_fit_max").get<double>(), 0.39);
+  EXPECT_TRUE(g.at("classic").at("shape_seed_se").is_null());  // not in that report
+  EXPECT_FALSE(g.contains("computed_summation"));              // not in that report
+  EXPECT_EQ(j.at("fabrics")[0].at("shape_closer"), "computed");
+  EXPECT_EQ(j.at("fabrics")[0].at("shape_verdicts"),
+            nlohmann::json::array({"Shape: computed wins"}));
+  EXPECT_EQ(j.at("fabrics")[0].at("absolute_comparable"), false);
   EXPECT_EQ(j.at("fabrics")[1].at("error"), "the sample fails");
+  EXPECT_EQ(j.at("shape_summary").at("computed_closer"), 1);
+  EXPECT_EQ(j.at("shape_summary").at("without_verdict"), 1);  // the failed one
   const std::string html = verify_suite_html(s, {good, bad});
   EXPECT_NE(html.find("good/index.html"), std::string::npos);
   EXPECT_NE(html.find("failed: the sample fails"), std::string::npos);
-  EXPECT_NE(html.find("0.310"), std::string::npos);
+  EXPECT_NE(html.find("0.310 &plusmn; 0.004 <small>(fits 0.280&ndash;0.390)"), std::string::npos);
+  EXPECT_NE(html.find("<small>(0.550)</small>"), std::string::npos);  // not comparable
+  EXPECT_NE(html.find("Shape: computed wins"), std::string::npos);
+  EXPECT_EQ(html.find("Absolute: not resolved"), std::string::npos);  // the shape verdicts only
+  EXPECT_NE(html.find("computed closer on 1, classic closer on 0"), std::string::npos);
+  EXPECT_NE(verify_suite_text({good, bad}).find("good: Shape: computed wins"), std::string::npos);
 }
 
 TEST(VerifySuite, OutputIsNewEmptyOrAnEarlierSuite) {

@@ -31,20 +31,48 @@ nlohmann::json finite_or_null(double v) {
   return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json();
 }
 
-// One model's figures in a fabric's metrics.json: shape, the paper's one-point and absolute
-// RMS log, with their uncertainties where the report gives them.
+// One model's figures in a fabric's metrics.json (docs/verify.md gives its keys): shape with its
+// seed standard error and the spread over the measurement's fits, the paper's one-point and the
+// absolute RMS log.
 nlohmann::json model_figures(const nlohmann::json& m, const SuiteModel& model) {
   using P = nlohmann::json::json_pointer;
   const std::string base = std::string("/models/") + model.key;
   if (!m.contains(P(base))) return nullptr;
-  nlohmann::json f;
-  f["shape_rms_log"] = finite_or_null(number_at(m, P(base + "/shape/rms_log")));
-  f["shape_seed_sd"] = finite_or_null(number_at(m, P(base + "/shape/seed_sd")));
-  f["shape_measurement_spread"] =
-      finite_or_null(number_at(m, P(base + "/shape/measurement_spread")));
-  f["paper_rms_log"] = finite_or_null(number_at(m, P(base + "/normalized/rms_log")));
-  f["absolute_rms_log"] = finite_or_null(number_at(m, P(base + "/absolute/rms_log")));
-  return f;
+  const auto at = [&](const std::string& path) {
+    return finite_or_null(number_at(m, P(base + path)));
+  };
+  return {{"shape_rms_log", at("/shape/rms_log")},
+          {"shape_seed_se", at("/uncertainty/shape/seed_se")},
+          {"shape_fit_min", at("/uncertainty/shape/fit_min")},
+          {"shape_fit_max", at("/uncertainty/shape/fit_max")},
+          {"paper_rms_log", at("/normalized/rms_log")},
+          {"absolute_rms_log", at("/absolute/rms_log")}};
+}
+
+// The report's verdicts on one figure ("shape", "paper_normalized", "absolute"): their texts.
+std::vector<std::string> verdict_texts(const nlohmann::json& metrics, const std::string& figure) {
+  std::vector<std::string> texts;
+  const nlohmann::json::json_pointer p("/verdict/" + figure);
+  if (!metrics.contains(p) || !metrics.at(p).is_array()) return texts;
+  for (const auto& v : metrics.at(p))
+    if (v.contains("text") && v.at("text").is_string()) texts.push_back(v.at("text"));
+  return texts;
+}
+
+// The shape verdict of the computed ray trace against the classic model: "computed", "classic"
+// or "unresolved"; empty when the report has no such verdict.
+std::string shape_closer(const nlohmann::json& metrics) {
+  const nlohmann::json::json_pointer p("/verdict/shape");
+  if (!metrics.contains(p) || !metrics.at(p).is_array()) return "";
+  for (const auto& v : metrics.at(p)) {
+    const std::string a = v.value("a", ""), b = v.value("b", "");
+    const bool pair = (a == "computed_raytrace" && b == "classic") ||
+                      (a == "classic" && b == "computed_raytrace");
+    if (!pair) continue;
+    if (!v.value("resolved", false)) return "unresolved";
+    return v.value("closer", "") == "classic" ? "classic" : "computed";
+  }
+  return "";
 }
 
 nlohmann::json suite_row_json(const SuiteRow& r) {
@@ -67,6 +95,9 @@ nlohmann::json suite_row_json(const SuiteRow& r) {
     if (!f.is_null()) models[model.key] = f;
   }
   j["models"] = models;
+  j["absolute_comparable"] = r.metrics.value("absolute_comparable", true);
+  j["shape_closer"] = shape_closer(r.metrics);
+  j["shape_verdicts"] = verdict_texts(r.metrics, "shape");
   if (r.metrics.contains("verdict")) j["verdict"] = r.metrics.at("verdict");
   return j;
 }
@@ -95,24 +126,52 @@ std::string fixed3(const nlohmann::json& v) {
   return buf;
 }
 
-// A model's cell: shape +- seed (measurement spread), then the paper's and the absolute figure.
-std::string model_cell(const nlohmann::json& f) {
+// A model's cell: shape +- the seed's standard error (the measurement's fits' range), then the
+// paper's and the absolute figure (in brackets where the colour spaces differ).
+std::string model_cell(const nlohmann::json& f, bool absolute_comparable) {
   if (f.is_null()) return "<td colspan=\"3\">not run</td>";
   std::string shape = fixed3(f["shape_rms_log"]);
-  if (f["shape_seed_sd"].is_number()) shape += " &plusmn; " + fixed3(f["shape_seed_sd"]);
-  if (f["shape_measurement_spread"].is_number())
-    shape += " <small>(fits " + fixed3(f["shape_measurement_spread"]) + ")</small>";
+  if (f["shape_seed_se"].is_number()) shape += " &plusmn; " + fixed3(f["shape_seed_se"]);
+  if (f["shape_fit_min"].is_number() && f["shape_fit_max"].is_number())
+    shape += " <small>(fits " + fixed3(f["shape_fit_min"]) + "&ndash;" +
+             fixed3(f["shape_fit_max"]) + ")</small>";
+  const std::string absolute = fixed3(f["absolute_rms_log"]);
   return "<td>" + shape + "</td><td>" + fixed3(f["paper_rms_log"]) + "</td><td>" +
-         fixed3(f["absolute_rms_log"]) + "</td>";
+         (absolute_comparable ? absolute : "<small>(" + absolute + ")</small>") + "</td>";
 }
 
-std::string verdict_text(const nlohmann::json& row) {
-  if (!row.contains("verdict")) return "";
-  const nlohmann::json& v = row.at("verdict");
-  if (v.is_string()) return v.get<std::string>();
-  if (v.is_object() && v.contains("text") && v.at("text").is_string())
-    return v.at("text").get<std::string>();
-  return v.dump();
+std::string joined(const nlohmann::json& texts, const std::string& separator) {
+  std::string out;
+  if (!texts.is_array()) return out;
+  for (const auto& t : texts) out += (out.empty() ? "" : separator) + t.get<std::string>();
+  return out;
+}
+
+// How many fabrics' shape verdicts (computed ray trace vs classic) went each way.
+nlohmann::json shape_summary(const nlohmann::json& rows) {
+  int computed = 0, classic = 0, unresolved = 0, not_run = 0;
+  for (const auto& row : rows) {
+    const std::string c = row.value("shape_closer", "");
+    (c == "computed"     ? computed
+     : c == "classic"    ? classic
+     : c == "unresolved" ? unresolved
+                         : not_run)++;
+  }
+  return {{"computed_closer", computed},
+          {"classic_closer", classic},
+          {"unresolved", unresolved},
+          {"without_verdict", not_run}};
+}
+
+std::string summary_sentence(const nlohmann::json& s) {
+  return "Shape, computed (ray trace) vs classic: computed closer on " +
+         std::to_string(s["computed_closer"].get<int>()) + ", classic closer on " +
+         std::to_string(s["classic_closer"].get<int>()) + ", not resolved on " +
+         std::to_string(s["unresolved"].get<int>()) + " fabric(s)" +
+         (s["without_verdict"].get<int>()
+              ? ", " + std::to_string(s["without_verdict"].get<int>()) + " without a verdict"
+              : "") +
+         ".";
 }
 
 }  // namespace
@@ -126,10 +185,13 @@ std::string verify_suite_json(const VerifySuite& suite, const std::vector<SuiteR
       "per model: shape_rms_log (RMS of ln(model / measured) after one least-squares gain per "
       "channel, the same for every model; the headline), paper_rms_log (the paper's one-point "
       "normalization at normal incidence and view), absolute_rms_log (no scaling: includes the "
-      "colour level, comparable only where the colour spaces agree)";
+      "colour level, comparable only where the colour spaces agree: absolute_comparable); "
+      "shape_seed_se, the seed's standard error; shape_fit_min..shape_fit_max, the figure against "
+      "each of the measurement's fits";
   nlohmann::json list = nlohmann::json::array();
   for (const auto& r : rows) list.push_back(suite_row_json(r));
   j["fabrics"] = list;
+  j["shape_summary"] = shape_summary(list);
   return j.dump(2) + "\n";
 }
 
@@ -156,9 +218,12 @@ std::string verify_suite_text(const std::vector<SuiteRow>& rows) {
                     num(f["absolute_rms_log"]));
       out << buf;
     }
-    const std::string v = verdict_text(row);
-    if (!v.empty()) out << "  " << r.fabric.name << ": " << v << "\n";
+    for (const auto& v : row["shape_verdicts"])
+      out << "  " << r.fabric.name << ": " << v.get<std::string>() << "\n";
   }
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& r : rows) list.push_back(suite_row_json(r));
+  out << "  " << summary_sentence(shape_summary(list)) << "\n";
   return out.str();
 }
 
@@ -173,8 +238,9 @@ std::string verify_suite_html(const VerifySuite& suite, const std::vector<SuiteR
     << "<p>Each fabric is verified with what is known of its sample (construction, fiber, "
        "colour space), never with its measured curve. Figures are RMS of ln(model / measured) "
        "over views up to 80&deg;: <b>shape</b> after one least-squares gain per channel, the "
-       "same procedure for every model (the headline; &plusmn; the seed spread, in brackets "
-       "the spread over the measurement's own fits where it has several); <b>paper's</b> "
+       "same procedure for every model (the headline; &plusmn; the seed's standard error, in "
+       "brackets the figure against each of the measurement's own fits where it has several); "
+       "<b>paper's</b> "
        "one-point normalization (Voloboy et al. 2010: hinges on the normal-incidence, "
        "normal-view point); <b>absolute</b> (includes the colour level: comparable only where "
        "model and measurement share a colour space).</p>\n<table>\n<tr><th rowspan=\"2\">fabric"
@@ -198,11 +264,16 @@ std::string verify_suite_html(const VerifySuite& suite, const std::vector<SuiteR
       continue;
     }
     for (const SuiteModel& model : kSuiteModels)
-      h << model_cell(row["models"].contains(model.key) ? row["models"][model.key]
-                                                        : nlohmann::json());
-    h << "<td>" << html_escape(verdict_text(row)) << "</td></tr>\n";
+      h << model_cell(
+          row["models"].contains(model.key) ? row["models"][model.key] : nlohmann::json(),
+          row["absolute_comparable"].get<bool>());
+    h << "<td>" << html_escape(joined(row["shape_verdicts"], "; ")) << "</td></tr>\n";
   }
-  h << "</table>\n</body></html>\n";
+  nlohmann::json list = nlohmann::json::array();
+  for (const auto& r : rows) list.push_back(suite_row_json(r));
+  h << "</table>\n<p>" << summary_sentence(shape_summary(list))
+    << " Absolute figures in brackets: the measurement's colour space is not the tables' "
+       "(camera or unknown RGB), so they are shown for what they are.</p>\n</body></html>\n";
   return h.str();
 }
 
