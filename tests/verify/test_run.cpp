@@ -75,5 +75,39 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
   EXPECT_NE(error_of([&] { run_verify(sample, in, m, s); }).find("theta_i_deg"), std::string::npos);
 }
 
+// A fiber that returns no light leaves the ray trace's normal bin empty: the paper's factor does
+// not exist there, so its figure is not defined (null in metrics.json) while the run and the
+// other model's figures go on (a deep dye at draft quality can empty that one bin in a channel).
+TEST(VerifyRun, PaperFigureNotDefinedWhereTheModelsNormalBinIsEmpty) {
+  WeaveOptions w;
+  w.detail = "fiber";
+  const WovenSample sample = make_woven_sample(overlay(red_cotton_weave_options(), w));
+  VerifySettings s = verify_settings(VerifyQuality::kDraft);
+  s.resolution = 2;
+  s.particles_per_bin = 200;
+  s.batches = 2;
+  s.azimuths = 3;
+  s.threads = 2;
+  VerifyInputs in;
+  in.fiber = constant_table(2, kNumBands, 0.0);
+  in.volume_albedo.fill(0.6);
+  in.classic_distribution = {MicrofacetModel::kBeckmann, 0.35};
+  in.classic_ior = 1.557;
+  MeasuredInplane m;
+  m.file = "synthetic";
+  m.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  const VerifyReport r = run_verify(sample, in, m, s);
+  ASSERT_EQ(r.models.size(), 2u);
+  const ModelCurves& computed = r.models[0];
+  const ModelCurves& classic = r.models[1];
+  ASSERT_EQ(computed.key, "computed_raytrace");
+  EXPECT_TRUE(std::isnan(computed.normalization.r));
+  EXPECT_TRUE(std::isnan(computed.normalized_overall.rms_log));
+  EXPECT_TRUE(std::isnan(computed.normalized[0].rms_log));
+  EXPECT_TRUE(std::isfinite(classic.normalized_overall.rms_log));
+  const std::string json = verify_metrics_json(r);
+  EXPECT_NE(json.find("\"computed_rms_log\": null"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace weft

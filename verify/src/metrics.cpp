@@ -38,15 +38,10 @@ CurveMetrics MetricsAccumulator::result() const {
   return m;
 }
 
-Rgb paper_normalization(const Rgb& model, const Rgb& measured, const std::string& name) {
+Rgb paper_normalization(const Rgb& model, const Rgb& measured) {
   Rgb f;
-  for (int k = 0; k < 3; ++k) {
-    if (!(model[k] > 0))
-      throw Error(name, "normalization",
-                  "the model's beta at normal incidence and view is not positive in channel " +
-                      std::to_string(k) + ": no normalization factor exists");
-    f[k] = measured[k] / model[k];
-  }
+  for (int k = 0; k < 3; ++k)
+    f[k] = model[k] > 0 ? measured[k] / model[k] : std::numeric_limits<double>::quiet_NaN();
   return f;
 }
 

@@ -121,7 +121,10 @@ void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& nor
            size_t normal_view) {
   const size_t normal_incidence = static_cast<size_t>(&normal_curve - meas.curves.data());
   const Rgb model0 = m.beta[normal_incidence][normal_view];
-  m.normalization = paper_normalization(model0, normal_curve.beta[normal_view], m.label);
+  m.normalization = paper_normalization(model0, normal_curve.beta[normal_view]);
+  // Without a factor in every channel the paper's figure is not defined (as in figures.h).
+  const bool normalized = std::isfinite(m.normalization.r) && std::isfinite(m.normalization.g) &&
+                          std::isfinite(m.normalization.b);
   m.figures = model_figures(m.beta, m.batch_beta, meas, {normal_incidence, normal_view});
   MetricsAccumulator abs_all, norm_all;
   for (size_t i = 0; i < meas.curves.size(); ++i) {
@@ -142,12 +145,12 @@ void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& nor
       ncm[k] = nc[k].result();
     }
     m.absolute.push_back(a.result());
-    m.normalized.push_back(n.result());
+    m.normalized.push_back(normalized ? n.result() : MetricsAccumulator{}.result());
     abs_all.add(a);
     norm_all.add(n);
   }
   m.absolute_overall = abs_all.result();
-  m.normalized_overall = norm_all.result();
+  m.normalized_overall = normalized ? norm_all.result() : MetricsAccumulator{}.result();
 }
 
 // Where the measurement has normal incidence and normal view.

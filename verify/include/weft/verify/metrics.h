@@ -26,9 +26,9 @@ struct MetricsAccumulator {
 };
 
 // The paper's normalization, per channel: the factor that makes the model's beta at normal
-// incidence and normal view equal the measured one. weft::Error when the model's value is not
-// positive there (no factor exists).
-Rgb paper_normalization(const Rgb& model_at_normal, const Rgb& measured_at_normal,
-                        const std::string& model_name);
+// incidence and normal view equal the measured one. NaN in a channel where the model's value is
+// not positive there (no factor exists: a fabric that absorbs a channel nearly whole, traced with
+// few particles, can leave that one bin empty); the paper's figure is then not defined.
+Rgb paper_normalization(const Rgb& model_at_normal, const Rgb& measured_at_normal);
 
 }  // namespace weft
