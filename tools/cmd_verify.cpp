@@ -178,6 +178,14 @@ int run_suite(const VerifyCliOptions& o) {
   const VerifyRequest& base = o.request;
   const VerifySuite suite = read_verify_suite(
       o.suite_file.empty() ? bundled_verify_suite() : std::filesystem::path(o.suite_file));
+  std::vector<NamedPath> inputs = {{suite.file.string(), "suite file"}};
+  for (const SuiteFabric& f : suite.fabrics) {
+    inputs.push_back({f.measured, f.name + "'s measured CSV"});
+    inputs.push_back({f.weave, f.name + "'s weave options"});
+    inputs.push_back({f.wif, f.name + "'s WIF draft"});
+    inputs.push_back({f.fiber, f.name + "'s fiber table or spec"});
+  }
+  validate_output_paths({}, inputs, {{base.output, "-o"}});
   check_suite_output(base.output);
   std::vector<VerifyPlan> plans;
   VerifyEstimate total;
