@@ -152,6 +152,20 @@ TEST(OutputGuard, VerifyRefusesAReportFolderHoldingItsMeasurement) {
                  "report/m.csv");
 }
 
+// The same for a suite: its output folder, an earlier suite's, holds the suite file and the
+// measurement it names.
+TEST(OutputGuard, VerifySuiteRefusesAnOutputFolderHoldingItsInputs) {
+  const fs::path dir = fresh_test_dir();
+  fs::create_directory(dir / "out");
+  std::ofstream(dir / "out" / "suite.json") << R"({"report": "weft verify suite"})";
+  fs::copy_file(kSource + "/materials/data/measured/merl-white-fabric/inplane.csv",
+                dir / "out" / "m.csv");
+  std::ofstream(dir / "out" / "mine.json") << R"({"title": "t", "fabrics": [{"name": "w",
+    "measured": "m.csv", "fiber": "white-cotton", "known": "k"}]})";
+  expect_refused(dir, "verify --quiet --quality draft --suite-file out/mine.json -o out", "out",
+                 "out/mine.json");
+}
+
 // Concurrent `weft compare --plot` runs shared one temporary file name for their curves (15 of 20
 // plots showed another run's curves). Each run's plot, drawn with others running at once, is
 // byte for byte the plot it draws alone, and no temporary stays behind in TMPDIR.
