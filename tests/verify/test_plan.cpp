@@ -80,6 +80,21 @@ TEST(VerifyPlan, BadRequestsAreRefusedNamingTheOption) {
   }
 }
 
+// A dye's concentration moves the hue: a fit of it is refused against the bundled measurement,
+// whose colour space (camera RGB) is not the tables', and planned when the measurement is sRGB.
+TEST(VerifyPlan, DyeConcentrationsFitOnlyWhereColourIsComparable) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.fit = true;
+  r.fit_params = "dye0_concentration";
+  EXPECT_NE(error_of([&] { plan_verify(r); }).find("colour space is camera"), std::string::npos);
+  r.fit_params = "dye_scale";  // the recipe's depth, its hue kept
+  EXPECT_NO_THROW(plan_verify(r));
+  r.fit_params = "dye0_concentration";
+  r.colour_space = "srgb";
+  EXPECT_EQ(plan_verify(r).fit_names, std::vector<std::string>{"dye0_concentration"});
+}
+
 TEST(VerifyPlan, ClassicAlbedoIsThreeReflectances) {
   const Rgb c = parse_classic_albedo("0.3,0.05,1");
   EXPECT_EQ(c.r, 0.3);

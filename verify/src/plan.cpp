@@ -53,6 +53,17 @@ void plan_fit(const VerifyRequest& o, VerifyPlan& p) {
     p.fit_options.max_evaluations = o.fit_evaluations;
     p.fit_options.validate(4);                       // the classic model always fits four
     (void)spec_fit_parameters(p.spec, p.fit_names);  // a spec without particles is refused here
+    // A dye's own concentration moves the hue: fitted only where the colour can be judged.
+    for (const auto& name : p.fit_names)
+      if (name.rfind("dye", 0) == 0 && name != "dye_scale" &&
+          !absolute_comparable(p.measured.colour_space))
+        throw Error(p.measured_path.string(), "--fit-params",
+                    "'" + name +
+                        "' fits a dye's concentration, which moves the colour; the "
+                        "measurement's colour space is " +
+                        colour_space_name(p.measured.colour_space) +
+                        ", not the tables' (linear sRGB), so its colour cannot judge it (give "
+                        "--colour-space srgb if the measurement is sRGB)");
   } else if (o.fit_params_given || o.fit_evaluations_given || o.fit_inner_given ||
              o.fit_method_given) {
     throw Error("",
