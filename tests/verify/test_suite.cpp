@@ -84,7 +84,8 @@ TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
   SuiteRow good{{"good", "m.csv", "red-cotton", "", "", "", "camera", "a red cloth"}, {}, ""};
   // The keys a report writes (docs/verify.md): figures per model with their uncertainty, and
   // the verdict per figure.
-  good.metrics = nlohmann::json::parse(R"({"absolute_comparable": false, "models": {
+  good.metrics = nlohmann::json::parse(R"({"absolute_comparable": false,
+      "fabric_table_gamut_clipped_components": 12, "models": {
       "computed_raytrace": {"shape": {"rms_log": 0.31}, "normalized": {"rms_log": 0.73},
           "absolute": {"rms_log": 0.55},
           "uncertainty": {"shape": {"seed_se": 0.004, "fit_min": 0.28, "fit_max": 0.39}}},
@@ -117,6 +118,7 @@ TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
   EXPECT_NE(html.find("0.310 &plusmn; 0.004 <small>(fits 0.280&ndash;0.390)"), std::string::npos);
   EXPECT_NE(html.find("<small>(0.550)</small>"), std::string::npos);  // not comparable
   EXPECT_NE(html.find("Shape: computed wins"), std::string::npos);
+  EXPECT_NE(html.find("12 components clipped to the sRGB gamut"), std::string::npos);
   EXPECT_EQ(html.find("Absolute: not resolved"), std::string::npos);  // the shape verdicts only
   EXPECT_NE(html.find("computed closer on 1, classic closer on 0"), std::string::npos);
   EXPECT_NE(verify_suite_text({good, bad}).find("good: Shape: computed wins"), std::string::npos);

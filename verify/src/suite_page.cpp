@@ -98,6 +98,10 @@ nlohmann::json suite_row_json(const SuiteRow& r) {
   j["absolute_comparable"] = r.metrics.value("absolute_comparable", true);
   j["shape_closer"] = shape_closer(r.metrics);
   j["shape_verdicts"] = verdict_texts(r.metrics, "shape");
+  // A deep dye's spectrum can leave the sRGB gamut: the table's clipped components then hold
+  // zero where the spectrum has light, and a channel's log figures compare clipped values.
+  j["computed_gamut_clipped_components"] =
+      r.metrics.value("fabric_table_gamut_clipped_components", 0);
   if (r.metrics.contains("verdict")) j["verdict"] = r.metrics.at("verdict");
   return j;
 }
@@ -256,8 +260,10 @@ std::string verify_suite_html(const VerifySuite& suite, const std::vector<SuiteR
       << html_escape(r.fabric.name) << "</a></td><td class=\"known\">"
       << html_escape(r.fabric.known) << "<br><small>fiber " << html_escape(r.fabric.fiber)
       << "; colour space "
-      << html_escape(r.fabric.colour_space.empty() ? "as the file says" : r.fabric.colour_space)
-      << "</small></td>";
+      << html_escape(r.fabric.colour_space.empty() ? "as the file says" : r.fabric.colour_space);
+    if (const int clipped = row.value("computed_gamut_clipped_components", 0); clipped > 0)
+      h << "; the computed table has " << clipped << " components clipped to the sRGB gamut";
+    h << "</small></td>";
     if (row.contains("error")) {
       h << "<td colspan=\"" << 3 * std::size(kSuiteModels) + 1
         << "\">failed: " << html_escape(r.error) << "</td></tr>\n";
