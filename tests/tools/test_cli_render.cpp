@@ -287,7 +287,13 @@ TEST(CliRender, CtrlCStopsALargeTileAtOnce) {
   cmd += dir.string() + "'; '" + WEFT_EXE + "' render '" +
          (kExamples / "lambert-plane.json").string() +
          "' --width 16 --height 16 --spp 1048576 -o out.exr --quiet 2>err & "
-         "pid=$!; sleep 1; t0=$(date +%s%N); kill -INT $pid; wait $pid; "
+         // A background job of sh starts with SIGINT ignored until weft catches it: wait for its
+         // handler (SigCgt holds SIGINT, bit 1) so a slow start on a loaded machine is not a
+         // signal lost, then let the render run a moment.
+         "pid=$!; n=0; while [ $n -lt 1200 ]; do "
+         "m=$(awk '/^SigCgt/ {print $2}' /proc/$pid/status 2>/dev/null); "
+         "[ -n \"$m\" ] && [ $(( 0x$m & 2 )) -ne 0 ] && break; n=$((n+1)); sleep 0.05; done; "
+         "sleep 0.5; t0=$(date +%s%N); kill -INT $pid; wait $pid; "
          "echo $? $(( ($(date +%s%N) - t0) / 1000000 )) > result";
   ASSERT_EQ(std::system(cmd.c_str()), 0);
   std::istringstream in(slurp(dir / "result"));
