@@ -22,7 +22,7 @@ cd '$tmp/run'
 '$prefix/bin/weft' verify --quality draft --quiet -o out >verify.txt
 SCRIPT
 
-if unshare -rm true 2>/dev/null; then
+if unshare -rm sh -c "mount -t tmpfs none '$src'" 2>/dev/null; then
   echo "source tree hidden: $src"
   unshare -rm bash -c "mount -t tmpfs none '$src' && bash '$tmp/commands.sh'"
 else
