@@ -77,14 +77,12 @@ ProgressCallback progress_bar(bool quiet) {
   };
 }
 
-SceneDescription load_scene_reporting_warnings(const std::string& path) {
-  return load_scene_reporting_warnings(path, {});
-}
-
 SceneDescription load_scene_reporting_warnings(const std::string& path,
-                                               const std::vector<SceneOverride>& overrides) {
+                                               const std::vector<SceneOverride>& overrides,
+                                               bool quiet) {
   SceneDescription desc = load_scene_description(path, overrides);
   for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
+  if (quiet) return desc;
   // What the lights are, in the renderer's units (glTF photometric values were converted).
   for (const auto& n : desc.notes) std::fprintf(stderr, "weft: %s\n", n.c_str());
   for (const auto& l : describe_lights(desc.lights))

@@ -37,11 +37,11 @@ ProgressCallback progress_bar(bool quiet);  // throws WorkWouldStart when check_
 void install_interrupt_handler();
 bool interrupted();
 
-// The scene description at 'path', its warnings printed on stderr (commands that render it).
-SceneDescription load_scene_reporting_warnings(const std::string& path);
-// Same with "-D key=value" overrides applied to the description (description.h).
+// The scene description at 'path' with "-D key=value" overrides applied (description.h), its
+// warnings printed on stderr (commands that render it); unless 'quiet', its notes and lights too.
 SceneDescription load_scene_reporting_warnings(const std::string& path,
-                                               const std::vector<SceneOverride>& overrides);
+                                               const std::vector<SceneOverride>& overrides,
+                                               bool quiet);
 // The end of a render on stderr, alike for every command that renders: a cancelled run says that
 // 'what' wrote nothing and gives exit code 130; dropped non-finite samples are a warning.
 // Returns the exit code to stop with, or 0 to go on to the outputs.

@@ -98,7 +98,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--spectral", o->spectral,
                 "transport light per wavelength band (33 bands; every material spectral, every "
                 "light grey), as the scene's render.spectral");
-  sub->add_flag("--quiet", o->quiet, "no progress and no summary on stderr");
+  sub->add_flag("--quiet", o->quiet,
+                "nothing on stderr but warnings and errors (no lights, progress or summary)");
   sub->add_flag("--json", o->json, "print a JSON summary on stdout");
   commands.push_back(
       {sub, [o, seed] {
@@ -106,7 +107,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
            throw Error("", "--mask-object", "is required with --mask");
          std::vector<SceneOverride> overrides;
          for (const auto& d : o->defines) overrides.push_back(parse_scene_override(d));
-         SceneDescription desc = load_scene_reporting_warnings(o->scene, overrides);
+         SceneDescription desc = load_scene_reporting_warnings(o->scene, overrides, o->quiet);
          RenderJob job;
          job.exr = o->output;
          if (!o->preview.empty()) job.png = o->preview;

@@ -204,11 +204,11 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--resume", o->resume,
                 "checkpoint every finished view beside the output and continue from a "
                 "checkpoint an earlier run of this sweep left there");
-  sub->add_flag("--quiet", o->quiet, "no progress bar");
+  sub->add_flag("--quiet", o->quiet, "no progress bar and no lights on stderr");
   sub->add_flag("--json", o->json, "also print the rows as JSON on stdout");
   commands.push_back(
       {sub, [o, lz, la, va, irr, seed] {
-         const SceneDescription desc = load_scene_reporting_warnings(o->scene);
+         const SceneDescription desc = load_scene_reporting_warnings(o->scene, {}, o->quiet);
          GonioSettings g = gonio_settings_from(desc);
          if (lz->count())
            g.light_zenith_deg = o->light_zenith;

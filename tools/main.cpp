@@ -5,6 +5,7 @@
 #include <new>
 
 #include "commands.h"
+#include "did_you_mean.h"
 #include "weft/core/error.h"
 
 int main(int argc, char** argv) {
@@ -12,7 +13,7 @@ int main(int argc, char** argv) {
   try {
     program->app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return program->app.exit(e);
+    return weft::cli::report_parse_error(program->app, e);
   }
   try {
     return weft::cli::run_program(*program);

@@ -6,10 +6,6 @@
 #include "weft/core/error.h"
 #include "weft/core/install_paths.h"
 
-#ifndef WEFT_TOOLS_DIR
-#define WEFT_TOOLS_DIR ""
-#endif
-
 namespace weft::cli {
 namespace {
 
@@ -29,7 +25,7 @@ std::string quoted(const std::string& s) {
 
 std::filesystem::path find_script(const std::string& script) {
   std::string tried;
-  const auto path = find_installed_file(WEFT_TOOLS_DIR, "tools", script, &tried);
+  const auto path = find_bundled_file(std::filesystem::path("tools") / script, &tried);
   if (path.empty()) throw Error(script, "", "plot script not found (tried: " + tried + ")");
   return path;
 }

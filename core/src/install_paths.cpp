@@ -1,26 +1,40 @@
 #include "weft/core/install_paths.h"
 
 #include <system_error>
-#include <vector>
+
+#ifndef WEFT_SOURCE_DIR
+#define WEFT_SOURCE_DIR ""
+#endif
 
 namespace weft {
 
-std::filesystem::path find_installed_file(const std::string& source_dir,
-                                          const std::string& share_subdir,
-                                          const std::filesystem::path& rel, std::string* tried) {
+std::vector<std::filesystem::path> bundled_data_roots() {
   namespace fs = std::filesystem;
+  std::vector<fs::path> roots;
   std::error_code ec;
-  std::vector<fs::path> candidates;
-  if (!source_dir.empty()) candidates.push_back(fs::path(source_dir) / rel);
+  // The installed tree first: an installed program must not read a source tree that happens to
+  // still exist at the path it was built from (it may be newer or older than the install).
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) candidates.push_back(exe.parent_path() / ".." / "share" / "weft" / share_subdir / rel);
+  if (!ec) roots.push_back((exe.parent_path() / ".." / "share" / "weft").lexically_normal());
+  if (!std::string(WEFT_SOURCE_DIR).empty()) roots.emplace_back(WEFT_SOURCE_DIR);
+  return roots;
+}
+
+std::filesystem::path find_file_under(const std::vector<std::filesystem::path>& roots,
+                                      const std::filesystem::path& rel, std::string* tried) {
+  std::error_code ec;
   std::string list;
-  for (const auto& c : candidates) {
-    if (fs::is_regular_file(c, ec)) return c;
+  for (const auto& root : roots) {
+    const auto c = root / rel;
+    if (std::filesystem::is_regular_file(c, ec)) return c;
     list += (list.empty() ? "" : ", ") + c.string();
   }
   if (tried) *tried = list;
   return {};
+}
+
+std::filesystem::path find_bundled_file(const std::filesystem::path& rel, std::string* tried) {
+  return find_file_under(bundled_data_roots(), rel, tried);
 }
 
 }  // namespace weft

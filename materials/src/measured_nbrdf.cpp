@@ -10,10 +10,6 @@
 #include "weft/core/math.h"
 #include "weft/core/params.h"
 
-#ifndef WEFT_DATA_DIR
-#define WEFT_DATA_DIR ""
-#endif
-
 namespace weft {
 namespace {
 
@@ -125,8 +121,8 @@ std::filesystem::path find_measured_nbrdf(const std::string& name) {
   }
   if (!known) throw Error("unknown measured material '" + name + "' (valid: " + valid + ")");
   std::string tried;
-  const fs::path path = find_installed_file(
-      WEFT_DATA_DIR, "materials", fs::path("measured") / name / "nbrdf_weights.txt", &tried);
+  const fs::path path =
+      find_bundled_file(fs::path("materials/data/measured") / name / "nbrdf_weights.txt", &tried);
   if (path.empty())
     throw Error("data for measured material '" + name + "' not found (tried: " + tried + ")");
   return path;

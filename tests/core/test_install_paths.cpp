@@ -1,5 +1,5 @@
-// find_installed_file (core/install_paths.h): the source tree first, then nothing, with the places
-// looked at.
+// Bundled data (core/install_paths.h): the installed tree beside the executable first, then the
+// source tree; a missing file is empty, with the places looked at.
 #include <gtest/gtest.h>
 
 #include <fstream>
@@ -10,24 +10,39 @@
 using namespace weft;
 using weft::testing::fresh_test_dir;
 
-TEST(InstallPaths, FindsAFileInTheSourceTree) {
+TEST(InstallPaths, TheInstallBesideTheExecutableComesBeforeTheSourceTree) {
+  const auto roots = bundled_data_roots();
+  ASSERT_EQ(roots.size(), 2u);
+  const auto exe = std::filesystem::read_symlink("/proc/self/exe");
+  EXPECT_EQ(roots[0], (exe.parent_path().parent_path() / "share" / "weft").lexically_normal());
+  EXPECT_EQ(roots[1], std::filesystem::path(WEFT_SOURCE_DIR));
+}
+
+TEST(InstallPaths, FindsTheFirstRootHoldingTheFile) {
   const auto dir = fresh_test_dir();
-  std::filesystem::create_directories(dir / "measured" / "a");
-  std::ofstream(dir / "measured" / "a" / "w.txt") << "x";
+  for (const char* root : {"a", "b"}) {
+    std::filesystem::create_directories(dir / root / "measured");
+    std::ofstream(dir / root / "measured" / "w.txt") << root;
+  }
   std::string tried = "unchanged";
-  const auto p = find_installed_file(dir.string(), "materials", "measured/a/w.txt", &tried);
-  EXPECT_EQ(p, dir / "measured" / "a" / "w.txt");
+  EXPECT_EQ(find_file_under({dir / "none", dir / "b", dir / "a"}, "measured/w.txt", &tried),
+            dir / "b" / "measured" / "w.txt");
   EXPECT_EQ(tried, "unchanged");  // only filled on failure
 }
 
 TEST(InstallPaths, MissingFileIsEmptyAndListsWhereItLooked) {
   const auto dir = fresh_test_dir();
-  std::filesystem::create_directories(dir / "b.txt");  // a folder, not a file
+  std::filesystem::create_directories(dir / "a" / "b.txt");  // a folder, not a file
   std::string tried;
-  EXPECT_TRUE(find_installed_file(dir.string(), "tools", "b.txt", &tried).empty());
-  EXPECT_NE(tried.find((dir / "b.txt").string()), std::string::npos) << tried;
-  EXPECT_NE(tried.find("share/weft/tools/b.txt"), std::string::npos) << tried;
-  // No source tree: only the installed place is looked at.
-  EXPECT_TRUE(find_installed_file("", "tools", "b.txt", &tried).empty());
-  EXPECT_EQ(tried.find(dir.string()), std::string::npos) << tried;
+  EXPECT_TRUE(find_file_under({dir / "a", dir / "c"}, "b.txt", &tried).empty());
+  EXPECT_EQ(tried, (dir / "a" / "b.txt").string() + ", " + (dir / "c" / "b.txt").string());
+}
+
+TEST(InstallPaths, FindsTheBundledDataOfThisSourceTree) {
+  // The test programs run from the build tree: no share/weft beside them, so the source tree.
+  const auto p = find_bundled_file("verify/data/suite.json");
+  EXPECT_EQ(p, std::filesystem::path(WEFT_SOURCE_DIR) / "verify/data/suite.json");
+  std::string tried;
+  EXPECT_TRUE(find_bundled_file("verify/data/no-such-file.json", &tried).empty());
+  EXPECT_NE(tried.find("share/weft/verify/data/no-such-file.json"), std::string::npos) << tried;
 }

@@ -12,10 +12,6 @@
 #include "weft/core/math.h"
 #include "weft/core/params.h"
 
-#ifndef WEFT_DATA_DIR
-#define WEFT_DATA_DIR ""
-#endif
-
 namespace weft {
 namespace {
 
@@ -223,8 +219,7 @@ std::vector<MeasuredFit> measured_fits(const MeasuredInplane& m) {
 
 std::filesystem::path bundled_measured_inplane() {
   std::string tried;
-  const auto p = find_installed_file(WEFT_DATA_DIR, "materials",
-                                     "measured/merl-red-fabric/inplane.csv", &tried);
+  const auto p = find_bundled_file("materials/data/measured/merl-red-fabric/inplane.csv", &tried);
   if (p.empty())
     throw Error("merl-red-fabric/inplane.csv", "--measured",
                 "the bundled measurement is not found (tried: " + tried + ")");

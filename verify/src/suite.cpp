@@ -5,11 +5,8 @@
 #include <sstream>
 
 #include "weft/core/error.h"
+#include "weft/core/install_paths.h"
 #include "weft/core/params.h"
-
-#ifndef WEFT_SUITE_FILE
-#error "WEFT_SUITE_FILE must point at verify/data/suite.json"
-#endif
 
 namespace weft {
 namespace {
@@ -60,7 +57,12 @@ SuiteFabric read_fabric(ParamReader r, const fs::path& base) {
 }  // namespace
 
 fs::path bundled_verify_suite() {
-  return fs::path(WEFT_SUITE_FILE);
+  std::string tried;
+  const auto p = find_bundled_file("verify/data/suite.json", &tried);
+  if (p.empty())
+    throw Error("verify/data/suite.json", "--suite",
+                "the bundled suite is not found (tried: " + tried + ")");
+  return p;
 }
 
 VerifySuite read_verify_suite(const fs::path& file) {

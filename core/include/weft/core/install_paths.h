@@ -1,18 +1,27 @@
 #pragma once
-// Files the program ships beside its code (measured data, plot scripts): found in the source tree
-// the build was made from, or in an installed tree laid out as <prefix>/bin/weft and
-// <prefix>/share/weft/<subdir>/...
+// Files the program ships beside its code (measured data, the verify suite, example scenes, plot
+// scripts), each named by its path in the source tree ("materials/data/measured/..."). An installed
+// program finds them under <prefix>/share/weft/<that path> (where `cmake --install` puts them,
+// beside <prefix>/bin/weft); a program run from its build tree, in the source tree it was built
+// from.
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace weft {
 
-// The first regular file among 'source_dir' / rel (skipped when source_dir is empty) and
-// <folder of this executable>/../share/weft/<share_subdir>/rel. Empty when none exists; 'tried'
-// (when given) then lists the places looked at, for the caller's error.
-std::filesystem::path find_installed_file(const std::string& source_dir,
-                                          const std::string& share_subdir,
-                                          const std::filesystem::path& rel,
-                                          std::string* tried = nullptr);
+// Where bundled data is looked for, in order: <folder of this executable>/../share/weft (an
+// installed program, wherever its prefix was copied), then the source tree of the build.
+std::vector<std::filesystem::path> bundled_data_roots();
+
+// The first regular file root / rel over 'roots'. Empty when none exists; 'tried' (when given)
+// then lists the places looked at, for the caller's error.
+std::filesystem::path find_file_under(const std::vector<std::filesystem::path>& roots,
+                                      const std::filesystem::path& rel,
+                                      std::string* tried = nullptr);
+
+// The bundled file 'rel' (a path in the source tree): find_file_under(bundled_data_roots(), ...).
+std::filesystem::path find_bundled_file(const std::filesystem::path& rel,
+                                        std::string* tried = nullptr);
 
 }  // namespace weft

@@ -40,9 +40,9 @@ struct NbrdfNetwork {
 
 // Bundled measured materials: the folders of materials/data/measured ("merl-red-fabric", ...).
 std::vector<std::string> measured_nbrdf_names();
-// The weights file of a bundled material: looked up in the data folder compiled in
-// (WEFT_DATA_DIR = materials/data of the source tree) and then relative to the executable
-// (<exe>/../share/weft/materials). Throws weft::Error listing the places tried.
+// The weights file of a bundled material (materials/data/measured/<name>, found by
+// find_bundled_file: the install, then the source tree). Throws weft::Error listing the places
+// tried.
 std::filesystem::path find_measured_nbrdf(const std::string& name);
 
 struct MeasuredNbrdfBsdf {
