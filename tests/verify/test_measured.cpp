@@ -133,5 +133,44 @@ TEST(VerifyMeasured, BadTablesNameFileAndField) {
             std::string::npos);
 }
 
+// Hostile tables are refused with the file and the field, and the huge ones before they are held
+// in memory: one past each limit of measured.h, the first row past it named.
+TEST(VerifyMeasured, HugeOrDegenerateTablesAreRefused) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path p = dir / "hostile.csv";
+  const std::string head = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n";
+  const auto refused = [&](const std::string& text, const std::string& part) {
+    write_text_atomically(p, text);
+    const std::string e = error_of([&] { read_measured_inplane(p); });
+    EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+    EXPECT_NE(e.find(part), std::string::npos) << part << " -> " << e;
+  };
+  // One incidence too many (distinct theta_i in [0, 90)), one view too many at one incidence.
+  std::string incidences = head, views = head;
+  for (size_t i = 0; i <= kMaxMeasuredIncidences; ++i)
+    incidences += std::to_string(i * 0.25) + ",0,1,1,1\n";
+  for (size_t v = 0; v <= kMaxMeasuredViews; ++v)
+    views += "0," + std::to_string(-89.75 + v * 0.25) + ",1,1,1\n";
+  refused(incidences, "line " + std::to_string(kMaxMeasuredIncidences + 2) + " theta_i_deg");
+  refused(incidences, "incidences");
+  refused(views, "line " + std::to_string(kMaxMeasuredViews + 2) + " theta_o_deg");
+  // Absurd, non-finite and negative values, and a channel of zeros at every row.
+  refused(head + "0,0,1,1e300,1\n", "line 2 nbrdf_beta_G");
+  refused(head + "0,0,1,1e300,1\n", "absurd");
+  refused(head + "0,0,inf,1,1\n", "line 2 nbrdf_beta_R");
+  refused(head + "0,0,1,1,nan\n", "line 2 nbrdf_beta_B");
+  refused(head + "0,0,-1e300,1,1\n", "line 2 nbrdf_beta_R");
+  refused(head + "0,0,0,0,0\n10,0,0,0,0\n", "nbrdf_beta_R");
+  refused(head + "0,0,1,0,1\n10,0,1,0,1\n", "field 'nbrdf_beta_G': zero at every row");
+  // A file over the size limit is refused before a byte of it is read (a sparse file: instant).
+  write_text_atomically(p, head + "0,0,1,1,1\n");
+  fs::resize_file(p, kMaxMeasuredBytes + 1);
+  const std::string e = error_of([&] { read_measured_inplane(p); });
+  EXPECT_NE(e.find(p.string() + ": field 'size'"), std::string::npos) << e;
+  // A single zero among positive values is a measurement (the bundled purple felt has zeros).
+  write_text_atomically(p, head + "0,0,1,0,1\n10,0,1,1,1\n");
+  EXPECT_EQ(read_measured_inplane(p).curves.size(), 2u);
+}
+
 }  // namespace
 }  // namespace weft
