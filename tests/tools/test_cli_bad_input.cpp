@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli_run.h"
 #include "test_util.h"
@@ -371,4 +373,40 @@ TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
   EXPECT_EQ(
       run("--max-memory-gb 0.05 table bake lambert -R 2 --spp 1 -o out.exr --quiet", dir).exit_code,
       0);
+}
+
+namespace {
+
+// What is in 'dir' besides the run's stdout and stderr and the inputs 'kept'.
+std::vector<std::string> left_behind(const fs::path& dir, const std::vector<std::string>& kept) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name != "stdout" && name != "stderr" &&
+        std::find(kept.begin(), kept.end(), name) == kept.end())
+      out.push_back(name);
+  }
+  return out;
+}
+
+}  // namespace
+
+// A measured table of a million incidences (26 MB) made `weft verify` run for minutes and abort
+// with std::bad_alloc; one past the limit of measured.h (180 incidences) is refused at once,
+// naming the file and the row, before any staging folder or bake cache exists.
+TEST(CliBadInput, HugeOrDegenerateMeasuredTableIsRefusedBeforeAnyWork) {
+  const fs::path dir = fresh_test_dir();
+  std::string table = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n";
+  for (int i = 0; i <= 180; ++i) table += std::to_string(i * 0.25) + ",0,0.1,0.1,0.1\n";
+  write(dir / "m.csv", table);
+  expect_error(run("verify --measured m.csv --quality draft -o rep", dir),
+               {"m.csv: field 'line 182 theta_i_deg'", "more than 180 incidences"}, dir / "rep");
+  EXPECT_EQ(slurp(dir / "m.csv"), table);
+  EXPECT_EQ(left_behind(dir, {"m.csv"}), std::vector<std::string>{});
+  write(dir / "m.csv",
+        "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n"
+        "0,0,0.1,1e300,0.1\n");
+  expect_error(run("verify --measured m.csv --quality draft -o rep", dir),
+               {"m.csv: field 'line 2 nbrdf_beta_G'", "absurd"}, dir / "rep");
+  EXPECT_EQ(left_behind(dir, {"m.csv"}), std::vector<std::string>{});
 }
