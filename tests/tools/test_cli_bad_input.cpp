@@ -410,3 +410,36 @@ TEST(CliBadInput, HugeOrDegenerateMeasuredTableIsRefusedBeforeAnyWork) {
                {"m.csv: field 'line 2 nbrdf_beta_G'", "absurd"}, dir / "rep");
   EXPECT_EQ(left_behind(dir, {"m.csv"}), std::vector<std::string>{});
 }
+
+// A scene's fiber_table named by a spec is baked on first use (bake_cache.h); 10^12 photons per
+// band ran with no estimate. Now the bake on first use takes the checks of `weft bake fiber`
+// (33 bands x 10^12 photons at >= 0.5 us each: years): refused without --yes-long, naming the
+// scene and the material's photons field, before the bake cache exists. The same for a sweep.
+TEST(CliBadInput, BakeOnFirstUseNeedsConfirmationLikeADirectBake) {
+  const fs::path dir = fresh_test_dir();
+  const std::string scene = replaced(
+      slurp(kPlane), R"({"type": "lambert", "params": {"reflectance": 0.5}})",
+      R"({"type": "fiber_table", "params": {"spec": "red-cotton", "photons": 1000000000000}})");
+  write(dir / "scene.json",
+        replaced(scene, "lambert-plane.gltf", kExamples + "/lambert-plane.gltf"));
+  for (const std::string output : {"t.exr", "t.csv"}) {
+    const std::string command = (output == "t.exr" ? "render" : "sweep");
+    expect_error(run(command + " scene.json -o " + output, dir),
+                 {"scene.json", "materials.plane.params.photons", "1000000000000 photons per band",
+                  "would take at least", "--yes-long"},
+                 dir / output);
+    EXPECT_FALSE(fs::exists(dir / ".weft-cache")) << command;
+  }
+}
+
+// A summation-visible table at R = 32 with 4096 direction pairs per cell pair: 2048^2 x 4096 =
+// 1.7e10 pairs at >= 5 us each (fabric_summation.h kMinSecondsPerVisiblePair; measured 26 us)
+// ran with no estimate; now it is refused before the fiber table is baked.
+TEST(CliBadInput, LongSummationNeedsConfirmation) {
+  const fs::path dir = fresh_test_dir();
+  expect_error(run("bake fabric --method summation-visible -R 32 --samples 4096 -o t.exr", dir),
+               {"--samples", "a summation-visible of 4194304 cell pairs x 4096 direction pairs",
+                "would take at least", "5 us per direction pair", "--yes-long"},
+               dir / "t.exr");
+  EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
+}
