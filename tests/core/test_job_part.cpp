@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "mutate.h"
 #include "test_util.h"
 #include "weft/core/job_part.h"
 
@@ -94,6 +95,36 @@ TEST(JobPart, StalePartIsRefusedNamingItsFile) {
             std::string::npos)
       << e;
   EXPECT_NE(e.find("setting 'photons' differs"), std::string::npos) << e;
+}
+
+// Random byte edits of a valid part file (its magic line, JSON header and raw doubles), seeded:
+// every mutant is read or refused with a weft::Error naming the file.
+TEST(JobPart, ByteMutationsAreReadOrRefusedNeverCrash) {
+  const fs::path dir = fresh_test_dir();
+  JobPart p;
+  p.command = "bake fiber";
+  p.job = {{"seed", 1}, {"photons", 100}, {"name", "red-cotton"}};
+  p.units_total = 33;
+  p.shard = {1, 4};
+  for (uint64_t u = 8; u < 16; ++u) p.units[u] = {double(u), 0.5, -1.25};
+  write_job_part(dir / "valid", p);
+  const std::string valid = testing::slurp(dir / "valid");
+  Rng rng(20261203);
+  int read = 0, refused = 0;
+  const fs::path path = dir / "mutant.part";
+  for (int trial = 0; trial < 200; ++trial) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << testing::mutated(valid, rng);
+    try {
+      const JobPart m = read_job_part(path);
+      EXPECT_LE(m.units.size(), m.units_total);
+      ++read;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(read, 0);
+  EXPECT_GT(refused, 0);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <tuple>
 
+#include "mutate.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/rng.h"
@@ -305,4 +306,25 @@ TEST(Wif, BinaryThinAndUninterlacedDraftsAreRefused) {
         << e;
     EXPECT_NE(e.find("every warp lies " + side), std::string::npos) << e;
   }
+}
+
+// Random byte edits (any byte, NUL and non-ASCII included) of the small draft and of the bundled
+// 8452.wif, seeded: every mutant parses and interlaces, or is refused with a weft::Error naming it.
+TEST(Wif, ByteMutationsAreErrorsOrDraftsNeverCrashes) {
+  Rng rng(20261203);
+  int parsed = 0, refused = 0;
+  for (const std::string& valid : {kSmall, weft::testing::slurp(kWif / "8452.wif")})
+    for (int trial = 0; trial < 1000; ++trial) {
+      const std::string text = weft::testing::mutated(valid, rng);
+      try {
+        const WifDraft d = parse_wif(text, "mutant.wif");
+        EXPECT_EQ(d.interlacing().warp_over.size(), d.warp.size() * d.weft.size());
+        ++parsed;
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("mutant.wif"), std::string::npos) << e.what();
+        ++refused;
+      }
+    }
+  EXPECT_GT(parsed, 0);
+  EXPECT_GT(refused, 0);
 }

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 
+#include "mutate.h"
 #include "test_util.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/math.h"
@@ -170,6 +172,32 @@ TEST(VerifyMeasured, HugeOrDegenerateTablesAreRefused) {
   // A single zero among positive values is a measurement (the bundled purple felt has zeros).
   write_text_atomically(p, head + "0,0,1,0,1\n10,0,1,1,1\n");
   EXPECT_EQ(read_measured_inplane(p).curves.size(), 2u);
+}
+
+// Random byte edits of the bundled table's first 40 rows (comment lines, header and numbers),
+// seeded: every mutant is read or refused with a weft::Error naming the file.
+TEST(VerifyMeasured, ByteMutationsAreReadOrRefusedNeverCrash) {
+  const fs::path dir = fresh_test_dir();
+  const std::string whole = testing::slurp(bundled_measured_inplane());
+  size_t cut = 0;
+  for (int line = 0; line < 43; ++line) cut = whole.find('\n', cut) + 1;
+  const std::string valid = whole.substr(0, cut);
+  Rng rng(20261203);
+  int read = 0, refused = 0;
+  const fs::path p = dir / "mutant.csv";
+  for (int trial = 0; trial < 200; ++trial) {
+    std::ofstream(p, std::ios::binary | std::ios::trunc) << testing::mutated(valid, rng);
+    try {
+      const MeasuredInplane m = read_measured_inplane(p);
+      EXPECT_FALSE(m.curves.empty());
+      ++read;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(read, 0);
+  EXPECT_GT(refused, 0);
 }
 
 }  // namespace
