@@ -112,6 +112,9 @@ JobPart read_job_part(const std::filesystem::path& path) {
                       std::to_string(kMaxShards) + ")");
     p.checkpoint = h.at("checkpoint").get<bool>();
     p.extra = h.at("extra");
+    // A unit is listed once at most: a longer list is refused before it is converted.
+    if (h.at("units").size() > p.units_total || h.at("unit_doubles").size() > p.units_total)
+      throw Error(file, "units", "lists more units than units_total");
     const auto units = h.at("units").get<std::vector<uint64_t>>();
     const auto sizes = h.at("unit_doubles").get<std::vector<uint64_t>>();
     if (units.size() != sizes.size()) throw Error(file, "units", "does not match unit_doubles");

@@ -52,6 +52,20 @@ TEST(JobPart, CraftedCountsAreRefusedAsTheHeaderIsRead) {
   EXPECT_NE(e.find(units.string() + ": field 'units_total'"), std::string::npos) << e;
   EXPECT_LT(seconds_of([&] { e = error_of([&] { merge_job_parts({shards}); }); }), 1.0);
   EXPECT_NE(e.find(shards.string() + ": field 'shards'"), std::string::npos) << e;
+  // A list of units longer than units_total is refused before it is converted.
+  const fs::path listed = dir / "listed.part";
+  nlohmann::json h = {{"command", "bake fiber"},
+                      {"job", {{"seed", 1}}},
+                      {"units_total", 2},
+                      {"shard", 0},
+                      {"shards", 1},
+                      {"checkpoint", false},
+                      {"extra", nlohmann::json::object()},
+                      {"units", {0, 1, 2}},
+                      {"unit_doubles", {0, 0, 0}}};
+  std::ofstream(listed, std::ios::binary) << "WEFT-PART 1\n" << h.dump() << "\n";
+  e = error_of([&] { read_job_part(listed); });
+  EXPECT_NE(e.find(listed.string() + ": field 'units': lists more units"), std::string::npos) << e;
   // At both limits a part reads.
   const fs::path empty = crafted_part(dir, "empty.part", kMaxJobUnits, 0, kMaxShards);
   EXPECT_EQ(read_job_part(empty).units_total, kMaxJobUnits);
