@@ -180,13 +180,12 @@ class Draft {
       Entry e{normalize_name(std::string_view(line).substr(0, eq)), trim(line.substr(eq + 1)),
               line_no};
       Section& s = sections_[current];
-      if (s.entries.size() >= kWifMaxSectionKeys || ++keys_ > kWifMaxKeys)
+      const bool section_full = s.entries.size() >= kWifMaxSectionKeys;
+      if (section_full || ++keys_ > kWifMaxKeys)
         throw Error(source_, "[" + current + "] " + e.key,
-                    "more than " +
-                        std::to_string(s.entries.size() >= kWifMaxSectionKeys ? kWifMaxSectionKeys
-                                                                              : kWifMaxKeys) +
-                        (s.entries.size() >= kWifMaxSectionKeys ? " keys in the section"
-                                                                : " keys in the file"));
+                    section_full
+                        ? "more than " + std::to_string(kWifMaxSectionKeys) + " keys in the section"
+                        : "more than " + std::to_string(kWifMaxKeys) + " keys in the file");
       if (!s.keys.insert(e.key).second)
         throw Error(source_, "[" + current + "] " + e.key, "key appears twice");
       s.entries.push_back(std::move(e));
@@ -401,7 +400,8 @@ Interlacing WifDraft::interlacing() const {
   }
   // Every crossing on one side: no thread interlaces, the cloth is two loose layers.
   const auto first = m.warp_over.begin();
-  if (std::all_of(first, m.warp_over.end(), [&](uint8_t o) { return o == *first; }))
+  if (!m.warp_over.empty() &&
+      std::all_of(first, m.warp_over.end(), [&](uint8_t o) { return o == *first; }))
     throw Error(source, weft_source == "LIFTPLAN" ? "[LIFTPLAN]" : "[TIEUP]",
                 std::string("no thread interlaces: every warp lies ") +
                     (*first ? "over" : "under") +
