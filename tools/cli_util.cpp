@@ -154,6 +154,22 @@ void check_memory(double bytes, const std::string& file, const std::string& fiel
                                             : " available (set the budget with --max-memory-gb)"));
 }
 
+void check_fiber_bake(const FiberTableBakeOptions& o, uint64_t bands,
+                      const FiberBakeSource& source) {
+  check_memory(fiber_table_bake_bytes(o), source.file, source.resolution_field,
+               "a bake at resolution " + std::to_string(o.resolution));
+  check_long_work(static_cast<double>(o.photons_per_band) * static_cast<double>(bands),
+                  kMinSecondsPerPhoton, o.threads, source.file, source.photons_field,
+                  std::to_string(o.photons_per_band) + " photons per band",
+                  "0.5 us per photon per core at least");
+}
+
+FiberTableResolver checked_fiber_table_resolver() {
+  return fiber_table_resolver({}, [](const FiberTableBakeOptions& o, const FiberBakeSource& s) {
+    check_fiber_bake(o, kNumBands, s);
+  });
+}
+
 double render_bytes(int width, int height, bool preview, bool mask) {
   const double per_pixel = 3 * sizeof(float) + (preview ? 3 : 0) +
                            (mask ? sizeof(uint32_t) + 6 * sizeof(double) + sizeof(float) : 0);

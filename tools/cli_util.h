@@ -12,6 +12,7 @@
 #include "weft/core/atomic_file.h"
 #include "weft/core/params.h"
 #include "weft/core/progress.h"
+#include "weft/fiber/bake_cache.h"
 
 namespace weft {
 struct RenderOutcome;
@@ -76,6 +77,14 @@ inline constexpr double kAnnouncedWorkSeconds = 60;
 // basis printed is it with the cores.
 void check_long_work(double units, double seconds_per_unit, int threads, const std::string& file,
                      const std::string& field, const std::string& what, const std::string& rate);
+// The checks before a fiber bake, the same for `weft bake fiber` and a bake on first use: its
+// memory (check_memory, fiber_table_bake_bytes) and its time for 'bands' bands (check_long_work at
+// kMinSecondsPerPhoton), naming the source's file and fields.
+void check_fiber_bake(const FiberTableBakeOptions& options, uint64_t bands,
+                      const FiberBakeSource& source);
+// The fiber-table resolver of every command that renders a scene: fiber_table_resolver (bake on
+// first use) with check_fiber_bake before a bake.
+FiberTableResolver checked_fiber_table_resolver();
 // The per-pixel buffers of a render: the image (3 floats), the sRGB preview (3 bytes) and a
 // masked render's hit counts, sums and squares (3 + 3 doubles) and coverage (a float).
 double render_bytes(int width, int height, bool preview, bool mask);

@@ -9,8 +9,8 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "weft/core/job_part.h"
 #include "weft/core/error.h"
+#include "weft/core/job_part.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
 
@@ -253,13 +253,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
                cp.units[range.first + i] = encode_fiber_band(states[i]);
              write_job_part(checkpoint_path(opt->output), cp);
            };
-         check_memory(fiber_table_bake_bytes(o), "", "--resolution",
-                      "a bake at resolution " + std::to_string(o.resolution));
-         check_long_work(static_cast<double>(o.photons_per_band) *
-                             static_cast<double>(range.last - range.first),
-                         kMinSecondsPerPhoton, o.threads, "", "--photons",
-                         std::to_string(o.photons_per_band) + " photons per band",
-                         "0.5 us per photon per core at least");
+         check_fiber_bake(o, range.last - range.first, {"", "--photons", "--resolution"});
          const auto start = std::chrono::steady_clock::now();
          FiberBandsResult traced;
          if (range.last > range.first) {

@@ -9,11 +9,11 @@
 #include <optional>
 
 #include "commands.h"
-#include "weft/fabric/fabric_parts.h"
 #include "weft/core/error.h"
+#include "weft/fabric/fabric_parts.h"
 #include "weft/fabric/fabric_raytrace.h"
-#include "weft/fiber/bake_cache.h"
 #include "weft/fabric/fabric_summation.h"
+#include "weft/fiber/bake_cache.h"
 #include "weft/scenes/weave.h"
 
 namespace weft::cli {
@@ -42,7 +42,9 @@ TabulatedBsdfTable fiber_table(const std::string& fiber, const ProgressCallback&
   FiberTableBakeOptions o;
   o.spectral = false;
   return TabulatedBsdfTable::read_exr(
-      cached_fiber_table(".weft-cache", load_fiber_spec(fiber), o, progress));
+      cached_fiber_table(".weft-cache", load_fiber_spec(fiber), o, progress, nullptr, [&] {
+        check_fiber_bake(o, kNumBands, {fiber, "--fiber", "--fiber"});
+      }));
 }
 
 WovenSample woven_sample(const BakeFabricOptions& o) {
@@ -87,6 +89,33 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
   return r;
 }
 
+// The work's time from a lower bound of its rate, before any (check_long_work): particles of the
+// ray trace, direction pairs of a summation.
+void check_fabric_work(const BakeFabricOptions& o) {
+  if (o.method == "raytrace") {
+    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
+    const UnitRange r =
+        shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"));
+    const uint64_t per_bin = o.samples.value_or(FabricRaytraceOptions{}.particles_per_bin);
+    check_long_work(double(r.last - r.first) * double(per_bin), kMinSecondsPerFabricParticle,
+                    o.threads, "", "--samples",
+                    "a ray trace of " + std::to_string(r.last - r.first) + " incident bins x " +
+                        std::to_string(per_bin) + " particles",
+                    "0.25 us per particle per core at least");
+  } else {
+    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
+    const uint64_t per_cell = o.samples.value_or(FabricSummationOptions{}.samples_per_cell);
+    const bool visible = o.method == "summation-visible";
+    check_long_work(double(bins * bins) * double(per_cell),
+                    visible ? kMinSecondsPerVisiblePair : kMinSecondsPerPaperPair, o.threads, "",
+                    "--samples",
+                    "a " + o.method + " of " + std::to_string(bins * bins) + " cell pairs x " +
+                        std::to_string(per_cell) + " direction pairs",
+                    visible ? "5 us per direction pair per core at least"
+                            : "0.1 us per direction pair per core at least");
+  }
+}
+
 int run(const BakeFabricOptions& o) {
   if ((!o.shard.empty() || o.resume) && o.method != "raytrace")
     throw Error("", "--shard", "--shard and --resume need --method raytrace");
@@ -112,17 +141,7 @@ int run(const BakeFabricOptions& o) {
                          {".weft-cache", "fiber-table bake cache"}});
   if (std::filesystem::path(o.output).extension() != ".exr" && o.shard.empty())
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
-  if (o.method == "raytrace") {
-    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
-    const UnitRange r =
-        shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"));
-    const uint64_t per_bin = o.samples.value_or(FabricRaytraceOptions{}.particles_per_bin);
-    check_long_work(double(r.last - r.first) * double(per_bin), kMinSecondsPerFabricParticle,
-                    o.threads, "", "--samples",
-                    "a ray trace of " + std::to_string(r.last - r.first) + " incident bins x " +
-                        std::to_string(per_bin) + " particles",
-                    "0.25 us per particle per core at least");
-  }
+  check_fabric_work(o);
   const auto progress = progress_bar(o.quiet);
   const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
   const WovenSample sample = woven_sample(o);
@@ -266,6 +285,5 @@ int merge_fabric_bake(const JobPart& all, const std::string& output, bool json) 
                 output.c_str(), t.resolution, r.relative_noise);
   return 0;
 }
-
 
 }  // namespace weft::cli

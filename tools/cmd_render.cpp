@@ -10,8 +10,8 @@
 #include "commands.h"
 #include "weft/core/error.h"
 #include "weft/core/progress.h"
-#include "weft/integrators/render_job.h"
 #include "weft/fiber/bake_cache.h"
+#include "weft/integrators/render_job.h"
 #include "weft/scenes/description.h"
 
 namespace weft::cli {
@@ -169,7 +169,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
          }
          const auto t0 = std::chrono::steady_clock::now();
          const RenderJobResult r =
-             render_to_files(desc, job, progress_bar(o->quiet), fiber_table_resolver());
+             render_to_files(desc, job, progress_bar(o->quiet), checked_fiber_table_resolver());
          const double sec =
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
          if (const int code = report_render_outcome(r, "render")) return code;

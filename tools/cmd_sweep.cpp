@@ -8,12 +8,12 @@
 #include <sstream>
 
 #include "commands.h"
-#include "weft/core/job_part.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
-#include "weft/integrators/gonio.h"
+#include "weft/core/job_part.h"
 #include "weft/fiber/bake_cache.h"
+#include "weft/integrators/gonio.h"
 #include "weft/scenes/description.h"
 
 namespace weft::cli {
@@ -272,7 +272,7 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
            };
          GonioResult r;
          if (!partial || !todo.empty()) {
-           r = run_gonio(desc, g, progress_bar(o->quiet), fiber_table_resolver(), on_unit);
+           r = run_gonio(desc, g, progress_bar(o->quiet), checked_fiber_table_resolver(), on_unit);
            if (const int code = report_render_outcome(r, "sweep")) return code;
          }
          if (!shard.whole()) {

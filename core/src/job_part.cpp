@@ -30,8 +30,9 @@ Shard parse_shard(const std::string& text, const std::string& option_name) {
   };
   if (slash == std::string::npos) throw Error("", option_name, "'" + text + "' is not K/N");
   const uint64_t k = whole_number(text.substr(0, slash)), n = whole_number(text.substr(slash + 1));
-  if (n < 1 || k >= n || n > 100000)
-    throw Error("", option_name, "'" + text + "' needs 0 <= K < N <= 100000");
+  if (n < 1 || k >= n || n > kMaxShards)
+    throw Error("", option_name,
+                "'" + text + "' needs 0 <= K < N <= " + std::to_string(kMaxShards));
   return {static_cast<uint32_t>(k), static_cast<uint32_t>(n)};
 }
 
@@ -100,8 +101,20 @@ JobPart read_job_part(const std::filesystem::path& path) {
     p.job = h.at("job");
     p.units_total = h.at("units_total").get<uint64_t>();
     p.shard = {h.at("shard").get<uint32_t>(), h.at("shards").get<uint32_t>()};
+    // The counts before anything is sized or looped over by them.
+    if (p.units_total > kMaxJobUnits)
+      throw Error(file, "units_total",
+                  std::to_string(p.units_total) + " is more than a job has (at most " +
+                      std::to_string(kMaxJobUnits) + ")");
+    if (p.shard.count > kMaxShards)
+      throw Error(file, "shards",
+                  std::to_string(p.shard.count) + " is more than a job is cut into (at most " +
+                      std::to_string(kMaxShards) + ")");
     p.checkpoint = h.at("checkpoint").get<bool>();
     p.extra = h.at("extra");
+    // A unit is listed once at most: a longer list is refused before it is converted.
+    if (h.at("units").size() > p.units_total || h.at("unit_doubles").size() > p.units_total)
+      throw Error(file, "units", "lists more units than units_total");
     const auto units = h.at("units").get<std::vector<uint64_t>>();
     const auto sizes = h.at("unit_doubles").get<std::vector<uint64_t>>();
     if (units.size() != sizes.size()) throw Error(file, "units", "does not match unit_doubles");
@@ -231,12 +244,19 @@ JobPart merge_job_parts(const std::vector<std::filesystem::path>& paths) {
       all.units.emplace(u, std::move(v));
     }
   }
+  // The first few missing shards by name, the rest counted (up to kMaxShards of them).
   std::string missing;
-  for (uint32_t k = 0; k < all.shard.count; ++k)
-    if (!shards_seen.count(k) && shard_units(all.units_total, {k, all.shard.count}).last >
-                                     shard_units(all.units_total, {k, all.shard.count}).first)
+  uint32_t more = 0;
+  for (uint32_t k = 0; k < all.shard.count; ++k) {
+    const UnitRange r = shard_units(all.units_total, {k, all.shard.count});
+    if (shards_seen.count(k) || r.last == r.first) continue;
+    if (missing.size() < 80)
       missing +=
           (missing.empty() ? "" : ", ") + std::to_string(k) + "/" + std::to_string(all.shard.count);
+    else
+      ++more;
+  }
+  if (more > 0) missing += " and " + std::to_string(more) + " more";
   if (!missing.empty()) throw Error("", "parts", "incomplete: missing shard " + missing);
   return all;
 }

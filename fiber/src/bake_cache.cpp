@@ -107,10 +107,12 @@ class FileLock {
 
 std::filesystem::path cached_fiber_table(const std::filesystem::path& dir, const FiberSpec& spec,
                                          const FiberTableBakeOptions& options,
-                                         const ProgressCallback& progress, bool* baked) {
+                                         const ProgressCallback& progress, bool* baked,
+                                         const std::function<void()>& before_bake) {
   if (baked) *baked = false;
   const std::filesystem::path file = fiber_table_cache_file(dir, spec, options);
   if (usable(file)) return file;
+  if (before_bake) before_bake();
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error(dir.string(), "", "cannot create the bake cache folder: " + ec.message());
@@ -126,8 +128,8 @@ std::filesystem::path cached_fiber_table(const std::filesystem::path& dir, const
   return file;
 }
 
-FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir) {
-  return [cache_dir](ParamReader& p, const MaterialContext& ctx) {
+FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir, FiberBakeCheck check) {
+  return [cache_dir, check](ParamReader& p, const MaterialContext& ctx) {
     const std::string name = p.string("spec");
     std::filesystem::path spec_path = name;
     std::error_code ec;
@@ -147,9 +149,17 @@ FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir) {
     o.photons_per_band = p.count("photons", defaults.photons_per_band, 1, kMaxPhotonsPerBand);
     o.seed = p.count("seed", defaults.seed, 0, uint64_t{1} << 53);
     const std::filesystem::path dir = cache_dir.empty() ? ctx.base_dir / ".weft-cache" : cache_dir;
+    bool refused = false;  // the check names its own fields
+    const auto before_bake = [&] {
+      if (!check) return;
+      refused = true;
+      check(o, {p.file(), p.field("photons"), p.field("resolution")});
+      refused = false;
+    };
     try {
-      return cached_fiber_table(dir, spec, o, ctx.progress);
+      return cached_fiber_table(dir, spec, o, ctx.progress, nullptr, before_bake);
     } catch (const Error& e) {
+      if (refused) throw;
       throw Error(p.file(), p.field("spec"), e.what());
     }
   };

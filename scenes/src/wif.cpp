@@ -7,8 +7,10 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <unordered_set>
 
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 
 namespace weft {
 namespace {
@@ -20,6 +22,7 @@ struct Entry {
 };
 struct Section {
   std::vector<Entry> entries;
+  std::unordered_set<std::string> keys;  // of 'entries': a duplicate found in constant time
   int line = 0;
 };
 
@@ -163,6 +166,9 @@ class Draft {
         current = normalize_name(std::string_view(line).substr(1, line.size() - 2));
         if (sections_.count(current))
           throw Error(source_, "[" + current + "]", "section appears twice");
+        if (sections_.size() >= kWifMaxSections)
+          throw Error(source_, "[" + current + "]",
+                      "more than " + std::to_string(kWifMaxSections) + " sections");
         sections_[current].line = line_no;
         continue;
       }
@@ -174,14 +180,21 @@ class Draft {
       Entry e{normalize_name(std::string_view(line).substr(0, eq)), trim(line.substr(eq + 1)),
               line_no};
       Section& s = sections_[current];
-      for (const Entry& o : s.entries)
-        if (o.key == e.key) throw Error(source_, "[" + current + "] " + e.key, "key appears twice");
+      const bool section_full = s.entries.size() >= kWifMaxSectionKeys;
+      if (section_full || ++keys_ > kWifMaxKeys)
+        throw Error(source_, "[" + current + "] " + e.key,
+                    section_full
+                        ? "more than " + std::to_string(kWifMaxSectionKeys) + " keys in the section"
+                        : "more than " + std::to_string(kWifMaxKeys) + " keys in the file");
+      if (!s.keys.insert(e.key).second)
+        throw Error(source_, "[" + current + "] " + e.key, "key appears twice");
       s.entries.push_back(std::move(e));
     }
   }
 
   std::string source_;
   std::map<std::string, Section> sections_;
+  size_t keys_ = 0;  // over every section
 };
 
 double unit_mm(const Draft& d, const std::string& sec) {
@@ -245,7 +258,13 @@ std::vector<WifThread> read_threads(const Draft& d, const std::string& dir, cons
   const double mm = unit_mm(d, dir);
   auto length = [&](const std::string& sec, const std::string& key, const std::string& text) {
     if (mm == 0) d.fail(dir, "UNITS", "is required when lengths are given");
-    return mm * d.number(sec, key, text, 1e-9, 1e9);
+    const double v = mm * d.number(sec, key, text, 1e-9, 1e9);
+    if (v < kWifMinThreadMm)
+      d.fail(sec, key,
+             trim(text) + " (" + ParamReader::fmt(v * 1e3) + " um) is thinner than one fiber (" +
+                 ParamReader::fmt(kWifMinThreadMm * 1e3) +
+                 " um; the finest textile fibers are a few um across)");
+    return v;
   };
   WifThread base;
   if (const auto v = d.value(dir, "SPACING")) base.spacing_mm = length(dir, "SPACING", *v);
@@ -278,6 +297,10 @@ std::vector<WifThread> read_threads(const Draft& d, const std::string& dir, cons
 
 WifDraft parse_wif(std::string_view text, const std::string& source) {
   if (text.size() > kWifMaxFileBytes) throw Error(source, "", "file is larger than 64 MiB");
+  if (const size_t nul = text.find('\0'); nul != std::string_view::npos)
+    throw Error(source,
+                "line " + std::to_string(1 + std::count(text.begin(), text.begin() + nul, '\n')),
+                "a NUL byte (at byte " + std::to_string(nul) + "): a WIF draft is a text file");
   const Draft d(text, source);
   WifDraft w;
   w.source = source;
@@ -375,6 +398,14 @@ Interlacing WifDraft::interlacing() const {
       m.warp_over[static_cast<size_t>(j) * m.warps + i] = (up == rising_shed) ? 1 : 0;
     }
   }
+  // Every crossing on one side: no thread interlaces, the cloth is two loose layers.
+  const auto first = m.warp_over.begin();
+  if (!m.warp_over.empty() &&
+      std::all_of(first, m.warp_over.end(), [&](uint8_t o) { return o == *first; }))
+    throw Error(source, weft_source == "LIFTPLAN" ? "[LIFTPLAN]" : "[TIEUP]",
+                std::string("no thread interlaces: every warp lies ") +
+                    (*first ? "over" : "under") +
+                    " every pick (with this [THREADING]), so the cloth would be two loose layers");
   return m;
 }
 

@@ -3,9 +3,12 @@
 // are errors naming the file, section and key. Expected values are read off the draft files.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 
+#include "mutate.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/rng.h"
@@ -241,6 +244,87 @@ TEST(Wif, MutatedDraftsAreErrorsOrDraftsNeverCrashes) {
       ++refused;
     }
   }
+  EXPECT_GT(parsed, 0);
+  EXPECT_GT(refused, 0);
+}
+
+// A section of many keys is scanned for duplicates in linear time: 65 536 distinct keys (the
+// per-section limit, kWifMaxSectionKeys) took minutes with a pairwise scan; one more key is refused
+// with the section and key named, and so is a duplicate at the end of a long section.
+TEST(Wif, ManyKeysAreLinearAndBounded) {
+  std::string keys;  // K2 .. K65536; K1 is added below, as is one key too many
+  for (size_t k = 2; k <= kWifMaxSectionKeys; ++k) keys += "K" + std::to_string(k) + "=1\n";
+  const std::string full = kSmall + "[PRIVATE]\nK1=1\n" + keys;
+  const auto t0 = std::chrono::steady_clock::now();
+  EXPECT_EQ(parse_wif(full, "many.wif").warp.size(), 4u);
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+  const std::string e = error_of(kSmall + "[PRIVATE]\nK0=1\nK1=1\n" + keys);
+  EXPECT_NE(e.find("[PRIVATE] K" + std::to_string(kWifMaxSectionKeys) + "'"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("keys in the section"), std::string::npos) << e;
+  const std::string twice = error_of(kSmall + "[PRIVATE]\nK65536=2\n" + keys);
+  EXPECT_NE(twice.find("[PRIVATE] K65536': key appears twice"), std::string::npos) << twice;
+  // Sections are bounded too (each is a map entry).
+  std::string sections;
+  for (size_t k = 0; k <= kWifMaxSections; ++k) sections += "[S" + std::to_string(k) + "]\n";
+  EXPECT_NE(error_of(sections + kSmall).find("more than 1024 sections"), std::string::npos);
+}
+
+// A NUL byte (a binary file renamed .wif), a thread thinner than a fiber and a draft where no
+// thread interlaces are refused, naming the file and the field.
+TEST(Wif, BinaryThinAndUninterlacedDraftsAreRefused) {
+  std::string nul = kSmall;
+  nul[kSmall.find("Shafts")] = '\0';
+  EXPECT_NE(error_of(nul).find("draft.wif: field 'line 5': a NUL byte"), std::string::npos)
+      << error_of(nul);
+  // 1e-9 cm = 1e-5 um; the per-thread override is checked the same way.
+  using Case = std::tuple<std::string, std::string, std::string>;
+  for (const auto& [from, to, field] :
+       {Case{"Spacing=0.25", "Spacing=1e-9", "[WARP] SPACING"},
+        Case{"Units=Inches\nSpacing=0.01", "Units=Centimeters\nSpacing=1e-9", "[WEFT] SPACING"},
+        Case{"Thickness=0.008", "Thickness=0.00001", "[WEFT] THICKNESS"},
+        Case{"[THREADING]", "[WEFT SPACING]\n2=0.00000001\n[THREADING]", "[WEFT SPACING] 2"}}) {
+    const std::string e = error_of(replace(kSmall, from, to));
+    EXPECT_NE(e.find("draft.wif: field '" + field + "'"), std::string::npos) << to << ": " << e;
+    EXPECT_NE(e.find("thinner than one fiber"), std::string::npos) << to << ": " << e;
+  }
+  // 1 um (kWifMinThreadMm) is still a thread.
+  EXPECT_NO_THROW(parse_wif(replace(kSmall, "Spacing=0.25", "Spacing=0.001"), "a.wif"));
+  // A tie-up that lifts nothing (every warp under every pick), one that lifts every shaft on
+  // every pick (every warp over), and a lift plan that lifts nothing.
+  const std::string tie = "1=1,2\n2=2,3\n3=3,4\n4=4,1\n";
+  const std::string none = replace(kSmall, tie, "1=\n2=\n3=\n4=\n");
+  const std::string all = replace(kSmall, tie, "1=1,2,3,4\n2=1,2,3,4\n3=1,2,3,4\n4=1,2,3,4\n");
+  const std::string lift_none =
+      kSmall.substr(0, kSmall.find("[TIEUP]")) + "[LIFTPLAN]\n1=\n2=\n3=\n4=\n";
+  for (const auto& [text, field, side] :
+       {Case{none, "[TIEUP]", "under"}, Case{all, "[TIEUP]", "over"},
+        Case{lift_none, "[LIFTPLAN]", "under"}}) {
+    const std::string e =
+        weft::testing::error_of([&] { parse_wif(text, "draft.wif").interlacing(); });
+    EXPECT_NE(e.find("draft.wif: field '" + field + "': no thread interlaces"), std::string::npos)
+        << e;
+    EXPECT_NE(e.find("every warp lies " + side), std::string::npos) << e;
+  }
+}
+
+// Random byte edits (any byte, NUL and non-ASCII included) of the small draft and of the bundled
+// 8452.wif, seeded: every mutant parses and interlaces, or is refused with a weft::Error naming it.
+TEST(Wif, ByteMutationsAreErrorsOrDraftsNeverCrashes) {
+  Rng rng(20261203);
+  int parsed = 0, refused = 0;
+  for (const std::string& valid : {kSmall, weft::testing::slurp(kWif / "8452.wif")})
+    for (int trial = 0; trial < 1000; ++trial) {
+      const std::string text = weft::testing::mutated(valid, rng);
+      try {
+        const WifDraft d = parse_wif(text, "mutant.wif");
+        EXPECT_EQ(d.interlacing().warp_over.size(), d.warp.size() * d.weft.size());
+        ++parsed;
+      } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("mutant.wif"), std::string::npos) << e.what();
+        ++refused;
+      }
+    }
   EXPECT_GT(parsed, 0);
   EXPECT_GT(refused, 0);
 }

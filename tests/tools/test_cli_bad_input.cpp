@@ -4,11 +4,13 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "cli_run.h"
 #include "test_util.h"
@@ -371,4 +373,73 @@ TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
   EXPECT_EQ(
       run("--max-memory-gb 0.05 table bake lambert -R 2 --spp 1 -o out.exr --quiet", dir).exit_code,
       0);
+}
+
+namespace {
+
+// What is in 'dir' besides the run's stdout and stderr and the inputs 'kept'.
+std::vector<std::string> left_behind(const fs::path& dir, const std::vector<std::string>& kept) {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name != "stdout" && name != "stderr" &&
+        std::find(kept.begin(), kept.end(), name) == kept.end())
+      out.push_back(name);
+  }
+  return out;
+}
+
+}  // namespace
+
+// A measured table of a million incidences (26 MB) made `weft verify` run for minutes and abort
+// with std::bad_alloc; one past the limit of measured.h (180 incidences) is refused at once,
+// naming the file and the row, before any staging folder or bake cache exists.
+TEST(CliBadInput, HugeOrDegenerateMeasuredTableIsRefusedBeforeAnyWork) {
+  const fs::path dir = fresh_test_dir();
+  std::string table = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n";
+  for (int i = 0; i <= 180; ++i) table += std::to_string(i * 0.25) + ",0,0.1,0.1,0.1\n";
+  write(dir / "m.csv", table);
+  expect_error(run("verify --measured m.csv --quality draft -o rep", dir),
+               {"m.csv: field 'line 182 theta_i_deg'", "more than 180 incidences"}, dir / "rep");
+  EXPECT_EQ(slurp(dir / "m.csv"), table);
+  EXPECT_EQ(left_behind(dir, {"m.csv"}), std::vector<std::string>{});
+  write(dir / "m.csv",
+        "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n"
+        "0,0,0.1,1e300,0.1\n");
+  expect_error(run("verify --measured m.csv --quality draft -o rep", dir),
+               {"m.csv: field 'line 2 nbrdf_beta_G'", "absurd"}, dir / "rep");
+  EXPECT_EQ(left_behind(dir, {"m.csv"}), std::vector<std::string>{});
+}
+
+// A scene's fiber_table named by a spec is baked on first use (bake_cache.h); 10^12 photons per
+// band ran with no estimate. Now the bake on first use takes the checks of `weft bake fiber`
+// (33 bands x 10^12 photons at >= 0.5 us each: years): refused without --yes-long, naming the
+// scene and the material's photons field, before the bake cache exists. The same for a sweep.
+TEST(CliBadInput, BakeOnFirstUseNeedsConfirmationLikeADirectBake) {
+  const fs::path dir = fresh_test_dir();
+  const std::string scene = replaced(
+      slurp(kPlane), R"({"type": "lambert", "params": {"reflectance": 0.5}})",
+      R"({"type": "fiber_table", "params": {"spec": "red-cotton", "photons": 1000000000000}})");
+  write(dir / "scene.json",
+        replaced(scene, "lambert-plane.gltf", kExamples + "/lambert-plane.gltf"));
+  for (const std::string output : {"t.exr", "t.csv"}) {
+    const std::string command = (output == "t.exr" ? "render" : "sweep");
+    expect_error(run(command + " scene.json -o " + output, dir),
+                 {"scene.json", "materials.plane.params.photons", "1000000000000 photons per band",
+                  "would take at least", "--yes-long"},
+                 dir / output);
+    EXPECT_FALSE(fs::exists(dir / ".weft-cache")) << command;
+  }
+}
+
+// A summation-visible table at R = 32 with 4096 direction pairs per cell pair: 2048^2 x 4096 =
+// 1.7e10 pairs at >= 5 us each (fabric_summation.h kMinSecondsPerVisiblePair; measured 26 us)
+// ran with no estimate; now it is refused before the fiber table is baked.
+TEST(CliBadInput, LongSummationNeedsConfirmation) {
+  const fs::path dir = fresh_test_dir();
+  expect_error(run("bake fabric --method summation-visible -R 32 --samples 4096 -o t.exr", dir),
+               {"--samples", "a summation-visible of 4194304 cell pairs x 4096 direction pairs",
+                "would take at least", "5 us per direction pair", "--yes-long"},
+               dir / "t.exr");
+  EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
 }

@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 
+#include "mutate.h"
 #include "test_util.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/math.h"
@@ -131,6 +133,71 @@ TEST(VerifyMeasured, BadTablesNameFileAndField) {
   }
   EXPECT_NE(error_of([&] { read_measured_inplane(dir / "missing.csv"); }).find("missing.csv"),
             std::string::npos);
+}
+
+// Hostile tables are refused with the file and the field, and the huge ones before they are held
+// in memory: one past each limit of measured.h, the first row past it named.
+TEST(VerifyMeasured, HugeOrDegenerateTablesAreRefused) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path p = dir / "hostile.csv";
+  const std::string head = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n";
+  const auto refused = [&](const std::string& text, const std::string& part) {
+    write_text_atomically(p, text);
+    const std::string e = error_of([&] { read_measured_inplane(p); });
+    EXPECT_NE(e.find(p.string()), std::string::npos) << e;
+    EXPECT_NE(e.find(part), std::string::npos) << part << " -> " << e;
+  };
+  // One incidence too many (distinct theta_i in [0, 90)), one view too many at one incidence.
+  std::string incidences = head, views = head;
+  for (size_t i = 0; i <= kMaxMeasuredIncidences; ++i)
+    incidences += std::to_string(i * 0.25) + ",0,1,1,1\n";
+  for (size_t v = 0; v <= kMaxMeasuredViews; ++v)
+    views += "0," + std::to_string(-89.75 + v * 0.25) + ",1,1,1\n";
+  refused(incidences, "line " + std::to_string(kMaxMeasuredIncidences + 2) + " theta_i_deg");
+  refused(incidences, "incidences");
+  refused(views, "line " + std::to_string(kMaxMeasuredViews + 2) + " theta_o_deg");
+  // Absurd, non-finite and negative values, and a channel of zeros at every row.
+  refused(head + "0,0,1,1e300,1\n", "line 2 nbrdf_beta_G");
+  refused(head + "0,0,1,1e300,1\n", "absurd");
+  refused(head + "0,0,inf,1,1\n", "line 2 nbrdf_beta_R");
+  refused(head + "0,0,1,1,nan\n", "line 2 nbrdf_beta_B");
+  refused(head + "0,0,-1e300,1,1\n", "line 2 nbrdf_beta_R");
+  refused(head + "0,0,0,0,0\n10,0,0,0,0\n", "nbrdf_beta_R");
+  refused(head + "0,0,1,0,1\n10,0,1,0,1\n", "field 'nbrdf_beta_G': zero at every row");
+  // A file over the size limit is refused before a byte of it is read (a sparse file: instant).
+  write_text_atomically(p, head + "0,0,1,1,1\n");
+  fs::resize_file(p, kMaxMeasuredBytes + 1);
+  const std::string e = error_of([&] { read_measured_inplane(p); });
+  EXPECT_NE(e.find(p.string() + ": field 'size'"), std::string::npos) << e;
+  // A single zero among positive values is a measurement (the bundled purple felt has zeros).
+  write_text_atomically(p, head + "0,0,1,0,1\n10,0,1,1,1\n");
+  EXPECT_EQ(read_measured_inplane(p).curves.size(), 2u);
+}
+
+// Random byte edits of the bundled table's first 40 rows (comment lines, header and numbers),
+// seeded: every mutant is read or refused with a weft::Error naming the file.
+TEST(VerifyMeasured, ByteMutationsAreReadOrRefusedNeverCrash) {
+  const fs::path dir = fresh_test_dir();
+  const std::string whole = testing::slurp(bundled_measured_inplane());
+  size_t cut = 0;
+  for (int line = 0; line < 43; ++line) cut = whole.find('\n', cut) + 1;
+  const std::string valid = whole.substr(0, cut);
+  Rng rng(20261203);
+  int read = 0, refused = 0;
+  const fs::path p = dir / "mutant.csv";
+  for (int trial = 0; trial < 200; ++trial) {
+    std::ofstream(p, std::ios::binary | std::ios::trunc) << testing::mutated(valid, rng);
+    try {
+      const MeasuredInplane m = read_measured_inplane(p);
+      EXPECT_FALSE(m.curves.empty());
+      ++read;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(p.string()), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(read, 0);
+  EXPECT_GT(refused, 0);
 }
 
 }  // namespace

@@ -7,6 +7,7 @@
 #include <optional>
 #include <utility>
 
+#include "common.h"
 #include "weft/core/error.h"
 #include "weft/core/install_paths.h"
 #include "weft/core/math.h"
@@ -113,13 +114,54 @@ void read_row(const std::vector<std::string>& f, const Columns& col, const std::
       const double v = parse_number(f[col.fit_at[j][k]], file, field);
       if (v < 0) throw Error(file, field, "a radiance coefficient is >= 0");
       b[k] = v * col.fit_scale[j];
+      if (b[k] > kMaxMeasuredBeta)
+        throw Error(file, field,
+                    "beta " + f[col.fit_at[j][k]] + " is absurd (above " + fmt(kMaxMeasuredBeta) +
+                        "; a fabric's is of order 1): a unit or export error?");
     }
     betas.push_back(b);
   }
+  // The limits before the row is stored, so that a huge table is refused as soon as it passes
+  // them instead of being held in memory first.
+  const auto at = rows.find(ti);
+  if (at == rows.end() && rows.size() >= kMaxMeasuredIncidences)
+    throw Error(file, where + " theta_i_deg",
+                "more than " + std::to_string(kMaxMeasuredIncidences) +
+                    " incidences (the limit of a measured table)");
+  if (at != rows.end() && at->second.size() >= kMaxMeasuredViews)
+    throw Error(file, where + " theta_o_deg",
+                "more than " + std::to_string(kMaxMeasuredViews) + " views at theta_i_deg " +
+                    fmt(ti, 6) + " (the limit of a measured table)");
   // The table's theta_o is negative on the mirror side, the paper's view positive (0.0 - x:
   // no negative zero).
   if (!rows[ti].emplace(0.0 - to, std::move(betas)).second)
     throw Error(file, where, "duplicate row for this (theta_i_deg, theta_o_deg)");
+}
+
+// A column that is zero at every row measured nothing (an empty export, a dark frame): every
+// comparison with it is undefined, so it is refused rather than scored.
+void check_not_all_zero(const Rows& rows, const Columns& col, const std::string& file) {
+  for (size_t j = 0; j < col.fit_at.size(); ++j)
+    for (int k = 0; k < 3; ++k) {
+      bool any = false;
+      for (const auto& [ti, views] : rows)
+        for (const auto& [v, b] : views) any = any || b[j][k] > 0;
+      if (!any)
+        throw Error(file, col.fit_columns[j][k],
+                    "zero at every row: nothing was measured in this channel");
+    }
+}
+
+// The size on disk before any of it is read.
+void check_file_size(const std::filesystem::path& path, const std::string& file) {
+  std::error_code ec;
+  const uintmax_t bytes = std::filesystem::file_size(path, ec);
+  if (!ec && bytes > kMaxMeasuredBytes)
+    throw Error(file, "size",
+                std::to_string(bytes) + " bytes; a measured in-plane table is at most " +
+                    std::to_string(kMaxMeasuredBytes >> 20) + " MiB (" +
+                    std::to_string(kMaxMeasuredIncidences) + " incidences of " +
+                    std::to_string(kMaxMeasuredViews) + " views)");
 }
 
 MeasuredInplane measured_from_rows(const Rows& rows, const Columns& col, const std::string& file) {
@@ -144,6 +186,7 @@ MeasuredInplane measured_from_rows(const Rows& rows, const Columns& col, const s
 
 MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
   const std::string file = path.string();
+  check_file_size(path, file);
   std::ifstream in(path);
   if (!in) throw Error(file, "", "cannot open the measured in-plane table");
   std::string line;
@@ -177,6 +220,7 @@ MeasuredInplane read_measured_inplane(const std::filesystem::path& path) {
     read_row(f, col, file, where, rows);
   }
   if (rows.empty()) throw Error(file, "", "no data rows");
+  check_not_all_zero(rows, col, file);
   MeasuredInplane m = measured_from_rows(rows, col, file);
   m.colour_space = space.value_or(MeasuredColourSpace::kUnknown);
   return m;

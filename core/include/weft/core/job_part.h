@@ -17,7 +17,13 @@
 
 namespace weft {
 
-// "K/N" with 0 <= K < N: the shard option of a command.
+// The most shards a job is cut into, and the most units a job has (a ray-traced fabric table has
+// 2048 bins at most, a sweep 100 001 views, verify's traces x bins some 10^5): a part file's counts
+// are checked against them before anything is sized or looped over by them.
+inline constexpr uint32_t kMaxShards = 100000;
+inline constexpr uint64_t kMaxJobUnits = uint64_t{1} << 24;
+
+// "K/N" with 0 <= K < N <= kMaxShards: the shard option of a command.
 struct Shard {
   uint32_t index = 0, count = 1;
   bool whole() const { return count == 1; }
@@ -45,8 +51,9 @@ struct JobPart {
 
 // Written atomically (core/atomic_file.h).
 void write_job_part(const std::filesystem::path& path, const JobPart& part);
-// Checks the magic line, the header's fields and that the payload has exactly the doubles the
-// header promises before allocating them; weft::Error naming the file and field otherwise.
+// Checks the magic line, the header's fields (units_total <= kMaxJobUnits, shards <= kMaxShards)
+// and that the payload has exactly the doubles the header promises before allocating them;
+// weft::Error naming the file and field otherwise.
 JobPart read_job_part(const std::filesystem::path& path);
 
 // Appends / reads raw values of a unit's payload with their exact bits.
@@ -70,9 +77,9 @@ nlohmann::json input_file_hashes(const std::vector<std::filesystem::path>& files
 // refusal ("the content of scene.gltf differs", "setting 'spp' differs"); "" when they agree.
 std::string job_difference(const JobPart& then, const JobPart& now);
 
-// Merges parts: all of one job, disjoint, together complete (a missing shard is named);
-// weft::Error naming the file otherwise. Returns the job (header of the first part) with every
-// unit.
+// Merges parts: all of one job, disjoint, together complete (the first missing shards are
+// named); weft::Error naming the file otherwise (a part of another job: the file and "job").
+// Returns the job (header of the first part) with every unit.
 JobPart merge_job_parts(const std::vector<std::filesystem::path>& paths);
 
 }  // namespace weft

@@ -57,6 +57,14 @@ struct FabricSummationOptions {
   void validate() const;  // weft::Error naming the field
 };
 
+// Lower bounds on the CPU time of one direction pair of a summation table (R = DirectionGrid
+// resolution: (2 R^2)^2 cell pairs x samples_per_cell pairs), seconds, for a front end's estimate
+// before it starts. PERFORMANCE.md's fabric tables (R = 8, 8 samples: 131 072 pairs, 2 threads):
+// the paper's summation 0.035 s, 0.53 us per pair per core; summation-visible 1.72 s, 26 us (its
+// cost grows with the visible orientations, so a sample with fewer is cheaper): 0.1 and 5 us.
+inline constexpr double kMinSecondsPerPaperPair = 0.1e-6;
+inline constexpr double kMinSecondsPerVisiblePair = 5e-6;
+
 // The fabric table (kind "fabric", the fiber table's channels) from a fiber table.
 TabulatedBsdfTable sum_fabric_table(const TabulatedBsdfTable& fiber,
                                     const FabricSummationOptions& options,

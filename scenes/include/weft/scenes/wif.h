@@ -14,7 +14,9 @@
 // its shafts is listed. Every thread 1..Threads must appear exactly once in THREADING and in
 // TREADLING/LIFTPLAN (an empty value means no shaft / no treadle); a treadle missing from TIEUP
 // lifts nothing. Every problem is a weft::Error naming the file, section and key; counts are
-// checked against limits before anything is sized by them.
+// checked against limits before anything is sized by them. Refused too: a NUL byte (not a text
+// file), a spacing or thickness below kWifMinThreadMm, and a draft where no thread interlaces
+// (interlacing(): every crossing on one side).
 #include <array>
 #include <filesystem>
 #include <string>
@@ -49,6 +51,11 @@ inline constexpr int kWifMaxThreads = 20000;  // per direction
 inline constexpr int kWifMaxShafts = 4096;    // and treadles
 inline constexpr double kWifMaxCells = 2e7;   // warp threads x picks (the matrix)
 inline constexpr size_t kWifMaxFileBytes = 64 << 20;
+inline constexpr size_t kWifMaxSections = 1024;
+inline constexpr size_t kWifMaxSectionKeys = 1 << 16;  // [COLOR TABLE] has up to 65536 entries
+inline constexpr size_t kWifMaxKeys = 1 << 20;         // in the whole file
+// A spacing or thickness below this is thinner than one fiber (a unit or export error).
+inline constexpr double kWifMinThreadMm = 1e-3;
 
 // 'source' names the text in errors.
 WifDraft parse_wif(std::string_view text, const std::string& source);

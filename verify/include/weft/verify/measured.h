@@ -1,5 +1,6 @@
 #pragma once
 // The measurement a verification compares against: a measured in-plane table (docs/verify.md).
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -54,13 +55,23 @@ struct MeasuredInplane {
 // others.
 std::vector<MeasuredFit> measured_fits(const MeasuredInplane& measured);
 
+// The limits of a measured table, checked before what they bound is read (a table of 0.5 degree
+// steps over the whole plane fits them): its size on disk, its incidences, its views per
+// incidence and its values (beta of a fabric is of order 1; the shiniest bundled satin peaks at
+// about 230).
+inline constexpr uintmax_t kMaxMeasuredBytes = 16u << 20;
+inline constexpr size_t kMaxMeasuredIncidences = 180;
+inline constexpr size_t kMaxMeasuredViews = 360;
+inline constexpr double kMaxMeasuredBeta = 1e6;
+
 // Reads a table in the format of materials/data/measured/*/inplane.csv: optional comment lines
 // starting with '#' or '"#' (one of them may be "# colour_space: camera|srgb"), a header naming at
 // least theta_i_deg, theta_o_deg, nbrdf_beta_R, nbrdf_beta_G, nbrdf_beta_B, and one row per
 // (theta_i, theta_o) with theta_o < 0 on the mirror side (that table's convention; flipped here).
 // The optional columns sgd_fr_R/G/B and abc_fr_R/G/B (each fit all three or none) are kept as
 // other_fits. weft::Error naming the file and the column (or line) on a missing file or column, a
-// non-number, a negative or non-finite beta, an angle out of range, or a duplicate row.
+// non-number, a negative, non-finite or absurd (> kMaxMeasuredBeta) beta, a column that is zero at
+// every row, an angle out of range, a duplicate row, or a table over the limits above.
 MeasuredInplane read_measured_inplane(const std::filesystem::path& path);
 
 // The bundled MERL red fabric (materials/data/measured/merl-red-fabric/inplane.csv), found in the

@@ -1,0 +1,145 @@
+// Part files of sharded jobs (core/job_part.h): crafted counts are refused before anything is sized
+// or looped over by them, and a part of another job (a stale part) is refused naming its file.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <fstream>
+#include <functional>
+#include <string>
+
+#include "mutate.h"
+#include "test_util.h"
+#include "weft/core/job_part.h"
+
+namespace fs = std::filesystem;
+using weft::testing::error_of;
+using weft::testing::fresh_test_dir;
+
+namespace weft {
+namespace {
+
+// A part file with the given header counts and no payload, as a hostile user writes one.
+fs::path crafted_part(const fs::path& dir, const std::string& name, uint64_t units_total,
+                      uint64_t shard, uint64_t shards) {
+  const nlohmann::json header = {{"command", "bake fiber"},
+                                 {"job", {{"seed", 1}}},
+                                 {"units_total", units_total},
+                                 {"shard", shard},
+                                 {"shards", shards},
+                                 {"checkpoint", false},
+                                 {"extra", nlohmann::json::object()},
+                                 {"units", nlohmann::json::array()},
+                                 {"unit_doubles", nlohmann::json::array()}};
+  const fs::path p = dir / name;
+  std::ofstream(p, std::ios::binary) << "WEFT-PART 1\n" << header.dump() << "\n";
+  return p;
+}
+
+double seconds_of(const std::function<void()>& f) {
+  const auto t0 = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// units_total 2^40 and 4e9 shards: the merge looped over every shard (and listed the missing ones
+// in a string of gigabytes); now both are refused as the header is read, naming the file and field.
+TEST(JobPart, CraftedCountsAreRefusedAsTheHeaderIsRead) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path units = crafted_part(dir, "units.part", uint64_t{1} << 40, 0, 1);
+  const fs::path shards = crafted_part(dir, "shards.part", 2, 0, 4000000000u);
+  std::string e;
+  EXPECT_LT(seconds_of([&] { e = error_of([&] { merge_job_parts({units}); }); }), 1.0);
+  EXPECT_NE(e.find(units.string() + ": field 'units_total'"), std::string::npos) << e;
+  EXPECT_LT(seconds_of([&] { e = error_of([&] { merge_job_parts({shards}); }); }), 1.0);
+  EXPECT_NE(e.find(shards.string() + ": field 'shards'"), std::string::npos) << e;
+  // A list of units longer than units_total is refused before it is converted.
+  const fs::path listed = dir / "listed.part";
+  nlohmann::json h = {{"command", "bake fiber"},
+                      {"job", {{"seed", 1}}},
+                      {"units_total", 2},
+                      {"shard", 0},
+                      {"shards", 1},
+                      {"checkpoint", false},
+                      {"extra", nlohmann::json::object()},
+                      {"units", {0, 1, 2}},
+                      {"unit_doubles", {0, 0, 0}}};
+  std::ofstream(listed, std::ios::binary) << "WEFT-PART 1\n" << h.dump() << "\n";
+  e = error_of([&] { read_job_part(listed); });
+  EXPECT_NE(e.find(listed.string() + ": field 'units': lists more units"), std::string::npos) << e;
+  // At both limits a part reads.
+  const fs::path empty = crafted_part(dir, "empty.part", kMaxJobUnits, 0, kMaxShards);
+  EXPECT_EQ(read_job_part(empty).units_total, kMaxJobUnits);
+}
+
+// A merge missing most of 100 000 shards names the first few and counts the rest.
+TEST(JobPart, MissingShardsAreNamedBriefly) {
+  const fs::path dir = fresh_test_dir();
+  JobPart p;
+  p.command = "bake fiber";
+  p.job = {{"seed", 1}};
+  p.units_total = kMaxShards;
+  p.shard = {0, kMaxShards};
+  p.units[0] = {1.0};
+  write_job_part(dir / "p0", p);
+  const std::string e = error_of([&] { merge_job_parts({dir / "p0"}); });
+  EXPECT_NE(e.find("missing shard 1/100000, 2/100000"), std::string::npos) << e;
+  EXPECT_NE(e.find(" more"), std::string::npos) << e;
+  EXPECT_LT(e.size(), 200u) << e;
+}
+
+// A part left from an earlier run with other settings (a stale part) is refused, naming its file,
+// the field 'job' and the setting that differs.
+TEST(JobPart, StalePartIsRefusedNamingItsFile) {
+  const fs::path dir = fresh_test_dir();
+  JobPart p;
+  p.command = "bake fiber";
+  p.job = {{"seed", 1}, {"photons", 100}};
+  p.units_total = 2;
+  p.shard = {0, 2};
+  p.units[0] = {1.0};
+  write_job_part(dir / "p0", p);
+  p.shard.index = 1;
+  p.units = {{1, {2.0}}};
+  write_job_part(dir / "p1", p);
+  EXPECT_EQ(merge_job_parts({dir / "p0", dir / "p1"}).units.size(), 2u);
+  p.job["photons"] = 200;
+  write_job_part(dir / "stale", p);
+  const std::string e = error_of([&] { merge_job_parts({dir / "p0", dir / "stale"}); });
+  EXPECT_NE(e.find((dir / "stale").string() + ": field 'job': belongs to another job"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("setting 'photons' differs"), std::string::npos) << e;
+}
+
+// Random byte edits of a valid part file (its magic line, JSON header and raw doubles), seeded:
+// every mutant is read or refused with a weft::Error naming the file.
+TEST(JobPart, ByteMutationsAreReadOrRefusedNeverCrash) {
+  const fs::path dir = fresh_test_dir();
+  JobPart p;
+  p.command = "bake fiber";
+  p.job = {{"seed", 1}, {"photons", 100}, {"name", "red-cotton"}};
+  p.units_total = 33;
+  p.shard = {1, 4};
+  for (uint64_t u = 8; u < 16; ++u) p.units[u] = {double(u), 0.5, -1.25};
+  write_job_part(dir / "valid", p);
+  const std::string valid = testing::slurp(dir / "valid");
+  Rng rng(20261203);
+  int read = 0, refused = 0;
+  const fs::path path = dir / "mutant.part";
+  for (int trial = 0; trial < 200; ++trial) {
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << testing::mutated(valid, rng);
+    try {
+      const JobPart m = read_job_part(path);
+      EXPECT_LE(m.units.size(), m.units_total);
+      ++read;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(path.string()), std::string::npos) << e.what();
+      ++refused;
+    }
+  }
+  EXPECT_GT(read, 0);
+  EXPECT_GT(refused, 0);
+}
+
+}  // namespace
+}  // namespace weft
