@@ -15,24 +15,42 @@ using weft::testing::error_of;
 namespace weft {
 namespace {
 
-TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
+// A small run on the bundled poplin at fiber detail: a grey fiber table of 'fiber_albedo', a
+// classic fiber of volume albedo 0.6, a flat measurement of 0.2 at normal incidence.
+struct SmallRun {
+  WovenSample sample;
+  VerifySettings settings;
+  VerifyInputs inputs;
+  MeasuredInplane measured;
+};
+
+SmallRun small_run(double fiber_albedo) {
   WeaveOptions w;
   w.detail = "fiber";
-  const WovenSample sample = make_woven_sample(overlay(red_cotton_weave_options(), w));
-  VerifySettings s = verify_settings(VerifyQuality::kDraft);
-  s.resolution = 2;
-  s.particles_per_bin = 200;
-  s.batches = 2;
+  SmallRun r{make_woven_sample(overlay(red_cotton_weave_options(), w)),
+             verify_settings(VerifyQuality::kDraft),
+             {},
+             {}};
+  r.settings.resolution = 2;
+  r.settings.particles_per_bin = 200;
+  r.settings.batches = 2;
+  r.settings.azimuths = 3;
+  r.inputs.fiber = constant_table(2, kNumBands, fiber_albedo);
+  r.inputs.volume_albedo.fill(0.6);
+  r.inputs.classic_distribution = {MicrofacetModel::kBeckmann, 0.35};
+  r.inputs.classic_ior = 1.557;
+  r.measured.file = "synthetic";
+  r.measured.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  return r;
+}
+
+TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
+  SmallRun run = small_run(0.2);
+  const WovenSample& sample = run.sample;
+  VerifySettings& s = run.settings;
   s.summation_samples = 2;
-  s.azimuths = 3;
-  VerifyInputs in;
-  in.fiber = constant_table(2, kNumBands, 0.2);
-  in.volume_albedo.fill(0.6);
-  in.classic_distribution = {MicrofacetModel::kBeckmann, 0.35};
-  in.classic_ior = 1.557;
-  MeasuredInplane m;
-  m.file = "synthetic";
-  m.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  const VerifyInputs& in = run.inputs;
+  MeasuredInplane& m = run.measured;
   m.curves.push_back({30, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
   std::string first;
   for (int threads : {1, 2}) {
@@ -79,24 +97,9 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
 // not exist there, so its figure is not defined (null in metrics.json) while the run and the
 // other model's figures go on (a deep dye at draft quality can empty that one bin in a channel).
 TEST(VerifyRun, PaperFigureNotDefinedWhereTheModelsNormalBinIsEmpty) {
-  WeaveOptions w;
-  w.detail = "fiber";
-  const WovenSample sample = make_woven_sample(overlay(red_cotton_weave_options(), w));
-  VerifySettings s = verify_settings(VerifyQuality::kDraft);
-  s.resolution = 2;
-  s.particles_per_bin = 200;
-  s.batches = 2;
-  s.azimuths = 3;
-  s.threads = 2;
-  VerifyInputs in;
-  in.fiber = constant_table(2, kNumBands, 0.0);
-  in.volume_albedo.fill(0.6);
-  in.classic_distribution = {MicrofacetModel::kBeckmann, 0.35};
-  in.classic_ior = 1.557;
-  MeasuredInplane m;
-  m.file = "synthetic";
-  m.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
-  const VerifyReport r = run_verify(sample, in, m, s);
+  SmallRun run = small_run(0.0);
+  run.settings.threads = 2;
+  const VerifyReport r = run_verify(run.sample, run.inputs, run.measured, run.settings);
   ASSERT_EQ(r.models.size(), 2u);
   const ModelCurves& computed = r.models[0];
   const ModelCurves& classic = r.models[1];
