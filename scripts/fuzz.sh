@@ -2,7 +2,8 @@
 # Builds the libFuzzer harnesses (tests/fuzz, clang with ASan/UBSan) and runs each for S seconds
 # (default 30) on its seeds: the bundled files of its format. A crash, a leak, an allocation
 # above 2 GB or an input taking more than 20 s fails the run; libFuzzer writes the input that did
-# it to ${WEFT_FUZZ_DIR}/artifacts. Usage: scripts/fuzz.sh [--seconds S] [--runs N] [harness...]
+# it to ${WEFT_FUZZ_DIR}/artifacts. Harnesses run WEFT_FUZZ_JOBS (default 2) at a time.
+# Usage: scripts/fuzz.sh [--seconds S] [--runs N] [harness...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=30
@@ -34,9 +35,19 @@ if ! command -v clang++ >/dev/null; then
   exit 0
 fi
 build=${WEFT_FUZZ_BUILD_DIR:-build-fuzz}
+# WEFT_FUZZ_TESTS names test programs to build in the same instrumented build and run before the
+# fuzzers (CI's sanitizer pass: the libraries are compiled once for both).
+read -r -a tests <<<"${WEFT_FUZZ_TESTS:-}"
+with_tests=OFF
+[ ${#tests[@]} -eq 0 ] || with_tests=ON
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DWEFT_FUZZ=ON -DWEFT_BUILD_TESTS=OFF -DWEFT_BUILD_BENCH=OFF >/dev/null
-cmake --build "$build" -j "${WEFT_JOBS:-2}" --target "${harnesses[@]}"
+  -DWEFT_FUZZ=ON -DWEFT_BUILD_TESTS="$with_tests" -DWEFT_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j "${WEFT_JOBS:-2}" --target "${harnesses[@]}" "${tests[@]}"
+for t in "${tests[@]}"; do
+  echo "== ASan/UBSan: $t"
+  ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+    "$build/tests/$t" --gtest_brief=1
+done
 
 # Seeds per harness: the bundled files of that format.
 seeds() {
@@ -57,21 +68,37 @@ out=${WEFT_FUZZ_DIR:-$build/fuzz-runs}
 mkdir -p "$out/artifacts"
 export ASAN_OPTIONS=detect_leaks=1:allocator_may_return_null=0
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-failed=()
-for h in "${harnesses[@]}"; do
-  corpus="$out/corpus/$h"
+# One harness: seeds in read-only, the corpus folder collects what libFuzzer finds; its verdict
+# goes to $out/$h.status so that harnesses can run side by side.
+run_one() {
+  local h=$1 corpus="$out/corpus/$1" seed_dir="$out/seeds/$1"
   mkdir -p "$corpus"
-  # The seeds go in read-only; the corpus folder collects what libFuzzer finds.
-  seed_dir="$out/seeds/$h"
   rm -rf "$seed_dir" && mkdir -p "$seed_dir"
   for f in $(seeds "$h"); do cp "$f" "$seed_dir/"; done
-  echo "== $h: ${seconds} s"
   if "$build/tests/fuzz/$h" -max_total_time="$seconds" -runs="$runs" -timeout=20 \
       -rss_limit_mb=2048 -max_len=1048576 -print_final_stats=1 \
       -artifact_prefix="$out/artifacts/$h-" "$corpus" "$seed_dir" 2>"$out/$h.log"; then
-    grep -E "^stat::number_of_executed_units|^#[0-9]+.*DONE" "$out/$h.log" | tail -2 || true
+    echo ok >"$out/$h.status"
   else
-    tail -40 "$out/$h.log"
+    echo failed >"$out/$h.status"
+  fi
+}
+# Harnesses run ${WEFT_FUZZ_JOBS:-2} at a time (each is single-threaded), so the whole run takes
+# about seconds x harnesses / jobs.
+jobs_max=${WEFT_FUZZ_JOBS:-2}
+for h in "${harnesses[@]}"; do
+  rm -f "$out/$h.status"
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs_max" ]; do wait -n || true; done
+  echo "== $h: ${seconds} s"
+  run_one "$h" &
+done
+wait
+failed=()
+for h in "${harnesses[@]}"; do
+  if [ "$(cat "$out/$h.status" 2>/dev/null)" = ok ]; then
+    echo "$h: $(grep -E "^stat::number_of_executed_units" "$out/$h.log" | tail -1)"
+  else
+    echo "== $h failed:"; tail -40 "$out/$h.log"
     failed+=("$h")
   fi
 done
