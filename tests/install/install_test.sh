@@ -32,7 +32,7 @@ fi
 
 fail=0
 for f in medium.txt weave.gltf verify.txt out/metrics.json out/inplane.csv out/index.html \
-  out/inplane-normalized.png out/render-reflection-computed.exr; do
+  out/inplane-00.0deg.png out/render-reflection-computed.exr; do
   if [ ! -s "$tmp/run/$f" ]; then
     echo "missing or empty: $f"
     fail=1
