@@ -103,6 +103,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--json", o->json, "print a JSON summary on stdout");
   commands.push_back(
       {sub, [o, seed] {
+         run_limits().quiet = o->quiet;
          if (!o->mask.empty() && o->mask_object.empty())
            throw Error("", "--mask-object", "is required with --mask");
          std::vector<SceneOverride> overrides;
