@@ -52,8 +52,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
     bool quiet = false, json = false, spectral = false;
   };
   auto o = std::make_shared<Options>();
-  auto* sub =
-      app.add_subcommand("render", "Path-trace a scene description (JSON) to an image (EXR, PNG, HDR)");
+  auto* sub = app.add_subcommand(
+      "render", "Path-trace a scene description (JSON) to an image (EXR, PNG, HDR)");
   sub->add_option("scene", o->scene, "scene description (.json)")->required();
   sub->add_option("-o,--output", o->output,
                   "output image by its extension: .exr (linear RGB OpenEXR with the render's "

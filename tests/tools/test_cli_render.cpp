@@ -195,7 +195,8 @@ TEST(CliRender, OutputFormatFollowsTheExtension) {
             0);
   ASSERT_EQ(run(plane(dir / "out.png"), dir).exit_code, 0);
   ASSERT_EQ(run(plane(dir / "out.hdr"), dir).exit_code, 0);
-  const weft::Image exr = weft::read_image(dir / "out.exr"), png = weft::read_image(dir / "out.png"),
+  const weft::Image exr = weft::read_image(dir / "out.exr"),
+                    png = weft::read_image(dir / "out.png"),
                     hdr = weft::read_image(dir / "out.hdr");
   // -o .png is the preview of the same render (same seed: the same pixels).
   EXPECT_EQ(png.rgb, weft::read_image(dir / "preview.png").rgb);
