@@ -1,12 +1,35 @@
 #!/usr/bin/env bash
-# Installs Weft's build and run dependencies from Debian 12 packages (the platform of README.md's
-# quick start). Skips apt entirely when everything is already present.
+# Installs Weft's dependencies from Debian 12 packages (the platform of README.md's quick start).
+# By default the build and run set (what scripts/demo.sh needs: the libraries, the compiler and
+# the plots' matplotlib); with --tests also what only the test suite needs (scripts/test.sh
+# passes it): Google Test and Google Benchmark, and slurm-wlm and munge for the single-node
+# Slurm of tests/tools/slurm_test.sh. Installs only the packages that are missing; skips apt
+# entirely when none is. --list prints the chosen set, one package a line, and installs nothing.
+# Usage: install-deps.sh [--tests] [--list]
 set -euo pipefail
-packages=(build-essential cmake ninja-build pkg-config
+build_run=(build-essential cmake ninja-build pkg-config
   libembree-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libtinygltf-dev nlohmann-json3-dev libtbb-dev libcli11-dev
-  libgtest-dev libbenchmark-dev python3-matplotlib python3-numpy
-  slurm-wlm munge)  # slurm-wlm, munge: the single-node Slurm of tests/tools/slurm_test.sh
+  python3-matplotlib python3-numpy)
+tests_only=(libgtest-dev libbenchmark-dev slurm-wlm munge)
+
+packages=("${build_run[@]}")
+list=0
+for a in "$@"; do
+  case "$a" in
+    --tests) packages+=("${tests_only[@]}") ;;
+    --list) list=1 ;;
+    *)
+      echo "install-deps: unknown option '$a' (usage: install-deps.sh [--tests] [--list])" >&2
+      exit 2
+      ;;
+  esac
+done
+if [ "$list" -eq 1 ]; then
+  printf '%s\n' "${packages[@]}"
+  exit 0
+fi
+
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

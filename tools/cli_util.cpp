@@ -186,7 +186,7 @@ void check_long_work(double units, double seconds_per_unit, int threads, const s
     throw Error(file, field,
                 what + " would take at least " + format_seconds(seconds) + " (" + basis +
                     "); add --yes-long to run it anyway");
-  if (seconds > kAnnouncedWorkSeconds)
+  if (seconds > kAnnouncedWorkSeconds && !run_limits().quiet)
     std::fprintf(stderr, "weft: %s: at least %s (%s)\n", what.c_str(),
                  format_seconds(seconds).c_str(), basis.c_str());
 }

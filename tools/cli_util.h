@@ -57,6 +57,8 @@ struct RunLimits {
   // throws WorkWouldStart where the work would start. The memory available here is not the
   // cluster's, so only an explicit --max-memory-gb is checked.
   bool check_only = false;
+  // The command's --quiet: check_long_work announces no long work (errors are still thrown).
+  bool quiet = false;
 };
 struct WorkWouldStart {};
 RunLimits& run_limits();

@@ -219,6 +219,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
 
   commands.push_back(
       {fiber, [opt] {
+         run_limits().quiet = opt->quiet;
          validate_output_paths(
              {{opt->output, "--output"}, {checkpoint_path(opt->output), "checkpoint"}},
              {{opt->spec, "fiber spec"}});

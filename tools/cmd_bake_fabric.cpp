@@ -117,6 +117,7 @@ void check_fabric_work(const BakeFabricOptions& o) {
 }
 
 int run(const BakeFabricOptions& o) {
+  run_limits().quiet = o.quiet;
   if ((!o.shard.empty() || o.resume) && o.method != "raytrace")
     throw Error("", "--shard", "--shard and --resume need --method raytrace");
   if (o.method != "raytrace" && !o.estimator.empty())

@@ -52,10 +52,14 @@ void add_render_command(CLI::App& app, Commands& commands) {
     bool quiet = false, json = false, spectral = false;
   };
   auto o = std::make_shared<Options>();
-  auto* sub =
-      app.add_subcommand("render", "Path-trace a scene description (JSON) to an OpenEXR image");
+  auto* sub = app.add_subcommand(
+      "render", "Path-trace a scene description (JSON) to an image (EXR, PNG, HDR)");
   sub->add_option("scene", o->scene, "scene description (.json)")->required();
-  sub->add_option("-o,--output", o->output, "linear RGB OpenEXR output (.exr)")->required();
+  sub->add_option("-o,--output", o->output,
+                  "output image by its extension: .exr (linear RGB OpenEXR with the render's "
+                  "metadata), .png (8-bit sRGB as --preview, --exposure applied) or .hdr "
+                  "(Radiance RGBE, linear)")
+      ->required();
   sub->add_option("-D,--define", o->defines,
                   "KEY=VALUE: set a value of the description, KEY its JSON path "
                   "(materials.seat.params.reflectance=0.5, lights[0].irradiance=[3,3,3], "
@@ -103,6 +107,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--json", o->json, "print a JSON summary on stdout");
   commands.push_back(
       {sub, [o, seed] {
+         run_limits().quiet = o->quiet;
          if (!o->mask.empty() && o->mask_object.empty())
            throw Error("", "--mask-object", "is required with --mask");
          std::vector<SceneOverride> overrides;

@@ -208,6 +208,7 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--json", o->json, "also print the rows as JSON on stdout");
   commands.push_back(
       {sub, [o, lz, la, va, irr, seed] {
+         run_limits().quiet = o->quiet;
          const SceneDescription desc = load_scene_reporting_warnings(o->scene, {}, o->quiet);
          GonioSettings g = gonio_settings_from(desc);
          if (lz->count())

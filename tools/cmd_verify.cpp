@@ -307,6 +307,7 @@ void add_verify_command(CLI::App& app, Commands& commands) {
   sub->add_option("--suite-file", o->suite_file, "a suite file in place of the bundled one")
       ->each([o](const std::string&) { o->suite = true; });
   commands.push_back({sub, [o, sub] {
+                        run_limits().quiet = o->quiet;
                         if (!o->suite) return run(*o);
                         for (const char* name : {"--measured", "--fiber", "--weave", "--pattern",
                                                  "--wif", "--shard", "--fit", "--classic-albedo"})

@@ -68,7 +68,7 @@ void add_weave_command(CLI::App& app, Commands& commands) {
     std::string sample, repeats, output;
     std::optional<double> yarn_width_mm, yarn_thickness_mm;
     WeaveParams legacy;
-    bool json = false;
+    bool json = false, quiet = false;
   };
   auto o = std::make_shared<Options>();
   auto* sub = app.add_subcommand(
@@ -134,6 +134,7 @@ void add_weave_command(CLI::App& app, Commands& commands) {
   sub->add_option("-o,--output", o->output, "output (.gltf with embedded buffer, or .glb)")
       ->required();
   sub->add_flag("--json", o->json, "print a JSON summary");
+  sub->add_flag("--quiet", o->quiet, "the summary only: no notes (errors are still printed)");
   commands.push_back(
       {sub, [o, sub, sides, yarns, radius, spacing, segments, amplitude] {
          if (yarns->count() || radius->count() || spacing->count() || segments->count() ||
@@ -194,6 +195,7 @@ void add_weave_command(CLI::App& app, Commands& commands) {
                "solidity %.3f\n",
                s.nonwoven->fibers, s.nonwoven->attempts, s.nonwoven->areal_density_gsm,
                s.nonwoven->thickness_mm, s.nonwoven->solidity);
+         if (o->quiet) return 0;
          for (const std::string& note : s.notes) std::printf("note: %s\n", note.c_str());
          if (!s.floating_warps.empty() || !s.floating_wefts.empty())
            std::printf("note: %zu warp and %zu weft threads never interlace (floating threads)\n",

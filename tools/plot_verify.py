@@ -1,14 +1,20 @@
 #!/usr/bin/python3
-"""Plots of `weft verify`: beta / pi against the view zenith, one panel per incidence and channel.
+"""Plots of `weft verify`: beta / pi against the view zenith, one figure per incidence.
 
-Usage: plot_verify.py INPLANE.csv METRICS.json OUT_DIR
+Usage: plot_verify.py [--describe LAYOUT.json] INPLANE.csv METRICS.json OUT_DIR
 
 Reads the long-form inplane.csv of `weft verify` (theta_i_deg, view_zenith_deg, model, channel,
 beta, beta_err, beta_norm, norm_factor; view > 0 on the mirror side, the paper's Fig. 7) and
-writes OUT_DIR/inplane-normalized.{png,svg} (the paper's normalization, each model's factor
-printed on every panel) and OUT_DIR/inplane-absolute.{png,svg}. Error bars: one standard error
-(beta_err). Run with /usr/bin/python3 (weft does): only it is known to have matplotlib.
+writes OUT_DIR/inplane-<theta_i>deg.{png,svg} (theta_i as 00.0, so the names sort by incidence):
+one figure per incidence, one column per channel; the top row with the paper's normalization
+(linear axis, each model's factors in the legend), the bottom row absolute on a log axis (values
+<= 0 or not finite cannot be drawn there: they are masked and counted in the panel's title). One
+legend per figure, below the panels; the mirror direction (view = theta_i) marked and labelled on
+every panel. Error bars: one standard error (beta_err). --describe writes the layout as JSON
+(files, axis scales, legend and axes boxes, mirror labels, masked points) for the tests. Run
+with /usr/bin/python3 (weft does): only it is known to have matplotlib.
 """
+import argparse
 import csv
 import json
 import math
@@ -21,23 +27,20 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 STYLE = {
-    "measured": dict(color="black", linestyle="--", marker="", label="measured"),
-    "computed_raytrace": dict(color="tab:red", linestyle="-", marker="o", markersize=2.5),
+    "measured": dict(color="black", linestyle="--", marker=""),
+    "computed_raytrace": dict(color="tab:red", linestyle="-", marker="o", markersize=3),
     "computed_summation": dict(color="tab:orange", linestyle=":", marker=""),
-    "classic": dict(color="tab:blue", linestyle="-.", marker="s", markersize=2.5),
+    "classic": dict(color="tab:blue", linestyle="-.", marker="s", markersize=3),
     # weft verify --fit: the fitted parameters at the run's quality, thinner and lighter.
     "computed_raytrace_fitted": dict(color="salmon", linestyle="-", marker="", alpha=0.8),
     "classic_fitted": dict(color="lightskyblue", linestyle="-.", marker="", alpha=0.8),
 }
-SHORT = {"computed_raytrace": "ray trace", "computed_summation": "summation",
-         "classic": "classic", "computed_raytrace_fitted": "ray trace fitted",
-         "classic_fitted": "classic fitted"}
+CHANNELS = ["R", "G", "B"]
+KINDS = ["normalized", "absolute"]
 
 
-def main():
-    if len(sys.argv) != 4:
-        sys.exit("usage: plot_verify.py INPLANE.csv METRICS.json OUT_DIR")
-    src, metrics_path, out_dir = sys.argv[1:]
+def read_inputs(src, metrics_path):
+    """The points per (incidence, model, channel), the model order and the models' labels."""
     with open(src, newline="") as f:
         rows = list(csv.DictReader(f))
     if not rows:
@@ -46,64 +49,130 @@ def main():
         metrics = json.load(f)
     labels = {k: v["label"] for k, v in metrics["models"].items()}
     labels["measured"] = "measured"
-    incidences = sorted({float(r["theta_i_deg"]) for r in rows})
-    channels = ["R", "G", "B"]
-    models = []
+    models, data = [], {}
     for r in rows:
         if r["model"] not in models:
             models.append(r["model"])
-    data = {}
-    for r in rows:
         key = (float(r["theta_i_deg"]), r["model"], r["channel"])
         data.setdefault(key, []).append(
             (float(r["view_zenith_deg"]), float(r["beta"]), float(r["beta_err"]),
              float(r["beta_norm"]), float(r["norm_factor"])))
+    return data, models, labels
 
-    for kind in ("normalized", "absolute"):
-        fig, axes = plt.subplots(len(incidences), 3, figsize=(13, 2.9 * len(incidences)),
-                                 squeeze=False, sharex=True)
-        for i, ti in enumerate(incidences):
-            for c, ch in enumerate(channels):
-                ax = axes[i][c]
-                factors = []
-                for m in models:
-                    pts = sorted(data.get((ti, m, ch), []))
-                    if not pts:
-                        continue
-                    x = [p[0] for p in pts]
-                    norm = kind == "normalized"
-                    scale = [p[4] if norm else 1.0 for p in pts]
-                    y = [(p[3] if norm else p[1]) / math.pi for p in pts]
-                    err = [p[2] * s / math.pi for p, s in zip(pts, scale)]
-                    style = dict(STYLE.get(m, {}))
-                    style["label"] = labels.get(m, m)
-                    if any(e > 0 for e in err):
-                        ax.errorbar(x, y, yerr=err, capsize=1.5, linewidth=1, elinewidth=0.7,
-                                    **style)
-                    else:
-                        ax.plot(x, y, linewidth=1, **style)
-                    if norm and m != "measured":
-                        factors.append(f"{SHORT.get(m, m)}: x{pts[0][4]:.3g}")
-                ax.set_title(f"light {ti:g} deg, {ch} channel", fontsize=9)
-                ax.grid(alpha=0.3)
-                ax.set_xlim(-90, 90)
-                ax.axvline(ti, color="grey", linewidth=0.5)
-                if factors:
-                    ax.text(0.02, 0.97, "normalization\n" + "\n".join(factors),
-                            transform=ax.transAxes, fontsize=6, va="top",
-                            bbox=dict(facecolor="white", alpha=0.7, linewidth=0))
-                ax.legend(fontsize=6, loc="upper right")
-                if c == 0:
-                    ax.set_ylabel("beta / pi" + (" (normalized)" if kind == "normalized" else ""))
-                if i == len(incidences) - 1:
-                    ax.set_xlabel("view zenith (deg; > 0 on the mirror side)")
-        title = ("paper's normalization: each model scaled per channel to the measurement at "
-                 "normal incidence and view" if kind == "normalized" else "absolute beta / pi")
-        fig.suptitle(title, fontsize=10)
-        fig.tight_layout(rect=(0, 0, 1, 0.985))  # room for the title above the first row
-        for ext in ("png", "svg"):
-            fig.savefig(os.path.join(out_dir, f"inplane-{kind}.{ext}"), dpi=80)
-        plt.close(fig)
+
+def legend_label(data, ti, model, labels):
+    """The model's label; with its normalization factors per channel when it has any."""
+    label = labels.get(model, model)
+    if model == "measured":
+        return label
+    factors = [sorted(data.get((ti, model, ch), [(0, 0, 0, 0, math.nan)]))[0][4]
+               for ch in CHANNELS]
+    return label + ", normalization \u00d7 " + " / ".join(f"{f:.3g}" for f in factors) + " (R / G / B)"
+
+
+def draw_curve(ax, pts, kind, style):
+    """One model's curve on one panel; returns how many points it could not draw."""
+    norm = kind == "normalized"
+    x = [p[0] for p in pts]
+    y = [(p[3] if norm else p[1]) / math.pi for p in pts]
+    err = [p[2] * (p[4] if norm else 1.0) / math.pi for p in pts]
+    # A log axis cannot show values <= 0; neither axis can show NaN: masked (NaN), and counted.
+    bad = [not math.isfinite(v) or (kind == "absolute" and v <= 0) for v in y]
+    y = [math.nan if b else v for v, b in zip(y, bad)]
+    err = [0.0 if b or not math.isfinite(e) else e for e, b in zip(err, bad)]
+    if any(e > 0 for e in err):
+        ax.errorbar(x, y, yerr=err, capsize=1.5, linewidth=1.2, elinewidth=0.7, **style)
+    else:
+        ax.plot(x, y, linewidth=1.2, **style)
+    return sum(bad)
+
+
+def mark_mirror(ax, ti):
+    """The mirror direction (view = theta_i, the paper's Fig. 7 sign): a line, labelled by a tick
+    above the panel, clear of the curves."""
+    ax.axvline(ti, color="dimgrey", linewidth=0.9, linestyle=(0, (5, 3)))
+    top = ax.secondary_xaxis("top")
+    top.set_xticks([ti])
+    top.set_xticklabels([f"mirror {ti:g}\u00b0"], fontsize=9, color="dimgrey")
+    return top.get_xticklabels()[0].get_text()
+
+
+def draw_panel(ax, data, models, ti, kind, ch):
+    """One panel (incidence, kind, channel); returns its layout entry."""
+    masked = 0
+    for m in models:
+        pts = sorted(data.get((ti, m, ch), []))
+        if pts:
+            masked += draw_curve(ax, pts, kind, dict(STYLE.get(m, {}), label=m))
+    if kind == "absolute":
+        ax.set_yscale("log", nonpositive="clip")  # error bars below zero run off the axis
+    title = f"{ch} channel, " + ("paper's normalization" if kind == "normalized" else "absolute")
+    if masked:
+        title += f"\n({masked} points <= 0 or NaN not shown)"
+    ax.set_title(title, fontsize=11)
+    ax.grid(alpha=0.3, which="both" if kind == "absolute" else "major")
+    ax.set_xlim(-90, 90)
+    ax.tick_params(labelsize=9)
+    mirror = mark_mirror(ax, ti)
+    return {"kind": kind, "channel": ch, "yscale": ax.get_yscale(), "mirror_deg": ti,
+            "mirror_label": mirror, "masked_points": masked,
+            "has_own_legend": ax.get_legend() is not None}
+
+
+def box(bb, fig):
+    """A display box in figure fractions, [x0, y0, x1, y1]."""
+    f = bb.transformed(fig.transFigure.inverted())
+    return [round(v, 4) for v in (f.x0, f.y0, f.x1, f.y1)]
+
+
+def incidence_figure(data, models, labels, ti, out_dir):
+    """The figure of one incidence, saved as PNG and SVG; returns its layout entry."""
+    fig, axes = plt.subplots(2, 3, figsize=(13, 8), sharex=True, squeeze=False)
+    panels = [draw_panel(axes[r][c], data, models, ti, kind, ch)
+              for r, kind in enumerate(KINDS) for c, ch in enumerate(CHANNELS)]
+    axes[0][0].set_ylabel("beta / pi, normalized", fontsize=11)
+    axes[1][0].set_ylabel("beta / pi (log axis)", fontsize=11)
+    for ax in axes[1]:
+        ax.set_xlabel("view zenith (deg; > 0 on the mirror side)", fontsize=10)
+    # One legend for the figure, below the panels, from the first panel's curves.
+    handles, keys = axes[0][0].get_legend_handles_labels()
+    order = sorted(range(len(keys)), key=lambda i: models.index(keys[i]))
+    handles, keys = [handles[i] for i in order], [keys[i] for i in order]
+    legend = fig.legend(handles, [legend_label(data, ti, k, labels) for k in keys],
+                        loc="lower center", ncol=2, fontsize=10, frameon=False)
+    fig.suptitle(f"light at {ti:g} deg: beta / pi in the plane of incidence", fontsize=13)
+    rows = math.ceil(len(keys) / 2)
+    fig.tight_layout(rect=(0, 0.035 + 0.03 * rows, 1, 0.97))  # room for the legend below
+    name = f"inplane-{ti:04.1f}deg"
+    for ext in ("png", "svg"):
+        fig.savefig(os.path.join(out_dir, f"{name}.{ext}"), dpi=80)
+    renderer = fig.canvas.get_renderer()
+    legend_bb = legend.get_window_extent(renderer)
+    for p, ax in zip(panels, axes.flat):
+        p["axes_box"] = box(ax.get_window_extent(renderer), fig)
+    entry = {"file": name + ".png", "theta_i_deg": ti, "panels": panels,
+             "legends": 1 + sum(p["has_own_legend"] for p in panels),
+             "legend_box": box(legend_bb, fig),
+             "legend_outside_axes": not any(legend_bb.overlaps(ax.get_window_extent(renderer))
+                                            for ax in axes.flat),
+             "legend_labels": [t.get_text() for t in legend.get_texts()]}
+    plt.close(fig)
+    return entry
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    p.add_argument("inplane")
+    p.add_argument("metrics")
+    p.add_argument("out_dir")
+    p.add_argument("--describe", help="write the figures' layout here as JSON")
+    a = p.parse_args()
+    data, models, labels = read_inputs(a.inplane, a.metrics)
+    incidences = sorted({k[0] for k in data})
+    figures = [incidence_figure(data, models, labels, ti, a.out_dir) for ti in incidences]
+    if a.describe:
+        with open(a.describe, "w") as f:
+            json.dump({"figures": figures}, f, indent=1)
 
 
 if __name__ == "__main__":

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "image_hdr.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 
@@ -115,6 +116,13 @@ void write_png_preview(const std::filesystem::path& path, const Image& image, do
   }
   OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
   write_oiio(path, ".png", spec, px.data());
+}
+
+void write_hdr(const std::filesystem::path& path, const Image& image) {
+  std::vector<float> px(image.rgb.size());
+  for (size_t i = 0; i < px.size(); ++i) px[i] = std::max(0.0f, image.rgb[i]);
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::FLOAT);
+  write_oiio(path, ".hdr", spec, px.data());
 }
 
 void write_mask_exr(const std::filesystem::path& path, int width, int height,

@@ -4,6 +4,7 @@
 #include <utility>
 #include <vector>
 
+#include "image_hdr.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/integrators/image.h"
@@ -14,7 +15,10 @@ namespace weft {
 namespace {
 
 void check_output(const std::filesystem::path& p, const std::string& ext, const std::string& what) {
-  if (p.extension() != ext) throw Error(p.string(), what, "must end in " + ext);
+  const bool image = what == "output" && (p.extension() == ".png" || p.extension() == ".hdr");
+  if (p.extension() != ext && !image)
+    throw Error(p.string(), what,
+                "must end in " + ext + (what == "output" ? ", .png or .hdr" : ""));
   const auto dir = p.has_parent_path() ? p.parent_path() : std::filesystem::path(".");
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
@@ -85,9 +89,19 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   RenderMetadata albedo_meta = meta, normal_meta = meta;
   albedo_meta.pass = "albedo";
   normal_meta.pass = "normal (world space, towards the camera)";
-  // All or none: a preview or pass that cannot be written leaves no EXR behind.
+  // All or none: a preview or pass that cannot be written leaves no EXR behind. The image goes
+  // in the format its name asks for: an EXR with the metadata, an sRGB PNG as the preview, or
+  // Radiance RGBE.
+  const std::string format = job.exr.extension().string();
   std::vector<std::pair<std::filesystem::path, FileWriter>> files{
-      {job.exr, [&](const std::filesystem::path& p) { write_exr(p, r.image, &meta); }}};
+      {job.exr, [&](const std::filesystem::path& p) {
+         if (format == ".png")
+           write_png_preview(p, r.image, job.preview_exposure);
+         else if (format == ".hdr")
+           write_hdr(p, r.image);
+         else
+           write_exr(p, r.image, &meta);
+       }}};
   if (job.png)
     files.emplace_back(*job.png, [&](const std::filesystem::path& p) {
       write_png_preview(p, r.image, job.preview_exposure);
@@ -97,11 +111,11 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
       write_mask_exr(p, settings.width, settings.height, coverage);
     });
   if (job.albedo)
-    files.emplace_back(*job.albedo,
-                       [&](const std::filesystem::path& p) { write_exr(p, r.albedo, &albedo_meta); });
+    files.emplace_back(
+        *job.albedo, [&](const std::filesystem::path& p) { write_exr(p, r.albedo, &albedo_meta); });
   if (job.normal)
-    files.emplace_back(*job.normal,
-                       [&](const std::filesystem::path& p) { write_exr(p, r.normal, &normal_meta); });
+    files.emplace_back(
+        *job.normal, [&](const std::filesystem::path& p) { write_exr(p, r.normal, &normal_meta); });
   write_all_atomically(files);
   return out;
 }

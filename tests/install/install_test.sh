@@ -18,6 +18,8 @@ cat >"$tmp/commands.sh" <<SCRIPT
 set -eu
 cd '$tmp/run'
 '$prefix/bin/weft' medium red-cotton >medium.txt
+'$prefix/bin/weft' medium '$prefix/share/weft/fiber/templates/full.json' >template.txt 2>/dev/null
+'$prefix/bin/weft' medium '$prefix/share/weft/fiber/presets/silk.json' >preset.txt 2>/dev/null
 '$prefix/bin/weft' weave -o weave.gltf >/dev/null
 '$prefix/bin/weft' verify --quality draft --quiet -o out >verify.txt
 SCRIPT
@@ -31,8 +33,8 @@ else
 fi
 
 fail=0
-for f in medium.txt weave.gltf verify.txt out/metrics.json out/inplane.csv out/index.html \
-  out/inplane-normalized.png out/render-reflection-computed.exr; do
+for f in medium.txt template.txt preset.txt weave.gltf verify.txt out/metrics.json \
+  out/inplane.csv out/index.html out/inplane-00.0deg.png out/render-reflection-computed.exr; do
   if [ ! -s "$tmp/run/$f" ]; then
     echo "missing or empty: $f"
     fail=1

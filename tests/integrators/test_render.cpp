@@ -139,7 +139,7 @@ TEST(Render, BadOutputsFailBeforeRendering) {
   const fs::path dir = fresh_dir("weft_test_badout");
   RenderJob job;
   job.settings = small(1);
-  job.exr = dir / "out.png";
+  job.exr = dir / "out.tif";  // .exr, .png or .hdr only
   EXPECT_THROW(render_to_files(woven(), job), Error);
   job.exr = dir / "missing" / "out.exr";
   EXPECT_THROW(render_to_files(woven(), job), Error);

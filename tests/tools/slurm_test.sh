@@ -4,7 +4,8 @@
 # sockets, in a temporary folder), then `weft slurm --shards 4` for a fiber bake, a sweep and a
 # draft verify (sbatch --array and a dependent merge job), each merged output compared byte for
 # byte with the one-process run (verify's metrics.json but for its timings); the daemons are
-# stopped at the end. Installs nothing (scripts/install-deps.sh installs slurm-wlm and munge);
+# stopped at the end. Installs nothing (scripts/install-deps.sh --tests, which scripts/test.sh
+# runs, installs slurm-wlm and munge);
 # exits 77 (skipped, with the reason) only where the scheduler
 # cannot start: not root, no slurm-wlm or munge, or the daemons do not come up.
 # Usage: slurm_test.sh WEFT_EXE SOURCE_DIR
@@ -14,7 +15,7 @@ src=$(readlink -f "$2")
 skip() { echo "slurm_test: SKIPPED: $*"; exit 77; }
 [ "$(id -u)" -eq 0 ] || skip "needs root to start munged, slurmctld and slurmd"
 for b in munged slurmctld slurmd sbatch squeue sinfo; do
-  command -v "$b" >/dev/null || skip "$b not found (scripts/install-deps.sh installs slurm-wlm and munge)"
+  command -v "$b" >/dev/null || skip "$b not found (scripts/install-deps.sh --tests installs slurm-wlm and munge)"
 done
 
 T=$(mktemp -d /tmp/weft-slurm.XXXXXX)

@@ -188,6 +188,33 @@ TEST(CliRender, ExposureScalesThePreviewOnly) {
   }
 }
 
+TEST(CliRender, OutputFormatFollowsTheExtension) {
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(run(plane(dir / "out.exr", "--preview '" + (dir / "preview.png").string() + "'"), dir)
+                .exit_code,
+            0);
+  ASSERT_EQ(run(plane(dir / "out.png"), dir).exit_code, 0);
+  ASSERT_EQ(run(plane(dir / "out.hdr"), dir).exit_code, 0);
+  const weft::Image exr = weft::read_image(dir / "out.exr"),
+                    png = weft::read_image(dir / "out.png"),
+                    hdr = weft::read_image(dir / "out.hdr");
+  // -o .png is the preview of the same render (same seed: the same pixels).
+  EXPECT_EQ(png.rgb, weft::read_image(dir / "preview.png").rgb);
+  // -o .hdr is linear: Radiance RGBE keeps 8-bit mantissas under a shared exponent (Ward, "Real
+  // Pixels", Graphics Gems II), so each channel is within 1/128 of the pixel's largest channel.
+  ASSERT_EQ(hdr.width, exr.width);
+  ASSERT_EQ(hdr.rgb.size(), exr.rgb.size());
+  for (size_t i = 0; i < exr.rgb.size(); i += 3) {
+    const float top = std::max({exr.rgb[i], exr.rgb[i + 1], exr.rgb[i + 2]});
+    for (int c = 0; c < 3; ++c) ASSERT_NEAR(hdr.rgb[i + c], exr.rgb[i + c], top / 128) << i;
+  }
+  // Another extension is refused before any work, naming the output.
+  const CliRun bad = run(plane(dir / "out.tif"), dir);
+  EXPECT_EQ(bad.exit_code, 2);
+  EXPECT_TRUE(contains(bad.err, ".png or .hdr")) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "out.tif"));
+}
+
 TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
   const fs::path dir = fresh_test_dir();
   const CliRun r = run(plane(dir / "out.exr", "--time-limit 1e-9 --json", 64), dir);

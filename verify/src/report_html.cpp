@@ -85,18 +85,24 @@ void html_fits(std::ostringstream& h, const VerifyReport& r) {
   }
 }
 
-// The plots of the in-plane curves, embedded.
+// The plots of the in-plane curves, embedded: one figure per incidence, in a grid of figures
+// wide enough to read, each linked to its file at full size.
 void html_curves(std::ostringstream& h,
                  const std::vector<std::pair<std::string, std::string>>& images) {
   h << "</table>\n<h2>In-plane curves</h2>\n<p>beta / pi against the view zenith (positive on "
-       "the mirror side), one panel per incidence and channel; error bars one standard "
-       "error.</p>\n";
+       "the mirror side), one figure per incidence: a panel per channel, the paper's "
+       "normalization above (each model's factors in the legend), absolute below on a log axis "
+       "(values &le; 0 or not finite cannot be drawn there: each panel's title counts them); "
+       "the dashed line is the mirror direction; error bars one standard error. Click a figure "
+       "for its full size.</p>\n<div style=\"display:grid;grid-template-columns:repeat(auto-fill,"
+       "minmax(680px,1fr));gap:8px\">\n";
   for (const auto& [name, bytes] : images) {
     const auto* p = reinterpret_cast<const uint8_t*>(bytes.data());
-    h << "<h3>" << html_escape(name) << "</h3>\n<img alt=\"" << html_escape(name)
+    h << "<a href=\"" << html_escape(name) << "\"><img alt=\"" << html_escape(name)
       << "\" src=\"data:image/png;base64," << base64(std::span<const uint8_t>(p, bytes.size()))
-      << "\">\n";
+      << "\"></a>\n";
   }
+  h << "</div>\n";
 }
 
 // The renders of the sample, linked beside their EXR.

@@ -3,7 +3,7 @@
 // preset), validated field by field (errors name the file and the field path), and hashed
 // canonically so caches and table headers can name the spec that produced them.
 //
-// JSON layout (every key is required unless marked optional; unknown keys are errors):
+// JSON layout (keys required unless marked optional; unknown keys are errors; docs/fiber-spec.md):
 // {
 //   "name": "red-cotton",
 //   "fiber_radius_um": 8.0,

@@ -14,7 +14,7 @@
 namespace weft {
 
 struct RenderJob {
-  std::filesystem::path exr;                  // required, .exr
+  std::filesystem::path exr;  // required: .exr; or .png (as the preview) or .hdr (Radiance RGBE)
   std::optional<std::filesystem::path> png;   // sRGB preview, .png
   std::optional<std::filesystem::path> mask;  // coverage of mask_object, .exr
   std::string mask_object;
