@@ -6,6 +6,7 @@ packages=(build-essential cmake ninja-build pkg-config
   libembree-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libtinygltf-dev nlohmann-json3-dev libtbb-dev libcli11-dev
   libgtest-dev libbenchmark-dev python3-matplotlib python3-numpy
+  pybind11-dev python3-dev python3-pytest  # the Python module (python/) and its tests
   slurm-wlm munge)  # slurm-wlm, munge: the single-node Slurm of tests/tools/slurm_test.sh
 missing=()
 for p in "${packages[@]}"; do
