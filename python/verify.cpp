@@ -1,12 +1,14 @@
 // weft.verify: `weft verify` from Python (verify/plan.h, verify/whole_run.h): the plan with its
 // checks, the time check, the run without the GIL, the report folder with its plots, and
-// metrics.json as a dict.
+// its metrics.json as a dict.
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <chrono>
 #include <filesystem>
+#include <fstream>
 #include <optional>
+#include <sstream>
 
 #include "cli_util.h"
 #include "plot_util.h"
@@ -67,7 +69,13 @@ py::dict verify(VerifyArgs a) {
   }
   progress.raise_if_interrupted();
   if (out.cancelled) throw Error(output, "", "verify was cancelled; nothing was written");
-  py::dict metrics = py::module_::import("json").attr("loads")(verify_metrics_json(out.report));
+  // The file as written (its renders and timings are the report's, not the run's).
+  const std::filesystem::path file = std::filesystem::path(output) / "metrics.json";
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(file.string(), "", "cannot read the report's metrics");
+  std::stringstream text;
+  text << in.rdbuf();
+  py::dict metrics = py::module_::import("json").attr("loads")(text.str());
   metrics["report_folder"] = output;
   return metrics;
 }
