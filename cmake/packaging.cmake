@@ -22,10 +22,11 @@ one. The bundled measured fabrics, verify suite, example scenes and plot scripts
 /usr/share/weft.")
 # The Debian 12 packages of the libraries weft links (dpkg-shlibdeps on the built program gives
 # these, with these lower bounds). The plot scripts of weft verify and weft compare need python3
-# with matplotlib; without them the other commands still run.
+# with matplotlib; without them the other commands still run. The Python module (in
+# /usr/lib/python3/dist-packages, for Debian's python3) needs numpy for its tables' values.
 set(CPACK_DEBIAN_PACKAGE_DEPENDS
     "libc6 (>= 2.35), libembree3-3 (>= 3.13.5+dfsg), libgcc-s1 (>= 4.0), \
 libopenexr-3-1-30 (>= 3.1.5), libopenimageio2.4 (>= 2.4.7.1+dfsg), libstdc++6 (>= 11), \
 libtbb12 (>= 2021.4.0), libtinygltf2d (>= 2.7.0+dfsg)")
-set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3, python3-matplotlib")
+set(CPACK_DEBIAN_PACKAGE_RECOMMENDS "python3, python3-matplotlib, python3-numpy")
 include(CPack)

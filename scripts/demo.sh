@@ -9,8 +9,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh  # the build and run set; the test set (Slurm among it) only for test.sh
-# The program alone: its tests and benchmarks need packages the demo does not install.
-scripts/build.sh -DWEFT_BUILD_TESTS=OFF -DWEFT_BUILD_BENCH=OFF
+# The program alone: its tests, benchmarks and Python module need packages the demo does not
+# install.
+scripts/build.sh -DWEFT_BUILD_TESTS=OFF -DWEFT_BUILD_BENCH=OFF -DWEFT_BUILD_PYTHON=OFF
 out=${WEFT_OUT:-out}
 mkdir -p "$out"
 weft=${WEFT_BUILD_DIR:-build}/tools/weft

@@ -2,8 +2,9 @@
 # Installs Weft's dependencies from Debian 12 packages (the platform of README.md's quick start).
 # By default the build and run set (what scripts/demo.sh needs: the libraries, the compiler and
 # the plots' matplotlib); with --tests also what only the test suite needs (scripts/test.sh
-# passes it): Google Test and Google Benchmark, and slurm-wlm and munge for the single-node
-# Slurm of tests/tools/slurm_test.sh. Installs only the packages that are missing; skips apt
+# passes it): Google Test and Google Benchmark, pybind11 and pytest for the Python module
+# (python/) and its tests, and slurm-wlm and munge for the single-node Slurm of
+# tests/tools/slurm_test.sh. Installs only the packages that are missing; skips apt
 # entirely when none is. --list prints the chosen set, one package a line, and installs nothing.
 # Usage: install-deps.sh [--tests] [--list]
 set -euo pipefail
@@ -11,7 +12,8 @@ build_run=(build-essential cmake ninja-build pkg-config
   libembree-dev libopenimageio-dev openimageio-tools libopenexr-dev libimath-dev
   libtinygltf-dev nlohmann-json3-dev libtbb-dev libcli11-dev
   python3-matplotlib python3-numpy)
-tests_only=(libgtest-dev libbenchmark-dev slurm-wlm munge)
+tests_only=(libgtest-dev libbenchmark-dev slurm-wlm munge
+  pybind11-dev python3-dev python3-pytest)  # the Python module (python/) and its tests
 
 packages=("${build_run[@]}")
 list=0

@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # README's test command: install dependencies (the test set too: Google Test and Benchmark,
-# slurm-wlm and munge), build with the tests and benchmarks (also in a build folder that
+# pybind11 and pytest, slurm-wlm and munge), build with the tests, benchmarks and Python module (also in a build folder that
 # scripts/demo.sh configured without them), run the whole test suite.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh --tests
-scripts/build.sh -DWEFT_BUILD_TESTS=ON -DWEFT_BUILD_BENCH=ON
+scripts/build.sh -DWEFT_BUILD_TESTS=ON -DWEFT_BUILD_BENCH=ON -DWEFT_BUILD_PYTHON=ON
 ctest --test-dir "${WEFT_BUILD_DIR:-build}" --output-on-failure -j 2

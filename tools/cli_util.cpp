@@ -20,6 +20,8 @@
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
+#include "weft/fabric/fabric_raytrace.h"
+#include "weft/fabric/fabric_summation.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/scenes/description.h"
 
@@ -162,6 +164,30 @@ void check_fiber_bake(const FiberTableBakeOptions& o, uint64_t bands,
                   kMinSecondsPerPhoton, o.threads, source.file, source.photons_field,
                   std::to_string(o.photons_per_band) + " photons per band",
                   "0.5 us per photon per core at least");
+}
+
+void check_fabric_bake(const std::string& method, int resolution, uint64_t bins_traced,
+                       std::optional<uint64_t> samples, int threads,
+                       const std::string& samples_field) {
+  if (method == "raytrace") {
+    const uint64_t per_bin = samples.value_or(FabricRaytraceOptions{}.particles_per_bin);
+    check_long_work(double(bins_traced) * double(per_bin), kMinSecondsPerFabricParticle, threads,
+                    "", samples_field,
+                    "a ray trace of " + std::to_string(bins_traced) + " incident bins x " +
+                        std::to_string(per_bin) + " particles",
+                    "0.25 us per particle per core at least");
+  } else {
+    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{resolution}.bins());
+    const uint64_t per_cell = samples.value_or(FabricSummationOptions{}.samples_per_cell);
+    const bool visible = method == "summation-visible";
+    check_long_work(double(bins * bins) * double(per_cell),
+                    visible ? kMinSecondsPerVisiblePair : kMinSecondsPerPaperPair, threads, "",
+                    samples_field,
+                    "a " + method + " of " + std::to_string(bins * bins) + " cell pairs x " +
+                        std::to_string(per_cell) + " direction pairs",
+                    visible ? "5 us per direction pair per core at least"
+                            : "0.1 us per direction pair per core at least");
+  }
 }
 
 FiberTableResolver checked_fiber_table_resolver() {

@@ -84,6 +84,13 @@ void check_long_work(double units, double seconds_per_unit, int threads, const s
 // kMinSecondsPerPhoton), naming the source's file and fields.
 void check_fiber_bake(const FiberTableBakeOptions& options, uint64_t bands,
                       const FiberBakeSource& source);
+// The time check before a fabric bake of 'method' (summation | summation-visible | raytrace), the
+// same for `weft bake fabric` and the Python module: check_long_work at the method's least rate
+// (fabric/) for a ray trace of 'bins_traced' incident bins x 'samples' particles, or a summation
+// of every cell pair x 'samples' direction pairs (the method's default when not given).
+void check_fabric_bake(const std::string& method, int resolution, uint64_t bins_traced,
+                       std::optional<uint64_t> samples, int threads,
+                       const std::string& samples_field);
 // The fiber-table resolver of every command that renders a scene: fiber_table_resolver (bake on
 // first use) with check_fiber_bake before a bake.
 FiberTableResolver checked_fiber_table_resolver();

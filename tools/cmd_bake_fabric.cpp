@@ -89,31 +89,15 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
   return r;
 }
 
-// The work's time from a lower bound of its rate, before any (check_long_work): particles of the
-// ray trace, direction pairs of a summation.
+// The work's time from a lower bound of its rate, before any (check_fabric_bake): a ray trace's
+// incident bins are those of its shard.
 void check_fabric_work(const BakeFabricOptions& o) {
-  if (o.method == "raytrace") {
-    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
-    const UnitRange r =
-        shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"));
-    const uint64_t per_bin = o.samples.value_or(FabricRaytraceOptions{}.particles_per_bin);
-    check_long_work(double(r.last - r.first) * double(per_bin), kMinSecondsPerFabricParticle,
-                    o.threads, "", "--samples",
-                    "a ray trace of " + std::to_string(r.last - r.first) + " incident bins x " +
-                        std::to_string(per_bin) + " particles",
-                    "0.25 us per particle per core at least");
-  } else {
-    const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
-    const uint64_t per_cell = o.samples.value_or(FabricSummationOptions{}.samples_per_cell);
-    const bool visible = o.method == "summation-visible";
-    check_long_work(double(bins * bins) * double(per_cell),
-                    visible ? kMinSecondsPerVisiblePair : kMinSecondsPerPaperPair, o.threads, "",
-                    "--samples",
-                    "a " + o.method + " of " + std::to_string(bins * bins) + " cell pairs x " +
-                        std::to_string(per_cell) + " direction pairs",
-                    visible ? "5 us per direction pair per core at least"
-                            : "0.1 us per direction pair per core at least");
-  }
+  const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
+  const UnitRange r =
+      o.method == "raytrace"
+          ? shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"))
+          : UnitRange{0, bins};
+  check_fabric_bake(o.method, o.resolution, r.last - r.first, o.samples, o.threads, "--samples");
 }
 
 int run(const BakeFabricOptions& o) {

@@ -1,5 +1,7 @@
 #include "weft/core/install_paths.h"
 
+#include <mutex>
+#include <optional>
 #include <system_error>
 
 #ifndef WEFT_SOURCE_DIR
@@ -7,6 +9,24 @@
 #endif
 
 namespace weft {
+namespace {
+
+struct InstalledRoot {
+  std::mutex mutex;
+  std::optional<std::filesystem::path> root;  // set_installed_data_root's
+};
+InstalledRoot& installed_root() {
+  static InstalledRoot r;
+  return r;
+}
+
+}  // namespace
+
+void set_installed_data_root(const std::filesystem::path& root) {
+  InstalledRoot& r = installed_root();
+  const std::lock_guard<std::mutex> lock(r.mutex);
+  r.root = root.lexically_normal();
+}
 
 std::vector<std::filesystem::path> bundled_data_roots() {
   namespace fs = std::filesystem;
@@ -14,8 +34,14 @@ std::vector<std::filesystem::path> bundled_data_roots() {
   std::error_code ec;
   // The installed tree first: an installed program must not read a source tree that happens to
   // still exist at the path it was built from (it may be newer or older than the install).
+  {
+    InstalledRoot& r = installed_root();
+    const std::lock_guard<std::mutex> lock(r.mutex);
+    if (r.root) roots.push_back(*r.root);
+  }
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) roots.push_back((exe.parent_path() / ".." / "share" / "weft").lexically_normal());
+  if (roots.empty() && !ec)
+    roots.push_back((exe.parent_path() / ".." / "share" / "weft").lexically_normal());
   if (!std::string(WEFT_SOURCE_DIR).empty()) roots.emplace_back(WEFT_SOURCE_DIR);
   return roots;
 }

@@ -46,3 +46,17 @@ TEST(InstallPaths, FindsTheBundledDataOfThisSourceTree) {
   EXPECT_TRUE(find_bundled_file("verify/data/no-such-file.json", &tried).empty());
   EXPECT_NE(tried.find("share/weft/verify/data/no-such-file.json"), std::string::npos) << tried;
 }
+
+// Last in this file: it sets the process's installed root for good.
+TEST(InstallPaths, AFrontEndInAnotherProgramNamesTheInstalledRoot) {
+  const auto dir = fresh_test_dir();
+  std::filesystem::create_directories(dir / "share" / "weft" / "verify" / "data");
+  std::ofstream(dir / "share" / "weft" / "verify" / "data" / "suite.json") << "{}";
+  set_installed_data_root(dir / "lib" / ".." / "share" / "weft");
+  const auto roots = bundled_data_roots();
+  ASSERT_EQ(roots.size(), 2u);  // in place of the executable's, before the source tree
+  EXPECT_EQ(roots[0], dir / "share" / "weft");
+  EXPECT_EQ(roots[1], std::filesystem::path(WEFT_SOURCE_DIR));
+  EXPECT_EQ(find_bundled_file("verify/data/suite.json"),
+            dir / "share" / "weft" / "verify" / "data" / "suite.json");
+}

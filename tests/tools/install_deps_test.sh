@@ -14,7 +14,7 @@ bad() {
 }
 default=$("$src/scripts/install-deps.sh" --list) || bad "--list failed"
 tests=$("$src/scripts/install-deps.sh" --tests --list) || bad "--tests --list failed"
-for p in slurm-wlm munge libgtest-dev libbenchmark-dev; do
+for p in slurm-wlm munge libgtest-dev libbenchmark-dev pybind11-dev python3-pytest; do
   grep -qx "$p" <<<"$default" && bad "the default set installs $p"
   grep -qx "$p" <<<"$tests" || bad "the --tests set lacks $p"
 done

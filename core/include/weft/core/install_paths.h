@@ -11,8 +11,14 @@
 namespace weft {
 
 // Where bundled data is looked for, in order: <folder of this executable>/../share/weft (an
-// installed program, wherever its prefix was copied), then the source tree of the build.
+// installed program, wherever its prefix was copied), or the folder a front end loaded into
+// another program named (set_installed_data_root), then the source tree of the build.
 std::vector<std::filesystem::path> bundled_data_roots();
+
+// A front end loaded into another program (the Python module, python/, runs in python3, whose
+// executable says nothing about Weft's prefix) names its installed share/weft itself, from where
+// its own file lies; it then replaces the executable's.
+void set_installed_data_root(const std::filesystem::path& root);
 
 // The first regular file root / rel over 'roots'. Empty when none exists; 'tried' (when given)
 // then lists the places looked at, for the caller's error.

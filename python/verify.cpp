@@ -1,0 +1,125 @@
+// weft.verify: `weft verify` from Python (verify/plan.h, verify/whole_run.h): the plan with its
+// checks, the time check, the run without the GIL, the report folder with its plots, and
+// its metrics.json as a dict.
+#include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <optional>
+#include <sstream>
+
+#include "cli_util.h"
+#include "plot_util.h"
+#include "weft/core/error.h"
+#include "weft/verify/plan.h"
+#include "weft/verify/report.h"
+#include "weft/verify/whole_run.h"
+#include "weft_python.h"
+
+namespace weft::python {
+
+namespace {
+
+struct VerifyArgs {
+  VerifyRequest request;
+  bool plots = true, yes_long = false, progress = false;
+};
+
+// The plan, its output folder and its time checked before any work, as `weft verify` does.
+VerifyPlan checked_plan(const VerifyArgs& a) {
+  const VerifyRequest& r = a.request;
+  const VerifyPlan p = plan_verify(r);
+  cli::validate_output_paths(
+      {}, {{p.measured_path, "measured"}, {r.weave, "weave"}, {r.wif, "wif"}, {r.fiber, "fiber"}},
+      {{r.output, "output"}});
+  check_verify_output(r.output);
+  check_with_limits(a.yes_long, [&] {
+    cli::check_long_work(estimate_verify(p).least, 1.0, p.settings.threads, "", "quality",
+                         "weft verify at quality " + r.quality + (r.fit ? " with fit" : ""),
+                         kVerifyLeastRates);
+  });
+  return p;
+}
+
+py::dict verify(VerifyArgs a) {
+  if (a.request.output.empty())
+    a.request.output = py::module_::import("tempfile")
+                           .attr("mkdtemp")(py::arg("prefix") = "weft-verify-")
+                           .cast<std::string>();
+  const VerifyPlan plan = checked_plan(a);
+  CallProgress progress(a.progress);
+  VerifyHooks hooks;
+  hooks.progress = progress.callback();
+  hooks.interrupted = [progress] { return progress.interrupted(); };
+  hooks.note = [progress](const std::string& line) { progress.note(line); };
+  const std::string output = a.request.output;
+  if (a.plots)
+    hooks.draw = [output](const std::filesystem::path& staging) {
+      cli::run_plot_script("plot_verify.py",
+                           {(staging / "inplane.csv").string(), (staging / "metrics.json").string(),
+                            staging.string()},
+                           output);
+    };
+  VerifyOutcome out;
+  {
+    py::gil_scoped_release release;
+    out = run_verify_plan(plan, hooks);
+  }
+  progress.raise_if_interrupted();
+  if (out.cancelled) throw Error(output, "", "verify was cancelled; nothing was written");
+  // The file as written (its renders and timings are the report's, not the run's).
+  const std::filesystem::path file = std::filesystem::path(output) / "metrics.json";
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw Error(file.string(), "", "cannot read the report's metrics");
+  std::stringstream text;
+  text << in.rdbuf();
+  py::dict metrics = py::module_::import("json").attr("loads")(text.str());
+  metrics["report_folder"] = output;
+  return metrics;
+}
+
+}  // namespace
+
+void bind_verify(py::module_& m) {
+  m.def(
+      "verify",
+      [](const std::string& quality, const std::optional<std::filesystem::path>& output,
+         const py::object& fiber, const std::optional<std::string>& measured,
+         const std::optional<std::string>& colour_space, const std::optional<std::string>& weave,
+         const std::optional<std::string>& pattern, const std::optional<std::string>& wif,
+         uint64_t seed, int threads, const std::optional<std::string>& classic_albedo, bool fit,
+         bool plots, bool yes_long, bool progress) {
+        VerifyArgs a;
+        VerifyRequest& r = a.request;
+        r.quality = quality;
+        r.output = output ? output->string() : "";
+        r.fiber = fiber.cast<std::filesystem::path>().string();
+        r.measured = measured.value_or("");
+        r.colour_space = colour_space.value_or("");
+        r.weave = weave.value_or("");
+        r.pattern = pattern.value_or("");
+        r.wif = wif.value_or("");
+        r.seed = seed;
+        r.threads = threads;
+        r.classic_albedo = classic_albedo.value_or("");
+        r.fit = fit;
+        a.plots = plots;
+        a.yes_long = yes_long;
+        a.progress = progress;
+        return verify(std::move(a));
+      },
+      py::arg("quality") = "draft", py::kw_only(), py::arg("output") = py::none(),
+      py::arg("fiber") = VerifyRequest{}.fiber, py::arg("measured") = py::none(),
+      py::arg("colour_space") = py::none(), py::arg("weave") = py::none(),
+      py::arg("pattern") = py::none(), py::arg("wif") = py::none(),
+      py::arg("seed") = VerifyRequest{}.seed, py::arg("threads") = 0,
+      py::arg("classic_albedo") = py::none(), py::arg("fit") = false, py::arg("plots") = true,
+      py::arg("yes_long") = false, py::arg("progress") = false,
+      "`weft verify` (docs/verify.md): the computed fabric, the paper's summation and the "
+      "classic model against a measurement. Writes the report folder 'output' (default: a new "
+      "temporary folder) and returns its metrics.json as a dict, with 'report_folder' added.");
+}
+
+}  // namespace weft::python
