@@ -143,11 +143,16 @@ std::string format_seconds(double s) {
   return buf;
 }
 
+double memory_budget_bytes() {
+  const RunLimits& l = run_limits();
+  if (l.check_only && !(l.max_memory_bytes > 0)) return 0;
+  return l.max_memory_bytes > 0 ? l.max_memory_bytes : available_memory_bytes();
+}
+
 void check_memory(double bytes, const std::string& file, const std::string& field,
                   const std::string& what) {
   const RunLimits& l = run_limits();
-  if (l.check_only && !(l.max_memory_bytes > 0)) return;
-  const double budget = l.max_memory_bytes > 0 ? l.max_memory_bytes : available_memory_bytes();
+  const double budget = memory_budget_bytes();
   if (budget > 0 && bytes > budget)
     throw Error(file, field,
                 what + " needs about " + format_bytes(bytes) + " of memory, more than the " +

@@ -64,6 +64,9 @@ struct WorkWouldStart {};
 RunLimits& run_limits();
 // MemAvailable from /proc/meminfo (what can be allocated without swapping), else free pages.
 double available_memory_bytes();
+// The memory budget: --max-memory-gb, else the memory available; 0 (none) in weft slurm's check
+// without an explicit --max-memory-gb.
+double memory_budget_bytes();
 // Error(file, field, ...) when an estimate of 'bytes' exceeds the memory budget: checked before
 // allocating, so a run that cannot fit stops at once instead of dying of std::bad_alloc.
 void check_memory(double bytes, const std::string& file, const std::string& field,

@@ -47,7 +47,7 @@ TabulatedBsdfTable fiber_table(const std::string& fiber, const ProgressCallback&
       }));
 }
 
-WovenSample woven_sample(const BakeFabricOptions& o) {
+WeaveOptions weave_options(const BakeFabricOptions& o) {
   WeaveOptions given;
   if (!o.pattern.empty()) given.pattern = o.pattern;
   if (!o.wif.empty()) given.wif = o.wif;
@@ -55,7 +55,61 @@ WovenSample woven_sample(const BakeFabricOptions& o) {
     throw Error("", "wif", "give either --pattern or --wif, not both");
   given.detail = o.detail;
   const WeaveOptions base = o.weave.empty() ? WeaveOptions{} : read_weave_options(o.weave);
-  return make_woven_sample(overlay(base, given));
+  return overlay(base, given);
+}
+
+// Coarser yarn tessellations (sides = segments per crossing) tried, finest first, where the
+// default one would not fit.
+constexpr int kFittingTessellations[] = {12, 8, 6, 4};
+
+// The memory of the scene a ray trace or summation-visible builds (fabric_scene_bytes), estimated
+// from the sample's options before anything is built and checked against the budget (check_memory)
+// naming the draft. Yarn tubes whose tessellation (sides, segments per crossing) was left at its
+// default take the finest coarser one that fits instead, said in 'note', unless the run is one
+// piece of a job ('may_coarsen' false: every piece must trace the same sample, whatever memory
+// its machine has); 'bytes' gets the estimate.
+WeaveOptions fitted_weave_options(WeaveOptions w, const std::string& draft, bool may_coarsen,
+                                  std::string* note, double* bytes) {
+  WovenSampleSize z = woven_sample_size(w);
+  const double budget = memory_budget_bytes();
+  if (may_coarsen && z.detail == "yarn" && !w.sides && !w.segments_per_crossing && budget > 0 &&
+      fabric_scene_bytes(z) > budget)
+    for (const int n : kFittingTessellations) {
+      WeaveOptions c = w;
+      c.sides = c.segments_per_crossing = n;
+      const WovenSampleSize cz = woven_sample_size(c);
+      if (fabric_scene_bytes(cz) > budget && n != kFittingTessellations[3]) continue;
+      *note = "yarn tubes of " + std::to_string(z.sides) + " sides and " +
+              std::to_string(z.segments_per_crossing) + " segments per crossing would need about " +
+              format_bytes(fabric_scene_bytes(z)) + ", more than the memory budget of " +
+              format_bytes(budget) + "; traced with " + std::to_string(n) + " and " +
+              std::to_string(n) + " (about " + format_bytes(fabric_scene_bytes(cz)) +
+              "); give \"sides\" and \"segments-per-crossing\" in --weave to choose";
+      w = c, z = cz;
+      break;
+    }
+  const bool yarn = z.detail == "yarn";
+  *bytes = fabric_scene_bytes(z);
+  check_memory(*bytes, draft, "--detail",
+               "the scene at " + z.detail + " detail (" +
+                   ParamReader::fmt(yarn ? z.triangles : z.curve_points) +
+                   (yarn ? " triangles" : " curve points") + ")");
+  return w;
+}
+
+// The sample's options, its scene's memory checked (fitted_weave_options) where the method builds
+// one: the summations of the paper's method need only the sample's name. 'draft_in_weave': the
+// WIF draft the --weave file names.
+WeaveOptions sample_options(const BakeFabricOptions& o, const std::string& draft_in_weave,
+                            std::string* note, double* bytes) {
+  if (o.method == "summation") return weave_options(o);
+  const std::string draft = !o.wif.empty()            ? o.wif
+                            : !draft_in_weave.empty() ? draft_in_weave
+                                                      : o.weave;
+  const WeaveOptions w =
+      fitted_weave_options(weave_options(o), draft, o.shard.empty() && !o.resume, note, bytes);
+  if (!note->empty()) std::fprintf(stderr, "weft: %s\n", note->c_str());
+  return w;
 }
 
 std::vector<FiberOrientation> orientations(const std::vector<Vec3>& tangents) {
@@ -100,8 +154,8 @@ void check_fabric_work(const BakeFabricOptions& o) {
   check_fabric_bake(o.method, o.resolution, r.last - r.first, o.samples, o.threads, "--samples");
 }
 
-int run(const BakeFabricOptions& o) {
-  run_limits().quiet = o.quiet;
+// The ray tracer's options given to a summation, and a summation's sample count, refused.
+void check_method_options(const BakeFabricOptions& o) {
   if ((!o.shard.empty() || o.resume) && o.method != "raytrace")
     throw Error("", "--shard", "--shard and --resume need --method raytrace");
   if (o.method != "raytrace" && !o.estimator.empty())
@@ -114,6 +168,11 @@ int run(const BakeFabricOptions& o) {
   if (o.method != "raytrace" && o.split_threshold)
     throw Error("", "--split-threshold",
                 "splitting is the ray tracer's: it needs --method raytrace");
+}
+
+int run(const BakeFabricOptions& o) {
+  run_limits().quiet = o.quiet;
+  check_method_options(o);
   const FabricRaytraceOptions r =
       o.method == "raytrace" ? raytrace_options(o) : FabricRaytraceOptions{};
   // The WIF draft a weave options file names is read too.
@@ -127,9 +186,12 @@ int run(const BakeFabricOptions& o) {
   if (std::filesystem::path(o.output).extension() != ".exr" && o.shard.empty())
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
   check_fabric_work(o);
+  std::string note;
+  double scene_bytes = 0;
+  const WeaveOptions weave = sample_options(o, weave_wif, &note, &scene_bytes);
   const auto progress = progress_bar(o.quiet);
   const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
-  const WovenSample sample = woven_sample(o);
+  const WovenSample sample = make_woven_sample(weave);
   const auto t0 = std::chrono::steady_clock::now();
   TabulatedBsdfTable table;
   nlohmann::json extra;
@@ -176,10 +238,13 @@ int run(const BakeFabricOptions& o) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   table.metadata["sample"] = sample.summary.source + " (" + sample.summary.detail + ")";
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
+  if (!note.empty()) table.metadata["note"] = note;
   table.write_exr(o.output);
   nlohmann::json j = {{"output", o.output}, {"method", o.method}, {"seconds", seconds}};
   j.update(fabric_table_summary(table));
   if (extra.is_object()) j.update(extra);
+  if (!note.empty()) j["notes"] = {note};
+  if (scene_bytes > 0) j["scene_memory_estimate_bytes"] = scene_bytes;
   if (o.json) {
     std::cout << j.dump(2) << "\n";
   } else {

@@ -34,6 +34,38 @@ std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_ab
   return out;
 }
 
+namespace {
+// Measured with peak RSS (docs/PERFORMANCE.md, "Memory of the fabric scene"): what weft holds
+// before the scene (the fiber table, the program), and Embree's acceleration structure with its
+// build's scratch per triangle and per round curve segment at high build quality.
+constexpr double kFabricSceneBaseBytes = 150e6;
+constexpr double kFabricSceneBvhBytesPerTriangle = 100;
+constexpr double kFabricSceneBvhBytesPerSegment = 100;
+}  // namespace
+
+double fabric_scene_bytes(const WovenSampleSize& z) {
+  // Yarn tubes. The sample's mesh per vertex: position, normal, tangent (xyzw), uv floats; per
+  // triangle three indices; its vectors grown by push_back hold up to twice that, the
+  // description's copy exactly that. Embree's copy: 12 B per vertex, 12 B per triangle.
+  constexpr double kVertexBytes = 12 * sizeof(float), kTriangleBytes = 3 * sizeof(uint32_t);
+  constexpr double kEmbreeVertexBytes = 12, kEmbreeTriangleBytes = 12;
+  // Embree's acceleration structure over the triangles, with its build's scratch, at high build
+  // quality (render_scene.cpp): measured, docs/PERFORMANCE.md.
+  constexpr double kBvhTriangleBytes = kFabricSceneBvhBytesPerTriangle;
+  const double mesh = z.vertices * kVertexBytes + z.triangles * kTriangleBytes;
+  const double tubes = 3 * mesh + z.vertices * kEmbreeVertexBytes +
+                       z.triangles * (kEmbreeTriangleBytes + kBvhTriangleBytes);
+  // Fibers, copied nine times: per point 4 floats in the sample and its copies, 4 floats in
+  // Embree's buffer; per segment its index (4 B), neighbour flags (1 B), the segment index
+  // (first point and curve, 8 B) and the acceleration structure.
+  constexpr double kPointBytes = 4 * sizeof(float), kEmbreePointBytes = 4 * sizeof(float);
+  constexpr double kSegmentBytes = 4 + 1 + 8 + kFabricSceneBvhBytesPerSegment;
+  const double fibers =
+      z.curve_points * kPointBytes +
+      9 * (z.curve_points * (kPointBytes + kEmbreePointBytes) + z.curve_segments * kSegmentBytes);
+  return kFabricSceneBaseBytes + tubes + fibers;
+}
+
 const char* channel_sampling_name(ChannelSampling s) {
   return s == ChannelSampling::mean ? "mean" : "hero";
 }

@@ -128,7 +128,8 @@ SceneDescription tiled_geometry(const WovenSample& sample) {
     throw Error("", "detail",
                 "the ray-traced estimator needs the sample's geometry (fibers or yarn tubes); "
                 "this sample has none");
-  SceneDescription d = tiled_woven_description(sample, 1, 1, "woven sample");
+  // Instanced: the neighbours of a yarn-detail repeat cost no memory of their own.
+  SceneDescription d = tiled_woven_description(sample, 1, 1, "woven sample", true);
   MaterialBinding any;
   any.type = "lambert";
   any.field = "fabric estimator";

@@ -50,6 +50,11 @@ struct RenderScene::Geometry {
   // tolerances (float epsilon on squared lengths) that fail for fibers of micrometres in metres.
   RTCScene curve_scene = nullptr;
   double curve_scale = 1;
+  // Shifted meshes (SceneDescription::mesh_shifts): the meshes in their own scene, instanced into
+  // 'scene' once per shift with instance IDs first_mesh_instance + shift index.
+  RTCScene mesh_scene = nullptr;
+  std::vector<Vec3> mesh_shifts;
+  unsigned first_mesh_instance = 0;
   std::vector<MeshRecord> meshes;
   std::vector<CurveRecord> curve_sets;  // reserved once: Embree holds pointers to its elements
   std::vector<Bsdf> bsdfs;
@@ -67,6 +72,7 @@ struct RenderScene::Geometry {
   ~Geometry() {
     if (scene) rtcReleaseScene(scene);
     if (curve_scene) rtcReleaseScene(curve_scene);
+    if (mesh_scene) rtcReleaseScene(mesh_scene);
     if (device) rtcReleaseDevice(device);
   }
 };
@@ -80,8 +86,13 @@ void on_embree_error(void* user, RTCError code, const char* str) {
     e->message = "Embree error " + std::to_string(code) + ": " + (str ? str : "");
 }
 
-Vec3 vertex(const TriangleMesh& m, uint32_t i) {
-  return m.position(i);
+// Vertex i of 'm', moved by 'shift' (null: not moved) as a shifted copy of the mesh holds it:
+// float sums, the bits of a copy whose positions were shifted in place.
+Vec3 vertex(const TriangleMesh& m, uint32_t i, const Vec3* shift) {
+  if (!shift) return m.position(i);
+  const float* p = &m.positions[3 * size_t(i)];
+  return {p[0] + static_cast<float>(shift->x), p[1] + static_cast<float>(shift->y),
+          p[2] + static_cast<float>(shift->z)};
 }
 
 // An Embree ray query for 'ray' (single precision, no hit yet).
@@ -185,13 +196,14 @@ void fiber_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
-// Fills the hit on triangle 'prim' of 'm' at barycentrics (b1, b2).
+// Fills the hit on triangle 'prim' of 'm', moved by 'shift' (null: in place), at barycentrics
+// (b1, b2).
 void triangle_hit(const TriangleMesh& m, uint32_t prim, double b1, double b2, const Ray& ray,
-                  SurfaceHit* hit) {
+                  SurfaceHit* hit, const Vec3* shift = nullptr) {
   const uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1],
                  i2 = m.indices[3 * prim + 2];
   const double b0 = 1 - b1 - b2;
-  const Vec3 p0 = vertex(m, i0), p1 = vertex(m, i1), p2 = vertex(m, i2);
+  const Vec3 p0 = vertex(m, i0, shift), p1 = vertex(m, i1, shift), p2 = vertex(m, i2, shift);
   hit->p = b0 * p0 + b1 * p1 + b2 * p2;
   Vec3 ng = cross(p1 - p0, p2 - p0);
   const double ng_len = length(ng);
@@ -274,8 +286,9 @@ class RenderScene::Builder {
  public:
   // The Embree device and scene; checks the override mask.
   Builder(const SceneDescription& desc, const RenderSceneOptions& options);
-  void add_meshes();      // geometry ID = mesh index
-  void add_curve_sets();  // after the meshes: their fibers' shape IDs follow the meshes'
+  void add_meshes();       // geometry ID = mesh index (in the mesh scene when shifted)
+  void instance_meshes();  // one instance of the mesh scene per shift
+  void add_curve_sets();   // after the meshes: their fibers' shape IDs follow the meshes'
   void instance_curve_scene();
   std::shared_ptr<const Geometry> finish();
 
@@ -359,6 +372,11 @@ RTCGeometry RenderScene::Builder::triangle_geometry(const TriangleMesh& m) const
 }
 
 void RenderScene::Builder::add_meshes() {
+  if (!desc_.mesh_shifts.empty()) {
+    geo_->mesh_scene = rtcNewScene(geo_->device);
+    rtcSetSceneFlags(geo_->mesh_scene, RTC_SCENE_FLAG_ROBUST);
+    rtcSetSceneBuildQuality(geo_->mesh_scene, RTC_BUILD_QUALITY_HIGH);
+  }
   for (size_t i = 0; i < desc_.meshes.size(); ++i) {
     const auto& mesh = desc_.meshes[i];
     const MaterialBinding& b = binding(i, mesh->material);
@@ -371,15 +389,44 @@ void RenderScene::Builder::add_meshes() {
     emission_.push_back({b.emission ? *b.emission : gl.emission,
                          b.double_sided ? *b.double_sided : gl.double_sided});
     geo_->meshes.push_back(rec);
-    geo_->bounds.expand(mesh->bounds());
+    if (desc_.mesh_shifts.empty()) geo_->bounds.expand(mesh->bounds());
+    for (const Vec3& s : desc_.mesh_shifts) {
+      const Bounds3 b = mesh->bounds();
+      geo_->bounds.expand(Bounds3{b.lo + s, b.hi + s});
+    }
     // Geometry IDs equal mesh indices; an empty mesh simply has no Embree geometry.
     if (mesh->vertex_count() == 0 || mesh->triangle_count() == 0) continue;
 
     RTCGeometry g = triangle_geometry(*mesh);
     rtcCommitGeometry(g);
-    rtcAttachGeometryByID(geo_->scene, g, static_cast<unsigned>(i));
+    rtcAttachGeometryByID(geo_->mesh_scene ? geo_->mesh_scene : geo_->scene, g,
+                          static_cast<unsigned>(i));
     rtcReleaseGeometry(g);
     geo_->triangles += mesh->triangle_count();
+  }
+}
+
+void RenderScene::Builder::instance_meshes() {
+  if (!geo_->mesh_scene) return;
+  for (size_t i = 0; i < emission_.size(); ++i)
+    if (!emission_[i].radiance.is_black())
+      throw Error(desc_.source, "mesh_shifts",
+                  "mesh " + std::to_string(i) +
+                      " emits light: shifted copies of emissive meshes are not supported");
+  rtcCommitScene(geo_->mesh_scene);
+  geo_->mesh_shifts = desc_.mesh_shifts;
+  geo_->first_mesh_instance = static_cast<unsigned>(desc_.shape_count() + 1);
+  for (size_t q = 0; q < geo_->mesh_shifts.size(); ++q) {
+    const Vec3& s = geo_->mesh_shifts[q];
+    RTCGeometry inst = rtcNewGeometry(geo_->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rtcSetGeometryInstancedScene(inst, geo_->mesh_scene);
+    const auto dx = static_cast<float>(s.x), dy = static_cast<float>(s.y),
+               dz = static_cast<float>(s.z);
+    const float xfm[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, dx, dy, dz};  // 3 x 4, column-major
+    rtcSetGeometryTransform(inst, 0, RTC_FORMAT_FLOAT3X4_COLUMN_MAJOR, xfm);
+    rtcCommitGeometry(inst);
+    rtcAttachGeometryByID(geo_->scene, inst, geo_->first_mesh_instance + static_cast<unsigned>(q));
+    rtcReleaseGeometry(inst);
   }
 }
 
@@ -519,6 +566,7 @@ std::shared_ptr<const RenderScene::Geometry> RenderScene::Builder::finish() {
 RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions& options) {
   Builder b(desc, options);
   b.add_meshes();
+  b.instance_meshes();
   b.add_curve_sets();
   b.instance_curve_scene();
   geo_ = b.finish();
@@ -574,6 +622,15 @@ bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fibe
   hit->shape = rh.hit.geomID;
   if (rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID && rh.hit.geomID < geo_->meshes.size()) {
     triangle_hit(*geo_->meshes[rh.hit.geomID].mesh, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit);
+    hit->fiber = kNoFiber;
+    hit->segment = 0;
+    return true;
+  }
+  if (geo_->mesh_scene && rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID &&
+      rh.hit.instID[0] >= geo_->first_mesh_instance) {
+    const Vec3& shift = geo_->mesh_shifts[rh.hit.instID[0] - geo_->first_mesh_instance];
+    triangle_hit(*geo_->meshes[rh.hit.geomID].mesh, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit,
+                 &shift);
     hit->fiber = kNoFiber;
     hit->segment = 0;
     return true;

@@ -106,6 +106,7 @@ struct Resolved {
   std::string source;
   std::vector<std::array<double, 3>> warp_rgb, weft_rgb;  // per repeat thread (WIF only)
   Interlacing repeat;
+  double curve_points = 0, curves = 0;  // estimated (fiber detail)
 };
 
 // The detail, repeat counts and tessellation, checked; the tessellation goes to r.layout.
@@ -248,11 +249,11 @@ detail::FiberSettings fiber_settings(const WeaveOptions& o) {
 }
 
 // The fibers' curve points, estimated (fibers per yarn from the packing unless given) before
-// anything is allocated.
-void check_curve_point_count(const Resolved& r, const ThreadSizes& t) {
+// anything is allocated; 'curves' gets the fibers' count.
+double curve_point_count(const Resolved& r, const ThreadSizes& t, double* curves = nullptr) {
   const detail::FiberSettings& fs = r.fibers;
   const int segments_per_crossing = r.layout.segments_per_crossing;
-  double points = 0;
+  double points = 0, fibers = 0;
   auto count = [&](const std::vector<ThreadSize>& ts, double yarns_per_thread, double along) {
     for (const ThreadSize& s : ts) {
       const double area = 2 * s.width_mm * s.thickness_mm / kPi;  // lens
@@ -261,10 +262,18 @@ void check_curve_point_count(const Resolved& r, const ThreadSizes& t) {
               ? fs.fibers_per_yarn
               : std::max(1.0, std::round(fs.packing * area / (kPi * fs.radius_mm * fs.radius_mm)));
       points += n * yarns_per_thread * (along * segments_per_crossing + 1);
+      fibers += n * yarns_per_thread;
     }
   };
   count(t.warp, r.repeats_z, tile_wefts(r));
   count(t.weft, r.repeats_x, tile_warps(r));
+  if (curves) *curves = fibers;
+  return points;
+}
+
+void check_curve_point_count(Resolved& r, const ThreadSizes& t) {
+  const detail::FiberSettings& fs = r.fibers;
+  const double points = r.curve_points = curve_point_count(r, t, &r.curves);
   if (points > kMaxCurvePoints)
     bad(fs.fibers_per_yarn > 0 ? "fibers-per-yarn" : "packing",
         "the sample would have " + ParamReader::fmt(points) +
@@ -701,6 +710,34 @@ WeaveOptions read_weave_options(const std::filesystem::path& json_file) {
   const nlohmann::json j = parse_json(text.str(), json_file.string());
   ParamReader r(j, json_file.string(), "");  // keeps a reference to j
   return read_weave_options(r, json_file.parent_path());
+}
+
+WovenSampleSize woven_sample_size(const WeaveOptions& options) {
+  WovenSampleSize z;
+  if (options.pattern == kNonwovenPattern) {  // a small mat (nonwoven.h): its counts as built
+    const WeaveSummary s = make_nonwoven_sample(options).summary;
+    z.detail = s.detail;
+    z.curves = double(s.curves), z.curve_points = double(s.curve_points);
+    z.curve_segments = double(s.curve_segments);
+    return z;
+  }
+  const Resolved r = resolve(options);
+  const Layout& L = r.layout;
+  z.detail = r.detail;
+  z.sides = L.sides;
+  z.segments_per_crossing = L.segments_per_crossing;
+  if (r.fiber_detail) {
+    z.curves = r.curves, z.curve_points = r.curve_points;
+    z.curve_segments = r.curve_points - r.curves;
+    return z;
+  }
+  // Each yarn a tube of K = crossings x segments rings of M sides (append_yarn_tube).
+  for (const YarnPath& y : L.yarns) {
+    const double K = double(y.crossing.size()) * L.segments_per_crossing, M = L.sides;
+    z.triangles += 2 * K * M;
+    z.vertices += (K + 1) * (M + 1);
+  }
+  return z;
 }
 
 WovenSample make_woven_sample(const WeaveOptions& options) {

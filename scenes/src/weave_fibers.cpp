@@ -706,7 +706,7 @@ SceneDescription fiber_patch_description(WeaveOptions options, const std::string
 }
 
 SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, int half_z,
-                                         const std::string& source) {
+                                         const std::string& source, bool instanced) {
   for (const auto& [half, field] : {std::pair{half_x, "half_x"}, std::pair{half_z, "half_z"}})
     if (half < 0 || half > 64)
       throw Error(source, field, "copies on each side must lie in [0, 64]");
@@ -733,7 +733,14 @@ SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, 
         }
         d.curves.push_back(std::make_shared<const FiberCurves>(std::move(c)));
       }
-  else
+  else if (instanced) {
+    for (const auto& mesh : sample.meshes) d.meshes.push_back(std::make_shared<TriangleMesh>(mesh));
+    for (int i = -half_x; i <= half_x; ++i)
+      for (int k = -half_z; k <= half_z; ++k) {
+        const auto [dx, dz] = shift(i, k);
+        d.mesh_shifts.push_back({dx, 0, dz});
+      }
+  } else
     for (const auto& mesh : sample.meshes)
       for (int i = -half_x; i <= half_x; ++i)
         for (int k = -half_z; k <= half_z; ++k) {

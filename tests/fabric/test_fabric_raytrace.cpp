@@ -8,6 +8,7 @@
 
 #include "flat_sheet.h"
 #include "test_util.h"
+#include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/fabric/fabric_raytrace.h"
@@ -681,3 +682,43 @@ TEST(FabricRaytrace, ALosslessFiberCreatesNoEnergyInAnyIncidentBin) {
     }
   }
 }
+
+namespace {
+
+const std::string kWifDir = std::string(WEFT_SOURCE_DIR) + "/scenes/data/wif/";
+
+// The scene's memory estimate (fabric_scene_bytes) grows with the sample and, for the bundled
+// 84 x 100 draft at yarn detail (8.6 M triangles, weave_test's count), stays under 24 GB, the
+// memory of the machine docs/PERFORMANCE.md measures on: the repeat's eight neighbours are
+// instances, so they cost nothing per triangle. The estimate against measured peak RSS:
+// scripts/fabric-memory.sh (docs/PERFORMANCE.md, "Memory of the fabric scene").
+TEST(FabricSceneBytes, TheBundledLargeDraftFitsAtYarnDetail) {
+  WeaveOptions o;
+  o.wif = kWifDir + "8452.wif";
+  const WovenSampleSize yarn = woven_sample_size(o);
+  const double bytes = fabric_scene_bytes(yarn);
+  EXPECT_LT(bytes, 24e9);
+  // More than the sample's own vertices and triangles: an estimate, not a floor of zero.
+  EXPECT_GT(bytes, yarn.vertices * 48 + yarn.triangles * 12);
+  WeaveOptions coarse = o;
+  coarse.sides = coarse.segments_per_crossing = 4;
+  EXPECT_LT(fabric_scene_bytes(woven_sample_size(coarse)), bytes / 4);
+}
+
+// A short ray trace on the bundled 84 x 100 draft completes; at 4 sides and 4 segments per
+// crossing (540 000 triangles) to keep the test short; the default tessellation's run is in
+// docs/PERFORMANCE.md. Every particle is traced and some scatter.
+TEST(FabricSceneBytes, AShortRayTraceOnTheLargeDraftCompletes) {
+  WeaveOptions o;
+  o.wif = kWifDir + "8452.wif";
+  o.sides = o.segments_per_crossing = 4;
+  const WovenSample s = make_woven_sample(o);
+  ASSERT_EQ(s.summary.triangles, 2u * 8400 * 4 * 4 * 2);
+  const auto fiber = uniform_fiber(2, 0.5 * kInvPi);
+  const FabricRaytraceResult r = raytrace_fabric_table(s, fiber, options(1, 200));
+  EXPECT_FALSE(r.cancelled);
+  EXPECT_EQ(r.particles, 200u * DirectionGrid{1}.bins());
+  EXPECT_GT(r.scatterings, 0u);
+}
+
+}  // namespace

@@ -443,3 +443,29 @@ TEST(CliBadInput, LongSummationNeedsConfirmation) {
                dir / "t.exr");
   EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
 }
+
+namespace {
+
+// The scene of a ray trace or summation-visible is estimated before anything is built
+// (fabric_scene_bytes, docs/weave.md "Large drafts"): over the budget it is refused naming the
+// draft and the estimate, before the fiber table is baked. The bundled 84 x 100 draft's yarn
+// tubes need about 2.1 GB at 16 x 16 and 0.28 GB at the coarsest 4 x 4 (docs/PERFORMANCE.md), so
+// 0.2 GB fits no tessellation; at fiber detail it needs about 9.7 GB.
+TEST(CliBadInput, FabricSceneOverTheMemoryBudgetIsRefusedNamingTheDraft) {
+  const fs::path dir = fresh_test_dir();
+  const std::string draft = std::string(WEFT_SOURCE_DIR) + "/scenes/data/wif/8452.wif";
+  for (const char* method : {"raytrace", "summation-visible"})
+    expect_error(run(std::string("--max-memory-gb 0.2 bake fabric --method ") + method +
+                         " -R 1 --wif '" + draft + "' -o t.exr",
+                     dir),
+                 {"8452.wif", "field '--detail'", "the scene at yarn detail", "needs about",
+                  "allowed by --max-memory-gb"},
+                 dir / "t.exr");
+  expect_error(run("--max-memory-gb 3 bake fabric --method raytrace --detail fiber -R 1 --wif '" +
+                       draft + "' -o t.exr",
+                   dir),
+               {"8452.wif", "the scene at fiber detail", "needs about 9.7 GB"}, dir / "t.exr");
+  EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
+}
+
+}  // namespace

@@ -137,6 +137,14 @@ void fabric_raytrace_totals(FabricRaytraceResult& result);
 // estimates a ray trace's time with it before starting.
 inline constexpr double kMinSecondsPerFabricParticle = 0.25e-6;
 
+// The peak memory, bytes, of the scene the ray trace flies its particles through (and that
+// visible_fiber_tangents, for summation-visible, looks at) on a sample of this size, from the
+// sample's counts alone, before anything is built: the sample, the scene description's copy of
+// it (yarn tubes once, instanced at the eight neighbours; fibers copied nine times) and Embree's
+// buffers and acceleration structures, at per-primitive sizes measured with peak RSS on the
+// bundled samples (docs/PERFORMANCE.md). A front end refuses a run over its memory budget with it.
+double fabric_scene_bytes(const WovenSampleSize& size);
+
 // The fiber directions seen at the cloth's surface, for the summations: the unit tangents (cloth
 // frame) at the first hits of a rays_per_side x rays_per_side grid of rays along the normal over
 // one repeat, from above (views on the cloth's face) or from below. Each stands for an equal share

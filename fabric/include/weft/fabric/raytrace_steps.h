@@ -88,7 +88,8 @@ Particle launched_particle(const Launch& l, int channels, const Strategies& st, 
 
 // --- flight and the periodic wrap
 // The scene the particles fly through: the repeat and its eight neighbours (weave.h
-// tiled_woven_description with one copy on each side), geometry only. weft::Error when the
+// tiled_woven_description with one copy on each side; yarn tubes instanced, so the neighbours
+// take no memory of their own), geometry only. weft::Error when the
 // sample has neither fibers nor yarn tubes.
 SceneDescription tiled_geometry(const WovenSample& sample);
 // Along the line p + t d: the distance to the first side of the repeat it crosses (side 0: -x,

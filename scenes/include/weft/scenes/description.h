@@ -82,6 +82,12 @@ struct SceneDescription {
   std::filesystem::path base_dir = ".";
   std::vector<std::shared_ptr<const TriangleMesh>> meshes;
   std::vector<std::shared_ptr<const FiberCurves>> curves;  // shapes meshes.size() + k
+  // Placements of the meshes, each a shift (metres, float values): empty, every mesh once where it
+  // is; else RenderScene traces every mesh at each shift, one stored copy and one acceleration
+  // structure reached through Embree instances (a periodic sample's neighbours without their
+  // memory). A hit's shape is then the mesh's index whatever the placement. Curves are never
+  // shifted; emissive meshes cannot be (the area light samples the stored triangles).
+  std::vector<Vec3> mesh_shifts;
   FiberGeometry fiber_geometry;                            // how RenderScene builds the curves
   std::map<std::string, GltfMaterialInfo> gltf_materials;  // emissive info by binding key
   std::map<std::string, MaterialBinding> materials;        // bindings by key

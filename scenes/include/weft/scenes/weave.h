@@ -158,6 +158,19 @@ struct WovenSample {
 // sample. Deterministic: equal options give equal samples.
 WovenSample make_woven_sample(const WeaveOptions& options);
 
+// The size of the sample make_woven_sample would build, from its options alone: the same checks
+// (weft::Error naming the field) but no geometry, for memory estimates before anything is
+// allocated. Yarn detail: its tubes' triangles and vertices exactly, with the tessellation they
+// take; fiber detail: its fibers and curve points as estimated from the packing (the count the
+// curve-point limit is checked on). A nonwoven mat (at most 20 000 fibers) is built and counted.
+struct WovenSampleSize {
+  std::string detail;
+  int sides = 0, segments_per_crossing = 0;  // yarn detail's tessellation
+  double triangles = 0, vertices = 0;
+  double curves = 0, curve_points = 0, curve_segments = 0;
+};
+WovenSampleSize woven_sample_size(const WeaveOptions& options);
+
 // Minimum distance between centre-line segments of distinct fibers, periodic copies in x and z
 // included, looked for within 'cutoff_m' with a uniform grid (not all pairs). Returns cutoff_m
 // when no two segments come closer.
@@ -188,9 +201,12 @@ SceneDescription fiber_patch_description(WeaveOptions options, const std::string
 // fiber detail copy q is curve set q (fiber c of the sample in it is fiber id q * curves + c,
 // RenderScene numbering fibers set by set); at yarn detail copy q of the sample's mesh m is mesh
 // m * copies + q. No materials are bound. weft::Error naming 'source' when the sample has no
-// geometry or no period, or half_x, half_z lie outside [0, 64].
+// geometry or no period, or half_x, half_z lie outside [0, 64]. 'instanced' (yarn detail): the
+// sample's meshes are stored once and placed at every copy by SceneDescription::mesh_shifts
+// (copy q at mesh_shifts[q]; RenderScene traces them as instances, a hit's shape is mesh m), the
+// memory of one repeat instead of (2 half_x + 1) (2 half_z + 1); fibers are copied either way.
 SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, int half_z,
-                                         const std::string& source);
+                                         const std::string& source, bool instanced = false);
 
 // ---------------------------------------------------------------------------------------------
 // The open-mesh plain-weave patch of earlier versions (circular tubes around sinusoidal centre
