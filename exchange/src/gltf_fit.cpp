@@ -3,6 +3,7 @@
 #include <optional>
 
 #include "weft/core/error.h"
+#include "weft/core/math.h"
 #include "weft/core/optimize.h"
 #include "weft/exchange/gltf_material.h"
 #include "weft/exchange/table_view.h"
@@ -94,7 +95,8 @@ GltfFit fit_gltf_material(const TabulatedBsdfTable& table, const GltfFitOptions&
   for (const auto& p : pairs) mean += p.target;
   std::vector<double> u0(8);
   for (int c = 0; c < 3; ++c)
-    u0[static_cast<size_t>(c)] = std::clamp(mean[c] * 3.14159 / pairs.size(), 0.0, 1.0);
+    u0[static_cast<size_t>(c)] =
+        std::clamp(mean[c] * kPi / static_cast<double>(pairs.size()), 0.0, 1.0);
   u0[3] = 0.7;
   for (int c = 4; c < 7; ++c) u0[static_cast<size_t>(c)] = 0.2;
   u0[7] = 0.5;

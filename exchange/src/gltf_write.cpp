@@ -81,7 +81,7 @@ tinygltf::Value rgb_value(const Rgb& c) {
       tinygltf::Value::Array{tinygltf::Value(c.r), tinygltf::Value(c.g), tinygltf::Value(c.b)});
 }
 
-tinygltf::Material make_material(const GltfFit& fit, const std::string& name) {
+tinygltf::Material make_material(const GltfFit& fit, const std::string& name, double eps) {
   const GltfMaterial& g = fit.material;
   tinygltf::Material mat;
   mat.name = name;
@@ -99,8 +99,9 @@ tinygltf::Material make_material(const GltfFit& fit, const std::string& name) {
       {"weft_fit_rms_log", tinygltf::Value(fit.rms_log)},
       {"weft_fit_points", tinygltf::Value(fit.points)},
       {"weft_fit_error",
-       tinygltf::Value(std::string("RMS over view x light bin centres and RGB of "
-                                   "log((f_gltf + 0.01/sr) / (f_table + 0.01/sr))"))},
+       tinygltf::Value("RMS over view x light bin centres and RGB of log((f_gltf + eps) / "
+                       "(f_table + eps)), eps = " +
+                       std::to_string(eps) + " / sr")},
       {"weft_source", tinygltf::Value(name)}});
   return mat;
 }
@@ -119,7 +120,7 @@ ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::fil
   m.extensionsUsed.push_back("KHR_materials_sheen");
   if (fit.material.transmission > 0) m.extensionsUsed.push_back("KHR_materials_transmission");
   add_quad(m);
-  m.materials.push_back(make_material(fit, name));
+  m.materials.push_back(make_material(fit, name, options.epsilon_per_sr));
   std::ostringstream out;
   tinygltf::TinyGLTF writer;
   if (!writer.WriteGltfSceneToStream(&m, out, true, ext == ".glb"))

@@ -132,6 +132,11 @@ void add_slice(const TableView& view, const RglOptions& o, const UGrid& ndf, dou
         slab[static_cast<size_t>((c * ns + y) * ns + x)] = f[static_cast<size_t>(c)];
     }
   for (double v : slab) out.values.push_back(static_cast<float>(v));
+  // The luminance only steers sampling; an incidence that reflects nothing is sampled uniformly
+  // (an all-zero slice cannot be normalized by the renderers).
+  const auto first = out.luminance.end() - ns * ns;
+  if (std::all_of(first, out.luminance.end(), [](float v) { return v == 0; }))
+    std::fill(first, out.luminance.end(), 1.0f);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 //    w_o the mirror of w_i about the microfacet normal m the warp maps the grid point to; f is the
 //    Weft table interpolated (TableView::isotropic). The renderers multiply back by
 //    D(m) / (4 sigma(w_i)), so the value is exact at the grid points and interpolated between.
+//    The luminance steers sampling only; an incidence that reflects nothing gets a uniform one.
 // Here w_i is the direction the renderer conditions on (towards the viewer, Weft's wo) and w_o
 // the other (towards the light, Weft's wi): the renderers gather f cos theta_light.
 // Spectral tables write 'spectra' + 'wavelengths' (the 33 band centres, 390..710 nm), which both
