@@ -13,8 +13,8 @@ using AddCommand = void(CLI::App& parent, Commands& commands);
 
 AddCommand add_slab_command, add_spectrum_command, add_bake_command, add_bench_command,
     add_mie_command, add_medium_command, add_table_command, add_render_command, add_sweep_command,
-    add_weave_command, add_compare_command, add_merge_command, add_slurm_command,
-    add_scene_command;
+    add_weave_command, add_compare_command, add_merge_command, add_slurm_command, add_scene_command,
+    add_export_command;
 
 // The "fabric" subcommand of the "bake" group (cmd_bake_fabric.cpp).
 AddCommand add_bake_fabric_command;

@@ -362,3 +362,28 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   expect_refused(sum + " --estimator hero", out, "--estimator", dir);
   expect_refused(sum + " --split-threshold 2", out, "--split-threshold", dir);
 }
+
+TEST(Cli, ExportWritesTheFormatItsExtensionNamesAndRefusesOthers) {
+  // A small Lambert table; the formats' contents are checked in tests/exchange, here the command:
+  // its summary, its output guard and its errors naming the option.
+  const fs::path dir = fresh_test_dir();
+  const fs::path table = dir / "lambert.exr";
+  ASSERT_EQ(run("table bake lambert --params '{\"reflectance\": 0.5}' -R 4 --spp 1 --quiet -o '" +
+                    table.string() + "'",
+                dir)
+                .exit_code,
+            0);
+  const fs::path out = dir / "lambert.mbsdf";
+  const CliRun ok = run("export --json '" + table.string() + "' -o '" + out.string() + "'", dir);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  const auto j = nlohmann::json::parse(ok.out);
+  EXPECT_EQ(j["format"], "MDL .mbsdf");
+  EXPECT_FALSE(j["dropped"].empty());
+  EXPECT_TRUE(fs::exists(out));
+  for (const std::string bad : {"lambert.txt", "no-folder/lambert.bsdf"}) {
+    const CliRun r = run("export '" + table.string() + "' -o '" + (dir / bad).string() + "'", dir);
+    EXPECT_EQ(r.exit_code, 2) << r.err;
+    EXPECT_NE(r.err.find("--output"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(dir / bad));
+  }
+}

@@ -1,0 +1,71 @@
+#pragma once
+// A table as a glTF 2.0 material: the core metallicRoughness model (metallic 0, the dielectric of
+// the specification's Appendix B: Lambert base weighted by 1 - F, GGX specular with the separable
+// Smith visibility, Schlick F with F0 = 0.04) under KHR_materials_sheen (Charlie distribution and
+// visibility, alpha = sheenRoughness, the base scaled by the albedo-scaling term
+// min(1 - max(sheenColor) E(n.v), 1 - max(sheenColor) E(n.l)), E the sheen's directional albedo,
+// here integrated numerically), and KHR_materials_transmission where the fabric transmits notably
+// (the diffuse base weighted by 1 - transmission). The reflection parameters are fitted to the
+// table by the project's optimizer (core/optimize.h, Levenberg-Marquardt) on the RMS of
+// log((f_model + eps) / (f_table + eps)) over the table's grid: view and light at the centres of
+// the upper hemisphere's bins (a grid of resolution min(R, 8)), RGB channels (spectral tables in
+// linear sRGB under D65), eps = 0.01 / sr so that near-black cells do not dominate.
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "weft/core/spectrum.h"
+#include "weft/core/vec.h"
+#include "weft/exchange/export_report.h"
+#include "weft/materials/bsdf_table.h"
+
+namespace weft {
+
+struct GltfMaterial {
+  Rgb base_color{0.5};
+  double roughness = 0.7;
+  Rgb sheen_color{0.0};
+  double sheen_roughness = 0.5;
+  double transmission = 0;  // 0: no KHR_materials_transmission
+};
+
+// The sheen's directional albedo E(cos theta) for one sheen roughness (colour 1), tabulated at
+// 32 cosines and interpolated linearly.
+class SheenAlbedo {
+ public:
+  explicit SheenAlbedo(double sheen_roughness);
+  double operator()(double cos_theta) const;
+
+ private:
+  std::vector<double> e_;
+};
+// The Charlie sheen lobe (colour 1): D * V, V including 1 / (4 n.l n.v).
+double charlie_sheen(double sheen_roughness, const Vec3& wo, const Vec3& wi);
+
+// f in 1/sr of the material for view wo and light wi (local frame, z the normal); 0 unless both
+// are above the surface. 'e' is SheenAlbedo(m.sheen_roughness).
+Rgb gltf_brdf(const GltfMaterial& m, const SheenAlbedo& e, const Vec3& wo, const Vec3& wi);
+
+struct GltfFit {
+  GltfMaterial material;
+  double rms_log = 0;        // the fit's error (see above)
+  double rms_log_start = 0;  // at the start point
+  int points = 0;            // direction pairs compared
+  int evaluations = 0;
+  double transmittance = 0;  // the table's mean hemispherical transmittance (view from above)
+};
+struct GltfFitOptions {
+  int max_resolution = 8;  // the comparison grid: min(R, this)
+  int max_evaluations = 400;
+  double epsilon_per_sr = 0.01;          // eps of the log error
+  double transmission_threshold = 0.05;  // mean transmittance above which transmission is written
+};
+GltfFit fit_gltf_material(const TabulatedBsdfTable& table, const GltfFitOptions& options = {});
+
+// Writes a glTF 2.0 asset (.gltf, buffer embedded as a data URI, or .glb by the extension): one
+// 1 m x 1 m double-sided quad carrying the fitted material, the fit's error and source in the
+// material's extras. Atomic.
+ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::filesystem::path& path,
+                                 const std::string& name, const GltfFitOptions& options = {});
+
+}  // namespace weft

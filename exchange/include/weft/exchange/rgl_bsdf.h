@@ -1,0 +1,45 @@
+#pragma once
+// A table as an RGL material file (.bsdf; Dupuy & Jakob 2018, "An Adaptive Parameterization for
+// Efficient Material Acquisition and Rendering"), which Mitsuba 3's `measured` BSDF and pbrt-v4's
+// `measured` material read. The format holds one reflection lobe on the upper side, isotropic
+// here (phi_i has one value), in the paper's adaptive parameterization:
+//  - ndf D(theta_m) and sigma(theta_i) = int D(m) <m . w_i> dm on a grid of u = sqrt(2 theta / pi)
+//    (rows: phi in u, two identical rows). D is the paper's retro-reflection estimate: with
+//    G2 ~ G1 = cos theta / sigma, f(w, w) = D(w) / (4 sigma(w) cos theta), solved for D by fixed
+//    point iteration from a flat surface (sigma = cos theta), normalized to int D cos = 1.
+//  - vndf: per theta_i, the visible normals' density D(m) <m . w_i> / sigma(w_i) in the
+//    (u_theta_m, u_phi_m - phi_i) square (times the square's Jacobian 2 pi^2 u sin theta_m).
+//  - luminance and rgb / spectra: per theta_i, on an n x n grid of the VNDF warp's sample space,
+//    the value f(w_i, w_o) cos theta_o 4 sigma(w_i) / D(m) (the file's 'jacobian' = 1), with
+//    w_o the mirror of w_i about the microfacet normal m the warp maps the grid point to; f is the
+//    Weft table interpolated (TableView::isotropic). The renderers multiply back by
+//    D(m) / (4 sigma(w_i)), so the value is exact at the grid points and interpolated between.
+//    The luminance steers sampling only; an incidence that reflects nothing gets a uniform one.
+// Here w_i is the direction the renderer conditions on (towards the viewer, Weft's wo) and w_o
+// the other (towards the light, Weft's wi): the renderers gather f cos theta_light.
+// Spectral tables write 'spectra' + 'wavelengths' (the 33 band centres, 390..710 nm), which both
+// renderers read; RGB tables write 'rgb', which only Mitsuba 3's RGB variants read (pbrt-v4 needs
+// a spectral table).
+#include <filesystem>
+#include <string>
+
+#include "weft/exchange/export_report.h"
+#include "weft/materials/bsdf_table.h"
+
+namespace weft {
+
+struct RglOptions {
+  int theta_i_count = 17;      // incidence angles, theta_k = (k / (count - 1))^2 * 90 deg
+  int ndf_resolution = 65;     // ndf and sigma nodes in u; (this - 1) a multiple of the above - 1
+  int vndf_resolution = 48;    // vndf: n x n
+  int sample_resolution = 32;  // luminance and rgb / spectra: n x n
+  int azimuths = 16;           // rotations averaged for the isotropic table
+  std::string description;     // the file's 'description' field
+  void validate() const;       // weft::Error naming the field
+};
+
+// Writes the file atomically; weft::Error naming the file and field on failure.
+ExportReport write_rgl_bsdf(const TabulatedBsdfTable& table, const std::filesystem::path& path,
+                            const RglOptions& options = {});
+
+}  // namespace weft

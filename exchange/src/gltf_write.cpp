@@ -1,0 +1,155 @@
+#include <tiny_gltf.h>
+
+#include <cstring>
+#include <sstream>
+
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
+#include "weft/exchange/gltf_material.h"
+
+namespace weft {
+namespace {
+
+template <class T>
+void append(std::vector<unsigned char>& out, const std::vector<T>& v) {
+  const size_t at = out.size();
+  out.resize(at + v.size() * sizeof(T));
+  std::memcpy(out.data() + at, v.data(), v.size() * sizeof(T));
+}
+
+// One accessor over a fresh buffer view of 'bytes' bytes at 'offset' of buffer 0.
+int add_accessor(tinygltf::Model& m, size_t offset, size_t bytes, int component, int type,
+                 size_t count, int target) {
+  tinygltf::BufferView bv;
+  bv.buffer = 0;
+  bv.byteOffset = offset;
+  bv.byteLength = bytes;
+  bv.target = target;
+  m.bufferViews.push_back(bv);
+  tinygltf::Accessor a;
+  a.bufferView = static_cast<int>(m.bufferViews.size() - 1);
+  a.componentType = component;
+  a.type = type;
+  a.count = count;
+  m.accessors.push_back(a);
+  return static_cast<int>(m.accessors.size() - 1);
+}
+
+// The quad: 1 m x 1 m in the x-z plane, facing +y (glTF's up).
+void add_quad(tinygltf::Model& m) {
+  const std::vector<float> pos{-0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 0.5f, 0, -0.5f, -0.5f, 0, -0.5f};
+  const std::vector<float> nrm{0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+  const std::vector<float> uv{0, 0, 1, 0, 1, 1, 0, 1};
+  const std::vector<uint16_t> idx{0, 1, 2, 0, 2, 3};
+  tinygltf::Buffer buffer;
+  append(buffer.data, pos);
+  append(buffer.data, nrm);
+  append(buffer.data, uv);
+  append(buffer.data, idx);
+  m.buffers.push_back(buffer);
+  const int p = add_accessor(m, 0, 48, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 4,
+                             TINYGLTF_TARGET_ARRAY_BUFFER);
+  m.accessors[static_cast<size_t>(p)].minValues = {-0.5, 0, -0.5};
+  m.accessors[static_cast<size_t>(p)].maxValues = {0.5, 0, 0.5};
+  const int n = add_accessor(m, 48, 48, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 4,
+                             TINYGLTF_TARGET_ARRAY_BUFFER);
+  const int t = add_accessor(m, 96, 32, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, 4,
+                             TINYGLTF_TARGET_ARRAY_BUFFER);
+  const int i = add_accessor(m, 128, 12, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                             TINYGLTF_TYPE_SCALAR, 6, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  tinygltf::Primitive prim;
+  prim.attributes = {{"POSITION", p}, {"NORMAL", n}, {"TEXCOORD_0", t}};
+  prim.indices = i;
+  prim.material = 0;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  tinygltf::Mesh mesh;
+  mesh.name = "fabric_sample";
+  mesh.primitives.push_back(prim);
+  m.meshes.push_back(mesh);
+  tinygltf::Node node;
+  node.mesh = 0;
+  node.name = "fabric_sample";
+  m.nodes.push_back(node);
+  tinygltf::Scene scene;
+  scene.nodes = {0};
+  m.scenes.push_back(scene);
+  m.defaultScene = 0;
+}
+
+tinygltf::Value rgb_value(const Rgb& c) {
+  return tinygltf::Value(
+      tinygltf::Value::Array{tinygltf::Value(c.r), tinygltf::Value(c.g), tinygltf::Value(c.b)});
+}
+
+tinygltf::Material make_material(const GltfFit& fit, const std::string& name, double eps) {
+  const GltfMaterial& g = fit.material;
+  tinygltf::Material mat;
+  mat.name = name;
+  mat.doubleSided = true;
+  mat.pbrMetallicRoughness.baseColorFactor = {g.base_color.r, g.base_color.g, g.base_color.b, 1};
+  mat.pbrMetallicRoughness.metallicFactor = 0;
+  mat.pbrMetallicRoughness.roughnessFactor = g.roughness;
+  mat.extensions["KHR_materials_sheen"] = tinygltf::Value(
+      tinygltf::Value::Object{{"sheenColorFactor", rgb_value(g.sheen_color)},
+                              {"sheenRoughnessFactor", tinygltf::Value(g.sheen_roughness)}});
+  if (g.transmission > 0)
+    mat.extensions["KHR_materials_transmission"] = tinygltf::Value(
+        tinygltf::Value::Object{{"transmissionFactor", tinygltf::Value(g.transmission)}});
+  mat.extras = tinygltf::Value(tinygltf::Value::Object{
+      {"weft_fit_rms_log", tinygltf::Value(fit.rms_log)},
+      {"weft_fit_points", tinygltf::Value(fit.points)},
+      {"weft_fit_error",
+       tinygltf::Value("RMS over view x light bin centres and RGB of log((f_gltf + eps) / "
+                       "(f_table + eps)), eps = " +
+                       std::to_string(eps) + " / sr")},
+      {"weft_source", tinygltf::Value(name)}});
+  return mat;
+}
+
+}  // namespace
+
+ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::filesystem::path& path,
+                                 const std::string& name, const GltfFitOptions& options) {
+  const std::string ext = path.extension().string();
+  if (ext != ".gltf" && ext != ".glb")
+    throw Error(path.string(), "output", "a glTF file ends in .gltf or .glb");
+  const GltfFit fit = fit_gltf_material(table, options);
+  tinygltf::Model m;
+  m.asset.version = "2.0";
+  m.asset.generator = std::string("Weft ") + WEFT_VERSION + " (weft export)";
+  m.extensionsUsed.push_back("KHR_materials_sheen");
+  if (fit.material.transmission > 0) m.extensionsUsed.push_back("KHR_materials_transmission");
+  add_quad(m);
+  m.materials.push_back(make_material(fit, name, options.epsilon_per_sr));
+  std::ostringstream out;
+  tinygltf::TinyGLTF writer;
+  if (!writer.WriteGltfSceneToStream(&m, out, true, ext == ".glb"))
+    throw Error(path.string(), "", "tinygltf could not write the asset");
+  write_text_atomically(path, out.str());
+  ExportReport r{"glTF 2.0", {}, {}, {}};
+  r.dropped = {"the table's angular detail beyond the fitted lobes (see the fit's error)",
+               "anisotropy", "the back side (one material for both sides)"};
+  if (fit.material.transmission > 0)
+    r.notes.push_back(
+        "transmission written as KHR_materials_transmission (glTF's transmission "
+        "is a rough specular BTDF, not the fabric's diffuse one)");
+  else
+    r.dropped.push_back("transmission (mean " + std::to_string(fit.transmittance) +
+                        ", below the threshold)");
+  r.figures = {{"fit RMS log error", fit.rms_log},
+               {"fit RMS log error at start", fit.rms_log_start},
+               {"direction pairs", fit.points},
+               {"evaluations", fit.evaluations},
+               {"base color R", fit.material.base_color.r},
+               {"base color G", fit.material.base_color.g},
+               {"base color B", fit.material.base_color.b},
+               {"roughness", fit.material.roughness},
+               {"sheen color R", fit.material.sheen_color.r},
+               {"sheen color G", fit.material.sheen_color.g},
+               {"sheen color B", fit.material.sheen_color.b},
+               {"sheen roughness", fit.material.sheen_roughness},
+               {"transmission", fit.material.transmission}};
+  return r;
+}
+
+}  // namespace weft

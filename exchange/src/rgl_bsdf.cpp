@@ -1,0 +1,221 @@
+#include "weft/exchange/rgl_bsdf.h"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+
+#include "marginal_warp.h"
+#include "tensor_file.h"
+#include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
+#include "weft/core/frame.h"
+#include "weft/core/math.h"
+#include "weft/exchange/table_view.h"
+
+namespace weft {
+namespace {
+
+// The format's square: u_theta = sqrt(2 theta / pi), u_phi = (phi + pi) / (2 pi).
+double u_to_theta(double u) {
+  return u * u * (kPi / 2);
+}
+double u_to_phi(double u) {
+  return (2 * u - 1) * kPi;
+}
+
+// A function of theta_m given at the nodes u_j = j / (n - 1), linear in u between them: how the
+// renderers interpolate the ndf and sigma grids (bilinear, two identical phi rows).
+struct UGrid {
+  std::vector<double> v;
+  double at(double u) const {
+    const double x = std::clamp(u, 0.0, 1.0) * static_cast<double>(v.size() - 1);
+    const size_t j = std::min(static_cast<size_t>(x), v.size() - 2);
+    return v[j] + (v[j + 1] - v[j]) * (x - static_cast<double>(j));
+  }
+};
+
+// int over the upper hemisphere of g(theta_m, m), by the midpoint rule in (u_theta, phi).
+template <class G>
+double hemisphere_integral(G&& g) {
+  constexpr int kU = 96, kPhi = 96;
+  double sum = 0;
+  for (int a = 0; a < kU; ++a) {
+    const double u = (a + 0.5) / kU, theta = u_to_theta(u);
+    const double jac = kPi * u * std::sin(theta);  // d theta = pi u du, d omega = sin d theta d phi
+    for (int b = 0; b < kPhi; ++b) {
+      const double phi = 2 * kPi * (b + 0.5) / kPhi;
+      sum += g(theta, spherical_direction(theta, phi)) * jac;
+    }
+  }
+  return sum * (1.0 / kU) * (2 * kPi / kPhi);
+}
+
+UGrid projected_area(const UGrid& ndf) {
+  UGrid sigma{std::vector<double>(ndf.v.size())};
+  for (size_t j = 0; j < ndf.v.size(); ++j) {
+    const Vec3 w = spherical_direction(u_to_theta(static_cast<double>(j) / (ndf.v.size() - 1)), 0);
+    sigma.v[j] = hemisphere_integral([&](double theta, const Vec3& m) {
+      return ndf.at(std::sqrt(theta * 2 / kPi)) * std::max(0.0, dot(m, w));
+    });
+  }
+  return sigma;
+}
+
+// The paper's retro-reflection estimate of the NDF (see rgl_bsdf.h), on 'nodes' u nodes.
+UGrid estimate_ndf(const TableView& view, int nodes) {
+  std::vector<double> retro(static_cast<size_t>(nodes)),
+      values(static_cast<size_t>(view.channels()));
+  for (int j = 0; j < nodes; ++j) {
+    const Vec3 w = spherical_direction(u_to_theta(static_cast<double>(j) / (nodes - 1)), 0);
+    view.isotropic(w, w, values);
+    retro[static_cast<size_t>(j)] = std::max(0.0, view.luminance(values));
+  }
+  UGrid ndf{std::vector<double>(static_cast<size_t>(nodes))};
+  UGrid sigma{std::vector<double>(static_cast<size_t>(nodes))};
+  for (int j = 0; j < nodes; ++j)
+    sigma.v[static_cast<size_t>(j)] = std::cos(u_to_theta(static_cast<double>(j) / (nodes - 1)));
+  for (int iteration = 0; iteration < 6; ++iteration) {
+    for (int j = 0; j < nodes; ++j) {
+      const double theta = u_to_theta(static_cast<double>(j) / (nodes - 1));
+      ndf.v[static_cast<size_t>(j)] =
+          4 * sigma.v[static_cast<size_t>(j)] * std::cos(theta) * retro[static_cast<size_t>(j)];
+    }
+    // A floor keeps every normal possible (the value tensors divide by D).
+    const double peak = *std::max_element(ndf.v.begin(), ndf.v.end());
+    if (!(peak > 0)) throw Error("", "ndf", "the table reflects nothing back towards the light");
+    for (double& d : ndf.v) d = std::max(d, 1e-3 * peak);
+    const double norm = hemisphere_integral([&](double theta, const Vec3&) {
+      return ndf.at(std::sqrt(theta * 2 / kPi)) * std::cos(theta);
+    });
+    for (double& d : ndf.v) d /= norm;
+    sigma = projected_area(ndf);
+  }
+  return ndf;
+}
+
+struct Slices {
+  std::vector<float> vndf, luminance, values;  // [theta_i][...]
+};
+
+// One theta_i's vndf, luminance and value tensors, appended to 'out'.
+void add_slice(const TableView& view, const RglOptions& o, const UGrid& ndf, double sigma,
+               double theta_i, Slices& out) {
+  const int nv = o.vndf_resolution, ns = o.sample_resolution, nc = view.channels();
+  const Vec3 wi = spherical_direction(theta_i, 0);
+  std::vector<double> density(static_cast<size_t>(nv * nv));
+  for (int y = 0; y < nv; ++y)
+    for (int x = 0; x < nv; ++x) {
+      const double ux = static_cast<double>(x) / (nv - 1), theta_m = u_to_theta(ux);
+      const Vec3 m = spherical_direction(theta_m, u_to_phi(static_cast<double>(y) / (nv - 1)));
+      const double d =
+          ndf.at(ux) * std::max(0.0, dot(m, wi)) / sigma * (2 * kPi * kPi * ux * std::sin(theta_m));
+      density[static_cast<size_t>(y * nv + x)] = d;
+      out.vndf.push_back(static_cast<float>(d));
+    }
+  const rgl::MarginalWarp warp(std::move(density), nv, nv);
+  std::vector<double> f(static_cast<size_t>(nc));
+  std::vector<double> slab(static_cast<size_t>(nc * ns * ns), 0.0);
+  for (int y = 0; y < ns; ++y)
+    for (int x = 0; x < ns; ++x) {
+      const Vec2 um =
+          warp.sample({static_cast<double>(x) / (ns - 1), static_cast<double>(y) / (ns - 1)});
+      const Vec3 m = spherical_direction(u_to_theta(um.x), u_to_phi(um.y));
+      const Vec3 wo = reflect(wi, m);
+      std::fill(f.begin(), f.end(), 0.0);
+      if (wo.z > 0 && dot(wi, m) > 0) {
+        view.isotropic(wi, wo, f);  // Weft's f(view, light): wi here is the view
+        const double scale = wo.z * 4 * sigma / ndf.at(um.x);
+        for (double& v : f) v = std::max(0.0, v) * scale;
+      }
+      out.luminance.push_back(static_cast<float>(view.luminance(f)));
+      for (int c = 0; c < nc; ++c)
+        slab[static_cast<size_t>((c * ns + y) * ns + x)] = f[static_cast<size_t>(c)];
+    }
+  for (double v : slab) out.values.push_back(static_cast<float>(v));
+  // The luminance only steers sampling; an incidence that reflects nothing is sampled uniformly
+  // (an all-zero slice cannot be normalized by the renderers).
+  const auto first = out.luminance.end() - ns * ns;
+  if (std::all_of(first, out.luminance.end(), [](float v) { return v == 0; }))
+    std::fill(first, out.luminance.end(), 1.0f);
+}
+
+}  // namespace
+
+void RglOptions::validate() const {
+  if (theta_i_count < 2 || theta_i_count > 90) throw Error("", "theta_i_count", "must be 2..90");
+  if (ndf_resolution < 2 || (ndf_resolution - 1) % (theta_i_count - 1) != 0)
+    throw Error("", "ndf_resolution",
+                "(ndf_resolution - 1) must be a multiple of theta_i_count - 1");
+  if (vndf_resolution < 2 || vndf_resolution > 512)
+    throw Error("", "vndf_resolution", "must be 2..512");
+  if (sample_resolution < 2 || sample_resolution > 256)
+    throw Error("", "sample_resolution", "must be 2..256");
+  if (azimuths < 1) throw Error("", "azimuths", "must be at least 1");
+}
+
+ExportReport write_rgl_bsdf(const TabulatedBsdfTable& table, const std::filesystem::path& path,
+                            const RglOptions& o) {
+  o.validate();
+  const TableView view(table, o.azimuths);
+  const UGrid ndf = estimate_ndf(view, o.ndf_resolution);
+  const UGrid sigma = projected_area(ndf);
+  const int nt = o.theta_i_count, stride = (o.ndf_resolution - 1) / (nt - 1);
+  Slices s;
+  std::vector<float> theta_i;
+  for (int k = 0; k < nt; ++k) {
+    // In double: pi/2 rounded to float lies below the horizon.
+    const double theta = u_to_theta(static_cast<double>(k) / (nt - 1));
+    theta_i.push_back(static_cast<float>(theta));
+    add_slice(view, o, ndf, sigma.v[static_cast<size_t>(k * stride)], theta, s);
+  }
+  const auto u64 = [](int v) { return static_cast<uint64_t>(v); };
+  const uint64_t ns = u64(o.sample_resolution), nv = u64(o.vndf_resolution);
+  const uint64_t nc = u64(view.channels()), nn = u64(o.ndf_resolution);
+  std::vector<float> ndf_rows, sigma_rows;
+  for (int row = 0; row < 2; ++row)
+    for (size_t j = 0; j < ndf.v.size(); ++j) {
+      ndf_rows.push_back(static_cast<float>(ndf.v[j]));
+      sigma_rows.push_back(static_cast<float>(sigma.v[j]));
+    }
+  std::vector<rgl::TensorField> fields{
+      rgl::byte_field("description", o.description),
+      rgl::byte_field("jacobian", std::string(1, '\1')),
+      rgl::float_field("theta_i", {u64(nt)}, theta_i),
+      rgl::float_field("phi_i", {1}, {0.0f}),
+      rgl::float_field("ndf", {2, nn}, ndf_rows),
+      rgl::float_field("sigma", {2, nn}, sigma_rows),
+      rgl::float_field("vndf", {1, u64(nt), nv, nv}, s.vndf),
+      rgl::float_field("luminance", {1, u64(nt), ns, ns}, s.luminance)};
+  if (view.spectral()) {
+    std::vector<float> wavelengths;
+    for (int b = 0; b < kNumBands; ++b)
+      wavelengths.push_back(static_cast<float>(band_wavelength_nm(b)));
+    fields.push_back(rgl::float_field("wavelengths", {nc}, wavelengths));
+    fields.push_back(rgl::float_field("spectra", {1, u64(nt), nc, ns, ns}, s.values));
+  } else {
+    fields.push_back(rgl::float_field("rgb", {1, u64(nt), nc, ns, ns}, s.values));
+  }
+  const std::vector<uint8_t> bytes = rgl::encode_tensor_file(fields);
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw Error(path.string(), "", "write failed");
+  });
+  ExportReport r{"RGL .bsdf", {}, {}, {}};
+  r.dropped = {
+      "transmission (light and viewer on opposite sides of the cloth)",
+      "the back side (a view from below: the format is one-sided)",
+      "anisotropy (averaged over " + std::to_string(o.azimuths) + " rotations about the normal)"};
+  if (!view.spectral())
+    r.notes.push_back(
+        "RGB file ('rgb' field): Mitsuba 3 RGB variants read it; pbrt-v4 reads only "
+        "spectral files, export a spectral table for it");
+  r.figures = {{"theta_i", nt},
+               {"samples per side", o.sample_resolution},
+               {"bytes", static_cast<double>(bytes.size())}};
+  return r;
+}
+
+}  // namespace weft

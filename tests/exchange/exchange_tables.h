@@ -1,0 +1,57 @@
+#pragma once
+// Small analytic tables for the export tests, with known exact answers.
+#include <cmath>
+#include <span>
+
+#include "weft/core/math.h"
+#include "weft/core/spectrum.h"
+#include "weft/materials/bsdf_table.h"
+
+namespace weft::testing {
+
+// Lambertian reflection rho / pi on either side and Lambertian transmission tau / pi through the
+// cloth, per channel ('rho' and 'tau' hold one value per channel). A constant per cell pair, so
+// every cell average and every interpolation of it is exact (bsdf_table.h: from_function's ratio
+// estimator reproduces a constant exactly).
+inline TabulatedBsdfTable lambert_table(int resolution, std::vector<double> rho,
+                                        std::vector<double> tau) {
+  const int channels = static_cast<int>(rho.size());
+  return TabulatedBsdfTable::from_function(
+      resolution, channels,
+      [=](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const bool same_side = (wo.z > 0) == (wi.z > 0);
+        for (int c = 0; c < channels; ++c)
+          v[static_cast<size_t>(c)] = (same_side ? rho : tau)[static_cast<size_t>(c)] / kPi;
+      },
+      1, 1);
+}
+
+inline TabulatedBsdfTable lambert_rgb(int resolution = 8) {
+  return lambert_table(resolution, {0.2, 0.5, 0.8}, {0, 0, 0});
+}
+
+// 33 bands, rho rising linearly from 0.1 at 390 nm to 0.9 at 710 nm.
+inline std::vector<double> ramp_spectrum() {
+  std::vector<double> rho;
+  for (int b = 0; b < kNumBands; ++b) rho.push_back(0.1 + 0.8 * b / (kNumBands - 1.0));
+  return rho;
+}
+
+// Lambertian rho / pi plus an isotropic, reciprocal sheen-like lobe towards grazing half vectors,
+// on the upper side only: a table whose NDF estimate is not trivial.
+inline TabulatedBsdfTable lobe_rgb(int resolution = 8) {
+  return TabulatedBsdfTable::from_function(
+      resolution, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        if (wo.z <= 0 || wi.z <= 0) {
+          v[0] = v[1] = v[2] = 0;
+          return;
+        }
+        const Vec3 h = normalize(wo + wi);
+        const double lobe = 0.3 * (1 - h.z * h.z);
+        v[0] = 0.6 / kPi + lobe, v[1] = 0.2 / kPi + lobe, v[2] = 0.1 / kPi + lobe;
+      },
+      2, 1);
+}
+
+}  // namespace weft::testing

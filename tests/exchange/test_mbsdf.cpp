@@ -1,0 +1,162 @@
+// The MDL .mbsdf export read back byte by byte, as the MDL SDK's reader reads it
+// (src/io/scene/bsdf_measurement/bsdf_measurement.cpp): the header line, then per part its magic
+// line, uint32 type (1 = RGB), res_theta, res_phi and res_theta^2 res_phi float triples.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "exchange_tables.h"
+#include "test_util.h"
+#include "weft/core/frame.h"
+#include "weft/exchange/export_table.h"
+
+namespace weft {
+namespace {
+
+struct MbsdfPart {
+  uint32_t type = 0, res_theta = 0, res_phi = 0;
+  std::vector<float> v;
+  // f of channel c at (theta_in index, theta_out index, phi index).
+  float at(uint32_t ti, uint32_t to, uint32_t p, int c) const {
+    return v[3 * ((ti * res_theta + to) * res_phi + p) + static_cast<uint32_t>(c)];
+  }
+};
+
+std::map<std::string, MbsdfPart> read_mbsdf(const std::filesystem::path& path) {
+  const std::string d = testing::slurp(path);
+  size_t at = 0;
+  auto line = [&] {
+    const size_t end = d.find('\n', at);
+    if (end == std::string::npos) throw std::runtime_error("no line end");
+    const std::string s = d.substr(at, end + 1 - at);
+    at = end + 1;
+    return s;
+  };
+  auto u32 = [&] {
+    if (at + 4 > d.size()) throw std::runtime_error("truncated");
+    uint32_t v = 0;
+    for (int k = 0; k < 4; ++k)
+      v |= static_cast<uint32_t>(static_cast<unsigned char>(d[at + k])) << (8 * k);
+    at += 4;
+    return v;
+  };
+  if (line() != "NVIDIA ARC MBSDF V1\n") throw std::runtime_error("header");
+  std::map<std::string, MbsdfPart> parts;
+  while (at < d.size()) {
+    const std::string magic = line();
+    MbsdfPart p;
+    p.type = u32();
+    p.res_theta = u32();
+    p.res_phi = u32();
+    const size_t n = size_t{p.res_theta} * p.res_theta * p.res_phi * (p.type == 1 ? 3 : 1);
+    if (at + 4 * n > d.size()) throw std::runtime_error("values truncated");
+    p.v.resize(n);
+    std::memcpy(p.v.data(), d.data() + at, 4 * n);
+    at += 4 * n;
+    parts[magic] = std::move(p);
+  }
+  return parts;
+}
+
+std::map<std::string, MbsdfPart> export_and_read(const TabulatedBsdfTable& t) {
+  const auto path = testing::fresh_test_dir() / "t.mbsdf";
+  ExportOptions o;
+  o.mbsdf.theta_resolution = 16;
+  o.mbsdf.phi_resolution = 24;
+  export_table(t, path, o);
+  return read_mbsdf(path);
+}
+
+// The hemispherical albedo of a part for theta_in index ti: sum of f cos sin dtheta dphi over
+// the cells, phi over [0, pi] counted twice (the file holds |phi_out - phi_in|).
+double part_albedo(const MbsdfPart& p, uint32_t ti, int c) {
+  const double dt = kPi / 2 / p.res_theta, dp = kPi / p.res_phi;
+  double sum = 0;
+  for (uint32_t to = 0; to < p.res_theta; ++to) {
+    const double t = (to + 0.5) * dt;
+    // exact integral of cos sin over the cell: (sin^2 t1 - sin^2 t0) / 2
+    const double w = (sqr(std::sin(t + dt / 2)) - sqr(std::sin(t - dt / 2))) / 2;
+    for (uint32_t ph = 0; ph < p.res_phi; ++ph) sum += p.at(ti, to, ph, c) * w * dp * 2;
+  }
+  return sum;
+}
+
+TEST(Mbsdf, LambertianReflectionAndTransmissionAreExact) {
+  // exchange_tables.h: rho / pi on the light's side, tau / pi through.
+  const std::vector<double> rho{0.2, 0.5, 0.8}, tau{0.3, 0.2, 0.1};
+  auto parts = export_and_read(testing::lambert_table(8, rho, tau));
+  ASSERT_EQ(parts.size(), 2u);
+  const auto& r = parts.at("MBSDF_DATA_REFLECTION=\n");
+  const auto& t = parts.at("MBSDF_DATA_TRANSMISSION=\n");
+  for (const auto* p : {&r, &t}) {
+    EXPECT_EQ(p->type, 1u);
+    EXPECT_EQ(p->res_theta, 16u);
+    EXPECT_EQ(p->res_phi, 24u);
+  }
+  for (uint32_t ti = 0; ti < 16; ti += 5)
+    for (uint32_t to = 0; to < 16; to += 3)
+      for (uint32_t ph = 0; ph < 24; ph += 7)
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(r.at(ti, to, ph, c), rho[static_cast<size_t>(c)] / kPi, 1e-6);
+          EXPECT_NEAR(t.at(ti, to, ph, c), tau[static_cast<size_t>(c)] / kPi, 1e-6);
+        }
+  // Energy: the albedo per incidence is rho and tau (cell-exact cosine weights, so only float
+  // rounding is left).
+  for (uint32_t ti : {0u, 8u, 15u})
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(part_albedo(r, ti, c), rho[static_cast<size_t>(c)], 1e-5);
+      EXPECT_NEAR(part_albedo(t, ti, c), tau[static_cast<size_t>(c)], 1e-5);
+    }
+}
+
+TEST(Mbsdf, LobeTableValuesAreItsIsotropicAverageAtTheCellCentres) {
+  const auto table = testing::lobe_rgb();
+  auto parts = export_and_read(table);
+  const auto& r = parts.at("MBSDF_DATA_REFLECTION=\n");
+  // mbsdf.h: in = light at (theta_in, 0), out = view at (theta_out, phi), cell centres; the mean
+  // over the 16 rotations 2 pi k / 16 of the table's interpolation.
+  for (uint32_t ti : {1u, 9u})
+    for (uint32_t to : {2u, 12u})
+      for (uint32_t ph : {0u, 11u, 23u}) {
+        const double t_in = (ti + 0.5) * kPi / 32, t_out = (to + 0.5) * kPi / 32;
+        const double phi = (ph + 0.5) * kPi / 24;
+        double mean[3] = {0, 0, 0};
+        for (int k = 0; k < 16; ++k) {
+          const double a = 2 * kPi * k / 16;
+          std::vector<double> f(3);
+          table.interpolate(spherical_direction(t_out, phi + a), spherical_direction(t_in, a), f);
+          for (int c = 0; c < 3; ++c) mean[c] += f[static_cast<size_t>(c)] / 16;
+        }
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(r.at(ti, to, ph, c), mean[c], 1e-5 * (1 + mean[c]));
+      }
+  // Energy: the file's albedo per incidence against the table's, integrated on a finer grid
+  // (64 x 128 midpoints) over the same 16 rotations.
+  for (uint32_t ti : {2u, 8u, 13u}) {
+    const double t_in = (ti + 0.5) * kPi / 32;
+    double ref[3] = {0, 0, 0};
+    std::vector<double> f(3);
+    for (int k = 0; k < 16; ++k)
+      for (int a = 0; a < 64; ++a)
+        for (int b = 0; b < 128; ++b) {
+          const double rot = 2 * kPi * k / 16, phi = 2 * kPi * (b + 0.5) / 128 + rot;
+          const Vec3 wo = spherical_direction(std::acos((a + 0.5) / 64), phi);
+          table.interpolate(wo, spherical_direction(t_in, rot), f);
+          for (int c = 0; c < 3; ++c)
+            ref[c] += f[static_cast<size_t>(c)] * wo.z / 64 * (2 * kPi / 128) / 16;
+        }
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(part_albedo(r, ti, c), ref[c], 0.02 * ref[c]);
+  }
+}
+
+TEST(Mbsdf, SpectralTableIsWrittenAsRgb) {
+  const auto rho = testing::ramp_spectrum();
+  auto parts = export_and_read(testing::lambert_table(4, rho, std::vector<double>(33, 0.0)));
+  const auto& r = parts.at("MBSDF_DATA_REFLECTION=\n");
+  EXPECT_EQ(r.type, 1u);
+  // The ramp rises towards red: R > G > B (linear sRGB under D65).
+  EXPECT_GT(r.at(3, 3, 3, 0), r.at(3, 3, 3, 1));
+  EXPECT_GT(r.at(3, 3, 3, 1), r.at(3, 3, 3, 2));
+}
+
+}  // namespace
+}  // namespace weft
