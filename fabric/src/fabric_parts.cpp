@@ -33,6 +33,8 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
            {"split_threshold", r.split_threshold},
            {"max_copies_per_particle", r.max_copies_per_particle},
            {"program_version", WEFT_VERSION}};
+  // Only where on, so that the parts of runs before the option keep their identity.
+  if (r.next_event_rays > 0) p.job["next_event_rays"] = r.next_event_rays;
   p.units_total = static_cast<uint64_t>(DirectionGrid{r.resolution}.bins());
   p.shard = shard;
   return p;

@@ -52,6 +52,11 @@ void FabricRaytraceOptions::validate() const {
   if (max_copies_per_particle < 1 || max_copies_per_particle > (1 << 20))
     throw Error("", "max_copies_per_particle", "must lie in [1, 2^20]");
   if (threads < 0) throw Error("", "threads", "must be >= 0");
+  if (next_event_rays < 0 || next_event_rays > kMaxNextEventRays)
+    throw Error("", "next_event_rays",
+                "must lie in [0, " + std::to_string(kMaxNextEventRays) + "]");
+  if (next_event_rays > 0 && channel_sampling == ChannelSampling::mean)
+    throw Error("", "next_event_rays", "the next-event estimate needs the hero estimator");
   const int bins = DirectionGrid{resolution}.bins();
   if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
     throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
@@ -144,16 +149,43 @@ struct Life {
 struct TaskScratch {
   std::vector<Particle> pending;
   std::vector<double> s_sum;
+  Particle probe;  // a next-event draw's particle (its vectors reused)
 };
+
+// The next-event estimate at a crossing x (FabricRaytraceOptions::next_event_rays): draws of the
+// step s is about to take, weighed as its own would be and followed out of the slab without
+// scattering; each that leaves books its weights over the count into its cell.
+void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Crossings& x,
+                      const Particle& s, TaskScratch& scratch, Rng& rng) {
+  const double share = 1.0 / t.o.next_event_rays;
+  Particle& probe = scratch.probe;
+  for (int k = 0; k < t.o.next_event_rays; ++k) {
+    const std::optional<ScatterDraw> draw = draw_scatter(t.fs, life.st, x, scratch.s_sum, rng);
+    if (!draw) return;  // the fiber absorbs all of the hero's light
+    probe.d = s.d;
+    probe.w = s.w, probe.pdf = s.pdf, probe.wp = s.wp;
+    const FiberPoint& pt = x.pts[draw->point];
+    weigh_scatter(t.fs, t.fiber, life.st, pt.bin, draw->exit_bin, scratch.s_sum, probe);
+    if (!h.on_fiber() && t.tube) weigh_as_round_fiber(*t.tube, t.tube_proposal, x, s.d, probe);
+    leave_fiber(pt.hit, draw->wo_local, probe);
+    const std::optional<Vec3> out =
+        escape_direction(t.scene, t.slab, t.curves, probe, 100 * t.o.max_scatterings);
+    if (!out) continue;
+    for (double& w : probe.w) w *= share;
+    tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, *out), probe.w);
+  }
+}
 
 // Scattering at the fiber the particle's line met at h (its weights' mean mean_w): false when the
 // particle's life ends there, absorbed or at the scattering cap (its weight booked as lost).
 bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Particle& s,
-             std::vector<double>& s_sum, Rng& rng) {
+             TaskScratch& scratch, Rng& rng) {
   FabricBinBooks& books = *life.books;
+  std::vector<double>& s_sum = scratch.s_sum;
   if (h.on_fiber() && dot(s.d, h.ng) >= 0) ++books.inside_hits;
   const Crossings x = crossings_of(t.scene, h, s.d, t.fs.grid);
   albedo_sums(t.fs, life.st, x, s_sum);
+  if (t.o.next_event_rays > 0) book_next_events(t, life, h, x, s, scratch, rng);
   const std::optional<ScatterDraw> draw = draw_scatter(t.fs, life.st, x, s_sum, rng);
   if (!draw) {  // the fiber absorbs all of the hero's light
     books.absorbed += mean_w;
@@ -164,6 +196,7 @@ bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Pa
   if (!h.on_fiber() && t.tube)
     books.absorbed += weigh_as_round_fiber(*t.tube, t.tube_proposal, x, s.d, s);
   leave_fiber(pt.hit, draw->wo_local, s);
+  s.scattered = true;
   ++books.scatterings;
   if (++s.events >= t.o.max_scatterings) {
     books.lost += mean_weight(s.w);
@@ -202,13 +235,14 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
     const double mean_w = mean_weight(s.w);
     SurfaceHit h;
     const Flight flight = fly(t.scene, t.slab, t.curves, s, &h);
-    if (flight == Flight::left_slab) {  // binned by its direction
-      tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, s.d), s.w);
+    if (flight == Flight::left_slab) {  // binned by its direction, unless next events did
+      if (t.o.next_event_rays == 0 || !s.scattered)
+        tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, s.d), s.w);
       books.exited += mean_w;
       return;
     }
     if (flight == Flight::hit && !passes_own_tube(h, s)) {
-      if (!scatter(t, life, h, mean_w, s, scratch.s_sum, rng)) return;
+      if (!scatter(t, life, h, mean_w, s, scratch, rng)) return;
       if (!keep_in_window(t, life, s, scratch.pending, rng)) return;
       continue;
     }
@@ -361,6 +395,7 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
                     {"estimator", channel_sampling_name(o.channel_sampling)},
                     {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
   if (o.proposal) table.metadata["proposal_checksum"] = o.proposal->checksum();
+  if (o.next_event_rays > 0) table.metadata["next_event_rays"] = std::to_string(o.next_event_rays);
   if (o.channel_sampling != ChannelSampling::mean) {
     char text[32];
     const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;

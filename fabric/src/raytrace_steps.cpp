@@ -168,6 +168,17 @@ bool passes_own_tube(const SurfaceHit& h, Particle& s) {
   return passes;
 }
 
+std::optional<Vec3> escape_direction(const RenderScene& scene, const RepeatSlab& slab,
+                                     int64_t curves, Particle& s, int max_events) {
+  for (int e = 0; e < max_events; ++e) {
+    SurfaceHit h;
+    const Flight f = fly(scene, slab, curves, s, &h);
+    if (f == Flight::left_slab) return s.d;
+    if (f == Flight::hit && !passes_own_tube(h, s)) return std::nullopt;
+  }
+  return std::nullopt;
+}
+
 Crossings crossings_of(const RenderScene& scene, const SurfaceHit& h, const Vec3& d,
                        const DirectionGrid& fiber_grid) {
   // The line meets a fiber at B' and would leave it at B''. A round fiber's B'' is where the line

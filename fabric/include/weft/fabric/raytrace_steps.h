@@ -54,6 +54,7 @@ struct Particle {
   std::vector<double> w;      // channel weights
   std::vector<double> pdf;    // per strategy, the path's density relative to their mean
   std::vector<double> wp;     // the weights under the proposal (with one; else empty)
+  bool scattered = false;     // by a fiber since its launch
 };
 
 // The mean of the channel weights (the power the books count).
@@ -126,6 +127,13 @@ Flight fly(const RenderScene& scene, const RepeatSlab& slab, int64_t curves, Par
 // tables non-reciprocal). True, and the particle moved past h, when h is that far side; either
 // way the particle is no longer in its tube.
 bool passes_own_tube(const SurfaceHit& h, Particle& s);
+// Where a particle just sent out of a fiber goes if nothing stops it: its line (wrapped through
+// the repeat's sides, and through its own yarn tube) is followed to the first surface it meets or
+// out of the slab; the direction it leaves the slab along, or none when a surface is met first
+// (or after max_events wraps and passes). The next-event estimate's visibility test: no
+// scattering and no random draw.
+std::optional<Vec3> escape_direction(const RenderScene& scene, const RepeatSlab& slab,
+                                     int64_t curves, Particle& s, int max_events);
 
 // --- crossings
 // Where a particle's line meets a fiber: the point, its local frame (x = axis, z = outward), the
