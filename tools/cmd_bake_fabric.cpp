@@ -23,7 +23,7 @@ namespace {
 // The summations' direction pairs per cell pair at most (fabric_summation.cpp checks the same).
 constexpr uint64_t kMaxSummationSamples = 4096;
 // --estimator nee's draws per scattering unless --next-event-rays is given (docs/PERFORMANCE.md).
-constexpr int kDefaultNextEventRays = 2;
+constexpr int kDefaultNextEventRays = 1, kDefaultLaunchLattice = 13;
 
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
@@ -33,6 +33,7 @@ struct BakeFabricOptions {
   uint64_t seed = 1;
   std::optional<double> split_threshold;  // the library's default unless given
   std::optional<int> next_event_rays;     // --estimator nee: kDefaultNextEventRays unless given
+  std::optional<int> launch_lattice;      // --estimator nee: kDefaultLaunchLattice unless given
   bool json = false, quiet = false, resume = false;
 };
 
@@ -81,7 +82,13 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
   if (o.next_event_rays && o.estimator != "nee")
     throw Error("", "--next-event-rays",
                 "next-event rays are the nee estimator's: give --estimator nee");
-  if (o.estimator == "nee") r.next_event_rays = o.next_event_rays.value_or(kDefaultNextEventRays);
+  if (o.launch_lattice && o.estimator != "nee")
+    throw Error("", "--launch-lattice",
+                "launch blocks are the nee estimator's: give --estimator nee");
+  if (o.estimator == "nee") {
+    r.next_event_rays = o.next_event_rays.value_or(kDefaultNextEventRays);
+    r.launch_lattice = o.launch_lattice.value_or(kDefaultLaunchLattice);
+  }
   if (o.split_threshold) {
     if (r.channel_sampling == ChannelSampling::mean)
       throw Error("", "--split-threshold",
@@ -181,6 +188,7 @@ int run(const BakeFabricOptions& o) {
     extra = raytrace_summary(res);
     extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
     extra["next_event_rays"] = r.next_event_rays;
+    extra["launch_lattice"] = r.launch_lattice;
     extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
                                    ? nlohmann::json(nullptr)
                                    : nlohmann::json(r.split_threshold);
@@ -269,6 +277,11 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
                   "raytrace, nee: draws of the exit per scattering (default " +
                       std::to_string(kDefaultNextEventRays) + ")")
       ->check(CLI::Range(1, kMaxNextEventRays));
+  sub->add_option("--launch-lattice", o->launch_lattice,
+                  "raytrace, nee: particles per launch block, their entry points on a lattice "
+                  "over the repeat (default " +
+                      std::to_string(kDefaultLaunchLattice) + ")")
+      ->check(CLI::Range(1, kMaxLaunchLattice));
   sub->add_option("--split-threshold", o->split_threshold,
                   "raytrace, hero: split a particle whose largest channel weight exceeds this "
                   "(default " +

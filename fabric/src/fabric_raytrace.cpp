@@ -55,6 +55,8 @@ void FabricRaytraceOptions::validate() const {
   if (next_event_rays < 0 || next_event_rays > kMaxNextEventRays)
     throw Error("", "next_event_rays",
                 "must lie in [0, " + std::to_string(kMaxNextEventRays) + "]");
+  if (launch_lattice < 1 || launch_lattice > kMaxLaunchLattice)
+    throw Error("", "launch_lattice", "must lie in [1, " + std::to_string(kMaxLaunchLattice) + "]");
   if (next_event_rays > 0 && channel_sampling == ChannelSampling::mean)
     throw Error("", "next_event_rays", "the next-event estimate needs the hero estimator");
   const int bins = DirectionGrid{resolution}.bins();
@@ -258,17 +260,37 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
   }
 }
 
-// Launches a particle of incident bin 'bin' and follows it and the copies its splits make.
-void trace_particle(const Tracer& t, int bin, Tally& tally, TaskScratch& scratch, Rng& rng) {
+// Particle k's launch when particles are launched in lattice blocks
+// (FabricRaytraceOptions::launch_lattice): the block's direction, and its point of the block's
+// lattice through the block's entry point, both drawn as a particle's launch from the block's own
+// stream (seed, bin, block + 1; a task's is (seed, task, 0)), so that they do not depend on how the
+// particles are split into tasks. The block's particles share the direction: whether a line
+// passes between the fibers depends on where it enters in concert with its direction (the gaps'
+// shadow moves across the repeat as the direction tilts), and on a lattice of one direction the
+// block's lines cover the gaps evenly.
+Launch lattice_launch(const Tracer& t, uint64_t k, int bin) {
+  const uint64_t idx = k - t.per_bin * static_cast<uint64_t>(bin);
+  const uint64_t count = static_cast<uint64_t>(t.o.launch_lattice);
+  Rng block(t.o.seed, static_cast<uint64_t>(bin), idx / count + 1);
+  Launch l = launch(t.grid, t.slab, bin, block);
+  l.p = lattice_point(t.slab, l.p, static_cast<int>(idx % count), t.o.launch_lattice);
+  return l;
+}
+
+// Launches particle k (of incident bin 'bin') and follows it and the copies its splits make; its
+// exits are merged per cell with those of its sample unit from unit_first on.
+void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t unit_first,
+                    TaskScratch& scratch, Rng& rng) {
   Life life;
   life.bin = bin;
   life.tally = &tally;
   life.books = &tally.books_of(bin);
-  const Launch l = launch(t.grid, t.slab, bin, rng);
+  Launch l = launch(t.grid, t.slab, bin, rng);  // drawn either way: the stream stays the same
+  if (t.o.launch_lattice > 1) l = lattice_launch(t, k, bin);
   life.st = draw_strategies(t.mis, t.nc, rng);
   life.books->launched += l.w0;
   ++life.books->particles;
-  life.first_exit = tally.exits.size();
+  life.first_exit = unit_first;
   scratch.pending.clear();
   scratch.pending.push_back(launched_particle(l, t.nc, life.st, t.proposal));
   while (!scratch.pending.empty()) {
@@ -285,11 +307,28 @@ void trace_task(const Tracer& t, uint64_t first, uint64_t count, Rng& rng, Tally
   TaskScratch scratch;
   scratch.s_sum.resize(t.mis ? t.nc : 1);
   Tally outside;
+  const Tally* last = nullptr;
+  size_t unit_first = 0;
   for (uint64_t k = first; k < first + count; ++k) {
     const int bin = static_cast<int>(k / t.per_bin);
     Tally& tally = k >= t.first_item && k < t.last_item ? task_tally : outside;
-    trace_particle(t, bin, tally, scratch, rng);
+    // A sample unit (a particle, or a launch block's part in this task) starts here.
+    if (&tally != last || (k - t.per_bin * static_cast<uint64_t>(bin)) % t.o.launch_lattice == 0)
+      unit_first = tally.exits.size();
+    last = &tally;
+    trace_particle(t, k, bin, tally, unit_first, scratch, rng);
   }
+}
+
+// The independent sample units of incident bin 'bin' (their exits are merged per cell): its launch
+// blocks (particles, without the lattice), a block split by a task's start counting twice.
+uint64_t sample_units(const Tracer& t, uint64_t items_per_task, int bin) {
+  const uint64_t m = static_cast<uint64_t>(t.o.launch_lattice);
+  const uint64_t begin = t.per_bin * static_cast<uint64_t>(bin), end = begin + t.per_bin;
+  uint64_t units = (t.per_bin + m - 1) / m;
+  for (uint64_t s = (begin / items_per_task + 1) * items_per_task; s < end; s += items_per_task)
+    units += (s - begin) % m != 0;
+  return units;
 }
 
 // A fiber sends out at most the light that hits it: a table's total albedo (the bake's exit
@@ -342,7 +381,7 @@ void add_task(const Tally& t, int nc, CellSums& sums, FabricRaytraceResult& resu
 // The table from the sums over per_bin particles per incident bin, its standard error, and each
 // bin's noise and signal.
 void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t per_bin,
-              FabricRaytraceResult& result) {
+              const std::vector<uint64_t>& units, FabricRaytraceResult& result) {
   TabulatedBsdfTable& table = result.table;
   const int bins = grid.bins();
   const auto areas = grid.cosine_weighted_areas();
@@ -354,6 +393,7 @@ void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t 
   const double omega = grid.bin_solid_angle();
   result.standard_error.assign(table.values.size(), 0.0f);
   for (int a = 0; a < bins; ++a) {
+    const double u = static_cast<double>(units[a]);
     std::vector<double>& noise2 = result.bin_books[a].noise2;
     std::vector<double>& signal2 = result.bin_books[a].signal2;
     noise2.assign(nc, 0.0);
@@ -366,9 +406,10 @@ void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t 
         const size_t v = cell * nc + c;
         const double f = sums.sum[v] * scale;
         table.values[v] = static_cast<float>(f);
-        // Per particle the cell receives one exit or none: the sample variance of its weight.
-        const double m1 = sums.sum[v] / n;
-        const double se = std::sqrt(std::max(0.0, sums.sum2[v] / n - m1 * m1) / n) * n * scale;
+        // Per sample unit (a particle, or a launch block) the sum of its weights in the cell:
+        // their sample variance.
+        const double m1 = sums.sum[v] / u;
+        const double se = std::sqrt(std::max(0.0, sums.sum2[v] / u - m1 * m1) / u) * u * scale;
         result.standard_error[v] = static_cast<float>(se);
         noise2[c] += se * se * w;
         signal2[c] += f * f * w;
@@ -387,15 +428,17 @@ void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t 
 
 void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
               const FabricRaytraceOptions& o, TabulatedBsdfTable& table) {
-  table.metadata = {{"method", "raytrace"},
-                    {"estimator_revision", std::to_string(kFabricRaytraceRevision)},
-                    {"fiber_checksum", fiber.checksum()},
-                    {"particles_per_bin", std::to_string(o.particles_per_bin)},
-                    {"seed", std::to_string(o.seed)},
-                    {"estimator", channel_sampling_name(o.channel_sampling)},
-                    {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
+  table.metadata = {
+      {"method", "raytrace"},
+      {"estimator_revision", std::to_string(kFabricRaytraceRevision)},
+      {"fiber_checksum", fiber.checksum()},
+      {"particles_per_bin", std::to_string(o.particles_per_bin)},
+      {"seed", std::to_string(o.seed)},
+      {"estimator", o.next_event_rays > 0 ? "nee" : channel_sampling_name(o.channel_sampling)},
+      {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
   if (o.proposal) table.metadata["proposal_checksum"] = o.proposal->checksum();
   if (o.next_event_rays > 0) table.metadata["next_event_rays"] = std::to_string(o.next_event_rays);
+  if (o.launch_lattice > 1) table.metadata["launch_lattice"] = std::to_string(o.launch_lattice);
   if (o.channel_sampling != ChannelSampling::mean) {
     char text[32];
     const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;
@@ -488,7 +531,10 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
       },
       [&](const Tally& tally) { add_task(tally, nc, sums, result); });
   result.cancelled = status.cancelled;
-  tabulate(sums, t.grid, nc, t.per_bin, result);
+  std::vector<uint64_t> units(bins);
+  const uint64_t per_task = batch_for(t, progress).items_per_task;
+  for (int a = 0; a < bins; ++a) units[a] = sample_units(t, per_task, a);
+  tabulate(sums, t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   return result;

@@ -76,6 +76,17 @@ Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& r
   return l;
 }
 
+Vec3 lattice_point(const RepeatSlab& slab, const Vec3& p, int m, int count) {
+  const double golden = 0.5 * (1 + std::sqrt(5.0));
+  const int64_t g = std::llround(count / golden);
+  const double fx = (p.x - slab.x0) / slab.px + static_cast<double>(m) / count;
+  const double fz = (p.z - slab.z0) / slab.pz + static_cast<double>((m * g) % count) / count;
+  Vec3 q = p;
+  q.x = slab.x0 + slab.px * (fx - std::floor(fx));
+  q.z = slab.z0 + slab.pz * (fz - std::floor(fz));
+  return q;
+}
+
 Strategies draw_strategies(bool mis, int channels, Rng& rng) {
   Strategies st;
   st.mis = mis;

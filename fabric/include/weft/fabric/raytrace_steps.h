@@ -70,6 +70,13 @@ struct Launch {
 };
 Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& rng);
 
+// Point m of the rank-1 lattice of 'count' points over the repeat that contains p (its point 0):
+// the fractions (m / count, m g / count) of the periods added to p's, modulo the periods, g the
+// integer nearest count over the golden ratio (a Fibonacci lattice when count is a Fibonacci
+// number; Sloan & Joe, Lattice Methods for Multiple Integration, 1994). Each point is uniform over
+// the repeat when p is, and together they cover it evenly.
+Vec3 lattice_point(const RepeatSlab& slab, const Vec3& p, int m, int count);
+
 // The sampling strategies a path is drawn and weighted with (FiberSampler strategy indices). With
 // spectral MIS one per channel, and the particle follows its hero, drawn uniformly; else one, the
 // channels' mean.
