@@ -8,7 +8,9 @@
 //   scattering  the hero strategy picks B' or B'' and an exit direction from the fiber table, and
 //               the path's weights become f over the strategies' mean probability (MIS); a yarn
 //               tube's crossing returns the line albedo of the fiber it stands for;
-//   tally       a particle leaving the slab adds its weights to its (incident, outgoing) cell;
+//   tally       a particle leaving the slab adds its weights to its (incident, outgoing) cell
+//               (with the next-event estimate, draws of its exit followed out of the slab:
+//               escape_direction; particles launched in blocks on a lattice: lattice_point);
 //   roulette and splitting  keep the weights in a window (below: roulette; above: copies).
 // Frames: world is the woven sample's (glTF, y up, metres), cloth the fabric table's (z = +y).
 // The steps that draw random numbers draw them in a fixed order from the particle's task stream:
