@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -21,6 +22,8 @@ namespace {
 
 // The summations' direction pairs per cell pair at most (fabric_summation.cpp checks the same).
 constexpr uint64_t kMaxSummationSamples = 4096;
+// --estimator nee's draws per scattering unless --next-event-rays is given (docs/PERFORMANCE.md).
+constexpr int kDefaultNextEventRays = 1, kDefaultLaunchLattice = 13;
 
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
@@ -29,6 +32,8 @@ struct BakeFabricOptions {
   std::optional<uint64_t> samples;  // the method's default unless given
   uint64_t seed = 1;
   std::optional<double> split_threshold;  // the library's default unless given
+  std::optional<int> next_event_rays;     // --estimator nee: kDefaultNextEventRays unless given
+  std::optional<int> launch_lattice;      // --estimator nee: kDefaultLaunchLattice unless given
   bool json = false, quiet = false, resume = false;
 };
 
@@ -128,6 +133,16 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
   r.threads = o.threads;
   r.channel_sampling =
       o.estimator == "mean" ? ChannelSampling::mean : ChannelSampling::spectral_mis;
+  if (o.next_event_rays && o.estimator != "nee")
+    throw Error("", "--next-event-rays",
+                "next-event rays are the nee estimator's: give --estimator nee");
+  if (o.launch_lattice && o.estimator != "nee")
+    throw Error("", "--launch-lattice",
+                "launch blocks are the nee estimator's: give --estimator nee");
+  if (o.estimator == "nee") {
+    r.next_event_rays = o.next_event_rays.value_or(kDefaultNextEventRays);
+    r.launch_lattice = o.launch_lattice.value_or(kDefaultLaunchLattice);
+  }
   if (o.split_threshold) {
     if (r.channel_sampling == ChannelSampling::mean)
       throw Error("", "--split-threshold",
@@ -193,6 +208,7 @@ int run(const BakeFabricOptions& o) {
   const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
   const WovenSample sample = make_woven_sample(weave);
   const auto t0 = std::chrono::steady_clock::now();
+  const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
   TabulatedBsdfTable table;
   nlohmann::json extra;
   if (o.method == "raytrace") {
@@ -217,7 +233,9 @@ int run(const BakeFabricOptions& o) {
     table = res.table;
     record_particle_counts(table, res.splits, res.roulette_kills);
     extra = raytrace_summary(res);
-    extra["estimator"] = channel_sampling_name(r.channel_sampling);
+    extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
+    extra["next_event_rays"] = r.next_event_rays;
+    extra["launch_lattice"] = r.launch_lattice;
     extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
                                    ? nlohmann::json(nullptr)
                                    : nlohmann::json(r.split_threshold);
@@ -240,7 +258,11 @@ int run(const BakeFabricOptions& o) {
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
   if (!note.empty()) table.metadata["note"] = note;
   table.write_exr(o.output);
-  nlohmann::json j = {{"output", o.output}, {"method", o.method}, {"seconds", seconds}};
+  const double cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  nlohmann::json j = {{"output", o.output},
+                      {"method", o.method},
+                      {"seconds", seconds},
+                      {"cpu_seconds", cpu_seconds}};
   j.update(fabric_table_summary(table));
   if (extra.is_object()) j.update(extra);
   if (!note.empty()) j["notes"] = {note};
@@ -298,9 +320,18 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   sub->add_option(
          "--estimator", o->estimator,
          "raytrace: hero (one channel steers each path, MIS over channels, roulette on the "
-         "largest weight, splitting; the default) | mean (the channels' mean steers; no "
-         "splitting)")
-      ->check(CLI::IsMember({"hero", "mean"}));
+         "largest weight, splitting; the default) | nee (hero, and the exits estimated at every "
+         "scattering by next-event draws) | mean (the channels' mean steers; no splitting)")
+      ->check(CLI::IsMember({"hero", "nee", "mean"}));
+  sub->add_option("--next-event-rays", o->next_event_rays,
+                  "raytrace, nee: draws of the exit per scattering (default " +
+                      std::to_string(kDefaultNextEventRays) + ")")
+      ->check(CLI::Range(1, kMaxNextEventRays));
+  sub->add_option("--launch-lattice", o->launch_lattice,
+                  "raytrace, nee: particles per launch block, their entry points on a lattice "
+                  "over the repeat (default " +
+                      std::to_string(kDefaultLaunchLattice) + ")")
+      ->check(CLI::Range(1, kMaxLaunchLattice));
   sub->add_option("--split-threshold", o->split_threshold,
                   "raytrace, hero: split a particle whose largest channel weight exceeds this "
                   "(default " +

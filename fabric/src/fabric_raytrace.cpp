@@ -84,6 +84,13 @@ void FabricRaytraceOptions::validate() const {
   if (max_copies_per_particle < 1 || max_copies_per_particle > (1 << 20))
     throw Error("", "max_copies_per_particle", "must lie in [1, 2^20]");
   if (threads < 0) throw Error("", "threads", "must be >= 0");
+  if (next_event_rays < 0 || next_event_rays > kMaxNextEventRays)
+    throw Error("", "next_event_rays",
+                "must lie in [0, " + std::to_string(kMaxNextEventRays) + "]");
+  if (launch_lattice < 1 || launch_lattice > kMaxLaunchLattice)
+    throw Error("", "launch_lattice", "must lie in [1, " + std::to_string(kMaxLaunchLattice) + "]");
+  if (next_event_rays > 0 && channel_sampling == ChannelSampling::mean)
+    throw Error("", "next_event_rays", "the next-event estimate needs the hero estimator");
   const int bins = DirectionGrid{resolution}.bins();
   if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
     throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
@@ -176,16 +183,43 @@ struct Life {
 struct TaskScratch {
   std::vector<Particle> pending;
   std::vector<double> s_sum;
+  Particle probe;  // a next-event draw's particle (its vectors reused)
 };
+
+// The next-event estimate at a crossing x (FabricRaytraceOptions::next_event_rays): draws of the
+// step s is about to take, weighed as its own would be and followed out of the slab without
+// scattering; each that leaves books its weights over the count into its cell.
+void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Crossings& x,
+                      const Particle& s, TaskScratch& scratch, Rng& rng) {
+  const double share = 1.0 / t.o.next_event_rays;
+  Particle& probe = scratch.probe;
+  for (int k = 0; k < t.o.next_event_rays; ++k) {
+    const std::optional<ScatterDraw> draw = draw_scatter(t.fs, life.st, x, scratch.s_sum, rng);
+    if (!draw) return;  // the fiber absorbs all of the hero's light
+    probe.d = s.d;
+    probe.w = s.w, probe.pdf = s.pdf, probe.wp = s.wp;
+    const FiberPoint& pt = x.pts[draw->point];
+    weigh_scatter(t.fs, t.fiber, life.st, pt.bin, draw->exit_bin, scratch.s_sum, probe);
+    if (!h.on_fiber() && t.tube) weigh_as_round_fiber(*t.tube, t.tube_proposal, x, s.d, probe);
+    leave_fiber(pt.hit, draw->wo_local, probe);
+    const std::optional<Vec3> out =
+        escape_direction(t.scene, t.slab, t.curves, probe, 100 * t.o.max_scatterings);
+    if (!out) continue;
+    for (double& w : probe.w) w *= share;
+    tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, *out), probe.w);
+  }
+}
 
 // Scattering at the fiber the particle's line met at h (its weights' mean mean_w): false when the
 // particle's life ends there, absorbed or at the scattering cap (its weight booked as lost).
 bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Particle& s,
-             std::vector<double>& s_sum, Rng& rng) {
+             TaskScratch& scratch, Rng& rng) {
   FabricBinBooks& books = *life.books;
+  std::vector<double>& s_sum = scratch.s_sum;
   if (h.on_fiber() && dot(s.d, h.ng) >= 0) ++books.inside_hits;
   const Crossings x = crossings_of(t.scene, h, s.d, t.fs.grid);
   albedo_sums(t.fs, life.st, x, s_sum);
+  if (t.o.next_event_rays > 0) book_next_events(t, life, h, x, s, scratch, rng);
   const std::optional<ScatterDraw> draw = draw_scatter(t.fs, life.st, x, s_sum, rng);
   if (!draw) {  // the fiber absorbs all of the hero's light
     books.absorbed += mean_w;
@@ -196,6 +230,7 @@ bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Pa
   if (!h.on_fiber() && t.tube)
     books.absorbed += weigh_as_round_fiber(*t.tube, t.tube_proposal, x, s.d, s);
   leave_fiber(pt.hit, draw->wo_local, s);
+  s.scattered = true;
   ++books.scatterings;
   if (++s.events >= t.o.max_scatterings) {
     books.lost += mean_weight(s.w);
@@ -234,13 +269,14 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
     const double mean_w = mean_weight(s.w);
     SurfaceHit h;
     const Flight flight = fly(t.scene, t.slab, t.curves, s, &h);
-    if (flight == Flight::left_slab) {  // binned by its direction
-      tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, s.d), s.w);
+    if (flight == Flight::left_slab) {  // binned by its direction, unless next events did
+      if (t.o.next_event_rays == 0 || !s.scattered)
+        tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, s.d), s.w);
       books.exited += mean_w;
       return;
     }
     if (flight == Flight::hit && !passes_own_tube(h, s)) {
-      if (!scatter(t, life, h, mean_w, s, scratch.s_sum, rng)) return;
+      if (!scatter(t, life, h, mean_w, s, scratch, rng)) return;
       if (!keep_in_window(t, life, s, scratch.pending, rng)) return;
       continue;
     }
@@ -256,17 +292,37 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
   }
 }
 
-// Launches a particle of incident bin 'bin' and follows it and the copies its splits make.
-void trace_particle(const Tracer& t, int bin, Tally& tally, TaskScratch& scratch, Rng& rng) {
+// Particle k's launch when particles are launched in lattice blocks
+// (FabricRaytraceOptions::launch_lattice): the block's direction, and its point of the block's
+// lattice through the block's entry point, both drawn as a particle's launch from the block's own
+// stream (seed, bin, block + 1; a task's is (seed, task, 0)), so that they do not depend on how the
+// particles are split into tasks. The block's particles share the direction: whether a line
+// passes between the fibers depends on where it enters in concert with its direction (the gaps'
+// shadow moves across the repeat as the direction tilts), and on a lattice of one direction the
+// block's lines cover the gaps evenly.
+Launch lattice_launch(const Tracer& t, uint64_t k, int bin) {
+  const uint64_t idx = k - t.per_bin * static_cast<uint64_t>(bin);
+  const uint64_t count = static_cast<uint64_t>(t.o.launch_lattice);
+  Rng block(t.o.seed, static_cast<uint64_t>(bin), idx / count + 1);
+  Launch l = launch(t.grid, t.slab, bin, block);
+  l.p = lattice_point(t.slab, l.p, static_cast<int>(idx % count), t.o.launch_lattice);
+  return l;
+}
+
+// Launches particle k (of incident bin 'bin') and follows it and the copies its splits make; its
+// exits are merged per cell with those of its sample unit from unit_first on.
+void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t unit_first,
+                    TaskScratch& scratch, Rng& rng) {
   Life life;
   life.bin = bin;
   life.tally = &tally;
   life.books = &tally.books_of(bin);
-  const Launch l = launch(t.grid, t.slab, bin, rng);
+  Launch l = launch(t.grid, t.slab, bin, rng);  // drawn either way: the stream stays the same
+  if (t.o.launch_lattice > 1) l = lattice_launch(t, k, bin);
   life.st = draw_strategies(t.mis, t.nc, rng);
   life.books->launched += l.w0;
   ++life.books->particles;
-  life.first_exit = tally.exits.size();
+  life.first_exit = unit_first;
   scratch.pending.clear();
   scratch.pending.push_back(launched_particle(l, t.nc, life.st, t.proposal));
   while (!scratch.pending.empty()) {
@@ -283,11 +339,28 @@ void trace_task(const Tracer& t, uint64_t first, uint64_t count, Rng& rng, Tally
   TaskScratch scratch;
   scratch.s_sum.resize(t.mis ? t.nc : 1);
   Tally outside;
+  const Tally* last = nullptr;
+  size_t unit_first = 0;
   for (uint64_t k = first; k < first + count; ++k) {
     const int bin = static_cast<int>(k / t.per_bin);
     Tally& tally = k >= t.first_item && k < t.last_item ? task_tally : outside;
-    trace_particle(t, bin, tally, scratch, rng);
+    // A sample unit (a particle, or a launch block's part in this task) starts here.
+    if (&tally != last || (k - t.per_bin * static_cast<uint64_t>(bin)) % t.o.launch_lattice == 0)
+      unit_first = tally.exits.size();
+    last = &tally;
+    trace_particle(t, k, bin, tally, unit_first, scratch, rng);
   }
+}
+
+// The independent sample units of incident bin 'bin' (their exits are merged per cell): its launch
+// blocks (particles, without the lattice), a block split by a task's start counting twice.
+uint64_t sample_units(const Tracer& t, uint64_t items_per_task, int bin) {
+  const uint64_t m = static_cast<uint64_t>(t.o.launch_lattice);
+  const uint64_t begin = t.per_bin * static_cast<uint64_t>(bin), end = begin + t.per_bin;
+  uint64_t units = (t.per_bin + m - 1) / m;
+  for (uint64_t s = (begin / items_per_task + 1) * items_per_task; s < end; s += items_per_task)
+    units += (s - begin) % m != 0;
+  return units;
 }
 
 // A fiber sends out at most the light that hits it: a table's total albedo (the bake's exit
@@ -340,7 +413,7 @@ void add_task(const Tally& t, int nc, CellSums& sums, FabricRaytraceResult& resu
 // The table from the sums over per_bin particles per incident bin, its standard error, and each
 // bin's noise and signal.
 void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t per_bin,
-              FabricRaytraceResult& result) {
+              const std::vector<uint64_t>& units, FabricRaytraceResult& result) {
   TabulatedBsdfTable& table = result.table;
   const int bins = grid.bins();
   const auto areas = grid.cosine_weighted_areas();
@@ -352,6 +425,7 @@ void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t 
   const double omega = grid.bin_solid_angle();
   result.standard_error.assign(table.values.size(), 0.0f);
   for (int a = 0; a < bins; ++a) {
+    const double u = static_cast<double>(units[a]);
     std::vector<double>& noise2 = result.bin_books[a].noise2;
     std::vector<double>& signal2 = result.bin_books[a].signal2;
     noise2.assign(nc, 0.0);
@@ -364,9 +438,10 @@ void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t 
         const size_t v = cell * nc + c;
         const double f = sums.sum[v] * scale;
         table.values[v] = static_cast<float>(f);
-        // Per particle the cell receives one exit or none: the sample variance of its weight.
-        const double m1 = sums.sum[v] / n;
-        const double se = std::sqrt(std::max(0.0, sums.sum2[v] / n - m1 * m1) / n) * n * scale;
+        // Per sample unit (a particle, or a launch block) the sum of its weights in the cell:
+        // their sample variance.
+        const double m1 = sums.sum[v] / u;
+        const double se = std::sqrt(std::max(0.0, sums.sum2[v] / u - m1 * m1) / u) * u * scale;
         result.standard_error[v] = static_cast<float>(se);
         noise2[c] += se * se * w;
         signal2[c] += f * f * w;
@@ -385,14 +460,17 @@ void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t 
 
 void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
               const FabricRaytraceOptions& o, TabulatedBsdfTable& table) {
-  table.metadata = {{"method", "raytrace"},
-                    {"estimator_revision", std::to_string(kFabricRaytraceRevision)},
-                    {"fiber_checksum", fiber.checksum()},
-                    {"particles_per_bin", std::to_string(o.particles_per_bin)},
-                    {"seed", std::to_string(o.seed)},
-                    {"estimator", channel_sampling_name(o.channel_sampling)},
-                    {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
+  table.metadata = {
+      {"method", "raytrace"},
+      {"estimator_revision", std::to_string(kFabricRaytraceRevision)},
+      {"fiber_checksum", fiber.checksum()},
+      {"particles_per_bin", std::to_string(o.particles_per_bin)},
+      {"seed", std::to_string(o.seed)},
+      {"estimator", o.next_event_rays > 0 ? "nee" : channel_sampling_name(o.channel_sampling)},
+      {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
   if (o.proposal) table.metadata["proposal_checksum"] = o.proposal->checksum();
+  if (o.next_event_rays > 0) table.metadata["next_event_rays"] = std::to_string(o.next_event_rays);
+  if (o.launch_lattice > 1) table.metadata["launch_lattice"] = std::to_string(o.launch_lattice);
   if (o.channel_sampling != ChannelSampling::mean) {
     char text[32];
     const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;
@@ -485,7 +563,10 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
       },
       [&](const Tally& tally) { add_task(tally, nc, sums, result); });
   result.cancelled = status.cancelled;
-  tabulate(sums, t.grid, nc, t.per_bin, result);
+  std::vector<uint64_t> units(bins);
+  const uint64_t per_task = batch_for(t, progress).items_per_task;
+  for (int a = 0; a < bins; ++a) units[a] = sample_units(t, per_task, a);
+  tabulate(sums, t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   return result;

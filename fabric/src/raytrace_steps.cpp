@@ -76,6 +76,17 @@ Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& r
   return l;
 }
 
+Vec3 lattice_point(const RepeatSlab& slab, const Vec3& p, int m, int count) {
+  const double golden = 0.5 * (1 + std::sqrt(5.0));
+  const int64_t g = std::llround(count / golden);
+  const double fx = (p.x - slab.x0) / slab.px + static_cast<double>(m) / count;
+  const double fz = (p.z - slab.z0) / slab.pz + static_cast<double>((m * g) % count) / count;
+  Vec3 q = p;
+  q.x = slab.x0 + slab.px * (fx - std::floor(fx));
+  q.z = slab.z0 + slab.pz * (fz - std::floor(fz));
+  return q;
+}
+
 Strategies draw_strategies(bool mis, int channels, Rng& rng) {
   Strategies st;
   st.mis = mis;
@@ -167,6 +178,17 @@ bool passes_own_tube(const SurfaceHit& h, Particle& s) {
   if (passes) s.p = h.spawn_origin(s.d);
   s.in_tube = false;
   return passes;
+}
+
+std::optional<Vec3> escape_direction(const RenderScene& scene, const RepeatSlab& slab,
+                                     int64_t curves, Particle& s, int max_events) {
+  for (int e = 0; e < max_events; ++e) {
+    SurfaceHit h;
+    const Flight f = fly(scene, slab, curves, s, &h);
+    if (f == Flight::left_slab) return s.d;
+    if (f == Flight::hit && !passes_own_tube(h, s)) return std::nullopt;
+  }
+  return std::nullopt;
 }
 
 Crossings crossings_of(const RenderScene& scene, const SurfaceHit& h, const Vec3& d,

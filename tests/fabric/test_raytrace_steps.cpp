@@ -3,11 +3,10 @@
 // (a yarn tube's by the line albedo), the tally of an exit, Russian roulette and splitting.
 #include <gtest/gtest.h>
 
-#include "flat_sheet.h"
-
 #include <cmath>
 #include <vector>
 
+#include "flat_sheet.h"
 #include "weft/core/math.h"
 #include "weft/fabric/fiber_sampler.h"
 #include "weft/fabric/line_albedo.h"
@@ -544,4 +543,50 @@ TEST(RaytraceSteps, SplittingSharesTheWeightAmongItsCopies) {
     EXPECT_EQ(c.ignore, 12);
     EXPECT_EQ(c.p.y, 2);
   }
+}
+
+TEST(RaytraceSteps, EscapeFollowsTheLineOutOfTheSlabOrStopsAtASurface) {
+  const WovenSample sheet = flat_sheet();
+  const RepeatSlab slab = repeat_slab_of(sheet);
+  const RenderScene scene(tiled_geometry(sheet));
+  Particle s;
+  // Up from above the sheet, almost level: wraps through the sides, then leaves by the top face.
+  s.p = {0.4e-3, 0.04e-3, 0.1e-3}, s.d = normalize(Vec3{1, 0.01, 0});
+  const std::optional<Vec3> up = escape_direction(scene, slab, 0, s, 100);
+  ASSERT_TRUE(up.has_value());
+  EXPECT_EQ(up->y, s.d.y);
+  // Down onto the sheet: stopped.
+  s.p = {0, 0.04e-3, 0}, s.d = normalize(Vec3{1, -0.01, 0});
+  EXPECT_FALSE(escape_direction(scene, slab, 0, s, 100).has_value());
+  // Too few wraps allowed to reach the face: stopped too.
+  s.p = {0.4e-3, 0.04e-3, 0.1e-3}, s.d = normalize(Vec3{1, 0.01, 0});
+  EXPECT_FALSE(escape_direction(scene, slab, 0, s, 1).has_value());
+}
+
+TEST(RaytraceSteps, LatticePointsCoverTheRepeatEvenlyFromTheEntryPoint) {
+  const RepeatSlab slab = small_slab();
+  const Vec3 p{0.3e-3, slab.y1, -0.2e-3};
+  EXPECT_NEAR(lattice_point(slab, p, 0, 13).x, p.x, 1e-15);
+  EXPECT_NEAR(lattice_point(slab, p, 0, 13).z, p.z, 1e-15);
+  // 13 points (a Fibonacci lattice, generator 8): every one of 13 columns and of 13 rows of the
+  // repeat holds exactly one, at the entry point's offset in it; y is kept.
+  std::vector<int> columns(13, 0), rows(13, 0);
+  for (int m = 0; m < 13; ++m) {
+    const Vec3 q = lattice_point(slab, p, m, 13);
+    EXPECT_EQ(q.y, p.y);
+    ASSERT_GE(q.x, slab.x0);
+    ASSERT_LT(q.x, slab.x0 + slab.px);
+    ASSERT_GE(q.z, slab.z0);
+    ASSERT_LT(q.z, slab.z0 + slab.pz);
+    const double fx = (q.x - slab.x0) / slab.px * 13, fz = (q.z - slab.z0) / slab.pz * 13;
+    ++columns[static_cast<int>(fx)];
+    ++rows[static_cast<int>(fz)];
+    EXPECT_NEAR(fx - std::floor(fx), 0.8 * 13 - std::floor(0.8 * 13), 1e-9);  // p at x fraction 0.8
+  }
+  for (int k = 0; k < 13; ++k) EXPECT_EQ(columns[k], 1) << k;
+  for (int k = 0; k < 13; ++k) EXPECT_EQ(rows[k], 1) << k;
+  // Point 1 is one column and 8 rows on (mod 13).
+  const Vec3 q1 = lattice_point(slab, p, 1, 13);
+  EXPECT_NEAR((q1.x - p.x) / slab.px, 1.0 / 13, 1e-12);
+  EXPECT_NEAR((q1.z - p.z) / slab.pz - std::floor((q1.z - p.z) / slab.pz), 8.0 / 13, 1e-12);
 }

@@ -325,7 +325,7 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   const std::string base = "bake fabric --fiber '" + fiber.string() +
                            "' --method raytrace --detail fiber -R 2 --samples 400 --quiet --json";
   std::map<std::string, uint64_t> splits;
-  for (const std::string& est : {"hero", "mean"}) {
+  for (const std::string& est : {"hero", "mean", "nee"}) {
     const fs::path out = dir / (est + ".exr");
     const CliRun r = run(base + " --estimator " + est + " -o '" + out.string() + "'", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -353,6 +353,9 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   for (const char* bad : {"0.05", "0.01", "-1", "inf", "nan"})
     expect_refused(base + " --split-threshold " + bad, out, "--split-threshold", dir);
   expect_refused(base + " --estimator mean --split-threshold 2", out, "--split-threshold", dir);
+  // The next-event estimate's counts are its own: refused with another estimator.
+  expect_refused(base + " --estimator hero --next-event-rays 2", out, "--next-event-rays", dir);
+  expect_refused(base + " --launch-lattice 5", out, "--launch-lattice", dir);
   // An unknown name is the option parser's refusal (its own exit code), naming the option.
   const CliRun fancy = run(base + " --estimator fancy -o '" + out.string() + "'", dir);
   EXPECT_NE(fancy.exit_code, 0);

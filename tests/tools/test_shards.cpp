@@ -124,30 +124,34 @@ TEST(Shards, RaytracedFabricOfFourShardsMergesToTheOneProcessBytes) {
       run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()}, dir),
       0);
   // 2100 particles per bin: the batch runner's tasks of 2048 straddle incident bins, so a
-  // shard's first and last task hold particles of its neighbours' bins.
-  const auto args =
-      split("bake fabric --method raytrace -R 2 --samples 2100 --quiet --fiber " + fiber.string());
-  const fs::path one = dir / "one.exr";
-  ASSERT_EQ(run_weft(args + std::vector<std::string>{"--json", "-o", one.string()}, dir), 0)
-      << slurp(dir / "stderr");
-  const auto whole = nlohmann::json::parse(slurp(dir / "stdout"));
-  std::string printed;
-  expect_shards_merge_to(args, one, dir, ".exr", {"--json"}, &printed);
-  ASSERT_FALSE(printed.empty());
-  const auto merged = nlohmann::json::parse(printed);
-  // The energy books, counts and noise are sums over the bins in bin order: the merge has the
-  // whole run's bits (JSON numbers print with round-trip precision).
-  for (const char* key : {"exited", "absorbed", "lost", "roulette_net", "relative_noise",
-                          "relative_noise_per_channel", "particles", "scatterings",
-                          "reflectance_normal_incidence", "transmittance_normal_incidence"}) {
-    ASSERT_TRUE(whole.contains(key) && merged.contains(key)) << key;
-    EXPECT_FALSE(merged[key].is_null()) << key;
-    EXPECT_EQ(whole[key].dump(), merged[key].dump()) << key;
+  // shard's first and last task hold particles of its neighbours' bins (and with the nee
+  // estimator, launch blocks of 13 straddle tasks).
+  for (const std::string estimator : {"hero", "nee"}) {
+    const auto args =
+        split("bake fabric --method raytrace -R 2 --samples 2100 --quiet --estimator " + estimator +
+              " --fiber " + fiber.string());
+    const fs::path one = dir / ("one-" + estimator + ".exr");
+    ASSERT_EQ(run_weft(args + std::vector<std::string>{"--json", "-o", one.string()}, dir), 0)
+        << slurp(dir / "stderr");
+    const auto whole = nlohmann::json::parse(slurp(dir / "stdout"));
+    std::string printed;
+    expect_shards_merge_to(args, one, dir, ".exr", {"--json"}, &printed);
+    ASSERT_FALSE(printed.empty());
+    const auto merged = nlohmann::json::parse(printed);
+    // The energy books, counts and noise are sums over the bins in bin order: the merge has the
+    // whole run's bits (JSON numbers print with round-trip precision).
+    for (const char* key : {"exited", "absorbed", "lost", "roulette_net", "relative_noise",
+                            "relative_noise_per_channel", "particles", "scatterings",
+                            "reflectance_normal_incidence", "transmittance_normal_incidence"}) {
+      ASSERT_TRUE(whole.contains(key) && merged.contains(key)) << key;
+      EXPECT_FALSE(merged[key].is_null()) << key;
+      EXPECT_EQ(whole[key].dump(), merged[key].dump()) << key;
+    }
+    EXPECT_GT(merged["relative_noise"].get<double>(), 0.0);
+    EXPECT_NEAR(merged["exited"].get<double>() + merged["absorbed"].get<double>() +
+                    merged["lost"].get<double>() + merged["roulette_net"].get<double>(),
+                1.0, 1e-9);  // fabric_raytrace.h: the books add up to 1 to rounding
   }
-  EXPECT_GT(merged["relative_noise"].get<double>(), 0.0);
-  EXPECT_NEAR(merged["exited"].get<double>() + merged["absorbed"].get<double>() +
-                  merged["lost"].get<double>() + merged["roulette_net"].get<double>(),
-              1.0, 1e-9);  // fabric_raytrace.h: the books add up to 1 to rounding
 }
 
 TEST(Shards, SweepOfFourShardsMergesToTheOneProcessBytes) {

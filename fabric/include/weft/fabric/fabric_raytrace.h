@@ -57,6 +57,10 @@ const char* channel_sampling_name(ChannelSampling s);
 // fiber. Fiber-detail results are unchanged.
 inline constexpr int kFabricRaytraceRevision = 3;
 
+// The most next-event draws per scattering and particles per launch block
+// (FabricRaytraceOptions::next_event_rays, launch_lattice).
+inline constexpr int kMaxNextEventRays = 64, kMaxLaunchLattice = 1024;
+
 struct FabricRaytraceOptions {
   int resolution = 8;                  // of the fabric table (DirectionGrid R)
   uint64_t particles_per_bin = 20000;  // per incident bin
@@ -74,6 +78,24 @@ struct FabricRaytraceOptions {
   // (docs/PERFORMANCE.md); at 1024 none reached it, at the same cost.
   int max_copies_per_particle = 1024;
   ChannelSampling channel_sampling = ChannelSampling::spectral_mis;
+  // The next-event estimate of the exits (0: off, the particles' own exits are binned). At every
+  // scattering, this many draws of the step the particle is about to take (the same point, cell
+  // and direction distribution and the same weights as its own) are each followed along their
+  // line, without scattering, out of the slab or to the surface that stops them; each that leaves
+  // books its weights over the count into its cell. The particle's own exit after a scattering is
+  // then not binned (its expectation is what the draws book); an exit before any scattering
+  // (light passing straight through) is, as without. Every scattering, not only the last, adds to
+  // the table: unbiased, each draw having the law of the exit it replaces.
+  int next_event_rays = 0;
+  // Particles launched in blocks of this many (1: each on its own): a block's particles share one
+  // direction of the bin and enter at the points of a lattice over the repeat through one entry
+  // point (raytrace::lattice_point), both drawn at random per block, so that each particle is
+  // still launched as without. On a dense cloth the light that passes straight through the gaps
+  // between the fibers goes to one cell per incident bin, whose hits and misses were most of the
+  // table's noise (docs/PERFORMANCE.md); a block's lines cover the gaps evenly. A block's exits are
+  // summed per cell before the variance is taken (the blocks are the independent samples), so the
+  // stated noise stays honest.
+  int launch_lattice = 1;
   // Trace only incident bins [first_bin, first_bin + bin_count) (0: all), for a table split over
   // processes: their rows have the bits of a whole run's, the other rows are zero.
   int first_bin = 0, bin_count = 0;
@@ -107,6 +129,9 @@ struct FabricRaytraceResult {
   // Energy books, as fractions of the power that fell on the cloth (mean over channels): exited +
   // absorbed + lost + roulette_net = 1 to rounding. absorbed is what the fibers' tables keep
   // (1 - A' - A'' per scattering, A the albedo of the table at the two crossing points).
+  // exited is the power of the particles that left the slab; with the next-event estimate the
+  // table books the expectation of those exits instead, so the table's albedo agrees with exited
+  // only within the noise.
   double exited = 0, absorbed = 0, lost = 0, roulette_net = 0;
   uint64_t particles = 0, scatterings = 0, wraps = 0;
   // Copies made by splitting, and particles (or copies) ended by Russian roulette, in all and

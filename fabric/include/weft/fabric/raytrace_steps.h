@@ -8,7 +8,9 @@
 //   scattering  the hero strategy picks B' or B'' and an exit direction from the fiber table, and
 //               the path's weights become f over the strategies' mean probability (MIS); a yarn
 //               tube's crossing returns the line albedo of the fiber it stands for;
-//   tally       a particle leaving the slab adds its weights to its (incident, outgoing) cell;
+//   tally       a particle leaving the slab adds its weights to its (incident, outgoing) cell
+//               (with the next-event estimate, draws of its exit followed out of the slab:
+//               escape_direction; particles launched in blocks on a lattice: lattice_point);
 //   roulette and splitting  keep the weights in a window (below: roulette; above: copies).
 // Frames: world is the woven sample's (glTF, y up, metres), cloth the fabric table's (z = +y).
 // The steps that draw random numbers draw them in a fixed order from the particle's task stream:
@@ -54,6 +56,7 @@ struct Particle {
   std::vector<double> w;      // channel weights
   std::vector<double> pdf;    // per strategy, the path's density relative to their mean
   std::vector<double> wp;     // the weights under the proposal (with one; else empty)
+  bool scattered = false;     // by a fiber since its launch
 };
 
 // The mean of the channel weights (the power the books count).
@@ -68,6 +71,13 @@ struct Launch {
   double w0 = 0;
 };
 Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& rng);
+
+// Point m of the rank-1 lattice of 'count' points over the repeat that contains p (its point 0):
+// the fractions (m / count, m g / count) of the periods added to p's, modulo the periods, g the
+// integer nearest count over the golden ratio (a Fibonacci lattice when count is a Fibonacci
+// number; Sloan & Joe, Lattice Methods for Multiple Integration, 1994). Each point is uniform over
+// the repeat when p is, and together they cover it evenly.
+Vec3 lattice_point(const RepeatSlab& slab, const Vec3& p, int m, int count);
 
 // The sampling strategies a path is drawn and weighted with (FiberSampler strategy indices). With
 // spectral MIS one per channel, and the particle follows its hero, drawn uniformly; else one, the
@@ -127,6 +137,13 @@ Flight fly(const RenderScene& scene, const RepeatSlab& slab, int64_t curves, Par
 // tables non-reciprocal). True, and the particle moved past h, when h is that far side; either
 // way the particle is no longer in its tube.
 bool passes_own_tube(const SurfaceHit& h, Particle& s);
+// Where a particle just sent out of a fiber goes if nothing stops it: its line (wrapped through
+// the repeat's sides, and through its own yarn tube) is followed to the first surface it meets or
+// out of the slab; the direction it leaves the slab along, or none when a surface is met first
+// (or after max_events wraps and passes). The next-event estimate's visibility test: no
+// scattering and no random draw.
+std::optional<Vec3> escape_direction(const RenderScene& scene, const RepeatSlab& slab,
+                                     int64_t curves, Particle& s, int max_events);
 
 // --- crossings
 // Where a particle's line meets a fiber: the point, its local frame (x = axis, z = outward), the
