@@ -18,7 +18,7 @@ while [ $# -gt 0 ]; do
   esac
 done
 all=(fuzz_scene_description fuzz_fiber_spec fuzz_weave_options fuzz_table_exr fuzz_wif fuzz_nbrdf
-  fuzz_inplane_csv fuzz_gltf fuzz_glb)
+  fuzz_inplane_csv fuzz_gltf fuzz_glb fuzz_job_part)
 [ ${#harnesses[@]} -gt 0 ] || harnesses=("${all[@]}")
 
 if ! command -v clang++ >/dev/null; then
@@ -43,11 +43,16 @@ with_tests=OFF
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DWEFT_FUZZ=ON -DWEFT_BUILD_TESTS="$with_tests" -DWEFT_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "${WEFT_JOBS:-2}" --target "${harnesses[@]}" "${tests[@]}"
+# The test programs run two at a time (each mostly on one thread); any failure stops the script.
+test_pids=()
 for t in "${tests[@]}"; do
   echo "== ASan/UBSan: $t"
   ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-    "$build/tests/$t" --gtest_brief=1
+    "$build/tests/$t" --gtest_brief=1 &
+  test_pids+=($!)
+  if [ ${#test_pids[@]} -ge 2 ]; then wait "${test_pids[0]}"; test_pids=("${test_pids[@]:1}"); fi
 done
+for p in "${test_pids[@]}"; do wait "$p"; done
 
 # Seeds per harness: the bundled files of that format.
 seeds() {
@@ -61,6 +66,7 @@ seeds() {
     fuzz_inplane_csv) ls materials/data/measured/*/inplane.csv ;;
     fuzz_gltf) ls scenes/examples/*.gltf tests/scenes/data/*.gltf ;;
     fuzz_glb) ls tests/fuzz/seeds/glb/*.glb ;;
+    fuzz_job_part) ls tests/fuzz/seeds/part/* ;;
   esac
 }
 
