@@ -134,6 +134,16 @@ void write_text_atomically(const std::filesystem::path& path, const std::string&
   });
 }
 
+void write_bytes_atomically(const std::filesystem::path& path, std::span<const uint8_t> bytes) {
+  write_atomically(path, [&](const std::filesystem::path& tmp) {
+    std::ofstream out(tmp, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes.data()),
+              static_cast<std::streamsize>(bytes.size()));
+    out.close();
+    if (!out) throw Error(path.string(), "", "write failed");
+  });
+}
+
 void check_output_paths(const std::vector<NamedPath>& outputs,
                         const std::vector<NamedPath>& inputs) {
   namespace fs = std::filesystem;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 
 #include "marginal_warp.h"
 #include "tensor_file.h"
@@ -196,13 +195,7 @@ ExportReport write_rgl_bsdf(const TabulatedBsdfTable& table, const std::filesyst
     fields.push_back(rgl::float_field("rgb", {1, u64(nt), nc, ns, ns}, s.values));
   }
   const std::vector<uint8_t> bytes = rgl::encode_tensor_file(fields);
-  write_atomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw Error(path.string(), "", "write failed");
-  });
+  write_bytes_atomically(path, bytes);
   ExportReport r{"RGL .bsdf", {}, {}, {}};
   r.dropped = {
       "transmission (light and viewer on opposite sides of the cloth)",

@@ -2,7 +2,6 @@
 // primitives with a _RADIUS attribute), one binary buffer, .gltf (base64) or .glb.
 #include <algorithm>
 #include <cstring>
-#include <fstream>
 
 #include "weave_internal.h"
 #include "weft/core/atomic_file.h"
@@ -192,13 +191,7 @@ void write_gltf(const std::filesystem::path& path, const GltfDocument& d) {
   if (12 + 8 + d.doc.dump().size() + 8 + d.bin.size() + 8 > 0xFFFFFFFFull)
     throw Error(path.string(), "", "a .glb holds at most 4 GiB; write .gltf or fewer repeats");
   const auto bytes = glb_bytes(d);
-  write_atomically(path, [&](const std::filesystem::path& tmp) {
-    std::ofstream out(tmp, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes.data()),
-              static_cast<std::streamsize>(bytes.size()));
-    out.close();
-    if (!out) throw Error(path.string(), "", "write failed");
-  });
+  write_bytes_atomically(path, bytes);
 }
 
 }  // namespace weft::detail

@@ -1,7 +1,9 @@
 #pragma once
 // Output files appear whole or not at all: write to a temporary sibling, then rename.
+#include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -45,5 +47,7 @@ size_t remove_stale_temporaries(const std::filesystem::path& path);
 
 // Same, for text content.
 void write_text_atomically(const std::filesystem::path& path, const std::string& text);
+// Same, for binary content.
+void write_bytes_atomically(const std::filesystem::path& path, std::span<const uint8_t> bytes);
 
 }  // namespace weft
