@@ -100,6 +100,13 @@ TEST(VerifyReportFiles, CameraRgbMarksAbsoluteFiguresNotComparable) {
     EXPECT_EQ(html.find("not comparable") != std::string::npos, !srgb);
     // The verdict leads the page, above the plots.
     EXPECT_LT(html.find("<h2>Verdict</h2>"), html.find("<h2>In-plane curves</h2>"));
+    // One page: the document ends once, and every table opened is closed.
+    EXPECT_EQ(html.find("</html>"), html.rfind("</html>"));
+    EXPECT_EQ(html.size() - html.find("</body></html>\n"), std::string("</body></html>\n").size());
+    size_t opened = 0, closed = 0;
+    for (size_t p = 0; (p = html.find("<table", p)) != std::string::npos; ++p) ++opened;
+    for (size_t p = 0; (p = html.find("</table>", p)) != std::string::npos; ++p) ++closed;
+    EXPECT_EQ(opened, closed);
   }
 }
 

@@ -198,7 +198,7 @@ void html_settings(std::ostringstream& h, const VerifyReport& r) {
     << fmt(r.raytrace_relative_noise) << "</td></tr>\n";
   for (const auto& [k, v] : r.seconds)
     h << "<tr><td>" << html_escape(k) << " (s)</td><td>" << fmt(v, 4) << "</td></tr>";
-  h << "</table>\n</body></html>\n";
+  h << "</table>\n";
 }
 
 }  // namespace
@@ -214,7 +214,7 @@ std::string verify_index_html(const VerifyReport& r,
   html_renders(h, r);
   html_colours(h, r);
   html_settings(h, r);
-  h << "</table>\n</body></html>\n";
+  h << "</body></html>\n";
   return h.str();
 }
 
