@@ -14,6 +14,20 @@ namespace weft::detail {
 
 inline constexpr double kMetresPerMm = 1e-3;
 
+// The bundled red-cotton sample (scenes/examples/red-cotton-weave.json; sources in
+// scenes/examples/README.md): a cotton poplin, warp Ne 50 at 120 ends/in, weft Ne 42 at 60
+// picks/in, lens sections of the Peirce yarn area, warp closed, weft straight. Lengths in mm.
+namespace red_cotton {
+inline constexpr double kRedWarpSpacing = 0.2117, kRedWarpWidth = 0.2117,
+                        kRedWarpThickness = 0.0959;
+inline constexpr double kRedWeftSpacing = 0.4233, kRedWeftWidth = 0.2310,
+                        kRedWeftThickness = 0.1047;
+inline constexpr double kRedWarpCrimpShare = 1.0;
+inline constexpr double kRedFiberRadiusUm = 8.0;
+inline constexpr double kRedPacking = 0.55;
+inline constexpr double kRedTwistPerMm = 1.0;
+}  // namespace red_cotton
+
 // One yarn of the sample: its axis, where it lies, and its crimped centre line.
 struct YarnPath {
   bool warp = true;   // warp: along x, positioned along z; weft: along z, positioned along x
