@@ -209,6 +209,19 @@ TEST(Wif, FloatingThreadsAreReported) {
   fs::remove_all(dir);
 }
 
+// A mutated draft parses and interlaces (one value per warp and weft crossing), or is refused
+// with a weft::Error naming its file; counted in 'parsed' or 'refused'.
+static void parse_mutant(const std::string& text, int& parsed, int& refused) {
+  try {
+    const WifDraft d = parse_wif(text, "mutant.wif");
+    EXPECT_EQ(d.interlacing().warp_over.size(), d.warp.size() * d.weft.size());
+    ++parsed;
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("mutant.wif"), std::string::npos) << e.what();
+    ++refused;
+  }
+}
+
 TEST(Wif, MutatedDraftsAreErrorsOrDraftsNeverCrashes) {
   // Deterministic mutations of a valid draft (characters replaced, lines dropped or repeated):
   // each parses or throws weft::Error; anything else (another exception, a crash) fails.
@@ -234,15 +247,7 @@ TEST(Wif, MutatedDraftsAreErrorsOrDraftsNeverCrashes) {
           text.insert(from, line);
       }
     }
-    try {
-      const WifDraft d = parse_wif(text, "mutant.wif");
-      const Interlacing m = d.interlacing();
-      EXPECT_EQ(m.warp_over.size(), d.warp.size() * d.weft.size());
-      ++parsed;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find("mutant.wif"), std::string::npos) << e.what();
-      ++refused;
-    }
+    parse_mutant(text, parsed, refused);
   }
   EXPECT_GT(parsed, 0);
   EXPECT_GT(refused, 0);
@@ -316,14 +321,7 @@ TEST(Wif, ByteMutationsAreErrorsOrDraftsNeverCrashes) {
   for (const std::string& valid : {kSmall, weft::testing::slurp(kWif / "8452.wif")})
     for (int trial = 0; trial < 1000; ++trial) {
       const std::string text = weft::testing::mutated(valid, rng);
-      try {
-        const WifDraft d = parse_wif(text, "mutant.wif");
-        EXPECT_EQ(d.interlacing().warp_over.size(), d.warp.size() * d.weft.size());
-        ++parsed;
-      } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("mutant.wif"), std::string::npos) << e.what();
-        ++refused;
-      }
+      parse_mutant(text, parsed, refused);
     }
   EXPECT_GT(parsed, 0);
   EXPECT_GT(refused, 0);
