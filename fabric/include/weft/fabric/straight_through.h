@@ -30,7 +30,7 @@ struct StraightThroughPlan {
   uint64_t rays() const;
 };
 // At least as many rays as the bin launches particles (a ray stops at the first fiber it meets:
-// it costs about a fifth of a particle on the bundled poplin), 5 points per direction at least.
+// it costs about a tenth of a particle on the bundled poplin), 5 points per direction at least.
 // The lattice sizes are Fibonacci numbers (lattice_point: the golden-ratio lattice covers the
 // repeat evenly).
 StraightThroughPlan straight_through_plan(uint64_t particles_per_bin);
