@@ -34,41 +34,48 @@ constexpr double kFar_m = 10;       // film 1 m = 100 repeats: 0.64 px a repeat 
 constexpr double kClose_m = 0.2;    // film 2 cm = 2 repeats: 32 px a repeat
 constexpr int kPixels = 64;
 
-// A transmitting Lambert-like fabric table: 0.5 / pi reflected, 0.3 / pi transmitted.
-fs::path write_fabric_table(const fs::path& dir) {
+// A transmitting Lambert-like fabric table: 0.5 / pi reflected, 0.3 / pi transmitted, in RGB or
+// in 33 bands.
+fs::path write_fabric_table(const fs::path& dir, int channels = 3) {
   auto t = TabulatedBsdfTable::from_function(
-      4, 3,
+      4, channels,
       [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        v[0] = v[1] = v[2] = (wo.z * wi.z > 0 ? 0.5 : 0.3) / kPi;
+        for (double& x : v) x = (wo.z * wi.z > 0 ? 0.5 : 0.3) / kPi;
       },
       2, 1);
   t.kind = "fabric";
-  t.write_exr(dir / "fabric.exr");
-  return dir / "fabric.exr";
+  const fs::path file = dir / ("fabric" + std::to_string(channels) + ".exr");
+  t.write_exr(file);
+  return file;
 }
 
 // The checker weave: cell (iu, iv) is colour A when iu + iv is even, else B; mean 1 exactly
-// (8 cells of each).
-fs::path write_checker_weave(const fs::path& dir) {
+// (8 cells of each). In bands: the first 11 bands as R above, the next 11 as G, the rest 1.
+fs::path write_checker_weave(const fs::path& dir, int channels = 3) {
   WeaveTable w;
+  w.channels = channels;
   w.resolution = 2;
   w.positions_u = w.positions_v = 4;
   w.repeat_u_m = w.repeat_v_m = kRepeat_m;
   const int n = w.bins();
-  w.modulation.resize(static_cast<size_t>(w.positions()) * n * n * 3);
+  w.modulation.resize(static_cast<size_t>(w.positions()) * n * n * channels);
   for (int iv = 0; iv < 4; ++iv)
     for (int iu = 0; iu < 4; ++iu) {
       const bool a = (iu + iv) % 2 == 0;
       for (int i = 0; i < n; ++i)
         for (int o = 0; o < n; ++o) {
           const int pos = iv * 4 + iu;
-          w.modulation[w.index(pos, i, o, 0)] = a ? 1.8f : 0.2f;
-          w.modulation[w.index(pos, i, o, 1)] = a ? 0.2f : 1.8f;
-          w.modulation[w.index(pos, i, o, 2)] = 1.0f;
+          for (int c = 0; c < channels; ++c) {
+            const int group = channels == 3 ? c : c / 11;
+            w.modulation[w.index(pos, i, o, c)] = group == 0   ? (a ? 1.8f : 0.2f)
+                                                  : group == 1 ? (a ? 0.2f : 1.8f)
+                                                               : 1.0f;
+          }
         }
     }
-  w.write_exr(dir / "weave.exr");
-  return dir / "weave.exr";
+  const fs::path file = dir / ("weave" + std::to_string(channels) + ".exr");
+  w.write_exr(file);
+  return file;
 }
 
 // The patch: 2 m x 2 m in z = 0 around the origin, normal +z, tangent +x, uv = (x, y) metres.
@@ -107,8 +114,9 @@ SceneDescription patch_scene(const Files& f, const std::string& level, double di
   return d;
 }
 
-RenderSettings settings(uint64_t seed) {
+RenderSettings settings(uint64_t seed, bool spectral = false) {
   RenderSettings s;
+  s.spectral = spectral;
   s.width = s.height = kPixels;
   s.spp = 16;
   s.max_depth = 4;
@@ -125,8 +133,8 @@ struct Render {
   RenderResult result;
   SampleMean mean[3];
 };
-Render render_patch(const SceneDescription& d, uint64_t seed) {
-  Render r{render(RenderScene(d), *d.camera, settings(seed)), {}};
+Render render_patch(const SceneDescription& d, uint64_t seed, bool spectral = false) {
+  Render r{render(RenderScene(d), *d.camera, settings(seed, spectral)), {}};
   for (int c = 0; c < 3; ++c) r.mean[c] = channel_mean(r.result.image, c);
   return r;
 }
@@ -134,9 +142,9 @@ Render render_patch(const SceneDescription& d, uint64_t seed) {
 // Same mean within 4 standard errors, channel by channel; prints the figures and the same
 // comparison from a second seed (the noise seen, not only estimated).
 void expect_same_means(const SceneDescription& weave, const SceneDescription& table,
-                       const char* what) {
+                       const char* what, bool spectral = false) {
   for (uint64_t seed : {1u, 2u}) {
-    const Render w = render_patch(weave, seed), t = render_patch(table, seed);
+    const Render w = render_patch(weave, seed, spectral), t = render_patch(table, seed, spectral);
     for (int c = 0; c < 3; ++c) {
       const double se = std::hypot(w.mean[c].std_error, t.mean[c].std_error);
       std::printf("%s seed %d channel %d: weave %.6f table %.6f (diff %+.2e, 1 se %.2e)\n", what,
@@ -147,6 +155,20 @@ void expect_same_means(const SceneDescription& weave, const SceneDescription& ta
           << what << " seed " << seed << " channel " << c;
     }
   }
+}
+
+// The standard deviation of the mean red over the close-up's 8 x 8 cells of 8 px (the film's
+// edges lie on cell edges: it spans -1 .. 1 cm).
+double cell_spread(const Image& im) {
+  std::vector<double> means;
+  for (int cy = 0; cy < 8; ++cy)
+    for (int cx = 0; cx < 8; ++cx) {
+      double sum = 0;
+      for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) sum += im.rgb[3 * ((cy * 8 + y) * im.width + cx * 8 + x)];
+      means.push_back(sum / 64);
+    }
+  return sample_mean(64, [&](int i) { return means[i]; }).std_error * 8;  // std-dev
 }
 
 class WeaveLevelRender : public ::testing::Test {
@@ -179,18 +201,6 @@ TEST_F(WeaveLevelRender, CloseUpShowsTheCellsAndKeepsTheMean) {
     const auto table = patch_scene(files_, "table", kClose_m, behind);
     expect_same_means(weave, table,
                       behind ? "close, lit from behind" : "close, lit from the front");
-    auto cell_spread = [](const Image& im) {
-      // 8 px a cell: the film's edges lie on cell edges (the film spans -1 .. 1 cm).
-      std::vector<double> means;
-      for (int cy = 0; cy < 8; ++cy)
-        for (int cx = 0; cx < 8; ++cx) {
-          double sum = 0;
-          for (int y = 0; y < 8; ++y)
-            for (int x = 0; x < 8; ++x) sum += im.rgb[3 * ((cy * 8 + y) * im.width + cx * 8 + x)];
-          means.push_back(sum / 64);
-        }
-      return sample_mean(64, [&](int i) { return means[i]; }).std_error * 8;  // std-dev
-    };
     const double sw = cell_spread(render_patch(weave, 1).result.image);
     const double st = cell_spread(render_patch(table, 1).result.image);
     std::printf("close (%s): std-dev of the cells' mean red: weave %.4g table %.4g ratio %.1f\n",
@@ -242,4 +252,40 @@ TEST(ChooseWeaveLevel, ThresholdsAndFootprints) {
   ortho.type = Camera::Type::orthographic;
   ortho.half_height = 0.5;  // 1 m over 100 px: 1 cm a pixel, at any distance
   EXPECT_NEAR(repeat_pixels(ortho, 100, box, 0.03), 3.0, 1e-12);
+}
+
+// A spectral render reads a spectral weave per band: the same mean as the table level over the
+// close-up's whole repeats, and the cells show in red (bands 390-490 nm and 500-600 nm carry the
+// checker; the red of linear sRGB takes its positive weights from both).
+TEST_F(WeaveLevelRender, SpectralWeaveRendersPerBand) {
+  const fs::path dir = fresh_test_dir();
+  const Files spectral{write_fabric_table(dir, kNumBands), write_checker_weave(dir, kNumBands)};
+  const auto weave = patch_scene(spectral, "weave", kClose_m, false);
+  const auto table = patch_scene(spectral, "table", kClose_m, false);
+  expect_same_means(weave, table, "close, spectral", true);
+  const double sw = cell_spread(render_patch(weave, 1, true).result.image);
+  const double st = cell_spread(render_patch(table, 1, true).result.image);
+  std::printf("close, spectral: std-dev of the cells' mean red: weave %.4g table %.4g\n", sw, st);
+  EXPECT_GT(sw, 5 * st);
+}
+
+// The scene's side: a woven mesh needs UVs; the level as built is the material's forced one
+// ("weave": on; "auto" and "table": off until a render chooses); with_weave_levels checks sizes.
+TEST_F(WeaveLevelRender, SceneKnowsItsWovenMeshes) {
+  for (const char* level : {"weave", "auto", "table"}) {
+    const RenderScene scene(patch_scene(files_, level, kFar_m, false));
+    ASSERT_EQ(scene.woven_meshes().size(), 1u);
+    EXPECT_EQ(scene.woven_meshes()[0].name, "patch");
+    EXPECT_EQ(scene.weave_level(0), std::string(level) == "weave") << level;
+    EXPECT_TRUE(scene.with_weave_levels({1}).weave_level(0));
+    EXPECT_FALSE(scene.with_weave_levels({0}).weave_level(0));
+    EXPECT_NE(error_of([&] { scene.with_weave_levels({}); }), "");
+  }
+  SceneDescription no_uv = patch_scene(files_, "", kFar_m, false);
+  auto mesh = std::make_shared<TriangleMesh>(*no_uv.meshes[0]);
+  mesh->uvs.clear();
+  no_uv.meshes = {mesh};
+  const std::string msg = error_of([&] { RenderScene{no_uv}; });
+  EXPECT_NE(msg.find("materials.cloth"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("UVs"), std::string::npos) << msg;
 }
