@@ -4,14 +4,13 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <numbers>
 #include <numeric>
 #include <set>
 #include <utility>
 
+#include "exr_io.h"
 #include "weft/core/error.h"
-#include "weft/core/hash.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
 #include "weft/core/rng.h"
@@ -43,15 +42,7 @@ void TabulatedBsdfTable::interpolate(const Vec3& wo, const Vec3& wi, std::span<d
 }
 
 std::string TabulatedBsdfTable::checksum() const {
-  uint64_t h = kFnv1a64Basis;
-  for (const float v : values) {
-    uint32_t bits = 0;
-    std::memcpy(&bits, &v, sizeof bits);
-    unsigned char bytes[4];
-    for (int k = 0; k < 4; ++k) bytes[k] = static_cast<unsigned char>((bits >> (8 * k)) & 0xffu);
-    h = fnv1a64(bytes, 4, h);  // little-endian bytes whatever the host's order
-  }
-  return hex64(h);
+  return exr_io::checksum(values);
 }
 
 std::string TabulatedBsdfTable::bands() const {
@@ -59,15 +50,7 @@ std::string TabulatedBsdfTable::bands() const {
 }
 
 std::vector<std::string> TabulatedBsdfTable::channel_names() const {
-  if (channels == 3) return {"R", "G", "B"};
-  std::vector<std::string> names;
-  for (int b = 0; b < channels; ++b) {
-    // Appending (rather than "w" + ...) sidesteps GCC 12's false -Wrestrict (PR 105329).
-    std::string name(1, 'w');
-    name += std::to_string(static_cast<int>(band_wavelength_nm(b)));
-    names.push_back(std::move(name));
-  }
-  return names;
+  return exr_io::channel_names(channels);
 }
 
 namespace {
