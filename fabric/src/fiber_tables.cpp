@@ -39,6 +39,44 @@ FiberTables fiber_tables_by_direction(const WovenSample& sample, const Tabulated
   return f;
 }
 
+FiberTables fiber_tables_by_colour(const WovenSample& sample,
+                                   std::vector<std::array<double, 3>>& colours,
+                                   const std::string& field) {
+  const std::vector<std::array<double, 3>>& rgb = sample.yarn_rgb;
+  const WeaveSummary& s = sample.summary;
+  const size_t warps = static_cast<size_t>(s.warps) * static_cast<size_t>(s.repeats_z);
+  const size_t wefts = static_cast<size_t>(s.wefts) * static_cast<size_t>(s.repeats_x);
+  if (rgb.empty() || rgb.size() != warps + wefts)
+    throw Error("", field, "the woven sample has no thread colours (they come from a WIF draft)");
+  colours.clear();
+  std::vector<int> of_yarn;
+  for (const auto& c : rgb) {
+    size_t k = 0;
+    while (k < colours.size() && colours[k] != c) ++k;
+    if (k == colours.size()) colours.push_back(c);
+    of_yarn.push_back(static_cast<int>(k));
+  }
+  FiberTables f;
+  f.tables.assign(colours.size(), nullptr);
+  if (!sample.fibers.yarn_material.empty()) {
+    if (sample.fibers.yarn_material.size() != rgb.size())
+      throw Error("", field, "the sample's fibers are not one yarn per thread of the draft");
+    f.table_of_yarn = of_yarn;
+  }
+  for (const TriangleMesh& m : sample.meshes) {
+    const bool warp = m.material == "warp";
+    const size_t first = warp ? 0 : warps, end = warp ? warps : warps + wefts;
+    for (size_t y = first; y < end; ++y)
+      if (of_yarn[y] != of_yarn[first])
+        throw Error("", field,
+                    std::string("at yarn detail all ") + (warp ? "warps" : "wefts") +
+                        " are one tube mesh, but the draft's differ in colour: trace it at fiber "
+                        "detail");
+    f.table_of_mesh.push_back(of_yarn[first]);
+  }
+  return f;
+}
+
 void validate_fiber_tables(const FiberTables& f, const WovenSample& sample) {
   if (f.tables.empty() || f.tables.size() > static_cast<size_t>(kMaxFiberTables))
     throw Error("", "fiber tables",

@@ -82,6 +82,7 @@ ThreadDye thread_dye(const std::array<double, 3>& srgb, double fiber_radius_um,
 FiberSpec thread_colour_spec(const FiberSpec& base, const std::array<double, 3>& srgb,
                              const std::string& field) {
   const ThreadDye dye = thread_dye(srgb, base.fiber_radius_um, field);
+  if (srgb == std::array<double, 3>{1, 1, 1}) return base;  // no dye: the base, named as it is
   FiberSpec s = base;
   for (int b = 0; b < kNumBands; ++b) s.host_absorption_per_um[b] += dye.absorption_per_um[b];
   s.name = base.name + " " + srgb_hex(srgb);

@@ -42,6 +42,11 @@ TEST(ThreadColour, WhiteIsTheBaseFiberItself) {
   }
   EXPECT_EQ(fiber_spec_hash_hex(thread_colour_spec(base, {1, 1, 1}, "colour")),
             fiber_spec_hash_hex(base));
+  EXPECT_EQ(thread_colour_spec(base, {1, 1, 1}, "colour").name, "white-cotton");
+  // Any other colour is a spec of its own, named by its colour.
+  const FiberSpec ivory = thread_colour_spec(base, {1, 1, 0.94}, "colour");
+  EXPECT_NE(fiber_spec_hash_hex(ivory), fiber_spec_hash_hex(base));
+  EXPECT_EQ(ivory.name, "white-cotton #fffff0");
 }
 
 TEST(ThreadColour, GreyIsAFlatReflectanceOfItsLinearValue) {

@@ -25,6 +25,7 @@
 //
 // Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -201,6 +202,14 @@ inline constexpr int kMaxFiberTables = 64;
 // The sample's warp yarns (material "warp", the "warp" mesh) take 'warp', the others 'weft'.
 FiberTables fiber_tables_by_direction(const WovenSample& sample, const TabulatedBsdfTable& warp,
                                       const TabulatedBsdfTable& weft);
+// One table per distinct thread colour of the sample (WovenSample::yarn_rgb, a WIF draft's), in the
+// order they first appear among its yarns (warps, then wefts): the map, its tables left null for
+// the caller, and 'colours' the colours in table order. At yarn detail each direction's tubes are
+// one mesh: weft::Error naming 'field' when a direction's yarns differ in colour, and when the
+// sample has no colours.
+FiberTables fiber_tables_by_colour(const WovenSample& sample,
+                                   std::vector<std::array<double, 3>>& colours,
+                                   const std::string& field);
 // weft::Error naming the table ("fiber tables[k] (name)") or the map when the tables differ in
 // resolution or channels, are not fiber tables, or the maps do not fit the sample.
 void validate_fiber_tables(const FiberTables& tables, const WovenSample& sample);

@@ -40,7 +40,7 @@ ThreadDye thread_dye(const std::array<double, 3>& srgb, double fiber_radius_um,
                      const std::string& field);
 
 // 'base' with the dye's absorption added to its host's, named "<base> #rrggbb". White gives
-// 'base' itself (the same spec hash).
+// 'base' itself (its name and spec hash).
 FiberSpec thread_colour_spec(const FiberSpec& base, const std::array<double, 3>& srgb,
                              const std::string& field);
 
