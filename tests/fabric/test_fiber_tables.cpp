@@ -96,17 +96,20 @@ TEST(FiberTables, EqualTablesAreTheSingleTableTraceBitForBit) {
 
 TEST(FiberTables, EveryYarnOnTheSecondTableIsThatTablesTraceBitForBit) {
   // Two distinct tables, every yarn mapped to the second: the per-yarn path looks each hit's table
-  // up, and none of the first table's values may leak into the trace.
+  // up (the next-event draws' too), and none of the first table's values may leak into the trace.
   for (const char* detail : {"yarn", "fiber"}) {
     const WovenSample sample = sample_at(detail);
     const auto red = coloured_fiber(4, {0.9, 0.2, 0.2}), grey = coloured_fiber(4, {0.6, 0.6, 0.6});
     FiberTables f = fiber_tables_by_direction(sample, red, grey);
     for (int& k : f.table_of_yarn) k = 1;
     for (int& k : f.table_of_mesh) k = 1;
-    const FabricRaytraceOptions o = options(200);
-    EXPECT_EQ(raytrace_fabric_table(sample, f, o).table.values,
-              raytrace_fabric_table(sample, grey, o).table.values)
-        << detail;
+    for (const int next_event_rays : {0, 2}) {
+      FabricRaytraceOptions o = options(200);
+      o.next_event_rays = next_event_rays;
+      EXPECT_EQ(raytrace_fabric_table(sample, f, o).table.values,
+                raytrace_fabric_table(sample, grey, o).table.values)
+          << detail << " next-event rays " << next_event_rays;
+    }
   }
 }
 
