@@ -86,8 +86,7 @@ bool per_yarn_fibers(const FabricFiberOptions& o) {
   return o.thread_colours || warp != weft;
 }
 
-void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& method,
-                                bool pieces) {
+void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& method) {
   if (o.thread_colours && (!o.warp_fiber.empty() || !o.weft_fiber.empty()))
     throw Error("", "--thread-colours",
                 "give either --thread-colours or --warp-fiber/--weft-fiber, not both");
@@ -102,10 +101,6 @@ void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& 
     throw Error("", option,
                 "the summations take one fiber for the whole cloth; per-yarn fibers need "
                 "--method raytrace");
-  if (pieces)
-    throw Error("", option,
-                "a ray trace with per-yarn fibers is traced whole: --shard and --resume take one "
-                "fiber");
 }
 
 FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& sample,

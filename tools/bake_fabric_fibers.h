@@ -21,9 +21,8 @@ struct FabricFiberOptions {
 inline constexpr int kMaxThreadColours = 8;
 
 // Checked before any work: the options that need a ray trace, a draft, or exclude each other
-// (weft::Error naming the option). 'method' is --method; 'pieces' whether --shard or --resume.
-void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& method,
-                                bool pieces);
+// (weft::Error naming the option). 'method' is --method.
+void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& method);
 // True when the run traces more than one fiber (per-yarn tables may still turn out equal).
 bool per_yarn_fibers(const FabricFiberOptions& o);
 

@@ -182,7 +182,7 @@ int run(const BakeFabricOptions& o) {
   const std::string weave_wif = o.weave.empty() ? "" : read_weave_options(o.weave).wif.value_or("");
   const FabricFiberOptions fiber_options{o.fiber, o.warp_fiber, o.weft_fiber, o.thread_colours,
                                          o.wif.empty() ? weave_wif : o.wif};
-  check_fabric_fiber_options(fiber_options, o.method, !o.shard.empty() || o.resume);
+  check_fabric_fiber_options(fiber_options, o.method);
   validate_output_paths({{o.output, "--output"}, {checkpoint_path(o.output), "checkpoint"}},
                         {{o.fiber, "fiber table or spec"},
                          {o.warp_fiber, "warp fiber table or spec"},
@@ -213,8 +213,8 @@ int run(const BakeFabricOptions& o) {
       std::vector<std::filesystem::path> inputs;
       for (const auto& f : {o.weave, o.wif})
         if (!f.empty()) inputs.emplace_back(f);
-      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
-                                              o.shard, o.resume, progress, &code);
+      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fibers.map, r,
+                                              o.output, o.shard, o.resume, progress, &code);
       if (!pieces) return code;
       res = std::move(*pieces);
     } else {

@@ -89,9 +89,6 @@ TEST(CliFabricFibers, OneFiberPerYarnIsTheSingleFiberRunAndTwoAreNamed) {
             0);
   expect_refused(sum + " --fiber '" + red.string() + "' --warp-fiber '" + white.string() + "'",
                  "--warp-fiber", dir);
-  expect_refused(
-      base + " --fiber '" + red.string() + "' --weft-fiber '" + white.string() + "' --shard 1/2",
-      "--weft-fiber", dir);
 }
 
 TEST(CliFabricFibers, ThreadColoursBakeOneFiberPerColourOfTheDraft) {
@@ -123,13 +120,12 @@ TEST(CliFabricFibers, ThreadColourMisuseIsRefusedByName) {
   const fs::path dir = fresh_test_dir();
   const std::string twill = (kWifDir / "red-white-twill.wif").string();
   const std::string rt = "bake fabric --method raytrace -R 2 --samples 10 --quiet";
-  // No draft; per-direction fibers as well; the summation; in pieces.
+  // No draft; per-direction fibers as well; the summation.
   expect_refused(rt + " --thread-colours", "--thread-colours", dir);
   expect_refused(rt + " --wif '" + twill + "' --thread-colours --warp-fiber white-cotton",
                  "--thread-colours", dir);
   expect_refused("bake fabric --method summation -R 2 --wif '" + twill + "' --thread-colours",
                  "--thread-colours", dir);
-  expect_refused(rt + " --wif '" + twill + "' --thread-colours --resume", "--thread-colours", dir);
   // The draft's colours dye a spec, not a table.
   const fs::path table = small_fiber("white-cotton", dir);
   expect_refused(rt + " --wif '" + twill + "' --thread-colours --fiber '" + table.string() + "'",
