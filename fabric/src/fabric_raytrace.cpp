@@ -508,7 +508,8 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
 }
 
 // Per-yarn tables in the metadata: in place of the one fiber's checksum and spec, per table
-// "name: checksum (spec name)" and which yarns take it, "; " between tables.
+// "name: checksum (spec name)", "; " between tables, how many of the fibers' yarns take each
+// (a draft has up to 40 000 yarns: counts, not the map) and each mesh's table.
 void describe_per_yarn(const FiberTables& f, TabulatedBsdfTable& table) {
   std::string list;
   for (size_t k = 0; k < f.tables.size(); ++k) {
@@ -530,7 +531,11 @@ void describe_per_yarn(const FiberTables& f, TabulatedBsdfTable& table) {
     }
     return out;
   };
-  if (!f.table_of_yarn.empty()) table.metadata["fiber_table_of_yarn"] = joined(f.table_of_yarn);
+  if (!f.table_of_yarn.empty()) {
+    std::vector<int> yarns(f.tables.size(), 0);
+    for (int k : f.table_of_yarn) ++yarns[k];
+    table.metadata["fiber_yarns_per_table"] = joined(yarns);
+  }
   if (!f.table_of_mesh.empty()) table.metadata["fiber_table_of_mesh"] = joined(f.table_of_mesh);
 }
 

@@ -66,6 +66,15 @@ void expect_two_colour_cloth_between(const char* detail, uint64_t particles) {
   // The red warp shows: red above green (the grey weft alone has them equal).
   EXPECT_GT(mixed[0] / mixed[1], 1.1) << detail;
   EXPECT_GT(mixed_run.table.metadata.count("fiber_tables"), 0u);
+  if (std::string(detail) == "fiber") {
+    size_t warps = 0;
+    for (const std::string& m : sample.fibers.yarn_material) warps += m == "warp";
+    EXPECT_EQ(
+        mixed_run.table.metadata.at("fiber_yarns_per_table"),
+        std::to_string(warps) + "," + std::to_string(sample.fibers.yarn_material.size() - warps));
+  } else {
+    EXPECT_EQ(mixed_run.table.metadata.at("fiber_table_of_mesh"), "0,1");  // warp, weft
+  }
   EXPECT_EQ(mixed_run.table.metadata.count("fiber_checksum"), 0u);
 }
 
