@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "bake_fabric_fibers.h"
 #include "commands.h"
 #include "weft/core/error.h"
 #include "weft/fabric/fabric_parts.h"
@@ -27,6 +28,8 @@ constexpr int kDefaultNextEventRays = 1, kDefaultLaunchLattice = 13;
 
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
+  std::string warp_fiber, weft_fiber;             // per-yarn fibers (raytrace); "" = --fiber
+  bool thread_colours = false;                    // a fiber per colour of the WIF draft's threads
   std::string detail = "yarn", shard, estimator;  // estimator: "" = hero
   std::string straight_through;                   // "" = the library's default
   int resolution = 8, threads = 0;
@@ -37,21 +40,6 @@ struct BakeFabricOptions {
   std::optional<int> launch_lattice;      // --estimator nee: kDefaultLaunchLattice unless given
   bool json = false, quiet = false, resume = false;
 };
-
-// The fiber table: a table file, or a fiber spec or preset baked once into ./.weft-cache (RGB).
-TabulatedBsdfTable fiber_table(const std::string& fiber, const ProgressCallback& progress) {
-  std::error_code ec;
-  if (std::filesystem::path(fiber).extension() == ".exr" ||
-      (std::filesystem::is_regular_file(fiber, ec) && fiber.size() > 4 &&
-       fiber.compare(fiber.size() - 4, 4, ".exr") == 0))
-    return TabulatedBsdfTable::read_exr(fiber);
-  FiberTableBakeOptions o;
-  o.spectral = false;
-  return TabulatedBsdfTable::read_exr(
-      cached_fiber_table(".weft-cache", load_fiber_spec(fiber), o, progress, nullptr, [&] {
-        check_fiber_bake(o, kNumBands, {fiber, "--fiber", "--fiber"});
-      }));
-}
 
 WeaveOptions weave_options(const BakeFabricOptions& o) {
   WeaveOptions given;
@@ -198,8 +186,13 @@ int run(const BakeFabricOptions& o) {
       o.method == "raytrace" ? raytrace_options(o) : FabricRaytraceOptions{};
   // The WIF draft a weave options file names is read too.
   const std::string weave_wif = o.weave.empty() ? "" : read_weave_options(o.weave).wif.value_or("");
+  const FabricFiberOptions fiber_options{o.fiber, o.warp_fiber, o.weft_fiber, o.thread_colours,
+                                         o.wif.empty() ? weave_wif : o.wif};
+  check_fabric_fiber_options(fiber_options, o.method);
   validate_output_paths({{o.output, "--output"}, {checkpoint_path(o.output), "checkpoint"}},
                         {{o.fiber, "fiber table or spec"},
+                         {o.warp_fiber, "warp fiber table or spec"},
+                         {o.weft_fiber, "weft fiber table or spec"},
                          {o.weave, "weave options"},
                          {o.wif, "WIF draft"},
                          {weave_wif, "WIF draft"},
@@ -211,8 +204,9 @@ int run(const BakeFabricOptions& o) {
   double scene_bytes = 0;
   const WeaveOptions weave = sample_options(o, weave_wif, &note, &scene_bytes);
   const auto progress = progress_bar(o.quiet);
-  const TabulatedBsdfTable fiber = fiber_table(o.fiber, progress);
   const WovenSample sample = make_woven_sample(weave);
+  const FabricFibers fibers = load_fabric_fibers(fiber_options, sample, progress);
+  const TabulatedBsdfTable& fiber = fibers.first();
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
   TabulatedBsdfTable table;
@@ -225,12 +219,13 @@ int run(const BakeFabricOptions& o) {
       std::vector<std::filesystem::path> inputs;
       for (const auto& f : {o.weave, o.wif})
         if (!f.empty()) inputs.emplace_back(f);
-      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
-                                              o.shard, o.resume, progress, &code);
+      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fibers.map, r,
+                                              o.output, o.shard, o.resume, progress, &code);
       if (!pieces) return code;
       res = std::move(*pieces);
     } else {
-      res = raytrace_fabric_table(sample, fiber, r, progress);
+      res = fibers.map.tables.size() == 1 ? raytrace_fabric_table(sample, fiber, r, progress)
+                                          : raytrace_fabric_table(sample, fibers.map, r, progress);
     }
     if (res.cancelled) {
       std::fprintf(stderr, "\nweft: bake cancelled; nothing was written\n");
@@ -239,6 +234,7 @@ int run(const BakeFabricOptions& o) {
     table = res.table;
     record_particle_counts(table, res.splits, res.roulette_kills);
     extra = raytrace_summary(res);
+    if (fibers.map.tables.size() > 1) extra["fiber_tables"] = fibers.summary();
     extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
     extra["next_event_rays"] = r.next_event_rays;
     extra["launch_lattice"] = r.launch_lattice;
@@ -305,8 +301,18 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
       bake.add_subcommand("fabric",
                           "Fabric BSDF table from a fiber table and a woven sample (summation, "
                           "summation-visible or the ray-traced reference)");
-  sub->add_option("--fiber", o->fiber, "fiber table (.exr), or a fiber spec or preset to bake")
+  sub->add_option("--fiber", o->fiber,
+                  "fiber table (.exr), or a fiber spec or preset to bake (with --thread-colours: "
+                  "the fiber the colours dye)")
       ->capture_default_str();
+  sub->add_option("--warp-fiber", o->warp_fiber,
+                  "raytrace: the warp yarns' fiber (table, spec or preset; default --fiber)");
+  sub->add_option("--weft-fiber", o->weft_fiber,
+                  "raytrace: the weft yarns' fiber (table, spec or preset; default --fiber)");
+  sub->add_flag("--thread-colours", o->thread_colours,
+                "raytrace: one fiber per thread colour of the WIF draft, --fiber dyed to the "
+                "colour (docs/fabric-bsdf.md; at most " +
+                    std::to_string(kMaxThreadColours) + " colours)");
   sub->add_option("--method", o->method, "summation | summation-visible | raytrace")
       ->check(CLI::IsMember({"summation", "summation-visible", "raytrace"}))
       ->capture_default_str();

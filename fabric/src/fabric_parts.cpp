@@ -15,14 +15,33 @@
 namespace weft {
 namespace {
 
-JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
+// The fibers in a job's identity: one table's checksum as ever, or per-yarn tables' checksums and
+// maps ('f' distinct).
+void describe_fibers(const FiberTables& f, nlohmann::json& job) {
+  if (f.tables.size() == 1) {
+    job["fiber_checksum"] = f.tables[0]->checksum();
+    return;
+  }
+  nlohmann::json sums = nlohmann::json::array();
+  for (const TabulatedBsdfTable* t : f.tables) sums.push_back(t->checksum());
+  job["fiber_tables"] = {
+      {"checksums", sums}, {"of_yarn", f.table_of_yarn}, {"of_mesh", f.table_of_mesh}};
+}
+
+// The ray trace of 'fibers' (distinct): the single-table call for one.
+FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& fibers,
+                           const FabricRaytraceOptions& r, const ProgressCallback& progress) {
+  return fibers.tables.size() == 1 ? raytrace_fabric_table(sample, *fibers.tables[0], r, progress)
+                                   : raytrace_fabric_table(sample, fibers, r, progress);
+}
+
+JobPart fabric_job(const FiberTables& fibers, const WovenSample& sample,
                    const nlohmann::json& inputs, const FabricRaytraceOptions& r, Shard shard) {
   JobPart p;
   p.command = "bake fabric";
   p.job = {{"method", "raytrace"},
            {"estimator_revision", kFabricRaytraceRevision},
            {"inputs", inputs},
-           {"fiber_checksum", fiber.checksum()},
            {"sample", sample.summary.source + " (" + sample.summary.detail + ")"},
            {"resolution", r.resolution},
            {"particles_per_bin", r.particles_per_bin},
@@ -33,6 +52,7 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
            {"split_threshold", r.split_threshold},
            {"max_copies_per_particle", r.max_copies_per_particle},
            {"program_version", WEFT_VERSION}};
+  describe_fibers(fibers, p.job);
   // Only where on, so that the parts of runs before the option keep their identity.
   if (r.next_event_rays > 0) p.job["next_event_rays"] = r.next_event_rays;
   if (r.launch_lattice > 1) p.job["launch_lattice"] = r.launch_lattice;
@@ -119,9 +139,19 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
     const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
     bool resume, const ProgressCallback& progress, int* exit_code) {
+  return raytrace_fabric_in_pieces(sample, inputs, FiberTables{{&fiber}, {}, {}, {}}, r, output,
+                                   shard_text, resume, progress, exit_code);
+}
+
+std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
+    const WovenSample& sample, const nlohmann::json& inputs, const FiberTables& given,
+    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
+    bool resume, const ProgressCallback& progress, int* exit_code) {
   *exit_code = 0;
   const Shard shard = shard_text.empty() ? Shard{} : parse_shard(shard_text, "--shard");
-  JobPart job = fabric_job(fiber, sample, inputs, r, shard);
+  if (given.tables.size() > 1) validate_fiber_tables(given, sample);
+  const FiberTables fibers = given.tables.size() > 1 ? distinct_fiber_tables(given) : given;
+  JobPart job = fabric_job(fibers, sample, inputs, r, shard);
   const UnitRange range = shard_units(job.units_total, shard);
   JobPart done = job;
   if (const auto cp = load_checkpoint(output, job, resume)) done = *cp;
@@ -139,7 +169,7 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     FabricRaytraceOptions piece = r;
     piece.first_bin = static_cast<int>(a);
     piece.bin_count = static_cast<int>(b - a);
-    const FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, piece, progress);
+    const FabricRaytraceResult res = trace(sample, fibers, piece, progress);
     if (res.cancelled) {
       std::fprintf(stderr, "\nweft: bake cancelled; %s\n",
                    resume ? "--resume continues from the last checkpoint" : "nothing was written");
@@ -157,7 +187,7 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     none.first_bin = 0;
     none.bin_count = 1;
     none.particles_per_bin = 1;
-    const auto t = raytrace_fabric_table(sample, fiber, none, no_progress());
+    const auto t = trace(sample, fibers, none, no_progress());
     auto md = t.table.metadata;
     md["particles_per_bin"] = std::to_string(r.particles_per_bin);
     done.extra = {{"channels", t.table.channels}, {"metadata", md}};

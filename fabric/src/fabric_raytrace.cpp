@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <deque>
 #include <optional>
 #include <string>
 
@@ -152,6 +153,14 @@ void fabric_raytrace_totals(FabricRaytraceResult& r) {
 namespace raytrace {
 namespace {
 
+// What a scattering at a hit draws from and weighs with: the table of its yarn (FiberTables), the
+// sampler its paths are drawn from and its yarn tubes' line albedo.
+struct YarnShading {
+  const FiberSampler* fs = nullptr;
+  const TabulatedBsdfTable* fiber = nullptr;
+  const LineAlbedo* tube = nullptr;
+};
+
 // What all the particles of a run share: the scene, the tables and the estimator's choices.
 struct Tracer {
   const RenderScene& scene;
@@ -170,7 +179,21 @@ struct Tracer {
   // Yarn detail: the line albedos of the table traced and of the proposal (weigh_as_round_fiber).
   const LineAlbedo* tube = nullptr;
   const LineAlbedo* tube_proposal = nullptr;
+  // Per-yarn tables (FiberTables, two or more distinct): each table's shading, and which table a
+  // fiber (per curve of the sample) or a yarn tube (per mesh) takes. Empty: every hit takes the
+  // fields above.
+  std::vector<YarnShading> shadings{};
+  std::vector<int> table_of_curve{}, table_of_mesh{};
 };
+
+// The shading of the yarn the particle's line met at h: its fiber's (fiber detail, the same fiber
+// in every copy of the repeat) or its tube's (yarn detail, the instanced mesh).
+YarnShading shading_at(const Tracer& t, const SurfaceHit& h) {
+  if (t.shadings.empty()) return {&t.fs, &t.fiber, t.tube};
+  const int k = h.on_fiber() ? t.table_of_curve[static_cast<size_t>(h.fiber % t.curves)]
+                             : t.table_of_mesh[h.shape];
+  return t.shadings[k];
+}
 
 // A particle's life from its launch: where its exits and books go, the strategies its path and
 // its copies' follow, and how many copies its splits made.
@@ -198,14 +221,15 @@ void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Cr
                       const Particle& s, TaskScratch& scratch, Rng& rng) {
   const double share = 1.0 / t.o.next_event_rays;
   Particle& probe = scratch.probe;
+  const YarnShading y = shading_at(t, h);
   for (int k = 0; k < t.o.next_event_rays; ++k) {
-    const std::optional<ScatterDraw> draw = draw_scatter(t.fs, life.st, x, scratch.s_sum, rng);
+    const std::optional<ScatterDraw> draw = draw_scatter(*y.fs, life.st, x, scratch.s_sum, rng);
     if (!draw) return;  // the fiber absorbs all of the hero's light
     probe.d = s.d;
     probe.w = s.w, probe.pdf = s.pdf, probe.wp = s.wp;
     const FiberPoint& pt = x.pts[draw->point];
-    weigh_scatter(t.fs, t.fiber, life.st, pt.bin, draw->exit_bin, scratch.s_sum, probe);
-    if (!h.on_fiber() && t.tube) weigh_as_round_fiber(*t.tube, t.tube_proposal, x, s.d, probe);
+    weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, scratch.s_sum, probe);
+    if (!h.on_fiber() && y.tube) weigh_as_round_fiber(*y.tube, t.tube_proposal, x, s.d, probe);
     leave_fiber(pt.hit, draw->wo_local, probe);
     const std::optional<Vec3> out =
         escape_direction(t.scene, t.slab, t.curves, probe, 100 * t.o.max_scatterings);
@@ -223,17 +247,18 @@ bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Pa
   std::vector<double>& s_sum = scratch.s_sum;
   if (h.on_fiber() && dot(s.d, h.ng) >= 0) ++books.inside_hits;
   const Crossings x = crossings_of(t.scene, h, s.d, t.fs.grid);
-  albedo_sums(t.fs, life.st, x, s_sum);
+  const YarnShading y = shading_at(t, h);
+  albedo_sums(*y.fs, life.st, x, s_sum);
   if (t.o.next_event_rays > 0) book_next_events(t, life, h, x, s, scratch, rng);
-  const std::optional<ScatterDraw> draw = draw_scatter(t.fs, life.st, x, s_sum, rng);
+  const std::optional<ScatterDraw> draw = draw_scatter(*y.fs, life.st, x, s_sum, rng);
   if (!draw) {  // the fiber absorbs all of the hero's light
     books.absorbed += mean_w;
     return false;
   }
   const FiberPoint& pt = x.pts[draw->point];
-  books.absorbed += weigh_scatter(t.fs, t.fiber, life.st, pt.bin, draw->exit_bin, s_sum, s);
-  if (!h.on_fiber() && t.tube)
-    books.absorbed += weigh_as_round_fiber(*t.tube, t.tube_proposal, x, s.d, s);
+  books.absorbed += weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, s_sum, s);
+  if (!h.on_fiber() && y.tube)
+    books.absorbed += weigh_as_round_fiber(*y.tube, t.tube_proposal, x, s.d, s);
   leave_fiber(pt.hit, draw->wo_local, s);
   s.scattered = true;
   ++books.scatterings;
@@ -496,6 +521,64 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
       table.metadata[std::string("fiber_") + key] = it->second;
 }
 
+// Per-yarn tables in the metadata: in place of the one fiber's checksum and spec, per table
+// "name: checksum (spec name)", "; " between tables, how many of the fibers' yarns take each
+// (a draft has up to 40 000 yarns: counts, not the map) and each mesh's table.
+void describe_per_yarn(const FiberTables& f, TabulatedBsdfTable& table) {
+  std::string list;
+  for (size_t k = 0; k < f.tables.size(); ++k) {
+    const TabulatedBsdfTable& t = *f.tables[k];
+    if (k) list += "; ";
+    list += (f.names.empty() ? std::to_string(k) : f.names[k]) + ": " + t.checksum();
+    if (const auto it = t.metadata.find("spec_name"); it != t.metadata.end())
+      list += " (" + it->second + ")";
+  }
+  table.metadata.erase("fiber_checksum");
+  table.metadata.erase("fiber_spec_hash");
+  table.metadata.erase("fiber_spec_name");
+  table.metadata["fiber_tables"] = list;
+  auto joined = [](const std::vector<int>& v) {
+    std::string out;
+    for (size_t i = 0; i < v.size(); ++i) {
+      if (i) out += ',';
+      out += std::to_string(v[i]);
+    }
+    return out;
+  };
+  if (!f.table_of_yarn.empty()) {
+    std::vector<int> yarns(f.tables.size(), 0);
+    for (int k : f.table_of_yarn) ++yarns[k];
+    table.metadata["fiber_yarns_per_table"] = joined(yarns);
+  }
+  if (!f.table_of_mesh.empty()) table.metadata["fiber_table_of_mesh"] = joined(f.table_of_mesh);
+}
+
+// The samplers and line albedos of the per-yarn tables after the first (the tracer's own), held
+// for the run at stable addresses.
+struct PerYarnHeld {
+  std::deque<FiberSampler> samplers;
+  std::deque<LineAlbedo> tubes;
+};
+
+// The tracer's shadings for two or more distinct tables f (table 0 the tracer's own fiber, no
+// proposal) and which table each fiber and yarn tube of the sample takes.
+void shade_per_yarn(const WovenSample& sample, const FiberTables& f, Tracer& t, PerYarnHeld& held) {
+  for (size_t k = 0; k < f.tables.size(); ++k) {
+    YarnShading y{&t.fs, &t.fiber, t.tube};
+    if (k > 0) {
+      y.fs = &held.samplers.emplace_back(*f.tables[k]);
+      y.fiber = f.tables[k];
+      y.tube = t.tube ? &held.tubes.emplace_back(*f.tables[k]) : nullptr;
+    }
+    t.shadings.push_back(y);
+  }
+  const FiberCurves& c = sample.fibers;
+  for (size_t i = 0; i < c.curve_count(); ++i)
+    t.table_of_curve.push_back(f.table_of_yarn.empty() ? 0 : f.table_of_yarn[c.curve_yarn[i]]);
+  t.table_of_mesh = f.table_of_mesh;
+  t.table_of_mesh.resize(sample.meshes.size(), 0);
+}
+
 // The tracer of a run from its options; the scene and the sampler stay the caller's.
 Tracer tracer_for(const RenderScene& scene, const RepeatSlab& slab, int64_t curves,
                   const FiberSampler& fs, const TabulatedBsdfTable& fiber,
@@ -568,18 +651,20 @@ CellSums straight_through_sums(const Tracer& t) {
   return exact;
 }
 
-}  // namespace
-}  // namespace raytrace
-
-FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
-                                           const TabulatedBsdfTable& fiber,
-                                           const FabricRaytraceOptions& o,
-                                           const ProgressCallback& progress) {
-  using namespace raytrace;
+// The ray trace with the distinct tables f (one: the single-table call, bit for bit).
+FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
+                           const FabricRaytraceOptions& o, const ProgressCallback& progress) {
+  const TabulatedBsdfTable& fiber = *f.tables[0];
+  const bool per_yarn = f.tables.size() > 1;
   o.validate();
   fiber.validate("");
   if (fiber.kind != "fiber") throw Error("", "fiber", "expected a fiber table, got " + fiber.kind);
-  check_fiber_energy(fiber, "fiber");
+  for (size_t k = 0; k < f.tables.size(); ++k)
+    check_fiber_energy(*f.tables[k], per_yarn ? fiber_table_field(f, k) : "fiber");
+  if (per_yarn && o.proposal)
+    throw Error("", "proposal",
+                "the likelihood-ratio proposal takes one fiber table; this trace has " +
+                    std::to_string(f.tables.size()) + " distinct per-yarn tables");
   const RepeatSlab slab = repeat_slab_of(sample);
   if (!(slab.px > 0 && slab.pz > 0 && slab.y1 > slab.y0))
     throw Error("", "sample", "the woven sample has no period or no thickness");
@@ -597,6 +682,8 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
     t.tube = &tube.emplace(fiber);
     if (o.proposal) t.tube_proposal = &tube_proposal.emplace(*o.proposal);
   }
+  PerYarnHeld held;
+  if (per_yarn) shade_per_yarn(sample, f, t, held);
   const int bins = t.grid.bins(), nc = t.nc;
   CellSums sums{std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0),
                 std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0)};
@@ -615,7 +702,25 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   tabulate(sums, straight_through_sums(t), t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
+  if (per_yarn) describe_per_yarn(f, result.table);
   return result;
+}
+
+}  // namespace
+}  // namespace raytrace
+
+FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
+                                           const TabulatedBsdfTable& fiber,
+                                           const FabricRaytraceOptions& o,
+                                           const ProgressCallback& progress) {
+  return raytrace::trace(sample, FiberTables{{&fiber}, {}, {}, {}}, o, progress);
+}
+
+FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample, const FiberTables& fibers,
+                                           const FabricRaytraceOptions& o,
+                                           const ProgressCallback& progress) {
+  validate_fiber_tables(fibers, sample);
+  return raytrace::trace(sample, distinct_fiber_tables(fibers), o, progress);
 }
 
 }  // namespace weft

@@ -325,6 +325,8 @@ WifDraft parse_wif(std::string_view text, const std::string& source) {
   }
   w.warp = read_threads(d, "WARP", pal);
   w.weft = read_threads(d, "WEFT", pal);
+  w.colours_given = d.value("WARP", "COLOR") || d.value("WEFT", "COLOR") ||
+                    d.section("WARP COLORS") || d.section("WEFT COLORS");
   const int nwarp = static_cast<int>(w.warp.size()), nweft = static_cast<int>(w.weft.size());
 
   d.required("THREADING", "which shaft each warp thread is on");

@@ -95,6 +95,21 @@ TEST(Wif, TwoByTwoDraftIsPlainWeave) {
     for (int j = 0; j < 2; ++j) EXPECT_EQ(m.over(i, j), plain.over((i + 1) % 2, j));
 }
 
+TEST(Wif, ThreadColoursAreGivenOrNot) {
+  // The project's red/white twill (scenes/data/wif/red-white-twill.wif): [COLOR TABLE] 1=200,30,30
+  // for every warp, 2=255,255,255 for every weft.
+  const WifDraft d = read_wif(kWif / "red-white-twill.wif");
+  EXPECT_TRUE(d.colours_given);
+  ASSERT_EQ(d.warp.size(), 4u);
+  for (const WifThread& t : d.warp) EXPECT_NEAR(t.rgb[0], 200.0 / 255, 1e-12);
+  for (const WifThread& t : d.weft) EXPECT_EQ(t.rgb[1], 1.0);
+  // kSmall states no colour: every thread is the default grey, and the draft says so.
+  EXPECT_FALSE(parse_wif(kSmall, "small.wif").colours_given);
+  EXPECT_TRUE(
+      parse_wif(replace(kSmall, "Thickness=0.2\n", "Thickness=0.2\nColor=10,20,30\n"), "small.wif")
+          .colours_given);
+}
+
 TEST(Wif, Draft8452DimensionsAndInterlacing) {
   const WifDraft d = read_wif(kWif / "8452.wif");
   EXPECT_EQ(d.shafts, 28);

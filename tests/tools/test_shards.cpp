@@ -154,6 +154,27 @@ TEST(Shards, RaytracedFabricOfFourShardsMergesToTheOneProcessBytes) {
   }
 }
 
+TEST(Shards, RaytracedFabricWithPerYarnFibersMergesToTheOneProcessBytes) {
+  // Warp and weft on fiber tables of their own (bake fabric --warp-fiber / --weft-fiber): the
+  // shards of that trace merge to its one-process bytes too.
+  const fs::path dir = fresh_test_dir();
+  const fs::path red = dir / "red.exr", white = dir / "white.exr";
+  ASSERT_EQ(
+      run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", red.string()}, dir),
+      0);
+  auto white_bake = kFiberBake;
+  white_bake[2] = "white-cotton";
+  ASSERT_EQ(
+      run_weft(white_bake + std::vector<std::string>{"--bands", "rgb", "-o", white.string()}, dir),
+      0);
+  const auto args = split("bake fabric --method raytrace -R 2 --samples 500 --quiet --warp-fiber " +
+                          red.string() + " --weft-fiber " + white.string());
+  const fs::path one = dir / "one.exr";
+  ASSERT_EQ(run_weft(args + std::vector<std::string>{"-o", one.string()}, dir), 0)
+      << slurp(dir / "stderr");
+  expect_shards_merge_to(args, one, dir, ".exr");
+}
+
 TEST(Shards, SweepOfFourShardsMergesToTheOneProcessBytes) {
   const fs::path dir = fresh_test_dir();
   // The scene normalizes (to beta at normal incidence): the reference render is a unit too.

@@ -21,6 +21,12 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
     const FabricRaytraceOptions& r, const std::string& output, const std::string& shard,
     bool resume, const ProgressCallback& progress, int* exit_code);
+// The same with per-yarn fiber tables (fabric_raytrace.h): the distinct tables' checksums and the
+// maps join the job's identity (one distinct table: the single-table job, its identity unchanged).
+std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
+    const WovenSample& sample, const nlohmann::json& inputs, const FiberTables& fibers,
+    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard,
+    bool resume, const ProgressCallback& progress, int* exit_code);
 
 // The unit of incident bin 'bin' of a ray trace (its row of the table, its books and noise, every
 // value with its exact bits); the channels of such a unit for a table of 'bins' bins; and the

@@ -25,7 +25,9 @@
 //
 // Frames: the woven sample is in glTF's frame (y up, warp along x, weft along z); the fabric table
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
+#include <array>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "weft/core/progress.h"
@@ -192,6 +194,44 @@ std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_ab
 
 FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                                            const TabulatedBsdfTable& fiber,
+                                           const FabricRaytraceOptions& options,
+                                           const ProgressCallback& progress = no_progress());
+
+// One fiber table per yarn: a two-colour draft's warp and weft (docs/fabric-bsdf.md, "Per-yarn
+// fibers"). A scattering on a fiber (or yarn tube) draws from and weighs with the table of its
+// yarn; the line albedos of the yarn tubes and the paths' sampling are per table. tables[k] is
+// table k (names[k] names it in errors and in the fabric table's metadata); table_of_yarn[y] the
+// table of yarn y of the sample's fibers (FiberCurves::curve_yarn's index) and table_of_mesh[m]
+// that of mesh m (yarn detail: "warp" and "weft"); either empty where the sample has none. All
+// tables share resolution and channels. Tables with equal checksums are one table: a map onto one
+// table traces bit for bit as the single-table call.
+struct FiberTables {
+  std::vector<const TabulatedBsdfTable*> tables;
+  std::vector<std::string> names;
+  std::vector<int> table_of_yarn, table_of_mesh;
+};
+// The most tables one ray trace takes (a draft's distinct thread colours are fewer).
+inline constexpr int kMaxFiberTables = 64;
+// The sample's warp yarns (material "warp", the "warp" mesh) take 'warp', the others 'weft'.
+FiberTables fiber_tables_by_direction(const WovenSample& sample, const TabulatedBsdfTable& warp,
+                                      const TabulatedBsdfTable& weft);
+// One table per distinct thread colour of the sample (WovenSample::yarn_rgb, a WIF draft's), in the
+// order they first appear among its yarns (warps, then wefts): the map, its tables left null for
+// the caller, and 'colours' the colours in table order. At yarn detail each direction's tubes are
+// one mesh: weft::Error naming 'field' when a direction's yarns differ in colour, and when the
+// sample has no colours.
+FiberTables fiber_tables_by_colour(const WovenSample& sample,
+                                   std::vector<std::array<double, 3>>& colours,
+                                   const std::string& field);
+// weft::Error naming the table ("fiber tables[k] (name)") or the map when the tables differ in
+// resolution or channels, are not fiber tables, or the maps do not fit the sample.
+void validate_fiber_tables(const FiberTables& tables, const WovenSample& sample);
+// How errors name table k: "fiber tables[k] (name)".
+std::string fiber_table_field(const FiberTables& tables, size_t k);
+// The same map onto the distinct tables (equal checksums are one; the first one's name is kept).
+FiberTables distinct_fiber_tables(const FiberTables& tables);
+// A proposal (FabricRaytraceOptions::proposal) is refused with more than one distinct table.
+FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample, const FiberTables& fibers,
                                            const FabricRaytraceOptions& options,
                                            const ProgressCallback& progress = no_progress());
 

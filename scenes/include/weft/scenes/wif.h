@@ -42,6 +42,9 @@ struct WifDraft {
   std::vector<WifThread> warp;  // in threading order
   std::vector<WifThread> weft;  // in treadling order: shafts = lifted on this pick
   std::string weft_source;      // "TREADLING" or "LIFTPLAN"
+  // Whether the draft states a colour ([WARP]/[WEFT] Color, [WARP COLORS], [WEFT COLORS]); else
+  // every thread has WifThread's default grey.
+  bool colours_given = false;
 
   Interlacing interlacing() const;
 };

@@ -1,0 +1,46 @@
+#pragma once
+// The fiber tables of `weft bake fabric`: the one --fiber, or one per yarn: --warp-fiber and
+// --weft-fiber, or a WIF draft's --thread-colours, each colour a dye of --fiber
+// (fiber/thread_colour.h; docs/fabric-bsdf.md "Per-yarn fibers").
+#include <deque>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "weft/core/progress.h"
+#include "weft/fabric/fabric_raytrace.h"
+
+namespace weft::cli {
+
+struct FabricFiberOptions {
+  std::string fiber, warp_fiber, weft_fiber;  // warp/weft: "" = --fiber
+  bool thread_colours = false;
+  std::string draft;  // the WIF draft (--wif, or the one --weave names); "" when none
+};
+
+// The most distinct thread colours --thread-colours takes (a fiber table baked for each).
+inline constexpr int kMaxThreadColours = 8;
+
+// Checked before any work: the options that need a ray trace, a draft, or exclude each other
+// (weft::Error naming the option). 'method' is --method.
+void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& method);
+// True when the run traces more than one fiber (per-yarn tables may still turn out equal).
+bool per_yarn_fibers(const FabricFiberOptions& o);
+
+// The tables, loaded or baked on first use into ./.weft-cache, held for the run; 'map' is what
+// the ray trace takes (one table, every yarn on it, without per-yarn options).
+struct FabricFibers {
+  std::deque<TabulatedBsdfTable> held;
+  FiberTables map;
+  const TabulatedBsdfTable& first() const { return *map.tables.at(0); }
+  // Per table: its name, checksum and spec name (for --json).
+  nlohmann::json summary() const;
+};
+FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& sample,
+                                const ProgressCallback& progress);
+
+// One fiber table: a table file (.exr), or a fiber spec or preset baked once into ./.weft-cache
+// (RGB); 'option' names it in the bake's checks.
+TabulatedBsdfTable fiber_table(const std::string& fiber, const std::string& option,
+                               const ProgressCallback& progress);
+
+}  // namespace weft::cli
