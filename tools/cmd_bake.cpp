@@ -91,6 +91,7 @@ JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
   if (o.estimator != FiberExitEstimator::kPlain)
     p.job["estimator"] = fiber_exit_estimator_name(o.estimator);
   if (o.mirror_fold) p.job["mirror_fold"] = true;
+  if (o.surface_samples != 1) p.job["surface_samples"] = o.surface_samples;
   p.units_total = kNumBands;
   p.shard = shard;
   // The spec as given (a merge makes the table's metadata from it; its hash is checked).
@@ -155,6 +156,7 @@ int merge_fiber_bake(const JobPart& all, const std::string& output, bool json) {
   o.passes = all.job.at("passes").get<uint64_t>();
   o.estimator = parse_fiber_exit_estimator(all.job.value("estimator", "plain"), "estimator");
   o.mirror_fold = all.job.value("mirror_fold", false);
+  o.surface_samples = all.job.value("surface_samples", 1);
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
   std::vector<FiberBandState> states;
   for (const auto& [band, v] : all.units) {
@@ -182,6 +184,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
     std::string route = "direct";
     std::string estimator = "plain";
     bool mirror_fold = false;
+    int surface_samples = 1;
     uint64_t seed = FiberTableBakeOptions{}.seed;
     uint64_t passes = FiberTableBakeOptions{}.passes;
     int threads = 0;
@@ -224,6 +227,10 @@ void add_bake_command(CLI::App& app, Commands& commands) {
       ->check(CLI::IsMember({"plain", "nee"}));
   fiber->add_flag("--mirror-fold", opt->mirror_fold,
                   "average every cell with its images under the fiber's mirror symmetries");
+  fiber
+      ->add_option("--surface-samples", opt->surface_samples,
+                   "surface-lobe directions drawn per photon (smooth boundary)")
+      ->check(CLI::Range(1, 1024));
   fiber->add_option("--seed", opt->seed, "random seed");
   fiber
       ->add_option("--passes", opt->passes,
@@ -258,6 +265,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          o.passes = opt->passes;
          o.estimator = parse_fiber_exit_estimator(opt->estimator, "--estimator");
          o.mirror_fold = opt->mirror_fold;
+         o.surface_samples = opt->surface_samples;
          const Shard shard = opt->shard.empty() ? Shard{} : parse_shard(opt->shard, "--shard");
          const JobPart job = fiber_bake_job(opt->spec, spec, o, shard);
          const UnitRange range = shard_units(kNumBands, shard);

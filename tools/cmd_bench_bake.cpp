@@ -1,5 +1,6 @@
 // weft bench bake: how the error of a baked fiber table falls with photons, and how many photons
 // a given relative RMS error needs (the measurement is bench/include/weft/bench/bake_bench.h).
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -8,25 +9,36 @@
 #include "commands.h"
 #include "weft/bench/bake_bench.h"
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 
 namespace weft::cli {
 
 namespace {
 
-// "plain,nee+mirror" -> the variants' names and bench options (weft::Error naming --estimators).
+// "plain,nee+mirror+s4" -> the variants' names and bench options: an estimator, then optionally
+// "mirror" (mirror folding) and "s<K>" (K surface samples), joined by '+' (weft::Error naming
+// --estimators).
 std::vector<std::pair<std::string, BakeBenchOptions>> parse_bake_variants(
     const std::string& list, const BakeBenchOptions& base) {
   std::vector<std::pair<std::string, BakeBenchOptions>> out;
   std::stringstream in(list);
   for (std::string item; std::getline(in, item, ',');) {
     BakeBenchOptions v = base;
-    std::string name = item;
-    const std::string suffix = "+mirror";
-    if (name.size() > suffix.size() && name.ends_with(suffix)) {
-      v.mirror_fold = true;
-      name.resize(name.size() - suffix.size());
+    std::stringstream parts(item);
+    std::string part;
+    std::getline(parts, part, '+');
+    v.estimator = parse_fiber_exit_estimator(part, "--estimators");
+    while (std::getline(parts, part, '+')) {
+      if (part == "mirror")
+        v.mirror_fold = true;
+      else if (const auto k =
+                   part.size() > 1 && part[0] == 's' ? finite_number(part.substr(1)) : std::nullopt;
+               k && *k >= 1 && *k <= 1024 && *k == std::floor(*k))
+        v.surface_samples = static_cast<int>(*k);
+      else
+        throw Error("", "--estimators",
+                    "unknown modifier '" + part + "' (mirror or s<K>, K in 1..1024)");
     }
-    v.estimator = parse_fiber_exit_estimator(name, "--estimators");
     out.emplace_back(item, v);
   }
   if (out.empty()) throw Error("", "--estimators", "name at least one variant");
@@ -112,7 +124,8 @@ void add_bench_bake_command(CLI::App& bench, Commands& commands) {
       ->capture_default_str();
   cmd->add_option("--estimators", opt->estimators,
                   "bake variants to compare, comma list of plain or nee, each optionally with "
-                  "+mirror (mirror folding); ratios are against the first")
+                  "+mirror (mirror folding) and +s<K> (K surface samples per photon); ratios are "
+                  "against the first")
       ->capture_default_str();
   cmd->add_flag("--json", opt->json, "print JSON");
   commands.push_back(

@@ -68,6 +68,7 @@ BakeBenchResult bench_bake(const FiberSpec& spec, const BakeBenchOptions& option
       o.threads = options.threads;
       o.estimator = options.estimator;
       o.mirror_fold = options.mirror_fold;
+      o.surface_samples = options.surface_samples;
       moments.add(bake_fiber_table(spec, o).table.values);
     }
     BakeBenchRun run;

@@ -31,6 +31,7 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
            ? std::string("|") + fiber_exit_estimator_name(o.estimator)
            : "") +
       (o.mirror_fold ? "|mirror_fold" : "") +
+      (o.surface_samples != 1 ? "|surface_samples" + std::to_string(o.surface_samples) : "") +
       (o.max_events_per_photon != FiberTableBakeOptions{}.max_events_per_photon
            ? "|E" + std::to_string(o.max_events_per_photon)
            : "");

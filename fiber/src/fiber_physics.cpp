@@ -191,18 +191,21 @@ void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, d
     return;
   }
   double sampled_surface = 0;
-  // Surface lobe: one sampled reflected direction with weight f cos / pdf (expectation = albedo).
-  Vec3 w_out;
-  double weight = 0;
-  const Vec2 u{rng.uniform(), rng.uniform()};
-  const double u_lobe = rng.uniform();
-  if (fiber.surface.sample && fiber.surface.sample(omega_local, u, u_lobe, &w_out, &weight) &&
-      weight > 0) {
-    sampled_surface = w0 * weight;
-    books.specular += sampled_surface;
-    if (surface_exits)
-      surface_exits(
-          ExitEvent{point, frame.to_world(w_out), sampled_surface, CylinderGeometry::kSurface, 0});
+  // Surface lobe: sampled reflected directions with weight f cos / pdf (expectation = albedo).
+  const int samples = std::max(1, fiber.surface.samples);
+  for (int k = 0; k < samples; ++k) {
+    Vec3 w_out;
+    double weight = 0;
+    const Vec2 u{rng.uniform(), rng.uniform()};
+    const double u_lobe = rng.uniform();
+    if (fiber.surface.sample && fiber.surface.sample(omega_local, u, u_lobe, &w_out, &weight) &&
+        weight > 0) {
+      const double w = w0 * weight / samples;
+      sampled_surface += w;
+      books.specular += w;
+      if (surface_exits)
+        surface_exits(ExitEvent{point, frame.to_world(w_out), w, CylinderGeometry::kSurface, 0});
+    }
   }
   // The rest enters, refracted at the macroscopic (smooth) normal.
   const double albedo = fiber.surface.albedo(cos_a);

@@ -26,6 +26,8 @@ void validate(const FiberTableBakeOptions& o) {
     throw Error("", "weight_mode", "must be implicit_capture or absorption_weight");
   if (o.estimator != FiberExitEstimator::kPlain && o.route != FiberBakeRoute::kDirect)
     throw Error("", "estimator", "next-event estimation is for the direct route");
+  if (o.surface_samples < 1 || o.surface_samples > 1024)
+    throw Error("", "surface_samples", "must lie in [1, 1024]");
 }
 
 }  // namespace
@@ -72,6 +74,10 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
                                                           spec.roughness_alpha, mb.host_n);
     physics[i] =
         fiber_band_physics(spec, mb, o.max_events_per_photon, albedo, o.weight_mode, o.estimator);
+    if (o.surface_samples != 1 && spec.boundary != FiberBoundary::kSmooth)
+      throw Error("", "surface_samples",
+                  "the rough dielectric boundary draws one walk per photon, not lobe samples");
+    physics[i].surface.samples = o.surface_samples;
     FiberBandState& st = states[i];
     st.mu_s_per_um = mb.mu_s_per_um, st.mu_a_per_um = mb.mu_a_per_um, st.g = mb.g;
     if (work.start.empty()) st.weighted_sum.assign(cells * cells, 0.0);
@@ -229,6 +235,7 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
   if (o.estimator != FiberExitEstimator::kPlain)
     table.metadata["exit_estimator"] = fiber_exit_estimator_name(o.estimator);
   if (o.mirror_fold) table.metadata["mirror_fold"] = "yes";
+  if (o.surface_samples != 1) table.metadata["surface_samples"] = std::to_string(o.surface_samples);
   if (!o.spectral)
     table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
   table.validate("");

@@ -471,9 +471,10 @@ TEST(FiberTableBake, AbsorptionWeightAgreesWithImplicitCaptureWithinStatisticalE
   }
 }
 
-// Next-event estimation of exits and mirror folding (docs/fiber-bsdf.md, "Fewer photons for the
-// same noise") estimate the plain bake's table. One band of the scattering, absorbing fiber of the
-// route test (mu_s R ~ 5), R = 3 (324 cell pairs), 8 bakes of 40 000 photons each per estimator.
+// Next-event estimation of exits, surface samples and mirror folding (docs/fiber-bsdf.md, "Fewer
+// photons for the same noise") estimate the plain bake's table. One band of the scattering,
+// absorbing fiber of the route test (mu_s R ~ 5), R = 3 (324 cell pairs), 8 bakes of 40 000
+// photons each per estimator: plain; next-event; next-event with 4 surface samples, folded.
 // Per cell, the difference from plain over its standard error has an RMS near 1: with standard
 // errors from 8 bakes each (Welch: 7 to 14 degrees of freedom) its square has mean 1.2 to 1.4,
 // so the RMS lies near 1.1-1.2, and a bias of one standard error in every cell would lift it to
@@ -488,9 +489,10 @@ TEST(FiberTableBake, NextEventEstimationAndMirrorFoldingEstimateThePlainTable) {
   CellStats st[3];           // plain, next-event, next-event folded
   const int resolution = 3;  // 324 cell pairs, about half of which receive light
   for (int m = 0; m < 3; ++m) {
-    const FiberBandPhysics ph =
+    FiberBandPhysics ph =
         fiber_band_physics(spec, mb, 10'000'000, nullptr, WeightMode::implicit_capture,
                            m == 0 ? FiberExitEstimator::kPlain : FiberExitEstimator::kNextEvent);
+    if (m == 2) ph.surface.samples = 4;
     FiberBakeSettings s = weft::testing::bake_settings(resolution, 40000, 2);
     st[m] = cell_stats(k, [&](uint64_t seed) {
       s.seed = seed + 100 * m;
@@ -536,7 +538,7 @@ TEST(FiberTableBake, NextEventEstimationAndMirrorFoldingEstimateThePlainTable) {
       EXPECT_NEAR(a, b, 4.5 * std::hypot(sa, sb)) << m << ": " << sa << " " << sb;
     }
   }
-  // Lower noise: next-event estimation, and mirror folding on top of it.
+  // Lower noise: next-event estimation, and surface samples with mirror folding on top of it.
   EXPECT_LT(noise(st[1]), 0.7 * noise(st[0]));
   EXPECT_LT(noise(st[2]), 0.5 * noise(st[1]));
 }
@@ -624,7 +626,7 @@ TEST(FiberTableBake, CacheKeyHoldsEveryOptionThatChangesTheTable) {
   const auto name = [&](const FiberTableBakeOptions& o) {
     return fiber_table_cache_file(dir, spec, o).filename().string();
   };
-  std::vector<FiberTableBakeOptions> variants(10, base);
+  std::vector<FiberTableBakeOptions> variants(11, base);
   variants[0].resolution = 6;
   variants[1].photons_per_band = 1000;
   variants[2].seed = 2;
@@ -635,6 +637,7 @@ TEST(FiberTableBake, CacheKeyHoldsEveryOptionThatChangesTheTable) {
   variants[7].max_events_per_photon = 1000;
   variants[8].estimator = FiberExitEstimator::kNextEvent;
   variants[9].mirror_fold = true;
+  variants[10].surface_samples = 4;
   std::set<std::string> names{name(base)};
   for (const auto& v : variants) EXPECT_TRUE(names.insert(name(v)).second) << name(v);
   // Threads change nothing (a bake's bits do not depend on them).

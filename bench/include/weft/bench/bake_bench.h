@@ -24,6 +24,7 @@ struct BakeBenchOptions {
   // The bake's variance reduction (fiber_table_bake.h).
   FiberExitEstimator estimator = FiberTableBakeOptions{}.estimator;
   bool mirror_fold = FiberTableBakeOptions{}.mirror_fold;
+  int surface_samples = FiberTableBakeOptions{}.surface_samples;
 };
 
 struct BakeBenchRun {

@@ -35,6 +35,9 @@ struct FiberSurfaceModel {
       sample;
   // Directional albedo of the surface lobe for light at cos theta (its complement enters).
   std::function<double(double cos_theta)> albedo;
+  // Lobe directions drawn per photon, each carrying 1/samples of the sampled weight: the surface
+  // part of a table is about half its noise, and a draw costs far less than the photon's transport.
+  int samples = 1;
 };
 
 // The inside of the fiber: its cylinder (radius, index outside), the index inside, and a tracer

@@ -43,6 +43,8 @@ struct FiberTableBakeOptions {
   FiberExitEstimator estimator = FiberExitEstimator::kPlain;
   // Average every cell pair with its images under the fiber's mirror symmetries.
   bool mirror_fold = false;
+  // Surface-lobe directions drawn per photon (smooth boundary only; FiberSurfaceModel::samples).
+  int surface_samples = 1;
 };
 
 struct FiberBandSummary {
