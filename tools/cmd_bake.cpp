@@ -35,6 +35,7 @@ int report_fiber_bake(const FiberTableBakeResult& r, const FiberSpec& spec,
                      {"lost", b.lost_fraction},
                      {"roulette_net", b.roulette_net},
                      {"surface_sampling_excess", b.surface_sampling_excess},
+                     {"expected_exit_excess", b.expected_exit_excess},
                      {"energy_balance", b.energy_balance},
                      {"table_energy", b.energy_table}});
   nlohmann::json j = {{"output", output},
@@ -86,6 +87,11 @@ JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
            {"max_events_per_photon", o.max_events_per_photon},
            {"passes", o.passes},
            {"program_version", WEFT_VERSION}};
+  // Only when not the default, so that parts written before these options still merge.
+  if (o.estimator != FiberExitEstimator::kPlain)
+    p.job["estimator"] = fiber_exit_estimator_name(o.estimator);
+  if (o.mirror_fold) p.job["mirror_fold"] = true;
+  if (o.surface_samples != 1) p.job["surface_samples"] = o.surface_samples;
   p.units_total = kNumBands;
   p.shard = shard;
   // The spec as given (a merge makes the table's metadata from it; its hash is checked).
@@ -102,28 +108,34 @@ JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
   return p;
 }
 
-constexpr size_t kBandHeader = 13;  // doubles before the weighted sums
+// Doubles before the weighted sums; next-event estimation adds its excess (so plain bakes keep
+// the record parts had before it).
+size_t band_header(FiberExitEstimator e) {
+  return e == FiberExitEstimator::kPlain ? 13 : 14;
+}
 
-std::vector<double> encode_fiber_band(const FiberBandState& s) {
+std::vector<double> encode_fiber_band(const FiberBandState& s, FiberExitEstimator e) {
   std::vector<double> v;
-  v.reserve(kBandHeader + s.weighted_sum.size());
+  v.reserve(band_header(e) + s.weighted_sum.size());
   push_u64(v, s.passes_done);
   push_u64(v, s.photons);
   push_u64(v, s.events);
   for (double x : {s.mu_s_per_um, s.mu_a_per_um, s.g, s.surface, s.exit, s.absorbed, s.roulette,
                    s.lost, s.excess, s.energy})
     v.push_back(x);
+  if (e != FiberExitEstimator::kPlain) v.push_back(s.exit_excess);
   v.insert(v.end(), s.weighted_sum.begin(), s.weighted_sum.end());
   return v;
 }
 
-FiberBandState decode_fiber_band(const std::vector<double>& v) {
-  if (v.size() < kBandHeader) throw Error("", "units", "a band's record is too short");
+FiberBandState decode_fiber_band(const std::vector<double>& v, FiberExitEstimator e) {
+  if (v.size() < band_header(e)) throw Error("", "units", "a band's record is too short");
   FiberBandState s;
   s.passes_done = as_u64(v[0]), s.photons = as_u64(v[1]), s.events = as_u64(v[2]);
   s.mu_s_per_um = v[3], s.mu_a_per_um = v[4], s.g = v[5], s.surface = v[6], s.exit = v[7];
   s.absorbed = v[8], s.roulette = v[9], s.lost = v[10], s.excess = v[11], s.energy = v[12];
-  s.weighted_sum.assign(v.begin() + kBandHeader, v.end());
+  if (e != FiberExitEstimator::kPlain) s.exit_excess = v[13];
+  s.weighted_sum.assign(v.begin() + static_cast<std::ptrdiff_t>(band_header(e)), v.end());
   return s;
 }
 
@@ -142,10 +154,13 @@ int merge_fiber_bake(const JobPart& all, const std::string& output, bool json) {
   o.route = all.job.at("route") == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
   o.max_events_per_photon = all.job.at("max_events_per_photon").get<uint64_t>();
   o.passes = all.job.at("passes").get<uint64_t>();
+  o.estimator = parse_fiber_exit_estimator(all.job.value("estimator", "plain"), "estimator");
+  o.mirror_fold = all.job.value("mirror_fold", false);
+  o.surface_samples = all.job.value("surface_samples", 1);
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
   std::vector<FiberBandState> states;
   for (const auto& [band, v] : all.units) {
-    states.push_back(decode_fiber_band(v));
+    states.push_back(decode_fiber_band(v, o.estimator));
     if (states.back().passes_done != passes)
       throw Error("", "units", "band " + std::to_string(band) + " is unfinished");
   }
@@ -167,6 +182,9 @@ void add_bake_command(CLI::App& app, Commands& commands) {
     int resolution = FiberTableBakeOptions{}.resolution;
     std::string bands = "spectral";
     std::string route = "direct";
+    std::string estimator = "plain";
+    bool mirror_fold = false;
+    int surface_samples = 1;
     uint64_t seed = FiberTableBakeOptions{}.seed;
     uint64_t passes = FiberTableBakeOptions{}.passes;
     int threads = 0;
@@ -202,6 +220,17 @@ void add_bake_command(CLI::App& app, Commands& commands) {
       ->check(CLI::IsMember({"spectral", "rgb"}));
   fiber->add_option("--route", opt->route, "direct (parallel beam) or bssrdf (the paper's route)")
       ->check(CLI::IsMember({"direct", "bssrdf"}));
+  fiber
+      ->add_option("--estimator", opt->estimator,
+                   "how exits are tallied: plain (one by one) or nee (next-event estimation at "
+                   "every scattering; smooth boundary, direct route)")
+      ->check(CLI::IsMember({"plain", "nee"}));
+  fiber->add_flag("--mirror-fold", opt->mirror_fold,
+                  "average every cell with its images under the fiber's mirror symmetries");
+  fiber
+      ->add_option("--surface-samples", opt->surface_samples,
+                   "surface-lobe directions drawn per photon (smooth boundary)")
+      ->check(CLI::Range(1, 1024));
   fiber->add_option("--seed", opt->seed, "random seed");
   fiber
       ->add_option("--passes", opt->passes,
@@ -234,6 +263,9 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          o.spectral = opt->bands == "spectral";
          o.route = opt->route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
          o.passes = opt->passes;
+         o.estimator = parse_fiber_exit_estimator(opt->estimator, "--estimator");
+         o.mirror_fold = opt->mirror_fold;
+         o.surface_samples = opt->surface_samples;
          const Shard shard = opt->shard.empty() ? Shard{} : parse_shard(opt->shard, "--shard");
          const JobPart job = fiber_bake_job(opt->spec, spec, o, shard);
          const UnitRange range = shard_units(kNumBands, shard);
@@ -241,7 +273,8 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          work.first_band = static_cast<int>(range.first);
          work.last_band = static_cast<int>(range.last);
          if (const auto cp = load_checkpoint(opt->output, job, opt->resume)) {
-           for (const auto& [band, v] : cp->units) work.start.push_back(decode_fiber_band(v));
+           for (const auto& [band, v] : cp->units)
+             work.start.push_back(decode_fiber_band(v, o.estimator));
            if (work.start.size() != range.last - range.first)
              throw Error(checkpoint_path(opt->output).string(), "units",
                          "does not hold every band of the shard");
@@ -251,7 +284,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
              JobPart cp = job;
              cp.checkpoint = true;
              for (size_t i = 0; i < states.size(); ++i)
-               cp.units[range.first + i] = encode_fiber_band(states[i]);
+               cp.units[range.first + i] = encode_fiber_band(states[i], o.estimator);
              write_job_part(checkpoint_path(opt->output), cp);
            };
          check_fiber_bake(o, range.last - range.first, {"", "--photons", "--resolution"});
@@ -276,7 +309,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
            }
            JobPart part = job;
            for (size_t i = 0; i < traced.bands.size(); ++i)
-             part.units[range.first + i] = encode_fiber_band(traced.bands[i]);
+             part.units[range.first + i] = encode_fiber_band(traced.bands[i], o.estimator);
            write_job_part(opt->output, part);
            std::filesystem::remove(checkpoint_path(opt->output));
            std::printf("bands %llu..%llu of %s (shard %u/%u) -> %s in %.1f s\n",

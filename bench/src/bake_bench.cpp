@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 
 #include "weft/core/error.h"
 
@@ -57,6 +58,7 @@ BakeBenchResult bench_bake(const FiberSpec& spec, const BakeBenchOptions& option
   for (double count : options.photons_per_band) {
     CellMoments moments;
     const auto start = std::chrono::steady_clock::now();
+    const std::clock_t cpu_start = std::clock();
     for (int k = 0; k < options.seeds; ++k) {
       FiberTableBakeOptions o;
       o.resolution = options.resolution;
@@ -64,6 +66,9 @@ BakeBenchResult bench_bake(const FiberSpec& spec, const BakeBenchOptions& option
       o.seed = 1 + static_cast<uint64_t>(k);
       o.passes = 1;
       o.threads = options.threads;
+      o.estimator = options.estimator;
+      o.mirror_fold = options.mirror_fold;
+      o.surface_samples = options.surface_samples;
       moments.add(bake_fiber_table(spec, o).table.values);
     }
     BakeBenchRun run;
@@ -71,6 +76,8 @@ BakeBenchResult bench_bake(const FiberSpec& spec, const BakeBenchOptions& option
     run.seconds_per_bake =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() /
         options.seeds;
+    run.cpu_seconds_per_bake =
+        static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / options.seeds;
     run.relative_rms_error = moments.relative_rms_error();
     result.runs.push_back(run);
     photons.push_back(count);
@@ -80,6 +87,19 @@ BakeBenchResult bench_bake(const FiberSpec& spec, const BakeBenchOptions& option
   if (const auto fit = fit_power_law(photons, errors)) {
     result.fitted_exponent = fit->b;
     result.photons_per_band_for_target = fit->x_at(options.target);
+  }
+  const auto [lo, hi] = std::minmax_element(result.runs.begin(), result.runs.end(),
+                                            [](const BakeBenchRun& a, const BakeBenchRun& b) {
+                                              return a.photons_per_band < b.photons_per_band;
+                                            });
+  if (lo != result.runs.end() && hi->photons_per_band > lo->photons_per_band) {
+    const double slope = (hi->cpu_seconds_per_bake - lo->cpu_seconds_per_bake) /
+                         (hi->photons_per_band - lo->photons_per_band);
+    result.cpu_seconds_per_photon_per_band = slope;
+    if (result.photons_per_band_for_target)
+      result.cpu_seconds_for_target =
+          lo->cpu_seconds_per_bake +
+          slope * (*result.photons_per_band_for_target - lo->photons_per_band);
   }
   return result;
 }

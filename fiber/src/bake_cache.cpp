@@ -27,6 +27,11 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
       // Only when not the default, so existing cache entries keep their names.
       (o.weight_mode == WeightMode::absorption_weight ? "|absorption_weight" : "") +
       (o.route == FiberBakeRoute::kBssrdf ? "|bssrdf" : "") +
+      (o.estimator != FiberExitEstimator::kPlain
+           ? std::string("|") + fiber_exit_estimator_name(o.estimator)
+           : "") +
+      (o.mirror_fold ? "|mirror_fold" : "") +
+      (o.surface_samples != 1 ? "|surface_samples" + std::to_string(o.surface_samples) : "") +
       (o.max_events_per_photon != FiberTableBakeOptions{}.max_events_per_photon
            ? "|E" + std::to_string(o.max_events_per_photon)
            : "");

@@ -1,6 +1,7 @@
 #include "weft/fiber/fiber_bake.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -8,9 +9,9 @@
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
-#include "weft/materials/bsdf_table.h"
 #include "weft/fiber/bssrdf.h"
 #include "weft/fiber/transport_batch.h"
+#include "weft/materials/bsdf_table.h"
 
 namespace weft {
 namespace {
@@ -48,6 +49,7 @@ FiberBandTable finish_table(int resolution, std::vector<double> weighted_sum,
   t.roulette_net = (books.roulette_loss - books.roulette_gain) * inv;
   t.lost_fraction = books.lost * inv;
   t.surface_sampling_excess = books.specular_excess * inv;
+  t.expected_exit_excess = books.expected_exit_excess * inv;
   t.cancelled = cancelled;
   return t;
 }
@@ -66,6 +68,26 @@ double fiber_table_energy(const FiberBandTable& table) {
   double sum = 0;
   for (double v : table.weighted_sum) sum += v;
   return sum;
+}
+
+std::vector<double> fold_fiber_mirror_symmetry(int resolution, const std::vector<double>& v) {
+  const DirectionGrid grid{resolution};
+  const size_t cells = static_cast<size_t>(grid.bins());
+  if (v.size() != cells * cells) throw Error("", "cells", "the sums do not fit the resolution");
+  // The bins' images under no flip, the axis flip, the binormal flip and both.
+  std::vector<std::array<int, 4>> image(cells);
+  for (size_t b = 0; b < cells; ++b) {
+    const int k = static_cast<int>(b), t = grid.mirrored_bin(k, 0), n = grid.mirrored_bin(k, 1);
+    image[b] = {k, t, n, grid.mirrored_bin(t, 1)};
+  }
+  std::vector<double> folded(v.size());
+  for (size_t i = 0; i < cells; ++i)
+    for (size_t o = 0; o < cells; ++o) {
+      double sum = 0;
+      for (int m = 0; m < 4; ++m) sum += v[static_cast<size_t>(image[i][m]) * cells + image[o][m]];
+      folded[i * cells + o] = 0.25 * sum;
+    }
+  return folded;
 }
 
 FiberBandTable bake_fiber_band_direct(const FiberBandPhysics& fiber, const FiberBakeSettings& s,

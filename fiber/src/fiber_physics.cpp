@@ -86,11 +86,23 @@ TransportMedium fiber_band_medium(const MediumBand& mb) {
   return TransportMedium{mb.mu_a_per_um, mb.mu_s_per_um, mb.host_n, mb.phase};
 }
 
+const char* fiber_exit_estimator_name(FiberExitEstimator e) {
+  return e == FiberExitEstimator::kNextEvent ? "nee" : "plain";
+}
+
+FiberExitEstimator parse_fiber_exit_estimator(const std::string& name, const std::string& field) {
+  for (const auto e : {FiberExitEstimator::kPlain, FiberExitEstimator::kNextEvent})
+    if (name == fiber_exit_estimator_name(e)) return e;
+  throw Error("", field, "unknown exit estimator '" + name + "' (plain or nee)");
+}
+
 TransportOptions fiber_band_transport_options(const FiberBandPhysics& fiber,
-                                              uint64_t max_events_per_photon, WeightMode mode) {
+                                              uint64_t max_events_per_photon, WeightMode mode,
+                                              FiberExitEstimator estimator) {
   TransportOptions topt;
   topt.max_events = max_events_per_photon;
   topt.mode = mode;
+  topt.expected_exits = estimator == FiberExitEstimator::kNextEvent;
   if (const auto boundary = fiber.boundary) {
     topt.boundary_scatter = [boundary](const Vec3& d, Rng& rng) {
       const RoughDielectricScatter s = boundary->scatter(d, rng);
@@ -106,7 +118,7 @@ TransportOptions fiber_band_transport_options(const FiberBandPhysics& fiber,
 FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
                                     uint64_t max_events_per_photon,
                                     std::shared_ptr<const SurfaceAlbedoTable> albedo,
-                                    WeightMode mode) {
+                                    WeightMode mode, FiberExitEstimator estimator) {
   FiberBandPhysics ph;
   if (spec.boundary == FiberBoundary::kRoughDielectric) {
     ph.boundary = std::make_shared<const RoughDielectricInterface>(
@@ -131,7 +143,7 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
   }
   ph.interior = FiberInterior::transport(std::make_shared<const CylinderTransport>(
       CylinderGeometry(spec.fiber_radius_um, 1.0), fiber_band_medium(mb),
-      fiber_band_transport_options(ph, max_events_per_photon, mode)));
+      fiber_band_transport_options(ph, max_events_per_photon, mode, estimator)));
   return ph;
 }
 
@@ -155,6 +167,7 @@ void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, d
   const auto trace_inside = [&](const Vec3& d, double w) {
     const PhotonTally inside = in.trace(point, normalize(d), w, rng, interior_exits);
     books.exited += inside.exited;
+    books.expected_exit_excess += inside.expected_exit_excess;
     books.absorbed += inside.absorbed;
     books.roulette_gain += inside.roulette_gain;
     books.roulette_loss += inside.roulette_loss;
@@ -178,18 +191,21 @@ void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, d
     return;
   }
   double sampled_surface = 0;
-  // Surface lobe: one sampled reflected direction with weight f cos / pdf (expectation = albedo).
-  Vec3 w_out;
-  double weight = 0;
-  const Vec2 u{rng.uniform(), rng.uniform()};
-  const double u_lobe = rng.uniform();
-  if (fiber.surface.sample && fiber.surface.sample(omega_local, u, u_lobe, &w_out, &weight) &&
-      weight > 0) {
-    sampled_surface = w0 * weight;
-    books.specular += sampled_surface;
-    if (surface_exits)
-      surface_exits(
-          ExitEvent{point, frame.to_world(w_out), sampled_surface, CylinderGeometry::kSurface, 0});
+  // Surface lobe: sampled reflected directions with weight f cos / pdf (expectation = albedo).
+  const int samples = std::max(1, fiber.surface.samples);
+  for (int k = 0; k < samples; ++k) {
+    Vec3 w_out;
+    double weight = 0;
+    const Vec2 u{rng.uniform(), rng.uniform()};
+    const double u_lobe = rng.uniform();
+    if (fiber.surface.sample && fiber.surface.sample(omega_local, u, u_lobe, &w_out, &weight) &&
+        weight > 0) {
+      const double w = w0 * weight / samples;
+      sampled_surface += w;
+      books.specular += w;
+      if (surface_exits)
+        surface_exits(ExitEvent{point, frame.to_world(w_out), w, CylinderGeometry::kSurface, 0});
+    }
   }
   // The rest enters, refracted at the macroscopic (smooth) normal.
   const double albedo = fiber.surface.albedo(cos_a);

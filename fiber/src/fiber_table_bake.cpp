@@ -24,6 +24,10 @@ void validate(const FiberTableBakeOptions& o) {
   if (o.weight_mode != WeightMode::implicit_capture &&
       o.weight_mode != WeightMode::absorption_weight)
     throw Error("", "weight_mode", "must be implicit_capture or absorption_weight");
+  if (o.estimator != FiberExitEstimator::kPlain && o.route != FiberBakeRoute::kDirect)
+    throw Error("", "estimator", "next-event estimation is for the direct route");
+  if (o.surface_samples < 1 || o.surface_samples > 1024)
+    throw Error("", "surface_samples", "must lie in [1, 1024]");
 }
 
 }  // namespace
@@ -68,7 +72,12 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
     if (!albedo && spec.boundary == FiberBoundary::kSmooth)
       albedo = std::make_shared<const SurfaceAlbedoTable>(spec.roughness_distribution,
                                                           spec.roughness_alpha, mb.host_n);
-    physics[i] = fiber_band_physics(spec, mb, o.max_events_per_photon, albedo, o.weight_mode);
+    physics[i] =
+        fiber_band_physics(spec, mb, o.max_events_per_photon, albedo, o.weight_mode, o.estimator);
+    if (o.surface_samples != 1 && spec.boundary != FiberBoundary::kSmooth)
+      throw Error("", "surface_samples",
+                  "the rough dielectric boundary draws one walk per photon, not lobe samples");
+    physics[i].surface.samples = o.surface_samples;
     FiberBandState& st = states[i];
     st.mu_s_per_um = mb.mu_s_per_um, st.mu_a_per_um = mb.mu_a_per_um, st.g = mb.g;
     if (work.start.empty()) st.weighted_sum.assign(cells * cells, 0.0);
@@ -114,6 +123,7 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
       st.absorbed += t.absorbed_fraction * n;
       st.roulette += t.roulette_net * n;
       st.excess += t.surface_sampling_excess * n;
+      st.exit_excess += t.expected_exit_excess * n;
       st.energy += fiber_table_energy(t) / kPi * n;
       st.photons += t.photons;
       st.events += t.scattering_events;
@@ -166,12 +176,14 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
       s.absorbed_fraction = st.absorbed * inv;
       s.roulette_net = st.roulette * inv;
       s.surface_sampling_excess = st.excess * inv;
+      s.expected_exit_excess = st.exit_excess * inv;
       s.energy_balance = s.exit_fraction + s.absorbed_fraction + s.roulette_net + s.lost_fraction -
-                         s.surface_sampling_excess;
+                         s.surface_sampling_excess - s.expected_exit_excess;
       s.energy_table = st.energy * inv;
       // The photon-weighted mean of the passes' sums, then cell averages.
       std::vector<double> mean_sum(st.weighted_sum.size());
       for (size_t k = 0; k < mean_sum.size(); ++k) mean_sum[k] = st.weighted_sum[k] * inv;
+      if (o.mirror_fold) mean_sum = fold_fiber_mirror_symmetry(R, mean_sum);
       band_f[band] = TabulatedBsdfTable::averages_from_weighted_sums(R, mean_sum);
     }
     result.bands.push_back(s);
@@ -220,6 +232,10 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
   // Only when not the default, so tables of the paper's model keep their header.
   if (spec.boundary != FiberBoundary::kSmooth)
     table.metadata["boundary"] = fiber_boundary_name(spec.boundary);
+  if (o.estimator != FiberExitEstimator::kPlain)
+    table.metadata["exit_estimator"] = fiber_exit_estimator_name(o.estimator);
+  if (o.mirror_fold) table.metadata["mirror_fold"] = "yes";
+  if (o.surface_samples != 1) table.metadata["surface_samples"] = std::to_string(o.surface_samples);
   if (!o.spectral)
     table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
   table.validate("");

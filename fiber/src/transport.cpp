@@ -30,6 +30,12 @@ void TransportOptions::validate() const {
   if (max_events == 0) throw Error("", "max_events", "must be >= 1");
   if (boundary_scatter && exit_reflectance)
     throw Error("", "boundary_scatter", "a rough boundary excludes exit_reflectance");
+  if (expected_exits && boundary_scatter)
+    throw Error("", "expected_exits",
+                "next-event estimation of exits needs the smooth boundary (its transmittance is "
+                "analytic), not a rough dielectric one");
+  if (!(expected_exit_cutoff > 0 && expected_exit_cutoff < 1))
+    throw Error("", "expected_exit_cutoff", "must lie in (0, 1)");
 }
 
 SlabGeometry::SlabGeometry(double thickness, double n_above, double n_below)

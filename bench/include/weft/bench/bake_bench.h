@@ -21,12 +21,17 @@ struct BakeBenchOptions {
   int seeds = 4;         // independent bakes per photon count (at least 2)
   double target = 0.01;  // relative RMS error to extrapolate to
   int threads = FiberTableBakeOptions{}.threads;
+  // The bake's variance reduction (fiber_table_bake.h).
+  FiberExitEstimator estimator = FiberTableBakeOptions{}.estimator;
+  bool mirror_fold = FiberTableBakeOptions{}.mirror_fold;
+  int surface_samples = FiberTableBakeOptions{}.surface_samples;
 };
 
 struct BakeBenchRun {
   double photons_per_band = 0;
   double relative_rms_error = 0;
   double seconds_per_bake = 0;
+  double cpu_seconds_per_bake = 0;  // this process's CPU time (all threads)
 };
 
 struct BakeBenchResult {
@@ -34,6 +39,10 @@ struct BakeBenchResult {
   // With two or more runs of non-zero error: error ~ N^fitted_exponent, and the photons per band
   // at which the fit reaches options.target.
   std::optional<double> fitted_exponent, photons_per_band_for_target;
+  // With two or more photon counts: the CPU time of one more photon per band, seconds (the slope
+  // of CPU time per bake between the smallest and the largest count: the Mie medium and the table's
+  // fixed costs cancel), and so the CPU seconds of a bake at the target.
+  std::optional<double> cpu_seconds_per_photon_per_band, cpu_seconds_for_target;
 };
 
 // 'on_run' sees each run as it finishes (for progress).

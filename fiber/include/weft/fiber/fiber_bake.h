@@ -32,18 +32,21 @@ struct FiberBandTable {
   std::vector<double> f;             // R^4 cell averages (1/sr)
   std::vector<double> weighted_sum;  // R^4 sums of f |cos_i| |cos_o| over the cell pair (sr^2)
   // Energy, as fractions of the light hitting the fiber. Per photon the books balance exactly:
-  //   exit + absorbed + roulette_net + lost - surface_sampling_excess = 1   (to rounding),
-  // where surface_sampling_excess = mean(sampled surface weight - tabulated surface albedo) has
-  // mean zero: the surface lobe is sampled, the part that enters uses the lobe's albedo.
+  //   exit + absorbed + roulette_net + lost - surface_sampling_excess - expected_exit_excess = 1
+  // (to rounding), where surface_sampling_excess = mean(sampled surface weight - tabulated surface
+  // albedo) has mean zero: the surface lobe is sampled, the part that enters uses the lobe's
+  // albedo; expected_exit_excess likewise for next-event estimation of exits (transport.h), zero
+  // without it. 'exit' is what the table holds.
   double exit_fraction = 0;      // everything that leaves (surface + volume)
   double surface_fraction = 0;   // of which reflected by the surface lobe
   double absorbed_fraction = 0;  // absorbed inside, as traced
   double roulette_net = 0;
   double lost_fraction = 0;  // weight the interior tracer gave up on (reported, not hidden)
   double surface_sampling_excess = 0;
+  double expected_exit_excess = 0;
   double energy_balance() const {
     return exit_fraction + absorbed_fraction + roulette_net + lost_fraction -
-           surface_sampling_excess;
+           surface_sampling_excess - expected_exit_excess;
   }
   // Far field (if asked): [s_i bin][s_o bin][azimuth-difference bin], integrals of F over the
   // bins (sr^2 per unit length in fiber radii); reciprocity: [a][b][c] = [b][a][n - 1 - c].
@@ -74,6 +77,12 @@ FiberBandTable bake_fiber_band_bssrdf(const FiberBandPhysics& fiber,
                                       const FiberBakeSettings& settings,
                                       const BssrdfRouteSettings& route,
                                       const ProgressCallback& progress);
+
+// The fiber's mirror symmetries (docs/fiber-bsdf.md), f(M w_i, M w_o) = f(w_i, w_o) for M flipping
+// the axis t, the binormal b or both, applied to R^4 cell-pair sums (weighted sums or averages):
+// each cell pair becomes the mean of its four images. Exact for the fiber, so an estimate folded
+// this way is as unbiased as before and pools four cells' photons.
+std::vector<double> fold_fiber_mirror_symmetry(int resolution, const std::vector<double>& cells);
 
 // Sum of f |cos_i| |cos_o| over all cell pairs: pi * (1 - absorbed) for a correct table.
 double fiber_table_energy(const FiberBandTable& table);

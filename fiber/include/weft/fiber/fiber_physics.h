@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "weft/core/rng.h"
@@ -34,6 +35,9 @@ struct FiberSurfaceModel {
       sample;
   // Directional albedo of the surface lobe for light at cos theta (its complement enters).
   std::function<double(double cos_theta)> albedo;
+  // Lobe directions drawn per photon, each carrying 1/samples of the sampled weight: the surface
+  // part of a table is about half its noise, and a draw costs far less than the photon's transport.
+  int samples = 1;
 };
 
 // The inside of the fiber: its cylinder (radius, index outside), the index inside, and a tracer
@@ -81,25 +85,36 @@ class SurfaceAlbedoTable {
   std::vector<double> albedo_;
 };
 
+// How the interior's exits are tallied: one by one as photons leave (plain), or by next-event
+// estimation at every flight's start (TransportOptions::expected_exits; smooth boundary only).
+// Both are unbiased estimates of the same table (docs/fiber-bsdf.md).
+enum class FiberExitEstimator : uint8_t { kPlain, kNextEvent };
+const char* fiber_exit_estimator_name(FiberExitEstimator e);  // "plain", "nee"
+// Parses a name of fiber_exit_estimator_name; weft::Error naming 'field' otherwise.
+FiberExitEstimator parse_fiber_exit_estimator(const std::string& name, const std::string& field);
+
 // One band of a spec. Boundary "smooth": the Cook-Torrance surface lobe at the band's host index,
 // the rough boundary both ways (light leaving the fiber is transmitted with 1 - the lobe's albedo
 // at the outside angle, as on entry, which keeps the fiber reciprocal). Boundary
 // "rough-dielectric": the rough dielectric interface of the spec's roughness at the band's host
 // index, both ways. Then cylinder transport in the band's medium. 'albedo' (smooth only) may be
 // shared between bands of equal host index; null computes it. 'mode': how the interior's transport
-// treats absorption (transport.h).
+// treats absorption (transport.h); 'estimator': how its exits are tallied (Error with the
+// rough-dielectric boundary and next-event estimation).
 FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& band,
                                     uint64_t max_events_per_photon = 10'000'000,
                                     std::shared_ptr<const SurfaceAlbedoTable> albedo = nullptr,
-                                    WeightMode mode = WeightMode::implicit_capture);
+                                    WeightMode mode = WeightMode::implicit_capture,
+                                    FiberExitEstimator estimator = FiberExitEstimator::kPlain);
 
 // The interior's medium of one band, and the transport options that make light leave a fiber
 // through the same boundary it entered by (the rough dielectric both ways, or the surface lobe's
 // complement as the exit transmittance): fiber_band_physics builds its cylinder from them, and
 // fiber cross-sections other than the round one (fiber_layer.h) build theirs the same way.
 TransportMedium fiber_band_medium(const MediumBand& band);
-TransportOptions fiber_band_transport_options(const FiberBandPhysics& fiber,
-                                              uint64_t max_events_per_photon, WeightMode mode);
+TransportOptions fiber_band_transport_options(
+    const FiberBandPhysics& fiber, uint64_t max_events_per_photon, WeightMode mode,
+    FiberExitEstimator estimator = FiberExitEstimator::kPlain);
 
 // Light from world direction 'omega' (towards the light) meets the fiber at surface angle phi
 // (axial position 0) with flux weight w0. The surface lobe's sampled reflection goes to

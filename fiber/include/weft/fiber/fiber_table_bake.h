@@ -9,11 +9,11 @@
 #include <vector>
 
 #include "weft/core/progress.h"
-#include "weft/materials/bsdf_table.h"
 #include "weft/fiber/fiber_bake.h"
 #include "weft/fiber/fiber_physics.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/medium.h"
+#include "weft/materials/bsdf_table.h"
 
 namespace weft {
 
@@ -38,6 +38,13 @@ struct FiberTableBakeOptions {
   // Photons are traced in this many passes over all bands; an interrupted bake keeps every
   // finished pass (results depend on it, not on threads).
   uint64_t passes = 8;
+  // Variance reduction (docs/fiber-bsdf.md, "Fewer photons for the same noise"); both unbiased.
+  // How exits are tallied: one by one (plain), or by next-event estimation (smooth boundary only).
+  FiberExitEstimator estimator = FiberExitEstimator::kPlain;
+  // Average every cell pair with its images under the fiber's mirror symmetries.
+  bool mirror_fold = false;
+  // Surface-lobe directions drawn per photon (smooth boundary only; FiberSurfaceModel::samples).
+  int surface_samples = 1;
 };
 
 struct FiberBandSummary {
@@ -50,8 +57,9 @@ struct FiberBandSummary {
   double lost_fraction = 0;
   double roulette_net = 0;             // Russian roulette's net removal (mean zero)
   double surface_sampling_excess = 0;  // sampled minus tabulated surface albedo (mean zero)
-  double energy_balance = 0;           // exit + absorbed + roulette + lost - excess: 1 to rounding
-  double energy_table = 0;  // table energy sum / pi: equals exit_fraction (white furnace)
+  double expected_exit_excess = 0;     // next-event estimated minus traced exits (mean zero)
+  double energy_balance = 0;  // exit + absorbed + roulette + lost - both excesses: 1 to rounding
+  double energy_table = 0;    // table energy sum / pi: equals exit_fraction (white furnace)
   uint64_t photons = 0;
   uint64_t scattering_events = 0;
 };
@@ -84,6 +92,7 @@ struct FiberBandState {
   double mu_s_per_um = 0, mu_a_per_um = 0, g = 0;  // the medium's band (for the summary)
   std::vector<double> weighted_sum;  // photon-weighted sum over passes of the cell sums
   double surface = 0, exit = 0, absorbed = 0, roulette = 0, lost = 0, excess = 0, energy = 0;
+  double exit_excess = 0;  // expected_exit_excess (next-event estimation only)
   uint64_t photons = 0, events = 0;
   uint64_t passes_done = 0;
 };

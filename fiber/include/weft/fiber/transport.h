@@ -41,6 +41,16 @@
 //   (a path that neither interacts nor meets the boundary). Nothing is dropped silently.
 // * Exits go to a recorder: any type with `void on_exit(const ExitEvent&)`. NullRecorder does
 //   nothing, so a bare walk compiles to the walk alone.
+// * TransportOptions::expected_exits (smooth boundary only) records exits by next-event
+//   estimation: where a flight starts (the walk's start, each scattering) the flight's specular
+//   chain is followed to the boundary and every hit's transmitted weight,
+//   w exp(-(mu_a + mu_s) L) (1 - R) times the reflectances before it, is recorded; the chain stops
+//   after the hit where its weight falls below expected_exit_cutoff * w (or at
+//   kMaxExpectedExitHits). The walk itself is unchanged (same draws, same path), but its own exit
+//   is recorded only when it happens after more internal reflections since the flight's start
+//   than the chain covered: the two partition the exits, so the estimate is unbiased. Books:
+//   'exited' is what the recorder got; expected_exit_excess = recorded expected weight minus the
+//   walk's exits it replaced (mean zero), so the books still close exactly.
 #include <algorithm>
 #include <cmath>
 #include <concepts>
@@ -62,6 +72,9 @@ namespace weft {
 
 // +infinity, named once: a semi-infinite slab thickness, a ray that never meets the boundary.
 inline constexpr double kTransportInfinity = std::numeric_limits<double>::infinity();
+// The most boundary hits of one flight's chain that next-event estimation records (a chain of
+// total internal reflections in a clear medium never falls below the cutoff).
+inline constexpr int kMaxExpectedExitHits = 32;
 
 // The medium inside the boundary.
 struct TransportMedium {
@@ -101,6 +114,9 @@ struct TransportOptions {
   // returns the direction after the interface: z > 0 outside, z < 0 inside. Empty: Fresnel at
   // the smooth normal. Excludes exit_reflectance.
   std::function<BoundaryScatter(const Vec3& d_local, Rng& rng)> boundary_scatter;
+  // Next-event estimation of exits (see the conventions above); excludes boundary_scatter.
+  bool expected_exits = false;
+  double expected_exit_cutoff = 1e-3;  // relative weight below which a chain stops, in (0, 1)
 
   void validate() const;
 };
@@ -126,6 +142,9 @@ struct PhotonTally {
   // weight minus its expectation: mean zero, kept so that the books still close exactly.
   double specular_excess = 0;
   double exited = 0;  // passed to the recorder (after entering)
+  // With expected exits (TransportOptions::expected_exits): the expected weight recorded minus the
+  // walk's own exits it stands for (mean zero), so that the books close exactly.
+  double expected_exit_excess = 0;
   double absorbed = 0;
   double roulette_gain = 0;  // weight added to roulette survivors
   double roulette_loss = 0;  // weight of photons killed by roulette
@@ -139,6 +158,7 @@ struct PhotonTally {
     specular += o.specular;
     specular_excess += o.specular_excess;
     exited += o.exited;
+    expected_exit_excess += o.expected_exit_excess;
     absorbed += o.absorbed;
     roulette_gain += o.roulette_gain;
     roulette_loss += o.roulette_loss;
@@ -149,8 +169,8 @@ struct PhotonTally {
   }
   // launched - (everything accounted for): zero up to rounding.
   double imbalance() const {
-    return launched -
-           (specular - specular_excess + exited + absorbed + roulette_loss - roulette_gain + lost);
+    return launched - (specular - specular_excess + exited - expected_exit_excess + absorbed +
+                       roulette_loss - roulette_gain + lost);
   }
 };
 
@@ -285,6 +305,7 @@ class PhotonTransport {
     options_.validate();
     mu_t_ = medium_.mu_a + medium_.mu_s;
     if (!std::isfinite(mu_t_)) throw Error("", "mu_a", "mu_a + mu_s overflows");
+    mu_total_ = mu_t_;
     absorb_fraction_ = mu_t_ > 0 ? medium_.mu_a / mu_t_ : 0.0;
     // mu_t_ is the coefficient free paths are drawn from: mu_s alone when absorption is a weight.
     if (options_.mode == WeightMode::absorption_weight) mu_t_ = medium_.mu_s;
@@ -372,6 +393,21 @@ class PhotonTransport {
       w = kept;
     };
     uint64_t events = 0, scatterings = 0;
+    // Next-event estimation: the boundary hits of this flight's chain that were recorded as
+    // expected exits, and the walk's internal reflections since the flight began.
+    const bool expected = options_.expected_exits;
+    int flight_chain = expected ? record_expected_exits(p, d, w, 0, recorder, tally) : 0;
+    int flight_reflections = 0;
+    // The walk's own exit along 'out': recorded, unless the flight's chain already stood for it.
+    const auto leave = [&](const Vec3& out, int boundary) {
+      if (flight_reflections < flight_chain) {
+        tally.expected_exit_excess -= w;
+      } else {
+        recorder.on_exit(ExitEvent{p, out, w, boundary, scatterings});
+        tally.exited += w;
+      }
+      tally.scatterings += scatterings;
+    };
     // A weighted photon walks on at weight 0 (underflow), so that the draws it makes, and so the
     // next photon's, do not depend on mu_a.
     while (w > 0 || weighted) {
@@ -390,9 +426,7 @@ class PhotonTransport {
           if (b.lost) break;
           const Vec3 out = normalize(frame.to_world(b.direction));
           if (b.direction.z > 0) {
-            recorder.on_exit(ExitEvent{p, out, w, hit.boundary, scatterings});
-            tally.exited += w;
-            tally.scatterings += scatterings;
+            leave(out, hit.boundary);
             return;
           }
           d = out;
@@ -401,9 +435,7 @@ class PhotonTransport {
           continue;
         }
         if (n_out == n_in) {
-          recorder.on_exit(ExitEvent{p, d, w, hit.boundary, scatterings});
-          tally.exited += w;
-          tally.scatterings += scatterings;
+          leave(d, hit.boundary);
           return;
         }
         double cos_t = 0;
@@ -411,15 +443,13 @@ class PhotonTransport {
         if (options_.exit_reflectance && r < 1) r = options_.exit_reflectance(cos_t);
         if (r < 1 && rng.uniform() >= r) {
           const double eta = n_in / n_out;
-          const Vec3 out = normalize(eta * d + (cos_t - eta * cos_i) * n);
-          recorder.on_exit(ExitEvent{p, out, w, hit.boundary, scatterings});
-          tally.exited += w;
-          tally.scatterings += scatterings;
+          leave(normalize(eta * d + (cos_t - eta * cos_i) * n), hit.boundary);
           return;
         }
         // Reflect only if the photon really moves outwards (rounding at grazing incidence).
         if (cos_i > 0) d = normalize(d - 2 * cos_i * n);
         ++tally.reflections;
+        ++flight_reflections;
         if (++events >= options_.max_events) break;
         continue;
       }
@@ -442,25 +472,73 @@ class PhotonTransport {
       d = medium_.phase.sample_direction(d, u1, u2);
       ++scatterings;
       if (++events >= options_.max_events) break;
-      if (!analog && !weighted && w < options_.roulette_threshold && w > 0) {
-        if (rng.uniform() < options_.roulette_survival) {
-          const double w_new = w * inv_survival_;
-          tally.roulette_gain += w_new - w;
-          w = w_new;
-        } else {
-          tally.roulette_loss += w;
-          w = 0;
-        }
-      }
+      if (!analog && !weighted) roulette(w, rng, tally);
+      if (expected && w > 0)
+        flight_chain = record_expected_exits(p, d, w, scatterings, recorder, tally);
+      flight_reflections = 0;
     }
     tally.lost += w;  // zero unless the cap or an endless path stopped the walk
     tally.scatterings += scatterings;
+  }
+
+  // MCML's Russian roulette below the weight threshold: survivors' weight divided by the survival
+  // probability (unbiased); both sides booked.
+  void roulette(double& w, Rng& rng, PhotonTally& tally) const {
+    if (!(w < options_.roulette_threshold && w > 0)) return;
+    if (rng.uniform() < options_.roulette_survival) {
+      const double w_new = w * inv_survival_;
+      tally.roulette_gain += w_new - w;
+      w = w_new;
+    } else {
+      tally.roulette_loss += w;
+      w = 0;
+    }
+  }
+
+  // Next-event estimation of one flight's exits (see the conventions above): follows the specular
+  // chain from p along d, records each hit's expected transmitted weight and returns how many hits
+  // it covered. Draws no random numbers.
+  template <ExitRecorder Recorder>
+  int record_expected_exits(Vec3 p, Vec3 d, double w, uint64_t scatterings, Recorder& recorder,
+                            PhotonTally& tally) const {
+    const double n_in = medium_.n;
+    double carried = w;  // the weight still travelling along the chain
+    int hits = 0;
+    while (hits < kMaxExpectedExitHits) {
+      const BoundaryHit hit = geometry_.distance_to_boundary(p, d);
+      if (!std::isfinite(hit.distance)) break;  // the walk never meets the boundary either
+      carried *= std::exp(-mu_total_ * hit.distance);
+      p = geometry_.snap(p + hit.distance * d, hit.boundary);
+      ++hits;
+      const Vec3 n = geometry_.outward_normal(p, hit.boundary);
+      const double n_out = geometry_.n_outside(hit.boundary);
+      const double cos_i = dot(d, n);
+      double r = 0, cos_t = cos_i;
+      Vec3 out = d;
+      if (n_out != n_in) {
+        r = fresnel_dielectric(cos_i, n_in, n_out, &cos_t);
+        if (options_.exit_reflectance && r < 1) r = options_.exit_reflectance(cos_t);
+        const double eta = n_in / n_out;
+        if (r < 1) out = normalize(eta * d + (cos_t - eta * cos_i) * n);
+      }
+      if (r < 1 && carried > 0) {
+        const double x = carried * (1 - r);
+        recorder.on_exit(ExitEvent{p, out, x, hit.boundary, scatterings});
+        tally.exited += x;
+        tally.expected_exit_excess += x;
+      }
+      carried *= r;
+      if (!(carried >= options_.expected_exit_cutoff * w)) break;
+      if (cos_i > 0) d = normalize(d - 2 * cos_i * n);
+    }
+    return hits;
   }
 
   Geometry geometry_;
   TransportMedium medium_;
   TransportOptions options_;
   double mu_t_ = 0, inv_mu_t_ = 0, absorb_fraction_ = 0, inv_survival_ = 1;
+  double mu_total_ = 0;  // mu_a + mu_s: a flight's survival to the boundary in every weight mode
 };
 
 using SlabTransport = PhotonTransport<SlabGeometry>;

@@ -53,7 +53,10 @@ struct PhotonFractions {
   MeanEstimate absorbed;
   MeanEstimate roulette;  // roulette losses minus gains (mean zero; nonzero by chance only)
   MeanEstimate lost;      // interaction cap or endless path (see TransportOptions::max_events)
-  double energy_imbalance = 0;  // 1 - the sum of the means: zero up to rounding
+  // Expected exits recorded minus the walk's exits they stand for (TransportOptions::
+  // expected_exits; mean zero, else exactly zero).
+  MeanEstimate expected_exit_excess;
+  double energy_imbalance = 0;  // 1 - the sum of the means (less the excess): zero to rounding
   uint64_t photons = 0;         // photons traced (fewer than asked when cancelled)
   uint64_t scatterings = 0;     // scattering events in all
   uint64_t reflections = 0;     // internal reflections in all
@@ -62,13 +65,14 @@ struct PhotonFractions {
 // Per-photon statistics of the energy books (PhotonTally): accumulators for each part of the
 // launched power, over the photons added.
 struct PhotonStats {
-  enum Part { kSpecular, kExited, kAbsorbed, kRoulette, kLost, kParts };
+  enum Part { kSpecular, kExited, kAbsorbed, kRoulette, kLost, kExitExcess, kParts };
   std::array<MeanAccumulator, kParts> part;
   uint64_t photons = 0, scatterings = 0, reflections = 0;
 
   void add(const PhotonTally& photon) {
-    const double values[kParts] = {photon.specular, photon.exited, photon.absorbed,
-                                   photon.roulette_loss - photon.roulette_gain, photon.lost};
+    const double values[kParts] = {photon.specular, photon.exited,
+                                   photon.absorbed, photon.roulette_loss - photon.roulette_gain,
+                                   photon.lost,     photon.expected_exit_excess};
     for (int k = 0; k < kParts; ++k) part[k].add(values[k]);
     photons += 1;
     scatterings += photon.scatterings;
@@ -83,12 +87,14 @@ struct PhotonStats {
   }
   PhotonFractions fractions() const {
     PhotonFractions f;
-    MeanEstimate* out[kParts] = {&f.specular, &f.exited, &f.absorbed, &f.roulette, &f.lost};
+    MeanEstimate* out[kParts] = {&f.specular, &f.exited, &f.absorbed,
+                                 &f.roulette, &f.lost,   &f.expected_exit_excess};
     double sum = 0;
     for (int k = 0; k < kParts; ++k) {
       *out[k] = part[k].estimate(photons);
-      sum += out[k]->mean;
+      if (k != kExitExcess) sum += out[k]->mean;
     }
+    sum -= f.expected_exit_excess.mean;
     f.energy_imbalance = photons == 0 ? 0.0 : 1.0 - sum;
     f.photons = photons;
     f.scatterings = scatterings;
