@@ -14,9 +14,10 @@
 # Top row: the whole seat; bottom row: a close-up camera 12 cm from the cushion's front piping
 # (a rendered close-up, not a crop), where one weave repeat spans about 18 pixels at 480 x 360.
 # Outputs in ${WEFT_OUT:-out/seat}/: seat.glb; per variant V the descriptions seat-V.json and
-# closeup-V.json, the renders seat-V.exr/.png and closeup-V.exr/.png and their render-V.json and
-# render-closeup-V.json; closeup-computed-table.exr/.png (the computed close-up at the fabric
-# table level: the same render as closeup-computed where there is no weave level); the crops of
+# closeup-V.json, the renders seat-V.exr/.png and closeup-V.exr/.png and their summaries
+# render-V.json and render-closeup-V.json; closeup-computed-table.exr/.png (the computed
+# close-up at the fabric table level: the same render as closeup-computed where there is no
+# weave level); closeup-camera.json (the close-up's geometry, the repeat in pixels); the crops of
 # the whole renders (crop-V.exr/.png, the cushion's front edge enlarged 4x); side-by-side.exr and
 # .png (labelled); closeup-levels.exr/.png (weave against table level, when there is a weave);
 # timings.json. The fiber and fabric tables are cached in that folder (red-cotton-fabric.exr with
@@ -156,28 +157,29 @@ print(f"computed fabric's backing reflectance: {backing}")
 PY
 
 echo "== 4. render"
-render() {  # description, output name; wall time = loading the scene + rendering
-  local start end
+render() {  # NAME: NAME.json rendered to NAME.exr/.png, its summary render-NAME.json (whole
+  # views: render-V.json); wall time = loading the scene + rendering
+  local start end js=$out/render-${1#seat-}.json
   start=$(date +%s.%N)
-  "$weft" render "$out/$1.json" -o "$out/$2.exr" --preview "$out/$2.png" \
-    --threads "$threads" "${size_args[@]}" --quiet --json > "$out/render-$2.json"
+  "$weft" render "$out/$1.json" -o "$out/$1.exr" --preview "$out/$1.png" \
+    --threads "$threads" "${size_args[@]}" --quiet --json > "$js"
   end=$(date +%s.%N)
   /usr/bin/python3 -c "
-import json; j = json.load(open('$out/render-$2.json'))
+import json; j = json.load(open('$js'))
 j['wall_seconds'] = $end - $start
-json.dump(j, open('$out/render-$2.json', 'w'), indent=2)
-print(f\"$2: {j['width']}x{j['height']}, {j['spp']} spp, {j['seconds']:.1f} s \"
+json.dump(j, open('$js', 'w'), indent=2)
+print(f\"$1: {j['width']}x{j['height']}, {j['spp']} spp, {j['seconds']:.1f} s \"
       f\"({j['wall_seconds']:.1f} s wall with loading), {j['rays']} rays, \"
       f\"{j['rays_per_s']/1e6:.2f} M rays/s, {j['nonfinite_samples']} non-finite samples\")
 for k, v in j.items():  # what the weave level reports (level chosen, repeat in pixels)
     if 'weave' in k or 'level' in k: print(f'  {k}: {json.dumps(v)}')"
 }
 for v in "${variants[@]}"; do
-  render "seat-$v" "seat-$v"
-  render "closeup-$v" "closeup-$v"
+  render "seat-$v"
+  render "closeup-$v"
 done
 if [ "$weave" = 1 ]; then
-  render closeup-computed-table closeup-computed-table
+  render closeup-computed-table
 else
   echo "closeup-computed is at the fabric table level: this weft has no weave level" \
     "(weft bake fabric --help lists no --weave-out); closeup-computed-table is the same render"
@@ -187,7 +189,7 @@ fi
 
 echo "== 5. side by side: whole seats on top, close-ups below, labelled"
 read -r width height < <(/usr/bin/python3 -c "
-import json; j = json.load(open('$out/render-seat-measured.json')); print(j['width'], j['height'])")
+import json; j = json.load(open('$out/render-measured.json')); print(j['width'], j['height'])")
 # Labels need a font; oiiotool names DejaVu Sans where fontconfig has it.
 font=DejaVuSans
 label_ok=1
@@ -241,7 +243,7 @@ cam = json.load(open(f"{out}/closeup-camera.json"))
 renders = {}
 for name in [f"seat-{v}" for v in variants] + [f"closeup-{v}" for v in variants] + \
         ["closeup-computed-table"]:
-    j = json.load(open(f"{out}/render-{name}.json"))
+    j = json.load(open(f"{out}/render-{name[5:] if name.startswith('seat-') else name}.json"))
     r = {"seconds": j["seconds"], "wall_seconds": j["wall_seconds"], "rays": j["rays"],
          "width": j["width"], "height": j["height"], "spp": j["spp"]}
     if name.startswith("closeup"):

@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # scripts/seat.sh at a tiny size (32 x 24 pixels, 1 spp, a 20 mm seat grid, a coarse fiber table,
-# 20 ray-trace particles per incident bin) in a scratch folder: every output it names is written, every panel has the
-# size asked for, the mosaic holds them (two rows, 4-pixel gaps), the labels are drawn where
-# oiiotool can draw text, the close-up is its own camera (12 cm from its look-at point, a repeat
-# of at least 16 pixels at the scene's 360-pixel height), and timings.json has every render.
+# 20 ray-trace particles per incident bin) in a scratch folder: every output it names is written,
+# every panel has the size asked for, the mosaic holds them (two rows, 4-pixel gaps), the labels
+# are drawn where oiiotool can draw text, the close-up is its own camera (12 cm from its look-at
+# point, a repeat of at least 16 pixels at the scene's 360-pixel height), and timings.json has
+# every render.
 # Usage: seat_test.sh WEFT SOURCE_DIR
 set -uo pipefail
 weft=$(readlink -f "$1")
@@ -29,9 +30,9 @@ for v in "${variants[@]}"; do
   for f in seat-$v closeup-$v crop-$v; do
     for ext in exr png; do [ -f "$out/$f.$ext" ] || bad "$f.$ext not written"; done
   done
+  for f in render-$v render-closeup-$v; do [ -f "$out/$f.json" ] || bad "$f.json not written"; done
   for f in seat-$v closeup-$v; do
     [ -f "$out/$f.json" ] || bad "$f.json not written"
-    [ -f "$out/render-$f.json" ] || bad "render-$f.json not written"
     for ext in exr png; do
       [ "$(size "$out/$f.$ext")" = 32x24 ] || bad "$f.$ext is $(size "$out/$f.$ext"), not 32x24"
     done
@@ -39,7 +40,8 @@ for v in "${variants[@]}"; do
   [ "$(size "$out/crop-$v.exr")" = 32x24 ] || bad "crop-$v.exr is $(size "$out/crop-$v.exr")"
 done
 for f in seat.glb closeup-computed-table.exr closeup-computed-table.png side-by-side.exr \
-  side-by-side.png timings.json fabric.json red-cotton-fabric.exr red-cotton-summation.exr; do
+  side-by-side.png timings.json closeup-camera.json fabric.json red-cotton-fabric.exr \
+  summation.json red-cotton-summation.exr; do
   [ -f "$out/$f" ] || bad "$f not written"
 done
 # Four panels of 32 with three 4-pixel gaps; two rows of 24 with one gap.
