@@ -95,7 +95,11 @@ import json; j = json.load(open('$out/fabric.json'))
 n = ' / '.join(f'{100 * x:.2f}' for x in j['relative_noise_per_channel'])
 print(f\"ray trace: {j['particles']} particles ({$particles} per incident bin), \"
       f\"{j['cpu_seconds']:.1f} CPU-s, {j['wall_seconds']:.0f} s wall, \"
-      f\"relative noise R / G / B {n} %\")"
+      f\"relative noise R / G / B {n} %\")
+if j.get('weave'):
+    w = j['weave']
+    print(f\"weave table: {w.get('positions')} positions, resolution {w.get('resolution')}, \"
+          f\"relative noise {w.get('relative_noise')}\")"
 
 echo "== 3. the descriptions, whole and close up"
 repeat_dir=$(mktemp -d)
