@@ -50,7 +50,9 @@ size_args=()
 [ -n "${WEFT_SPP:-}" ] && size_args+=(--spp "$WEFT_SPP")
 # The fabric table's weave level (docs/car-seat.md), where this weft has it.
 weave=0
-"$weft" bake fabric --help | grep -q -- '--weave-out' && weave=1
+# (the help read whole first: grep -q may close the pipe early, and pipefail would count that)
+bake_help=$("$weft" bake fabric --help)
+grep -q -- '--weave-out' <<< "$bake_help" && weave=1
 
 echo "== 1. the seat"
 "$weft" scene car-seat -o "$out/seat.glb" --cell-mm "${WEFT_SEAT_CELL_MM:-5}"
