@@ -202,14 +202,15 @@ label_ok=1
 oiiotool --create 8x8 3 --text:font=$font:size=8 x -o "$repeat_dir/font.exr" > /dev/null 2>&1 ||
   { label_ok=0; echo "seat.sh: oiiotool cannot draw text with $font: panels unlabelled" >&2; }
 size=$(( height / 24 > 8 ? height / 24 : 8 ))
-label() {  # in, out, text: white text with a dark shadow, top left
-  if [ "$label_ok" = 1 ]; then
-    local x=$((size / 2)) y=$((size + size / 2))
-    oiiotool "$1" --text:x=$((x + 1)):y=$((y + 1)):size=$size:color=0,0,0:font=$font "$3" \
-      --text:x=$x:y=$y:size=$size:color=1,1,1:font=$font "$3" -o "$2"
-  else
-    cp "$1" "$2"
-  fi
+# labelled IMAGE TEXT: oiiotool arguments that read IMAGE and write TEXT into it at the top left,
+# white with a dark shadow, into the array 'ops' (one oiiotool call for all panels: each call
+# costs seconds of start-up on a loaded machine).
+labelled() {
+  ops=("$1")
+  [ "$label_ok" = 1 ] || return 0
+  local x=$((size / 2)) y=$((size + size / 2))
+  ops+=("--text:x=$((x + 1)):y=$((y + 1)):size=$size:color=0,0,0:font=$font" "$2"
+    "--text:x=$x:y=$y:size=$size:color=1,1,1:font=$font" "$2")
 }
 level=table
 [ "$weave" = 1 ] && level="weave (auto)"
@@ -222,24 +223,28 @@ declare -A names=([measured]="measured (MERL red fabric)"
 crop_w=$(( width * 120 / 480 > 1 ? width * 120 / 480 : 1 ))
 crop_h=$(( height * 90 / 360 > 1 ? height * 90 / 360 : 1 ))
 crop="${crop_w}x${crop_h}+$(( width * 140 / 480 ))+$(( height * 195 / 360 ))"
-lab=$repeat_dir/labelled
-mkdir -p "$lab"
 for ext in exr png; do
-  top=() bottom=()
+  args=()  # the crops, each written and popped; then the panels, labelled, and their mosaic
   for v in "${variants[@]}"; do
-    oiiotool "$out/seat-$v.$ext" --cut "$crop" --resample $((4 * crop_w))x$((4 * crop_h)) \
-      -o "$out/crop-$v.$ext"
-    label "$out/seat-$v.$ext" "$lab/seat-$v.$ext" "${names[$v]}"
+    args+=("$out/seat-$v.$ext" --cut "$crop" --resample $((4 * crop_w))x$((4 * crop_h))
+      -o "$out/crop-$v.$ext" --pop)
+  done
+  for v in "${variants[@]}"; do
+    labelled "$out/seat-$v.$ext" "${names[$v]}"
+    args+=("${ops[@]}")
+  done
+  for v in "${variants[@]}"; do
     text="close-up"
     [ "$v" = computed ] && text="close-up, $level"
-    label "$out/closeup-$v.$ext" "$lab/closeup-$v.$ext" "$text; repeat ${repeat_px} px"
-    top+=("$lab/seat-$v.$ext") bottom+=("$lab/closeup-$v.$ext")
+    labelled "$out/closeup-$v.$ext" "$text; repeat ${repeat_px} px"
+    args+=("${ops[@]}")
   done
-  oiiotool "${top[@]}" "${bottom[@]}" --mosaic:pad=4 ${#variants[@]}x2 -o "$out/side-by-side.$ext"
+  oiiotool "${args[@]}" --mosaic:pad=4 ${#variants[@]}x2 -o "$out/side-by-side.$ext"
   if [ "$weave" = 1 ]; then
-    label "$out/closeup-computed-table.$ext" "$lab/closeup-table.$ext" "fabric table level"
-    oiiotool "$lab/closeup-computed.$ext" "$lab/closeup-table.$ext" --mosaic:pad=4 2x1 \
-      -o "$out/closeup-levels.$ext"
+    labelled "$out/closeup-computed.$ext" "close-up, $level; repeat ${repeat_px} px"
+    args=("${ops[@]}")
+    labelled "$out/closeup-computed-table.$ext" "close-up, fabric table level"
+    oiiotool "${args[@]}" "${ops[@]}" --mosaic:pad=4 2x1 -o "$out/closeup-levels.$ext"
   fi
 done
 /usr/bin/python3 - "$out" "$weave" "${variants[@]}" <<'PY'
