@@ -50,6 +50,7 @@ size_args=()
 [ -n "${WEFT_SPP:-}" ] && size_args+=(--spp "$WEFT_SPP")
 # The fabric table's weave level (docs/car-seat.md), where this weft has it.
 weave=0
+no_weave="(weft bake fabric --help lists no --weave-out)"
 # (the help read whole first: grep -q may close the pipe early, and pipefail would count that)
 bake_help=$("$weft" bake fabric --help)
 grep -q -- '--weave-out' <<< "$bake_help" && weave=1
@@ -107,8 +108,9 @@ echo "== 3. the descriptions, whole and close up"
 repeat_dir=$(mktemp -d)
 trap 'rm -rf "$repeat_dir"' EXIT
 "$weft" weave -o "$repeat_dir/poplin.glb" --json > "$repeat_dir/poplin.json"
-/usr/bin/python3 - "$scene_dir" "$out" "$backing" "$weave" "$repeat_dir/poplin.json" \
-  "${WEFT_HEIGHT:-}" "${variants[@]}" <<'PY'
+describe() {  # the descriptions, with the weave level where $weave is 1
+  /usr/bin/python3 - "$scene_dir" "$out" "$backing" "$weave" "$repeat_dir/poplin.json" \
+    "${WEFT_HEIGHT:-}" "${variants[@]}" <<'PY'
 import json, math, sys
 scene_dir, out, backing, weave, poplin, height = sys.argv[1:7]
 variants = sys.argv[7:]
@@ -161,6 +163,15 @@ for name in variants + (["computed-table"] if weave == "1" else []):
 print(f"classic diffuse colour = computed table's reflectance at normal incidence: {rho}")
 print(f"computed fabric's backing reflectance: {backing}")
 PY
+}
+describe
+# A weft may bake the weave table before its renderer reads one: a tiny render tells.
+if [ "$weave" = 1 ] && ! "$weft" render "$out/closeup-computed.json" -o "$repeat_dir/probe.exr" \
+  --width 8 --height 6 --spp 1 --threads "$threads" --quiet 2> "$repeat_dir/probe.err"; then
+  no_weave="(this weft's renderer refused it: $(head -c 300 "$repeat_dir/probe.err"))"
+  weave=0
+  describe > /dev/null
+fi
 
 echo "== 4. render"
 render() {  # NAME: NAME.json rendered to NAME.exr/.png, its summary render-NAME.json (whole
@@ -188,7 +199,7 @@ if [ "$weave" = 1 ]; then
   render closeup-computed-table
 else
   echo "closeup-computed is at the fabric table level: this weft has no weave level" \
-    "(weft bake fabric --help lists no --weave-out); closeup-computed-table is the same render"
+    "$no_weave; closeup-computed-table is the same render"
   for ext in exr png; do cp "$out/closeup-computed.$ext" "$out/closeup-computed-table.$ext"; done
   cp "$out/render-closeup-computed.json" "$out/render-closeup-computed-table.json"
 fi
