@@ -127,6 +127,29 @@ TEST(CarSeatScene, BundledDescriptionLoadsAndRendersFinite) {
   EXPECT_GT(sum, 0);
 }
 
+// The ground reaches the horizon: the sky is 0 below it (environment_map.h), so a ground that
+// ended short of it (the 200 m quad alone: 0.57 degrees below the horizon from the camera's 1 m
+// height, 6 pixels of the bundled 480 x 360 view) left a black band between ground and sky. The
+// rows around the horizon left of the seat (the bundled view's pixels x < 240, y 26 to 47 see only
+// ground and sky) are no darker than half their mean anywhere.
+TEST(CarSeatScene, GroundMeetsTheSkyAtTheHorizon) {
+  const fs::path dir = weft::testing::fresh_test_dir();
+  const SceneDescription d = parse_scene_description(seat_description(dir), kSeatDir, "seat.json");
+  RenderSettings s;
+  s.width = 480, s.height = 360, s.spp = 4, s.max_depth = 1;
+  s.crop = PixelWindow{0, 240, 26, 48};
+  const RenderResult r = render(RenderScene(d), *d.camera, s);
+  const size_t n = r.image.rgb.size() / 3;
+  ASSERT_EQ(n, 240u * 22u);
+  double mean = 0;
+  for (float v : r.image.rgb) mean += v;
+  mean /= 3.0 * n;
+  ASSERT_GT(mean, 0);
+  for (size_t p = 0; p < n; ++p)
+    ASSERT_GT(r.image.rgb[3 * p], 0.5 * mean)
+        << "pixel x " << p % 240 << ", y " << 26 + p / 240 << " (crop mean " << mean << ")";
+}
+
 TEST(CarSeatScene, ThreeVariantsDifferOnTheFabricAndNowhereElse) {
   const fs::path dir = weft::testing::fresh_test_dir();
   nlohmann::json base = seat_description(dir);
