@@ -12,6 +12,7 @@
 #include "weft/core/task_batch.h"
 #include "weft/fabric/fiber_sampler.h"
 #include "weft/fabric/raytrace_steps.h"
+#include "weft/fabric/weave_tally.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
@@ -94,6 +95,7 @@ void FabricRaytraceOptions::validate() const {
   const int bins = DirectionGrid{resolution}.bins();
   if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
     throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
+  validate_weave_options(*this);
 }
 
 void FabricBinBooks::add(const FabricBinBooks& o) {
@@ -165,6 +167,7 @@ struct Tracer {
   // Yarn detail: the line albedos of the table traced and of the proposal (weigh_as_round_fiber).
   const LineAlbedo* tube = nullptr;
   const LineAlbedo* tube_proposal = nullptr;
+  const WeaveLayout* weave = nullptr;  // the weave tally, when on
 };
 
 // A particle's life from its launch: where its exits and books go, the strategies its path and
@@ -186,6 +189,15 @@ struct TaskScratch {
   Particle probe;  // a next-event draw's particle (its vectors reused)
 };
 
+// An exit along d whose line passes through p, with weights w: into the table's tally and, when on,
+// the weave's.
+void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d,
+               std::span<const double> w) {
+  const uint64_t cell = exit_cell(t.grid, life.bin, d);
+  tally_exit(*life.tally, life.first_exit, cell, w);
+  if (t.weave) tally_weave_exit(*t.weave, life.tally->weave, life.first_exit, cell, p, d, w);
+}
+
 // The next-event estimate at a crossing x (FabricRaytraceOptions::next_event_rays): draws of the
 // step s is about to take, weighed as its own would be and followed out of the slab without
 // scattering; each that leaves books its weights over the count into its cell.
@@ -206,7 +218,7 @@ void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Cr
         escape_direction(t.scene, t.slab, t.curves, probe, 100 * t.o.max_scatterings);
     if (!out) continue;
     for (double& w : probe.w) w *= share;
-    tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, *out), probe.w);
+    book_exit(t, life, probe.p, *out, probe.w);
   }
 }
 
@@ -270,8 +282,7 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
     SurfaceHit h;
     const Flight flight = fly(t.scene, t.slab, t.curves, s, &h);
     if (flight == Flight::left_slab) {  // binned by its direction, unless next events did
-      if (t.o.next_event_rays == 0 || !s.scattered)
-        tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, s.d), s.w);
+      if (t.o.next_event_rays == 0 || !s.scattered) book_exit(t, life, s.p, s.d, s.w);
       books.exited += mean_w;
       return;
     }
@@ -556,12 +567,22 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                 std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0)};
   FabricRaytraceResult result;
   result.bin_books.resize(bins);
+  std::optional<WeaveLayout> weave;
+  WeaveSums weave_sums;
+  if (o.weave_positions_u > 0) {
+    t.weave =
+        &weave.emplace(weave_layout(o, nc, slab.x0, slab.z0, slab.px, slab.pz, slab.y0, slab.y1));
+    weave_sums = weave_sums_for(*weave);
+  }
   const TaskBatchStatus status = run_batch<Tally>(
       batch_for(t, progress),
       [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, Tally& tally) {
         trace_task(t, first, count, rng, tally);
       },
-      [&](const Tally& tally) { add_task(tally, nc, sums, result); });
+      [&](const Tally& tally) {
+        add_task(tally, nc, sums, result);
+        if (weave) add_weave_task(*weave, tally.weave, weave_sums);
+      });
   result.cancelled = status.cancelled;
   std::vector<uint64_t> units(bins);
   const uint64_t per_task = batch_for(t, progress).items_per_task;
@@ -569,6 +590,10 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   tabulate(sums, t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
+  if (weave) {
+    weave_bin_books(*weave, weave_sums, t.per_bin, units, result);
+    weave_totals(weave->shape, result);
+  }
   return result;
 }
 
