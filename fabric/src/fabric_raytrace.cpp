@@ -195,7 +195,10 @@ void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d,
                std::span<const double> w) {
   const uint64_t cell = exit_cell(t.grid, life.bin, d);
   tally_exit(*life.tally, life.first_exit, cell, w);
-  if (t.weave) tally_weave_exit(*t.weave, life.tally->weave, life.first_exit, cell, p, d, w);
+  if (t.weave) {
+    const int exit_bin = static_cast<int>(cell - static_cast<uint64_t>(life.bin) * t.grid.bins());
+    tally_weave_exit(*t.weave, life.tally->weave, life.first_exit, life.bin, exit_bin, p, d, w);
+  }
 }
 
 // The next-event estimate at a crossing x (FabricRaytraceOptions::next_event_rays): draws of the

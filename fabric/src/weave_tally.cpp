@@ -167,18 +167,20 @@ int weave_position(const WeaveLayout& w, const Vec3& p, const Vec3& d) {
   return cell(fv, w.shape.positions_v) * w.shape.positions_u + cell(fu, w.shape.positions_u);
 }
 
-void tally_weave_exit(const WeaveLayout& w, WeaveExits& tally, uint64_t unit, uint64_t cell,
+void tally_weave_exit(const WeaveLayout& w, WeaveExits& tally, uint64_t unit, int bin, int exit_bin,
                       const Vec3& p, const Vec3& d, std::span<const double> weights) {
-  const uint64_t key = cell * static_cast<uint64_t>(w.shape.positions()) +
-                       static_cast<uint64_t>(weave_position(w, p, d));
+  const uint64_t cell = (static_cast<uint64_t>(bin) * static_cast<uint64_t>(w.shape.positions()) +
+                         static_cast<uint64_t>(weave_position(w, p, d))) *
+                            static_cast<uint64_t>(w.coarse_bins) +
+                        static_cast<uint64_t>(w.coarse_of_fine[exit_bin]);
   // The unit's exits are the last ones in the list.
   for (size_t e = tally.exits.size(); e > 0 && tally.exits[e - 1].unit == unit; --e)
-    if (tally.exits[e - 1].key == key) {
+    if (tally.exits[e - 1].cell == cell) {
       for (size_t c = 0; c < weights.size(); ++c)
         tally.weights[tally.exits[e - 1].first + c] += weights[c];
       return;
     }
-  tally.exits.push_back({key, unit, static_cast<uint32_t>(tally.weights.size())});
+  tally.exits.push_back({cell, unit, static_cast<uint32_t>(tally.weights.size())});
   tally.weights.insert(tally.weights.end(), weights.begin(), weights.end());
 }
 
@@ -188,13 +190,9 @@ WeaveSums weave_sums_for(const WeaveLayout& w) {
 }
 
 void add_weave_task(const WeaveLayout& w, const WeaveExits& tally, WeaveSums& sums) {
-  const uint64_t np = static_cast<uint64_t>(w.shape.positions());
-  const uint64_t fb = static_cast<uint64_t>(w.fine_bins);
   const size_t nc = static_cast<size_t>(w.channels);
   for (const WeaveExit& e : tally.exits) {
-    const uint64_t cell = e.key / np, pos = e.key % np;
-    const uint64_t bin = cell / fb, out = static_cast<uint64_t>(w.coarse_of_fine[cell % fb]);
-    const size_t at = ((bin * np + pos) * static_cast<uint64_t>(w.coarse_bins) + out) * nc;
+    const size_t at = e.cell * nc;
     for (size_t c = 0; c < nc; ++c) {
       const double x = tally.weights[e.first + c];
       sums.sum[at + c] += x;

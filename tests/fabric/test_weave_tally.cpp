@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "test_util.h"
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -92,6 +93,13 @@ TEST(WeaveTally, PositionMeanIsTheTablesCoarseAverage) {
     ASSERT_EQ(hero.weave.positions_u, 4);
     ASSERT_EQ(hero.weave.positions_v, 3);
     EXPECT_NO_THROW(hero.weave.validate(""));
+    // It belongs to this table, and its file reads back as written.
+    EXPECT_EQ(hero.weave.metadata.at("fabric_checksum"), hero.table.checksum());
+    const auto file = weft::testing::fresh_test_dir() / "weave.exr";
+    hero.weave.write_exr(file);
+    const WeaveTable back = WeaveTable::read_exr(file);
+    EXPECT_EQ(back.modulation, hero.weave.modulation);
+    EXPECT_EQ(back.repeat_u_m, hero.weave.repeat_u_m);
     expect_position_mean_is_the_table(hero);
     EXPECT_GT(hero.weave_relative_noise, 0.0);
     // The weave tally draws no random number: the table keeps its bits with it off.

@@ -197,8 +197,8 @@ TEST(CliBadInput, WeaveTableOptionsAreNamedBeforeAnyWork) {
   for (const Case& c : std::vector<Case>{
            {bake + "--weave-out w.exr", {"--weave-out", "--method raytrace"}},
            {bake + "--weave-positions 4", {"--weave-positions", "--method raytrace"}},
-           {raytrace + "--weave-positions 4", {"--weave-positions", "needs --weave-out"}},
-           {raytrace + "--weave-resolution 2", {"--weave-resolution", "needs --weave-out"}},
+           {raytrace + "--weave-positions 4", {"--weave-positions", "--weave-out"}},
+           {raytrace + "--weave-resolution 2", {"--weave-resolution", "--weave-out"}},
            {raytrace + "--weave-out w.png", {"w.png", "--weave-out", ".exr"}},
            {raytrace + "--weave-out w.exr --weave-positions 0", {"--weave-positions", "[1, 64]"}},
            {raytrace + "--weave-out w.exr --weave-positions 65", {"--weave-positions", "'65'"}},

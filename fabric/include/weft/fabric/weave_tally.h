@@ -75,9 +75,10 @@ WeaveLayout weave_layout(const FabricRaytraceOptions& o, int channels, double x0
 int weave_position(const WeaveLayout& w, const Vec3& p, const Vec3& d);
 
 // A task's weave exits; those of one sample unit (tagged by the unit's first exit of the table's
-// tally, Life::first_exit) are merged per (table cell, position) like the table's.
+// tally, Life::first_exit) are merged per cell of WeaveSums, as the table's per its cell, so that
+// the variance is that of the unit's total there.
 struct WeaveExit {
-  uint64_t key;    // table cell * positions + position
+  uint64_t cell;   // (incident bin, position, coarse outgoing bin): WeaveSums' index / channels
   uint64_t unit;   // the sample unit's tag
   uint32_t first;  // index of its channel weights
 };
@@ -85,7 +86,9 @@ struct WeaveExits {
   std::vector<WeaveExit> exits;
   std::vector<double> weights;
 };
-void tally_weave_exit(const WeaveLayout& w, WeaveExits& tally, uint64_t unit, uint64_t cell,
+// An exit of a particle of incident bin 'bin' into the table's outgoing bin 'exit_bin', along d
+// with its line through p.
+void tally_weave_exit(const WeaveLayout& w, WeaveExits& tally, uint64_t unit, int bin, int exit_bin,
                       const Vec3& p, const Vec3& d, std::span<const double> weights);
 
 // Per (fine incident bin, position, coarse outgoing bin, channel), over the sample units: the sum
