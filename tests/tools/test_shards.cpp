@@ -326,6 +326,19 @@ TEST(Shards, WeaveTallyTravelsInThePartsAndMergesToTheOneProcessBytes) {
       << slurp(dir / "stderr");
   EXPECT_TRUE(slurp(resumed_weave) == a);
   EXPECT_TRUE(slurp(dir / "r.exr") == slurp(one));
+  // weft slurm's merge job writes the weave table the wrapped command names.
+  const fs::path slurm_weave = dir / "sw.exr";
+  ASSERT_EQ(run_weft(split("slurm --shards 2 --dry-run bake fabric --method raytrace -R 2 "
+                           "--samples 100 -o " +
+                           (dir / "s.exr").string() + " --weave-out " + slurm_weave.string()),
+                     dir),
+            0)
+      << slurp(dir / "stderr");
+  const std::string scripts = slurp(dir / "stdout");
+  ASSERT_NE(scripts.find(" merge "), std::string::npos) << scripts;
+  const std::string merge_line = scripts.substr(scripts.find(" merge "));
+  EXPECT_NE(merge_line.find("--weave-out '" + slurm_weave.string() + "'"), std::string::npos)
+      << scripts;
 }
 
 namespace {
