@@ -262,6 +262,72 @@ void print_weave_summary(const nlohmann::json& w) {
               w.at("resolution").get<int>(), w.at("relative_noise").get<double>());
 }
 
+// The ray trace of run(), whole or in pieces, into 'table', its --json keys 'extra' and, with
+// --weave-out, 'weave_table'; an exit code when the run ends without a table to write (a shard's
+// part written, or cancelled).
+std::optional<int> raytrace(const BakeFabricOptions& o, const FabricRaytraceOptions& r,
+                            const WovenSample& sample, const TabulatedBsdfTable& fiber,
+                            const ProgressCallback& progress, double weave_bytes,
+                            TabulatedBsdfTable& table, nlohmann::json& extra,
+                            WeaveTable& weave_table) {
+  FabricRaytraceResult res;
+  if (!o.shard.empty() || o.resume) {
+    int code = 0;
+    // The files the woven sample was made from (the fiber table is in the job by checksum).
+    std::vector<std::filesystem::path> inputs;
+    for (const auto& f : {o.weave, o.wif})
+      if (!f.empty()) inputs.emplace_back(f);
+    auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
+                                            o.shard, o.resume, progress, &code);
+    if (!pieces) {
+      if (code == 0 && !o.weave_out.empty())
+        std::fprintf(stderr,
+                     "weft: the part carries the weave tally; `weft merge --weave-out %s` "
+                     "writes the weave table\n",
+                     o.weave_out.c_str());
+      return code;
+    }
+    res = std::move(*pieces);
+  } else {
+    res = raytrace_fabric_table(sample, fiber, r, progress);
+  }
+  if (res.cancelled) {
+    std::fprintf(stderr, "\nweft: bake cancelled; nothing was written\n");
+    return 130;
+  }
+  table = res.table;
+  record_particle_counts(table, res.splits, res.roulette_kills);
+  extra = raytrace_summary(res);
+  extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
+  extra["next_event_rays"] = r.next_event_rays;
+  extra["launch_lattice"] = r.launch_lattice;
+  extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
+                                 ? nlohmann::json(nullptr)
+                                 : nlohmann::json(r.split_threshold);
+  if (!o.weave_out.empty()) {
+    extra["weave"] = weave_summary(res, o.weave_out);
+    extra["weave"]["memory_estimate_bytes"] = weave_bytes;
+    weave_table = std::move(res.weave);
+  }
+  return std::nullopt;
+}
+
+// The summations of run() (the paper's, or the visible layer's).
+TabulatedBsdfTable summation(const BakeFabricOptions& o, const WovenSample& sample,
+                             const TabulatedBsdfTable& fiber, const ProgressCallback& progress) {
+  FabricSummationOptions s;
+  s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
+  s.resolution = o.resolution;
+  if (o.samples) s.samples_per_cell = static_cast<int>(*o.samples);  // checked in run()
+  s.seed = o.seed;
+  s.threads = o.threads;
+  if (s.method == FabricSummation::kVisible) {
+    s.top = orientations(visible_fiber_tangents(sample, true));
+    s.bottom = orientations(visible_fiber_tangents(sample, false));
+  }
+  return sum_fabric_table(fiber, s, progress);
+}
+
 int run(const BakeFabricOptions& o) {
   run_limits().quiet = o.quiet;
   check_method_options(o);
@@ -292,59 +358,11 @@ int run(const BakeFabricOptions& o) {
   TabulatedBsdfTable table;
   nlohmann::json extra;
   WeaveTable weave_table;  // with --weave-out
-  if (o.method == "raytrace") {
-    FabricRaytraceResult res;
-    if (!o.shard.empty() || o.resume) {
-      int code = 0;
-      // The files the woven sample was made from (the fiber table is in the job by checksum).
-      std::vector<std::filesystem::path> inputs;
-      for (const auto& f : {o.weave, o.wif})
-        if (!f.empty()) inputs.emplace_back(f);
-      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
-                                              o.shard, o.resume, progress, &code);
-      if (!pieces) {
-        if (code == 0 && !o.weave_out.empty())
-          std::fprintf(stderr,
-                       "weft: the part carries the weave tally; `weft merge --weave-out %s` "
-                       "writes the weave table\n",
-                       o.weave_out.c_str());
-        return code;
-      }
-      res = std::move(*pieces);
-    } else {
-      res = raytrace_fabric_table(sample, fiber, r, progress);
-    }
-    if (res.cancelled) {
-      std::fprintf(stderr, "\nweft: bake cancelled; nothing was written\n");
-      return 130;
-    }
-    table = res.table;
-    record_particle_counts(table, res.splits, res.roulette_kills);
-    extra = raytrace_summary(res);
-    extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
-    extra["next_event_rays"] = r.next_event_rays;
-    extra["launch_lattice"] = r.launch_lattice;
-    extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
-                                   ? nlohmann::json(nullptr)
-                                   : nlohmann::json(r.split_threshold);
-    if (!o.weave_out.empty()) {
-      extra["weave"] = weave_summary(res, o.weave_out);
-      extra["weave"]["memory_estimate_bytes"] = weave_bytes;
-      weave_table = std::move(res.weave);
-    }
-  } else {
-    FabricSummationOptions s;
-    s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
-    s.resolution = o.resolution;
-    if (o.samples) s.samples_per_cell = static_cast<int>(*o.samples);  // checked in run()
-    s.seed = o.seed;
-    s.threads = o.threads;
-    if (s.method == FabricSummation::kVisible) {
-      s.top = orientations(visible_fiber_tangents(sample, true));
-      s.bottom = orientations(visible_fiber_tangents(sample, false));
-    }
-    table = sum_fabric_table(fiber, s, progress);
-  }
+  if (o.method != "raytrace")
+    table = summation(o, sample, fiber, progress);
+  else if (const auto ended =
+               raytrace(o, r, sample, fiber, progress, weave_bytes, table, extra, weave_table))
+    return *ended;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   table.metadata["sample"] = sample.summary.source + " (" + sample.summary.detail + ")";
