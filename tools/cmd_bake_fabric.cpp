@@ -262,70 +262,28 @@ void print_weave_summary(const nlohmann::json& w) {
               w.at("resolution").get<int>(), w.at("relative_noise").get<double>());
 }
 
-// The ray trace of run(), whole or in pieces, into 'table', its --json keys 'extra' and, with
-// --weave-out, 'weave_table'; an exit code when the run ends without a table to write (a shard's
-// part written, or cancelled).
-std::optional<int> raytrace(const BakeFabricOptions& o, const FabricRaytraceOptions& r,
-                            const WovenSample& sample, const TabulatedBsdfTable& fiber,
-                            const ProgressCallback& progress, double weave_bytes,
-                            TabulatedBsdfTable& table, nlohmann::json& extra,
-                            WeaveTable& weave_table) {
-  FabricRaytraceResult res;
-  if (!o.shard.empty() || o.resume) {
-    int code = 0;
-    // The files the woven sample was made from (the fiber table is in the job by checksum).
-    std::vector<std::filesystem::path> inputs;
-    for (const auto& f : {o.weave, o.wif})
-      if (!f.empty()) inputs.emplace_back(f);
-    auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
-                                            o.shard, o.resume, progress, &code);
-    if (!pieces) {
-      if (code == 0 && !o.weave_out.empty())
-        std::fprintf(stderr,
-                     "weft: the part carries the weave tally; `weft merge --weave-out %s` "
-                     "writes the weave table\n",
-                     o.weave_out.c_str());
-      return code;
-    }
-    res = std::move(*pieces);
-  } else {
-    res = raytrace_fabric_table(sample, fiber, r, progress);
-  }
-  if (res.cancelled) {
-    std::fprintf(stderr, "\nweft: bake cancelled; nothing was written\n");
-    return 130;
-  }
-  table = res.table;
-  record_particle_counts(table, res.splits, res.roulette_kills);
-  extra = raytrace_summary(res);
-  extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
-  extra["next_event_rays"] = r.next_event_rays;
-  extra["launch_lattice"] = r.launch_lattice;
-  extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
-                                 ? nlohmann::json(nullptr)
-                                 : nlohmann::json(r.split_threshold);
-  if (!o.weave_out.empty()) {
-    extra["weave"] = weave_summary(res, o.weave_out);
-    extra["weave"]["memory_estimate_bytes"] = weave_bytes;
-    weave_table = std::move(res.weave);
-  }
-  return std::nullopt;
+// The weave table of a ray trace with --weave-out, its --json keys added to 'extra'.
+WeaveTable take_weave(FabricRaytraceResult& res, const std::string& file, double bytes,
+                      nlohmann::json& extra) {
+  extra["weave"] = weave_summary(res, file);
+  extra["weave"]["memory_estimate_bytes"] = bytes;
+  return std::move(res.weave);
 }
 
-// The summations of run() (the paper's, or the visible layer's).
-TabulatedBsdfTable summation(const BakeFabricOptions& o, const WovenSample& sample,
-                             const TabulatedBsdfTable& fiber, const ProgressCallback& progress) {
-  FabricSummationOptions s;
-  s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
-  s.resolution = o.resolution;
-  if (o.samples) s.samples_per_cell = static_cast<int>(*o.samples);  // checked in run()
-  s.seed = o.seed;
-  s.threads = o.threads;
-  if (s.method == FabricSummation::kVisible) {
-    s.top = orientations(visible_fiber_tangents(sample, true));
-    s.bottom = orientations(visible_fiber_tangents(sample, false));
-  }
-  return sum_fabric_table(fiber, s, progress);
+// Written after the fabric table, its metadata the table's as written.
+void write_weave(const TabulatedBsdfTable& table, WeaveTable& weave, const std::string& file) {
+  describe_weave(table, weave);
+  weave.write_exr(file);
+}
+
+// A shard's run ends with its part written ('code' 0), which carries the weave tally.
+int part_written(const BakeFabricOptions& o, int code) {
+  if (code == 0 && !o.weave_out.empty())
+    std::fprintf(stderr,
+                 "weft: the part carries the weave tally; `weft merge --weave-out %s` writes the "
+                 "weave table\n",
+                 o.weave_out.c_str());
+  return code;
 }
 
 int run(const BakeFabricOptions& o) {
@@ -358,21 +316,55 @@ int run(const BakeFabricOptions& o) {
   TabulatedBsdfTable table;
   nlohmann::json extra;
   WeaveTable weave_table;  // with --weave-out
-  if (o.method != "raytrace")
-    table = summation(o, sample, fiber, progress);
-  else if (const auto ended =
-               raytrace(o, r, sample, fiber, progress, weave_bytes, table, extra, weave_table))
-    return *ended;
+  if (o.method == "raytrace") {
+    FabricRaytraceResult res;
+    if (!o.shard.empty() || o.resume) {
+      int code = 0;
+      // The files the woven sample was made from (the fiber table is in the job by checksum).
+      std::vector<std::filesystem::path> inputs;
+      for (const auto& f : {o.weave, o.wif})
+        if (!f.empty()) inputs.emplace_back(f);
+      auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fiber, r, o.output,
+                                              o.shard, o.resume, progress, &code);
+      if (!pieces) return part_written(o, code);
+      res = std::move(*pieces);
+    } else {
+      res = raytrace_fabric_table(sample, fiber, r, progress);
+    }
+    if (res.cancelled) {
+      std::fprintf(stderr, "\nweft: bake cancelled; nothing was written\n");
+      return 130;
+    }
+    table = res.table;
+    record_particle_counts(table, res.splits, res.roulette_kills);
+    extra = raytrace_summary(res);
+    extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
+    extra["next_event_rays"] = r.next_event_rays;
+    extra["launch_lattice"] = r.launch_lattice;
+    extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
+                                   ? nlohmann::json(nullptr)
+                                   : nlohmann::json(r.split_threshold);
+    if (!o.weave_out.empty()) weave_table = take_weave(res, o.weave_out, weave_bytes, extra);
+  } else {
+    FabricSummationOptions s;
+    s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
+    s.resolution = o.resolution;
+    if (o.samples) s.samples_per_cell = static_cast<int>(*o.samples);  // checked in run()
+    s.seed = o.seed;
+    s.threads = o.threads;
+    if (s.method == FabricSummation::kVisible) {
+      s.top = orientations(visible_fiber_tangents(sample, true));
+      s.bottom = orientations(visible_fiber_tangents(sample, false));
+    }
+    table = sum_fabric_table(fiber, s, progress);
+  }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   table.metadata["sample"] = sample.summary.source + " (" + sample.summary.detail + ")";
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
   if (!note.empty()) table.metadata["note"] = note;
   table.write_exr(o.output);
-  if (!o.weave_out.empty()) {  // its metadata the table's as written
-    describe_weave(table, weave_table);
-    weave_table.write_exr(o.weave_out);
-  }
+  if (!o.weave_out.empty()) write_weave(table, weave_table, o.weave_out);
   const double cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   nlohmann::json j = {{"output", o.output},
                       {"method", o.method},
