@@ -35,6 +35,7 @@ constexpr int kDefaultWeavePositions = 8, kDefaultWeaveResolution = 4;
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
   std::string detail = "yarn", shard, estimator;  // estimator: "" = hero
+  std::string straight_through;                   // "" = the library's default
   int resolution = 8, threads = 0;
   std::optional<uint64_t> samples;  // the method's default unless given
   uint64_t seed = 1;
@@ -187,6 +188,9 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
     r.next_event_rays = o.next_event_rays.value_or(kDefaultNextEventRays);
     r.launch_lattice = o.launch_lattice.value_or(kDefaultLaunchLattice);
   }
+  if (!o.straight_through.empty())
+    r.straight_through =
+        o.straight_through == "sampled" ? StraightThrough::sampled : StraightThrough::exact;
   if (o.split_threshold) {
     if (r.channel_sampling == ChannelSampling::mean)
       throw Error("", "--split-threshold",
@@ -225,6 +229,8 @@ void check_method_options(const BakeFabricOptions& o) {
     throw Error("", "--samples",
                 "a summation takes 1 to " + std::to_string(kMaxSummationSamples) +
                     " direction pairs per cell pair, got " + std::to_string(*o.samples));
+  if (o.method != "raytrace" && !o.straight_through.empty())
+    throw Error("", "--straight-through", "the ray tracer's: it needs --method raytrace");
   if (o.method != "raytrace" && o.split_threshold)
     throw Error("", "--split-threshold",
                 "splitting is the ray tracer's: it needs --method raytrace");
@@ -341,6 +347,7 @@ int run(const BakeFabricOptions& o) {
     extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
     extra["next_event_rays"] = r.next_event_rays;
     extra["launch_lattice"] = r.launch_lattice;
+    extra["straight_through"] = straight_through_name(r.straight_through);
     extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
                                    ? nlohmann::json(nullptr)
                                    : nlohmann::json(r.split_threshold);
@@ -440,6 +447,10 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
                   "over the repeat (default " +
                       std::to_string(kDefaultLaunchLattice) + ")")
       ->check(CLI::Range(1, kMaxLaunchLattice));
+  sub->add_option("--straight-through", o->straight_through,
+                  "raytrace: exact (the light passing between the fibers computed, the particles "
+                  "book what meets a fiber; the default) | sampled (booked by the particles too)")
+      ->check(CLI::IsMember({"exact", "sampled"}));
   sub->add_option("--split-threshold", o->split_threshold,
                   "raytrace, hero: split a particle whose largest channel weight exceeds this "
                   "(default " +

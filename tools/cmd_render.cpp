@@ -199,6 +199,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
              const PixelWindow& w = *job.settings.crop;
              j["crop"] = {w.x0, w.x1, w.y0, w.y1};
            }
+           if (!r.weave_levels.empty()) j["weave_levels"] = weave_levels_json(r.weave_levels);
            if (job.albedo) j["albedo"] = job.albedo->string();
            if (job.normal) j["normal"] = job.normal->string();
            std::cout << j.dump(2) << "\n";

@@ -37,6 +37,8 @@ JobPart fabric_job(const TabulatedBsdfTable& fiber, const WovenSample& sample,
   // Only where on, so that the parts of runs before the option keep their identity.
   if (r.next_event_rays > 0) p.job["next_event_rays"] = r.next_event_rays;
   if (r.launch_lattice > 1) p.job["launch_lattice"] = r.launch_lattice;
+  if (r.straight_through != StraightThrough::sampled)
+    p.job["straight_through"] = straight_through_name(r.straight_through);
   if (r.weave_positions_u > 0) {  // the parts carry the weave tally (weave_tally.h)
     p.job["weave_positions"] = {r.weave_positions_u, r.weave_positions_v};
     p.job["weave_resolution"] = r.weave_resolution;

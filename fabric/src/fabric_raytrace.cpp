@@ -12,6 +12,7 @@
 #include "weft/core/task_batch.h"
 #include "weft/fabric/fiber_sampler.h"
 #include "weft/fabric/raytrace_steps.h"
+#include "weft/fabric/straight_through.h"
 #include "weft/fabric/weave_tally.h"
 #include "weft/scenes/render_scene.h"
 
@@ -69,6 +70,10 @@ double fabric_scene_bytes(const WovenSampleSize& z) {
 
 const char* channel_sampling_name(ChannelSampling s) {
   return s == ChannelSampling::mean ? "mean" : "hero";
+}
+
+const char* straight_through_name(StraightThrough s) {
+  return s == StraightThrough::sampled ? "sampled" : "exact";
 }
 
 void FabricRaytraceOptions::validate() const {
@@ -285,7 +290,10 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
     SurfaceHit h;
     const Flight flight = fly(t.scene, t.slab, t.curves, s, &h);
     if (flight == Flight::left_slab) {  // binned by its direction, unless next events did
-      if (t.o.next_event_rays == 0 || !s.scattered) book_exit(t, life, s.p, s.d, s.w);
+      // or, having met nothing, the straight-through part is computed (straight_through.h)
+      const bool binned =
+          s.scattered ? t.o.next_event_rays == 0 : t.o.straight_through == StraightThrough::sampled;
+      if (binned) book_exit(t, life, s.p, s.d, s.w);
       books.exited += mean_w;
       return;
     }
@@ -424,10 +432,11 @@ void add_task(const Tally& t, int nc, CellSums& sums, FabricRaytraceResult& resu
   for (const auto& [a, b] : t.books) result.bin_books[a].add(b);
 }
 
-// The table from the sums over per_bin particles per incident bin, its standard error, and each
-// bin's noise and signal.
-void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t per_bin,
-              const std::vector<uint64_t>& units, FabricRaytraceResult& result) {
+// The table from the sums over per_bin particles per incident bin and the exact part (its values'
+// sums and their variance, per cell pair; empty: none), its standard error, and each bin's noise
+// and signal.
+void tabulate(const CellSums& sums, const CellSums& exact, const DirectionGrid& grid, int nc,
+              uint64_t per_bin, const std::vector<uint64_t>& units, FabricRaytraceResult& result) {
   TabulatedBsdfTable& table = result.table;
   const int bins = grid.bins();
   const auto areas = grid.cosine_weighted_areas();
@@ -450,12 +459,16 @@ void tabulate(const CellSums& sums, const DirectionGrid& grid, int nc, uint64_t 
       const double w = areas[a] * areas[b];
       for (int c = 0; c < nc; ++c) {
         const size_t v = cell * nc + c;
-        const double f = sums.sum[v] * scale;
+        const double exact_sum = exact.sum.empty() ? 0.0 : exact.sum[cell];
+        const double f = (sums.sum[v] + exact_sum) * scale;
         table.values[v] = static_cast<float>(f);
         // Per sample unit (a particle, or a launch block) the sum of its weights in the cell:
         // their sample variance.
         const double m1 = sums.sum[v] / u;
-        const double se = std::sqrt(std::max(0.0, sums.sum2[v] / u - m1 * m1) / u) * u * scale;
+        double se = std::sqrt(std::max(0.0, sums.sum2[v] / u - m1 * m1) / u) * u * scale;
+        // The exact part's variance, independent of the particles' (its own streams).
+        if (!exact.sum2.empty() && exact.sum2[cell] > 0)
+          se = std::sqrt(se * se + exact.sum2[cell] * scale * scale);
         result.standard_error[v] = static_cast<float>(se);
         noise2[c] += se * se * w;
         signal2[c] += f * f * w;
@@ -485,6 +498,8 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
   if (o.proposal) table.metadata["proposal_checksum"] = o.proposal->checksum();
   if (o.next_event_rays > 0) table.metadata["next_event_rays"] = std::to_string(o.next_event_rays);
   if (o.launch_lattice > 1) table.metadata["launch_lattice"] = std::to_string(o.launch_lattice);
+  if (o.straight_through != StraightThrough::sampled)
+    table.metadata["straight_through"] = straight_through_name(o.straight_through);
   if (o.channel_sampling != ChannelSampling::mean) {
     char text[32];
     const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;
@@ -534,6 +549,38 @@ TaskBatch batch_for(const Tracer& t, const ProgressCallback& progress) {
   batch.progress = progress;
   batch.stage = "particles";
   return batch;
+}
+
+// The exact straight-through part of the bins traced (FabricRaytraceOptions::straight_through),
+// per cell pair: the sum the particles of the bin would book there on average (per_bin times the
+// power per particle) and that sum's variance; empty when sampled. A task per bin (its streams
+// are the bin's), the same at any thread count.
+CellSums straight_through_sums(const Tracer& t) {
+  if (t.o.straight_through == StraightThrough::sampled) return {};
+  const int bins = t.grid.bins();
+  const int first = t.o.first_bin, count = (t.o.bin_count ? first + t.o.bin_count : bins) - first;
+  const StraightThroughPlan plan = straight_through_plan(t.per_bin);
+  const double n = static_cast<double>(t.per_bin);
+  CellSums exact{std::vector<double>(static_cast<size_t>(bins) * bins, 0.0),
+                 std::vector<double>(static_cast<size_t>(bins) * bins, 0.0)};
+  TaskBatch batch;
+  batch.items = static_cast<uint64_t>(count);
+  batch.seed = t.o.seed;
+  batch.threads = t.o.threads;
+  batch.items_per_task = 1;
+  run_batch<std::vector<StraightThroughCell>>(
+      batch,
+      [&](uint64_t, uint64_t item, uint64_t, Rng&, std::vector<StraightThroughCell>& cells) {
+        cells = straight_through_of_bin(t.scene, t.slab, t.grid, first + static_cast<int>(item),
+                                        plan, t.o.seed, 100 * t.o.max_scatterings);
+      },
+      [&](const std::vector<StraightThroughCell>& cells) {
+        for (const StraightThroughCell& c : cells) {
+          exact.sum[c.cell] += n * c.power;
+          exact.sum2[c.cell] += n * n * c.variance;
+        }
+      });
+  return exact;
 }
 
 }  // namespace
@@ -590,7 +637,7 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   std::vector<uint64_t> units(bins);
   const uint64_t per_task = batch_for(t, progress).items_per_task;
   for (int a = 0; a < bins; ++a) units[a] = sample_units(t, per_task, a);
-  tabulate(sums, t.grid, nc, t.per_bin, units, result);
+  tabulate(sums, straight_through_sums(t), t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   if (weave) {

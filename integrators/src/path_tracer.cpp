@@ -5,12 +5,15 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <optional>
 #include <utility>
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
 #include "weft/core/spectrum.h"
+#include "weft/integrators/weave_level.h"
+#include "weft/materials/bound_bsdf.h"
 #include "weft/materials/bsdfs.h"
 
 namespace weft {
@@ -63,19 +66,19 @@ Bands operator/(Bands a, double s) {
 // table by its RGB mean); Russian roulette follows the largest value the path carries.
 struct RgbShading {
   using Color = Rgb;
-  static Rgb f(const Bsdf& b, const Vec3& wo, const Vec3& wi) { return b.eval(wo, wi); }
-  static Rgb weight(const Bsdf&, const Vec3&, const BsdfSample& s) { return s.weight; }
+  static Rgb f(const BoundBsdf& b, const Vec3& wo, const Vec3& wi) { return b.eval(wo, wi); }
+  static Rgb weight(const BoundBsdf&, const Vec3&, const BsdfSample& s) { return s.weight; }
   static Rgb light(const Rgb& L) { return L; }
   static Rgb to_rgb(const Rgb& c) { return c; }
 };
 struct BandShading {
   using Color = Bands;
-  static Bands f(const Bsdf& b, const Vec3& wo, const Vec3& wi) {
+  static Bands f(const BoundBsdf& b, const Vec3& wo, const Vec3& wi) {
     Bands out;
     eval_bands(b, wo, wi, out.v);
     return out;
   }
-  static Bands weight(const Bsdf& b, const Vec3& wo, const BsdfSample& s) {
+  static Bands weight(const BoundBsdf& b, const Vec3& wo, const BsdfSample& s) {
     Bands out;
     sample_weight_bands(b, wo, s, out.v);
     return out;
@@ -86,10 +89,11 @@ struct BandShading {
   }
 };
 
-// A shading point of a path: the hit, its BSDF and the direction back along the path.
+// A shading point of a path: the hit, its BSDF (bound to the hit's place in a weave) and the
+// direction back along the path.
 struct PathVertex {
   const SurfaceHit& hit;
-  const Bsdf& bsdf;
+  BoundBsdf bsdf;
   Vec3 wo;       // towards the previous vertex, in the shading frame
   double wo_ng;  // the same direction in the world, dotted with the facet normal
 
@@ -130,7 +134,7 @@ class PathTrace {
         add_found_light(*light, LightHit::on_surface(ray_.d, hit.shape, hit.prim, hit.ng, hit.t));
       if (depth >= settings_.max_depth) break;
 
-      const PathVertex v{hit, scene_.bsdf(hit), hit.shading.to_local(wo_world),
+      const PathVertex v{hit, scene_.bsdf_at(hit), hit.shading.to_local(wo_world),
                          dot(wo_world, hit.ng)};
       sample_lights(v);
       if (!extend(v, depth)) break;
@@ -417,7 +421,7 @@ class WindowRender {
       const Vec3 wo = hit.shading.to_local(wo_world);
       const double u_lobe = aov_rng.uniform();
       const Vec2 u{aov_rng.uniform(), aov_rng.uniform()};
-      const Bsdf& bsdf = scene_.bsdf(hit);
+      const BoundBsdf bsdf = scene_.bsdf_at(hit);
       const auto bs = bsdf.sample(wo, u, u_lobe);
       if (bs && finite(bs->weight)) {
         const Rgb a =
@@ -466,12 +470,19 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   const PixelWindow win = s.crop.value_or(PixelWindow{0, s.width, 0, s.height});
   check_crop(win, s.width, s.height, "", "render.crop");
   if (s.spectral) scene.check_spectral();
-  WindowRender film(scene, camera, s, progress, observers, win);
+  // Woven meshes at the level their footprint calls for (weave_level.h); a scene without any is
+  // rendered as it is, not copied.
+  std::vector<WeaveLevelChoice> levels = choose_weave_levels(scene, camera, s);
+  std::optional<RenderScene> leveled;
+  if (!levels.empty()) leveled = scene.with_weave_levels(weave_flags(levels));
+  WindowRender film(leveled ? *leveled : scene, camera, s, progress, observers, win);
   if (s.time_limit_s == 0)
     film.render_all();
   else
     film.render_timed();
-  return film.finish();
+  RenderResult out = film.finish();
+  out.weave_levels = std::move(levels);
+  return out;
 }
 
 }  // namespace weft

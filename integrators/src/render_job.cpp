@@ -76,6 +76,7 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
   out.nonfinite_samples = r.nonfinite_samples;
   out.cancelled = r.cancelled;
   out.spp_done = r.spp_done;
+  out.weave_levels = r.weave_levels;
   if (r.cancelled) return out;  // nothing half-finished reaches the disk
   RenderMetadata meta;
   meta.scene = std::filesystem::path(desc.source).filename().string();

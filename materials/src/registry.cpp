@@ -39,6 +39,56 @@ double read_ior(ParamReader& p) {
   return p.number("ior", kCottonIor, 1.0, 4.0);
 }
 
+// fabric_table's weave table and how it is used (weave_modulation.h TableWeave), or null when the
+// material names none. Reads its keys before finish(); the file is loaded by load_weave.
+struct WeaveParams {
+  std::filesystem::path file;
+  TableWeave settings;
+};
+std::optional<WeaveParams> read_weave_params(ParamReader& p, const MaterialContext& ctx,
+                                             const std::string& kind) {
+  if (kind != "fabric") {
+    for (const char* k : {"weave", "level", "uv_metres", "weave_min_pixels"})
+      p.reject_unused(k, "applies only to fabric_table (a weave of a fabric table)");
+    return std::nullopt;
+  }
+  if (!p.has("weave")) {
+    for (const char* k : {"level", "uv_metres", "weave_min_pixels"})
+      p.reject_unused(k, "applies only with 'weave' (a weave table)");
+    return std::nullopt;
+  }
+  WeaveParams w;
+  w.file = p.string("weave");
+  if (w.file.is_relative()) w.file = ctx.base_dir / w.file;
+  w.settings.file = w.file.string();
+  const std::string level = p.choice("level", "auto", {"auto", "weave", "table"});
+  w.settings.level = level == "weave"   ? WeaveLevel::weave
+                     : level == "table" ? WeaveLevel::table
+                                        : WeaveLevel::automatic;
+  // Metres per UV unit: from a micrometre to a kilometre per unit.
+  w.settings.uv_metres = p.number("uv_metres", 1.0, 1e-6, 1e3);
+  w.settings.min_pixels = p.number("weave_min_pixels", 4.0, 0.0, 1e6);
+  return w;
+}
+
+// The weave loaded and checked against its fabric table.
+std::shared_ptr<const TableWeave> load_table_weave(ParamReader& p, const MaterialContext& ctx,
+                                                   WeaveParams w, const TabulatedBsdfData& table) {
+  try {
+    w.settings.modulation = ctx.cache ? ctx.cache->weave(w.file) : load_weave(w.file);
+  } catch (const Error& e) {
+    throw Error(p.file(), p.field("weave"), e.what());
+  }
+  const int table_channels = table.bands.empty() ? 3 : kNumBands;
+  if (w.settings.modulation->table().channels != table_channels)
+    throw Error(p.file(), p.field("weave"),
+                w.file.string() + " has " +
+                    std::to_string(w.settings.modulation->table().channels) +
+                    " channels, its fabric table " + std::to_string(table_channels) +
+                    " (a weave belongs to the table it was baked with)");
+  return std::make_shared<const TableWeave>(std::move(w.settings));
+}
+
 // fiber_table / fabric_table: the table file (relative to base_dir) or, for fiber tables, a fiber
 // spec that the context's resolver bakes on demand; its tint and scale.
 Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::string& kind) {
@@ -85,6 +135,7 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
   } else {
     p.reject_unused("interpolation", "applies only to fiber_table");
   }
+  std::optional<WeaveParams> weave = read_weave_params(p, ctx, kind);
   p.finish();
   std::shared_ptr<const TabulatedBsdfData> data;
   try {
@@ -96,6 +147,7 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
     throw Error(p.file(), p.field(key),
                 file.string() + " holds a " + data->kind + " table, expected a " + kind + " table");
   TabulatedBsdf bsdf{data, tint * scale, lookup};
+  if (weave) bsdf.weave = load_table_weave(p, ctx, std::move(*weave), *data);
   if (backing) {
     try {
       bsdf.backing = TableBacking::make(*data, bsdf.scale, *backing);

@@ -46,6 +46,16 @@ std::shared_ptr<const TabulatedBsdfData> TableCache::tabulated(const std::filesy
   return load_once(tables_, key, [](const std::string& path) { return load_tabulated_bsdf(path); });
 }
 
+std::shared_ptr<const WeaveModulation> load_weave(const std::filesystem::path& file) {
+  return std::make_shared<const WeaveModulation>(WeaveTable::read_exr(file));
+}
+
+std::shared_ptr<const WeaveModulation> TableCache::weave(const std::filesystem::path& file) {
+  const std::string key = canonical_key(file);
+  std::lock_guard lock(mutex_);
+  return load_once(weaves_, key, [](const std::string& path) { return load_weave(path); });
+}
+
 std::shared_ptr<const NbrdfNetwork> TableCache::nbrdf(const std::filesystem::path& file) {
   const std::string key = canonical_key(file);
   std::lock_guard lock(mutex_);
@@ -56,7 +66,7 @@ std::shared_ptr<const NbrdfNetwork> TableCache::nbrdf(const std::filesystem::pat
 
 size_t TableCache::size() const {
   std::lock_guard lock(mutex_);
-  return tables_.size() + networks_.size();
+  return tables_.size() + networks_.size() + weaves_.size();
 }
 
 }  // namespace weft

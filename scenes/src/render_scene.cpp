@@ -571,6 +571,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   b.instance_curve_scene();
   geo_ = b.finish();
   set_lights(desc.lights);
+  find_woven_meshes(desc);
 }
 
 const Light* RenderScene::surface_light(uint32_t shape) const {
@@ -757,6 +758,8 @@ FiberGeometry RenderScene::fiber_geometry() const {
 RenderScene RenderScene::with_lights(const Lights& lights) const {
   RenderScene r;
   r.geo_ = geo_;
+  r.woven_ = woven_;
+  r.weave_on_ = weave_on_;
   r.set_lights(lights);
   return r;
 }

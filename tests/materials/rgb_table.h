@@ -3,6 +3,7 @@
 #include <functional>
 #include <span>
 
+#include "weft/core/spectrum.h"
 #include "weft/materials/bsdf_table.h"
 
 namespace weft::testing {

@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <sstream>
 #include <string>
 
@@ -17,6 +18,8 @@
 #include "test_util.h"
 #include "weft/core/spectrum.h"
 #include "weft/integrators/image.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/materials/weave_table.h"
 
 namespace fs = std::filesystem;
 using weft::testing::fresh_test_dir;
@@ -331,4 +334,47 @@ TEST(CliRender, CtrlCStopsALargeTileAtOnce) {
   EXPECT_GE(ms, 0);
   EXPECT_LT(ms, 10000) << "ms from the signal to the exit";
   EXPECT_FALSE(fs::exists(dir / "out.exr"));
+}
+
+// The bundled plane (1 m, framed by an orthographic camera: 20 px high is 5 cm a pixel) as a
+// fabric_table with a weave of repeat 0.5 m (10 px): auto chooses the weave level at the default
+// weave_min_pixels (4) and the table level when it asks for 1000; --json says which.
+TEST(CliRender, JsonReportsTheWeaveLevelChosenPerObject) {
+  const fs::path dir = fresh_test_dir();
+  auto table = weft::TabulatedBsdfTable::from_function(
+      2, 3,
+      [](const weft::Vec3&, const weft::Vec3&, std::span<double> v) { v[0] = v[1] = v[2] = 0.1; },
+      1, 1);
+  table.kind = "fabric";
+  table.write_exr(dir / "fabric.exr");
+  weft::WeaveTable weave;
+  weave.resolution = 1;
+  weave.positions_u = weave.positions_v = 2;
+  weave.repeat_u_m = weave.repeat_v_m = 0.5;
+  weave.modulation = std::vector<float>(4 * 2 * 2 * 3, 1.0f);
+  weave.write_exr(dir / "weave.exr");
+  nlohmann::json d = nlohmann::json::parse(slurp(kExamples / "lambert-plane.json"));
+  d["gltf"] = (kExamples / "lambert-plane.gltf").string();
+  d["materials"]["plane"] = {{"type", "fabric_table"},
+                             {"params", {{"file", "fabric.exr"}, {"weave", "weave.exr"}}}};
+  d.erase("sweep");
+  std::ofstream(dir / "woven.json") << d.dump(2);
+  const CliRun near = run("render '" + (dir / "woven.json").string() +
+                              "' --width 24 --height 20 --spp 1 --quiet --json -o '" +
+                              (dir / "out.exr").string() + "'",
+                          dir);
+  ASSERT_EQ(near.exit_code, 0) << near.err;
+  const nlohmann::json j = nlohmann::json::parse(near.out);
+  ASSERT_EQ(j["weave_levels"].size(), 1u) << near.out;
+  EXPECT_EQ(j["weave_levels"][0]["object"], "plane");
+  EXPECT_EQ(j["weave_levels"][0]["level"], "weave");
+  EXPECT_EQ(j["weave_levels"][0]["setting"], "auto");
+  EXPECT_GE(j["weave_levels"][0]["repeat_pixels"].get<double>(), 9.0);  // 0.5 m at <= 5 cm a px
+  const CliRun strict =
+      run("render '" + (dir / "woven.json").string() +
+              "' --width 24 --height 20 --spp 1 --quiet --json -o '" + (dir / "out.exr").string() +
+              "' -D materials.plane.params.weave_min_pixels=1000",
+          dir);
+  ASSERT_EQ(strict.exit_code, 0) << strict.err;
+  EXPECT_EQ(nlohmann::json::parse(strict.out)["weave_levels"][0]["level"], "table");
 }

@@ -47,6 +47,15 @@ enum class ChannelSampling { spectral_mis, mean };
 // The names the command line and the table's metadata use: "hero" (spectral_mis) and "mean".
 const char* channel_sampling_name(ChannelSampling s);
 
+// The light that passes straight through the gaps between the fibers (meeting none) leaves along
+// its launch direction, into one cell per incident bin. exact: its expectation is computed
+// (straight_through.h: randomized quasi-Monte Carlo over the launch's law, with its variance) and
+// the particles book only what meets a fiber; sampled: the particles book it too (the estimator
+// before the option, bit for bit). Both are unbiased; exact removes that cell's hit-or-miss noise.
+enum class StraightThrough { exact, sampled };
+// The names the command line and the table's metadata use: "exact", "sampled".
+const char* straight_through_name(StraightThrough s);
+
 // The estimator's revision, raised whenever a change alters its results for the same options: it
 // is part of a sharded or resumed run's identity (parts of another revision are refused, not
 // merged) and of the table's metadata. 2: the scene passes rays through fibers they are inside
@@ -55,7 +64,10 @@ const char* channel_sampling_name(ChannelSampling s);
 // other fiber met from inside. 3: a yarn tube's crossing returns the fiber table's line albedo
 // (what a round fiber returns, averaged over where lines cross it), before which it returned
 // A' + A'' at its facets: 1.2 of the light at normal incidence for a nearly lossless white-cotton
-// fiber. Fiber-detail results are unchanged.
+// fiber. Fiber-detail results are unchanged. The straight-through option (StraightThrough)
+// changed the default's results without a new revision: the table's metadata and a part's job
+// name it where it is exact, so a part or table of revision 3 without it is the sampled
+// estimator's, which the option still gives bit for bit.
 inline constexpr int kFabricRaytraceRevision = 3;
 
 // The most next-event draws per scattering and particles per launch block
@@ -79,6 +91,7 @@ struct FabricRaytraceOptions {
   // (docs/PERFORMANCE.md); at 1024 none reached it, at the same cost.
   int max_copies_per_particle = 1024;
   ChannelSampling channel_sampling = ChannelSampling::spectral_mis;
+  StraightThrough straight_through = StraightThrough::exact;
   // The next-event estimate of the exits (0: off, the particles' own exits are binned). At every
   // scattering, this many draws of the step the particle is about to take (the same point, cell
   // and direction distribution and the same weights as its own) are each followed along their

@@ -34,6 +34,7 @@
 #include "weft/core/rng.h"
 #include "weft/integrators/image.h"
 #include "weft/integrators/render_settings.h"
+#include "weft/integrators/weave_level.h"
 #include "weft/scenes/camera.h"
 #include "weft/scenes/render_scene.h"
 
@@ -72,6 +73,8 @@ struct RenderResult : RenderOutcome {
   // the sampled weight f cos / pdf, whose mean is the albedo), and its shading normal in world
   // space turned towards the camera. A camera ray that hits nothing adds zero to both.
   Image albedo, normal;
+  // The level each woven mesh was shaded at (weave_level.h); empty when the scene has none.
+  std::vector<WeaveLevelChoice> weave_levels;
 };
 
 // After every camera sample: its pixel (row-major on the whole film, a crop window too), the shape

@@ -29,6 +29,7 @@ struct RenderJob {
 // A cancelled job wrote nothing; a time-limited one wrote spp_done samples per pixel.
 struct RenderJobResult : RenderOutcome {
   int spp_done = 0;
+  std::vector<WeaveLevelChoice> weave_levels;  // RenderResult::weave_levels
 };
 
 // Every output's file name: the required extension, an existing folder, no two outputs the same

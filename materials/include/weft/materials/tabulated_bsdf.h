@@ -52,6 +52,7 @@
 #include "weft/core/spectrum.h"
 #include "weft/materials/bsdf.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/weave_modulation.h"
 
 namespace weft {
 
@@ -133,6 +134,9 @@ struct TabulatedBsdf {
   TableLookup lookup = TableLookup::bilinear;
   std::optional<TableBacking> backing =
       std::nullopt;  // none: the bare table (transmission included)
+  // fabric_table's weave (weave_modulation.h); null for every other table. This BSDF is the
+  // table level; the renderer binds the weave level to a hit (bound_bsdf.h).
+  std::shared_ptr<const TableWeave> weave = nullptr;
 
   Rgb eval(const Vec3& wo, const Vec3& wi) const;
   std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const;

@@ -13,6 +13,7 @@
 
 #include "weft/core/frame.h"
 #include "weft/core/spectrum.h"
+#include "weft/materials/bound_bsdf.h"
 #include "weft/materials/bsdfs.h"
 #include "weft/materials/registry.h"
 #include "weft/materials/table_cache.h"
@@ -99,6 +100,30 @@ class RenderScene {
 
   // The BSDF of a hit's material (per mesh, or per fiber of a curve set).
   const Bsdf& bsdf(const SurfaceHit& hit) const;
+  // The material as the renderer shades it at the hit (bound_bsdf.h): bsdf(hit), bound to the
+  // hit's place in the weave (its uv) where the mesh is at its weave level.
+  BoundBsdf bsdf_at(const SurfaceHit& hit) const {
+    const Bsdf& b = bsdf(hit);
+    if (weave_on_.empty() || hit.on_fiber() || !weave_on_[hit.shape]) return {&b, nullptr, {}};
+    const TableWeave& w = *weave_on_[hit.shape];
+    return {&b, w.modulation.get(), w.modulation->locate(hit.uv, w.uv_metres)};
+  }
+
+  // Meshes whose material is a fabric_table with a weave (weave_modulation.h), in mesh order,
+  // for the choice of their level before a render (integrators weave_level.h).
+  struct WovenMesh {
+    uint32_t shape = 0;
+    std::string name;  // the mesh's first name, or "mesh <index>"
+    const TableWeave* weave = nullptr;
+    Bounds3 bounds;  // world, every placement (mesh_shifts) included
+  };
+  const std::vector<WovenMesh>& woven_meshes() const { return woven_; }
+  // Whether woven mesh k (of woven_meshes()) is shaded at its weave level. As built: those whose
+  // level is "weave"; "auto" and "table" start at the table level.
+  bool weave_level(size_t k) const;
+  // The same scene with woven mesh k at its weave level where weave_on[k] (one flag per
+  // woven_meshes() entry), the table level elsewhere. Error unless the sizes agree.
+  RenderScene with_weave_levels(const std::vector<uint8_t>& weave_on) const;
   // Whether a spectral render can draw this scene: weft::Error naming the description's file and
   // the field of the first material without spectral values (bsdfs.h spectral_obstacle), or a
   // light whose colour is not grey (an RGB colour is not a spectrum; grey is one, the same at
@@ -138,7 +163,13 @@ class RenderScene {
   FiberQueryContext query_context(int64_t ignore_fiber) const;
   RenderScene() = default;
   void set_lights(const Lights& lights);
+  // woven_ and the levels as built (render_scene_weave.cpp).
+  void find_woven_meshes(const SceneDescription& desc);
   std::shared_ptr<const Geometry> geo_;
+  std::vector<WovenMesh> woven_;
+  // Per mesh: its weave when at the weave level, else null; empty when none is (the common case:
+  // bsdf_at then tests one size).
+  std::vector<const TableWeave*> weave_on_;
   std::vector<Light> lights_;
   int surface_light_ = -1;  // index of the area light in lights_
 };
