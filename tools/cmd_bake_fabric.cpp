@@ -1,5 +1,6 @@
 // weft bake fabric: a fiber table (file, or a spec baked on demand) and a woven sample -> a fabric
 // BSDF table, by the paper's summation, our visible-layer summation or the ray-traced reference.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -8,13 +9,16 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <utility>
 
 #include "bake_fabric_fibers.h"
 #include "commands.h"
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 #include "weft/fabric/fabric_parts.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fabric_summation.h"
+#include "weft/fabric/weave_tally.h"
 #include "weft/fiber/bake_cache.h"
 #include "weft/scenes/weave.h"
 
@@ -25,6 +29,9 @@ namespace {
 constexpr uint64_t kMaxSummationSamples = 4096;
 // --estimator nee's draws per scattering unless --next-event-rays is given (docs/PERFORMANCE.md).
 constexpr int kDefaultNextEventRays = 1, kDefaultLaunchLattice = 13;
+// The weave table's position cells per side and coarse R unless given (docs/fabric-bsdf.md, "The
+// weave table": its noise and cost on the bundled poplin).
+constexpr int kDefaultWeavePositions = 8, kDefaultWeaveResolution = 4;
 
 struct BakeFabricOptions {
   std::string fiber = "red-cotton", method = "summation", output, weave, pattern, wif;
@@ -38,6 +45,9 @@ struct BakeFabricOptions {
   std::optional<double> split_threshold;  // the library's default unless given
   std::optional<int> next_event_rays;     // --estimator nee: kDefaultNextEventRays unless given
   std::optional<int> launch_lattice;      // --estimator nee: kDefaultLaunchLattice unless given
+  std::string weave_out;                  // the weave table (.exr); "" = no weave tally
+  std::optional<std::string> weave_positions;  // "N" or "UxV"
+  std::optional<int> weave_resolution;         // kDefaultWeaveResolution (at most R) unless given
   bool json = false, quiet = false, resume = false;
 };
 
@@ -112,6 +122,40 @@ std::vector<FiberOrientation> orientations(const std::vector<Vec3>& tangents) {
   return out;
 }
 
+// --weave-positions: "N" (N x N cells) or "UxV", each a whole number in [1, kMaxPositions].
+std::pair<int, int> weave_positions_of(const std::string& text) {
+  auto side = [&](const std::string& part) {
+    const std::optional<double> n = finite_number(part);
+    if (!n || *n != std::floor(*n) || *n < 1 || *n > WeaveTable::kMaxPositions)
+      throw Error("", "--weave-positions",
+                  "expected N or UxV, whole numbers in [1, " +
+                      std::to_string(WeaveTable::kMaxPositions) + "], got '" + text + "'");
+    return static_cast<int>(*n);
+  };
+  const size_t x = text.find('x');
+  if (x == std::string::npos) return {side(text), side(text)};
+  return {side(text.substr(0, x)), side(text.substr(x + 1))};
+}
+
+// The weave tally's settings (weave_tally.h): on with --weave-out.
+void weave_tally_options(const BakeFabricOptions& o, FabricRaytraceOptions& r) {
+  if (o.weave_out.empty()) {
+    if (o.weave_positions)
+      throw Error("", "--weave-positions", "the weave table's positions need --weave-out");
+    if (o.weave_resolution)
+      throw Error("", "--weave-resolution", "the weave table's resolution needs --weave-out");
+    return;
+  }
+  const auto [u, v] =
+      weave_positions_of(o.weave_positions.value_or(std::to_string(kDefaultWeavePositions)));
+  r.weave_positions_u = u, r.weave_positions_v = v;
+  r.weave_resolution = o.weave_resolution.value_or(std::min(kDefaultWeaveResolution, r.resolution));
+  if (r.weave_resolution < 1 || r.weave_resolution > r.resolution)
+    throw Error("", "--weave-resolution",
+                "must lie in [1, the table's resolution " + std::to_string(r.resolution) +
+                    "], got " + std::to_string(r.weave_resolution));
+}
+
 // The ray tracer's settings from the command line, checked before any work: options that do
 // nothing in the configuration given are errors, and a bad value names its option.
 FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
@@ -146,6 +190,7 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
                       std::to_string(r.roulette_threshold) + ", got " +
                       std::to_string(r.split_threshold));
   }
+  weave_tally_options(o, r);
   r.validate();
   return r;
 }
@@ -177,6 +222,62 @@ void check_method_options(const BakeFabricOptions& o) {
   if (o.method != "raytrace" && o.split_threshold)
     throw Error("", "--split-threshold",
                 "splitting is the ray tracer's: it needs --method raytrace");
+  if (o.method != "raytrace" && (!o.weave_out.empty() || o.weave_positions || o.weave_resolution))
+    throw Error("", o.weave_out.empty() ? "--weave-positions" : "--weave-out",
+                "the weave table is the ray tracer's: it needs --method raytrace");
+  if (!o.weave_out.empty() && std::filesystem::path(o.weave_out).extension() != ".exr")
+    throw Error(o.weave_out, "--weave-out", "the weave table must be written to a .exr file");
+}
+
+// The scene's memory and the weave tally's (weave_tally_bytes) against the budget, once the
+// fiber table's channels are known; the tally's bytes (0 without it).
+double check_weave_memory(const FabricRaytraceOptions& r, int channels, double scene_bytes) {
+  if (r.weave_positions_u == 0) return 0;
+  const double bytes = weave_tally_bytes(r.resolution, r.weave_resolution, r.weave_positions_u,
+                                         r.weave_positions_v, channels);
+  check_memory(scene_bytes + bytes, "", "--weave-positions",
+               "the scene and the weave tally of " + std::to_string(r.weave_positions_u) + "x" +
+                   std::to_string(r.weave_positions_v) + " positions at resolution " +
+                   std::to_string(r.weave_resolution) + " (" + format_bytes(bytes) + ")");
+  return bytes;
+}
+
+// What --json says of the weave table, and its line without --json.
+nlohmann::json weave_summary(const FabricRaytraceResult& res, const std::string& file) {
+  return {{"file", file},
+          {"positions",
+           std::to_string(res.weave.positions_u) + "x" + std::to_string(res.weave.positions_v)},
+          {"resolution", res.weave.resolution},
+          {"relative_noise", res.weave_relative_noise}};
+}
+void print_weave_summary(const nlohmann::json& w) {
+  std::printf("%s: weave table, %s positions, resolution %d; relative noise %.4g\n",
+              w.at("file").get<std::string>().c_str(), w.at("positions").get<std::string>().c_str(),
+              w.at("resolution").get<int>(), w.at("relative_noise").get<double>());
+}
+
+// The weave table of a ray trace with --weave-out, its --json keys added to 'extra'.
+WeaveTable take_weave(FabricRaytraceResult& res, const std::string& file, double bytes,
+                      nlohmann::json& extra) {
+  extra["weave"] = weave_summary(res, file);
+  extra["weave"]["memory_estimate_bytes"] = bytes;
+  return std::move(res.weave);
+}
+
+// Written after the fabric table, its metadata the table's as written.
+void write_weave(const TabulatedBsdfTable& table, WeaveTable& weave, const std::string& file) {
+  describe_weave(table, weave);
+  weave.write_exr(file);
+}
+
+// A shard's run ends with its part written ('code' 0), which carries the weave tally.
+int part_written(const BakeFabricOptions& o, int code) {
+  if (code == 0 && !o.weave_out.empty())
+    std::fprintf(stderr,
+                 "weft: the part carries the weave tally; `weft merge --weave-out %s` writes the "
+                 "weave table\n",
+                 o.weave_out.c_str());
+  return code;
 }
 
 int run(const BakeFabricOptions& o) {
@@ -189,7 +290,9 @@ int run(const BakeFabricOptions& o) {
   const FabricFiberOptions fiber_options{o.fiber, o.warp_fiber, o.weft_fiber, o.thread_colours,
                                          o.wif.empty() ? weave_wif : o.wif};
   check_fabric_fiber_options(fiber_options, o.method);
-  validate_output_paths({{o.output, "--output"}, {checkpoint_path(o.output), "checkpoint"}},
+  validate_output_paths({{o.output, "--output"},
+                         {checkpoint_path(o.output), "checkpoint"},
+                         {o.weave_out, "--weave-out"}},
                         {{o.fiber, "fiber table or spec"},
                          {o.warp_fiber, "warp fiber table or spec"},
                          {o.weft_fiber, "weft fiber table or spec"},
@@ -207,10 +310,12 @@ int run(const BakeFabricOptions& o) {
   const WovenSample sample = make_woven_sample(weave);
   const FabricFibers fibers = load_fabric_fibers(fiber_options, sample, progress);
   const TabulatedBsdfTable& fiber = fibers.first();
+  const double weave_bytes = check_weave_memory(r, fiber.channels, scene_bytes);
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
   TabulatedBsdfTable table;
   nlohmann::json extra;
+  WeaveTable weave_table;  // with --weave-out
   if (o.method == "raytrace") {
     FabricRaytraceResult res;
     if (!o.shard.empty() || o.resume) {
@@ -221,7 +326,7 @@ int run(const BakeFabricOptions& o) {
         if (!f.empty()) inputs.emplace_back(f);
       auto pieces = raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fibers.map, r,
                                               o.output, o.shard, o.resume, progress, &code);
-      if (!pieces) return code;
+      if (!pieces) return part_written(o, code);
       res = std::move(*pieces);
     } else {
       res = fibers.map.tables.size() == 1 ? raytrace_fabric_table(sample, fiber, r, progress)
@@ -242,6 +347,7 @@ int run(const BakeFabricOptions& o) {
     extra["split_threshold"] = r.channel_sampling == ChannelSampling::mean
                                    ? nlohmann::json(nullptr)
                                    : nlohmann::json(r.split_threshold);
+    if (!o.weave_out.empty()) weave_table = take_weave(res, o.weave_out, weave_bytes, extra);
   } else {
     FabricSummationOptions s;
     s.method = o.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
@@ -261,6 +367,7 @@ int run(const BakeFabricOptions& o) {
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
   if (!note.empty()) table.metadata["note"] = note;
   table.write_exr(o.output);
+  if (!o.weave_out.empty()) write_weave(table, weave_table, o.weave_out);
   const double cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
   nlohmann::json j = {{"output", o.output},
                       {"method", o.method},
@@ -289,6 +396,7 @@ int run(const BakeFabricOptions& o) {
         "along the normal: reflected %.4f, transmitted %.4f (means over channels)\n",
         o.output.c_str(), o.method.c_str(), o.resolution, seconds, mean(normal.reflectance),
         mean(normal.transmittance), mean(view.reflectance), mean(view.transmittance));
+    if (extra.contains("weave")) print_weave_summary(extra["weave"]);
   }
   return 0;
 }
@@ -353,6 +461,19 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
                   "raytrace, hero: split a particle whose largest channel weight exceeds this "
                   "(default " +
                       std::to_string(FabricRaytraceOptions{}.split_threshold) + ")");
+  sub->add_option("--weave-out", o->weave_out,
+                  "raytrace: also the weave table (.exr): how the cloth varies over its repeat, "
+                  "the exits binned by where they cross the cloth's mid-plane (with --shard, the "
+                  "parts carry it and `weft merge --weave-out` writes it)");
+  sub->add_option("--weave-positions", o->weave_positions,
+                  "raytrace, --weave-out: position cells over the repeat, N (N x N) or UxV (u "
+                  "along the warp), each 1 to " +
+                      std::to_string(WeaveTable::kMaxPositions) + " (default " +
+                      std::to_string(kDefaultWeavePositions) + ")");
+  sub->add_option("--weave-resolution", o->weave_resolution,
+                  "raytrace, --weave-out: the weave table's coarse bins per hemisphere side, 1 to "
+                  "the table's -R (default " +
+                      std::to_string(kDefaultWeaveResolution) + ", at most -R)");
   sub->add_option("--seed", o->seed, "random seed")->capture_default_str();
   sub->add_option("--threads", o->threads, "threads (0 = all cores)")->check(CLI::Range(0, 4096));
   sub->add_option("-o,--output", o->output, "output fabric table (.exr)")->required();
@@ -367,7 +488,18 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   commands.push_back({sub, [o] { return run(*o); }});
 }
 
-int merge_fabric_bake(const JobPart& all, const std::string& output, bool json) {
+int merge_fabric_bake(const JobPart& all, const std::string& output, const std::string& weave_out,
+                      bool json) {
+  const bool weave = all.job.contains("weave_positions");
+  if (weave && weave_out.empty())
+    throw Error("", "--weave-out",
+                "the parts carry a weave tally (bake fabric --weave-out): give --weave-out "
+                "FILE.exr for its table");
+  if (!weave && !weave_out.empty())
+    throw Error(weave_out, "--weave-out",
+                "the parts carry no weave tally: bake them with --weave-out to have one");
+  if (weave && std::filesystem::path(weave_out).extension() != ".exr")
+    throw Error(weave_out, "--weave-out", "the weave table must be written to a .exr file");
   FabricRaytraceResult r = assemble_fabric_job(all, all.job.at("resolution").get<int>());
   TabulatedBsdfTable& t = r.table;
   t.metadata["sample"] = all.job.at("sample").get<std::string>();
@@ -376,6 +508,12 @@ int merge_fabric_bake(const JobPart& all, const std::string& output, bool json) 
   nlohmann::json j = {{"output", output}, {"method", "raytrace"}, {"parts_merged", true}};
   j.update(fabric_table_summary(t));
   j.update(raytrace_summary(r));
+  if (weave) {
+    describe_weave(t, r.weave);
+    r.weave.write_exr(weave_out);
+    j["weave"] = weave_summary(r, weave_out);
+    if (!json) print_weave_summary(j["weave"]);
+  }
   if (json)
     std::cout << j.dump(2) << "\n";
   else

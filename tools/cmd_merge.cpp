@@ -12,7 +12,7 @@ namespace weft::cli {
 void add_merge_command(CLI::App& app, Commands& commands) {
   struct Options {
     std::vector<std::string> parts;
-    std::string output;
+    std::string output, weave_out;
     bool json = false;
   };
   auto o = std::make_shared<Options>();
@@ -24,6 +24,9 @@ void add_merge_command(CLI::App& app, Commands& commands) {
   sub->add_option("-o,--output", o->output,
                   "output (.exr table, .csv sweep or verify's report folder)")
       ->required();
+  sub->add_option("--weave-out", o->weave_out,
+                  "bake fabric parts that carry a weave tally (bake fabric --weave-out): the weave "
+                  "table (.exr)");
   sub->add_flag("--json", o->json, "print the command's summary as JSON");
   commands.push_back(
       {sub, [o] {
@@ -36,13 +39,16 @@ void add_merge_command(CLI::App& app, Commands& commands) {
          for (const auto& p : o->parts) inputs.push_back({p, "part file"});
          for (const auto* j : {&all.job, &all.extra})
            for (auto& f : json_named_files(*j, "job's input")) inputs.push_back(std::move(f));
+         if (!o->weave_out.empty() && all.command != "bake fabric")
+           throw Error(o->weave_out, "--weave-out", "only bake fabric parts carry a weave tally");
          if (all.command == "verify")
            validate_output_paths({}, inputs, {{o->output, "--output"}});
          else
-           validate_output_paths({{o->output, "--output"}}, inputs);
+           validate_output_paths({{o->output, "--output"}, {o->weave_out, "--weave-out"}}, inputs);
          if (all.command == "verify") return merge_verify(all, o->output, o->json);
          if (all.command == "bake fiber") return merge_fiber_bake(all, o->output, o->json);
-         if (all.command == "bake fabric") return merge_fabric_bake(all, o->output, o->json);
+         if (all.command == "bake fabric")
+           return merge_fabric_bake(all, o->output, o->weave_out, o->json);
          if (all.command == "sweep") return merge_sweep(all, o->output, o->json);
          throw Error(o->parts.front(), "command", "unknown command '" + all.command + "'");
        }});

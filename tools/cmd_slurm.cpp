@@ -160,9 +160,11 @@ int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
                            args[0] == "sweep" || verify))
     throw Error("", "command",
                 "expected `bake fiber ...`, `bake fabric ...`, `sweep ...` or `verify ...`");
-  std::string output;
+  std::string output, weave_out;  // bake fabric --weave-out: the merge writes it
   size_t output_at = 0;
   for (size_t i = 0; i < args.size(); ++i) {
+    if (args[i] == "--weave-out" && i + 1 < args.size()) weave_out = args[i + 1];
+    if (args[i].rfind("--weave-out=", 0) == 0) weave_out = args[i].substr(12);
     if (args[i] == "--shard" || args[i].rfind("--shard=", 0) == 0 || args[i] == "--resume")
       throw Error("", args[i], "is set by weft slurm for each shard");
     if (verify && args[i] == "--fit")
@@ -203,6 +205,7 @@ int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
                                     {dir / "merge.sh", "merge script"}};
   for (int k = 0; k < n; ++k) outputs.push_back({part(k), "part file"});
   if (!verify) outputs.push_back({out_abs, "--output"});
+  if (!weave_out.empty()) outputs.push_back({fs::absolute(weave_out), "--weave-out"});
   std::vector<NamedPath> folders = {{dir, "script folder"}};
   if (verify) folders.push_back({out_abs, "--output"});
   validate_output_paths(outputs, inputs, folders);
@@ -230,7 +233,9 @@ int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
   std::string merge = directives(name + "-merge", "merge.log");
   merge += "set -eu\ncd " + shell_quote(cwd) + "\nexec " + shell_quote(weft) + " merge";
   for (int k = 0; k < n; ++k) merge += " " + shell_quote(part(k).string());
-  merge += " -o " + shell_quote(out_abs.string()) + "\n";
+  merge += " -o " + shell_quote(out_abs.string());
+  if (!weave_out.empty()) merge += " --weave-out " + shell_quote(fs::absolute(weave_out).string());
+  merge += "\n";
 
   const fs::path array_sh = dir / "array.sh", merge_sh = dir / "merge.sh";
   if (o.dry_run) {

@@ -39,7 +39,9 @@ int run_program(const Program& p);
 // Each command's merge (in its cmd_*.cpp): writes 'output' from all units of its job and prints
 // the command's summary. Returns the exit code.
 int merge_fiber_bake(const JobPart& all, const std::string& output, bool json);
-int merge_fabric_bake(const JobPart& all, const std::string& output, bool json);
+// weave_out: the weave table's file, given exactly when the parts carry a weave tally.
+int merge_fabric_bake(const JobPart& all, const std::string& output, const std::string& weave_out,
+                      bool json);
 int merge_sweep(const JobPart& all, const std::string& output, bool json);
 int merge_verify(const JobPart& all, const std::string& output, bool json);
 

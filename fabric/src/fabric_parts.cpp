@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "weft/core/error.h"
+#include "weft/fabric/weave_tally.h"
 
 namespace weft {
 namespace {
@@ -58,14 +59,36 @@ JobPart fabric_job(const FiberTables& fibers, const WovenSample& sample,
   if (r.launch_lattice > 1) p.job["launch_lattice"] = r.launch_lattice;
   if (r.straight_through != StraightThrough::sampled)
     p.job["straight_through"] = straight_through_name(r.straight_through);
+  if (r.weave_positions_u > 0) {  // the parts carry the weave tally (weave_tally.h)
+    p.job["weave_positions"] = {r.weave_positions_u, r.weave_positions_v};
+    p.job["weave_resolution"] = r.weave_resolution;
+  }
   p.units_total = static_cast<uint64_t>(DirectionGrid{r.resolution}.bins());
   p.shard = shard;
   return p;
 }
 
 // A bin's unit: its row of the table, then its books (FabricBinBooks: the power as doubles, the
-// counts as raw 64-bit values, noise2 and signal2 per channel).
+// counts as raw 64-bit values, noise2 and signal2 per channel), then with the weave tally its
+// weave_values and weave_noise2.
 constexpr size_t kBookValues = 5 + 7;
+
+// The weave a job's parts carry (positions 0: none): sizes from the job, the repeat from extra.
+WeaveShape weave_shape_of(const JobPart& all) {
+  WeaveShape w;
+  if (!all.job.contains("weave_positions")) return w;
+  const auto p = all.job.at("weave_positions").get<std::vector<int>>();
+  const auto repeat = all.extra.at("weave_repeat_m").get<std::vector<double>>();
+  w.resolution = all.job.at("weave_resolution").get<int>();
+  if (p.size() != 2 || p[0] < 1 || p[0] > WeaveTable::kMaxPositions || p[1] < 1 ||
+      p[1] > WeaveTable::kMaxPositions || w.resolution < 1 ||
+      w.resolution > TabulatedBsdfTable::kMaxResolution)
+    throw Error("", "weave_positions", "not the weave tally's positions and resolution");
+  if (repeat.size() != 2) throw Error("", "weave_repeat_m", "expected the repeat's two sizes");
+  w.positions_u = p[0], w.positions_v = p[1];
+  w.repeat_u_m = repeat[0], w.repeat_v_m = repeat[1];
+  return w;
+}
 
 }  // namespace
 
@@ -75,10 +98,12 @@ void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t rou
 }
 
 FabricRaytraceResult assemble_fabric_job(const JobPart& all, int resolution) {
-  FabricRaytraceResult r = assemble_fabric_bins(all.units, 0, all.units_total, resolution,
-                                                all.extra.at("channels").get<int>());
+  FabricRaytraceResult r =
+      assemble_fabric_bins(all.units, 0, all.units_total, resolution,
+                           all.extra.at("channels").get<int>(), weave_shape_of(all));
   r.table.metadata = all.extra.at("metadata").get<std::map<std::string, std::string>>();
   record_particle_counts(r.table, r.splits, r.roulette_kills);
+  if (r.weave.positions_u > 0) describe_weave(r.table, r.weave);
   return r;
 }
 
@@ -93,6 +118,8 @@ void encode_fabric_bin(const FabricRaytraceResult& res, uint64_t a, std::vector<
     push_u64(v, x);
   v.insert(v.end(), b.noise2.begin(), b.noise2.end());
   v.insert(v.end(), b.signal2.begin(), b.signal2.end());
+  v.insert(v.end(), b.weave_values.begin(), b.weave_values.end());
+  v.insert(v.end(), b.weave_noise2.begin(), b.weave_noise2.end());
 }
 
 int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins) {
@@ -104,7 +131,7 @@ int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins) {
 
 FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<double>>& units,
                                           uint64_t first_unit, uint64_t bins, int resolution,
-                                          int channels) {
+                                          int channels, const WeaveShape& weave) {
   FabricRaytraceResult r;
   TabulatedBsdfTable& t = r.table;
   t.resolution = resolution;
@@ -118,7 +145,12 @@ FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<d
     if (it == units.end())
       throw Error("", "units", "incident bin " + std::to_string(a) + " is missing");
     const std::vector<double>& v = it->second;
-    if (v.size() != row + kBookValues + 2 * nc)
+    const size_t weave_values =
+        weave.on() ? static_cast<size_t>(weave.positions()) *
+                         static_cast<size_t>(DirectionGrid{weave.resolution}.bins()) * nc
+                   : 0;
+    const size_t books = row + kBookValues + 2 * nc;
+    if (v.size() != books + (weave.on() ? weave_values + nc : 0))
       throw Error("", "units", "a bin's record of another size");
     for (size_t k = 0; k < row; ++k) t.values[a * row + k] = static_cast<float>(v[k]);
     FabricBinBooks& b = r.bin_books[a];
@@ -129,9 +161,12 @@ FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<d
     b.roulette_kills = as_u64(x[10]), b.tube_passes = as_u64(x[11]);
     b.noise2.assign(x + kBookValues, x + kBookValues + nc);
     b.signal2.assign(x + kBookValues + nc, x + kBookValues + 2 * nc);
+    b.weave_values.assign(v.begin() + books, v.begin() + books + weave_values);
+    if (weave.on()) b.weave_noise2.assign(v.begin() + books + weave_values, v.end());
   }
   t.validate("");
   fabric_raytrace_totals(r);
+  weave_totals(weave, r);
   return r;
 }
 
@@ -178,6 +213,8 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     }
     for (uint64_t u = a; u < b; ++u) encode_fabric_bin(res, u, done.units[u]);
     done.extra = {{"channels", res.table.channels}, {"metadata", res.table.metadata}};
+    if (r.weave_positions_u > 0)
+      done.extra["weave_repeat_m"] = {res.weave.repeat_u_m, res.weave.repeat_v_m};
     if (resume) write_job_part(checkpoint_path(output), done);
     a = b;
   }
@@ -191,6 +228,8 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     auto md = t.table.metadata;
     md["particles_per_bin"] = std::to_string(r.particles_per_bin);
     done.extra = {{"channels", t.table.channels}, {"metadata", md}};
+    if (r.weave_positions_u > 0)
+      done.extra["weave_repeat_m"] = {t.weave.repeat_u_m, t.weave.repeat_v_m};
   }
   done.checkpoint = false;
   if (!shard.whole()) {

@@ -14,6 +14,7 @@
 #include "weft/fabric/fiber_sampler.h"
 #include "weft/fabric/raytrace_steps.h"
 #include "weft/fabric/straight_through.h"
+#include "weft/fabric/weave_tally.h"
 #include "weft/scenes/render_scene.h"
 
 namespace weft {
@@ -100,6 +101,7 @@ void FabricRaytraceOptions::validate() const {
   const int bins = DirectionGrid{resolution}.bins();
   if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
     throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
+  validate_weave_options(*this);
 }
 
 void FabricBinBooks::add(const FabricBinBooks& o) {
@@ -184,6 +186,7 @@ struct Tracer {
   // fields above.
   std::vector<YarnShading> shadings{};
   std::vector<int> table_of_curve{}, table_of_mesh{};
+  const WeaveLayout* weave = nullptr;  // the weave tally, when on
 };
 
 // The shading of the yarn the particle's line met at h: its fiber's (fiber detail, the same fiber
@@ -214,6 +217,18 @@ struct TaskScratch {
   Particle probe;  // a next-event draw's particle (its vectors reused)
 };
 
+// An exit along d whose line passes through p, with weights w: into the table's tally and, when on,
+// the weave's.
+void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d,
+               std::span<const double> w) {
+  const uint64_t cell = exit_cell(t.grid, life.bin, d);
+  tally_exit(*life.tally, life.first_exit, cell, w);
+  if (t.weave) {
+    const int exit_bin = static_cast<int>(cell - static_cast<uint64_t>(life.bin) * t.grid.bins());
+    tally_weave_exit(*t.weave, life.tally->weave, life.first_exit, life.bin, exit_bin, p, d, w);
+  }
+}
+
 // The next-event estimate at a crossing x (FabricRaytraceOptions::next_event_rays): draws of the
 // step s is about to take, weighed as its own would be and followed out of the slab without
 // scattering; each that leaves books its weights over the count into its cell.
@@ -235,7 +250,7 @@ void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Cr
         escape_direction(t.scene, t.slab, t.curves, probe, 100 * t.o.max_scatterings);
     if (!out) continue;
     for (double& w : probe.w) w *= share;
-    tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, *out), probe.w);
+    book_exit(t, life, probe.p, *out, probe.w);
   }
 }
 
@@ -303,7 +318,7 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
       // or, having met nothing, the straight-through part is computed (straight_through.h)
       const bool binned =
           s.scattered ? t.o.next_event_rays == 0 : t.o.straight_through == StraightThrough::sampled;
-      if (binned) tally_exit(*life.tally, life.first_exit, exit_cell(t.grid, life.bin, s.d), s.w);
+      if (binned) book_exit(t, life, s.p, s.d, s.w);
       books.exited += mean_w;
       return;
     }
@@ -621,9 +636,10 @@ TaskBatch batch_for(const Tracer& t, const ProgressCallback& progress) {
 
 // The exact straight-through part of the bins traced (FabricRaytraceOptions::straight_through),
 // per cell pair: the sum the particles of the bin would book there on average (per_bin times the
-// power per particle) and that sum's variance; empty when sampled. A task per bin (its streams
-// are the bin's), the same at any thread count.
-CellSums straight_through_sums(const Tracer& t) {
+// power per particle) and that sum's variance; empty when sampled. With the weave tally, the same
+// per WeaveSums cell into 'weave' (its sum and sum2 then hold the sum and its variance). A task
+// per bin (its streams are the bin's), the same at any thread count.
+CellSums straight_through_sums(const Tracer& t, WeaveSums& weave) {
   if (t.o.straight_through == StraightThrough::sampled) return {};
   const int bins = t.grid.bins();
   const int first = t.o.first_bin, count = (t.o.bin_count ? first + t.o.bin_count : bins) - first;
@@ -636,17 +652,32 @@ CellSums straight_through_sums(const Tracer& t) {
   batch.seed = t.o.seed;
   batch.threads = t.o.threads;
   batch.items_per_task = 1;
-  run_batch<std::vector<StraightThroughCell>>(
+  if (t.weave) weave = weave_sums_for(*t.weave);
+  struct Bin {
+    int bin = 0;
+    std::vector<StraightThroughCell> table, weave;
+  };
+  run_batch<Bin>(
       batch,
-      [&](uint64_t, uint64_t item, uint64_t, Rng&, std::vector<StraightThroughCell>& cells) {
-        cells = straight_through_of_bin(t.scene, t.slab, t.grid, first + static_cast<int>(item),
-                                        plan, t.o.seed, 100 * t.o.max_scatterings);
+      [&](uint64_t, uint64_t item, uint64_t, Rng&, Bin& b) {
+        b.bin = first + static_cast<int>(item);
+        b.table = straight_through_of_bin(t.scene, t.slab, t.grid, b.bin, plan, t.o.seed,
+                                          100 * t.o.max_scatterings, t.weave, &b.weave);
       },
-      [&](const std::vector<StraightThroughCell>& cells) {
-        for (const StraightThroughCell& c : cells) {
+      [&](const Bin& b) {
+        for (const StraightThroughCell& c : b.table) {
           exact.sum[c.cell] += n * c.power;
           exact.sum2[c.cell] += n * n * c.variance;
         }
+        if (!t.weave) return;
+        // The power leaves in every channel alike (its launch weight |cos theta_i|).
+        const size_t nc = static_cast<size_t>(t.weave->channels);
+        const size_t row = static_cast<size_t>(b.bin) * t.weave->per_bin();
+        for (const StraightThroughCell& c : b.weave)
+          for (size_t k = row + c.cell * nc; k < row + (c.cell + 1) * nc; ++k) {
+            weave.sum[k] += n * c.power;
+            weave.sum2[k] += n * n * c.variance;
+          }
       });
   return exact;
 }
@@ -689,20 +720,35 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
                 std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0)};
   FabricRaytraceResult result;
   result.bin_books.resize(bins);
+  std::optional<WeaveLayout> weave;
+  WeaveSums weave_sums;
+  if (o.weave_positions_u > 0) {
+    t.weave =
+        &weave.emplace(weave_layout(o, nc, slab.x0, slab.z0, slab.px, slab.pz, slab.y0, slab.y1));
+    weave_sums = weave_sums_for(*weave);
+  }
   const TaskBatchStatus status = run_batch<Tally>(
       batch_for(t, progress),
       [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, Tally& tally) {
         trace_task(t, first, count, rng, tally);
       },
-      [&](const Tally& tally) { add_task(tally, nc, sums, result); });
+      [&](const Tally& tally) {
+        add_task(tally, nc, sums, result);
+        if (weave) add_weave_task(*weave, tally.weave, weave_sums);
+      });
   result.cancelled = status.cancelled;
   std::vector<uint64_t> units(bins);
   const uint64_t per_task = batch_for(t, progress).items_per_task;
   for (int a = 0; a < bins; ++a) units[a] = sample_units(t, per_task, a);
-  tabulate(sums, straight_through_sums(t), t.grid, nc, t.per_bin, units, result);
+  WeaveSums weave_exact;  // the computed straight-through light's part of the weave, if any
+  tabulate(sums, straight_through_sums(t, weave_exact), t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   if (per_yarn) describe_per_yarn(f, result.table);
+  if (weave) {
+    weave_bin_books(*weave, weave_sums, weave_exact, t.per_bin, units, result);
+    weave_totals(weave->shape, result);
+  }
   return result;
 }
 

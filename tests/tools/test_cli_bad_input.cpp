@@ -184,6 +184,41 @@ TEST(CliBadInput, LongRendersSweepsAndRayTracesNeedConfirmation) {
   EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
 }
 
+TEST(CliBadInput, WeaveTableOptionsAreNamedBeforeAnyWork) {
+  // bake fabric --weave-out and its options (docs/fabric-bsdf.md, "The weave table"): refused by
+  // name before the fiber table is baked, so no bake cache appears and no output is written.
+  const fs::path dir = fresh_test_dir();
+  const std::string bake = "bake fabric -R 4 -o t.exr ";
+  const std::string raytrace = bake + "--method raytrace ";
+  struct Case {
+    std::string args;
+    std::vector<const char*> parts;
+  };
+  for (const Case& c : std::vector<Case>{
+           {bake + "--weave-out w.exr", {"--weave-out", "--method raytrace"}},
+           {bake + "--weave-positions 4", {"--weave-positions", "--method raytrace"}},
+           {raytrace + "--weave-positions 4", {"--weave-positions", "--weave-out"}},
+           {raytrace + "--weave-resolution 2", {"--weave-resolution", "--weave-out"}},
+           {raytrace + "--weave-out w.png", {"w.png", "--weave-out", ".exr"}},
+           {raytrace + "--weave-out w.exr --weave-positions 0", {"--weave-positions", "[1, 64]"}},
+           {raytrace + "--weave-out w.exr --weave-positions 65", {"--weave-positions", "'65'"}},
+           {raytrace + "--weave-out w.exr --weave-positions 8x", {"--weave-positions", "'8x'"}},
+           {raytrace + "--weave-out w.exr --weave-positions 2.5", {"--weave-positions"}},
+           {raytrace + "--weave-out w.exr --weave-positions nanx4", {"--weave-positions"}},
+           {raytrace + "--weave-out w.exr --weave-resolution 5", {"--weave-resolution", "4"}},
+           {raytrace + "--weave-out w.exr --weave-resolution 0", {"--weave-resolution"}},
+           {raytrace + "--weave-out t.exr", {"t.exr", "--weave-out"}},
+       }) {
+    const CliRun r = run(c.args, dir);
+    EXPECT_NE(r.exit_code, 0) << c.args;
+    for (const char* p : c.parts)
+      EXPECT_NE(r.err.find(p), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(dir / "t.exr")) << c.args;
+    EXPECT_FALSE(fs::exists(dir / "w.exr")) << c.args;
+  }
+  EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
+}
+
 TEST(CliBadInput, MemoryBudgetRefusesBeforeAllocating) {
   const fs::path dir = fresh_test_dir();
   // A bake at R = 32 holds 33 bands of 2048^2 doubles twice: 2.3 GB even for one photon (the

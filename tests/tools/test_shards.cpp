@@ -296,6 +296,72 @@ TEST(Resume, ShardOfARaytracedFabricKilledAtRandomMomentsResumesToTheSameBytes) 
                   ".part", 4, dir);
 }
 
+TEST(Shards, WeaveTallyTravelsInThePartsAndMergesToTheOneProcessBytes) {
+  // bake fabric --weave-out: the parts carry each bin's weave books, and `weft merge --weave-out`
+  // writes the weave table of the one-process run, bit for bit (2100 particles per bin: tasks
+  // straddle bins, as above).
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = dir / "fiber.exr";
+  ASSERT_EQ(
+      run_weft(kFiberBake + std::vector<std::string>{"--bands", "rgb", "-o", fiber.string()}, dir),
+      0);
+  const auto args = split(
+      "bake fabric --method raytrace -R 2 --samples 2100 --quiet "
+      "--weave-positions 3x2 --weave-resolution 1 --fiber " +
+      fiber.string());
+  const fs::path one = dir / "one.exr", one_weave = dir / "one-weave.exr";
+  ASSERT_EQ(run_weft(args + std::vector<std::string>{"--json", "-o", one.string(), "--weave-out",
+                                                     one_weave.string()},
+                     dir),
+            0)
+      << slurp(dir / "stderr");
+  const auto whole = nlohmann::json::parse(slurp(dir / "stdout"));
+  ASSERT_TRUE(whole.contains("weave"));
+  EXPECT_EQ(whole["weave"]["positions"], "3x2");
+  EXPECT_EQ(whole["weave"]["resolution"], 1);
+  EXPECT_GT(whole["weave"]["relative_noise"].get<double>(), 0.0);
+  const fs::path merged_weave = dir / "merged-weave.exr";
+  std::string printed;
+  expect_shards_merge_to(
+      args + std::vector<std::string>{"--weave-out", (dir / "unused.exr").string()}, one, dir,
+      ".exr", {"--json", "--weave-out", merged_weave.string()}, &printed);
+  EXPECT_FALSE(fs::exists(dir / "unused.exr"));  // a shard writes its part only
+  const std::string a = slurp(one_weave), b = slurp(merged_weave);
+  EXPECT_GT(a.size(), 0u);
+  EXPECT_TRUE(a == b) << "the merged weave table differs from the one-process run's";
+  EXPECT_EQ(nlohmann::json::parse(printed)["weave"]["relative_noise"].dump(),
+            whole["weave"]["relative_noise"].dump());
+  // The parts carry a weave: a merge without --weave-out is refused by name.
+  std::vector<std::string> merge = {"merge"};
+  for (int k = 0; k < 4; ++k)
+    merge.push_back((dir / ("part-" + std::to_string(k) + ".part")).string());
+  EXPECT_EQ(run_weft(merge + std::vector<std::string>{"-o", (dir / "m2.exr").string()}, dir), 2);
+  EXPECT_NE(slurp(dir / "stderr").find("--weave-out"), std::string::npos);
+  EXPECT_FALSE(fs::exists(dir / "m2.exr"));
+  // --resume (checkpoints of the whole run) writes the same weave table.
+  const fs::path resumed_weave = dir / "resumed-weave.exr";
+  ASSERT_EQ(run_weft(args + std::vector<std::string>{"--resume", "-o", (dir / "r.exr").string(),
+                                                     "--weave-out", resumed_weave.string()},
+                     dir),
+            0)
+      << slurp(dir / "stderr");
+  EXPECT_TRUE(slurp(resumed_weave) == a);
+  EXPECT_TRUE(slurp(dir / "r.exr") == slurp(one));
+  // weft slurm's merge job writes the weave table the wrapped command names.
+  const fs::path slurm_weave = dir / "sw.exr";
+  ASSERT_EQ(run_weft(split("slurm --shards 2 --dry-run bake fabric --method raytrace -R 2 "
+                           "--samples 100 -o " +
+                           (dir / "s.exr").string() + " --weave-out " + slurm_weave.string()),
+                     dir),
+            0)
+      << slurp(dir / "stderr");
+  const std::string scripts = slurp(dir / "stdout");
+  ASSERT_NE(scripts.find(" merge "), std::string::npos) << scripts;
+  const std::string merge_line = scripts.substr(scripts.find(" merge "));
+  EXPECT_NE(merge_line.find("--weave-out '" + slurm_weave.string() + "'"), std::string::npos)
+      << scripts;
+}
+
 namespace {
 
 // RFC 4648 base64 (the bundled glTF's data URI) to bytes.

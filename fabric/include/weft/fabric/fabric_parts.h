@@ -6,6 +6,7 @@
 
 #include "weft/core/job_part.h"
 #include "weft/fabric/fabric_raytrace.h"
+#include "weft/fabric/weave_tally.h"
 
 namespace weft {
 
@@ -31,14 +32,15 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
 // The unit of incident bin 'bin' of a ray trace (its row of the table, its books and noise, every
 // value with its exact bits); the channels of such a unit for a table of 'bins' bins; and the
 // whole result (table, books, noise summed as raytrace_fabric_table sums them) from the units
-// [first_unit, first_unit + bins) of all its bins. weft::Error naming a missing or malformed unit.
+// [first_unit, first_unit + bins) of all its bins, with the weave table when the units carry the
+// weave tally of that shape. weft::Error naming a missing or malformed unit.
 void encode_fabric_bin(const FabricRaytraceResult& result, uint64_t bin, std::vector<double>& unit);
 int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins);
 // The whole table (with the pieces' metadata and particle counts) of a merged job of every bin.
 FabricRaytraceResult assemble_fabric_job(const JobPart& all, int resolution);
 FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<double>>& units,
                                           uint64_t first_unit, uint64_t bins, int resolution,
-                                          int channels);
+                                          int channels, const WeaveShape& weave = {});
 
 // What `bake fabric --json` and `merge --json` print of a ray trace (books, counts, noise) and of a
 // fabric table (resolution, sample, albedo at normal incidence): one list of keys for both.

@@ -32,6 +32,7 @@
 
 #include "weft/core/progress.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/weave_table.h"
 #include "weft/scenes/weave.h"
 
 namespace weft {
@@ -122,6 +123,12 @@ struct FabricRaytraceOptions {
   // the proposal is nonzero wherever the table is; the noise grows as the two tables differ. Null:
   // the fiber table itself (the default estimator, bit for bit).
   const TabulatedBsdfTable* proposal = nullptr;
+  // The weave tally (weave_tally.h; 0: off): the exits binned also by where their line crosses
+  // the cloth's mid-plane, in weave_positions_u x weave_positions_v cells of the repeat (u along
+  // the warp), at a coarse DirectionGrid of weave_resolution (at most the table's): the
+  // result's weave table. It draws no random number, so the table keeps its bits either way.
+  int weave_positions_u = 0, weave_positions_v = 0;
+  int weave_resolution = 4;
 
   void validate() const;  // weft::Error naming the field
 };
@@ -136,7 +143,10 @@ struct FabricBinBooks {
   // Per channel, over the bin's row of the table: sum of se^2 D_i D_o and of f^2 D_i D_o (the
   // relative noise's numerator and denominator, D the cosine-weighted areas).
   std::vector<double> noise2, signal2;
-  void add(const FabricBinBooks& other);  // the power and counts (not noise2, signal2)
+  // With the weave tally: per (position, coarse outgoing bin, channel) this bin's part of the
+  // booked values B (weave_totals), and per channel its part of their noise's numerator.
+  std::vector<double> weave_values, weave_noise2;
+  void add(const FabricBinBooks& other);  // the power and counts (not noise2, signal2, weave)
 };
 
 struct FabricRaytraceResult {
@@ -165,6 +175,15 @@ struct FabricRaytraceResult {
   std::vector<double> relative_noise_per_channel;  // the same, channel by channel
   std::vector<float> standard_error;               // per value of the table (cell pair and channel)
   std::vector<FabricBinBooks> bin_books;  // per incident bin (zero outside the bins traced)
+  // With the weave tally (FabricRaytraceOptions::weave_positions_u): the weave table, m = B / the
+  // mean of B over the positions (1 where that mean is 0), B per position cell p what the exits
+  // through p booked as a cosine-weighted coarse cell average, scaled to the cell's share of the
+  // repeat (the local BSDF at p); weave_mean that mean per [coarse wi][coarse wo][channel], the
+  // fabric table's coarse average to rounding (coarse_table_average); and the relative noise of B,
+  // weighted like the table's (D_i D_o over the coarse cells, positions and channels summed).
+  WeaveTable weave;
+  std::vector<double> weave_mean;
+  double weave_relative_noise = 0;
   bool cancelled = false;
 };
 

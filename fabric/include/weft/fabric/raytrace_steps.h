@@ -27,6 +27,7 @@
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fiber_sampler.h"
 #include "weft/fabric/line_albedo.h"
+#include "weft/fabric/weave_tally.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 
@@ -212,6 +213,7 @@ struct Tally {
   // The books of the particles by incident bin (a task may straddle two bins): kept apart so that
   // every bin's books sum alike however the bins are split over runs.
   std::vector<std::pair<int, FabricBinBooks>> books;
+  WeaveExits weave;  // the weave tally's exits, when on (weave_tally.h)
   FabricBinBooks& books_of(int bin);
 };
 uint64_t exit_cell(const DirectionGrid& grid, int bin, const Vec3& d);
