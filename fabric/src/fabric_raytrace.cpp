@@ -553,9 +553,10 @@ TaskBatch batch_for(const Tracer& t, const ProgressCallback& progress) {
 
 // The exact straight-through part of the bins traced (FabricRaytraceOptions::straight_through),
 // per cell pair: the sum the particles of the bin would book there on average (per_bin times the
-// power per particle) and that sum's variance; empty when sampled. A task per bin (its streams
-// are the bin's), the same at any thread count.
-CellSums straight_through_sums(const Tracer& t) {
+// power per particle) and that sum's variance; empty when sampled. With the weave tally, the same
+// per WeaveSums cell into 'weave' (its sum and sum2 then hold the sum and its variance). A task
+// per bin (its streams are the bin's), the same at any thread count.
+CellSums straight_through_sums(const Tracer& t, WeaveSums& weave) {
   if (t.o.straight_through == StraightThrough::sampled) return {};
   const int bins = t.grid.bins();
   const int first = t.o.first_bin, count = (t.o.bin_count ? first + t.o.bin_count : bins) - first;
@@ -568,17 +569,32 @@ CellSums straight_through_sums(const Tracer& t) {
   batch.seed = t.o.seed;
   batch.threads = t.o.threads;
   batch.items_per_task = 1;
-  run_batch<std::vector<StraightThroughCell>>(
+  if (t.weave) weave = weave_sums_for(*t.weave);
+  struct Bin {
+    int bin = 0;
+    std::vector<StraightThroughCell> table, weave;
+  };
+  run_batch<Bin>(
       batch,
-      [&](uint64_t, uint64_t item, uint64_t, Rng&, std::vector<StraightThroughCell>& cells) {
-        cells = straight_through_of_bin(t.scene, t.slab, t.grid, first + static_cast<int>(item),
-                                        plan, t.o.seed, 100 * t.o.max_scatterings);
+      [&](uint64_t, uint64_t item, uint64_t, Rng&, Bin& b) {
+        b.bin = first + static_cast<int>(item);
+        b.table = straight_through_of_bin(t.scene, t.slab, t.grid, b.bin, plan, t.o.seed,
+                                          100 * t.o.max_scatterings, t.weave, &b.weave);
       },
-      [&](const std::vector<StraightThroughCell>& cells) {
-        for (const StraightThroughCell& c : cells) {
+      [&](const Bin& b) {
+        for (const StraightThroughCell& c : b.table) {
           exact.sum[c.cell] += n * c.power;
           exact.sum2[c.cell] += n * n * c.variance;
         }
+        if (!t.weave) return;
+        // The power leaves in every channel alike (its launch weight |cos theta_i|).
+        const size_t nc = static_cast<size_t>(t.weave->channels);
+        const size_t row = static_cast<size_t>(b.bin) * t.weave->per_bin();
+        for (const StraightThroughCell& c : b.weave)
+          for (size_t k = row + c.cell * nc; k < row + (c.cell + 1) * nc; ++k) {
+            weave.sum[k] += n * c.power;
+            weave.sum2[k] += n * n * c.variance;
+          }
       });
   return exact;
 }
@@ -637,11 +653,12 @@ FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
   std::vector<uint64_t> units(bins);
   const uint64_t per_task = batch_for(t, progress).items_per_task;
   for (int a = 0; a < bins; ++a) units[a] = sample_units(t, per_task, a);
-  tabulate(sums, straight_through_sums(t), t.grid, nc, t.per_bin, units, result);
+  WeaveSums weave_exact;  // the computed straight-through light's part of the weave, if any
+  tabulate(sums, straight_through_sums(t, weave_exact), t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   if (weave) {
-    weave_bin_books(*weave, weave_sums, t.per_bin, units, result);
+    weave_bin_books(*weave, weave_sums, weave_exact, t.per_bin, units, result);
     weave_totals(weave->shape, result);
   }
   return result;

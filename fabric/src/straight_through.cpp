@@ -3,8 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <unordered_map>
 
 #include "weft/core/rng.h"
+#include "weft/fabric/weave_tally.h"
 
 namespace weft::raytrace {
 namespace {
@@ -14,35 +16,66 @@ namespace {
 // the same state, and their first draws were seen to agree).
 constexpr uint64_t kStraightThroughStream = uint64_t{1} << 62;
 
-// The cell a ray of incident bin 'bin' leaves through when it meets nothing: light from wi_cloth
-// entering the face it faces at p's x and z, as launch() starts a particle, flown as fly() flies
-// it (to the first side of the repeat or face of the slab, through the side and in again through
-// the opposite one), with the scene's cheaper visibility query; none when it meets a surface or is
+// A ray that met nothing: its cell of the table, and its direction and the start of its last
+// flight (a point of its line, as a particle's when it leaves the slab).
+struct StraightExit {
+  uint64_t cell;
+  Vec3 p, d;
+};
+
+// Where a ray of incident bin 'bin' leaves when it meets nothing: light from wi_cloth entering the
+// face it faces at p's x and z, as launch() starts a particle, flown as fly() flies it (to the
+// first side of the repeat or face of the slab, through the side and in again through the
+// opposite one), with the scene's cheaper visibility query; none when it meets a surface or is
 // lost (the trace loses a particle at its (max_wraps + 1)-th wrap).
-std::optional<uint64_t> straight_exit(const RenderScene& scene, const RepeatSlab& slab,
-                                      const DirectionGrid& grid, int bin, const Vec3& wi_cloth,
-                                      Vec3 p, int max_wraps) {
+std::optional<StraightExit> straight_exit(const RenderScene& scene, const RepeatSlab& slab,
+                                          const DirectionGrid& grid, int bin, const Vec3& wi_cloth,
+                                          Vec3 p, int max_wraps) {
   const Vec3 d = -cloth_to_world(wi_cloth);
   p.y = wi_cloth.z > 0 ? slab.y1 : slab.y0;
   for (int wraps = 0; wraps <= max_wraps; ++wraps) {
     const Boundaries b = boundaries_ahead(slab, p, d);
     if (scene.occluded(p, d, std::min(b.t_side, b.t_slab))) return std::nullopt;
-    if (b.t_slab <= b.t_side) return exit_cell(grid, bin, d);
+    if (b.t_slab <= b.t_side) return StraightExit{exit_cell(grid, bin, d), p, d};
     p = wrap_through_side(slab, p, d, b.t_side, b.side);
   }
   return std::nullopt;
 }
 
-// Adds 'power' to the replicate's sum in 'cell'.
-void add_to(std::vector<StraightThroughCell>& cells, std::vector<std::vector<double>>& sums,
-            int replicates, int r, uint64_t cell, double power) {
-  size_t k = 0;
-  while (k < cells.size() && cells[k].cell != cell) ++k;
-  if (k == cells.size()) {
-    cells.push_back({cell, 0, 0});
-    sums.emplace_back(replicates, 0.0);
+// Per cell, each replicate's sum of the power booked there; the cells in the order first met.
+struct ReplicateSums {
+  int replicates;
+  std::vector<StraightThroughCell> cells;
+  std::vector<std::vector<double>> sums;  // per cell, per replicate
+  std::unordered_map<uint64_t, size_t> index;
+
+  void add(int r, uint64_t cell, double power) {
+    const auto [at, fresh] = index.try_emplace(cell, cells.size());
+    if (fresh) {
+      cells.push_back({cell, 0, 0});
+      sums.emplace_back(replicates, 0.0);
+    }
+    sums[at->second][r] += power;
   }
-  sums[k][r] += power;
+  // The replicates' mean and the variance of that mean (their sample variance over their count).
+  std::vector<StraightThroughCell> estimates() {
+    for (size_t k = 0; k < cells.size(); ++k) {
+      double mean = 0, var = 0;
+      for (double x : sums[k]) mean += x / replicates;
+      for (double x : sums[k]) var += (x - mean) * (x - mean);
+      cells[k].power = mean;
+      cells[k].variance = replicates > 1 ? var / (replicates - 1) / replicates : 0.0;
+    }
+    return std::move(cells);
+  }
+};
+
+// The weave's cell of an exit (straight_through_of_bin's weave_cells).
+uint64_t weave_cell(const WeaveLayout& w, const DirectionGrid& grid, int bin,
+                    const StraightExit& e) {
+  const uint64_t exit_bin = e.cell - static_cast<uint64_t>(bin) * grid.bins();
+  return static_cast<uint64_t>(weave_position(w, e.p, e.d)) * w.coarse_bins +
+         static_cast<uint64_t>(w.coarse_of_fine[exit_bin]);
 }
 
 }  // namespace
@@ -65,15 +98,14 @@ StraightThroughPlan straight_through_plan(uint64_t particles_per_bin) {
   return plan;
 }
 
-std::vector<StraightThroughCell> straight_through_of_bin(const RenderScene& scene,
-                                                         const RepeatSlab& slab,
-                                                         const DirectionGrid& grid, int bin,
-                                                         const StraightThroughPlan& plan,
-                                                         uint64_t seed, int max_wraps) {
+std::vector<StraightThroughCell> straight_through_of_bin(
+    const RenderScene& scene, const RepeatSlab& slab, const DirectionGrid& grid, int bin,
+    const StraightThroughPlan& plan, uint64_t seed, int max_wraps, const WeaveLayout* weave,
+    std::vector<StraightThroughCell>* weave_cells) {
   const int n = plan.directions_per_side, m = plan.lattice_points, reps = plan.replicates;
   const double rays_per_replicate = static_cast<double>(n) * n * m;
-  std::vector<StraightThroughCell> cells;
-  std::vector<std::vector<double>> sums;  // per cell, per replicate
+  ReplicateSums table{reps, {}, {}, {}}, woven{reps, {}, {}, {}};
+  const bool tally_weave = weave && weave_cells;
   for (int r = 0; r < reps; ++r) {
     Rng rng(seed, kStraightThroughStream + static_cast<uint64_t>(bin) * reps + r);
     for (int a = 0; a < n; ++a)
@@ -86,20 +118,16 @@ std::vector<StraightThroughCell> straight_through_of_bin(const RenderScene& scen
         const Vec3 shift{slab.x0 + slab.px * sx, 0, slab.z0 + slab.pz * sz};
         for (int k = 0; k < m; ++k) {
           const Vec3 p = lattice_point(slab, shift, k, m);
-          if (const auto cell = straight_exit(scene, slab, grid, bin, wi, p, max_wraps))
-            add_to(cells, sums, reps, r, *cell, std::abs(wi.z) / rays_per_replicate);
+          const auto out = straight_exit(scene, slab, grid, bin, wi, p, max_wraps);
+          if (!out) continue;
+          const double power = std::abs(wi.z) / rays_per_replicate;
+          table.add(r, out->cell, power);
+          if (tally_weave) woven.add(r, weave_cell(*weave, grid, bin, *out), power);
         }
       }
   }
-  // The replicates' mean and the variance of that mean (their sample variance over their count).
-  for (size_t k = 0; k < cells.size(); ++k) {
-    double mean = 0, var = 0;
-    for (double x : sums[k]) mean += x / reps;
-    for (double x : sums[k]) var += (x - mean) * (x - mean);
-    cells[k].power = mean;
-    cells[k].variance = reps > 1 ? var / (reps - 1) / reps : 0.0;
-  }
-  return cells;
+  if (tally_weave) *weave_cells = woven.estimates();
+  return table.estimates();
 }
 
 }  // namespace weft::raytrace

@@ -64,9 +64,10 @@ double weave_tally_bytes(int table_resolution, int weave_resolution, int positio
   const double fine = DirectionGrid{table_resolution}.bins();
   const double coarse = DirectionGrid{weave_resolution}.bins();
   const double per_bin = static_cast<double>(positions_u) * positions_v * coarse * channels;
-  // During the trace the sums and squares per fine bin; the bins' books and a part file's copy of
-  // them; the booked values, the modulation (floats) and its copy for the writer.
-  const double sums = 2 * fine * per_bin * sizeof(double);
+  // During the trace the sums and squares per fine bin, and as many for the computed
+  // straight-through light's part; the bins' books and a part file's copy of them; the booked
+  // values, the modulation (floats) and its copy for the writer.
+  const double sums = 4 * fine * per_bin * sizeof(double);
   const double books = 2 * fine * per_bin * sizeof(double);
   const double table = per_bin * coarse * (sizeof(double) + 2 * sizeof(float));
   return sums + books + table;
@@ -201,8 +202,9 @@ void add_weave_task(const WeaveLayout& w, const WeaveExits& tally, WeaveSums& su
   }
 }
 
-void weave_bin_books(const WeaveLayout& w, const WeaveSums& sums, uint64_t per_bin,
-                     const std::vector<uint64_t>& units, FabricRaytraceResult& result) {
+void weave_bin_books(const WeaveLayout& w, const WeaveSums& sums, const WeaveSums& exact,
+                     uint64_t per_bin, const std::vector<uint64_t>& units,
+                     FabricRaytraceResult& result) {
   const DirectionGrid fine{w.table_resolution};
   const std::vector<double> area = coarse_areas(fine, w.coarse_of_fine, w.coarse_bins);
   const int np = w.shape.positions(), cb = w.coarse_bins, nc = w.channels;
@@ -225,8 +227,11 @@ void weave_bin_books(const WeaveLayout& w, const WeaveSums& sums, uint64_t per_b
           const size_t v = static_cast<size_t>(a) * w.per_bin() + k;
           const double m1 = sums.sum[v] / u;
           const double se = std::sqrt(std::max(0.0, sums.sum2[v] / u - m1 * m1) / u) * u * scale;
-          b.weave_values[k] = sums.sum[v] * scale;
-          b.weave_noise2[c] += se * se * area_i * area[o];
+          const bool computed = !exact.sum.empty();
+          b.weave_values[k] = (sums.sum[v] + (computed ? exact.sum[v] : 0.0)) * scale;
+          // The computed part's variance, independent of the particles' (its own streams).
+          const double se2 = se * se + (computed ? exact.sum2[v] * scale * scale : 0.0);
+          b.weave_noise2[c] += se2 * area_i * area[o];
         }
       }
   }

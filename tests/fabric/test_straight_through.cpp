@@ -8,6 +8,7 @@
 #include "flat_sheet.h"
 #include "weft/core/direction_grid.h"
 #include "weft/fabric/straight_through.h"
+#include "weft/fabric/weave_tally.h"
 
 using namespace weft;
 using namespace weft::raytrace;
@@ -100,4 +101,44 @@ TEST(StraightThrough, StreamsAreTheSeedsAndBinsOwn) {
   EXPECT_EQ(a[0].power, b[0].power);
   EXPECT_EQ(a[0].variance, b[0].variance);
   EXPECT_NE(a[0].power, c[0].power);
+}
+
+TEST(StraightThrough, ItsRaysAreBookedWhereTheyCrossTheMidPlane) {
+  // The half sheet lies in the slab's mid-plane (y = 0 of [-0.05, 0.05] mm) and covers its x < 0:
+  // every ray that passes crosses it at x > 0, in the weave's position cells iu = 2, 3 of 4 along
+  // x (weave_tally.h: u counted from the repeat's least x). Over the positions, the weave's cells
+  // hold the table cell's power; the table cell keeps its bits (the weave draws nothing more).
+  const WovenSample sample = half_sheet();
+  const RenderScene scene(tiled_geometry(sample));
+  const RepeatSlab slab = repeat_slab_of(sample);
+  const DirectionGrid grid{4};
+  const StraightThroughPlan plan = straight_through_plan(1000);
+  FabricRaytraceOptions o;
+  o.resolution = 4;
+  o.weave_positions_u = 4;
+  o.weave_positions_v = 2;
+  o.weave_resolution = 2;
+  const WeaveLayout w = weave_layout(o, 3, slab.x0, slab.z0, slab.px, slab.pz, slab.y0, slab.y1);
+  for (const int bin : kBins) {
+    std::vector<StraightThroughCell> woven;
+    const auto cells = straight_through_of_bin(scene, slab, grid, bin, plan, 1, 100000, &w, &woven);
+    const auto alone = straight_through_of_bin(scene, slab, grid, bin, plan, 1, 100000);
+    ASSERT_EQ(cells.size(), 1u) << "bin " << bin;
+    ASSERT_EQ(alone.size(), 1u) << "bin " << bin;
+    EXPECT_EQ(cells[0].power, alone[0].power) << "bin " << bin;
+    EXPECT_EQ(cells[0].variance, alone[0].variance) << "bin " << bin;
+    const uint64_t exit_bin = cells[0].cell - static_cast<uint64_t>(bin) * grid.bins();
+    double power = 0;
+    for (const StraightThroughCell& c : woven) {
+      const uint64_t position = c.cell / w.coarse_bins;
+      EXPECT_EQ(c.cell % w.coarse_bins, static_cast<uint64_t>(w.coarse_of_fine[exit_bin]));
+      EXPECT_LT(position, 8u);
+      EXPECT_GE(position % 4, 2u) << "bin " << bin << " position " << position;
+      EXPECT_GE(c.variance, 0.0);
+      power += c.power;
+    }
+    // Both open columns of both rows are met (the entry points cover the repeat).
+    EXPECT_EQ(woven.size(), 4u) << "bin " << bin;
+    EXPECT_NEAR(power, cells[0].power, 1e-12 * cells[0].power) << "bin " << bin;
+  }
 }

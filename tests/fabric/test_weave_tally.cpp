@@ -81,38 +81,45 @@ void expect_position_mean_is_the_table(const FabricRaytraceResult& r) {
   EXPECT_GT(nonzero, coarse.size() / 4);
 }
 
+// Both ways of booking the light that meets no fiber (FabricRaytraceOptions::straight_through).
+constexpr StraightThrough kStraightThrough[] = {StraightThrough::exact, StraightThrough::sampled};
+
 }  // namespace
 
 TEST(WeaveTally, PositionMeanIsTheTablesCoarseAverage) {
   const WovenSample sample = sample_at("yarn");
   const auto fiber = lossy_fiber(3);
-  // Nested grids (R 4 over 2) and not (R 3 over 2), positions not square, hero and nee exits.
-  for (const auto& [r, rw] : {std::pair{4, 2}, std::pair{3, 2}}) {
-    FabricRaytraceOptions o = weave_options(r, 400, 4, 3, rw);
-    const auto hero = raytrace_fabric_table(sample, fiber, o);
-    ASSERT_EQ(hero.weave.positions_u, 4);
-    ASSERT_EQ(hero.weave.positions_v, 3);
-    EXPECT_NO_THROW(hero.weave.validate(""));
-    // It belongs to this table, and its file reads back as written.
-    EXPECT_EQ(hero.weave.metadata.at("fabric_checksum"), hero.table.checksum());
-    const auto file = weft::testing::fresh_test_dir() / "weave.exr";
-    hero.weave.write_exr(file);
-    const WeaveTable back = WeaveTable::read_exr(file);
-    EXPECT_EQ(back.modulation, hero.weave.modulation);
-    EXPECT_EQ(back.repeat_u_m, hero.weave.repeat_u_m);
-    expect_position_mean_is_the_table(hero);
-    EXPECT_GT(hero.weave_relative_noise, 0.0);
-    // The weave tally draws no random number: the table keeps its bits with it off.
-    FabricRaytraceOptions off = o;
-    off.weave_positions_u = off.weave_positions_v = 0;
-    const auto plain = raytrace_fabric_table(sample, fiber, off);
-    EXPECT_EQ(plain.table.values, hero.table.values);
-    EXPECT_EQ(plain.relative_noise, hero.relative_noise);
-    EXPECT_TRUE(plain.weave.modulation.empty());
-    o.next_event_rays = 1;
-    o.launch_lattice = 13;
-    expect_position_mean_is_the_table(raytrace_fabric_table(sample, fiber, o));
-  }
+  // Nested grids (R 4 over 2) and not (R 3 over 2), positions not square, hero and nee exits; the
+  // straight-through light computed (its rays booked by position too) and sampled.
+  for (const StraightThrough st : kStraightThrough)
+    for (const auto& [r, rw] : {std::pair{4, 2}, std::pair{3, 2}}) {
+      SCOPED_TRACE(straight_through_name(st));
+      FabricRaytraceOptions o = weave_options(r, 400, 4, 3, rw);
+      o.straight_through = st;
+      const auto hero = raytrace_fabric_table(sample, fiber, o);
+      ASSERT_EQ(hero.weave.positions_u, 4);
+      ASSERT_EQ(hero.weave.positions_v, 3);
+      EXPECT_NO_THROW(hero.weave.validate(""));
+      // It belongs to this table, and its file reads back as written.
+      EXPECT_EQ(hero.weave.metadata.at("fabric_checksum"), hero.table.checksum());
+      const auto file = weft::testing::fresh_test_dir() / "weave.exr";
+      hero.weave.write_exr(file);
+      const WeaveTable back = WeaveTable::read_exr(file);
+      EXPECT_EQ(back.modulation, hero.weave.modulation);
+      EXPECT_EQ(back.repeat_u_m, hero.weave.repeat_u_m);
+      expect_position_mean_is_the_table(hero);
+      EXPECT_GT(hero.weave_relative_noise, 0.0);
+      // The weave tally draws no random number: the table keeps its bits with it off.
+      FabricRaytraceOptions off = o;
+      off.weave_positions_u = off.weave_positions_v = 0;
+      const auto plain = raytrace_fabric_table(sample, fiber, off);
+      EXPECT_EQ(plain.table.values, hero.table.values);
+      EXPECT_EQ(plain.relative_noise, hero.relative_noise);
+      EXPECT_TRUE(plain.weave.modulation.empty());
+      o.next_event_rays = 1;
+      o.launch_lattice = 13;
+      expect_position_mean_is_the_table(raytrace_fabric_table(sample, fiber, o));
+    }
 }
 
 TEST(WeaveTally, NoiseMatchesTheSpreadOfIndependentRuns) {
@@ -188,28 +195,34 @@ TEST(WeaveTally, GapsBetweenYarnsTransmitStraightThrough) {
   const DirectionGrid grid{kR};
   o.first_bin = grid.bin_of({0, 0, 1});
   o.bin_count = 1;
-  const auto res = raytrace_fabric_table(sample, lossy_fiber(3), o);
   const int wi = grid.bin_of({0, 0, 1}), wo = grid.bin_of({0, 0, -1});
   const raytrace::RepeatSlab slab = raytrace::repeat_slab_of(sample);
   const RenderScene scene(raytrace::tiled_geometry(sample));
-  int gaps = 0, covered = 0;
-  for (int iv = 0; iv < kPositions; ++iv)
-    for (int iu = 0; iu < kPositions; ++iu) {
-      const double f = covered_fraction(scene, slab, kPositions, iu, iv);
-      const int pos = iv * kPositions + iu;
-      for (int c = 0; c < 3; ++c) {
-        const float m = res.weave.modulation[res.weave.index(pos, wi, wo, c)];
-        if (f == 0) {
-          EXPECT_GT(m, 1.0f) << "gap cell " << iu << " " << iv << " channel " << c;
-        } else if (f == 1) {
-          EXPECT_LT(m, 1.0f) << "yarn cell " << iu << " " << iv << " channel " << c;
+  // The light through the gaps computed (its rays booked where they cross the mid-plane) and
+  // sampled (the particles that meet nothing booked there).
+  for (const StraightThrough st : kStraightThrough) {
+    SCOPED_TRACE(straight_through_name(st));
+    o.straight_through = st;
+    const auto res = raytrace_fabric_table(sample, lossy_fiber(3), o);
+    int gaps = 0, covered = 0;
+    for (int iv = 0; iv < kPositions; ++iv)
+      for (int iu = 0; iu < kPositions; ++iu) {
+        const double f = covered_fraction(scene, slab, kPositions, iu, iv);
+        const int pos = iv * kPositions + iu;
+        for (int c = 0; c < 3; ++c) {
+          const float m = res.weave.modulation[res.weave.index(pos, wi, wo, c)];
+          if (f == 0) {
+            EXPECT_GT(m, 1.0f) << "gap cell " << iu << " " << iv << " channel " << c;
+          } else if (f == 1) {
+            EXPECT_LT(m, 1.0f) << "yarn cell " << iu << " " << iv << " channel " << c;
+          }
         }
+        gaps += f == 0, covered += f == 1;
       }
-      gaps += f == 0, covered += f == 1;
-    }
-  // The geometry as described: a quarter of the repeat open, 2 x 2 cells per gap at least.
-  EXPECT_GE(gaps, 4 * 2);
-  EXPECT_GE(covered, 16);
+    // The geometry as described: a quarter of the repeat open, 2 x 2 cells per gap at least.
+    EXPECT_GE(gaps, 4 * 2);
+    EXPECT_GE(covered, 16);
+  }
 }
 
 TEST(WeaveTally, BitIdenticalAtAnyThreadCountAndInParts) {

@@ -41,14 +41,19 @@ struct StraightThroughCell {
   uint64_t cell = 0;
   double power = 0, variance = 0;
 };
+struct WeaveLayout;  // weave_tally.h
+
 // Incident bin 'bin''s estimate: its rays follow the particles' flight (fly, through the repeat's
 // sides) to the first surface or out of the slab; a particle that wraps more than max_wraps times
 // is lost, as in the trace. Random numbers from the streams (seed, 2^62 + bin x replicates +
 // replicate): the same bits in a whole run and in any piece of it.
-std::vector<StraightThroughCell> straight_through_of_bin(const RenderScene& scene,
-                                                         const RepeatSlab& slab,
-                                                         const DirectionGrid& grid, int bin,
-                                                         const StraightThroughPlan& plan,
-                                                         uint64_t seed, int max_wraps);
+// With the weave tally (weave and weave_cells given): the same rays' power also by where each
+// ray's line crosses the cloth's mid-plane (weave_position, as a particle's exit), into
+// *weave_cells: cell = position x the weave's coarse bins + the coarse outgoing bin (the bin's
+// part of WeaveSums over the channels), with its replicates' variance. It draws nothing more.
+std::vector<StraightThroughCell> straight_through_of_bin(
+    const RenderScene& scene, const RepeatSlab& slab, const DirectionGrid& grid, int bin,
+    const StraightThroughPlan& plan, uint64_t seed, int max_wraps,
+    const WeaveLayout* weave = nullptr, std::vector<StraightThroughCell>* weave_cells = nullptr);
 
 }  // namespace weft::raytrace

@@ -43,8 +43,9 @@ std::vector<int> coarse_bins_of(const DirectionGrid& fine, const DirectionGrid& 
 // [coarse wi][coarse wo][channel]. What the weave's booked values average to over the positions.
 std::vector<double> coarse_table_average(const TabulatedBsdfTable& table, int coarse_resolution);
 
-// Bytes the weave tally holds during a ray trace and in its result (its per-bin sums, the books'
-// copies and the table), for a front end's memory budget; 0 when positions_u is 0.
+// Bytes the weave tally holds during a ray trace and in its result (its per-bin sums and the
+// computed straight-through part's, the books' copies and the table), for a front end's memory
+// budget; 0 when positions_u is 0.
 double weave_tally_bytes(int table_resolution, int weave_resolution, int positions_u,
                          int positions_v, int channels);
 
@@ -99,9 +100,12 @@ struct WeaveSums {
 WeaveSums weave_sums_for(const WeaveLayout& w);
 void add_weave_task(const WeaveLayout& w, const WeaveExits& tally, WeaveSums& sums);
 // Each bin's weave books (FabricBinBooks::weave_values, weave_noise2) from the sums over per_bin
-// particles per bin in units[bin] sample units.
-void weave_bin_books(const WeaveLayout& w, const WeaveSums& sums, uint64_t per_bin,
-                     const std::vector<uint64_t>& units, FabricRaytraceResult& result);
+// particles per bin in units[bin] sample units, and the computed straight-through light's part
+// (FabricRaytraceOptions::straight_through exact; empty: none), whose sum is added to the
+// particles' and whose sum2 is that sum's variance, added to the noise (as the table's cell).
+void weave_bin_books(const WeaveLayout& w, const WeaveSums& sums, const WeaveSums& exact,
+                     uint64_t per_bin, const std::vector<uint64_t>& units,
+                     FabricRaytraceResult& result);
 
 }  // namespace raytrace
 }  // namespace weft
