@@ -4,9 +4,9 @@
 #   1. measured: the MERL red fabric as a neural BRDF (measured_nbrdf merl-red-fabric),
 #   2. computed: the fabric table ray-traced through the fiber-level red-cotton poplin (`weft bake
 #      fabric --method raytrace --detail fiber`), on a light-grey foam backing
-#      (backing_reflectance, WEFT_BACKING, default 0.6; "none" for the bare sheet); with the weave
-#      level where `weft bake fabric` can write one (--weave-out): the close-up then shows the
-#      weave, the whole seat the table (a repeat there is far below a pixel),
+#      (backing_reflectance, WEFT_BACKING, default 0.6; "none" for the bare sheet), with its weave
+#      table (--weave-out) at level auto: the close-up shows the weave, the whole seat the table
+#      (a repeat there is far below a pixel); WEFT_WEAVE=0 leaves the weave out,
 #   3. classic: Lambert + Cook-Torrance fibers, diffuse colour = the computed table's reflectance
 #      at normal incidence (same brightness, classic angular behaviour),
 #   4. summation (WEFT_SUMMATION=1, the default; 0 leaves it out): the paper's summed table from
@@ -16,8 +16,7 @@
 # Outputs in ${WEFT_OUT:-out/seat}/: seat.glb; per variant V the descriptions seat-V.json and
 # closeup-V.json, the renders seat-V.exr/.png and closeup-V.exr/.png and their summaries
 # render-V.json and render-closeup-V.json; closeup-computed-table.exr/.png (the computed
-# close-up at the fabric table level: the same render as closeup-computed where there is no
-# weave level); closeup-camera.json (the close-up's geometry, the repeat in pixels); the crops of
+# close-up at the fabric table level: the same render as closeup-computed with WEFT_WEAVE=0); closeup-camera.json (the close-up's geometry, the repeat in pixels); the crops of
 # the whole renders (crop-V.exr/.png, the cushion's front edge enlarged 4x); side-by-side.exr and
 # .png (labelled); closeup-levels.exr/.png (weave against table level, when there is a weave);
 # timings.json. The fiber and fabric tables are cached in that folder (red-cotton-fabric.exr with
@@ -26,7 +25,7 @@
 # Environment: WEFT_OUT; WEFT_WIDTH, WEFT_HEIGHT, WEFT_SPP (every render; default the scene's
 # 480 x 360, 16 spp); WEFT_THREADS (0 = all); WEFT_BACKING; WEFT_PARTICLES (ray-trace particles
 # per incident bin, default 200000); WEFT_FIBER (the fiber table, spec or preset both fabric
-# tables are made from, default red-cotton); WEFT_SUMMATION; WEFT_SEAT_CELL_MM (the seat's grid,
+# tables are made from, default red-cotton); WEFT_SUMMATION; WEFT_WEAVE; WEFT_SEAT_CELL_MM (the seat's grid,
 # default 5); WEFT_BIN (the weft program, default ${WEFT_BUILD_DIR:-build}/tools/weft).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -48,12 +47,10 @@ size_args=()
 [ -n "${WEFT_WIDTH:-}" ] && size_args+=(--width "$WEFT_WIDTH")
 [ -n "${WEFT_HEIGHT:-}" ] && size_args+=(--height "$WEFT_HEIGHT")
 [ -n "${WEFT_SPP:-}" ] && size_args+=(--spp "$WEFT_SPP")
-# The fabric table's weave level (docs/car-seat.md), where this weft has it.
-weave=0
-no_weave="(weft bake fabric --help lists no --weave-out)"
-# (the help read whole first: grep -q may close the pipe early, and pipefail would count that)
-bake_help=$("$weft" bake fabric --help)
-grep -q -- '--weave-out' <<< "$bake_help" && weave=1
+# The fabric table's weave level (docs/car-seat.md): the close-up shows the weave; WEFT_WEAVE=0
+# renders every view at the table level.
+weave=${WEFT_WEAVE:-1}
+no_weave="(WEFT_WEAVE=0)"
 
 echo "== 1. the seat"
 "$weft" scene car-seat -o "$out/seat.glb" --cell-mm "${WEFT_SEAT_CELL_MM:-5}"
@@ -165,13 +162,6 @@ print(f"computed fabric's backing reflectance: {backing}")
 PY
 }
 describe
-# A weft may bake the weave table before its renderer reads one: a tiny render tells.
-if [ "$weave" = 1 ] && ! "$weft" render "$out/closeup-computed.json" -o "$repeat_dir/probe.exr" \
-  --width 8 --height 6 --spp 1 --threads "$threads" --quiet 2> "$repeat_dir/probe.err"; then
-  no_weave="(this weft's renderer refused it: $(head -c 300 "$repeat_dir/probe.err"))"
-  weave=0
-  describe > /dev/null
-fi
 
 echo "== 4. render"
 render() {  # NAME: NAME.json rendered to NAME.exr/.png, its summary render-NAME.json (whole

@@ -8,7 +8,10 @@
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/direction_grid.h"
 #include "weft/fabric/fabric_raytrace.h"
+#include "weft/fabric/raytrace_steps.h"
+#include "weft/scenes/render_scene.h"
 #include "weft/scenes/weave.h"
 
 using namespace weft;
@@ -86,6 +89,51 @@ TEST(FiberTables, TwoColourYarnClothLiesBetweenItsColours) {
 
 TEST(FiberTables, TwoColourFiberClothLiesBetweenItsColours) {
   expect_two_colour_cloth_between("fiber", 300);
+}
+
+// A two-colour draft shows its pattern in the weave table (the weave level's close-up) while its
+// fabric table is the mixed colour: on the poplin (plain weave) with a red warp and a grey weft, lit
+// from straight above, the light reflected straight back is greener, relative to red, over the
+// position cells where a grey weft yarn is on top than over those where a red warp yarn is. The
+// yarn on top of a cell is the one a ray from above meets at the cell's centre (the weave table's
+// cell convention, weave_tally.h: u along x from the repeat's least x, v along -z from its
+// greatest z). Expected ratio: the grey yarn's G/R albedo over the red one's, 1 / 0.22, diluted by
+// light that scattered between the yarns; the test asks for 2.
+TEST(FiberTables, TwoColourDraftShowsItsPatternInTheWeaveTable) {
+  const WovenSample sample = sample_at("yarn");
+  const auto red = coloured_fiber(4, {0.9, 0.2, 0.2}), grey = coloured_fiber(4, {0.6, 0.6, 0.6});
+  constexpr int kR = 3, kPositions = 8;  // odd R: a bin centred on the normal
+  const DirectionGrid grid{kR};
+  const int up = grid.bin_of({0, 0, 1});
+  FabricRaytraceOptions o = options(40000);
+  o.resolution = kR;
+  o.first_bin = up;
+  o.bin_count = 1;
+  o.weave_positions_u = o.weave_positions_v = kPositions;
+  o.weave_resolution = kR;
+  const auto run = raytrace_fabric_table(sample, fiber_tables_by_direction(sample, red, grey), o);
+  const WeaveTable& w = run.weave;
+  ASSERT_EQ(w.positions(), kPositions * kPositions);
+  const raytrace::RepeatSlab r = raytrace::repeat_slab_of(sample);
+  const RenderScene scene(raytrace::tiled_geometry(sample));
+  double ratio_sum[2] = {0, 0};
+  int cells[2] = {0, 0};  // [0]: a warp yarn on top, [1]: a weft yarn
+  for (int iv = 0; iv < kPositions; ++iv)
+    for (int iu = 0; iu < kPositions; ++iu) {
+      const double fu = (iu + 0.5) / kPositions, fv = (iv + 0.5) / kPositions;
+      SurfaceHit h;
+      ASSERT_TRUE(scene.intersect(
+          {{r.x0 + r.px * fu, r.y1 + 1e-6, r.z0 + r.pz - r.pz * fv}, {0, -1, 0}, 1e300}, &h));
+      ASSERT_FALSE(h.on_fiber());
+      const int k = sample.meshes.at(h.shape).material == "warp" ? 0 : 1;
+      const int pos = iv * kPositions + iu;
+      ratio_sum[k] += w.modulation[w.index(pos, up, up, 1)] / w.modulation[w.index(pos, up, up, 0)];
+      ++cells[k];
+    }
+  ASSERT_GE(cells[0], 8);
+  ASSERT_GE(cells[1], 8);
+  const double warp_top = ratio_sum[0] / cells[0], weft_top = ratio_sum[1] / cells[1];
+  EXPECT_GT(weft_top, 2.0 * warp_top) << "warp on top " << warp_top << ", weft " << weft_top;
 }
 
 TEST(FiberTables, EqualTablesAreTheSingleTableTraceBitForBit) {
