@@ -246,6 +246,7 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
   data->grid = grid;
   data->kind = table.kind;
   data->metadata = table.metadata;
+  data->checksum = table.checksum();
   data->rgb.resize(cells * 3);
   const std::vector<float> mean = reduce_to_rgb(table, *data);
   const std::vector<float> blur = neighbourhood_means(grid, mean);

@@ -106,6 +106,18 @@ TEST(WeaveMaterial, BadParamsNameTheField) {
   const std::string channels =
       error("fabric_table", {{"file", "tables/fabric.exr"}, {"weave", "spectral.exr"}});
   EXPECT_NE(channels.find("channels"), std::string::npos) << channels;
+  // A weave records the table it was baked with (fabric_checksum); another table's is refused.
+  WeaveTable other = varied_weave(3);
+  other.metadata["fabric_checksum"] = "0123456789abcdef";
+  other.write_exr(ctx.base_dir / "other.exr");
+  const std::string foreign =
+      error("fabric_table", {{"file", "tables/fabric.exr"}, {"weave", "other.exr"}});
+  EXPECT_NE(foreign.find("'weave'"), std::string::npos) << foreign;
+  EXPECT_NE(foreign.find("0123456789abcdef"), std::string::npos) << foreign;
+  WeaveTable own = varied_weave(3);
+  own.metadata["fabric_checksum"] = lambert_like().checksum();
+  own.write_exr(ctx.base_dir / "own.exr");
+  EXPECT_NO_THROW(fabric(ctx, {{"weave", "own.exr"}}));
   // The fabric table named as a weave: its kind says what it is.
   const std::string kind =
       error("fabric_table", {{"file", "tables/fabric.exr"}, {"weave", "tables/fabric.exr"}});
