@@ -89,7 +89,8 @@ std::shared_ptr<const TableWeave> load_table_weave(ParamReader& p, const Materia
   // The ray trace records the table its weave modulates; a weave of another table would move the
   // weave level's mean away from the table level's.
   const auto& meta = w.settings.modulation->table().metadata;
-  if (const auto it = meta.find("fabric_checksum"); it != meta.end() && it->second != table.checksum)
+  if (const auto it = meta.find("fabric_checksum");
+      it != meta.end() && it->second != table.checksum)
     throw Error(p.file(), p.field("weave"),
                 w.file.string() + " was baked with the fabric table of checksum " + it->second +
                     ", not this one (" + table.checksum +

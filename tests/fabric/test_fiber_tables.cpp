@@ -6,9 +6,9 @@
 #include <array>
 #include <string>
 
+#include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
-#include "weft/core/direction_grid.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/raytrace_steps.h"
 #include "weft/scenes/render_scene.h"
@@ -92,8 +92,8 @@ TEST(FiberTables, TwoColourFiberClothLiesBetweenItsColours) {
 }
 
 // A two-colour draft shows its pattern in the weave table (the weave level's close-up) while its
-// fabric table is the mixed colour: on the poplin (plain weave) with a red warp and a grey weft, lit
-// from straight above, the light reflected straight back is greener, relative to red, over the
+// fabric table is the mixed colour: on the poplin (plain weave) with a red warp and a grey weft,
+// lit from straight above, the light reflected straight back is greener, relative to red, over the
 // position cells where a grey weft yarn is on top than over those where a red warp yarn is. The
 // yarn on top of a cell is the one a ray from above meets at the cell's centre (the weave table's
 // cell convention, weave_tally.h: u along x from the repeat's least x, v along -z from its

@@ -60,8 +60,8 @@ struct TabulatedBsdfData {
   DirectionGrid grid;
   std::string kind;                             // "fiber" | "fabric"
   std::map<std::string, std::string> metadata;  // from the table
-  std::string checksum;  // the table's values_fnv1a64 (TabulatedBsdfTable::checksum)
-  std::vector<float> rgb;                       // [wi_bin][wo_bin][3]
+  std::string checksum;    // the table's values_fnv1a64 (TabulatedBsdfTable::checksum)
+  std::vector<float> rgb;  // [wi_bin][wo_bin][3]
   // Spectral tables: the band values as stored, [wi_bin][wo_bin][kNumBands], which a spectral
   // render reads (TabulatedBsdf::eval_bands); empty for RGB tables. Sampling follows the RGB
   // mean either way (its coverage term keeps the density > 0 wherever any band is). Kept whether
