@@ -7,6 +7,7 @@
 #include <string>
 
 #include "flat_sheet.h"
+#include "raytrace_test_util.h"
 #include "test_util.h"
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
@@ -21,44 +22,7 @@ using namespace weft;
 namespace {
 
 using weft::testing::flat_sheet;
-
-// A fiber table given per point: f(wo, wi) in every channel.
-template <class F>
-TabulatedBsdfTable fiber_table(int resolution, F f) {
-  auto t = TabulatedBsdfTable::from_function(
-      resolution, 3,
-      [&](const Vec3& wo, const Vec3& wi, std::span<double> v) { v[0] = v[1] = v[2] = f(wo, wi); },
-      2, 1);
-  t.kind = "fiber";
-  return t;
-}
-
-// A fiber table given per point and channel.
-template <class F>
-TabulatedBsdfTable fiber_table3(int resolution, F f) {
-  auto t = TabulatedBsdfTable::from_function(resolution, 3, f, 2, 1);
-  t.kind = "fiber";
-  return t;
-}
-
-FabricRaytraceOptions options(int resolution, uint64_t particles_per_bin) {
-  FabricRaytraceOptions o;
-  o.resolution = resolution;
-  o.particles_per_bin = particles_per_bin;
-  return o;
-}
-
-// A lossless-shaped "fiber": every point sends a fraction of the light to its outer hemisphere.
-TabulatedBsdfTable uniform_fiber(int resolution, double f) {
-  return fiber_table(resolution, [f](const Vec3& wo, const Vec3&) { return wo.z > 0 ? f : 0.0; });
-}
-
-// The bundled red-cotton sample at yarn or fiber detail.
-WovenSample default_sample(const char* detail = "yarn") {
-  WeaveOptions o;
-  o.detail = detail;
-  return make_woven_sample(overlay(red_cotton_weave_options(), o));
-}
+using namespace weft::testing;
 
 }  // namespace
 
@@ -194,52 +158,6 @@ TEST(FabricRaytrace, FiberLevelBitIdenticalAtOneAndTwoThreads) {
   EXPECT_EQ(a.exited, b.exited);
   EXPECT_EQ(a.scatterings, b.scatterings);
 }
-
-namespace {
-
-// A reciprocal fiber table, unchanged when the fiber's axis is reversed (x, y -> -x, -y): more
-// light to the outer side, a little transmitted, a dependence on the azimuth about the axis.
-TabulatedBsdfTable reciprocal_fiber(int resolution) {
-  return fiber_table(resolution, [](const Vec3& wo, const Vec3& wi) {
-    auto g = [](double z) { return z > 0 ? 1.0 : 0.5; };
-    return g(wo.z) * g(wi.z) * (0.25 + 0.1 * wo.x * wi.x) * kInvPi;
-  });
-}
-
-// z-scores of a against b cell by cell, with the stated standard errors; cells where either has
-// fewer than about 25 exits (standard error above a fifth of the value) are left out.
-struct ZStats {
-  double rms = 0;
-  double beyond4 = 0;  // fraction with |z| > 4
-  size_t cells = 0;
-};
-template <class Map>
-ZStats z_scores(const FabricRaytraceResult& a, const FabricRaytraceResult& b, Map map) {
-  const int bins = a.table.bins(), nc = a.table.channels;
-  ZStats z;
-  double sum2 = 0;
-  size_t far = 0;
-  for (int i = 0; i < bins; ++i)
-    for (int o = 0; o < bins; ++o) {
-      const auto [bi, bo] = map(i, o);
-      for (int c = 0; c < nc; ++c) {
-        const size_t va = (static_cast<size_t>(i) * bins + o) * nc + c,
-                     vb = (static_cast<size_t>(bi) * bins + bo) * nc + c;
-        const double fa = a.table.values[va], fb = b.table.values[vb];
-        const double sa = a.standard_error[va], sb = b.standard_error[vb];
-        if (!(sa > 0 && sb > 0 && sa < 0.2 * fa && sb < 0.2 * fb)) continue;
-        const double zz = (fa - fb) / std::sqrt(sa * sa + sb * sb);
-        sum2 += zz * zz;
-        far += std::abs(zz) > 4;
-        ++z.cells;
-      }
-    }
-  z.rms = z.cells ? std::sqrt(sum2 / z.cells) : 0;
-  z.beyond4 = z.cells ? double(far) / z.cells : 0;
-  return z;
-}
-
-}  // namespace
 
 TEST(FabricRaytrace, TablesAreReciprocalWithinTheirNoise) {
   // With a reciprocal fiber table the fabric's is reciprocal: f(wi, wo) = f(wo, wi). Cell pair
@@ -592,49 +510,6 @@ TEST(FabricRaytrace, EnergyCreatingFiberTablesAreRefusedBeforeAnyWork) {
   for (float v : r.table.values) ASSERT_TRUE(std::isfinite(v));
 }
 
-namespace {
-
-// A lossless fiber shaped like a clear one: what a point returns depends on where the light's line
-// crosses the fiber. Light along a line at impact u (in radii) through a round fiber comes, in the
-// frames of B' and B'' alike, from a direction with q = wi_z^2 / (wi_y^2 + wi_z^2) = 1 - u^2;
-// A(wi) = 1/2 + 1.2 (q^4 - 128/315), sent evenly to the outer hemisphere. A' + A'' is 2.4 on
-// lines through the axis and 0.02 at the edges, and 1 averaged over u at every line direction
-// (the mean of (1 - u^2)^4 is 128/315): the total albedo is 1, 0.988 tabulated at R = 8.
-TabulatedBsdfTable clear_lossless_fiber(int resolution) {
-  return fiber_table(resolution, [](const Vec3& wo, const Vec3& wi) {
-    const double across2 = wi.y * wi.y + wi.z * wi.z;
-    const double q = across2 > 0 ? wi.z * wi.z / across2 : 0.0;
-    return wo.z > 0 ? (0.5 + 1.2 * (std::pow(q, 4) - 128.0 / 315)) * kInvPi : 0.0;
-  });
-}
-
-// One incident bin of a ray-traced table, as the channels' mean (the books count the mean): the
-// table's directional albedo (reflected + transmitted) and its standard error (from the cells',
-// taken as independent; the mean's at most the channels' mean), and the fraction of the launched
-// power that the books say exited.
-struct BinEnergy {
-  double albedo = 0, sigma = 0, exited = 0;
-};
-BinEnergy bin_energy(const FabricRaytraceResult& r, int bin) {
-  const DirectionGrid g = r.table.grid();
-  const auto d = g.cosine_weighted_areas();
-  const int nc = r.table.channels;
-  const auto a = r.table.directional_albedo(bin);
-  BinEnergy e;
-  for (int c = 0; c < nc; ++c) {
-    double var = 0;
-    for (int o = 0; o < g.bins(); ++o)
-      var += std::pow(r.standard_error[r.table.index(bin, o, c)] * d[o], 2);
-    e.albedo += a.total(c) / nc;
-    e.sigma += std::sqrt(var) / nc;
-  }
-  const FabricBinBooks& b = r.bin_books[bin];
-  e.exited = b.exited / b.launched;
-  return e;
-}
-
-}  // namespace
-
 TEST(FabricRaytrace, DirectionalAlbedoIsWhatTheBooksSayExitedInEveryIncidentBin) {
   // At every incident bin the table's directional albedo, sum_o f D_o reflected and transmitted,
   // is the fraction of the bin's launched power that its books say exited. Both add up the same
@@ -659,8 +534,9 @@ TEST(FabricRaytrace, DirectionalAlbedoIsWhatTheBooksSayExitedInEveryIncidentBin)
         const BinEnergy e = bin_energy(r, i);
         const FabricBinBooks& b = r.bin_books[i];
         const double expected_launch = double(b.particles) * d[i] / g.bin_solid_angle();
-        if (st == StraightThrough::sampled)
+        if (st == StraightThrough::sampled) {
           EXPECT_NEAR(e.albedo * expected_launch / b.exited, 1.0, 1e-5) << detail << " bin " << i;
+        }
         EXPECT_NEAR(e.albedo, e.exited, 4 * e.sigma) << detail << " bin " << i;
         EXPECT_GT(e.sigma, 0) << detail << " bin " << i;
         EXPECT_LT(e.sigma, 0.05) << detail << " bin " << i;  // a test of some power
@@ -733,259 +609,3 @@ TEST(FabricSceneBytes, AShortRayTraceOnTheLargeDraftCompletes) {
 }
 
 }  // namespace
-
-// --- The next-event estimate of the exits and the launch lattice (FabricRaytraceOptions
-// next_event_rays, launch_lattice: weft bake fabric --estimator nee).
-
-namespace {
-
-FabricRaytraceOptions nee_options(int resolution, uint64_t particles_per_bin) {
-  FabricRaytraceOptions o = options(resolution, particles_per_bin);
-  o.next_event_rays = 2;
-  o.launch_lattice = 13;
-  return o;
-}
-
-// A coloured table whose channels differ in shape, not only in scale: the hero's MIS weights
-// matter (the proposal test's shape, with a transmitted lobe).
-TabulatedBsdfTable coloured_fiber(int resolution) {
-  return fiber_table3(resolution, [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-    const double shape = (wo.z > 0 ? 1.0 : 0.3) * (1 + 0.5 * wo.z * wi.z) * kInvPi;
-    v[0] = 0.3 * shape, v[1] = 0.15 * shape * (0.5 + wo.x * wo.x), v[2] = 0.08 * shape;
-  });
-}
-
-}  // namespace
-
-TEST(FabricRaytrace, NextEventEstimateIsUnbiased) {
-  // The next-event estimate and the particles' own exits estimate the same table: cell by cell
-  // against each other's stated standard errors (different seeds), with the proposal test's
-  // bounds (z rms about 1, almost none beyond 4), for a reciprocal and a coloured fiber (the
-  // hero's MIS weights per channel), at fiber and yarn detail (light passing its own tube).
-  const std::pair<const char*, TabulatedBsdfTable> cases[] = {
-      {"fiber", reciprocal_fiber(4)}, {"fiber", coloured_fiber(4)}, {"yarn", coloured_fiber(4)}};
-  for (const auto& [detail, fiber] : cases) {
-    const auto exits = raytrace_fabric_table(default_sample(detail), fiber, options(3, 6000));
-    FabricRaytraceOptions o = nee_options(3, 3000);
-    o.seed = 2;
-    const auto nee = raytrace_fabric_table(default_sample(detail), fiber, o);
-    EXPECT_EQ(nee.table.metadata.at("next_event_rays"), "2");
-    const ZStats z = z_scores(nee, exits, [](int i, int k) { return std::pair{i, k}; });
-    EXPECT_GT(z.cells, 200u) << detail;
-    EXPECT_NEAR(z.rms, 1.0, 0.25) << detail;
-    EXPECT_LT(z.beyond4, 0.01) << detail;
-    // The books still close: exited is what the particles took out of the slab.
-    EXPECT_NEAR(nee.exited + nee.absorbed + nee.lost + nee.roulette_net, 1.0, 1e-9) << detail;
-  }
-}
-
-TEST(FabricRaytrace, NextEventEstimateIsReciprocalAndItsNoiseHonest) {
-  // Reciprocity as TablesAreReciprocalWithinTheirNoise checks it, and the stated noise against
-  // the spread of two seeds as NoiseEstimateMatchesTheSpreadOfIndependentRuns checks it (a launch
-  // block's exits and next events are summed per cell before the variance is taken: the blocks,
-  // not their particles, are the independent samples).
-  const auto fiber = reciprocal_fiber(4);
-  const auto a = raytrace_fabric_table(default_sample("fiber"), fiber, nee_options(3, 3000));
-  const ZStats z = z_scores(a, a, [](int i, int k) { return std::pair{k, i}; });
-  EXPECT_GT(z.cells, 200u);
-  EXPECT_NEAR(z.rms, 1.0, 0.25);
-  EXPECT_LT(z.beyond4, 0.01);
-  FabricRaytraceOptions o = nee_options(3, 3000);
-  o.seed = 2;
-  const auto b = raytrace_fabric_table(default_sample("fiber"), fiber, o);
-  const double measured = compare_tables(a.table, b.table).overall.rel_rms;
-  const double stated =
-      std::sqrt(a.relative_noise * a.relative_noise + b.relative_noise * b.relative_noise);
-  EXPECT_NEAR(measured / stated, 1.0, 0.25) << measured << " vs " << stated;
-}
-
-TEST(FabricRaytrace, NextEventEstimateOfALosslessFabricConservesEnergy) {
-  // The white furnace: the lossless fiber of EnergyAtMostOnePerIncidentBin. Per incident bin
-  // the table's albedo is 1 at most within its noise and close to it (a bin's particles share
-  // 2002 / 13 directions, so a bin's albedo spreads more than the hero estimator's: 0.93 to 0.95
-  // at four bins of another count), 0.97 or more over all bins (FiberLevelSampleLeaksNoEnergy: the
-  // grazing lines absorb under 0.5 %); the particles' own exits (the books) are no longer what the
-  // table adds up, only its expectation: within 4 standard errors of it.
-  const auto fiber = uniform_fiber(4, 0.5 * kInvPi);
-  const auto r = raytrace_fabric_table(default_sample("fiber"), fiber, nee_options(3, 2002));
-  double mean = 0;
-  for (int i = 0; i < r.table.bins(); ++i) {
-    const BinEnergy e = bin_energy(r, i);
-    EXPECT_LE(e.albedo, 1 + 4 * e.sigma) << "bin " << i;
-    EXPECT_GT(e.albedo, 0.9) << "bin " << i;
-    EXPECT_NEAR(e.albedo, e.exited, 4 * e.sigma + 0.01) << "bin " << i;
-    mean += e.albedo / r.table.bins();
-  }
-  EXPECT_GT(mean, 0.97);
-  EXPECT_LE(mean, 1.01);
-}
-
-TEST(FabricRaytrace, NextEventEstimateIsBitIdenticalAtAnyThreadCountAndInPieces) {
-  const auto fiber = uniform_fiber(3, 0.4 * kInvPi);
-  FabricRaytraceOptions o = nee_options(2, 300);
-  o.threads = 1;
-  const WovenSample sample = default_sample("fiber");
-  const auto a = raytrace_fabric_table(sample, fiber, o);
-  o.threads = 2;
-  const auto b = raytrace_fabric_table(sample, fiber, o);
-  EXPECT_EQ(a.table.values, b.table.values);
-  EXPECT_EQ(a.standard_error, b.standard_error);
-  EXPECT_EQ(a.exited, b.exited);
-  o.first_bin = 3;
-  o.bin_count = 2;
-  const auto piece = raytrace_fabric_table(sample, fiber, o);
-  const size_t row = static_cast<size_t>(a.table.bins()) * 3;
-  EXPECT_TRUE(std::equal(a.table.values.begin() + 3 * row, a.table.values.begin() + 5 * row,
-                         piece.table.values.begin() + 3 * row));
-  // The hero estimator's bits do not move with the option off (its default).
-  const auto off = raytrace_fabric_table(sample, fiber, options(2, 300));
-  EXPECT_NE(off.table.values, a.table.values);
-  EXPECT_EQ(off.table.metadata.count("next_event_rays"), 0u);
-  // Bad counts are refused by name.
-  o.next_event_rays = kMaxNextEventRays + 1;
-  EXPECT_THROW(raytrace_fabric_table(sample, fiber, o), Error);
-  o.next_event_rays = 1;
-  o.launch_lattice = 0;
-  EXPECT_THROW(raytrace_fabric_table(sample, fiber, o), Error);
-  o.launch_lattice = 1;
-  o.channel_sampling = ChannelSampling::mean;
-  EXPECT_THROW(raytrace_fabric_table(sample, fiber, o), Error);
-}
-
-// --- The light passing straight through, computed (FabricRaytraceOptions::straight_through,
-// fabric/straight_through.h; weft bake fabric --straight-through).
-
-namespace {
-
-// Whether cell (i, o) is incident bin i's straight-through cell: the direction continued.
-bool straight_cell(const DirectionGrid& g, int i, int o) {
-  return g.bin_of(-g.bin_center(i)) == o;
-}
-
-FabricRaytraceOptions sampled(FabricRaytraceOptions o) {
-  o.straight_through = StraightThrough::sampled;
-  return o;
-}
-
-}  // namespace
-
-TEST(FabricRaytrace, ExactStraightThroughIsUnbiased) {
-  // The computed straight-through part and the sampled one estimate the same table: cell by cell
-  // against each other's stated standard errors (different seeds), with the proposal test's
-  // bounds (z rms about 1, almost none beyond 4), and every straight-through cell within 4 of
-  // them, for a reciprocal and a coloured fiber, at fiber and yarn detail. The exact part is
-  // exercised: its cells' standard errors are well below the sampled ones.
-  const std::pair<const char*, TabulatedBsdfTable> cases[] = {
-      {"fiber", reciprocal_fiber(4)}, {"fiber", coloured_fiber(4)}, {"yarn", coloured_fiber(4)}};
-  for (const auto& [detail, fiber] : cases) {
-    const auto old =
-        raytrace_fabric_table(default_sample(detail), fiber, sampled(options(3, 8000)));
-    FabricRaytraceOptions o = options(3, 8000);
-    o.seed = 2;
-    const auto exact = raytrace_fabric_table(default_sample(detail), fiber, o);
-    EXPECT_EQ(exact.table.metadata.at("straight_through"), "exact");
-    EXPECT_EQ(old.table.metadata.count("straight_through"), 0u);
-    const ZStats z = z_scores(exact, old, [](int i, int k) { return std::pair{i, k}; });
-    EXPECT_GT(z.cells, 200u) << detail;
-    EXPECT_NEAR(z.rms, 1.0, 0.25) << detail;
-    EXPECT_LT(z.beyond4, 0.01) << detail;
-    const DirectionGrid g = old.table.grid();
-    const int nc = old.table.channels;
-    double se_exact = 0, se_old = 0;
-    for (int i = 0; i < g.bins(); ++i)
-      for (int k = 0; k < g.bins(); ++k) {
-        if (!straight_cell(g, i, k)) continue;
-        for (int c = 0; c < nc; ++c) {
-          const size_t v = old.table.index(i, k, c);
-          const double sa = exact.standard_error[v], sb = old.standard_error[v];
-          EXPECT_LT(std::abs(exact.table.values[v] - old.table.values[v]),
-                    4 * std::sqrt(sa * sa + sb * sb))
-              << detail << " cell " << i << ", " << k << " channel " << c;
-          se_exact += sa, se_old += sb;
-        }
-      }
-    EXPECT_LT(se_exact, 0.9 * se_old) << detail;
-    // The books are the particles' (they still fly the light that meets nothing): they close.
-    EXPECT_NEAR(exact.exited + exact.absorbed + exact.lost + exact.roulette_net, 1.0, 1e-9);
-  }
-}
-
-TEST(FabricRaytrace, ExactStraightThroughNoiseMatchesTheSpreadOfIndependentRuns) {
-  // As NoiseEstimateMatchesTheSpreadOfIndependentRuns checks the particles' noise: two seeds
-  // differ by the two stated noises combined (the exact part's variance from its replicates
-  // included), overall and channel by channel, within 25 %; and the stated noise of the dim
-  // channels, which the straight-through light's hit-or-miss dominates, is below the sampled
-  // estimator's at the same count. (Not red's: in these wide bins (R = 3) much of the bright red
-  // light scattered forwards lands in the straight-through cell too, and a particle books one or
-  // the other: sampled, the two parts' covariance is negative and takes back some of the
-  // straight-through part's variance. At R = 8 on red cotton red gains too: docs/PERFORMANCE.md.)
-  const auto red = fiber_table3(4, [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-    const double s = wo.z > 0 ? (0.3 + 0.2 * std::max(0.0, wi.z)) * kInvPi : 0.1 * kInvPi;
-    v[0] = 0.9 * s, v[1] = 0.2 * s * (wo.z > 0), v[2] = 0.1 * s;
-  });
-  FabricRaytraceOptions o = options(3, 4000);
-  const auto a = raytrace_fabric_table(default_sample("fiber"), red, o);
-  o.seed = 2;
-  const auto b = raytrace_fabric_table(default_sample("fiber"), red, o);
-  const auto old = raytrace_fabric_table(default_sample("fiber"), red, sampled(o));
-  const double measured = compare_tables(a.table, b.table).overall.rel_rms;
-  const double stated =
-      std::sqrt(a.relative_noise * a.relative_noise + b.relative_noise * b.relative_noise);
-  EXPECT_NEAR(measured / stated, 1.0, 0.25) << measured << " vs " << stated;
-  const DirectionGrid g = a.table.grid();
-  const auto d = g.cosine_weighted_areas();
-  for (int c = 0; c < 3; ++c) {
-    double diff2 = 0, ref2 = 0;
-    for (int i = 0; i < g.bins(); ++i)
-      for (int k = 0; k < g.bins(); ++k) {
-        const size_t v = a.table.index(i, k, c);
-        diff2 += d[i] * d[k] * std::pow(a.table.values[v] - b.table.values[v], 2);
-        ref2 += d[i] * d[k] * std::pow(a.table.values[v], 2);
-      }
-    const double na = a.relative_noise_per_channel[c], nb = b.relative_noise_per_channel[c];
-    EXPECT_NEAR(std::sqrt(diff2 / ref2) / std::sqrt(na * na + nb * nb), 1.0, 0.25)
-        << "channel " << c;
-    if (c > 0)
-      EXPECT_LT(b.relative_noise_per_channel[c], 0.9 * old.relative_noise_per_channel[c])
-          << "channel " << c;
-  }
-}
-
-TEST(FabricRaytrace, ExactStraightThroughChangesOnlyTheStraightThroughCells) {
-  // The particles fly as before (the exact part has streams of its own), so every cell but the
-  // straight-through ones keeps its bits, and the books are the same; the straight-through cells
-  // change. The same bits at one and two threads, and in pieces.
-  const auto fiber = uniform_fiber(3, 0.4 * kInvPi);
-  const WovenSample sample = default_sample("fiber");
-  FabricRaytraceOptions o = options(2, 500);
-  o.threads = 1;
-  const auto exact = raytrace_fabric_table(sample, fiber, o);
-  const auto old = raytrace_fabric_table(sample, fiber, sampled(o));
-  EXPECT_EQ(exact.exited, old.exited);
-  EXPECT_EQ(exact.scatterings, old.scatterings);
-  const DirectionGrid g = exact.table.grid();
-  int changed = 0;
-  for (int i = 0; i < g.bins(); ++i)
-    for (int k = 0; k < g.bins(); ++k)
-      for (int c = 0; c < 3; ++c) {
-        const size_t v = exact.table.index(i, k, c);
-        if (straight_cell(g, i, k))
-          changed += exact.table.values[v] != old.table.values[v];
-        else
-          EXPECT_EQ(exact.table.values[v], old.table.values[v]) << i << ", " << k;
-      }
-  EXPECT_EQ(changed, 3 * g.bins());
-  o.threads = 2;
-  const auto two = raytrace_fabric_table(sample, fiber, o);
-  EXPECT_EQ(two.table.values, exact.table.values);
-  EXPECT_EQ(two.standard_error, exact.standard_error);
-  o.first_bin = 3;
-  o.bin_count = 2;
-  const auto piece = raytrace_fabric_table(sample, fiber, o);
-  const size_t row = static_cast<size_t>(g.bins()) * 3;
-  EXPECT_TRUE(std::equal(exact.table.values.begin() + 3 * row, exact.table.values.begin() + 5 * row,
-                         piece.table.values.begin() + 3 * row));
-  EXPECT_TRUE(std::equal(exact.standard_error.begin() + 3 * row,
-                         exact.standard_error.begin() + 5 * row,
-                         piece.standard_error.begin() + 3 * row));
-}
