@@ -256,6 +256,20 @@ void print_weave_summary(const nlohmann::json& w) {
               w.at("resolution").get<int>(), w.at("relative_noise").get<double>());
 }
 
+// The line without --json of what 1 % noise per channel would cost (noise_cost_summary).
+void print_noise_cost(const nlohmann::json& cost, const nlohmann::json& noise) {
+  std::printf("relative noise per channel");
+  for (const auto& n : noise) std::printf(" %.3g %%", 100 * n.get<double>());
+  std::printf("; 1 %% in each would take");
+  for (const auto& c : cost.at("cpu_seconds_to_target")) {
+    if (c.is_null())
+      std::printf(" -");
+    else
+      std::printf(" %.3g", c.get<double>());
+  }
+  std::printf(" CPU-s\n");
+}
+
 // The weave table of a ray trace with --weave-out, its --json keys added to 'extra'.
 WeaveTable take_weave(FabricRaytraceResult& res, const std::string& file, double bytes,
                       nlohmann::json& extra) {
@@ -315,7 +329,8 @@ int run(const BakeFabricOptions& o) {
   const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
   TabulatedBsdfTable table;
   nlohmann::json extra;
-  WeaveTable weave_table;  // with --weave-out
+  WeaveTable weave_table;                 // with --weave-out
+  std::vector<double> noise_per_channel;  // of a ray trace run whole in this process
   if (o.method == "raytrace") {
     FabricRaytraceResult res;
     if (!o.shard.empty() || o.resume) {
@@ -339,6 +354,7 @@ int run(const BakeFabricOptions& o) {
     table = res.table;
     record_particle_counts(table, res.splits, res.roulette_kills);
     extra = raytrace_summary(res);
+    if (!o.resume) noise_per_channel = res.relative_noise_per_channel;
     if (fibers.map.tables.size() > 1) extra["fiber_tables"] = fibers.summary();
     extra["estimator"] = r.next_event_rays > 0 ? "nee" : channel_sampling_name(r.channel_sampling);
     extra["next_event_rays"] = r.next_event_rays;
@@ -375,6 +391,9 @@ int run(const BakeFabricOptions& o) {
                       {"cpu_seconds", cpu_seconds}};
   j.update(fabric_table_summary(table));
   if (extra.is_object()) j.update(extra);
+  // A resumed run's CPU time is of its last part only: its cost of 1 % would be too low.
+  if (!noise_per_channel.empty())
+    j["noise_cost"] = noise_cost_summary(noise_per_channel, r.particles_per_bin, cpu_seconds);
   if (!note.empty()) j["notes"] = {note};
   if (scene_bytes > 0) j["scene_memory_estimate_bytes"] = scene_bytes;
   if (o.json) {
@@ -396,6 +415,8 @@ int run(const BakeFabricOptions& o) {
         "along the normal: reflected %.4f, transmitted %.4f (means over channels)\n",
         o.output.c_str(), o.method.c_str(), o.resolution, seconds, mean(normal.reflectance),
         mean(normal.transmittance), mean(view.reflectance), mean(view.transmittance));
+    if (j.contains("noise_cost"))
+      print_noise_cost(j["noise_cost"], j["relative_noise_per_channel"]);
     if (extra.contains("weave")) print_weave_summary(extra["weave"]);
   }
   return 0;

@@ -258,6 +258,28 @@ nlohmann::json raytrace_summary(const FabricRaytraceResult& res) {
           {"relative_noise_per_channel", res.relative_noise_per_channel}};
 }
 
+nlohmann::json noise_cost_summary(const std::vector<double>& relative_noise_per_channel,
+                                  uint64_t particles_per_bin, double cpu_seconds) {
+  if (!(cpu_seconds > 0) || !std::isfinite(cpu_seconds))
+    throw Error("", "cpu_seconds", "must be positive and finite to scale the noise's cost");
+  if (particles_per_bin == 0)
+    throw Error("", "particles_per_bin", "must be positive to scale the noise's cost");
+  constexpr double kTarget = 0.01;
+  nlohmann::json cpu = nlohmann::json::array(), particles = nlohmann::json::array();
+  for (double noise : relative_noise_per_channel) {
+    if (!(noise > 0) || !std::isfinite(noise)) {
+      cpu.push_back(nullptr), particles.push_back(nullptr);
+      continue;
+    }
+    const double scale = (noise / kTarget) * (noise / kTarget);
+    cpu.push_back(cpu_seconds * scale);
+    particles.push_back(std::ceil(static_cast<double>(particles_per_bin) * scale));
+  }
+  return {{"target_relative_noise", kTarget},
+          {"cpu_seconds_to_target", cpu},
+          {"particles_per_bin_to_target", particles}};
+}
+
 nlohmann::json fabric_table_summary(const TabulatedBsdfTable& table) {
   // Light arriving along the normal, where it goes; and what a view along the normal gathers
   // under uniform light (they differ for a non-reciprocal table, fabric_summation.h).

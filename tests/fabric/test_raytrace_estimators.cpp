@@ -14,6 +14,7 @@
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/fabric/fabric_parts.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/materials/classic_fiber.h"
 #include "weft/materials/table_compare.h"
@@ -277,4 +278,39 @@ TEST(FabricRaytrace, ExactStraightThroughChangesOnlyTheStraightThroughCells) {
   EXPECT_TRUE(std::equal(exact.standard_error.begin() + 3 * row,
                          exact.standard_error.begin() + 5 * row,
                          piece.standard_error.begin() + 3 * row));
+}
+
+TEST(FabricRaytrace, NoiseCostScalesTheRunToOnePercent) {
+  // bake fabric --json's noise_cost: a run's CPU seconds and particles scaled by (noise / 1 %)^2.
+  // Where the particles' noise dominates a channel (red here), the noise falls as
+  // 1/sqrt(particles): runs at 1 000 and 4 000 particles per bin project the same particles for
+  // 1 % within 25 %. Where the computed straight-through light's noise dominates (green and blue:
+  // little of them is scattered), it falls faster (its randomized lattice), so the projection is an
+  // upper bound: the smaller run's is not below the larger's. A channel without noise projects
+  // nothing (null); a cost without CPU time or particles is refused by name.
+  const auto red = fiber_table3(4, [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+    const double s = wo.z > 0 ? (0.3 + 0.2 * std::max(0.0, wi.z)) * kInvPi : 0.1 * kInvPi;
+    v[0] = 0.9 * s, v[1] = 0.2 * s * (wo.z > 0), v[2] = 0.1 * s;
+  });
+  const auto small = raytrace_fabric_table(default_sample("fiber"), red, options(3, 1000));
+  const auto large = raytrace_fabric_table(default_sample("fiber"), red, options(3, 4000));
+  const auto a = noise_cost_summary(small.relative_noise_per_channel, 1000, 2.0);
+  const auto b = noise_cost_summary(large.relative_noise_per_channel, 4000, 8.0);
+  ASSERT_EQ(a.at("particles_per_bin_to_target").size(), 3u);
+  for (int c = 0; c < 3; ++c) {
+    const double n = small.relative_noise_per_channel[c];
+    EXPECT_DOUBLE_EQ(a.at("cpu_seconds_to_target")[c].get<double>(), 2.0 * n * n / 1e-4);
+    const double pa = a.at("particles_per_bin_to_target")[c].get<double>(),
+                 pb = b.at("particles_per_bin_to_target")[c].get<double>();
+    if (c == 0)
+      EXPECT_NEAR(pa / pb, 1.0, 0.25) << pa << " vs " << pb;
+    else
+      EXPECT_GT(pa / pb, 0.9) << "channel " << c << ": " << pa << " vs " << pb;
+  }
+  const auto none = noise_cost_summary({0.02, 0.0}, 100, 1.0);
+  EXPECT_DOUBLE_EQ(none.at("cpu_seconds_to_target")[0].get<double>(), 4.0);
+  EXPECT_TRUE(none.at("cpu_seconds_to_target")[1].is_null());
+  EXPECT_THROW(noise_cost_summary({0.02}, 100, 0.0), Error);
+  EXPECT_THROW(noise_cost_summary({0.02}, 100, std::nan("")), Error);
+  EXPECT_THROW(noise_cost_summary({0.02}, 0, 1.0), Error);
 }

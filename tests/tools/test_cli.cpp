@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -338,6 +339,17 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
               std::to_string(j.at("roulette_kills").get<uint64_t>()));
     EXPECT_GT(j.at("roulette_kills").get<uint64_t>(), 0u);
     splits[est] = j.at("splits").get<uint64_t>();
+    // The cost of 1 % per channel follows from this run: its CPU seconds and particles scaled by
+    // (noise / 1 %)^2 (fabric_parts.h noise_cost_summary).
+    const auto& cost = j.at("noise_cost");
+    for (size_t c = 0; c < 3; ++c) {
+      const double n = j.at("relative_noise_per_channel")[c].get<double>();
+      EXPECT_NEAR(cost.at("cpu_seconds_to_target")[c].get<double>(),
+                  j.at("cpu_seconds").get<double>() * n * n / 1e-4,
+                  1e-9 * cost.at("cpu_seconds_to_target")[c].get<double>());
+      EXPECT_EQ(cost.at("particles_per_bin_to_target")[c].get<double>(),
+                std::ceil(400 * n * n / 1e-4));
+    }
   }
   // Red cotton's fiber weights exceed 1 along a line near the axis: the hero estimator splits.
   EXPECT_GT(splits["hero"], 0u);

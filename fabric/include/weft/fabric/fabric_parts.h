@@ -46,5 +46,12 @@ FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<d
 // fabric table (resolution, sample, albedo at normal incidence): one list of keys for both.
 nlohmann::json raytrace_summary(const FabricRaytraceResult& result);
 nlohmann::json fabric_table_summary(const TabulatedBsdfTable& table);
+// What a ray trace's run says 1 % relative noise per channel costs: its CPU seconds and
+// particles per incident bin scaled by (noise / 0.01)^2, the noise falling as 1/sqrt(particles)
+// (the particles are independent; the computed straight-through light's rays grow with them).
+// Null per channel where the channel has no noise to scale (no signal). weft::Error for CPU
+// seconds or particles that are not positive and finite.
+nlohmann::json noise_cost_summary(const std::vector<double>& relative_noise_per_channel,
+                                  uint64_t particles_per_bin, double cpu_seconds);
 
 }  // namespace weft
