@@ -43,6 +43,7 @@ struct BakeFabricOptions {
   std::optional<uint64_t> samples;  // the method's default unless given
   uint64_t seed = 1;
   std::optional<double> split_threshold;  // the library's default unless given
+  std::optional<int> max_scatterings;     // the library's default unless given
   std::optional<int> next_event_rays;     // --estimator nee: kDefaultNextEventRays unless given
   std::optional<int> launch_lattice;      // --estimator nee: kDefaultLaunchLattice unless given
   std::string weave_out;                  // the weave table (.exr); "" = no weave tally
@@ -190,6 +191,7 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
                       std::to_string(r.roulette_threshold) + ", got " +
                       std::to_string(r.split_threshold));
   }
+  if (o.max_scatterings) r.max_scatterings = *o.max_scatterings;
   weave_tally_options(o, r);
   r.validate();
   return r;
@@ -219,6 +221,8 @@ void check_method_options(const BakeFabricOptions& o) {
                     " direction pairs per cell pair, got " + std::to_string(*o.samples));
   if (o.method != "raytrace" && !o.straight_through.empty())
     throw Error("", "--straight-through", "the ray tracer's: it needs --method raytrace");
+  if (o.method != "raytrace" && o.max_scatterings)
+    throw Error("", "--max-scatterings", "the ray tracer's: it needs --method raytrace");
   if (o.method != "raytrace" && o.split_threshold)
     throw Error("", "--split-threshold",
                 "splitting is the ray tracer's: it needs --method raytrace");
@@ -482,6 +486,12 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
                   "raytrace, hero: split a particle whose largest channel weight exceeds this "
                   "(default " +
                       std::to_string(FabricRaytraceOptions{}.split_threshold) + ")");
+  sub->add_option("--max-scatterings", o->max_scatterings,
+                  "raytrace: a particle ends at its Nth scattering, its weight booked as lost, so "
+                  "the table holds the paths of fewer (what each order of scattering carries; "
+                  "default " +
+                      std::to_string(FabricRaytraceOptions{}.max_scatterings) + ")")
+      ->check(CLI::Range(1, 1000000));
   sub->add_option("--weave-out", o->weave_out,
                   "raytrace: also the weave table (.exr): how the cloth varies over its repeat, "
                   "the exits binned by where they cross the cloth's mid-plane (with --shard, the "

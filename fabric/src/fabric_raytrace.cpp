@@ -525,6 +525,9 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
   if (o.launch_lattice > 1) table.metadata["launch_lattice"] = std::to_string(o.launch_lattice);
   if (o.straight_through != StraightThrough::sampled)
     table.metadata["straight_through"] = straight_through_name(o.straight_through);
+  // A table of paths cut short says so (only then, so that other tables keep their bytes).
+  if (o.max_scatterings != FabricRaytraceOptions{}.max_scatterings)
+    table.metadata["max_scatterings"] = std::to_string(o.max_scatterings);
   if (o.channel_sampling != ChannelSampling::mean) {
     char text[32];
     const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;

@@ -376,6 +376,28 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   const std::string sum = "bake fabric --fiber '" + fiber.string() + "' --method summation -R 2";
   expect_refused(sum + " --estimator hero", out, "--estimator", dir);
   expect_refused(sum + " --split-threshold 2", out, "--split-threshold", dir);
+  expect_refused(sum + " --max-scatterings 2", out, "--max-scatterings", dir);
+
+  // --max-scatterings 1 ends every particle at its first fiber: the table holds the light that
+  // passes straight through alone (grey: the same in every channel), what met a fiber is booked
+  // as lost, and the table says it was cut.
+  const fs::path cut = dir / "cut.exr";
+  const CliRun c = run(base + " --max-scatterings 1 -o '" + cut.string() + "'", dir);
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const auto jc = nlohmann::json::parse(c.out);
+  EXPECT_GT(jc.at("lost").get<double>(), 0.1);
+  EXPECT_GT(jc.at("scatterings").get<uint64_t>(), 0u);  // at most one per particle
+  EXPECT_LE(jc.at("scatterings").get<uint64_t>(), jc.at("particles").get<uint64_t>());
+  const auto tc = weft::TabulatedBsdfTable::read_exr(cut);
+  EXPECT_EQ(tc.metadata.at("max_scatterings"), "1");
+  for (size_t v = 0; v + 2 < tc.values.size(); v += 3) {
+    ASSERT_EQ(tc.values[v], tc.values[v + 1]) << v;
+    ASSERT_EQ(tc.values[v], tc.values[v + 2]) << v;
+  }
+  const CliRun zero = run(base + " --max-scatterings 0 -o '" + out.string() + "'", dir);
+  EXPECT_NE(zero.exit_code, 0);  // the option parser's refusal, naming the option
+  EXPECT_NE(zero.err.find("--max-scatterings"), std::string::npos) << zero.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(Cli, ExportWritesTheFormatItsExtensionNamesAndRefusesOthers) {
