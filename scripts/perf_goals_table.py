@@ -1,0 +1,112 @@
+#!/usr/bin/env python3
+"""The table of scripts/perf-goals.sh: reads the programs' outputs in OUT and writes OUT/goals.md
+and OUT/goals.json. Usage: perf_goals_table.py OUT BASELINE_REVISION SEEDS"""
+import json
+import os
+import sys
+
+TARGET = 0.01  # relative noise or error the goals are stated at
+
+
+def read_json(path):
+    with open(path) as f:
+        return json.load(f)
+
+
+def number(path):
+    with open(path) as f:
+        return float(f.read().split()[0])
+
+
+def have(out, name):
+    return os.path.exists(os.path.join(out, name + ".time"))
+
+
+def raytrace(out, seeds):
+    """CPU seconds to 1 % per channel, mean over the seeds, before and after."""
+    cost = {}
+    for who in ("before", "after"):
+        per_seed = []
+        for seed in range(1, seeds + 1):
+            name = "raytrace-%s-%d" % (who, seed)
+            j = read_json(os.path.join(out, name + ".out"))
+            cpu = number(os.path.join(out, name + ".cpu"))
+            per_seed.append([cpu * (n / TARGET) ** 2 for n in j["relative_noise_per_channel"]])
+        cost[who] = [sum(s[c] for s in per_seed) / seeds for c in range(len(per_seed[0]))]
+    rows = []
+    for c, label in enumerate("RGB"):
+        b, a = cost["before"][c], cost["after"][c]
+        rows.append(("fabric ray trace, CPU-s to 1 %% %s" % label, b, a, b / a))
+    return rows
+
+
+def bake(out):
+    """Photons per band and CPU seconds for a 1 % table error: each program's default bake. CPU
+    per photon is the process's CPU over all photons it baked (every variant is baked at the same
+    counts), for both programs alike."""
+    rows, figures = [], {}
+    for who in ("before", "after"):
+        j = read_json(os.path.join(out, "bake-%s.out" % who))
+        v = j["variants"][0] if "variants" in j else j
+        photons = sum(r["photons_per_band"] for r in v["runs"]) * j["seeds"]
+        variants = len(j["variants"]) if "variants" in j else 1
+        cpu = number(os.path.join(out, "bake-%s.cpu" % who)) / variants
+        figures[who] = (v["photons_per_band_for_target"], cpu / photons * v["photons_per_band_for_target"],
+                        v.get("estimator", "plain"))
+    (pb, cb, nb), (pa, ca, na) = figures["before"], figures["after"]
+    rows.append(("fiber bake, photons per band to 1 %% (%s → %s)" % (nb, na), pb, pa, pb / pa))
+    rows.append(("fiber bake, CPU-s to 1 %", cb, ca, cb / ca))
+    return rows
+
+
+def render(out):
+    rows = []
+    before = read_json(os.path.join(out, "render-before.out"))["scenes"]
+    after = read_json(os.path.join(out, "render-after.out"))["scenes"]
+    for b, a in zip(before, after):
+        rows.append(("path tracer / bare Embree, %s" % a["name"], b["ratio_replay"], a["ratio_replay"],
+                     a["ratio_replay"] / b["ratio_replay"]))
+    return rows
+
+
+def fit(out):
+    rows = []
+    for who in ("before", "after"):
+        if not have(out, "fit-" + who):
+            continue
+        wall = number(os.path.join(out, "fit-%s.wall" % who))
+        m = read_json(os.path.join(out, "fit-%s" % who, "fit", "metrics.json"))
+        conv = ", ".join("%s %s in %d" % (k, "converged" if f["converged"] else "not converged",
+                                          f["evaluations"]) for k, f in m.get("fit", {}).items())
+        rows.append(("verify --quality default --fit (%s), wall s; %s" % (who, conv), wall, None, None))
+    return rows
+
+
+def fmt(x):
+    if x is None:
+        return "–"
+    return "%.3g" % x
+
+
+def main():
+    out, rev, seeds = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    rows = []
+    if have(out, "raytrace-after-1"):
+        rows += raytrace(out, seeds)
+    if have(out, "bake-after"):
+        rows += bake(out)
+    if have(out, "render-after"):
+        rows += render(out)
+    rows += fit(out)
+    with open(os.path.join(out, "goals.json"), "w") as f:
+        json.dump([{"figure": r[0], "before": r[1], "after": r[2], "gain": r[3]} for r in rows], f,
+                  indent=2)
+    with open(os.path.join(out, "goals.md"), "w") as f:
+        f.write("| figure | before (%s) | after | gain |\n| --- | --- | --- | --- |\n" % rev)
+        for r in rows:
+            f.write("| %s | %s | %s | %s |\n" % (r[0], fmt(r[1]), fmt(r[2]),
+                                                 "–" if r[3] is None else "%.2f×" % r[3]))
+
+
+if __name__ == "__main__":
+    main()
