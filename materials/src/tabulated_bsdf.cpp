@@ -295,7 +295,7 @@ const std::vector<Distribution2D>& TabulatedBsdfData::cell_sampling() const {
     std::vector<double> cos_avg = grid.cosine_weighted_areas();
     for (double& c : cos_avg) c /= grid.bin_solid_angle();
     const FineGrid fine = fine_grid(grid.resolution);
-    // One thread: this may run inside a render's worker (a few ms at R = 8).
+    // One thread: this may run inside a render's worker (one pass over wo bin x fine cell).
     cell_sampling_built.resize(n);
     for (int wo = 0; wo < n; ++wo)
       cell_sampling_built[wo] = wi_sampling(grid, wo, mean, blur, cos_avg, fine, TableLookup::cell);
