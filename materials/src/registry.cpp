@@ -137,12 +137,15 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
   if (kind == "fiber")
     p.reject_unused("backing_reflectance", "applies only to fabric_table (a cloth on a backing)");
   // Fiber tables only: a fabric table's backing and albedos are those of the interpolated table.
-  TableLookup lookup = TableLookup::bilinear;
+  TableLookup lookup = TableLookup::bilinear, sampling = TableLookup::bilinear;
   if (kind == "fiber") {
-    if (p.choice("interpolation", "bilinear", {"bilinear", "cell"}) == "cell")
-      lookup = TableLookup::cell;
+    const std::string read = p.choice("interpolation", "bilinear", {"bilinear", "cell"});
+    if (read == "cell") lookup = TableLookup::cell;
+    // What the sampling density follows within a cell: by default what eval reads.
+    if (p.choice("sampling", read, {"bilinear", "cell"}) == "cell") sampling = TableLookup::cell;
   } else {
     p.reject_unused("interpolation", "applies only to fiber_table");
+    p.reject_unused("sampling", "applies only to fiber_table");
   }
   std::optional<WeaveParams> weave = read_weave_params(p, ctx, kind);
   p.finish();
@@ -156,6 +159,7 @@ Bsdf make_table_bsdf(ParamReader& p, const MaterialContext& ctx, const std::stri
     throw Error(p.file(), p.field(key),
                 file.string() + " holds a " + data->kind + " table, expected a " + kind + " table");
   TabulatedBsdf bsdf{data, tint * scale, lookup};
+  bsdf.sampling = sampling;
   if (weave) bsdf.weave = load_table_weave(p, ctx, std::move(*weave), *data);
   if (backing) {
     try {

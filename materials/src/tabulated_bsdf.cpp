@@ -192,11 +192,23 @@ void add_albedos(TabulatedBsdfData& data) {
   }
 }
 
+// The shape of the sampling density for wo bin 'wo' read by cell: the cell pair's channel mean
+// times |cos| of each fine cell, f cos itself where f is the cell's value.
+std::vector<double> cell_shape(int n, int wo, const std::vector<float>& mean,
+                               const FineGrid& fine) {
+  std::vector<double> shape(fine.fn);
+  for (int s = 0; s < fine.fn; ++s)
+    shape[s] =
+        std::max(0.0, static_cast<double>(mean[cell_at(n, fine.coarse_of[s], wo)])) * fine.cos[s];
+  return shape;
+}
+
 // The sampling density over fine wi cells for wo bin 'wo': a share kSamplingCoverage flat over
-// each table cell, the rest following the interpolated f cos.
+// each table cell, the rest following f cos, interpolated (follow bilinear) or the cell's own
+// value (follow cell).
 Distribution2D wi_sampling(const DirectionGrid& grid, int wo, const std::vector<float>& mean,
                            const std::vector<float>& blur, const std::vector<double>& cos_avg,
-                           const FineGrid& fine) {
+                           const FineGrid& fine, TableLookup follow) {
   const int n = grid.bins(), fn = fine.fn, k = fine.k;
   // Coverage: per table cell, cos_avg * (m + m3) / 2, which is > 0 wherever the interpolated f
   // can be for any wo in this bin.
@@ -215,13 +227,19 @@ Distribution2D wi_sampling(const DirectionGrid& grid, int wo, const std::vector<
         grid.chart_point(wo, 0.25 + 0.5 * (q % 2), 0.25 + 0.5 * (q / 2)));
   std::vector<double> shape(fn);
   double shape_sum = 0;
-  for (int s = 0; s < fn; ++s) {
-    double v = 0;
-    for (const Vec3& o_dir : wo_at)
-      for_each_interpolated_cell(grid, o_dir, fine.dir[s],
-                                 [&](int i, int o, double w) { v += mean[cell_at(n, i, o)] * w; });
-    shape[s] = std::max(0.0, v) * fine.cos[s];
-    shape_sum += shape[s];
+  if (follow == TableLookup::cell) {
+    shape = cell_shape(n, wo, mean, fine);
+    for (double v : shape) shape_sum += v;
+  } else {
+    for (int s = 0; s < fn; ++s) {
+      double v = 0;
+      for (const Vec3& o_dir : wo_at)
+        for_each_interpolated_cell(grid, o_dir, fine.dir[s], [&](int i, int o, double w) {
+          v += mean[cell_at(n, i, o)] * w;
+        });
+      shape[s] = std::max(0.0, v) * fine.cos[s];
+      shape_sum += shape[s];
+    }
   }
   std::vector<double> w(fn, 0.0);
   if (cell_sum > 0) {
@@ -261,9 +279,28 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
   data->sampling.resize(n);
   parallel_for(static_cast<uint64_t>(n), 0, [&](uint64_t task) {
     const int wo = static_cast<int>(task);
-    data->sampling[wo] = wi_sampling(grid, wo, mean, blur, cos_avg, fine);
+    data->sampling[wo] = wi_sampling(grid, wo, mean, blur, cos_avg, fine, TableLookup::bilinear);
   });
   return data;
+}
+
+const std::vector<Distribution2D>& TabulatedBsdfData::cell_sampling() const {
+  std::call_once(cell_sampling_once, [this] {
+    // The channel means again, from the stored RGB (prepare's own are not kept).
+    const int n = grid.bins();
+    std::vector<float> mean(rgb.size() / 3);
+    for (size_t c = 0; c < mean.size(); ++c)
+      mean[c] = static_cast<float>((double(rgb[3 * c]) + rgb[3 * c + 1] + rgb[3 * c + 2]) / 3);
+    const std::vector<float> blur = neighbourhood_means(grid, mean);
+    std::vector<double> cos_avg = grid.cosine_weighted_areas();
+    for (double& c : cos_avg) c /= grid.bin_solid_angle();
+    const FineGrid fine = fine_grid(grid.resolution);
+    // One thread: this may run inside a render's worker (one pass over wo bin x fine cell).
+    cell_sampling_built.resize(n);
+    for (int wo = 0; wo < n; ++wo)
+      cell_sampling_built[wo] = wi_sampling(grid, wo, mean, blur, cos_avg, fine, TableLookup::cell);
+  });
+  return cell_sampling_built;
 }
 
 Rgb TabulatedBsdf::eval_table(const Vec3& wo, const Vec3& wi) const {
@@ -303,9 +340,14 @@ Rgb TabulatedBsdf::eval(const Vec3& wo, const Vec3& wi) const {
   return eval_table(wo, wi) + eval_backing(wo, wi);
 }
 
+const Distribution2D& TabulatedBsdf::distribution(const Vec3& wo) const {
+  const int bin = data->grid.bin_of(wo);
+  return sampling == TableLookup::cell ? data->cell_sampling()[bin] : data->sampling[bin];
+}
+
 double TabulatedBsdf::pdf_table(const Vec3& wo, const Vec3& wi) const {
   const DirectionGrid& grid = data->grid;
-  const Distribution2D& dist = data->sampling[grid.bin_of(wo)];
+  const Distribution2D& dist = distribution(wo);
   if (dist.integral() == 0) return 0;
   // The density is constant over each fine cell: evaluate it at the centre of the fine cell that
   // holds wi, taken within the table cell the grid assigns, so the table cell is decided by
@@ -322,7 +364,7 @@ double TabulatedBsdf::pdf_table(const Vec3& wo, const Vec3& wi) const {
 
 TabulatedBsdf::BackedLobes TabulatedBsdf::backed_lobes(const Vec3& wo) const {
   BackedLobes l;
-  const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
+  const Distribution2D& dist = distribution(wo);
   // The upper hemisphere is the first half of the chart's rows.
   if (dist.integral() > 0) l.upper_mass = dist.marginal().cdf(dist.nv() / 2);
   const double table =
@@ -350,7 +392,7 @@ double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
 
 std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double u_lobe) const {
   if (!data) return std::nullopt;
-  const Distribution2D& dist = data->sampling[data->grid.bin_of(wo)];
+  const Distribution2D& dist = distribution(wo);
   Vec3 wi;
   double p = 0;
   if (!backing) {

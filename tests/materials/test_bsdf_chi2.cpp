@@ -67,7 +67,7 @@ const double kMeasuredAngles[] = {20, 70, 45};
 
 constexpr int kChi2Tests = 1 /* self-test acceptance */ + std::size(kLambertAngles) +
                            std::size(kCookTorranceCases) + std::size(kClassicFiberCases) +
-                           2 * std::size(kTableWo) + 2 /* backed table, wo above */ +
+                           3 * std::size(kTableWo) + 2 /* backed table, wo above */ +
                            std::size(kMeasuredAngles);
 const double kSignificance = sidak_significance(0.01, kChi2Tests);
 
@@ -168,7 +168,10 @@ TEST(Chi2, FiberAndFabricTables) {
   // Histogram on the tables' own cells (R = 8, see chi2.h): the pdf is constant on each.
   const DirectionGridBins grid{8, 4};
   uint64_t seed = 400;
-  for (const Bsdf& b : {Bsdf(fiber_like_table()), Bsdf(fabric_like_table())}) {
+  // The fiber table also read and sampled by cell (fiber_table "interpolation": "cell").
+  TabulatedBsdf by_cell = fiber_like_table();
+  by_cell.lookup = by_cell.sampling = TableLookup::cell;
+  for (const Bsdf& b : {Bsdf(fiber_like_table()), Bsdf(fabric_like_table()), Bsdf(by_cell)}) {
     for (const Vec3& wo : kTableWo) {
       const auto r =
           chi2_test(bsdf_sampler(b, wo), bsdf_pdf(b, wo), grid, kSamples, kSignificance, seed++);

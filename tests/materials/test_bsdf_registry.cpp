@@ -98,6 +98,14 @@ TEST(Registry, ParametersReachTheMaterial) {
   const auto& tc = std::get<TabulatedBsdf>(cell.variant());
   const auto& tb = std::get<TabulatedBsdf>(t2.variant());
   EXPECT_EQ(tc.lookup, TableLookup::cell);
+  // Sampling follows what eval reads unless "sampling" says otherwise (tabulated_bsdf.h).
+  EXPECT_EQ(tc.sampling, TableLookup::cell);
+  EXPECT_EQ(std::get<TabulatedBsdf>(t2.variant()).sampling, TableLookup::bilinear);
+  const Bsdf cell_old = make_bsdf(
+      "fiber_table",
+      {{"file", "tables/fiber.exr"}, {"interpolation", "cell"}, {"sampling", "bilinear"}}, ctx);
+  EXPECT_EQ(std::get<TabulatedBsdf>(cell_old.variant()).lookup, TableLookup::cell);
+  EXPECT_EQ(std::get<TabulatedBsdf>(cell_old.variant()).sampling, TableLookup::bilinear);
   const DirectionGrid& g = tc.data->grid;
   int differ = 0;
   for (int k = 0; k < 200; ++k) {
@@ -152,6 +160,10 @@ TEST(Registry, BadParametersAreNamed) {
                "interpolation");
   expect_error("fabric_table", {{"file", "tables/fabric.exr"}, {"interpolation", "cell"}}, ctx,
                "interpolation", "only to fiber_table");
+  expect_error("fiber_table", {{"file", "tables/fiber.exr"}, {"sampling", "nearest"}}, ctx,
+               "sampling", "bilinear, cell");
+  expect_error("fabric_table", {{"file", "tables/fabric.exr"}, {"sampling", "cell"}}, ctx,
+               "sampling", "only to fiber_table");
   expect_error("measured_nbrdf", {{"name", "blue-fabric"}}, ctx, "name", "merl-white-fabric");
   expect_error("measured_nbrdf", json::object(), ctx, "name", "exactly one");
   expect_error("measured_nbrdf", {{"file", "nbrdf.txt"}}, ctx, "file", "nbrdf.txt");

@@ -43,8 +43,9 @@ namespace weft {
 // The path tracer's revision, raised whenever a change alters its images for the same inputs:
 // part of a split or resumed sweep's identity (parts of another revision are refused, not
 // merged). 2: rays leaving a fiber pass through its continuation across a tile's side, which
-// revision 1 took for a wall (render_scene.h intersect).
-inline constexpr int kPathTracerRevision = 2;
+// revision 1 took for a wall (render_scene.h intersect). 3: a fiber table read by cell is sampled
+// by its cells' values (tabulated_bsdf.h; same mean, other bits).
+inline constexpr int kPathTracerRevision = 3;
 
 struct RayCounts {
   uint64_t camera = 0, bounce = 0, shadow = 0;

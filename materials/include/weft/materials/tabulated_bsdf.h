@@ -18,9 +18,14 @@
 //     cells, where m is the channel mean of the table and m3 its mean over the 3 x 3
 //     neighbourhoods of b and of c within their hemispheres (what bilinear eval can reach): it
 //     makes pdf > 0 wherever the interpolated f > 0, for any wo in b.
-// cos_avg is the mean |cos theta| over a cell. wi is uniform (in solid angle) within the chosen
-// fine cell. pdf(wo, wi) = p_chart(wi | bin(wo)) / (4 pi), the fine cell taken within the table
-// cell that DirectionGrid assigns wi, as sample does.
+// cos_avg is the mean |cos theta| over a cell. A table read by cell (TableLookup::cell) is
+// sampled by default with the shape taken from the cell pair's own value instead, cos_avg(s) *
+// m(b, c(s)) (TabulatedBsdfData::cell_sampling): that is f cos itself up to cos within a fine
+// cell, where the interpolated shape, peaked inside a cell whose read value is flat, gave the
+// weights f cos / pdf of the cell's edges several times the albedo (fireflies in the fiber-level
+// renders: docs/fabric-bsdf.md, "Noise of the fiber-level renders"). wi is uniform (in solid
+// angle) within the chosen fine cell. pdf(wo, wi) = p_chart(wi | bin(wo)) / (4 pi), the fine cell
+// taken within the table cell that DirectionGrid assigns wi, as sample does.
 //
 // Backing (fabric_table's backing_reflectance; docs/scenes.md): the cloth lies on an opaque
 // Lambertian backing of albedo rho_b (upholstery foam). Light the cloth transmits downwards
@@ -44,6 +49,7 @@
 // wi above the cloth) or a cosine lobe for the backing term, chosen with probability in
 // proportion to each part's albedo for this wo.
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -84,6 +90,14 @@ struct TabulatedBsdfData {
 
   // Reduces a (validated) table to RGB and builds the per-wo-bin sampling distributions.
   static std::shared_ptr<const TabulatedBsdfData> prepare(const TabulatedBsdfTable& table);
+
+  // The per-wo-bin distributions whose shape follows the cell pairs' own values (for tables read
+  // by cell; the top of this file), same fine cells and coverage as 'sampling'. Built on first
+  // use, once, whichever thread asks (the same values either way): most tables are never read
+  // by cell, and the distributions take as much memory as 'sampling'.
+  const std::vector<Distribution2D>& cell_sampling() const;
+  mutable std::once_flag cell_sampling_once;
+  mutable std::vector<Distribution2D> cell_sampling_built;
 
   // A per-bin quantity interpolated at direction w like eval interpolates f over wo.
   Rgb interpolate(const std::vector<Rgb>& per_bin, const Vec3& w) const;
@@ -138,6 +152,9 @@ struct TabulatedBsdf {
   // fabric_table's weave (weave_modulation.h); null for every other table. This BSDF is the
   // table level; the renderer binds the weave level to a hit (bound_bsdf.h).
   std::shared_ptr<const TableWeave> weave = nullptr;
+  // What the sampling density follows within a table cell: the interpolated f (bilinear) or the
+  // cell pair's own value (cell). fiber_table's "sampling", by default its "interpolation".
+  TableLookup sampling = TableLookup::bilinear;
 
   Rgb eval(const Vec3& wo, const Vec3& wi) const;
   std::optional<BsdfSample> sample(const Vec3& wo, Vec2 u, double u_lobe) const;
@@ -152,6 +169,7 @@ struct TabulatedBsdf {
  private:
   Rgb eval_table(const Vec3& wo, const Vec3& wi) const;
   double pdf_table(const Vec3& wo, const Vec3& wi) const;
+  const Distribution2D& distribution(const Vec3& wo) const;
   // With a backing: the probability of sampling the table's reflection part for wo, and that
   // part's share of the table's sampling distribution (wi above the cloth).
   struct BackedLobes {
