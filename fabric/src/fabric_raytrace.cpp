@@ -13,6 +13,7 @@
 #include "weft/core/task_batch.h"
 #include "weft/fabric/fiber_sampler.h"
 #include "weft/fabric/raytrace_steps.h"
+#include "weft/fabric/recorded_paths.h"
 #include "weft/fabric/straight_through.h"
 #include "weft/fabric/weave_tally.h"
 #include "weft/scenes/render_scene.h"
@@ -187,7 +188,13 @@ struct Tracer {
   std::vector<YarnShading> shadings{};
   std::vector<int> table_of_curve{}, table_of_mesh{};
   const WeaveLayout* weave = nullptr;  // the weave tally, when on
+  bool record = false;                 // the steps into each task's path_ops (recorded_paths.h)
 };
+
+// A step of the particle's life into its task's record, when recording.
+void record_op(const Tracer& t, Tally& tally, PathOp op) {
+  if (t.record) tally.path_ops.push_back(op);
+}
 
 // The shading of the yarn the particle's line met at h: its fiber's (fiber detail, the same fiber
 // in every copy of the repeat) or its tube's (yarn detail, the instanced mesh).
@@ -222,6 +229,7 @@ struct TaskScratch {
 void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d,
                std::span<const double> w) {
   const uint64_t cell = exit_cell(t.grid, life.bin, d);
+  record_op(t, *life.tally, {0, static_cast<int64_t>(cell), 0, PathOp::book});
   tally_exit(*life.tally, life.first_exit, cell, w);
   if (t.weave) {
     const int exit_bin = static_cast<int>(cell - static_cast<uint64_t>(life.bin) * t.grid.bins());
@@ -271,9 +279,16 @@ bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Pa
     return false;
   }
   const FiberPoint& pt = x.pts[draw->point];
-  books.absorbed += weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, s_sum, s);
-  if (!h.on_fiber() && y.tube)
+  double mean_pdf = 0;
+  books.absorbed +=
+      weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, s_sum, s, &mean_pdf);
+  record_op(t, *life.tally, {mean_pdf, pt.bin, draw->exit_bin, PathOp::scatter});
+  if (!h.on_fiber() && y.tube) {
+    record_op(t, *life.tally,
+              {dot(s.d, x.pts[0].hit.shading.s), x.pts[0].bin, x.count > 1 ? x.pts[1].bin : -1,
+               PathOp::tube});
     books.absorbed += weigh_as_round_fiber(*y.tube, t.tube_proposal, x, s.d, s);
+  }
   leave_fiber(pt.hit, draw->wo_local, s);
   s.scattered = true;
   ++books.scatterings;
@@ -290,8 +305,10 @@ bool keep_in_window(const Tracer& t, Life& life, Particle& s, std::vector<Partic
                     Rng& rng) {
   const Steering w = steering_of(s);
   const double steer = t.window ? w.max_w : w.mean_p;
-  if (!survives_roulette(steer, t.o.roulette_threshold, w.mean_w, s, *life.books, rng))
+  double divided_by = 0;
+  if (!survives_roulette(steer, t.o.roulette_threshold, w.mean_w, s, *life.books, rng, &divided_by))
     return false;
+  if (divided_by > 0) record_op(t, *life.tally, {divided_by, 0, 0, PathOp::divide});
   // Splitting above the window: a fiber's albedo along one line, A' + A'', exceeds 1 where the
   // line runs near its axis (up to ~3 in red for red cotton), so weights grow along a path; a few
   // heavy paths would carry much of the table. n copies of weight w / n each, which go their own
@@ -299,6 +316,7 @@ bool keep_in_window(const Tracer& t, Life& life, Particle& s, std::vector<Partic
   const int max_copies = t.o.max_copies_per_particle;
   if (t.window && w.max_w > t.o.split_threshold && life.copies < max_copies) {
     const int n = split_count(w.max_w, t.o.split_threshold, max_copies - life.copies);
+    record_op(t, *life.tally, {0, n, 0, PathOp::split});
     split(s, n, pending);
     life.books->splits += n - 1;
     life.copies += n - 1;
@@ -372,9 +390,11 @@ void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t u
   life.first_exit = unit_first;
   scratch.pending.clear();
   scratch.pending.push_back(launched_particle(l, t.nc, life.st, t.proposal));
+  record_op(t, tally, {l.w0, 0, 0, PathOp::launch});
   while (!scratch.pending.empty()) {
     Particle s = std::move(scratch.pending.back());
     scratch.pending.pop_back();
+    record_op(t, tally, {0, 0, 0, PathOp::pop});
     follow(t, life, s, scratch, rng);
   }
 }
@@ -392,8 +412,10 @@ void trace_task(const Tracer& t, uint64_t first, uint64_t count, Rng& rng, Tally
     const int bin = static_cast<int>(k / t.per_bin);
     Tally& tally = k >= t.first_item && k < t.last_item ? task_tally : outside;
     // A sample unit (a particle, or a launch block's part in this task) starts here.
-    if (&tally != last || (k - t.per_bin * static_cast<uint64_t>(bin)) % t.o.launch_lattice == 0)
+    if (&tally != last || (k - t.per_bin * static_cast<uint64_t>(bin)) % t.o.launch_lattice == 0) {
       unit_first = tally.exits.size();
+      record_op(t, tally, {0, 0, 0, PathOp::unit});
+    }
     last = &tally;
     trace_particle(t, k, bin, tally, unit_first, scratch, rng);
   }
@@ -685,9 +707,27 @@ CellSums straight_through_sums(const Tracer& t, WeaveSums& weave) {
   return exact;
 }
 
-// The ray trace with the distinct tables f (one: the single-table call, bit for bit).
+// What a recording keeps of its trace (recorded_paths.h) besides the tasks' steps.
+void keep_record(const Tracer& t, const TabulatedBsdfTable& fiber, const CellSums& exact,
+                 const std::vector<uint64_t>& units, const FabricRaytraceResult& result,
+                 RecordedFabricPaths& record) {
+  record.options = t.o;
+  record.options.proposal = nullptr;
+  record.proposal_checksum = fiber.checksum();
+  record.fiber_resolution = fiber.resolution;
+  record.channels = t.nc;
+  record.yarn_tubes = t.tube != nullptr;
+  record.exact_sum = exact.sum;
+  record.exact_sum2 = exact.sum2;
+  record.units = units;
+  record.traced = result;
+}
+
+// The ray trace with the distinct tables f (one: the single-table call, bit for bit), its steps
+// into 'record' where given.
 FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
-                           const FabricRaytraceOptions& o, const ProgressCallback& progress) {
+                           const FabricRaytraceOptions& o, const ProgressCallback& progress,
+                           RecordedFabricPaths* record = nullptr) {
   const TabulatedBsdfTable& fiber = *f.tables[0];
   const bool per_yarn = f.tables.size() > 1;
   o.validate();
@@ -718,6 +758,7 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   }
   PerYarnHeld held;
   if (per_yarn) shade_per_yarn(sample, f, t, held);
+  t.record = record != nullptr;
   const int bins = t.grid.bins(), nc = t.nc;
   CellSums sums{std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0),
                 std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0)};
@@ -735,18 +776,21 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
       [&](uint64_t, uint64_t first, uint64_t count, Rng& rng, Tally& tally) {
         trace_task(t, first, count, rng, tally);
       },
-      [&](const Tally& tally) {
+      [&](Tally& tally) {
         add_task(tally, nc, sums, result);
         if (weave) add_weave_task(*weave, tally.weave, weave_sums);
+        if (record) record->tasks.push_back(std::move(tally.path_ops));
       });
   result.cancelled = status.cancelled;
   std::vector<uint64_t> units(bins);
   const uint64_t per_task = batch_for(t, progress).items_per_task;
   for (int a = 0; a < bins; ++a) units[a] = sample_units(t, per_task, a);
   WeaveSums weave_exact;  // the computed straight-through light's part of the weave, if any
-  tabulate(sums, straight_through_sums(t, weave_exact), t.grid, nc, t.per_bin, units, result);
+  const CellSums exact = straight_through_sums(t, weave_exact);
+  tabulate(sums, exact, t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
+  if (record) keep_record(t, fiber, exact, units, result, *record);
   if (per_yarn) describe_per_yarn(f, result.table);
   if (weave) {
     weave_bin_books(*weave, weave_sums, weave_exact, t.per_bin, units, result);
@@ -755,8 +799,77 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   return result;
 }
 
+// The recorded paths re-weighted for 'fiber' (reweight_fabric_paths): the trace's batch of tasks,
+// each task's steps replayed into its tally, the tallies summed and tabulated as the trace does.
+FabricRaytraceResult reweight(const RecordedFabricPaths& p, const TabulatedBsdfTable& fiber,
+                              int threads) {
+  fiber.validate("");
+  if (fiber.kind != "fiber" || fiber.resolution != p.fiber_resolution ||
+      fiber.channels != p.channels)
+    throw Error("", "fiber",
+                "the table re-weighting recorded paths must be a fiber table of the proposal's "
+                "resolution and channels");
+  check_fiber_energy(fiber, "fiber");
+  std::optional<LineAlbedo> tube;
+  if (p.yarn_tubes) tube.emplace(fiber);
+  const DirectionGrid grid{p.options.resolution};
+  const int bins = grid.bins(), nc = p.channels;
+  const uint64_t per_bin = p.options.particles_per_bin;
+  CellSums sums{std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0),
+                std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0)};
+  FabricRaytraceResult result;
+  result.bin_books = p.traced.bin_books;
+  for (FabricBinBooks& b : result.bin_books)
+    b.launched = b.exited = b.absorbed = b.lost = b.roulette_net = 0;
+  TaskBatch batch;
+  batch.items = per_bin * static_cast<uint64_t>(bins);
+  batch.seed = p.options.seed;
+  batch.threads = threads;
+  batch.items_per_task = std::min<uint64_t>(per_bin, 2048);  // the trace's (batch_for)
+  run_batch<Tally>(
+      batch,
+      [&](uint64_t task, uint64_t, uint64_t, Rng&, Tally& tally) {
+        replay_path_ops(p.tasks.at(task), fiber, tube ? &*tube : nullptr, nc, tally);
+      },
+      [&](const Tally& tally) { add_task(tally, nc, sums, result); });
+  tabulate(sums, {p.exact_sum, p.exact_sum2}, grid, nc, per_bin, p.units, result);
+  fabric_raytrace_totals(result);
+  // The trace's description, of this table (describe).
+  result.table.metadata = p.traced.table.metadata;
+  result.table.metadata["fiber_checksum"] = fiber.checksum();
+  for (const char* key : {"spec_hash", "spec_name"}) {
+    const auto it = fiber.metadata.find(key);
+    if (it != fiber.metadata.end())
+      result.table.metadata[std::string("fiber_") + key] = it->second;
+    else
+      result.table.metadata.erase(std::string("fiber_") + key);
+  }
+  return result;
+}
+
 }  // namespace
 }  // namespace raytrace
+
+RecordedFabricPaths record_fabric_paths(const WovenSample& sample,
+                                        const TabulatedBsdfTable& proposal,
+                                        const FabricRaytraceOptions& options) {
+  if (options.first_bin != 0 || options.bin_count != 0)
+    throw Error("", "bin_count", "recorded paths are of a whole trace, not of some bins");
+  if (options.next_event_rays > 0)
+    throw Error("", "next_event_rays", "the next-event estimate's draws are not recorded");
+  if (options.weave_positions_u > 0)
+    throw Error("", "weave_positions_u", "the weave tally is not recorded");
+  FabricRaytraceOptions o = options;
+  o.proposal = &proposal;
+  RecordedFabricPaths record;
+  (void)raytrace::trace(sample, FiberTables{{&proposal}, {}, {}, {}}, o, no_progress(), &record);
+  return record;
+}
+
+FabricRaytraceResult reweight_fabric_paths(const RecordedFabricPaths& paths,
+                                           const TabulatedBsdfTable& fiber, int threads) {
+  return raytrace::reweight(paths, fiber, threads);
+}
 
 FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                                            const TabulatedBsdfTable& fiber,

@@ -246,7 +246,8 @@ std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies
 }
 
 double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, const Strategies& st,
-                     int bin, int exit_bin, std::span<const double> s_sum, Particle& s) {
+                     int bin, int exit_bin, std::span<const double> s_sum, Particle& s,
+                     double* mean_pdf_out) {
   // Throughput f_c D_o over the strategies' mean probability of this step (D_o and the
   // within-cell density are common to all and cancel); densities kept relative to their mean so
   // that long paths neither underflow nor overflow.
@@ -267,23 +268,28 @@ double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, co
   if (!s.wp.empty())
     for (int c = 0; c < nc; ++c) s.wp[c] *= fs.table->at(bin, exit_bin, c) / mean_pdf;
   for (double& x : s.pdf) x /= mean_pdf;
+  if (mean_pdf_out) *mean_pdf_out = mean_pdf;
   return (before - after) / nc;
+}
+
+void scale_as_round_fiber(const LineAlbedo& table, double axial, std::span<const int> bins,
+                          std::vector<double>& w) {
+  for (size_t c = 0; c < w.size(); ++c) {
+    const int ch = static_cast<int>(c);
+    double s_sum = 0;
+    for (int bin : bins) s_sum += table.point(bin, ch);
+    if (s_sum > 0) w[c] *= table.line(axial, ch) / s_sum;
+  }
 }
 
 double weigh_as_round_fiber(const LineAlbedo& traced, const LineAlbedo* proposal,
                             const Crossings& x, const Vec3& d, Particle& s) {
   const double axial = dot(d, x.pts[0].hit.shading.s);
-  auto scale = [&](const LineAlbedo& table, std::vector<double>& w) {
-    for (size_t c = 0; c < w.size(); ++c) {
-      const int ch = static_cast<int>(c);
-      double s_sum = 0;
-      for (int q = 0; q < x.count; ++q) s_sum += table.point(x.pts[q].bin, ch);
-      if (s_sum > 0) w[c] *= table.line(axial, ch) / s_sum;
-    }
-  };
+  const int bins[2] = {x.pts[0].bin, x.pts[1].bin};
+  const std::span<const int> points(bins, static_cast<size_t>(x.count));
   const double before = mean_weight(s.w);
-  scale(traced, s.w);
-  if (proposal && !s.wp.empty()) scale(*proposal, s.wp);
+  scale_as_round_fiber(traced, axial, points, s.w);
+  if (proposal && !s.wp.empty()) scale_as_round_fiber(*proposal, axial, points, s.wp);
   return before - mean_weight(s.w);
 }
 
@@ -326,10 +332,11 @@ Steering steering_of(const Particle& s) {
 }
 
 bool survives_roulette(double steer, double threshold, double mean_w, Particle& s,
-                       FabricBinBooks& books, Rng& rng) {
+                       FabricBinBooks& books, Rng& rng, double* divided_by) {
   if (!(steer < threshold)) return true;
   const double survive = steer / (threshold);
   if (rng.uniform() < survive) {
+    if (divided_by) *divided_by = survive;
     for (double& x : s.w) x /= survive;
     for (double& x : s.wp) x /= survive;
     books.roulette_net -= mean_w / survive - mean_w;

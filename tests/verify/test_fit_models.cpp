@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "test_util.h"
+#include "weft/fabric/recorded_paths.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/verify/fit_models.h"
 
@@ -128,6 +129,39 @@ TEST(VerifyFit, FitInnerObjectiveIsSmoothInDyeAtAFixedSeed) {
     for (size_t k = 0; k + 2 < j.size(); ++k)
       EXPECT_LT(std::abs(j[k + 2] - 2 * j[k + 1] + j[k]), bound) << name << " " << k;
     EXPECT_GT(std::abs(j[4] - j[0]), 1e-3) << name;  // and the objective does move with the dye
+  }
+}
+
+// The ray-trace inner model's evaluations re-weight the proposal's recorded paths
+// (fit_inner_model, recorded_paths.h) in place of tracing each table with the proposal: at the
+// command's inner settings on red-cotton and the bundled measurement, the objective of the
+// re-weighted paths is that of the trace bit for bit, at dye scales around the proposal's and at a
+// particle fraction that changes the bake's photons' paths, on another thread count.
+TEST(VerifyFit, RaytraceInnerModelReweightsRecordedPathsAsTracingDoes) {
+  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
+  weft::FitInnerSettings inner =
+      weft::fit_inner_settings(weft::verify_settings(weft::VerifyQuality::kDraft));
+  inner.inner = weft::FitInner::kRaytrace;
+  inner.particles_per_bin = 200;  // the paths' bits do not depend on their number
+  inner.threads = 2;
+  const weft::WovenSample sample = verify_sample();
+  const weft::MeasuredInplane measured = weft::read_measured_inplane(
+      fs::path(WEFT_SOURCE_DIR) / "materials/data/measured/merl-red-fabric/inplane.csv");
+  const std::vector<std::string> names = {"dye_scale", "particle_fraction_scale"};
+  const weft::TabulatedBsdfTable proposal =
+      weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, {1, 1}), inner);
+  const weft::RecordedFabricPaths paths =
+      weft::record_fabric_paths(sample, proposal, weft::inner_raytrace_options(inner, nullptr));
+  for (const std::vector<double>& x : {std::vector<double>{1, 1}, {1.02, 1}, {1.5, 1}, {1, 1.1}}) {
+    const weft::TabulatedBsdfTable table =
+        weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), inner);
+    const auto traced = weft::fit_residuals(
+        weft::inner_fabric_curves(sample, table, inner, measured, &proposal), measured);
+    const auto reweighted =
+        weft::fit_residuals(weft::table_curves(weft::reweight_fabric_paths(paths, table, 1).table,
+                                               measured, inner.azimuths),
+                            measured);
+    EXPECT_EQ(reweighted, traced) << x[0] << " " << x[1];
   }
 }
 

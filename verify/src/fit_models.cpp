@@ -3,10 +3,13 @@
 #include "weft/verify/fit_models.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
+#include "common.h"
 #include "weft/core/error.h"
 #include "weft/fabric/fabric_raytrace.h"
+#include "weft/fabric/recorded_paths.h"
 #include "weft/materials/classic_fiber.h"
 
 namespace weft {
@@ -216,6 +219,17 @@ std::string classic_inner_model_name(const FitInnerSettings& f) {
          std::to_string(f.seed) + " at every evaluation";
 }
 
+FabricRaytraceOptions inner_raytrace_options(const FitInnerSettings& f,
+                                             const TabulatedBsdfTable* proposal) {
+  FabricRaytraceOptions o;
+  o.resolution = f.resolution;
+  o.particles_per_bin = f.particles_per_bin;
+  o.seed = f.seed;
+  o.threads = f.threads;
+  o.proposal = proposal;
+  return o;
+}
+
 std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& sample,
                                                   const TabulatedBsdfTable& fiber,
                                                   const FitInnerSettings& f,
@@ -226,13 +240,9 @@ std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& sample,
         sum_fabric_table(
             fiber, verify_summation_options(f.resolution, f.summation_samples, f.seed, f.threads)),
         measured, f.azimuths);
-  FabricRaytraceOptions o;
-  o.resolution = f.resolution;
-  o.particles_per_bin = f.particles_per_bin;
-  o.seed = f.seed;
-  o.threads = f.threads;
-  o.proposal = proposal;
-  return table_curves(raytrace_fabric_table(sample, fiber, o).table, measured, f.azimuths);
+  return table_curves(
+      raytrace_fabric_table(sample, fiber, inner_raytrace_options(f, proposal)).table, measured,
+      f.azimuths);
 }
 
 TabulatedBsdfTable computed_inner_fiber_table(const FiberSpec& spec, const FitInnerSettings& f) {
@@ -299,23 +309,30 @@ FitResult fit_inner_model(
     const std::function<TabulatedBsdfTable(const std::vector<double>&)>& table_of,
     const WovenSample& sample, const FitInnerSettings& f, const MeasuredInplane& measured,
     const FitOptions& options) {
-  const auto curves_of = [&](const TabulatedBsdfTable* proposal) -> InplaneModel {
-    return [&, proposal](const std::vector<double>& x) {
-      return inner_fabric_curves(sample, table_of(x), f, measured, proposal);
-    };
-  };
   if (f.inner != FitInner::kRaytrace)
-    return fit_inplane(model, parameters, curves_of(nullptr), measured, options);
+    return fit_inplane(
+        model, parameters,
+        [&](const std::vector<double>& x) {
+          return inner_fabric_curves(sample, table_of(x), f, measured);
+        },
+        measured, options);
+  // The ray trace under the proposal, its paths traced once per proposal and re-weighted for each
+  // evaluation's table: the bits of tracing that table with the proposal (recorded_paths.h).
+  RecordedFabricPaths paths;
+  const InplaneModel reweighted = [&](const std::vector<double>& x) {
+    return table_curves(reweight_fabric_paths(paths, table_of(x), f.threads).table, measured,
+                        f.azimuths);
+  };
   const std::vector<FitParameter> given = parameters;
   FitResult first, last;
   int evaluations = 0;
   double seconds = 0, moved = 0, previous_move = 0;
   std::vector<std::vector<double>> restart_optima;  // of the searches after the first
-  TabulatedBsdfTable proposal;
   for (int stage = 0;; ++stage) {
     std::vector<double> x;
     for (const auto& p : parameters) x.push_back(p.start);
-    proposal = table_of(x);
+    const auto t0 = std::chrono::steady_clock::now();
+    paths = record_fabric_paths(sample, table_of(x), inner_raytrace_options(f, nullptr));
     FitOptions o = options;
     o.max_evaluations = options.max_evaluations - evaluations;
     o.uncertainty = false;  // the last stage's, once it is known to be the last (below)
@@ -324,9 +341,9 @@ FitResult fit_inner_model(
     // box, not the first search's whole step.
     // (Nelder-Mead's; Levenberg-Marquardt takes its steps from the Jacobian.)
     if (stage > 0) o.initial_step = std::clamp(2 * moved, 0.02, options.initial_step);
-    last = fit_inplane(model, parameters, curves_of(&proposal), measured, o);
+    last = fit_inplane(model, parameters, reweighted, measured, o);
     evaluations += last.evaluations;
-    seconds += last.seconds;
+    seconds += seconds_since(t0);  // the recording's trace and the search
     if (stage == 0) first = last;
     if (stage > 0) {
       restart_optima.emplace_back();
@@ -352,7 +369,7 @@ FitResult fit_inner_model(
   last.start_metrics = first.start_metrics;
   last.evaluations = evaluations;
   last.seconds = seconds;
-  if (options.uncertainty) add_fit_uncertainty(last, curves_of(&proposal), measured, options);
+  if (options.uncertainty) add_fit_uncertainty(last, reweighted, measured, options);
   return last;
 }
 

@@ -149,6 +149,14 @@ constexpr double kTypicalFixedSeconds = 10;
 constexpr double kTypicalSecondsPerWeaveSample = 6.5e-6;
 constexpr int kWeaveRenders = 4;  // computed and classic, reflection and transmission
 constexpr double kLeastSecondsPerParticle = 1.25e-6;
+// The fit (docs/verify.md "Fitting"): its inner bake (RGB, absorption as a weight, so no roulette)
+// took 0.51 s of CPU for its 165 000 photons (5 000 in each of the 33 bands) on red-cotton near the
+// fitted point (2026-12-03), 3.1 us per photon; its ray traces are one per search stage and model
+// (the evaluations re-weight the stage's recorded paths, recorded_paths.h), typically 4 stages; an
+// evaluation's re-weighting, curves and classic table about 0.04 s.
+constexpr double kTypicalSecondsPerInnerPhoton = 3.1e-6;
+constexpr double kTypicalFitStages = 4;
+constexpr double kTypicalSecondsPerFitEvaluation = 0.04;
 
 }  // namespace
 
@@ -162,6 +170,7 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
   const double run_particles = 2.0 * double(s.particles_per_bin) * bins;
   e.photons = run_photons;
   e.particles = run_particles;
+  double fit_seconds = 0;
   if (fit) {
     const FitInnerSettings inner = fit_inner_settings(s);
     const double inner_bins = 2.0 * inner.resolution * inner.resolution;
@@ -169,14 +178,22 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
     // model has 4).
     const double computed_evals = fit_evaluations + 1 + 2.0 * double(fit_params);
     const double classic_evals = fit_evaluations + 1 + 8.0;
-    e.photons += computed_evals * double(inner.fiber_photons_per_band) * kNumBands + run_photons;
-    e.particles += (computed_evals + classic_evals) * double(inner.particles_per_bin) * inner_bins +
-                   run_particles;
+    const double inner_photons = computed_evals * double(inner.fiber_photons_per_band) * kNumBands;
+    const double inner_particles =
+        2 * kTypicalFitStages * double(inner.particles_per_bin) * inner_bins;
+    e.photons += inner_photons + run_photons;
+    e.particles += inner_particles + run_particles;
+    fit_seconds = inner_photons * kTypicalSecondsPerInnerPhoton +
+                  inner_particles * kTypicalSecondsPerParticle +
+                  (computed_evals + classic_evals) * kTypicalSecondsPerFitEvaluation;
   }
   const double weave_samples =
       double(kWeaveRenders) * s.weave_render_size * s.weave_render_size * s.weave_render_spp;
-  e.typical = e.photons * kTypicalSecondsPerPhoton + e.particles * kTypicalSecondsPerParticle +
-              weave_samples * kTypicalSecondsPerWeaveSample + kTypicalFixedSeconds;
+  // The run's (with the fit: twice, the fitted models at the run's quality) and the fit's.
+  const double runs = fit ? 2 : 1;
+  e.typical =
+      runs * (run_photons * kTypicalSecondsPerPhoton + run_particles * kTypicalSecondsPerParticle) +
+      fit_seconds + weave_samples * kTypicalSecondsPerWeaveSample + kTypicalFixedSeconds;
   e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
   return e;
 }

@@ -121,7 +121,8 @@ struct FabricRaytraceOptions {
   // so at a fixed seed the particles keep their paths when the fiber table changes and the result
   // is a smooth function of it: weft verify --fit's inner model (docs/verify.md). Unbiased where
   // the proposal is nonzero wherever the table is; the noise grows as the two tables differ. Null:
-  // the fiber table itself (the default estimator, bit for bit).
+  // the fiber table itself (the default estimator, bit for bit). At a fixed seed the paths can be
+  // recorded once and re-weighted for other tables (recorded_paths.h).
   const TabulatedBsdfTable* proposal = nullptr;
   // The weave tally (weave_tally.h; 0: off): the exits binned also by where their line crosses
   // the cloth's mid-plane, in weave_positions_u x weave_positions_v cells of the repeat (u along

@@ -27,6 +27,7 @@
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fiber_sampler.h"
 #include "weft/fabric/line_albedo.h"
+#include "weft/fabric/recorded_paths.h"
 #include "weft/fabric/weave_tally.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
@@ -181,9 +182,12 @@ std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies
                                         Rng& rng);
 // The path's weights after scattering from light bin 'bin' into cell 'exit_bin': times f_c over
 // the strategies' mean probability of the step (the proposal's weights times its own f), the
-// densities kept relative to their mean. Returns the power the step absorbed (channels' mean).
+// densities kept relative to their mean. Returns the power the step absorbed (channels' mean);
+// the mean probability the weights were divided by into *mean_pdf_out where given
+// (recorded_paths.h).
 double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, const Strategies& st,
-                     int bin, int exit_bin, std::span<const double> s_sum, Particle& s);
+                     int bin, int exit_bin, std::span<const double> s_sum, Particle& s,
+                     double* mean_pdf_out = nullptr);
 // A yarn tube stands for a round fiber: the weights after scattering at the tube's crossing x of
 // the line along d are scaled per channel by L_c / S_c, L the table's line albedo for d
 // (line_albedo.h, axial cosine with the yarn's tangent at x.pts[0]) and S_c the albedos summed
@@ -196,6 +200,10 @@ double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, co
 // adds).
 double weigh_as_round_fiber(const LineAlbedo& traced, const LineAlbedo* proposal,
                             const Crossings& x, const Vec3& d, Particle& s);
+// Its scaling of one weight vector: per channel times L_c(axial) / S_c, S_c the point albedos of
+// 'bins' (the crossing's fiber bins) summed.
+void scale_as_round_fiber(const LineAlbedo& table, double axial, std::span<const int> bins,
+                          std::vector<double>& w);
 // The particle leaves fiber point 'hit' along wo_local (its frame): the new line, the fiber to
 // pass through, and whether it was sent into its own yarn tube.
 void leave_fiber(const SurfaceHit& hit, const Vec3& wo_local, Particle& s);
@@ -213,7 +221,8 @@ struct Tally {
   // The books of the particles by incident bin (a task may straddle two bins): kept apart so that
   // every bin's books sum alike however the bins are split over runs.
   std::vector<std::pair<int, FabricBinBooks>> books;
-  WeaveExits weave;  // the weave tally's exits, when on (weave_tally.h)
+  WeaveExits weave;              // the weave tally's exits, when on (weave_tally.h)
+  std::vector<PathOp> path_ops;  // the task's steps, when recorded (recorded_paths.h)
   FabricBinBooks& books_of(int bin);
 };
 uint64_t exit_cell(const DirectionGrid& grid, int bin, const Vec3& d);
@@ -230,9 +239,9 @@ struct Steering {
 Steering steering_of(const Particle& s);
 // Russian roulette on 'steer' below 'threshold': the particle survives with probability
 // steer / threshold and its weights are divided by it. False when it dies; both books the net
-// change of the power (mean_w before).
+// change of the power (mean_w before). The divisor of a survivor into *divided_by where given.
 bool survives_roulette(double steer, double threshold, double mean_w, Particle& s,
-                       FabricBinBooks& books, Rng& rng);
+                       FabricBinBooks& books, Rng& rng, double* divided_by = nullptr);
 // The most copies one split makes (the weights are divided by the count made, so any cap is
 // unbiased; it bounds the work a freak weight can cause).
 inline constexpr int kMaxSplit = 16;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fabric_summation.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
@@ -72,6 +73,11 @@ FabricSummationOptions verify_summation_options(int resolution, int samples_per_
 std::string computed_inner_model_name(const FitInnerSettings& f);
 std::string classic_inner_model_name(const FitInnerSettings& f);
 
+// The ray-trace inner model's options: the settings' resolution, particles, seed and threads, paths
+// drawn from 'proposal' when given.
+FabricRaytraceOptions inner_raytrace_options(const FitInnerSettings& f,
+                                             const TabulatedBsdfTable* proposal);
+
 // The inner model's step from a fiber table to the curves, with the fixed seed. The ray trace
 // draws its paths from 'proposal' when given (FabricRaytraceOptions::proposal): the fit passes the
 // table of its start, so that the objective is smooth in the parameters (docs/verify.md).
@@ -114,7 +120,8 @@ std::vector<std::vector<Rgb>> classic_inner_curves(const Rgb& diffuse,
 // cube) from its proposal's point, or the evaluations are spent (options.max_evaluations over
 // all stages; the uncertainty, computed once at the last stage's optimum with its proposal, adds
 // 2 p + 1). The result: the last stage's optimum and uncertainty, the first's start, the
-// evaluations and seconds of all.
+// evaluations and seconds of all. Each proposal's paths are traced once and re-weighted for every
+// evaluation's table (recorded_paths.h): the bits of tracing each table with the proposal.
 FitResult fit_inner_model(
     const std::string& model, std::vector<FitParameter> parameters,
     const std::function<TabulatedBsdfTable(const std::vector<double>&)>& table_of,
