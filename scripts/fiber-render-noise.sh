@@ -10,7 +10,8 @@
 #
 # FIBER_TABLE.exr: e.g. the `fiber-computed.exr` of a `weft verify --quality default` report.
 # SPP: samples per pixel (16). SAMPLING: the fiber_table's "sampling", cell (the default with
-# cell reads) or bilinear (the density before 2026-12-03). Prints per configuration: the CPU
+# cell reads) or bilinear (the density before 2026-12-03), or default: the key left out (the
+# material's default; for a weft from before the parameter). Prints per configuration: the CPU
 # seconds of each render (user + system, `/usr/bin/time`, loading included), the per-pixel noise
 # per channel R, G, B: RMS over the pixels of the two seeds' difference over the image mean (one
 # render's own per-pixel noise is that over sqrt 2), and the two images' means. Needs oiiotool.
@@ -21,7 +22,9 @@ spp=${3:-16}
 sampling=${4:-cell}
 weft=${WEFT:-build/tools/weft}
 mkdir -p "$out"
-"$weft" weave --detail fiber --repeats 5x5 --quiet -o "$out/poplin5.glb" > /dev/null
+sampling_key=", \"sampling\": \"$sampling\""
+[ "$sampling" = default ] && sampling_key=""
+"$weft" weave --detail fiber --repeats 5x5 -o "$out/poplin5.glb" > /dev/null
 for config in back front; do
   y=$([ "$config" = back ] && echo -1 || echo 1)
   cat > "$out/$config.json" <<EOF
@@ -29,9 +32,9 @@ for config in back front; do
   "gltf": "poplin5.glb",
   "materials": {
     "warp": {"type": "fiber_table",
-             "params": {"file": "$table", "interpolation": "cell", "sampling": "$sampling"}},
+             "params": {"file": "$table", "interpolation": "cell"$sampling_key}},
     "weft": {"type": "fiber_table",
-             "params": {"file": "$table", "interpolation": "cell", "sampling": "$sampling"}}
+             "params": {"file": "$table", "interpolation": "cell"$sampling_key}}
   },
   "lights": [{"type": "parallel", "irradiance": 3.141592653589793, "direction": [0, $y, 0]}],
   "camera": {"type": "orthographic", "position": [-0.005, 0.008660254037844387, 0],

@@ -9,6 +9,9 @@
 #             1 % table error, the baseline's default against this tree's;
 #   render    the path tracer's rays per second over the same rays through bare Embree
 #             (`weft bench render`, ratio_replay), both bundled benchmark scenes;
+#   backlit   the fiber-level render lit from behind and in front (scripts/fiber-render-noise.sh,
+#             16 spp, a spectral red-cotton table at R = 8, 200 000 photons, baked once by the
+#             baseline): pixel noise of two seeds and CPU seconds, so noise at equal time follows;
 #   fit       `weft verify --quality default --fit`: wall and CPU time, convergence (this tree
 #             only unless WEFT_FIT_BASELINE=1: the baseline's takes about an hour).
 # Writes ${WEFT_OUT:-out/perf-goals}/goals.md (the table) and goals.json, with every program's
@@ -17,7 +20,7 @@
 # set against); WEFT_BASELINE_BIN (a weft built from it; else it is built into
 # ${WEFT_BASELINE_BUILD:-build-baseline} from `git archive`); WEFT_BIN (this tree's weft, default
 # build/tools/weft); WEFT_THREADS (default 2); WEFT_SEEDS (default 2); WEFT_GOALS (comma list,
-# default raytrace,bake,render,fit); WEFT_PARTICLES (default 40000).
+# default raytrace,bake,render,backlit,fit); WEFT_PARTICLES (default 40000).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -26,7 +29,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 threads=${WEFT_THREADS:-2}
 seeds=${WEFT_SEEDS:-2}
-goals=",${WEFT_GOALS:-raytrace,bake,render,fit},"
+goals=",${WEFT_GOALS:-raytrace,bake,render,backlit,fit},"
 particles=${WEFT_PARTICLES:-40000}
 rev=${WEFT_BASELINE:-0c7d278}
 new=$(realpath "${WEFT_BIN:-build/tools/weft}")
@@ -93,6 +96,17 @@ if [[ $goals == *,render,* ]]; then
   for who in before after; do
     bin=$old && [ $who = after ] && bin=$new
     timed "render-$who" "$bin" bench render --threads "$threads" --json
+  done
+fi
+
+if [[ $goals == *,backlit,* ]]; then
+  echo "== fiber-level render lit from behind and in front"
+  [ -f "$out/fiber-spectral.exr" ] || (cd "$out" && "$old" bake fiber red-cotton --resolution 8 \
+    --photons 200000 --quiet -o fiber-spectral.exr > fiber-spectral.log)
+  for who in before after; do
+    bin=$old && [ $who = after ] && bin=$new
+    WEFT=$bin bash "$root/scripts/fiber-render-noise.sh" "$out/fiber-spectral.exr" \
+      "$out/backlit-$who" 16 default > "$out/backlit-$who.out"
   done
 fi
 

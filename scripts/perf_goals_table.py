@@ -22,6 +22,10 @@ def have(out, name):
     return os.path.exists(os.path.join(out, name + ".time"))
 
 
+def have_backlit(out):
+    return os.path.exists(os.path.join(out, "backlit-after.out"))
+
+
 def raytrace(out, seeds):
     """CPU seconds to 1 % per channel, mean over the seeds, before and after."""
     cost = {}
@@ -69,6 +73,27 @@ def render(out):
     return rows
 
 
+def backlit(out):
+    """Red noise at equal time of the fiber-level renders: noise^2 x CPU seconds (the variance a
+    CPU-second leaves), from fiber-render-noise.sh's lines
+    'back default 16spp cpu_s 9.9 10.1  noise 2.72 46.9 2.84  means ...'."""
+    figures = {}
+    for who in ("before", "after"):
+        with open(os.path.join(out, "backlit-%s.out" % who)) as f:
+            for line in f:
+                words = line.split()
+                if len(words) < 10 or words[3] != "cpu_s":
+                    continue
+                cpu = (float(words[4]) + float(words[5])) / 2
+                red = float(words[words.index("noise") + 1])
+                figures[(words[0], who)] = red * red * cpu
+    rows = []
+    for light, label in (("back", "lit from behind"), ("front", "lit in front")):
+        b, a = figures[(light, "before")], figures[(light, "after")]
+        rows.append(("fiber-level render %s, red noise² × CPU-s" % label, b, a, b / a))
+    return rows
+
+
 def fit(out):
     rows = []
     for who in ("before", "after"):
@@ -97,6 +122,8 @@ def main():
         rows += bake(out)
     if have(out, "render-after"):
         rows += render(out)
+    if have_backlit(out):
+        rows += backlit(out)
     rows += fit(out)
     with open(os.path.join(out, "goals.json"), "w") as f:
         json.dump([{"figure": r[0], "before": r[1], "after": r[2], "gain": r[3]} for r in rows], f,
