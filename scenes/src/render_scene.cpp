@@ -219,14 +219,6 @@ void triangle_hit(const TriangleMesh& m, const std::vector<Vec3>& unit_normals, 
                   const Vec3* shift = nullptr) {
   const uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1],
                  i2 = m.indices[3 * prim + 2];
-  // The corners' attributes lie in five arrays, mostly outside the cache on large meshes: ask for
-  // them all at once rather than one after another as the code below reads them.
-  for (const uint32_t v : {i0, i2}) {
-    if (!m.normals.empty()) __builtin_prefetch(&m.normals[3 * size_t(v)]);
-    if (!unit_normals.empty()) __builtin_prefetch(&unit_normals[v]);
-    if (!m.tangents.empty()) __builtin_prefetch(&m.tangents[4 * size_t(v)]);
-    if (!m.uvs.empty()) __builtin_prefetch(&m.uvs[2 * size_t(v)]);
-  }
   const double b0 = 1 - b1 - b2;
   const Vec3 p0 = vertex(m, i0, shift), p1 = vertex(m, i1, shift), p2 = vertex(m, i2, shift);
   hit->p = b0 * p0 + b1 * p1 + b2 * p2;
