@@ -119,8 +119,9 @@ class PathTrace {
   Rgb run(const Ray& camera_ray, int64_t* first_mesh) {
     ray_ = camera_ray;
     if (first_mesh) *first_mesh = -1;
+    // One record for every vertex: a hit overwrites all of it (RenderScene::intersect).
+    SurfaceHit hit;
     for (int depth = 0;; ++depth) {
-      SurfaceHit hit;
       if (on_ray_) (*on_ray_)(ray_, false);
       const bool found = scene_.intersect(ray_, &hit, ignore_fiber_);
       if (!found) {

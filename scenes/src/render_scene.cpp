@@ -31,6 +31,7 @@ struct CurveRecord {
   std::vector<uint32_t> yarn_bsdf;          // per yarn of 'curves'
   int64_t first_fiber = 0;                  // scene-wide id of curve 0
   std::shared_ptr<const FiberTubes> tubes;  // set when the fibers are tubes
+  std::vector<Vec3> tube_unit_normals;      // unit_vertex_normals(tubes->mesh)
   std::vector<uint32_t> prim_curve;         // per Embree primitive (segment or triangle): curve
   double scale = 1;  // of the space Embree traces these primitives in (Geometry::curve_scale)
 };
@@ -39,6 +40,7 @@ struct CurveRecord {
 struct RenderScene::Geometry {
   struct MeshRecord {
     std::shared_ptr<const TriangleMesh> mesh;
+    std::vector<Vec3> unit_normals;  // unit_vertex_normals(*mesh)
     uint32_t bsdf = 0;
     bool emits = false;  // part of the area light
   };
@@ -157,10 +159,12 @@ bool meets_from_inside(const CurveRecord& rec, const Candidate& c) {
 // Whether the candidate lies inside one of the ignored fiber's end segments (the next piece of
 // a cut fiber begins with an end sphere inside the fiber's own end).
 bool inside_ignored_end(const FiberQueryContext& ctx, const Candidate& c) {
-  for (int k = 0; k < ctx.end_count; ++k) {
+  if (!ctx.ends) return false;
+  const FiberEnds& ends = *ctx.ends;
+  for (int k = 0; k < ends.count; ++k) {
     // Most candidates lie far from both ends: a bounding sphere first.
-    if (length_squared(c.p - ctx.end_centre[k]) > ctx.end_reach2[k]) continue;
-    const FiberSegment& s = ctx.ends[k];
+    if (length_squared(c.p - ends.centre[k]) > ends.reach2[k]) continue;
+    const FiberSegment& s = ends.segment[k];
     const double u = s.closest_u(c.p);
     // Within float rounding of the surface counts as inside: there the two end spheres coincide.
     if (length(c.p - s.axis_point(u)) < s.radius_at(u) * (1 + 1e-5)) return true;
@@ -196,10 +200,23 @@ void fiber_filter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
-// Fills the hit on triangle 'prim' of 'm', moved by 'shift' (null: in place), at barycentrics
-// (b1, b2).
-void triangle_hit(const TriangleMesh& m, uint32_t prim, double b1, double b2, const Ray& ray,
-                  SurfaceHit* hit, const Vec3* shift = nullptr) {
+// The mesh's vertex normals made unit in double precision (zero where a normal is degenerate),
+// once per scene: every hit's shadow-terminator lift reads three of them.
+std::vector<Vec3> unit_vertex_normals(const TriangleMesh& m) {
+  std::vector<Vec3> out(m.normals.size() / 3);
+  for (size_t v = 0; v < out.size(); ++v) {
+    const Vec3 nk{m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
+    const double nlen = length(nk);
+    if (nlen > 1e-12) out[v] = nk / nlen;
+  }
+  return out;
+}
+
+// Fills the hit on triangle 'prim' of 'm' (whose unit_vertex_normals are 'unit_normals'), moved
+// by 'shift' (null: in place), at barycentrics (b1, b2).
+void triangle_hit(const TriangleMesh& m, const std::vector<Vec3>& unit_normals, uint32_t prim,
+                  double b1, double b2, const Ray& ray, SurfaceHit* hit,
+                  const Vec3* shift = nullptr) {
   const uint32_t i0 = m.indices[3 * prim], i1 = m.indices[3 * prim + 1],
                  i2 = m.indices[3 * prim + 2];
   const double b0 = 1 - b1 - b2;
@@ -226,11 +243,8 @@ void triangle_hit(const TriangleMesh& m, uint32_t prim, double b1, double b2, co
     const Vec3 pc[3] = {p0, p1, p2};
     const double bc[3] = {b0, b1, b2};
     for (int k = 0; k < 3; ++k) {
-      const uint32_t v = corner[k];
-      const Vec3 nk{m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
-      const double nlen = length(nk);
-      if (!(nlen > 1e-12)) continue;
-      const Vec3 nu = nk / nlen;
+      const Vec3& nu = unit_normals[corner[k]];
+      if (nu == Vec3{}) continue;
       const double d = dot(hit->p - pc[k], nu);
       hit->lift_front -= nu * (bc[k] * std::min(0.0, d));
       hit->lift_back -= nu * (bc[k] * std::max(0.0, d));
@@ -273,6 +287,7 @@ void curve_hit(const FiberSegment& s, double t, const Ray& ray, SurfaceHit* hit)
   // The fiber frame: tangent along the segment (orthogonalised against n on the end spheres).
   hit->shading = Frame::from_normal_tangent(n, axis_len > 0 ? axis / axis_len : Vec3{});
   hit->uv = {u, 0};
+  hit->lift_front = hit->lift_back = Vec3{};  // a fiber has no smooth surface to lift onto
   const Vec3& p = hit->p;
   const double mag = std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
   hit->offset = 2e-6 * mag + 1e-30;
@@ -382,6 +397,7 @@ void RenderScene::Builder::add_meshes() {
     const MaterialBinding& b = binding(i, mesh->material);
     Geometry::MeshRecord rec;
     rec.mesh = mesh;
+    rec.unit_normals = unit_vertex_normals(*mesh);
     rec.bsdf = bsdf_index(b);
     const auto info = desc_.gltf_materials.find(mesh->material);
     const GltfMaterialInfo gl =
@@ -498,6 +514,7 @@ RTCGeometry RenderScene::Builder::tube_geometry(CurveRecord& rec) {
     rec.prim_curve[i] = rec.segments.curve[t->triangle_segment[i]];
   RTCGeometry g = triangle_geometry(t->mesh);
   geo_->triangles += t->mesh.triangle_count();
+  rec.tube_unit_normals = unit_vertex_normals(t->mesh);
   rec.tubes = std::move(t);
   return g;
 }
@@ -593,9 +610,9 @@ void RenderScene::set_lights(const Lights& lights) {
   for (const auto& map : lights.environment_maps) lights_.push_back(map);
 }
 
-FiberQueryContext RenderScene::query_context(int64_t ignore_fiber) const {
-  FiberQueryContext ctx(ignore_fiber);
-  if (ignore_fiber == kNoFiber || ignore_fiber < 0 || ignore_fiber >= geo_->fibers) return ctx;
+std::optional<FiberEnds> RenderScene::fiber_ends(int64_t ignore_fiber) const {
+  if (ignore_fiber == kNoFiber || ignore_fiber < 0 || ignore_fiber >= geo_->fibers)
+    return std::nullopt;
   const FiberRef r = fiber_ref(ignore_fiber);
   const FiberCurves& c = *geo_->curve_sets[r.curve_set].curves;
   const uint32_t first = c.curve_first[r.curve], last = first + c.curve_points[r.curve] - 2;
@@ -603,26 +620,30 @@ FiberQueryContext RenderScene::query_context(int64_t ignore_fiber) const {
   const double corner = geo_->fiber_geometry.type == FiberGeometry::Type::tubes
                             ? tube_corner_radius_scale(geo_->fiber_geometry.tube_sides)
                             : 1.0;
+  FiberEnds ends;
   for (const uint32_t i : {first, last}) {
     const FiberSegment s{c.point(i), c.point(i + 1), c.radius(i) * corner,
                          c.radius(i + 1) * corner};
     const double reach = 0.5 * length(s.p1 - s.p0) + 1.01 * std::max(s.r0, s.r1);
-    ctx.end_centre[ctx.end_count] = 0.5 * (s.p0 + s.p1);
-    ctx.end_reach2[ctx.end_count] = reach * reach;
-    ctx.ends[ctx.end_count++] = s;
+    ends.centre[ends.count] = 0.5 * (s.p0 + s.p1);
+    ends.reach2[ends.count] = reach * reach;
+    ends.segment[ends.count++] = s;
   }
-  return ctx;
+  return ends;
 }
 
 bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fiber) const {
   RTCRayHit rh = embree_ray(ray);
-  FiberQueryContext ctx = query_context(ignore_fiber);
+  const std::optional<FiberEnds> ends =
+      ignore_fiber == kNoFiber ? std::nullopt : fiber_ends(ignore_fiber);  // most queries: none
+  FiberQueryContext ctx(ignore_fiber, ends ? &*ends : nullptr);
   rtcIntersect1(geo_->scene, &ctx.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit->t = rh.ray.tfar;
   hit->shape = rh.hit.geomID;
   if (rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID && rh.hit.geomID < geo_->meshes.size()) {
-    triangle_hit(*geo_->meshes[rh.hit.geomID].mesh, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit);
+    const Geometry::MeshRecord& m = geo_->meshes[rh.hit.geomID];
+    triangle_hit(*m.mesh, m.unit_normals, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit);
     hit->fiber = kNoFiber;
     hit->segment = 0;
     return true;
@@ -630,8 +651,8 @@ bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fibe
   if (geo_->mesh_scene && rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID &&
       rh.hit.instID[0] >= geo_->first_mesh_instance) {
     const Vec3& shift = geo_->mesh_shifts[rh.hit.instID[0] - geo_->first_mesh_instance];
-    triangle_hit(*geo_->meshes[rh.hit.geomID].mesh, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit,
-                 &shift);
+    const Geometry::MeshRecord& m = geo_->meshes[rh.hit.geomID];
+    triangle_hit(*m.mesh, m.unit_normals, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit, &shift);
     hit->fiber = kNoFiber;
     hit->segment = 0;
     return true;
@@ -642,7 +663,8 @@ bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fibe
   hit->shape = static_cast<uint32_t>(geo_->meshes.size() + set);
   const CurveRecord& rec = geo_->curve_sets[set];
   if (rec.tubes) {
-    triangle_hit(rec.tubes->mesh, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit);
+    triangle_hit(rec.tubes->mesh, rec.tube_unit_normals, rh.hit.primID, rh.hit.u, rh.hit.v, ray,
+                 hit);
     hit->segment = rec.tubes->triangle_segment[rh.hit.primID];
   } else {
     hit->segment = rh.hit.primID;
@@ -659,7 +681,9 @@ RTCSceneTy* RenderScene::embree_scene() const {
 
 bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax,
                            int64_t ignore_fiber) const {
-  FiberQueryContext ctx = query_context(ignore_fiber);
+  const std::optional<FiberEnds> ends =
+      ignore_fiber == kNoFiber ? std::nullopt : fiber_ends(ignore_fiber);  // most queries: none
+  FiberQueryContext ctx(ignore_fiber, ends ? &*ends : nullptr);
   RTCRay r;
   r.org_x = static_cast<float>(origin.x);
   r.org_y = static_cast<float>(origin.y);

@@ -11,18 +11,25 @@
 
 namespace weft {
 
+// The ignored fiber's first and last segments (world units; tubes: the radius of their polygon's
+// corners), where a fiber cut into several curves overlaps its next piece.
+struct FiberEnds {
+  FiberSegment segment[2];
+  Vec3 centre[2];  // their bounding spheres, to skip candidates far from them
+  double reach2[2] = {0, 0};
+  int count = 0;
+};
+
 struct FiberQueryContext {
   RTCIntersectContext embree;  // first member: Embree hands its address back to the filters
   int64_t ignore_fiber = -1;   // kNoFiber (render_scene.h): ignore nothing
-  // The ignored fiber's first and last segments (world units; tubes: the radius of their polygon's
-  // corners), where a fiber cut into several curves overlaps its next piece: RenderScene fills
-  // them for its own queries; without them (end_count 0) only hits from inside are passed.
-  FiberSegment ends[2];
-  Vec3 end_centre[2];  // their bounding spheres, to skip candidates far from them
-  double end_reach2[2] = {0, 0};
-  int end_count = 0;
+  // The ignored fiber's ends, owned by the caller: RenderScene fills them for its own queries;
+  // without them (null) only hits from inside are passed. A pointer, so that the context of a
+  // query that ignores nothing (most of a path tracer's) costs no more than Embree's own.
+  const FiberEnds* ends = nullptr;
 
-  explicit FiberQueryContext(int64_t ignore = -1) : ignore_fiber(ignore) {
+  explicit FiberQueryContext(int64_t ignore = -1, const FiberEnds* ignored_ends = nullptr)
+      : ignore_fiber(ignore), ends(ignored_ends) {
     rtcInitIntersectContext(&embree);
   }
 };

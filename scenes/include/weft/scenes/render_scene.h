@@ -27,7 +27,7 @@ struct RTCSceneTy;  // Embree's scene (RTCScene is a pointer to it)
 
 namespace weft {
 
-struct FiberQueryContext;  // embree_context.h
+struct FiberEnds;  // embree_context.h
 
 // Fiber ids are scene-wide: the curves of the description's curve sets numbered in order (set 0's
 // curves first). kNoFiber: a triangle of a mesh, or "ignore nothing" in queries.
@@ -88,7 +88,7 @@ class RenderScene {
   // repeat's sides) the ray runs on through the next piece too: for a ray that leaves a fiber,
   // no fiber is met from inside, nor inside the left fiber's end segments. Embree filter
   // functions on the fiber geometries do the ignoring; meshes have none, so triangle-only scenes
-  // pay nothing for it.
+  // pay nothing for it. A hit sets every field of *hit, so one record may serve many queries.
   bool intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fiber = kNoFiber) const;
   // Whether anything but fiber 'ignore_fiber' lies along origin + t dir, 0 < t < tmax.
   bool occluded(const Vec3& origin, const Vec3& dir, double tmax,
@@ -159,8 +159,9 @@ class RenderScene {
  private:
   struct Geometry;
   class Builder;  // makes the Geometry (render_scene.cpp)
-  // The query context for a ray that leaves fiber 'ignore_fiber' (kNoFiber: none).
-  FiberQueryContext query_context(int64_t ignore_fiber) const;
+  // The end segments of fiber 'ignore_fiber' that a ray leaving it must not meet (none for
+  // kNoFiber), for its query context.
+  std::optional<FiberEnds> fiber_ends(int64_t ignore_fiber) const;
   RenderScene() = default;
   void set_lights(const Lights& lights);
   // woven_ and the levels as built (render_scene_weave.cpp).
