@@ -215,7 +215,7 @@ std::string computed_inner_model_name(const FitInnerSettings& f) {
 
 std::string classic_inner_model_name(const FitInnerSettings& f) {
   return inner_step_name(f) + " of the classic fiber table (" +
-         std::to_string(f.summation_samples) + " samples per cell pair), seed " +
+         std::to_string(f.classic_samples) + " samples per cell pair), seed " +
          std::to_string(f.seed) + " at every evaluation";
 }
 
@@ -261,7 +261,7 @@ std::vector<std::vector<Rgb>> computed_inner_curves(const FiberSpec& spec,
 
 TabulatedBsdfTable classic_inner_fiber_table(const Rgb& diffuse, const MicrofacetDistribution& d,
                                              double ior, const FitInnerSettings& f) {
-  return classic_fiber_table(diffuse, d, ior, f.resolution, f.summation_samples, f.seed, f.threads);
+  return classic_fiber_table(diffuse, d, ior, f.resolution, f.classic_samples, f.seed, f.threads);
 }
 
 std::vector<std::vector<Rgb>> classic_inner_curves(const Rgb& diffuse,

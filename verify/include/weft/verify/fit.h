@@ -113,7 +113,11 @@ struct FitInnerSettings {
   int resolution = 6;
   uint64_t fiber_photons_per_band = 5000;
   uint64_t particles_per_bin = 2000;  // kRaytrace: one ray trace
-  int summation_samples = 4;          // the summation's and the classic fiber table's
+  int summation_samples = 4;          // the summation's
+  // The classic fiber table's samples per cell pair: its lobe narrows to roughness 0.05 at the
+  // box's bound, which 4 samples resolve so poorly that the fitted objective moved by 0.09 from
+  // seed to seed (docs/verify.md, "The fit's time and the inner model's noise").
+  int classic_samples = 64;
   uint64_t seed = 1;
   int azimuths = 24;
   int threads = 0;
