@@ -92,6 +92,7 @@ JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
     p.job["estimator"] = fiber_exit_estimator_name(o.estimator);
   if (o.mirror_fold) p.job["mirror_fold"] = true;
   if (o.surface_samples != 1) p.job["surface_samples"] = o.surface_samples;
+  if (o.entry != FiberEntrySampling::kRandom) p.job["entry"] = fiber_entry_sampling_name(o.entry);
   p.units_total = kNumBands;
   p.shard = shard;
   // The spec as given (a merge makes the table's metadata from it; its hash is checked).
@@ -157,6 +158,7 @@ int merge_fiber_bake(const JobPart& all, const std::string& output, bool json) {
   o.estimator = parse_fiber_exit_estimator(all.job.value("estimator", "plain"), "estimator");
   o.mirror_fold = all.job.value("mirror_fold", false);
   o.surface_samples = all.job.value("surface_samples", 1);
+  o.entry = parse_fiber_entry_sampling(all.job.value("entry", "random"), "entry");
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
   std::vector<FiberBandState> states;
   for (const auto& [band, v] : all.units) {
@@ -185,6 +187,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
     std::string estimator = "plain";
     bool mirror_fold = false;
     int surface_samples = 1;
+    std::string entry = "random";
     uint64_t seed = FiberTableBakeOptions{}.seed;
     uint64_t passes = FiberTableBakeOptions{}.passes;
     int threads = 0;
@@ -231,6 +234,11 @@ void add_bake_command(CLI::App& app, Commands& commands) {
       ->add_option("--surface-samples", opt->surface_samples,
                    "surface-lobe directions drawn per photon (smooth boundary)")
       ->check(CLI::Range(1, 1024));
+  fiber
+      ->add_option("--entry", opt->entry,
+                   "how photons' entries are drawn: random or stratified (randomised Sobol' "
+                   "points per task; direct route)")
+      ->check(CLI::IsMember({"random", "stratified"}));
   fiber->add_option("--seed", opt->seed, "random seed");
   fiber
       ->add_option("--passes", opt->passes,
@@ -266,6 +274,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          o.estimator = parse_fiber_exit_estimator(opt->estimator, "--estimator");
          o.mirror_fold = opt->mirror_fold;
          o.surface_samples = opt->surface_samples;
+         o.entry = parse_fiber_entry_sampling(opt->entry, "--entry");
          const Shard shard = opt->shard.empty() ? Shard{} : parse_shard(opt->shard, "--shard");
          const JobPart job = fiber_bake_job(opt->spec, spec, o, shard);
          const UnitRange range = shard_units(kNumBands, shard);

@@ -32,6 +32,9 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
            : "") +
       (o.mirror_fold ? "|mirror_fold" : "") +
       (o.surface_samples != 1 ? "|surface_samples" + std::to_string(o.surface_samples) : "") +
+      (o.entry != FiberEntrySampling::kRandom
+           ? std::string("|entry_") + fiber_entry_sampling_name(o.entry)
+           : "") +
       (o.max_events_per_photon != FiberTableBakeOptions{}.max_events_per_photon
            ? "|E" + std::to_string(o.max_events_per_photon)
            : "");

@@ -45,6 +45,8 @@ struct FiberTableBakeOptions {
   bool mirror_fold = false;
   // Surface-lobe directions drawn per photon (smooth boundary only; FiberSurfaceModel::samples).
   int surface_samples = 1;
+  // How photons' entries are drawn (FiberEntrySampling; direct route only).
+  FiberEntrySampling entry = FiberEntrySampling::kRandom;
 };
 
 struct FiberBandSummary {
