@@ -184,10 +184,11 @@ void add_bake_command(CLI::App& app, Commands& commands) {
     int resolution = FiberTableBakeOptions{}.resolution;
     std::string bands = "spectral";
     std::string route = "direct";
-    std::string estimator = "plain";
-    bool mirror_fold = false;
-    int surface_samples = 1;
-    std::string entry = "random";
+    // Empty or 0: the spec's and route's default (fiber_bake_defaults).
+    std::string estimator;
+    bool mirror_fold = FiberTableBakeOptions{}.mirror_fold;
+    int surface_samples = 0;
+    std::string entry;
     uint64_t seed = FiberTableBakeOptions{}.seed;
     uint64_t passes = FiberTableBakeOptions{}.passes;
     int threads = 0;
@@ -226,18 +227,20 @@ void add_bake_command(CLI::App& app, Commands& commands) {
   fiber
       ->add_option("--estimator", opt->estimator,
                    "how exits are tallied: plain (one by one) or nee (next-event estimation at "
-                   "every scattering; smooth boundary, direct route)")
+                   "every scattering; smooth boundary, direct route; the default there)")
       ->check(CLI::IsMember({"plain", "nee"}));
-  fiber->add_flag("--mirror-fold", opt->mirror_fold,
-                  "average every cell with its images under the fiber's mirror symmetries");
+  fiber->add_flag("--mirror-fold,!--no-mirror-fold", opt->mirror_fold,
+                  "average every cell with its images under the fiber's mirror symmetries "
+                  "(default on)");
   fiber
       ->add_option("--surface-samples", opt->surface_samples,
-                   "surface-lobe directions drawn per photon (smooth boundary)")
+                   "surface-lobe directions drawn per photon (smooth boundary; default " +
+                       std::to_string(FiberTableBakeOptions{}.surface_samples) + ", else 1)")
       ->check(CLI::Range(1, 1024));
   fiber
       ->add_option("--entry", opt->entry,
                    "how photons' entries are drawn: random or stratified (randomised Sobol' "
-                   "points per task; direct route)")
+                   "points per task; direct route; the default there)")
       ->check(CLI::IsMember({"random", "stratified"}));
   fiber->add_option("--seed", opt->seed, "random seed");
   fiber
@@ -263,18 +266,20 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          // A shard writes a part file for `weft merge`, not a table.
          if (opt->shard.empty()) TabulatedBsdfTable::check_output_path(opt->output, "--output");
          const FiberSpec spec = load_fiber_spec(opt->spec);
-         FiberTableBakeOptions o;
+         const FiberBakeRoute route =
+             opt->route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
+         FiberTableBakeOptions o = fiber_bake_defaults(spec, route);
          o.resolution = opt->resolution;
          o.photons_per_band = opt->photons;
          o.seed = opt->seed;
          o.threads = opt->threads;
          o.spectral = opt->bands == "spectral";
-         o.route = opt->route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
          o.passes = opt->passes;
-         o.estimator = parse_fiber_exit_estimator(opt->estimator, "--estimator");
+         if (!opt->estimator.empty())
+           o.estimator = parse_fiber_exit_estimator(opt->estimator, "--estimator");
          o.mirror_fold = opt->mirror_fold;
-         o.surface_samples = opt->surface_samples;
-         o.entry = parse_fiber_entry_sampling(opt->entry, "--entry");
+         if (opt->surface_samples > 0) o.surface_samples = opt->surface_samples;
+         if (!opt->entry.empty()) o.entry = parse_fiber_entry_sampling(opt->entry, "--entry");
          const Shard shard = opt->shard.empty() ? Shard{} : parse_shard(opt->shard, "--shard");
          const JobPart job = fiber_bake_job(opt->spec, spec, o, shard);
          const UnitRange range = shard_units(kNumBands, shard);

@@ -56,6 +56,14 @@ uint32_t owen_scramble(uint32_t x, uint32_t seed) {
   return reverse_bits(x);
 }
 
+// The sequence's coordinate without the range check (the hot path of sample()).
+uint32_t sobol_unchecked(uint32_t index, int dim) {
+  uint32_t x = 0;
+  for (const uint32_t* v = kMatrices[dim].data(); index != 0; index >>= 1, ++v)
+    if (index & 1u) x ^= *v;
+  return x;
+}
+
 }  // namespace
 
 ScrambledSobol::ScrambledSobol(Rng& rng) {
@@ -67,19 +75,15 @@ ScrambledSobol::ScrambledSobol(Rng& rng) {
 
 uint32_t ScrambledSobol::sobol_bits(uint32_t index, int dim) {
   if (dim < 0 || dim >= kDimensions) throw Error("", "dim", "Sobol' dimension out of range");
-  uint32_t x = 0;
-  for (int k = 0; index != 0; ++k, index >>= 1)
-    if (index & 1u) x ^= kMatrices[dim][k];
-  return x;
+  return sobol_unchecked(index, dim);
 }
 
 double ScrambledSobol::sample(uint32_t index, int dim) const {
-  const uint32_t bits = owen_scramble(sobol_bits(index, dim), scramble_[dim]);
-  // 32 scrambled digits, then 21 digits hashed from the point (an Owen scramble's digits below
-  // the sequence's precision are random); the shift makes the 53-bit word uniform.
-  const uint64_t low = mix64((static_cast<uint64_t>(scramble_[dim]) << 32) | index) >> 43;
-  const uint64_t word = ((static_cast<uint64_t>(bits) << 21) | low) ^ shift_[dim];
-  return static_cast<double>(word) * 0x1.0p-53;
+  if (dim < 0 || dim >= kDimensions) throw Error("", "dim", "Sobol' dimension out of range");
+  const uint64_t bits = owen_scramble(sobol_unchecked(index, dim), scramble_[dim]);
+  // 32 scrambled digits above 21 zero ones, shifted by a uniform 53-bit word: the point is uniform
+  // on the 2^-53 grid (its low digits are the shift's, the same for every point of the set).
+  return static_cast<double>((bits << 21) ^ shift_[dim]) * 0x1.0p-53;
 }
 
 }  // namespace weft

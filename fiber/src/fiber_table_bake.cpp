@@ -34,6 +34,17 @@ void validate(const FiberTableBakeOptions& o) {
 
 }  // namespace
 
+FiberTableBakeOptions fiber_bake_defaults(const FiberSpec& spec, FiberBakeRoute route) {
+  FiberTableBakeOptions o;
+  o.route = route;
+  const bool smooth = spec.boundary == FiberBoundary::kSmooth;
+  const bool direct = route == FiberBakeRoute::kDirect;
+  if (!smooth || !direct) o.estimator = FiberExitEstimator::kPlain;
+  if (!smooth) o.surface_samples = 1;
+  if (!direct) o.entry = FiberEntrySampling::kRandom;
+  return o;
+}
+
 double fiber_table_bake_bytes(const FiberTableBakeOptions& o) {
   const double cells = DirectionGrid{std::clamp(o.resolution, 1, 1 << 12)}.bins();
   const double pairs = cells * cells;
