@@ -227,20 +227,20 @@ void add_bake_command(CLI::App& app, Commands& commands) {
   fiber
       ->add_option("--estimator", opt->estimator,
                    "how exits are tallied: plain (one by one) or nee (next-event estimation at "
-                   "every scattering; smooth boundary, direct route; the default there)")
+                   "every scattering; smooth boundary, direct route); default plain")
       ->check(CLI::IsMember({"plain", "nee"}));
   fiber->add_flag("--mirror-fold,!--no-mirror-fold", opt->mirror_fold,
                   "average every cell with its images under the fiber's mirror symmetries "
-                  "(default on)");
+                  "(default on; --no-mirror-fold turns it off)");
   fiber
       ->add_option("--surface-samples", opt->surface_samples,
                    "surface-lobe directions drawn per photon (smooth boundary; default " +
-                       std::to_string(FiberTableBakeOptions{}.surface_samples) + ", else 1)")
+                       std::to_string(FiberTableBakeOptions{}.surface_samples) + ")")
       ->check(CLI::Range(1, 1024));
   fiber
       ->add_option("--entry", opt->entry,
                    "how photons' entries are drawn: random or stratified (randomised Sobol' "
-                   "points per task; direct route; the default there)")
+                   "points per task; direct route); default random")
       ->check(CLI::IsMember({"random", "stratified"}));
   fiber->add_option("--seed", opt->seed, "random seed");
   fiber

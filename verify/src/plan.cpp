@@ -136,12 +136,11 @@ Rgb parse_classic_albedo(const std::string& text) {
 
 namespace {
 
-// Measured (docs/verify.md "Time"): red-cotton's full bake, 1.2 us per photon per core with plain
-// exits, about 4x that with the bake's default estimators (docs/PERFORMANCE.md, "Accuracy against
-// photons"), so 4.8 us; the bundled poplin's fiber-level ray traces at default quality, computed
+// Measured (docs/verify.md "Time"): red-cotton's full bake, 1.2 us per photon per core
+// (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default quality, computed
 // and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so 18 us per
 // particle; the plots and the rest, about 10 s of CPU whatever the quality.
-constexpr double kTypicalSecondsPerPhoton = 4.8e-6;
+constexpr double kTypicalSecondsPerPhoton = 1.2e-6;
 constexpr double kTypicalSecondsPerParticle = 18e-6;
 constexpr double kTypicalFixedSeconds = 10;
 // The fiber-level renders (docs/verify.md "Renders"): 23 s of CPU at default quality for the four

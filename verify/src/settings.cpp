@@ -18,12 +18,10 @@ std::string quality_name(VerifyQuality q) {
 }
 
 VerifySettings verify_settings(VerifyQuality q) {
-  // The default's photons are FiberTableBakeOptions{}'s; what a row omits keeps its default. The
-  // photons are a quarter of those of the plain bake the defaults replaced (each costs about 4x
-  // the CPU; the table's error is less than half: docs/PERFORMANCE.md "Accuracy against photons").
+  // The default's photons are FiberTableBakeOptions{}'s; what a row omits keeps its default.
   static const VerifySettings kDraft{.quality = VerifyQuality::kDraft,
                                      .resolution = 6,
-                                     .fiber_photons_per_band = 5000,
+                                     .fiber_photons_per_band = 20000,
                                      .particles_per_bin = 4000,
                                      .batches = 2,
                                      .summation_samples = 4,
@@ -33,7 +31,7 @@ VerifySettings verify_settings(VerifyQuality q) {
                                      .weave_render_spp = 4};
   static const VerifySettings kDefault{.quality = VerifyQuality::kDefault,
                                        .resolution = 8,
-                                       .fiber_photons_per_band = 50000,
+                                       .fiber_photons_per_band = 200000,
                                        .particles_per_bin = 64000,
                                        .batches = 4,
                                        .summation_samples = 8,
@@ -43,7 +41,7 @@ VerifySettings verify_settings(VerifyQuality q) {
                                        .weave_render_spp = 16};
   static const VerifySettings kPublication{.quality = VerifyQuality::kPublication,
                                            .resolution = 12,
-                                           .fiber_photons_per_band = 250000,
+                                           .fiber_photons_per_band = 1000000,
                                            .particles_per_bin = 256000,
                                            .batches = 8,
                                            .summation_samples = 16,

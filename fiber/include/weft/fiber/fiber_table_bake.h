@@ -25,10 +25,7 @@ inline constexpr uint64_t kMaxPhotonsPerBand = uint64_t{1} << 40;
 // The defaults here are the only ones: `weft bake fiber` and the bake cache start from them.
 struct FiberTableBakeOptions {
   int resolution = 8;  // R x R equal-area bins per direction
-  // A quarter of the 200 000 of the plain bake these defaults replaced: a photon of the defaults
-  // costs about 4x the CPU, and the table's error for the same CPU is less than half
-  // (docs/PERFORMANCE.md, "Accuracy against photons").
-  uint64_t photons_per_band = 50000;
+  uint64_t photons_per_band = 200000;
   uint64_t seed = 1;
   int threads = 0;       // 0 = all cores; results do not depend on it
   bool spectral = true;  // 33 bands, else linear sRGB (D65) from the 33 bands
@@ -42,18 +39,18 @@ struct FiberTableBakeOptions {
   // finished pass (results depend on it, not on threads).
   uint64_t passes = 8;
   // Variance reduction (docs/fiber-bsdf.md, "Fewer photons for the same noise"); all unbiased.
-  // The defaults are the combination that needs the least CPU for a 1 % table error (20x fewer
-  // photons than the plain bake, 5x less CPU; docs/PERFORMANCE.md). The next-event estimator and
-  // the surface samples are the smooth boundary's, the stratified entry the direct route's: a bake
-  // of the rough dielectric boundary or the BSSRDF route names plain, 1 and random.
+  // The default folds mirror images only: 4x fewer photons for the same table error at no cost
+  // per photon, and a table's energy stays exact. Next-event estimation (with surface samples and
+  // stratified entries: 20x fewer photons, 4x less CPU) adds noise to the energy itself, which
+  // puts a lossless fiber's table above a total albedo of 1 at few photons (docs/PERFORMANCE.md).
   // How exits are tallied: one by one (plain), or by next-event estimation (smooth boundary only).
-  FiberExitEstimator estimator = FiberExitEstimator::kNextEvent;
+  FiberExitEstimator estimator = FiberExitEstimator::kPlain;
   // Average every cell pair with its images under the fiber's mirror symmetries.
   bool mirror_fold = true;
   // Surface-lobe directions drawn per photon (smooth boundary only; FiberSurfaceModel::samples).
-  int surface_samples = 4;
+  int surface_samples = 1;
   // How photons' entries are drawn (FiberEntrySampling; direct route only).
-  FiberEntrySampling entry = FiberEntrySampling::kStratified;
+  FiberEntrySampling entry = FiberEntrySampling::kRandom;
 };
 
 // The defaults for a spec and route: FiberTableBakeOptions{}, less the variance reductions that do

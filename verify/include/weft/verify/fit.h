@@ -111,9 +111,9 @@ std::string fit_inner_name(FitInner inner);
 struct FitInnerSettings {
   FitInner inner = FitInner::kRaytrace;
   int resolution = 6;
-  uint64_t fiber_photons_per_band = 1250;  // a quarter of the plain bake's 5000 (settings.cpp)
-  uint64_t particles_per_bin = 2000;       // kRaytrace: one ray trace
-  int summation_samples = 4;               // the summation's and the classic fiber table's
+  uint64_t fiber_photons_per_band = 5000;
+  uint64_t particles_per_bin = 2000;  // kRaytrace: one ray trace
+  int summation_samples = 4;          // the summation's and the classic fiber table's
   uint64_t seed = 1;
   int azimuths = 24;
   int threads = 0;
