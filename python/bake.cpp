@@ -35,8 +35,9 @@ struct FiberBakeArgs {
   std::string bands = "spectral", route = "direct";
 };
 
-// The options of a bake, each checked against the range `weft bake fiber` allows.
-FiberTableBakeOptions fiber_bake_options(const FiberBakeArgs& a) {
+// The options of a bake, each checked against the range `weft bake fiber` allows, over the
+// spec's and route's defaults (fiber_bake_defaults).
+FiberTableBakeOptions fiber_bake_options(const FiberSpec& spec, const FiberBakeArgs& a) {
   if (a.photons < 1 || a.photons > kMaxPhotonsPerBand)
     throw Error("", "photons", "must be in [1, 2^40], got " + std::to_string(a.photons));
   if (a.resolution < 2 || a.resolution > TabulatedBsdfTable::kMaxResolution)
@@ -50,14 +51,14 @@ FiberTableBakeOptions fiber_bake_options(const FiberBakeArgs& a) {
     throw Error("", "bands", "must be 'spectral' or 'rgb', got '" + a.bands + "'");
   if (a.route != "direct" && a.route != "bssrdf")
     throw Error("", "route", "must be 'direct' or 'bssrdf', got '" + a.route + "'");
-  FiberTableBakeOptions o;
+  FiberTableBakeOptions o = fiber_bake_defaults(
+      spec, a.route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf);
   o.photons_per_band = a.photons;
   o.resolution = a.resolution;
   o.seed = a.seed;
   o.passes = a.passes;
   o.threads = a.threads;
   o.spectral = a.bands == "spectral";
-  o.route = a.route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
   return o;
 }
 
@@ -79,8 +80,8 @@ Table bake_fiber_checked(const FiberSpec& spec, const FiberTableBakeOptions& o, 
 }
 
 Table bake_fiber(const py::object& spec, const FiberBakeArgs& a, bool yes_long, bool print) {
-  const FiberTableBakeOptions o = fiber_bake_options(a);
-  return bake_fiber_checked(fiber_spec_argument(spec), o, yes_long, print);
+  const FiberSpec s = fiber_spec_argument(spec);
+  return bake_fiber_checked(s, fiber_bake_options(s, a), yes_long, print);
 }
 
 // bake_fabric's fiber: a Table, a table file (.exr), or a spec baked here at the bake's defaults
@@ -92,9 +93,10 @@ Table fabric_fiber(const py::object& fiber, bool yes_long, bool print) {
     const std::filesystem::path p = fiber.cast<std::filesystem::path>();
     if (p.extension() == ".exr") return Table(TabulatedBsdfTable::read_exr(p));
   }
-  FiberTableBakeOptions o;
+  const FiberSpec spec = fiber_spec_argument(fiber);
+  FiberTableBakeOptions o = fiber_bake_defaults(spec);
   o.spectral = false;
-  return bake_fiber_checked(fiber_spec_argument(fiber), o, yes_long, print);
+  return bake_fiber_checked(spec, o, yes_long, print);
 }
 
 // The woven sample: the bundled poplin, a weave options file or dict (`weft weave`'s options),

@@ -22,7 +22,7 @@ bool is_table_file(const std::string& fiber) {
 // The table of a spec baked once into ./.weft-cache (RGB); 'source' names it in the checks.
 TabulatedBsdfTable cached_table(const FiberSpec& spec, const std::string& source,
                                 const std::string& option, const ProgressCallback& progress) {
-  FiberTableBakeOptions o;
+  FiberTableBakeOptions o = fiber_bake_defaults(spec);
   o.spectral = false;
   return TabulatedBsdfTable::read_exr(
       cached_fiber_table(".weft-cache", spec, o, progress, nullptr, [&] {

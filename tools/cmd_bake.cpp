@@ -92,6 +92,7 @@ JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
     p.job["estimator"] = fiber_exit_estimator_name(o.estimator);
   if (o.mirror_fold) p.job["mirror_fold"] = true;
   if (o.surface_samples != 1) p.job["surface_samples"] = o.surface_samples;
+  if (o.entry != FiberEntrySampling::kRandom) p.job["entry"] = fiber_entry_sampling_name(o.entry);
   p.units_total = kNumBands;
   p.shard = shard;
   // The spec as given (a merge makes the table's metadata from it; its hash is checked).
@@ -157,6 +158,7 @@ int merge_fiber_bake(const JobPart& all, const std::string& output, bool json) {
   o.estimator = parse_fiber_exit_estimator(all.job.value("estimator", "plain"), "estimator");
   o.mirror_fold = all.job.value("mirror_fold", false);
   o.surface_samples = all.job.value("surface_samples", 1);
+  o.entry = parse_fiber_entry_sampling(all.job.value("entry", "random"), "entry");
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
   std::vector<FiberBandState> states;
   for (const auto& [band, v] : all.units) {
@@ -182,9 +184,11 @@ void add_bake_command(CLI::App& app, Commands& commands) {
     int resolution = FiberTableBakeOptions{}.resolution;
     std::string bands = "spectral";
     std::string route = "direct";
-    std::string estimator = "plain";
-    bool mirror_fold = false;
-    int surface_samples = 1;
+    // Empty or 0: the spec's and route's default (fiber_bake_defaults).
+    std::string estimator;
+    bool mirror_fold = FiberTableBakeOptions{}.mirror_fold;
+    int surface_samples = 0;
+    std::string entry;
     uint64_t seed = FiberTableBakeOptions{}.seed;
     uint64_t passes = FiberTableBakeOptions{}.passes;
     int threads = 0;
@@ -223,14 +227,21 @@ void add_bake_command(CLI::App& app, Commands& commands) {
   fiber
       ->add_option("--estimator", opt->estimator,
                    "how exits are tallied: plain (one by one) or nee (next-event estimation at "
-                   "every scattering; smooth boundary, direct route)")
+                   "every scattering; smooth boundary, direct route); default plain")
       ->check(CLI::IsMember({"plain", "nee"}));
-  fiber->add_flag("--mirror-fold", opt->mirror_fold,
-                  "average every cell with its images under the fiber's mirror symmetries");
+  fiber->add_flag("--mirror-fold,!--no-mirror-fold", opt->mirror_fold,
+                  "average every cell with its images under the fiber's mirror symmetries "
+                  "(default on; --no-mirror-fold turns it off)");
   fiber
       ->add_option("--surface-samples", opt->surface_samples,
-                   "surface-lobe directions drawn per photon (smooth boundary)")
+                   "surface-lobe directions drawn per photon (smooth boundary; default " +
+                       std::to_string(FiberTableBakeOptions{}.surface_samples) + ")")
       ->check(CLI::Range(1, 1024));
+  fiber
+      ->add_option("--entry", opt->entry,
+                   "how photons' entries are drawn: random or stratified (randomised Sobol' "
+                   "points per task; direct route); default random")
+      ->check(CLI::IsMember({"random", "stratified"}));
   fiber->add_option("--seed", opt->seed, "random seed");
   fiber
       ->add_option("--passes", opt->passes,
@@ -255,17 +266,20 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          // A shard writes a part file for `weft merge`, not a table.
          if (opt->shard.empty()) TabulatedBsdfTable::check_output_path(opt->output, "--output");
          const FiberSpec spec = load_fiber_spec(opt->spec);
-         FiberTableBakeOptions o;
+         const FiberBakeRoute route =
+             opt->route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
+         FiberTableBakeOptions o = fiber_bake_defaults(spec, route);
          o.resolution = opt->resolution;
          o.photons_per_band = opt->photons;
          o.seed = opt->seed;
          o.threads = opt->threads;
          o.spectral = opt->bands == "spectral";
-         o.route = opt->route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
          o.passes = opt->passes;
-         o.estimator = parse_fiber_exit_estimator(opt->estimator, "--estimator");
+         if (!opt->estimator.empty())
+           o.estimator = parse_fiber_exit_estimator(opt->estimator, "--estimator");
          o.mirror_fold = opt->mirror_fold;
-         o.surface_samples = opt->surface_samples;
+         if (opt->surface_samples > 0) o.surface_samples = opt->surface_samples;
+         if (!opt->entry.empty()) o.entry = parse_fiber_entry_sampling(opt->entry, "--entry");
          const Shard shard = opt->shard.empty() ? Shard{} : parse_shard(opt->shard, "--shard");
          const JobPart job = fiber_bake_job(opt->spec, spec, o, shard);
          const UnitRange range = shard_units(kNumBands, shard);

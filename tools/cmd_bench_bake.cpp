@@ -16,14 +16,18 @@ namespace weft::cli {
 namespace {
 
 // "plain,nee+mirror+s4" -> the variants' names and bench options: an estimator, then optionally
-// "mirror" (mirror folding) and "s<K>" (K surface samples), joined by '+' (weft::Error naming
-// --estimators).
+// "mirror" (mirror folding), "strat" (stratified entries) and "s<K>" (K surface samples), joined
+// by '+' (weft::Error naming --estimators).
 std::vector<std::pair<std::string, BakeBenchOptions>> parse_bake_variants(
     const std::string& list, const BakeBenchOptions& base) {
   std::vector<std::pair<std::string, BakeBenchOptions>> out;
   std::stringstream in(list);
   for (std::string item; std::getline(in, item, ',');) {
+    // A variant names all its options: "plain" is the bare bake whatever the bake's defaults.
     BakeBenchOptions v = base;
+    v.mirror_fold = false;
+    v.surface_samples = 1;
+    v.entry = FiberEntrySampling::kRandom;
     std::stringstream parts(item);
     std::string part;
     std::getline(parts, part, '+');
@@ -31,13 +35,15 @@ std::vector<std::pair<std::string, BakeBenchOptions>> parse_bake_variants(
     while (std::getline(parts, part, '+')) {
       if (part == "mirror")
         v.mirror_fold = true;
+      else if (part == "strat")
+        v.entry = FiberEntrySampling::kStratified;
       else if (const auto k =
                    part.size() > 1 && part[0] == 's' ? finite_number(part.substr(1)) : std::nullopt;
                k && *k >= 1 && *k <= 1024 && *k == std::floor(*k))
         v.surface_samples = static_cast<int>(*k);
       else
         throw Error("", "--estimators",
-                    "unknown modifier '" + part + "' (mirror or s<K>, K in 1..1024)");
+                    "unknown modifier '" + part + "' (mirror, strat or s<K>, K in 1..1024)");
     }
     out.emplace_back(item, v);
   }
@@ -124,8 +130,8 @@ void add_bench_bake_command(CLI::App& bench, Commands& commands) {
       ->capture_default_str();
   cmd->add_option("--estimators", opt->estimators,
                   "bake variants to compare, comma list of plain or nee, each optionally with "
-                  "+mirror (mirror folding) and +s<K> (K surface samples per photon); ratios are "
-                  "against the first")
+                  "+mirror (mirror folding), +strat (stratified entries) and +s<K> (K surface "
+                  "samples per photon); ratios are against the first")
       ->capture_default_str();
   cmd->add_flag("--json", opt->json, "print JSON");
   commands.push_back(

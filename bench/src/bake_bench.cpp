@@ -69,6 +69,7 @@ BakeBenchResult bench_bake(const FiberSpec& spec, const BakeBenchOptions& option
       o.estimator = options.estimator;
       o.mirror_fold = options.mirror_fold;
       o.surface_samples = options.surface_samples;
+      o.entry = options.entry;
       moments.add(bake_fiber_table(spec, o).table.values);
     }
     BakeBenchRun run;

@@ -24,7 +24,8 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
       std::to_string(o.photons_per_band) + "|S" + std::to_string(o.seed) + "|P" +
       std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") + "|v" +
       std::to_string(TabulatedBsdfTable::kFormatVersion) +
-      // Only when not the default, so existing cache entries keep their names.
+      // Only when not the former defaults (plain, unfolded, one surface sample, random entries),
+      // so entries baked with them keep their names and are never read for other options.
       (o.weight_mode == WeightMode::absorption_weight ? "|absorption_weight" : "") +
       (o.route == FiberBakeRoute::kBssrdf ? "|bssrdf" : "") +
       (o.estimator != FiberExitEstimator::kPlain
@@ -32,6 +33,9 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
            : "") +
       (o.mirror_fold ? "|mirror_fold" : "") +
       (o.surface_samples != 1 ? "|surface_samples" + std::to_string(o.surface_samples) : "") +
+      (o.entry != FiberEntrySampling::kRandom
+           ? std::string("|entry_") + fiber_entry_sampling_name(o.entry)
+           : "") +
       (o.max_events_per_photon != FiberTableBakeOptions{}.max_events_per_photon
            ? "|E" + std::to_string(o.max_events_per_photon)
            : "");
@@ -146,8 +150,8 @@ FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir, FiberBa
     } catch (const Error& e) {
       throw Error(p.file(), p.field("spec"), e.what());
     }
-    const FiberTableBakeOptions defaults;
-    FiberTableBakeOptions o;
+    const FiberTableBakeOptions defaults = fiber_bake_defaults(spec);
+    FiberTableBakeOptions o = defaults;
     o.spectral = false;  // the renderer is RGB
     o.resolution = static_cast<int>(
         p.integer("resolution", defaults.resolution, 2, TabulatedBsdfTable::kMaxResolution));

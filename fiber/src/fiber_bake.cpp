@@ -3,12 +3,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "weft/core/error.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
+#include "weft/core/sobol.h"
 #include "weft/fiber/bssrdf.h"
 #include "weft/fiber/transport_batch.h"
 #include "weft/materials/bsdf_table.h"
@@ -24,6 +27,13 @@ void validate(const FiberBandPhysics& fiber, const FiberBakeSettings& s) {
                     std::to_string(TabulatedBsdfTable::kMaxResolution) + "]");
   if (s.photons == 0) throw Error("", "photons", "need at least one photon");
   if (s.photons_per_task == 0) throw Error("", "photons_per_task", "must be positive");
+  if (s.entry != FiberEntrySampling::kRandom && s.entry != FiberEntrySampling::kStratified)
+    throw Error("", "entry", "must be random or stratified");
+  // A task's Sobol' points are indexed by 32 bits (photon times surface samples).
+  if (s.entry == FiberEntrySampling::kStratified &&
+      s.photons_per_task * static_cast<uint64_t>(std::max(1, fiber.surface.samples)) >
+          (uint64_t{1} << 32))
+    throw Error("", "photons_per_task", "too many photons per task for a stratified entry");
 }
 
 TaskBatch batch_of(const FiberBakeSettings& s, const ProgressCallback& progress) {
@@ -54,6 +64,27 @@ FiberBandTable finish_table(int resolution, std::vector<double> weighted_sum,
   return t;
 }
 
+// A photon's entry for the direct route (the uniforms of bake_fiber_band_direct's photon k of a
+// task): from the task's Sobol' points when stratified (dimensions 0-2 the entry, 3-5 the surface
+// lobe's samples k * samples + j), else from rng in the order the random entry always drew them.
+struct EntryDraws {
+  double u[3];               // light direction (two), impact parameter
+  std::vector<double> lobe;  // 3 per surface sample; empty: enter_fiber draws them from rng
+};
+void draw_entry(const ScrambledSobol* sobol, uint64_t k, int lobe_samples, Rng& rng,
+                EntryDraws& e) {
+  if (!sobol) {
+    for (double& u : e.u) u = rng.uniform();
+    return;
+  }
+  const auto index = static_cast<uint32_t>(k);
+  for (int d = 0; d < 3; ++d) e.u[d] = sobol->sample(index, d);
+  e.lobe.resize(3 * static_cast<size_t>(lobe_samples));
+  for (int j = 0; j < lobe_samples; ++j)
+    for (int d = 0; d < 3; ++d)
+      e.lobe[3 * j + d] = sobol->sample(index * static_cast<uint32_t>(lobe_samples) + j, 3 + d);
+}
+
 struct DirectTally {
   // Exits in the order they happened: (cell index, weight). Sparse, because a task's photons
   // touch few of the R^4 cells; merged in task order, so sums are the same at any thread count.
@@ -63,6 +94,16 @@ struct DirectTally {
 };
 
 }  // namespace
+
+const char* fiber_entry_sampling_name(FiberEntrySampling e) {
+  return e == FiberEntrySampling::kStratified ? "stratified" : "random";
+}
+
+FiberEntrySampling parse_fiber_entry_sampling(const std::string& name, const std::string& field) {
+  for (const auto e : {FiberEntrySampling::kRandom, FiberEntrySampling::kStratified})
+    if (name == fiber_entry_sampling_name(e)) return e;
+  throw Error("", field, "unknown entry sampling '" + name + "' (random or stratified)");
+}
 
 double fiber_table_energy(const FiberBandTable& table) {
   double sum = 0;
@@ -100,6 +141,9 @@ FiberBandTable bake_fiber_band_direct(const FiberBandPhysics& fiber, const Fiber
   const bool far_field = s.far_field_s_bins > 0 && s.far_field_psi_bins > 0;
   const int ffs = s.far_field_s_bins, ffp = s.far_field_psi_bins;
   std::vector<double> far_total(far_field ? static_cast<size_t>(ffs) * ffs * ffp : 0, 0.0);
+  const bool stratified = s.entry == FiberEntrySampling::kStratified;
+  // The rough dielectric boundary draws its walk from rng, not lobe samples.
+  const int lobe_samples = fiber.boundary ? 0 : std::max(1, fiber.surface.samples);
 
   const TaskBatchStatus status = run_batch<DirectTally>(
       batch_of(s, progress),
@@ -121,18 +165,23 @@ FiberBandTable bake_fiber_band_direct(const FiberBandPhysics& fiber, const Fiber
             tally.far_field.emplace_back((static_cast<uint64_t>(a) * ffs + b) * ffp + c, e.weight);
           }
         };
+        // Stratified: the task's own Sobol' points, drawn from its stream (any thread count).
+        std::optional<ScrambledSobol> sobol;
+        if (stratified) sobol.emplace(rng);
+        EntryDraws e;
         for (uint64_t k = 0; k < count; ++k) {
+          draw_entry(sobol ? &*sobol : nullptr, k, lobe_samples, rng, e);
           // Axial cosine s of the light direction with density (2/pi) sqrt(1 - s^2) (the fiber's
           // projected width), via the x coordinate of a uniform point in the unit disk.
-          const double r = std::sqrt(rng.uniform());
-          const double s_axial = r * std::cos(2 * kPi * rng.uniform());
+          const double r = std::sqrt(e.u[0]);
+          const double s_axial = r * std::cos(2 * kPi * e.u[1]);
           const double c = safe_sqrt(1 - s_axial * s_axial);
           omega = {s_axial, 0, c};  // towards the light, which is above (+z)
           // Impact parameter uniform across the projected width: entry angle phi_A on the lit
           // half.
-          const double p = 2 * rng.uniform() - 1;  // in units of R
+          const double p = 2 * e.u[2] - 1;  // in units of R
           const double phi_a = std::atan2(safe_sqrt(1 - p * p), p);
-          enter_fiber(fiber, phi_a, omega, 1.0, rng, sink, sink, tally.books);
+          enter_fiber(fiber, phi_a, omega, 1.0, rng, sink, sink, tally.books, e.lobe);
         }
       },
       [&](const DirectTally& t) {

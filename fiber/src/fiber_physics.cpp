@@ -148,8 +148,8 @@ FiberBandPhysics fiber_band_physics(const FiberSpec& spec, const MediumBand& mb,
 }
 
 void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
-                 const ExitSink& surface_exits, const ExitSink& interior_exits,
-                 PhotonTally& books) {
+                 const ExitSink& surface_exits, const ExitSink& interior_exits, PhotonTally& books,
+                 std::span<const double> lobe_uniforms) {
   // Light that enters must leave somewhere: an unset sink would drop it (or call an empty
   // std::function) deep inside the transport.
   if (!interior_exits) throw Error("enter_fiber: no sink for the interior's exits (internal)");
@@ -193,11 +193,14 @@ void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, d
   double sampled_surface = 0;
   // Surface lobe: sampled reflected directions with weight f cos / pdf (expectation = albedo).
   const int samples = std::max(1, fiber.surface.samples);
+  if (!lobe_uniforms.empty() && lobe_uniforms.size() != 3 * static_cast<size_t>(samples))
+    throw Error("enter_fiber: lobe uniforms do not match the surface samples (internal)");
   for (int k = 0; k < samples; ++k) {
     Vec3 w_out;
     double weight = 0;
-    const Vec2 u{rng.uniform(), rng.uniform()};
-    const double u_lobe = rng.uniform();
+    const double* given = lobe_uniforms.empty() ? nullptr : &lobe_uniforms[3 * k];
+    const Vec2 u = given ? Vec2{given[0], given[1]} : Vec2{rng.uniform(), rng.uniform()};
+    const double u_lobe = given ? given[2] : rng.uniform();
     if (fiber.surface.sample && fiber.surface.sample(omega_local, u, u_lobe, &w_out, &weight) &&
         weight > 0) {
       const double w = w0 * weight / samples;

@@ -26,11 +26,24 @@ void validate(const FiberTableBakeOptions& o) {
     throw Error("", "weight_mode", "must be implicit_capture or absorption_weight");
   if (o.estimator != FiberExitEstimator::kPlain && o.route != FiberBakeRoute::kDirect)
     throw Error("", "estimator", "next-event estimation is for the direct route");
+  if (o.entry != FiberEntrySampling::kRandom && o.route != FiberBakeRoute::kDirect)
+    throw Error("", "entry", "a stratified entry is for the direct route");
   if (o.surface_samples < 1 || o.surface_samples > 1024)
     throw Error("", "surface_samples", "must lie in [1, 1024]");
 }
 
 }  // namespace
+
+FiberTableBakeOptions fiber_bake_defaults(const FiberSpec& spec, FiberBakeRoute route) {
+  FiberTableBakeOptions o;
+  o.route = route;
+  const bool smooth = spec.boundary == FiberBoundary::kSmooth;
+  const bool direct = route == FiberBakeRoute::kDirect;
+  if (!smooth || !direct) o.estimator = FiberExitEstimator::kPlain;
+  if (!smooth) o.surface_samples = 1;
+  if (!direct) o.entry = FiberEntrySampling::kRandom;
+  return o;
+}
 
 double fiber_table_bake_bytes(const FiberTableBakeOptions& o) {
   const double cells = DirectionGrid{std::clamp(o.resolution, 1, 1 << 12)}.bins();
@@ -104,6 +117,7 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
       // Disjoint random streams per (seed, pass, band).
       settings.seed = mix64(mix64(o.seed) ^ (pass * kNumBands + static_cast<uint64_t>(band)));
       settings.threads = o.threads;
+      settings.entry = o.entry;
       const uint64_t base = units_done;
       // A stop request may arrive after a band's last task: remember it for the loops here.
       ProgressCallback band_progress = [&](const ProgressUpdate& u) {
@@ -236,6 +250,8 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
     table.metadata["exit_estimator"] = fiber_exit_estimator_name(o.estimator);
   if (o.mirror_fold) table.metadata["mirror_fold"] = "yes";
   if (o.surface_samples != 1) table.metadata["surface_samples"] = std::to_string(o.surface_samples);
+  if (o.entry != FiberEntrySampling::kRandom)
+    table.metadata["entry"] = fiber_entry_sampling_name(o.entry);
   if (!o.spectral)
     table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
   table.validate("");

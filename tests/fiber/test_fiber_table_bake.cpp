@@ -119,10 +119,11 @@ TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
     EXPECT_EQ(b.absorbed_fraction, 0.0);
     EXPECT_EQ(b.lost_fraction, 0.0);
     EXPECT_EQ(b.roulette_net, 0.0);
-    // The books balance per photon; the only difference from 1 is the mean-zero excess of the
-    // sampled surface weight over the tabulated surface albedo.
+    // The books balance per photon; the only differences from 1 are the mean-zero excesses of
+    // the sampled surface weight over the tabulated surface albedo and of the next-event
+    // estimated exits over the walks' own (zero with plain exits).
     EXPECT_NEAR(b.energy_balance, 1.0, 1e-12);
-    EXPECT_NEAR(b.exit_fraction - b.surface_sampling_excess, 1.0, 1e-12);
+    EXPECT_NEAR(b.exit_fraction - b.surface_sampling_excess - b.expected_exit_excess, 1.0, 1e-12);
     // The table holds exactly the exiting energy (sum of f D_i D_o = pi * exit).
     EXPECT_NEAR(b.energy_table, b.exit_fraction, 1e-12);
     excess_sum += b.surface_sampling_excess;
@@ -359,17 +360,26 @@ TEST(FiberTableBake, BitIdenticalAtOneAndTwoThreads) {
 }
 
 TEST(FiberTableBake, RoughDielectricBoundaryIsBitIdenticalAtOneAndTwoThreads) {
-  FiberTableBakeOptions o{.resolution = 4, .photons_per_band = 200, .threads = 1, .passes = 2};
   const FiberSpec spec = rough_dielectric(load_fiber_spec("red-cotton"));
+  // The rough boundary's defaults: plain exits and one walk per photon (fiber_bake_defaults).
+  FiberTableBakeOptions o = fiber_bake_defaults(spec);
+  EXPECT_EQ(o.estimator, FiberExitEstimator::kPlain);
+  EXPECT_EQ(o.surface_samples, 1);
+  o.resolution = 4, o.photons_per_band = 200, o.threads = 1, o.passes = 2;
   const auto a = bake_fiber_table(spec, o);
   o.threads = 2;
   const auto b = bake_fiber_table(spec, o);
   EXPECT_EQ(a.table.checksum(), b.table.checksum());
   EXPECT_EQ(a.table.metadata.at("boundary"), "rough-dielectric");
   // The default's header has no boundary entry (its tables are those of before the option).
-  o.photons_per_band = 20;
+  o = FiberTableBakeOptions{.resolution = 4, .photons_per_band = 20, .threads = 2};
   EXPECT_EQ(bake_fiber_table(load_fiber_spec("red-cotton"), o).table.metadata.count("boundary"),
             0u);
+  // A bake of the BSSRDF route likewise drops what is the direct route's.
+  o = fiber_bake_defaults(load_fiber_spec("red-cotton"), FiberBakeRoute::kBssrdf);
+  EXPECT_EQ(o.estimator, FiberExitEstimator::kPlain);
+  EXPECT_EQ(o.entry, FiberEntrySampling::kRandom);
+  EXPECT_EQ(o.surface_samples, FiberTableBakeOptions{}.surface_samples);
 }
 
 TEST(FiberTableBake, ExtremesStayFiniteAndBalanced) {
@@ -550,6 +560,95 @@ TEST(FiberTableBake, NextEventEstimationAndMirrorFoldingEstimateThePlainTable) {
 // move every path and the albedo jitters by its noise: not monotone (the inner objective of
 // weft verify --fit was as rough, docs/verify.md). Red-cotton, RGB, R = 4, 2000 photons per band,
 // dye 1.00, 1.01, ..., 1.04.
+// Stratified entries (FiberEntrySampling::kStratified: per task the points of a randomised Sobol'
+// sequence, core/sobol.h) estimate the same table as independent ones: the normalised differences
+// of the cells against plain random entries, by the criteria of the test above (8 bakes each, at
+// most one cell beyond 4.5 standard errors, their RMS in [0.8, 1.4]; a bias of one standard error
+// in every cell lifts it to 1.5), for the plain estimator and for next-event estimation with four
+// surface samples (whose lobe uniforms are Sobol' dimensions too); the exit and absorbed
+// fractions agree within 4.5 standard errors and the books close per photon.
+TEST(FiberTableBake, StratifiedEntriesEstimateThePlainTable) {
+  const FiberSpec spec = test_spec(20, 0.10, 0.01);
+  const MediumBand mb = compute_medium_band(spec, 16);
+  const int k = 8, resolution = 3;
+  std::vector<double> exit[4], absorbed[4];
+  // Random plain, stratified plain, stratified and random next-event with 4 surface samples.
+  CellStats st[4];
+  for (int m = 0; m < 4; ++m) {
+    FiberBandPhysics ph =
+        fiber_band_physics(spec, mb, 10'000'000, nullptr, WeightMode::implicit_capture,
+                           m >= 2 ? FiberExitEstimator::kNextEvent : FiberExitEstimator::kPlain);
+    if (m >= 2) ph.surface.samples = 4;
+    FiberBakeSettings s = weft::testing::bake_settings(resolution, 40000, 2);
+    s.entry = m == 0 || m == 3 ? FiberEntrySampling::kRandom : FiberEntrySampling::kStratified;
+    st[m] = cell_stats(k, [&](uint64_t seed) {
+      s.seed = seed + 100 * m;
+      const FiberBandTable t = bake_fiber_band_direct(ph, s, nullptr);
+      EXPECT_NEAR(t.energy_balance(), 1.0, 1e-12);
+      EXPECT_NEAR(fiber_table_energy(t) / kPi, t.exit_fraction, 1e-12);
+      exit[m].push_back(t.exit_fraction);
+      absorbed[m].push_back(t.absorbed_fraction);
+      return t;
+    });
+  }
+  const auto mean_se = [](const std::vector<double>& v) {
+    double s = 0, s2 = 0;
+    for (double x : v) s += x, s2 += x * x;
+    const double m = s / v.size();
+    return std::pair{m, std::sqrt(std::max(0.0, s2 / v.size() - m * m) / (v.size() - 1))};
+  };
+  const auto noise = [](const CellStats& c) {
+    double v = 0;
+    for (double e : c.se) v += e * e;
+    return v;
+  };
+  for (int m = 1; m < 4; ++m) {
+    EXPECT_LE(count_outliers(st[0].mean, st[0].se, st[m].mean, st[m].se, 4.5), 1) << m;
+    double z2 = 0;
+    int n = 0;
+    for (size_t c = 0; c < st[0].mean.size(); ++c) {
+      const double se = std::hypot(st[0].se[c], st[m].se[c]);
+      if (!(se > 0)) continue;
+      z2 += sqr((st[0].mean[c] - st[m].mean[c]) / se), ++n;
+    }
+    ASSERT_GT(n, 100);
+    const double rms = std::sqrt(z2 / n);
+    EXPECT_GT(rms, 0.8) << m;
+    EXPECT_LT(rms, 1.4) << m;
+    for (const auto* v : {exit, absorbed}) {
+      const auto [a, sa] = mean_se(v[0]);
+      const auto [b, sb] = mean_se(v[m]);
+      EXPECT_NEAR(a, b, 4.5 * std::hypot(sa, sb)) << m << ": " << sa << " " << sb;
+    }
+  }
+  // With plain exits where a photon leaves is the noise, and stratifying its entry leaves the
+  // total variance about as it was (0.97 of it here); with next-event estimation the entry's
+  // randomness is much of what is left, and stratifying it lowers the variance (0.83 of it here;
+  // docs/PERFORMANCE.md measures 1.5x fewer photons for the same error on red cotton).
+  EXPECT_LT(noise(st[1]), 1.1 * noise(st[0]));
+  EXPECT_LT(noise(st[2]), 0.9 * noise(st[3]));
+}
+
+TEST(FiberTableBake, StratifiedEntriesAreBitIdenticalAtAnyThreadCount) {
+  FiberTableBakeOptions o{.resolution = 4, .photons_per_band = 300, .threads = 1, .passes = 2};
+  o.entry = FiberEntrySampling::kStratified;
+  o.surface_samples = 3;
+  const auto a = bake_fiber_table(load_fiber_spec("red-cotton"), o);
+  o.threads = 3;
+  const auto b = bake_fiber_table(load_fiber_spec("red-cotton"), o);
+  EXPECT_EQ(a.table.checksum(), b.table.checksum());
+  EXPECT_EQ(a.table.metadata.at("entry"), "stratified");
+  // A stratified entry is the direct route's; names are parsed strictly.
+  o.route = FiberBakeRoute::kBssrdf;
+  o.estimator = FiberExitEstimator::kPlain;
+  EXPECT_NE(weft::testing::error_of([&] {
+              bake_fiber_table(load_fiber_spec("red-cotton"), o);
+            }).find("entry"),
+            std::string::npos);
+  EXPECT_THROW(parse_fiber_entry_sampling("sobol", "entry"), Error);
+  EXPECT_EQ(parse_fiber_entry_sampling("stratified", "entry"), FiberEntrySampling::kStratified);
+}
+
 TEST(FiberTableBake, AbsorptionWeightMakesTheAlbedoSmoothInTheDyeAtAFixedSeed) {
   const FiberSpec spec = load_fiber_spec("red-cotton");
   const auto albedo_along_dye = [&](WeightMode mode) {
@@ -626,7 +725,7 @@ TEST(FiberTableBake, CacheKeyHoldsEveryOptionThatChangesTheTable) {
   const auto name = [&](const FiberTableBakeOptions& o) {
     return fiber_table_cache_file(dir, spec, o).filename().string();
   };
-  std::vector<FiberTableBakeOptions> variants(11, base);
+  std::vector<FiberTableBakeOptions> variants(12, base);
   variants[0].resolution = 6;
   variants[1].photons_per_band = 1000;
   variants[2].seed = 2;
@@ -635,15 +734,57 @@ TEST(FiberTableBake, CacheKeyHoldsEveryOptionThatChangesTheTable) {
   variants[5].weight_mode = WeightMode::absorption_weight;
   variants[6].route = FiberBakeRoute::kBssrdf;
   variants[7].max_events_per_photon = 1000;
-  variants[8].estimator = FiberExitEstimator::kNextEvent;
-  variants[9].mirror_fold = true;
-  variants[10].surface_samples = 4;
+  // The estimator options, each turned away from the default (whichever it is).
+  variants[8].estimator = base.estimator == FiberExitEstimator::kPlain
+                              ? FiberExitEstimator::kNextEvent
+                              : FiberExitEstimator::kPlain;
+  variants[9].mirror_fold = !base.mirror_fold;
+  variants[10].surface_samples = base.surface_samples == 4 ? 2 : 4;
+  variants[11].entry = base.entry == FiberEntrySampling::kRandom ? FiberEntrySampling::kStratified
+                                                                 : FiberEntrySampling::kRandom;
   std::set<std::string> names{name(base)};
   for (const auto& v : variants) EXPECT_TRUE(names.insert(name(v)).second) << name(v);
   // Threads change nothing (a bake's bits do not depend on them).
   FiberTableBakeOptions threads = base;
   threads.threads = 7;
   EXPECT_EQ(name(threads), name(base));
+}
+
+// The bake cache never serves a table baked with one set of estimator options for another: an
+// entry of the former default (plain exits, no folding, one surface sample, random entries) is not
+// read for today's default, nor the reverse, and the former default's entry keeps the name it had
+// before these options existed (so caches written then stay valid for bakes that ask for it).
+TEST(FiberTableBake, CacheKeepsTheFormerDefaultsTablesApart) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / "weft-bake-cache-defaults";
+  fs::remove_all(dir);
+  const FiberSpec spec = load_fiber_spec("white-cotton");
+  FiberTableBakeOptions now{.resolution = 2, .photons_per_band = 64, .threads = 2};
+  now.spectral = false;
+  FiberTableBakeOptions former = now;
+  former.estimator = FiberExitEstimator::kPlain;
+  former.mirror_fold = false;
+  former.surface_samples = 1;
+  former.entry = FiberEntrySampling::kRandom;
+  // The name this entry had before the defaults changed (printed by this test at commit 886028c,
+  // whose key named none of these options at their former defaults).
+  EXPECT_EQ(fiber_table_cache_file(dir, spec, former).filename().string(),
+            "fiber-a8281024d6a0e84e-3914f0fcf59896a4.exr");
+  bool baked = false;
+  const fs::path a = cached_fiber_table(dir, spec, former, no_progress(), &baked);
+  EXPECT_TRUE(baked);
+  const fs::path b = cached_fiber_table(dir, spec, now, no_progress(), &baked);
+  EXPECT_TRUE(baked) << "the former default's entry was served for the new default";
+  EXPECT_NE(a, b);
+  EXPECT_EQ(cached_fiber_table(dir, spec, former, no_progress(), &baked), a);
+  EXPECT_FALSE(baked);
+  EXPECT_EQ(cached_fiber_table(dir, spec, now, no_progress(), &baked), b);
+  EXPECT_FALSE(baked);
+  // What each entry holds says how it was baked.
+  EXPECT_EQ(TabulatedBsdfTable::read_exr(a).metadata.count("mirror_fold"), 0u);
+  EXPECT_EQ(TabulatedBsdfTable::read_exr(b).metadata.count("mirror_fold"),
+            now.mirror_fold ? 1u : 0u);
+  fs::remove_all(dir);
 }
 
 TEST(FiberTableBake, FiberTableMaterialBakesASpecOnDemandOnce) {

@@ -173,9 +173,10 @@ std::vector<FitParameter> classic_fit_parameters(const Rgb& diffuse, double alph
           {"roughness_alpha", "", 0.05, 1, std::clamp(alpha, 0.05, 1.0), false}};
 }
 
-FiberTableBakeOptions verify_bake_options(int resolution, uint64_t photons_per_band, uint64_t seed,
-                                          int threads, bool fit_inner) {
-  FiberTableBakeOptions b;
+FiberTableBakeOptions verify_bake_options(const FiberSpec& spec, int resolution,
+                                          uint64_t photons_per_band, uint64_t seed, int threads,
+                                          bool fit_inner) {
+  FiberTableBakeOptions b = fiber_bake_defaults(spec);
   b.resolution = resolution;
   b.photons_per_band = photons_per_band;
   b.seed = seed;
@@ -247,7 +248,7 @@ std::vector<std::vector<Rgb>> inner_fabric_curves(const WovenSample& sample,
 
 TabulatedBsdfTable computed_inner_fiber_table(const FiberSpec& spec, const FitInnerSettings& f) {
   const FiberTableBakeOptions b =
-      verify_bake_options(f.resolution, f.fiber_photons_per_band, f.seed, f.threads, true);
+      verify_bake_options(spec, f.resolution, f.fiber_photons_per_band, f.seed, f.threads, true);
   return bake_fiber_table(spec, b).table;
 }
 

@@ -25,7 +25,7 @@ std::optional<VerifyReport> fitted_at_run_quality(const VerifyPlan& p, const Wov
   in.fiber_name = base.fiber_name + " (fitted)";
   in.sample_name = base.sample_name;
   const FiberTableBakeOptions b =
-      verify_bake_options(s.resolution, s.fiber_photons_per_band, s.seed, s.threads, false);
+      verify_bake_options(fitted, s.resolution, s.fiber_photons_per_band, s.seed, s.threads, false);
   FiberTableBakeResult fiber = bake_fiber_table(fitted, b, progress);
   if (fiber.cancelled) return std::nullopt;
   for (const auto& band : fiber.bands)

@@ -21,7 +21,7 @@ namespace {
 bool fiber_from_cache(const VerifyPlan& p, VerifyInputs& in, const VerifyHooks& hooks) {
   const VerifySettings& s = p.settings;
   const FiberTableBakeOptions b =
-      verify_bake_options(s.resolution, s.fiber_photons_per_band, s.seed, s.threads, false);
+      verify_bake_options(p.spec, s.resolution, s.fiber_photons_per_band, s.seed, s.threads, false);
   std::filesystem::path file;
   try {
     file = cached_fiber_table(".weft-cache", p.spec, b, hooks.progress);

@@ -25,6 +25,7 @@ struct BakeBenchOptions {
   FiberExitEstimator estimator = FiberTableBakeOptions{}.estimator;
   bool mirror_fold = FiberTableBakeOptions{}.mirror_fold;
   int surface_samples = FiberTableBakeOptions{}.surface_samples;
+  FiberEntrySampling entry = FiberTableBakeOptions{}.entry;
 };
 
 struct BakeBenchRun {

@@ -5,12 +5,22 @@
 // table: the direct one (a parallel beam over the whole lit cylinder) and the paper's (its BSSRDF,
 // bssrdf.h, summed over the lit cells).
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "weft/core/progress.h"
 #include "weft/fiber/fiber_physics.h"
 
 namespace weft {
+
+// How the direct route draws a photon's entry (its light direction, its impact parameter across
+// the fiber and its surface-lobe directions): independent uniforms (random), or per task of
+// photons the points of a randomised Sobol' sequence (core/sobol.h), which stratifies them while
+// each photon's entry stays uniform, so the estimate stays unbiased (docs/fiber-bsdf.md).
+enum class FiberEntrySampling : uint8_t { kRandom, kStratified };
+const char* fiber_entry_sampling_name(FiberEntrySampling e);  // "random", "stratified"
+// Parses a name of fiber_entry_sampling_name; weft::Error naming 'field' otherwise.
+FiberEntrySampling parse_fiber_entry_sampling(const std::string& name, const std::string& field);
 
 struct FiberBakeSettings {
   int resolution = 8;    // R: R x R equal-area bins per hemisphere and direction (DirectionGrid)
@@ -23,6 +33,7 @@ struct FiberBakeSettings {
   // axis, the reciprocal quantity (docs/fiber-bsdf.md).
   int far_field_s_bins = 0;
   int far_field_psi_bins = 0;
+  FiberEntrySampling entry = FiberEntrySampling::kRandom;  // the direct route's entries
 };
 
 // The cosine-weighted cell averages of one band: value[i * R^2 + o] with i the incident (light)

@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -122,8 +123,11 @@ TransportOptions fiber_band_transport_options(
 // 1 - albedo, enters refracted at the smooth normal and is traced, its exits going to
 // 'interior_exits' (required: Error if empty). With a rough dielectric boundary the photon either
 // reflects off it (to 'surface_exits', booked as specular) or enters refracted by it, whole. Adds
-// one launched photon to 'books'. Deterministic given rng.
+// one launched photon to 'books'. Deterministic given rng. 'lobe_uniforms' (smooth boundary; may
+// be empty: drawn from rng) holds the surface lobe's uniforms, 3 per sample (u, then u_lobe), as a
+// stratified entry draws them (fiber_bake.h, FiberEntrySampling).
 void enter_fiber(const FiberBandPhysics& fiber, double phi, const Vec3& omega, double w0, Rng& rng,
-                 const ExitSink& surface_exits, const ExitSink& interior_exits, PhotonTally& books);
+                 const ExitSink& surface_exits, const ExitSink& interior_exits, PhotonTally& books,
+                 std::span<const double> lobe_uniforms = {});
 
 }  // namespace weft

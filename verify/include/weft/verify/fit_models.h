@@ -63,9 +63,11 @@ std::vector<FitParameter> classic_fit_parameters(const Rgb& diffuse, double alph
 // bake (through the bake cache, and again for the fitted spec) and the fit's inner models. The
 // run's bake is spectral (the colour table needs the spectrum) with the default weights; the fit's
 // inner bake ('fit_inner') is RGB with absorption as a weight, so that at its fixed seed the table
-// is a smooth function of dye_scale (transport.h, docs/verify.md).
-FiberTableBakeOptions verify_bake_options(int resolution, uint64_t photons_per_band, uint64_t seed,
-                                          int threads, bool fit_inner);
+// is a smooth function of dye_scale (transport.h, docs/verify.md). Both start from the spec's
+// bake defaults (fiber_bake_defaults).
+FiberTableBakeOptions verify_bake_options(const FiberSpec& spec, int resolution,
+                                          uint64_t photons_per_band, uint64_t seed, int threads,
+                                          bool fit_inner);
 FabricSummationOptions verify_summation_options(int resolution, int samples_per_cell, uint64_t seed,
                                                 int threads);
 
