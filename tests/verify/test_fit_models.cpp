@@ -198,6 +198,11 @@ TEST(VerifyFit, RaytraceFitRecentresItsProposalAndConverges) {
   inner.fiber_photons_per_band = 1000;
   inner.particles_per_bin = 300;
   inner.threads = 2;
+  // Seed 5 (measurement and fit): with the fiber bake's mirror folding (its default since
+  // 2026-12-03, a less noisy inner table) seeds 1 and 3 settle after one restart (no spread to
+  // report); seeds 2, 4, 5, 6 restart twice or more: dye 1.98, 1.76, 1.87, 1.89, sigma_restarts
+  // 0.19, 0.24, 0.099, 0.12, after 48, 81, 37, 48 evaluations.
+  inner.seed = 5;
   const weft::WovenSample sample = verify_sample();
   const std::vector<std::string> names = {"dye_scale"};
   weft::MeasuredInplane geometry = weft::read_measured_inplane(
@@ -226,13 +231,9 @@ TEST(VerifyFit, RaytraceFitRecentresItsProposalAndConverges) {
   EXPECT_LT(r.objective, std::sqrt(ss / floor.size()));
   EXPECT_EQ(r.parameters[0].parameter.start, 1.0);  // the given start, not a restart's
   EXPECT_LE(r.evaluations, options.max_evaluations + 2);
-  // Two restarts or more: their spread is reported beside the Gauss-Newton sigma (NaN with fewer,
-  // fit.h). Whether this realization restarts depends on the inner table's noise: the measurements
-  // above had two or more, but with the fiber bake's mirror folding (its default since
-  // 2026-12-03, a less noisy table) this one settles in its first search.
-  if (std::isfinite(r.parameters[0].sigma_restarts)) {
-    EXPECT_GT(r.parameters[0].sigma_restarts, 0);
-  }
+  // Two restarts or more: their spread is reported beside the Gauss-Newton sigma.
+  EXPECT_TRUE(std::isfinite(r.parameters[0].sigma_restarts));
+  EXPECT_GT(r.parameters[0].sigma_restarts, 0);
 }
 
 // The classic model's four (diffuse colour per channel, roughness) from its own synthetic
