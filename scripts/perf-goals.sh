@@ -6,7 +6,9 @@
 #             one fiber table for both, baked once by the baseline): CPU seconds to 1 % relative
 #             noise per channel, CPU seconds x (noise / 1 %)^2, over WEFT_SEEDS seeds;
 #   bake      the fiber bake (`weft bench bake red-cotton`): photons per band and CPU seconds for a
-#             1 % table error, the baseline's default against this tree's;
+#             1 % table error, the baseline's default against this tree's variants
+#             WEFT_BAKE_VARIANTS (default plain+mirror, the default bake, and
+#             nee+mirror+s4+strat, its fewest-photons options);
 #   render    the path tracer's rays per second over the same rays through bare Embree
 #             (`weft bench render`, ratio_replay), both bundled benchmark scenes;
 #   backlit   the fiber-level render lit from behind and in front (scripts/fiber-render-noise.sh,
@@ -84,11 +86,11 @@ fi
 
 if [[ $goals == *,bake,* ]]; then
   echo "== fiber bake (bench bake, 4 seeds)"
-  for who in before after; do
-    bin=$old && [ $who = after ] && bin=$new
-    timed "bake-$who" "$bin" bench bake red-cotton --photons 2000,8000,32000 --seeds 4 \
-      --threads "$threads" --json
-  done
+  timed "bake-before" "$old" bench bake red-cotton --photons 2000,8000,32000 --seeds 4 \
+    --threads "$threads" --json
+  # This tree's default bake (mirror folding), and its fewest-photons options.
+  timed "bake-after" "$new" bench bake red-cotton --photons 2000,8000,32000 --seeds 4 \
+    --threads "$threads" --json --estimators "${WEFT_BAKE_VARIANTS:-plain+mirror,nee+mirror+s4+strat}"
 fi
 
 if [[ $goals == *,render,* ]]; then
