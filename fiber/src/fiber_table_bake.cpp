@@ -150,6 +150,39 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
   return result;
 }
 
+namespace {
+
+// The header of a baked fiber table: what it is of and how it was baked (the options only where
+// not their former defaults, so that tables baked before an option keep their header).
+std::map<std::string, std::string> fiber_table_metadata(const FiberSpec& spec,
+                                                        const FiberTableBakeOptions& o,
+                                                        uint64_t min_photons, bool cancelled) {
+  std::map<std::string, std::string> m = {
+      {"spec_hash", fiber_spec_hash_hex(spec)},
+      {"spec_name", spec.name},
+      {"photons", std::to_string(min_photons)},
+      {"photons_requested", std::to_string(o.photons_per_band)},
+      {"interrupted", cancelled ? "yes" : "no"},
+      {"seed", std::to_string(o.seed)},
+      {"route", o.route == FiberBakeRoute::kDirect ? "direct" : "bssrdf"},
+      {"fiber_radius_um", std::to_string(spec.fiber_radius_um)},
+      {"roughness", std::string(microfacet_model_name(spec.roughness_distribution)) + " alpha " +
+                        std::to_string(spec.roughness_alpha)},
+      {"definition",
+       "f = L_o / (E |cos theta_i|); cosine-weighted cell averages (docs/fiber-bsdf.md)"},
+  };
+  // Only when not the default, so tables of the paper's model keep their header.
+  if (spec.boundary != FiberBoundary::kSmooth) m["boundary"] = fiber_boundary_name(spec.boundary);
+  if (o.estimator != FiberExitEstimator::kPlain)
+    m["exit_estimator"] = fiber_exit_estimator_name(o.estimator);
+  if (o.mirror_fold) m["mirror_fold"] = "yes";
+  if (o.surface_samples != 1) m["surface_samples"] = std::to_string(o.surface_samples);
+  if (o.entry != FiberEntrySampling::kRandom) m["entry"] = fiber_entry_sampling_name(o.entry);
+  return m;
+}
+
+}  // namespace
+
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
                                       const ProgressCallback& progress) {
   const FiberBandsResult r = trace_fiber_bands(spec, o, FiberBandWork{}, progress);
@@ -229,29 +262,7 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
     }
   }
   result.rgb_negative_clipped = gamut.largest;
-  table.metadata = {
-      {"spec_hash", fiber_spec_hash_hex(spec)},
-      {"spec_name", spec.name},
-      {"photons", std::to_string(min_photons)},
-      {"photons_requested", std::to_string(o.photons_per_band)},
-      {"interrupted", result.cancelled ? "yes" : "no"},
-      {"seed", std::to_string(o.seed)},
-      {"route", o.route == FiberBakeRoute::kDirect ? "direct" : "bssrdf"},
-      {"fiber_radius_um", std::to_string(spec.fiber_radius_um)},
-      {"roughness", std::string(microfacet_model_name(spec.roughness_distribution)) + " alpha " +
-                        std::to_string(spec.roughness_alpha)},
-      {"definition",
-       "f = L_o / (E |cos theta_i|); cosine-weighted cell averages (docs/fiber-bsdf.md)"},
-  };
-  // Only when not the default, so tables of the paper's model keep their header.
-  if (spec.boundary != FiberBoundary::kSmooth)
-    table.metadata["boundary"] = fiber_boundary_name(spec.boundary);
-  if (o.estimator != FiberExitEstimator::kPlain)
-    table.metadata["exit_estimator"] = fiber_exit_estimator_name(o.estimator);
-  if (o.mirror_fold) table.metadata["mirror_fold"] = "yes";
-  if (o.surface_samples != 1) table.metadata["surface_samples"] = std::to_string(o.surface_samples);
-  if (o.entry != FiberEntrySampling::kRandom)
-    table.metadata["entry"] = fiber_entry_sampling_name(o.entry);
+  table.metadata = fiber_table_metadata(spec, o, min_photons, result.cancelled);
   if (!o.spectral)
     table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);
   table.validate("");
