@@ -104,6 +104,45 @@ RouteStats bake_both_routes(const FiberBandPhysics& ph) {
   return r;
 }
 
+// Two estimators of one table, judged alike (the tests of the bake's options): cell by cell at most
+// one normalised difference beyond 4.5 standard errors and their RMS in [0.8, 1.4] (a bias of one
+// standard error in every cell lifts it to 1.5), and the exit and absorbed fractions within 4.5
+// standard errors of each other. 'label' names the estimator in the failures.
+void expect_same_table(const CellStats& a, const CellStats& b, const std::vector<double>& exit_a,
+                       const std::vector<double>& exit_b, const std::vector<double>& absorbed_a,
+                       const std::vector<double>& absorbed_b, int label) {
+  const auto mean_se = [](const std::vector<double>& v) {
+    double s = 0, s2 = 0;
+    for (double x : v) s += x, s2 += x * x;
+    const double m = s / v.size();
+    return std::pair{m, std::sqrt(std::max(0.0, s2 / v.size() - m * m) / (v.size() - 1))};
+  };
+  EXPECT_LE(count_outliers(a.mean, a.se, b.mean, b.se, 4.5), 1) << label;
+  double z2 = 0;
+  int n = 0;
+  for (size_t c = 0; c < a.mean.size(); ++c) {
+    const double se = std::hypot(a.se[c], b.se[c]);
+    if (!(se > 0)) continue;
+    z2 += sqr((a.mean[c] - b.mean[c]) / se), ++n;
+  }
+  ASSERT_GT(n, 100) << label;
+  const double rms = std::sqrt(z2 / n);
+  EXPECT_GT(rms, 0.8) << label;
+  EXPECT_LT(rms, 1.4) << label;
+  for (const auto& [va, vb] : {std::pair{&exit_a, &exit_b}, std::pair{&absorbed_a, &absorbed_b}}) {
+    const auto [ma, sa] = mean_se(*va);
+    const auto [mb, sb] = mean_se(*vb);
+    EXPECT_NEAR(ma, mb, 4.5 * std::hypot(sa, sb)) << label << ": " << sa << " " << sb;
+  }
+}
+
+// The summed variance of a table's cell means.
+double cell_noise(const CellStats& c) {
+  double v = 0;
+  for (double e : c.se) v += e * e;
+  return v;
+}
+
 }  // namespace
 
 TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
@@ -518,48 +557,13 @@ TEST(FiberTableBake, NextEventEstimationAndMirrorFoldingEstimateThePlainTable) {
       return t;
     });
   }
-  const auto mean_se = [](const std::vector<double>& v) {
-    double s = 0, s2 = 0;
-    for (double x : v) s += x, s2 += x * x;
-    const double m = s / v.size();
-    return std::pair{m, std::sqrt(std::max(0.0, s2 / v.size() - m * m) / (v.size() - 1))};
-  };
-  const auto noise = [](const CellStats& c) {
-    double v = 0;
-    for (double e : c.se) v += e * e;
-    return v;
-  };
-  for (int m = 1; m < 3; ++m) {
-    EXPECT_LE(count_outliers(st[0].mean, st[0].se, st[m].mean, st[m].se, 4.5), 1) << m;
-    double z2 = 0;
-    int n = 0;
-    for (size_t c = 0; c < st[0].mean.size(); ++c) {
-      const double se = std::hypot(st[0].se[c], st[m].se[c]);
-      if (!(se > 0)) continue;
-      z2 += sqr((st[0].mean[c] - st[m].mean[c]) / se), ++n;
-    }
-    ASSERT_GT(n, 100);
-    const double rms = std::sqrt(z2 / n);
-    EXPECT_GT(rms, 0.8) << m;
-    EXPECT_LT(rms, 1.4) << m;
-    for (const auto* v : {exit, absorbed}) {
-      const auto [a, sa] = mean_se(v[0]);
-      const auto [b, sb] = mean_se(v[m]);
-      EXPECT_NEAR(a, b, 4.5 * std::hypot(sa, sb)) << m << ": " << sa << " " << sb;
-    }
-  }
+  for (int m = 1; m < 3; ++m)
+    expect_same_table(st[0], st[m], exit[0], exit[m], absorbed[0], absorbed[m], m);
   // Lower noise: next-event estimation, and surface samples with mirror folding on top of it.
-  EXPECT_LT(noise(st[1]), 0.7 * noise(st[0]));
-  EXPECT_LT(noise(st[2]), 0.5 * noise(st[1]));
+  EXPECT_LT(cell_noise(st[1]), 0.7 * cell_noise(st[0]));
+  EXPECT_LT(cell_noise(st[2]), 0.5 * cell_noise(st[1]));
 }
 
-// At a fixed seed, absorption as a weight keeps every photon's path when the dye changes, so each
-// photon's exit weight is w exp(-mu_a L) for its own path length L: the bake's albedo is then
-// exactly decreasing and convex in the dye (mu_a is linear in it), band by band, to rounding. The
-// default (implicit capture with roulette) draws its free paths from mu_a + mu_s, so the same steps
-// move every path and the albedo jitters by its noise: not monotone (the inner objective of
-// weft verify --fit was as rough, docs/verify.md). Red-cotton, RGB, R = 4, 2000 photons per band,
-// dye 1.00, 1.01, ..., 1.04.
 // Stratified entries (FiberEntrySampling::kStratified: per task the points of a randomised Sobol'
 // sequence, core/sobol.h) estimate the same table as independent ones: the normalised differences
 // of the cells against plain random entries, by the criteria of the test above (8 bakes each, at
@@ -591,42 +595,14 @@ TEST(FiberTableBake, StratifiedEntriesEstimateThePlainTable) {
       return t;
     });
   }
-  const auto mean_se = [](const std::vector<double>& v) {
-    double s = 0, s2 = 0;
-    for (double x : v) s += x, s2 += x * x;
-    const double m = s / v.size();
-    return std::pair{m, std::sqrt(std::max(0.0, s2 / v.size() - m * m) / (v.size() - 1))};
-  };
-  const auto noise = [](const CellStats& c) {
-    double v = 0;
-    for (double e : c.se) v += e * e;
-    return v;
-  };
-  for (int m = 1; m < 4; ++m) {
-    EXPECT_LE(count_outliers(st[0].mean, st[0].se, st[m].mean, st[m].se, 4.5), 1) << m;
-    double z2 = 0;
-    int n = 0;
-    for (size_t c = 0; c < st[0].mean.size(); ++c) {
-      const double se = std::hypot(st[0].se[c], st[m].se[c]);
-      if (!(se > 0)) continue;
-      z2 += sqr((st[0].mean[c] - st[m].mean[c]) / se), ++n;
-    }
-    ASSERT_GT(n, 100);
-    const double rms = std::sqrt(z2 / n);
-    EXPECT_GT(rms, 0.8) << m;
-    EXPECT_LT(rms, 1.4) << m;
-    for (const auto* v : {exit, absorbed}) {
-      const auto [a, sa] = mean_se(v[0]);
-      const auto [b, sb] = mean_se(v[m]);
-      EXPECT_NEAR(a, b, 4.5 * std::hypot(sa, sb)) << m << ": " << sa << " " << sb;
-    }
-  }
+  for (int m = 1; m < 4; ++m)
+    expect_same_table(st[0], st[m], exit[0], exit[m], absorbed[0], absorbed[m], m);
   // With plain exits where a photon leaves is the noise, and stratifying its entry leaves the
   // total variance about as it was (0.97 of it here); with next-event estimation the entry's
   // randomness is much of what is left, and stratifying it lowers the variance (0.83 of it here;
   // docs/PERFORMANCE.md measures 1.5x fewer photons for the same error on red cotton).
-  EXPECT_LT(noise(st[1]), 1.1 * noise(st[0]));
-  EXPECT_LT(noise(st[2]), 0.9 * noise(st[3]));
+  EXPECT_LT(cell_noise(st[1]), 1.1 * cell_noise(st[0]));
+  EXPECT_LT(cell_noise(st[2]), 0.9 * cell_noise(st[3]));
 }
 
 TEST(FiberTableBake, StratifiedEntriesAreBitIdenticalAtAnyThreadCount) {
@@ -649,6 +625,13 @@ TEST(FiberTableBake, StratifiedEntriesAreBitIdenticalAtAnyThreadCount) {
   EXPECT_EQ(parse_fiber_entry_sampling("stratified", "entry"), FiberEntrySampling::kStratified);
 }
 
+// At a fixed seed, absorption as a weight keeps every photon's path when the dye changes, so each
+// photon's exit weight is w exp(-mu_a L) for its own path length L: the bake's albedo is then
+// exactly decreasing and convex in the dye (mu_a is linear in it), band by band, to rounding. The
+// default (implicit capture with roulette) draws its free paths from mu_a + mu_s, so the same steps
+// move every path and the albedo jitters by its noise: not monotone (the inner objective of
+// weft verify --fit was as rough, docs/verify.md). Red-cotton, RGB, R = 4, 2000 photons per band,
+// dye 1.00, 1.01, ..., 1.04.
 TEST(FiberTableBake, AbsorptionWeightMakesTheAlbedoSmoothInTheDyeAtAFixedSeed) {
   const FiberSpec spec = load_fiber_spec("red-cotton");
   const auto albedo_along_dye = [&](WeightMode mode) {
