@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "chi2.h"
+#include "fiber_bake_test_util.h"
 #include "transport_test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -25,125 +26,7 @@
 
 using namespace weft;
 
-namespace {
-
-// A minimal spec: cotton host with air voids; optional dye and overrides.
-FiberSpec test_spec(double radius_um = 8, double void_fraction = 0.02, double dye_per_um = 0,
-                    double void_radius_um = 0.3) {
-  const std::string json = R"({"name": "test", "fiber_radius_um": )" + std::to_string(radius_um) +
-                           R"(, "roughness": {"distribution": "ggx", "alpha": 0.3},
-    "host": {"n": 1.557, "absorption_per_um": )" +
-                           std::to_string(dye_per_um) + R"(},
-    "species": [{"name": "voids", "n": 1.0, "k": 0.0, "volume_fraction": )" +
-                           std::to_string(void_fraction) + R"(,
-      "size": {"distribution": "monodisperse", "radius_um": )" +
-                           std::to_string(void_radius_um) + R"(}}]})";
-  return parse_fiber_spec(json, "test-spec");
-}
-
-// The transport engine's numerical extremes lie beyond what a user's spec may ask for
-// (fiber_spec.h bounds the radius to [0.5, 500] um): made from a valid spec, then changed.
-FiberSpec extreme_spec(double radius_um, double void_fraction, double dye_per_um,
-                       double void_radius_um = 0.3) {
-  FiberSpec s = test_spec(8, void_fraction, dye_per_um, std::min(void_radius_um, 1.0));
-  s.fiber_radius_um = radius_um;
-  for (auto& sp : s.species) sp.size.radius_um = void_radius_um;
-  return s;
-}
-
-// Mean and standard error per cell over K independent bakes of one band.
-struct CellStats {
-  std::vector<double> mean, se;
-};
-template <class BakeFn>
-CellStats cell_stats(int k, const BakeFn& bake) {
-  std::vector<double> s, s2;
-  for (int i = 0; i < k; ++i) {
-    const FiberBandTable t = bake(static_cast<uint64_t>(1000 + i));
-    if (s.empty()) s.assign(t.f.size(), 0.0), s2.assign(t.f.size(), 0.0);
-    for (size_t c = 0; c < t.f.size(); ++c) s[c] += t.f[c], s2[c] += t.f[c] * t.f[c];
-  }
-  CellStats st;
-  for (size_t c = 0; c < s.size(); ++c) {
-    const double m = s[c] / k;
-    st.mean.push_back(m);
-    st.se.push_back(std::sqrt(std::max(0.0, s2[c] / k - m * m) / (k - 1)));
-  }
-  return st;
-}
-
-// Number of cells where |a - b| exceeds z standard errors (cells with both means 0 skipped).
-int count_outliers(const std::vector<double>& a, const std::vector<double>& sa,
-                   const std::vector<double>& b, const std::vector<double>& sb, double z) {
-  int n = 0;
-  for (size_t c = 0; c < a.size(); ++c) {
-    if (a[c] == 0 && b[c] == 0) continue;
-    const double se = std::sqrt(sa[c] * sa[c] + sb[c] * sb[c]);
-    if (std::abs(a[c] - b[c]) > z * se + 1e-12) ++n;
-  }
-  return n;
-}
-
-// The direct and the BSSRDF route's cell statistics over 5 bakes each of band physics 'ph' at
-// R = 3 (18 x 18 cells), the BSSRDF route at its default grid.
-struct RouteStats {
-  CellStats direct, bssrdf;
-};
-RouteStats bake_both_routes(const FiberBandPhysics& ph) {
-  FiberBakeSettings s = weft::testing::bake_settings(3, 60000, 2);
-  const int k = 5;
-  RouteStats r;
-  r.direct = cell_stats(k, [&](uint64_t seed) {
-    s.seed = seed;
-    return bake_fiber_band_direct(ph, s, nullptr);
-  });
-  r.bssrdf = cell_stats(k, [&](uint64_t seed) {
-    s.seed = seed + 100;
-    return bake_fiber_band_bssrdf(ph, s, BssrdfRouteSettings{}, nullptr);
-  });
-  return r;
-}
-
-// Two estimators of one table, judged alike (the tests of the bake's options): cell by cell at most
-// one normalised difference beyond 4.5 standard errors and their RMS in [0.8, 1.4] (a bias of one
-// standard error in every cell lifts it to 1.5), and the exit and absorbed fractions within 4.5
-// standard errors of each other. 'label' names the estimator in the failures.
-void expect_same_table(const CellStats& a, const CellStats& b, const std::vector<double>& exit_a,
-                       const std::vector<double>& exit_b, const std::vector<double>& absorbed_a,
-                       const std::vector<double>& absorbed_b, int label) {
-  const auto mean_se = [](const std::vector<double>& v) {
-    double s = 0, s2 = 0;
-    for (double x : v) s += x, s2 += x * x;
-    const double m = s / v.size();
-    return std::pair{m, std::sqrt(std::max(0.0, s2 / v.size() - m * m) / (v.size() - 1))};
-  };
-  EXPECT_LE(count_outliers(a.mean, a.se, b.mean, b.se, 4.5), 1) << label;
-  double z2 = 0;
-  int n = 0;
-  for (size_t c = 0; c < a.mean.size(); ++c) {
-    const double se = std::hypot(a.se[c], b.se[c]);
-    if (!(se > 0)) continue;
-    z2 += sqr((a.mean[c] - b.mean[c]) / se), ++n;
-  }
-  ASSERT_GT(n, 100) << label;
-  const double rms = std::sqrt(z2 / n);
-  EXPECT_GT(rms, 0.8) << label;
-  EXPECT_LT(rms, 1.4) << label;
-  for (const auto& [va, vb] : {std::pair{&exit_a, &exit_b}, std::pair{&absorbed_a, &absorbed_b}}) {
-    const auto [ma, sa] = mean_se(*va);
-    const auto [mb, sb] = mean_se(*vb);
-    EXPECT_NEAR(ma, mb, 4.5 * std::hypot(sa, sb)) << label << ": " << sa << " " << sb;
-  }
-}
-
-// The summed variance of a table's cell means.
-double cell_noise(const CellStats& c) {
-  double v = 0;
-  for (double e : c.se) v += e * e;
-  return v;
-}
-
-}  // namespace
+using namespace weft::testing;
 
 TEST(FiberTableBake, WhiteCottonIsLosslessAndPassesTheWhiteFurnace) {
   // No dye, non-absorbing inclusions: everything that hits the fiber leaves it.
@@ -482,44 +365,6 @@ TEST(FiberTableBake, BakedTableSamplingPassesChiSquare) {
 // Absorption as a weight (transport.h) estimates the same table as implicit capture: one band of a
 // scattering, absorbing fiber (mu_s R ~ 5, as in the route test above), R = 3, 5 seeds each, with
 // the same outlier allowance as there, and the same energy books to 4.5 standard errors.
-TEST(FiberTableBake, AbsorptionWeightAgreesWithImplicitCaptureWithinStatisticalError) {
-  const FiberSpec spec = test_spec(20, 0.10, 0.01);
-  const MediumBand mb = compute_medium_band(spec, 16);
-  const int k = 5;
-  std::vector<double> exit[2], absorbed[2];
-  CellStats st[2];
-  for (int m = 0; m < 2; ++m) {
-    const FiberBandPhysics ph =
-        fiber_band_physics(spec, mb, 10'000'000, nullptr,
-                           m == 0 ? WeightMode::implicit_capture : WeightMode::absorption_weight);
-    FiberBakeSettings s = weft::testing::bake_settings(3, 40000, 2);
-    st[m] = cell_stats(k, [&](uint64_t seed) {
-      s.seed = seed + 100 * m;
-      const FiberBandTable t = bake_fiber_band_direct(ph, s, nullptr);
-      EXPECT_NEAR(t.energy_balance(), 1.0, 1e-12);
-      if (m == 1) {
-        EXPECT_EQ(t.roulette_net, 0.0);  // no roulette: it would decide on the weight
-      }
-      exit[m].push_back(t.exit_fraction);
-      absorbed[m].push_back(t.absorbed_fraction);
-      return t;
-    });
-  }
-  EXPECT_LE(count_outliers(st[0].mean, st[0].se, st[1].mean, st[1].se, 4.5), 1);
-  const auto mean_se = [](const std::vector<double>& v) {
-    double s = 0, s2 = 0;
-    for (double x : v) s += x, s2 += x * x;
-    const double m = s / v.size();
-    return std::pair{m, std::sqrt(std::max(0.0, s2 / v.size() - m * m) / (v.size() - 1))};
-  };
-  for (const auto* v : {exit, absorbed}) {
-    const auto [a, sa] = mean_se(v[0]);
-    const auto [b, sb] = mean_se(v[1]);
-    EXPECT_GT(a, 0.05);
-    EXPECT_NEAR(a, b, 4.5 * std::hypot(sa, sb)) << sa << " " << sb;
-  }
-}
-
 // Next-event estimation of exits, surface samples and mirror folding (docs/fiber-bsdf.md, "Fewer
 // photons for the same noise") estimate the plain bake's table. One band of the scattering,
 // absorbing fiber of the route test (mu_s R ~ 5), R = 3 (324 cell pairs), 8 bakes of 40 000
@@ -530,40 +375,6 @@ TEST(FiberTableBake, AbsorptionWeightAgreesWithImplicitCaptureWithinStatisticalE
 // 1.5. No cell lies beyond 4.5 standard errors but the one the route test allows. The exit and
 // absorbed fractions agree within 4.5 standard errors, the books close per photon, the table
 // holds what was recorded, and the noise is lower.
-TEST(FiberTableBake, NextEventEstimationAndMirrorFoldingEstimateThePlainTable) {
-  const FiberSpec spec = test_spec(20, 0.10, 0.01);
-  const MediumBand mb = compute_medium_band(spec, 16);
-  const int k = 8;
-  std::vector<double> exit[3], absorbed[3];
-  CellStats st[3];           // plain, next-event, next-event folded
-  const int resolution = 3;  // 324 cell pairs, about half of which receive light
-  for (int m = 0; m < 3; ++m) {
-    FiberBandPhysics ph =
-        fiber_band_physics(spec, mb, 10'000'000, nullptr, WeightMode::implicit_capture,
-                           m == 0 ? FiberExitEstimator::kPlain : FiberExitEstimator::kNextEvent);
-    if (m == 2) ph.surface.samples = 4;
-    FiberBakeSettings s = weft::testing::bake_settings(resolution, 40000, 2);
-    st[m] = cell_stats(k, [&](uint64_t seed) {
-      s.seed = seed + 100 * m;
-      FiberBandTable t = bake_fiber_band_direct(ph, s, nullptr);
-      EXPECT_NEAR(t.energy_balance(), 1.0, 1e-12);
-      EXPECT_NEAR(fiber_table_energy(t) / kPi, t.exit_fraction, 1e-12);
-      if (m == 0) {
-        EXPECT_EQ(t.expected_exit_excess, 0.0);
-      }
-      if (m == 2) t.f = fold_fiber_mirror_symmetry(resolution, t.f);
-      exit[m].push_back(t.exit_fraction);
-      absorbed[m].push_back(t.absorbed_fraction);
-      return t;
-    });
-  }
-  for (int m = 1; m < 3; ++m)
-    expect_same_table(st[0], st[m], exit[0], exit[m], absorbed[0], absorbed[m], m);
-  // Lower noise: next-event estimation, and surface samples with mirror folding on top of it.
-  EXPECT_LT(cell_noise(st[1]), 0.7 * cell_noise(st[0]));
-  EXPECT_LT(cell_noise(st[2]), 0.5 * cell_noise(st[1]));
-}
-
 // Stratified entries (FiberEntrySampling::kStratified: per task the points of a randomised Sobol'
 // sequence, core/sobol.h) estimate the same table as independent ones: the normalised differences
 // of the cells against plain random entries, by the criteria of the test above (8 bakes each, at
@@ -571,60 +382,6 @@ TEST(FiberTableBake, NextEventEstimationAndMirrorFoldingEstimateThePlainTable) {
 // in every cell lifts it to 1.5), for the plain estimator and for next-event estimation with four
 // surface samples (whose lobe uniforms are Sobol' dimensions too); the exit and absorbed
 // fractions agree within 4.5 standard errors and the books close per photon.
-TEST(FiberTableBake, StratifiedEntriesEstimateThePlainTable) {
-  const FiberSpec spec = test_spec(20, 0.10, 0.01);
-  const MediumBand mb = compute_medium_band(spec, 16);
-  const int k = 8, resolution = 3;
-  std::vector<double> exit[4], absorbed[4];
-  // Random plain, stratified plain, stratified and random next-event with 4 surface samples.
-  CellStats st[4];
-  for (int m = 0; m < 4; ++m) {
-    FiberBandPhysics ph =
-        fiber_band_physics(spec, mb, 10'000'000, nullptr, WeightMode::implicit_capture,
-                           m >= 2 ? FiberExitEstimator::kNextEvent : FiberExitEstimator::kPlain);
-    if (m >= 2) ph.surface.samples = 4;
-    FiberBakeSettings s = weft::testing::bake_settings(resolution, 40000, 2);
-    s.entry = m == 0 || m == 3 ? FiberEntrySampling::kRandom : FiberEntrySampling::kStratified;
-    st[m] = cell_stats(k, [&](uint64_t seed) {
-      s.seed = seed + 100 * m;
-      const FiberBandTable t = bake_fiber_band_direct(ph, s, nullptr);
-      EXPECT_NEAR(t.energy_balance(), 1.0, 1e-12);
-      EXPECT_NEAR(fiber_table_energy(t) / kPi, t.exit_fraction, 1e-12);
-      exit[m].push_back(t.exit_fraction);
-      absorbed[m].push_back(t.absorbed_fraction);
-      return t;
-    });
-  }
-  for (int m = 1; m < 4; ++m)
-    expect_same_table(st[0], st[m], exit[0], exit[m], absorbed[0], absorbed[m], m);
-  // With plain exits where a photon leaves is the noise, and stratifying its entry leaves the
-  // total variance about as it was (0.97 of it here); with next-event estimation the entry's
-  // randomness is much of what is left, and stratifying it lowers the variance (0.83 of it here;
-  // docs/PERFORMANCE.md measures 1.5x fewer photons for the same error on red cotton).
-  EXPECT_LT(cell_noise(st[1]), 1.1 * cell_noise(st[0]));
-  EXPECT_LT(cell_noise(st[2]), 0.9 * cell_noise(st[3]));
-}
-
-TEST(FiberTableBake, StratifiedEntriesAreBitIdenticalAtAnyThreadCount) {
-  FiberTableBakeOptions o{.resolution = 4, .photons_per_band = 300, .threads = 1, .passes = 2};
-  o.entry = FiberEntrySampling::kStratified;
-  o.surface_samples = 3;
-  const auto a = bake_fiber_table(load_fiber_spec("red-cotton"), o);
-  o.threads = 3;
-  const auto b = bake_fiber_table(load_fiber_spec("red-cotton"), o);
-  EXPECT_EQ(a.table.checksum(), b.table.checksum());
-  EXPECT_EQ(a.table.metadata.at("entry"), "stratified");
-  // A stratified entry is the direct route's; names are parsed strictly.
-  o.route = FiberBakeRoute::kBssrdf;
-  o.estimator = FiberExitEstimator::kPlain;
-  EXPECT_NE(weft::testing::error_of([&] {
-              bake_fiber_table(load_fiber_spec("red-cotton"), o);
-            }).find("entry"),
-            std::string::npos);
-  EXPECT_THROW(parse_fiber_entry_sampling("sobol", "entry"), Error);
-  EXPECT_EQ(parse_fiber_entry_sampling("stratified", "entry"), FiberEntrySampling::kStratified);
-}
-
 // At a fixed seed, absorption as a weight keeps every photon's path when the dye changes, so each
 // photon's exit weight is w exp(-mu_a L) for its own path length L: the bake's albedo is then
 // exactly decreasing and convex in the dye (mu_a is linear in it), band by band, to rounding. The
@@ -632,47 +389,6 @@ TEST(FiberTableBake, StratifiedEntriesAreBitIdenticalAtAnyThreadCount) {
 // move every path and the albedo jitters by its noise: not monotone (the inner objective of
 // weft verify --fit was as rough, docs/verify.md). Red-cotton, RGB, R = 4, 2000 photons per band,
 // dye 1.00, 1.01, ..., 1.04.
-TEST(FiberTableBake, AbsorptionWeightMakesTheAlbedoSmoothInTheDyeAtAFixedSeed) {
-  const FiberSpec spec = load_fiber_spec("red-cotton");
-  const auto albedo_along_dye = [&](WeightMode mode) {
-    std::vector<std::vector<double>> out;  // [step][band]
-    for (int k = 0; k < 5; ++k) {
-      FiberSpec dyed = spec;
-      for (double& a : dyed.host_absorption_per_um) a *= 1 + 0.01 * k;
-      for (auto& c : dyed.dyes) c.concentration_owf_percent *= 1 + 0.01 * k;  // its recipe's
-      FiberTableBakeOptions o{.resolution = 4,
-                              .photons_per_band = 2000,
-                              .threads = 2,
-                              .spectral = false,
-                              .weight_mode = mode,
-                              .passes = 1};
-      const auto r = bake_fiber_table(dyed, o);
-      std::vector<double> a;
-      for (const auto& b : r.bands) a.push_back(b.exit_fraction);
-      out.push_back(a);
-    }
-    return out;
-  };
-  // Violations of "decreasing and convex" along the steps, over all bands.
-  const auto violations = [](const std::vector<std::vector<double>>& a) {
-    int n = 0;
-    for (size_t b = 0; b < a[0].size(); ++b)
-      for (size_t k = 0; k + 1 < a.size(); ++k) {
-        if (!(a[k + 1][b] < a[k][b])) ++n;
-        if (k + 2 < a.size() && a[k + 2][b] - 2 * a[k + 1][b] + a[k][b] < -1e-12) ++n;
-      }
-    return n;
-  };
-  const auto weighted = albedo_along_dye(WeightMode::absorption_weight);
-  EXPECT_EQ(violations(weighted), 0);
-  // Red-cotton's dye absorbs: the albedo does move with it. Its recipe (docs/presets.md) leaves
-  // little but the surface's reflection at 450-550 nm, so it moves most where the fibre is half
-  // absorbing, about 600 nm (band 21).
-  EXPECT_LT(weighted[4][21], weighted[0][21] - 1e-3);
-  // The contrast this mode exists for: the default's albedo along the same steps is not monotone.
-  EXPECT_GT(violations(albedo_along_dye(WeightMode::implicit_capture)), 10);
-}
-
 TEST(FiberTableBake, RejectsBadOptions) {
   FiberTableBakeOptions o;
   o.resolution = 1;
