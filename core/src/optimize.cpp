@@ -17,10 +17,6 @@ double sum_squares(const std::vector<double>& r) {
   return s;
 }
 
-double rms(const std::vector<double>& r) {
-  return r.empty() ? 0.0 : std::sqrt(sum_squares(r) / static_cast<double>(r.size()));
-}
-
 std::vector<double> clamped(std::vector<double> u) {
   for (double& x : u) x = std::clamp(x, 0.0, 1.0);
   return u;
@@ -104,10 +100,10 @@ void nelder_mead_step(Simplex& s, CountedResiduals& eval) {
     return clamped(u);
   };
   const auto ur = along(-1.0);
-  const double fr = rms(eval(ur));
+  const double fr = residual_rms(eval(ur));
   if (fr < f[0]) {
     const auto ue = along(-2.0);
-    const double fe = rms(eval(ue));
+    const double fe = residual_rms(eval(ue));
     if (fe < fr) {
       simplex[n] = ue;
       f[n] = fe;
@@ -121,7 +117,7 @@ void nelder_mead_step(Simplex& s, CountedResiduals& eval) {
   } else {
     const bool outside = fr < f[n];
     const auto uc = along(outside ? -0.5 : 0.5);
-    const double fc = rms(eval(uc));
+    const double fc = residual_rms(eval(uc));
     if (fc < (outside ? fr : f[n])) {
       simplex[n] = uc;
       f[n] = fc;
@@ -129,7 +125,7 @@ void nelder_mead_step(Simplex& s, CountedResiduals& eval) {
       for (size_t k = 1; k <= n; ++k) {
         for (size_t d = 0; d < n; ++d)
           simplex[k][d] = simplex[0][d] + 0.5 * (simplex[k][d] - simplex[0][d]);
-        f[k] = rms(eval(simplex[k]));
+        f[k] = residual_rms(eval(simplex[k]));
       }
     }
   }
@@ -245,6 +241,10 @@ LmOutcome lm_steps(CountedResiduals& eval, const OptimizeOptions& o, const Matri
 
 }  // namespace
 
+double residual_rms(const std::vector<double>& r) {
+  return r.empty() ? 0.0 : std::sqrt(sum_squares(r) / static_cast<double>(r.size()));
+}
+
 void OptimizeOptions::validate() const {
   if (max_evaluations < 0) throw Error("", "max_evaluations", "must be >= 0");
   if (!(tolerance > 0) || !std::isfinite(tolerance))
@@ -268,7 +268,7 @@ OptimizeResult nelder_mead(const ResidualFunction& residuals, const std::vector<
     s.points.push_back(u);
   }
   for (const auto& u : s.points) {
-    s.f.push_back(rms(eval(u)));
+    s.f.push_back(residual_rms(eval(u)));
     if (s.f.size() == 1 && at_start) at_start();
   }
   OptimizeResult out;

@@ -183,6 +183,9 @@ TEST(CliVerify, BadFitOptionsAreRefusedBeforeAnyWork) {
       {"--fit-inner summation", "--fit-inner", "only with --fit"},
       {"--fit --fit-method newton", "--fit-method", "not lm or nelder-mead"},
       {"--fit-method nelder-mead", "--fit-method", "only with --fit"},
+      {"--fit --fit-seeds 0", "--fit-seeds", "outside 1 to 16"},
+      {"--fit --fit-seeds 17", "--fit-seeds", "outside 1 to 16"},
+      {"--fit-seeds 2", "--fit-seeds", "only with --fit"},
       {"--fit --fiber '" + bare_spec.string() + "' --fit-params particle_radius_scale",
        "--fit-params", "the spec has no particle species"}};
   for (const auto& c : cases) {

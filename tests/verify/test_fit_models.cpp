@@ -405,3 +405,54 @@ TEST(VerifyFitParameters, DyeConcentrationsOfTheRecipe) {
             }).find("dyeK_concentration (K = 0..7"),
             std::string::npos);
 }
+
+// fit_over_seeds on a made-up model whose fits land apart, one per seed: the fit kept is the one
+// whose optimum is best on average over every seed's objective, not the one whose own search ended
+// lowest; each parameter's spread is that of the fits; every judging evaluation is counted.
+TEST(VerifyFit, FitOverSeedsKeepsTheFitBestOverAllSeedsAndReportsTheSpread) {
+  weft::FitInnerSettings f;
+  f.seed = 7;
+  // Seed 7 ends lowest at its own seed (0.40) but is the worst on average; seed 8 is best.
+  const auto fit_at = [](const weft::FitInnerSettings& g) {
+    weft::FitResult r;
+    r.model = "made-up";
+    const double x = g.seed == 7 ? 2.0 : g.seed == 8 ? 1.0 : 1.5;
+    weft::FitParameterResult p;
+    p.parameter = {"x", "", 0.1, 10, 1, true};
+    p.value = x;
+    r.parameters = {p};
+    r.objective = g.seed == 7 ? 0.40 : 0.50;
+    r.evaluations = 10 + static_cast<int>(g.seed);
+    r.converged = g.seed != 9;
+    r.seconds = 1;
+    return r;
+  };
+  // A bowl at x = 1, plus each seed's own offset.
+  const auto objective_at = [](const std::vector<double>& x, const weft::FitInnerSettings& g) {
+    return 0.5 + (x[0] - 1) * (x[0] - 1) + 0.01 * static_cast<double>(g.seed - 7);
+  };
+  const weft::FitResult r = weft::fit_over_seeds(3, f, fit_at, objective_at);
+  EXPECT_EQ(r.parameters[0].value, 1.0);
+  EXPECT_EQ(r.objective, 0.50);  // the kept search's own
+  ASSERT_EQ(r.seed_fits.size(), 3u);
+  EXPECT_EQ(r.seed_fits[0].seed, 8u);  // the kept fit first, then the others in seed order
+  EXPECT_EQ(r.seed_fits[1].seed, 7u);
+  EXPECT_EQ(r.seed_fits[2].seed, 9u);
+  EXPECT_NEAR(r.seed_fits[0].objective_over_seeds, 0.51, 1e-12);  // mean of 0.50, 0.51, 0.52
+  EXPECT_NEAR(r.seed_fits[0].objective_over_seeds_sd, 0.01, 1e-12);
+  EXPECT_NEAR(r.seed_fits[1].objective_over_seeds, 1.51, 1e-12);
+  EXPECT_FALSE(r.seed_fits[2].converged);
+  EXPECT_EQ(r.parameters[0].seeds_lo, 1.0);
+  EXPECT_EQ(r.parameters[0].seeds_hi, 2.0);
+  EXPECT_NEAR(r.parameters[0].sigma_seeds, 0.5, 1e-12);  // sd of 2, 1, 1.5
+  EXPECT_EQ(r.evaluations, 17 + 18 + 19 + 9);
+  EXPECT_GE(r.seconds, 3.0);
+  // One seed: its fit, judged at its own seed, and no spread.
+  const weft::FitResult one = weft::fit_over_seeds(1, f, fit_at, objective_at);
+  EXPECT_EQ(one.parameters[0].value, 2.0);
+  ASSERT_EQ(one.seed_fits.size(), 1u);
+  EXPECT_TRUE(std::isnan(one.parameters[0].sigma_seeds));
+  EXPECT_TRUE(std::isnan(one.parameters[0].seeds_lo));
+  EXPECT_EQ(one.evaluations, 17 + 1);
+  EXPECT_THROW(weft::fit_over_seeds(0, f, fit_at, objective_at), weft::Error);
+}

@@ -63,6 +63,9 @@ TEST(VerifyPlan, BadRequestsAreRefusedNamingTheOption) {
        "field '--fit-params': only with --fit"},
       {[](VerifyRequest& r) { r.fit_method_given = true; },
        "field '--fit-method': only with --fit"},
+      {[](VerifyRequest& r) { r.fit_seeds_given = true; }, "field '--fit-seeds': only with --fit"},
+      {[](VerifyRequest& r) { r.fit = true, r.fit_seeds = 0; },
+       "field '--fit-seeds': 0 is outside 1 to 16"},
       {[](VerifyRequest& r) { r.fit = true, r.shard = "0/2"; }, "not with --shard"},
       {[](VerifyRequest& r) { r.fit = true, r.fit_params = "dye_scale,hue"; },
        "'hue' is not one of"},
@@ -144,11 +147,15 @@ TEST(VerifyPlan, EstimateGrowsWithTheFit) {
   EXPECT_GT(e.photons, 0);  // the spec is baked
   EXPECT_GT(e.particles, 0);
   EXPECT_GT(e.typical, e.least);
-  const VerifyEstimate fit = estimate_verify(p.settings, true, true, 100, 4);
+  const VerifyEstimate fit = estimate_verify(p.settings, true, true, 100, 4, 1);
   EXPECT_GT(fit.photons, e.photons);
   EXPECT_GT(fit.particles, e.particles);
+  // Each further inner seed adds a fit and judges every fit at it.
+  const VerifyEstimate seeds = estimate_verify(p.settings, true, true, 100, 4, 3);
+  EXPECT_GT(seeds.photons, fit.photons);
+  EXPECT_GT(seeds.typical, fit.typical);
   // A baked table is not baked again.
-  EXPECT_EQ(estimate_verify(p.settings, false, false, 0, 0).photons, 0);
+  EXPECT_EQ(estimate_verify(p.settings, false, false, 0, 0, 1).photons, 0);
 }
 
 }  // namespace

@@ -55,6 +55,10 @@ std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
   return r;
 }
 
+double fit_rms_log(const std::vector<std::vector<Rgb>>& model, const MeasuredInplane& measured) {
+  return residual_rms(fit_residuals(model, measured));
+}
+
 FitMethod parse_fit_method(const std::string& name) {
   if (name == "lm") return FitMethod::kLevenbergMarquardt;
   if (name == "nelder-mead") return FitMethod::kNelderMead;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <tuple>
 
 #include "common.h"
 #include "weft/core/error.h"
@@ -215,9 +216,8 @@ std::string computed_inner_model_name(const FitInnerSettings& f) {
 }
 
 std::string classic_inner_model_name(const FitInnerSettings& f) {
-  return inner_step_name(f) + " of the classic fiber table (" +
-         std::to_string(f.classic_samples) + " samples per cell pair), seed " +
-         std::to_string(f.seed) + " at every evaluation";
+  return inner_step_name(f) + " of the classic fiber table (" + std::to_string(f.classic_samples) +
+         " samples per cell pair), seed " + std::to_string(f.seed) + " at every evaluation";
 }
 
 FabricRaytraceOptions inner_raytrace_options(const FitInnerSettings& f,
@@ -372,6 +372,67 @@ FitResult fit_inner_model(
   last.seconds = seconds;
   if (options.uncertainty) add_fit_uncertainty(last, reweighted, measured, options);
   return last;
+}
+
+namespace {
+
+// Mean and sample standard deviation (NaN for fewer than two) of 'v'.
+std::pair<double, double> mean_and_sd(const std::vector<double>& v) {
+  double mean = 0, ss = 0;
+  for (double x : v) mean += x / static_cast<double>(v.size());
+  for (double x : v) ss += (x - mean) * (x - mean);
+  return {mean, v.size() < 2 ? std::nan("") : std::sqrt(ss / static_cast<double>(v.size() - 1))};
+}
+
+}  // namespace
+
+FitResult fit_over_seeds(int seeds, const FitInnerSettings& f,
+                         const std::function<FitResult(const FitInnerSettings&)>& fit_at,
+                         const std::function<double(const std::vector<double>&,
+                                                    const FitInnerSettings&)>& objective_at) {
+  if (seeds < 1) throw Error("", "--fit-seeds", "must be at least 1, not " + std::to_string(seeds));
+  std::vector<FitInnerSettings> at(static_cast<size_t>(seeds), f);
+  for (int k = 0; k < seeds; ++k) at[k].seed = f.seed + static_cast<uint64_t>(k);
+  std::vector<FitResult> fits;
+  std::vector<SeedFit> judged;
+  int evaluations = 0;
+  double seconds = 0;
+  for (const FitInnerSettings& g : at) {
+    fits.push_back(fit_at(g));
+    evaluations += fits.back().evaluations;
+    seconds += fits.back().seconds;
+  }
+  const auto t0 = std::chrono::steady_clock::now();
+  for (size_t k = 0; k < fits.size(); ++k) {
+    SeedFit s;
+    s.seed = at[k].seed;
+    for (const auto& p : fits[k].parameters) s.values.push_back(p.value);
+    s.objective = fits[k].objective;
+    s.evaluations = fits[k].evaluations;
+    s.converged = fits[k].converged;
+    std::vector<double> j;
+    for (const FitInnerSettings& g : at) j.push_back(objective_at(s.values, g));
+    evaluations += seeds;
+    std::tie(s.objective_over_seeds, s.objective_over_seeds_sd) = mean_and_sd(j);
+    judged.push_back(std::move(s));
+  }
+  size_t best = 0;
+  for (size_t k = 1; k < judged.size(); ++k)
+    if (judged[k].objective_over_seeds < judged[best].objective_over_seeds) best = k;
+  FitResult out = std::move(fits[best]);
+  for (size_t i = 0; seeds > 1 && i < out.parameters.size(); ++i) {
+    std::vector<double> v;
+    for (const SeedFit& s : judged) v.push_back(s.values[i]);
+    out.parameters[i].seeds_lo = *std::min_element(v.begin(), v.end());
+    out.parameters[i].seeds_hi = *std::max_element(v.begin(), v.end());
+    out.parameters[i].sigma_seeds = mean_and_sd(v).second;
+  }
+  std::rotate(judged.begin(), judged.begin() + static_cast<std::ptrdiff_t>(best),
+              judged.begin() + static_cast<std::ptrdiff_t>(best) + 1);
+  out.seed_fits = std::move(judged);
+  out.evaluations = evaluations;
+  out.seconds = seconds + seconds_since(t0);
+  return out;
 }
 
 }  // namespace weft

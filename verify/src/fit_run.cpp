@@ -40,32 +40,72 @@ std::optional<VerifyReport> fitted_at_run_quality(const VerifyPlan& p, const Wov
   return again;
 }
 
+// The computed model fitted at the plan's inner seeds (fit_over_seeds).
+FitResult fit_computed(const VerifyPlan& p, const WovenSample& sample,
+                       const FitInnerSettings& inner) {
+  const std::vector<FitParameter> params = spec_fit_parameters(p.spec, p.fit_names);
+  const MeasuredInplane& measured = p.measured;
+  return fit_over_seeds(
+      p.fit_seeds, inner,
+      [&](const FitInnerSettings& g) {
+        return fit_inner_model(
+            "computed", params,
+            [&](const std::vector<double>& x) {
+              return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), g);
+            },
+            sample, g, measured, p.fit_options);
+      },
+      [&](const std::vector<double>& x, const FitInnerSettings& g) {
+        return fit_rms_log(
+            computed_inner_curves(apply_spec_fit(p.spec, p.fit_names, x), sample, g, measured),
+            measured);
+      });
+}
+
+// The classic model (diffuse colour and roughness from 'start') fitted the same way.
+FitResult fit_classic(const VerifyPlan& p, const WovenSample& sample, const FitInnerSettings& inner,
+                      const Rgb& start_diffuse, const MicrofacetDistribution& start, double ior) {
+  const std::vector<FitParameter> params = classic_fit_parameters(start_diffuse, start.alpha);
+  const MeasuredInplane& measured = p.measured;
+  const MicrofacetModel model = start.model;
+  return fit_over_seeds(
+      p.fit_seeds, inner,
+      [&](const FitInnerSettings& g) {
+        return fit_inner_model(
+            "classic", params,
+            [&](const std::vector<double>& x) {
+              return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, g);
+            },
+            sample, g, measured, p.fit_options);
+      },
+      [&](const std::vector<double>& x, const FitInnerSettings& g) {
+        return fit_rms_log(
+            classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, sample, g, measured),
+            measured);
+      });
+}
+
+// What the inner model's name adds for a fit at several seeds.
+std::string seeds_note(const VerifyPlan& p, const FitInnerSettings& inner) {
+  if (p.fit_seeds < 2) return "";
+  return "; fitted at seeds " + std::to_string(inner.seed) + " to " +
+         std::to_string(inner.seed + static_cast<uint64_t>(p.fit_seeds) - 1) +
+         ", the fit whose optimum is best over all of them kept";
+}
+
 }  // namespace
 
 bool fit_verify_models(const VerifyPlan& p, const WovenSample& sample, const VerifyInputs& base,
                        VerifyReport& report, const VerifyHooks& hooks) {
-  const MeasuredInplane& measured = p.measured;
   FitInnerSettings inner = fit_inner_settings(p.settings);
   inner.inner = p.fit_inner;
   hooks.note("\nweft: fitting the computed model (" + p.request.fiber + ")\n");
-  FitResult computed = fit_inner_model(
-      "computed", spec_fit_parameters(p.spec, p.fit_names),
-      [&](const std::vector<double>& x) {
-        return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), inner);
-      },
-      sample, inner, measured, p.fit_options);
-  computed.inner_model = computed_inner_model_name(inner);
+  FitResult computed = fit_computed(p, sample, inner);
+  computed.inner_model = computed_inner_model_name(inner) + seeds_note(p, inner);
   hooks.note("weft: fitting the classic model\n");
-  const MicrofacetModel model = base.classic_distribution.model;
-  FitResult classic = fit_inner_model(
-      "classic",
-      classic_fit_parameters(report.classic_reflectance, base.classic_distribution.alpha),
-      [&](const std::vector<double>& x) {
-        return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, base.classic_ior,
-                                         inner);
-      },
-      sample, inner, measured, p.fit_options);
-  classic.inner_model = classic_inner_model_name(inner);
+  FitResult classic = fit_classic(p, sample, inner, report.classic_reflectance,
+                                  base.classic_distribution, base.classic_ior);
+  classic.inner_model = classic_inner_model_name(inner) + seeds_note(p, inner);
 
   const auto t0 = std::chrono::steady_clock::now();
   const std::optional<VerifyReport> again =

@@ -51,6 +51,10 @@ void plan_fit(const VerifyRequest& o, VerifyPlan& p) {
     p.fit_inner = parse_fit_inner(o.fit_inner);
     p.fit_options.method = parse_fit_method(o.fit_method);
     p.fit_options.max_evaluations = o.fit_evaluations;
+    if (o.fit_seeds < 1 || o.fit_seeds > kMaxFitSeeds)
+      throw Error("", "--fit-seeds",
+                  std::to_string(o.fit_seeds) + " is outside 1 to " + std::to_string(kMaxFitSeeds));
+    p.fit_seeds = o.fit_seeds;
     p.fit_options.validate(4);                       // the classic model always fits four
     (void)spec_fit_parameters(p.spec, p.fit_names);  // a spec without particles is refused here
     // A dye's own concentration moves the hue: fitted only where the colour can be judged.
@@ -65,12 +69,13 @@ void plan_fit(const VerifyRequest& o, VerifyPlan& p) {
                         ", not the tables' (linear sRGB), so its colour cannot judge it (give "
                         "--colour-space srgb if the measurement is sRGB)");
   } else if (o.fit_params_given || o.fit_evaluations_given || o.fit_inner_given ||
-             o.fit_method_given) {
+             o.fit_method_given || o.fit_seeds_given) {
     throw Error("",
                 o.fit_params_given        ? "--fit-params"
                 : o.fit_evaluations_given ? "--fit-evaluations"
                 : o.fit_inner_given       ? "--fit-inner"
-                                          : "--fit-method",
+                : o.fit_method_given      ? "--fit-method"
+                                          : "--fit-seeds",
                 "only with --fit");
   }
 }
@@ -164,7 +169,7 @@ constexpr double kTypicalSecondsPerClassicSample = 1.25e-6;
 }  // namespace
 
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
-                               size_t fit_params) {
+                               size_t fit_params, int fit_seeds) {
   VerifyEstimate e;
   e.cores = std::max(1u, s.threads > 0 ? unsigned(s.threads) : std::thread::hardware_concurrency());
   const double bins = 2.0 * s.resolution * s.resolution;
@@ -177,13 +182,14 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
   if (fit) {
     const FitInnerSettings inner = fit_inner_settings(s);
     const double inner_bins = 2.0 * inner.resolution * inner.resolution;
-    // Per model: the search, the optimum again and the Jacobian (2 per parameter; the classic
-    // model has 4).
-    const double computed_evals = fit_evaluations + 1 + 2.0 * double(fit_params);
-    const double classic_evals = fit_evaluations + 1 + 8.0;
+    // Per model and seed: the search, the optimum again and the Jacobian (2 per parameter; the
+    // classic model has 4); then each seed's optimum at every seed, each a whole ray trace.
+    const double seeds = fit_seeds, judged = seeds * seeds;
+    const double computed_evals = seeds * (fit_evaluations + 1 + 2.0 * double(fit_params)) + judged;
+    const double classic_evals = seeds * (fit_evaluations + 1 + 8.0) + judged;
     const double inner_photons = computed_evals * double(inner.fiber_photons_per_band) * kNumBands;
     const double inner_particles =
-        2 * kTypicalFitStages * double(inner.particles_per_bin) * inner_bins;
+        2 * (seeds * kTypicalFitStages + judged) * double(inner.particles_per_bin) * inner_bins;
     e.photons += inner_photons + run_photons;
     e.particles += inner_particles + run_particles;
     const double classic_samples =
@@ -206,7 +212,7 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
 
 VerifyEstimate estimate_verify(const VerifyPlan& p) {
   return estimate_verify(p.settings, !p.fiber_table, p.request.fit, p.fit_options.max_evaluations,
-                         p.fit_names.size());
+                         p.fit_names.size(), p.fit_seeds);
 }
 
 // ---- The sharded job -------------------------------------------------------------------------

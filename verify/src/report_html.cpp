@@ -59,7 +59,7 @@ void html_fits(std::ostringstream& h, const VerifyReport& r) {
          "<p>Objective: RMS of ln(model / measured), absolute, of the inner model; then the fitted "
          "parameters at the run's quality (the models marked fitted above).</p>\n<table><tr>"
          "<th>model</th><th>parameter</th><th>start</th><th>box</th><th>fitted</th><th>sigma</th>"
-         "<th>sigma over restarts</th></tr>\n";
+         "<th>sigma over restarts</th><th>over the seeds' fits: range (sd)</th></tr>\n";
     for (const auto& f : r.fits)
       for (const auto& p : f.parameters)
         h << "<tr><td>" << html_escape(f.model) << "</td><td>" << html_escape(p.parameter.name)
@@ -69,15 +69,21 @@ void html_fits(std::ostringstream& h, const VerifyReport& r) {
           << (p.at_bound ? " (at bound)" : "") << "</td><td>"
           << (std::isfinite(p.sigma) ? fmt(p.sigma, 2) : std::string("&mdash;")) << "</td><td>"
           << (std::isfinite(p.sigma_restarts) ? fmt(p.sigma_restarts, 2) : std::string("&mdash;"))
+          << "</td><td>"
+          << (std::isfinite(p.sigma_seeds) ? fmt(p.seeds_lo, 3) + " &ndash; " + fmt(p.seeds_hi, 3) +
+                                                 " (" + fmt(p.sigma_seeds, 2) + ")"
+                                           : std::string("&mdash;"))
           << "</td></tr>\n";
     h << "</table>\n<table><tr><th>model</th><th>search</th><th>inner RMS log, "
-         "start</th><th>inner RMS log, fitted</th><th>evaluations</th><th>converged</th>"
-         "<th>seconds</th></tr>\n";
+         "start</th><th>inner RMS log, fitted</th><th>the same, mean over the seeds</th>"
+         "<th>seeds</th><th>evaluations</th><th>converged</th><th>seconds</th></tr>\n";
     for (const auto& f : r.fits)
       h << "<tr><td>" << html_escape(f.model) << "</td><td>" << html_escape(f.method) << "</td><td>"
-        << fmt(f.objective_start) << "</td><td>" << fmt(f.objective) << "</td><td>" << f.evaluations
-        << "</td><td>" << (f.converged ? "yes" : "no") << "</td><td>" << fmt(f.seconds, 4)
-        << "</td></tr>\n";
+        << fmt(f.objective_start) << "</td><td>" << fmt(f.objective) << "</td><td>"
+        << (f.seed_fits.empty() ? std::string("&mdash;")
+                                : fmt(f.seed_fits.front().objective_over_seeds))
+        << "</td><td>" << f.seed_fits.size() << "</td><td>" << f.evaluations << "</td><td>"
+        << (f.converged ? "yes" : "no") << "</td><td>" << fmt(f.seconds, 4) << "</td></tr>\n";
     h << "</table>\n<p>Inner models: ";
     for (const auto& f : r.fits)
       h << html_escape(f.model) << ": " << html_escape(f.inner_model) << ". ";

@@ -156,19 +156,34 @@ void add_headline_figures(nlohmann::json& j, const std::vector<ModelCurves>& mod
 nlohmann::json fit_parameters_json(const FitResult& f) {
   nlohmann::json ps = nlohmann::json::array();
   for (const auto& p : f.parameters)
-    ps.push_back(
-        {{"name", p.parameter.name},
-         {"unit", p.parameter.unit},
-         {"start", p.parameter.start},
-         {"lo", p.parameter.lo},
-         {"hi", p.parameter.hi},
-         {"log_scale", p.parameter.log_scale},
-         {"value", p.value},
-         {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma) : nlohmann::json()},
-         {"sigma_restarts",
-          std::isfinite(p.sigma_restarts) ? nlohmann::json(p.sigma_restarts) : nlohmann::json()},
-         {"at_bound", p.at_bound}});
+    ps.push_back({{"name", p.parameter.name},
+                  {"unit", p.parameter.unit},
+                  {"start", p.parameter.start},
+                  {"lo", p.parameter.lo},
+                  {"hi", p.parameter.hi},
+                  {"log_scale", p.parameter.log_scale},
+                  {"value", p.value},
+                  {"sigma", std::isfinite(p.sigma) ? nlohmann::json(p.sigma) : nlohmann::json()},
+                  {"sigma_restarts", number_json(p.sigma_restarts)},
+                  {"seeds_lo", number_json(p.seeds_lo)},
+                  {"seeds_hi", number_json(p.seeds_hi)},
+                  {"sigma_seeds", number_json(p.sigma_seeds)},
+                  {"at_bound", p.at_bound}});
   return ps;
+}
+
+// The fits at each inner seed (fit_over_seeds), the chosen one first.
+nlohmann::json seed_fits_json(const FitResult& f) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const SeedFit& s : f.seed_fits)
+    out.push_back({{"seed", s.seed},
+                   {"values", s.values},
+                   {"inner_rms_log", s.objective},
+                   {"inner_rms_log_over_seeds", s.objective_over_seeds},
+                   {"inner_rms_log_over_seeds_sd", number_json(s.objective_over_seeds_sd)},
+                   {"evaluations", s.evaluations},
+                   {"converged", s.converged}});
+  return out;
 }
 
 // One fit: its parameters, its search, and the fitted model at the run's quality.
@@ -184,6 +199,7 @@ nlohmann::json fit_json(const FitResult& f, const std::vector<ModelCurves>& mode
                       {"inner_fitted", metrics_json(f.fitted_metrics)},
                       {"evaluations", f.evaluations},
                       {"converged", f.converged},
+                      {"seeds", seed_fits_json(f)},
                       {"seconds", f.seconds}};
   // The fitted parameters at the run's quality (the same ray trace as the unfitted curves).
   const std::string key = f.model == "computed" ? "computed_raytrace_fitted" : f.model + "_fitted";

@@ -13,6 +13,9 @@ namespace weft {
 // The residuals at a point u of the unit cube; every call returns a vector of the same length.
 using ResidualFunction = std::function<std::vector<double>(const std::vector<double>& u)>;
 
+// The root mean square of residuals (0 for none): the objective every search here minimizes.
+double residual_rms(const std::vector<double>& r);
+
 struct OptimizeOptions {
   // Evaluations of the residuals during a search. Levenberg-Marquardt stays within it;
   // Nelder-Mead evaluates its whole start simplex (n + 1 points) and finishes the step it is in

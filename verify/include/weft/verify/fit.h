@@ -60,6 +60,26 @@ struct FitParameterResult {
   // ray trace's noise (NaN with fewer than two). What sigma leaves out: the noise is correlated
   // across the residuals, so it moves the optimum more than independent residuals would.
   double sigma_restarts = std::numeric_limits<double>::quiet_NaN();
+  // The fits at several inner seeds (fit_over_seeds, --fit-seeds): the lowest and highest optimum
+  // and their standard deviation over the seeds' fits (NaN with fewer than two). Where the
+  // measurement does not determine a parameter, the fits at other realizations of the inner
+  // model's noise land far apart on a floor of equal objective: this is that spread.
+  double seeds_lo = std::numeric_limits<double>::quiet_NaN();
+  double seeds_hi = std::numeric_limits<double>::quiet_NaN();
+  double sigma_seeds = std::numeric_limits<double>::quiet_NaN();
+};
+
+// One of a model's fits at several inner seeds (fit_over_seeds).
+struct SeedFit {
+  uint64_t seed = 0;
+  std::vector<double> values;  // its optimum
+  double objective = 0;        // the inner rms_log its search ended at, at its own seed
+  // Its optimum's inner rms_log averaged over every seed's inner model (the judge), and their
+  // standard deviation (NaN for one seed).
+  double objective_over_seeds = 0;
+  double objective_over_seeds_sd = std::numeric_limits<double>::quiet_NaN();
+  int evaluations = 0;
+  bool converged = false;
 };
 
 struct FitResult {
@@ -72,10 +92,15 @@ struct FitResult {
   bool converged = false;  // the tolerance was met before max_evaluations
   std::string method;      // fit_method_name of the search
   double seconds = 0;
+  // The fits at each inner seed (fit_over_seeds), the chosen one (this result's) first.
+  std::vector<SeedFit> seed_fits;
   std::string uncertainty =
       "Gauss-Newton: covariance s^2 (J^T J)^-1 of the log residuals at the optimum, J by central "
       "differences, s^2 = SSR / (n - p); treats the residuals as independent";
 };
+
+// The RMS of fit_residuals: the fit's objective (rms_log, absolute) of a model's curves.
+double fit_rms_log(const std::vector<std::vector<Rgb>>& model, const MeasuredInplane& measured);
 
 // The residuals the fit minimizes: ln(model / measured) at every view, incidence and channel
 // where the measurement is positive (the points of rms_log); a model value <= 0 counts as

@@ -17,6 +17,10 @@
 
 namespace weft {
 
+// --fit-seeds: the inner seeds each model is fitted at by default, and the most a request may ask.
+inline constexpr int kDefaultFitSeeds = 3;
+inline constexpr int kMaxFitSeeds = 16;
+
 // What a user asks of weft verify. Paths are as given; empty strings are options not given.
 struct VerifyRequest {
   std::string measured;      // measured in-plane table (empty: the bundled MERL red fabric)
@@ -35,9 +39,12 @@ struct VerifyRequest {
   int fit_evaluations = FitOptions{}.max_evaluations;
   std::string fit_inner = fit_inner_name(FitInnerSettings{}.inner);
   std::string fit_method = fit_method_name(FitOptions{}.method);
+  // Each model is fitted at this many inner seeds and the best of the fits kept (fit_over_seeds):
+  // one seed's optimum is that of one realization of the inner model's noise.
+  int fit_seeds = kDefaultFitSeeds;
   // Which fit options the user gave: each is refused without 'fit'.
   bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false,
-       fit_method_given = false;
+       fit_method_given = false, fit_seeds_given = false;
 };
 
 // The request's inputs, read and checked before any work (every way of running verify starts
@@ -55,6 +62,7 @@ struct VerifyPlan {
   std::vector<std::string> fit_names;
   FitOptions fit_options;
   FitInner fit_inner = FitInner::kRaytrace;
+  int fit_seeds = kDefaultFitSeeds;
 };
 
 // weft::Error naming the option (or the file and field) at fault: an unreadable measurement,
@@ -78,7 +86,7 @@ struct VerifyEstimate {
 inline constexpr const char* kVerifyLeastRates =
     "0.5 us per photon and 1.25 us per particle per core at least";
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
-                               size_t fit_params);
+                               size_t fit_params, int fit_seeds);
 VerifyEstimate estimate_verify(const VerifyPlan& plan);
 
 // A sharded verify's job: the options that fix its result (a merge runs them again for the parts
