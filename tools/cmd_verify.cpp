@@ -4,6 +4,7 @@
 // and prints.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -103,11 +104,19 @@ void print_summary(const VerifyPlan& p, const VerifyReport& report, double secon
                   m->absolute_overall.rms_log, m->absolute_overall.rms_rel);
   }
   for (const auto& f : report.fits) {
-    std::printf("  fit %s: inner rms_log %.3f -> %.3f, %d evaluations, %.1f s:", f.model.c_str(),
+    std::printf("  fit %s: inner rms_log %.3f -> %.3f, %d evaluations, %.1f s", f.model.c_str(),
                 f.objective_start, f.objective, f.evaluations, f.seconds);
-    for (const auto& fp : f.parameters)
+    if (f.seed_fits.size() > 1)
+      std::printf(", kept seed %llu of %zu fits",
+                  static_cast<unsigned long long>(f.seed_fits.front().seed), f.seed_fits.size());
+    std::printf(":");
+    for (const auto& fp : f.parameters) {
       std::printf(" %s %.4g +- %.2g%s", fp.parameter.name.c_str(), fp.value, fp.sigma,
                   fp.at_bound ? " (at bound)" : "");
+      // The spread over the seeds' fits: what the measurement leaves undetermined shows here.
+      if (std::isfinite(fp.sigma_seeds))
+        std::printf(" [fits %.4g..%.4g]", fp.seeds_lo, fp.seeds_hi);
+    }
     std::printf("\n");
   }
 }

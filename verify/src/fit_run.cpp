@@ -40,20 +40,35 @@ std::optional<VerifyReport> fitted_at_run_quality(const VerifyPlan& p, const Wov
   return again;
 }
 
+// A fit at one inner seed, announced before and summed up after (a fit takes tens of seconds).
+FitResult noted_fit(const VerifyPlan& p, const FitInnerSettings& g, const FitInnerSettings& first,
+                    const VerifyHooks& hooks, const std::function<FitResult()>& fit) {
+  const uint64_t k = g.seed - first.seed + 1;
+  hooks.note("  inner seed " + std::to_string(g.seed) + " (" + std::to_string(k) + " of " +
+             std::to_string(p.fit_seeds) + ")");
+  FitResult r = fit();
+  hooks.note(": inner rms_log " + fmt(r.objective, 4) + " after " + std::to_string(r.evaluations) +
+             " evaluations, " + fmt(r.seconds, 3) + " s" + (r.converged ? "" : ", not converged") +
+             "\n");
+  return r;
+}
+
 // The computed model fitted at the plan's inner seeds (fit_over_seeds).
 FitResult fit_computed(const VerifyPlan& p, const WovenSample& sample,
-                       const FitInnerSettings& inner) {
+                       const FitInnerSettings& inner, const VerifyHooks& hooks) {
   const std::vector<FitParameter> params = spec_fit_parameters(p.spec, p.fit_names);
   const MeasuredInplane& measured = p.measured;
   return fit_over_seeds(
       p.fit_seeds, inner,
       [&](const FitInnerSettings& g) {
-        return fit_inner_model(
-            "computed", params,
-            [&](const std::vector<double>& x) {
-              return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), g);
-            },
-            sample, g, measured, p.fit_options);
+        return noted_fit(p, g, inner, hooks, [&] {
+          return fit_inner_model(
+              "computed", params,
+              [&](const std::vector<double>& x) {
+                return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), g);
+              },
+              sample, g, measured, p.fit_options);
+        });
       },
       [&](const std::vector<double>& x, const FitInnerSettings& g) {
         return fit_rms_log(
@@ -64,25 +79,37 @@ FitResult fit_computed(const VerifyPlan& p, const WovenSample& sample,
 
 // The classic model (diffuse colour and roughness from 'start') fitted the same way.
 FitResult fit_classic(const VerifyPlan& p, const WovenSample& sample, const FitInnerSettings& inner,
-                      const Rgb& start_diffuse, const MicrofacetDistribution& start, double ior) {
+                      const VerifyHooks& hooks, const Rgb& start_diffuse,
+                      const MicrofacetDistribution& start, double ior) {
   const std::vector<FitParameter> params = classic_fit_parameters(start_diffuse, start.alpha);
   const MeasuredInplane& measured = p.measured;
   const MicrofacetModel model = start.model;
   return fit_over_seeds(
       p.fit_seeds, inner,
       [&](const FitInnerSettings& g) {
-        return fit_inner_model(
-            "classic", params,
-            [&](const std::vector<double>& x) {
-              return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, g);
-            },
-            sample, g, measured, p.fit_options);
+        return noted_fit(p, g, inner, hooks, [&] {
+          return fit_inner_model(
+              "classic", params,
+              [&](const std::vector<double>& x) {
+                return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, g);
+              },
+              sample, g, measured, p.fit_options);
+        });
       },
       [&](const std::vector<double>& x, const FitInnerSettings& g) {
         return fit_rms_log(
             classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, sample, g, measured),
             measured);
       });
+}
+
+// Which seed's fit was kept, and its objective over every seed (fit_over_seeds judges by it).
+void note_kept(const VerifyHooks& hooks, const FitResult& r) {
+  if (r.seed_fits.size() < 2) return;
+  const SeedFit& kept = r.seed_fits.front();
+  hooks.note("  kept seed " + std::to_string(kept.seed) + ": inner rms_log over the seeds " +
+             fmt(kept.objective_over_seeds, 4) + " +- " + fmt(kept.objective_over_seeds_sd, 2) +
+             "\n");
 }
 
 // What the inner model's name adds for a fit at several seeds.
@@ -100,11 +127,13 @@ bool fit_verify_models(const VerifyPlan& p, const WovenSample& sample, const Ver
   FitInnerSettings inner = fit_inner_settings(p.settings);
   inner.inner = p.fit_inner;
   hooks.note("\nweft: fitting the computed model (" + p.request.fiber + ")\n");
-  FitResult computed = fit_computed(p, sample, inner);
+  FitResult computed = fit_computed(p, sample, inner, hooks);
+  note_kept(hooks, computed);
   computed.inner_model = computed_inner_model_name(inner) + seeds_note(p, inner);
   hooks.note("weft: fitting the classic model\n");
-  FitResult classic = fit_classic(p, sample, inner, report.classic_reflectance,
+  FitResult classic = fit_classic(p, sample, inner, hooks, report.classic_reflectance,
                                   base.classic_distribution, base.classic_ior);
+  note_kept(hooks, classic);
   classic.inner_model = classic_inner_model_name(inner) + seeds_note(p, inner);
 
   const auto t0 = std::chrono::steady_clock::now();
