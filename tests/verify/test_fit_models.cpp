@@ -16,6 +16,8 @@
 #include "weft/fabric/recorded_paths.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/verify/fit_models.h"
+#include "weft/verify/plan.h"
+#include "weft/verify/whole_run.h"
 
 namespace fs = std::filesystem;
 
@@ -455,4 +457,31 @@ TEST(VerifyFit, FitOverSeedsKeepsTheFitBestOverAllSeedsAndReportsTheSpread) {
   EXPECT_TRUE(std::isnan(one.parameters[0].seeds_lo));
   EXPECT_EQ(one.evaluations, 17 + 1);
   EXPECT_THROW(weft::fit_over_seeds(0, f, fit_at, objective_at), weft::Error);
+}
+
+// An interrupt during the fit stops it at its next evaluation (the inner bakes take no progress
+// callback, so the fit asks between evaluations): fit_verify_models returns false, so the caller
+// writes no report, having asked once, before the first inner table was made.
+TEST(VerifyFit, AnInterruptStopsTheFitAtItsNextEvaluation) {
+  weft::VerifyRequest r;
+  r.quality = "draft";
+  r.threads = 2;
+  r.fit = true;
+  const weft::VerifyPlan p = weft::plan_verify(r);
+  weft::VerifyInputs base;
+  base.classic_distribution = {p.spec.roughness_distribution, p.spec.roughness_alpha};
+  weft::VerifyReport report;
+  report.classic_reflectance = weft::Rgb(0.3, 0.05, 0.03);
+  int asked = 0;
+  std::string notes;
+  weft::VerifyHooks hooks;
+  hooks.interrupted = [&] {
+    ++asked;
+    return true;
+  };
+  hooks.note = [&](const std::string& line) { notes += line; };
+  EXPECT_FALSE(weft::fit_verify_models(p, verify_sample(), base, report, hooks));
+  EXPECT_EQ(asked, 1);
+  EXPECT_TRUE(report.fits.empty());
+  EXPECT_NE(notes.find("inner seed 1 (1 of 3)"), std::string::npos) << notes;
 }

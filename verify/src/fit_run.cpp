@@ -40,6 +40,13 @@ std::optional<VerifyReport> fitted_at_run_quality(const VerifyPlan& p, const Wov
   return again;
 }
 
+// Thrown from inside a fit when the user interrupts: a fit in progress has nothing to keep, and
+// its inner bakes take no progress callback, so the fit checks between its evaluations.
+struct FitInterrupted {};
+void stop_if_interrupted(const VerifyHooks& hooks) {
+  if (hooks.interrupted()) throw FitInterrupted{};
+}
+
 // A fit at one inner seed, announced before and summed up after (a fit takes tens of seconds).
 FitResult noted_fit(const VerifyPlan& p, const FitInnerSettings& g, const FitInnerSettings& first,
                     const VerifyHooks& hooks, const std::function<FitResult()>& fit) {
@@ -65,12 +72,14 @@ FitResult fit_computed(const VerifyPlan& p, const WovenSample& sample,
           return fit_inner_model(
               "computed", params,
               [&](const std::vector<double>& x) {
+                stop_if_interrupted(hooks);
                 return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), g);
               },
               sample, g, measured, p.fit_options);
         });
       },
       [&](const std::vector<double>& x, const FitInnerSettings& g) {
+        stop_if_interrupted(hooks);
         return fit_rms_log(
             computed_inner_curves(apply_spec_fit(p.spec, p.fit_names, x), sample, g, measured),
             measured);
@@ -91,12 +100,14 @@ FitResult fit_classic(const VerifyPlan& p, const WovenSample& sample, const FitI
           return fit_inner_model(
               "classic", params,
               [&](const std::vector<double>& x) {
+                stop_if_interrupted(hooks);
                 return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, g);
               },
               sample, g, measured, p.fit_options);
         });
       },
       [&](const std::vector<double>& x, const FitInnerSettings& g) {
+        stop_if_interrupted(hooks);
         return fit_rms_log(
             classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, sample, g, measured),
             measured);
@@ -126,14 +137,19 @@ bool fit_verify_models(const VerifyPlan& p, const WovenSample& sample, const Ver
                        VerifyReport& report, const VerifyHooks& hooks) {
   FitInnerSettings inner = fit_inner_settings(p.settings);
   inner.inner = p.fit_inner;
-  hooks.note("\nweft: fitting the computed model (" + p.request.fiber + ")\n");
-  FitResult computed = fit_computed(p, sample, inner, hooks);
-  note_kept(hooks, computed);
+  FitResult computed, classic;
+  try {
+    hooks.note("\nweft: fitting the computed model (" + p.request.fiber + ")\n");
+    computed = fit_computed(p, sample, inner, hooks);
+    note_kept(hooks, computed);
+    hooks.note("weft: fitting the classic model\n");
+    classic = fit_classic(p, sample, inner, hooks, report.classic_reflectance,
+                          base.classic_distribution, base.classic_ior);
+    note_kept(hooks, classic);
+  } catch (const FitInterrupted&) {
+    return false;
+  }
   computed.inner_model = computed_inner_model_name(inner) + seeds_note(p, inner);
-  hooks.note("weft: fitting the classic model\n");
-  FitResult classic = fit_classic(p, sample, inner, hooks, report.classic_reflectance,
-                                  base.classic_distribution, base.classic_ior);
-  note_kept(hooks, classic);
   classic.inner_model = classic_inner_model_name(inner) + seeds_note(p, inner);
 
   const auto t0 = std::chrono::steady_clock::now();
