@@ -107,8 +107,10 @@ def fit(out):
             continue
         wall = number(os.path.join(out, "fit-%s.wall" % who))
         m = read_json(os.path.join(out, "fit-%s" % who, "fit", "metrics.json"))
-        conv = ", ".join("%s %s in %d" % (k, "converged" if f["converged"] else "not converged",
-                                          f["evaluations"]) for k, f in m.get("fit", {}).items())
+        # evaluations: every seed's fit and the judging of their optima (verify --fit-seeds)
+        conv = ", ".join("%s %s in %d (%d seed fits)" % (
+            k, "converged" if f["converged"] else "not converged", f["evaluations"],
+            max(1, len(f.get("seeds", [])))) for k, f in m.get("fit", {}).items())
         rows.append(("verify --quality default --fit (%s), wall s; %s" % (who, conv), wall, None, None))
     return rows
 
