@@ -310,8 +310,9 @@ TEST(Fibers, LightFromBehindCrossesTheJointsOfAFiberCutIntoPieces) {
     const Estimate whole =
         render_f(RenderScene(one_fiber(table_binding(table), geometry)), wi, wo, 5, 64);
     const Estimate pieces_f = render_f(RenderScene(cut), wi, wo, 5, 64);
-    if (std::string(geometry) == "curves")
+    if (std::string(geometry) == "curves") {
       EXPECT_NEAR(pieces_f.value, std::sqrt(1 - s * s) / 4, 4 * pieces_f.std_error);
+    }
     EXPECT_NEAR(pieces_f.value, whole.value, 4 * std::hypot(whole.std_error, pieces_f.std_error));
     EXPECT_LT(pieces_f.std_error, 0.01 * pieces_f.value);
   }
