@@ -299,9 +299,10 @@ void add_verify_command(CLI::App& app, Commands& commands) {
              "drawn from a proposal table re-centred between restarts) or summation (the paper's "
              "summation table: cheaper, no light between fibers)");
   fit_option("--fit-seeds", r.fit_seeds, r.fit_seeds_given,
-             "fit each model at this many inner seeds (1 to " + std::to_string(kMaxFitSeeds) +
-                 ") and keep the fit whose optimum is best over all of them; metrics.json gives "
-                 "each parameter's spread over the fits");
+             "fit each model this many times (1 to " + std::to_string(kMaxFitSeeds) +
+                 "), each at its own inner seed and from its own start, and keep the fit whose "
+                 "optimum is best over all the seeds; metrics.json gives each parameter's spread "
+                 "over the fits");
   fit_option("--fit-method", r.fit_method, r.fit_method_given,
              "the search: lm (Levenberg-Marquardt on the log residuals) or nelder-mead "
              "(derivative-free, slower from a distant start)");

@@ -120,3 +120,32 @@ TEST(VerifyFit, OptionsNameTheirField) {
 
 }  // namespace
 }  // namespace weft
+
+// The starts of a model's several fits: the given ones first, then each moved a quarter of its box
+// in the unit cube in another pattern (all down, all up, alternating), kept inside [0.02, 0.98];
+// after eight patterns the step halves.
+TEST(Fit, SeveralFitsStartAQuarterOfTheBoxApartInOtherPatterns) {
+  const std::vector<weft::FitParameter> given = {{"scale", "", 0.1, 10, 1, true},
+                                                 {"alpha", "", 0.05, 1, 0.35, false},
+                                                 {"low", "", 0, 1, 0.1, false}};
+  auto unit = [&](const std::vector<weft::FitParameter>& ps, size_t i) {
+    return weft::fit_unit(ps[i], ps[i].start);
+  };
+  const auto same = weft::fit_start_of(given, 0);
+  for (size_t i = 0; i < given.size(); ++i) EXPECT_EQ(same[i].start, given[i].start);
+  const auto down = weft::fit_start_of(given, 1), up = weft::fit_start_of(given, 2),
+             alternating = weft::fit_start_of(given, 3), finer = weft::fit_start_of(given, 9);
+  EXPECT_NEAR(down[0].start, std::pow(10.0, -0.5), 1e-12);  // ln-box [0.1, 10]: a quarter is 10^0.5
+  EXPECT_NEAR(unit(down, 1), unit(given, 1) - 0.25, 1e-12);
+  EXPECT_NEAR(unit(down, 2), 0.02, 1e-12);  // 0.1 - 0.25 is outside: kept at 0.02
+  EXPECT_NEAR(unit(up, 0), 0.75, 1e-12);
+  EXPECT_NEAR(unit(up, 2), 0.35, 1e-12);
+  EXPECT_NEAR(unit(alternating, 0), 0.25, 1e-12);
+  EXPECT_NEAR(unit(alternating, 1), unit(given, 1) + 0.25, 1e-12);
+  EXPECT_NEAR(unit(finer, 0), 0.375, 1e-12);  // the first pattern again, at half the step
+  for (const auto& ps : {down, up, alternating, finer})
+    for (size_t i = 0; i < ps.size(); ++i) {
+      EXPECT_GE(ps[i].start, ps[i].lo);
+      EXPECT_LE(ps[i].start, ps[i].hi);
+    }
+}

@@ -81,6 +81,27 @@ double to_value(const FitParameter& p, double u) {
                      : p.lo + u * (p.hi - p.lo);
 }
 
+}  // namespace
+
+std::vector<FitParameter> fit_start_of(std::vector<FitParameter> params, int k) {
+  if (k <= 0) return params;
+  // Directions per parameter (up to four), one pattern per fit: all down, all up, alternating,
+  // then in pairs.
+  static constexpr int kSigns[8][4] = {{-1, -1, -1, -1}, {1, 1, 1, 1},   {-1, 1, -1, 1},
+                                       {1, -1, 1, -1},   {-1, -1, 1, 1}, {1, 1, -1, -1},
+                                       {-1, 1, 1, -1},   {1, -1, -1, 1}};
+  const int pattern = (k - 1) % 8;
+  const double step = 0.25 / static_cast<double>(1 << std::min((k - 1) / 8, 8));
+  for (size_t i = 0; i < params.size(); ++i) {
+    FitParameter& p = params[i];
+    const double u = fit_unit(p, p.start) + step * kSigns[pattern][i % 4];
+    p.start = std::clamp(to_value(p, std::clamp(u, 0.02, 0.98)), p.lo, p.hi);
+  }
+  return params;
+}
+
+namespace {
+
 CurveMetrics absolute_metrics(const std::vector<std::vector<Rgb>>& model,
                               const MeasuredInplane& measured) {
   MetricsAccumulator a;

@@ -70,7 +70,7 @@ FitResult fit_computed(const VerifyPlan& p, const WovenSample& sample,
       [&](const FitInnerSettings& g) {
         return noted_fit(p, g, inner, hooks, [&] {
           return fit_inner_model(
-              "computed", params,
+              "computed", fit_start_of(params, static_cast<int>(g.seed - inner.seed)),
               [&](const std::vector<double>& x) {
                 stop_if_interrupted(hooks);
                 return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), g);
@@ -98,7 +98,7 @@ FitResult fit_classic(const VerifyPlan& p, const WovenSample& sample, const FitI
       [&](const FitInnerSettings& g) {
         return noted_fit(p, g, inner, hooks, [&] {
           return fit_inner_model(
-              "classic", params,
+              "classic", fit_start_of(params, static_cast<int>(g.seed - inner.seed)),
               [&](const std::vector<double>& x) {
                 stop_if_interrupted(hooks);
                 return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, g);

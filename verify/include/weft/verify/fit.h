@@ -27,6 +27,13 @@ struct FitParameter {
 // A parameter's value as its coordinate in the optimizer's unit cube (ln x where log_scale).
 double fit_unit(const FitParameter& p, double x);
 
+// The starts of the k-th of several fits of one model (fit_over_seeds): k = 0 the given starts;
+// k >= 1 each start moved by a quarter of its box in the search's unit cube, in another pattern of
+// directions for each fit (all down, all up, alternating, in pairs), the step halved after every
+// eight fits, kept within [0.02, 0.98] of the cube. A search from one start stops at the first
+// minimum it meets, and the fit's objective has several (docs/verify.md).
+std::vector<FitParameter> fit_start_of(std::vector<FitParameter> params, int k);
+
 // The model being fitted: the in-plane beta [incidence][view] of the measurement's views for a
 // parameter vector (in the parameters' own units).
 using InplaneModel = std::function<std::vector<std::vector<Rgb>>(const std::vector<double>&)>;

@@ -132,7 +132,8 @@ FitResult fit_inner_model(
 
 // The fit at 'seeds' inner seeds, f.seed, f.seed + 1, ... (--fit-seeds): each another
 // realization of the inner model's noise, which a fit at one seed cannot tell from the
-// measurement's. fit_at(g) fits at g.seed; objective_at(x, g) is the inner rms_log of parameters x
+// measurement's. fit_at(g) fits at g.seed (verify's from the start fit_start_of(.., g.seed -
+// f.seed)); objective_at(x, g) is the inner rms_log of parameters x
 // at g.seed, without a proposal. Each fit's optimum is judged by its objective averaged over every
 // seed's inner model (seeds^2 evaluations), and the best judged is returned (its seed_fits list
 // every fit, the chosen first), with each parameter's spread over the fits (seeds_lo, seeds_hi,

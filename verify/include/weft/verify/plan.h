@@ -39,8 +39,9 @@ struct VerifyRequest {
   int fit_evaluations = FitOptions{}.max_evaluations;
   std::string fit_inner = fit_inner_name(FitInnerSettings{}.inner);
   std::string fit_method = fit_method_name(FitOptions{}.method);
-  // Each model is fitted at this many inner seeds and the best of the fits kept (fit_over_seeds):
-  // one seed's optimum is that of one realization of the inner model's noise.
+  // Each model is fitted this many times, each at its own inner seed and from its own start
+  // (fit_start_of), and the best of the fits kept (fit_over_seeds): one search finds the first
+  // minimum of one realization of the inner model's noise.
   int fit_seeds = kDefaultFitSeeds;
   // Which fit options the user gave: each is refused without 'fit'.
   bool fit_params_given = false, fit_evaluations_given = false, fit_inner_given = false,
