@@ -60,57 +60,33 @@ FitResult noted_fit(const VerifyPlan& p, const FitInnerSettings& g, const FitInn
   return r;
 }
 
-// The computed model fitted at the plan's inner seeds (fit_over_seeds).
-FitResult fit_computed(const VerifyPlan& p, const WovenSample& sample,
-                       const FitInnerSettings& inner, const VerifyHooks& hooks) {
-  const std::vector<FitParameter> params = spec_fit_parameters(p.spec, p.fit_names);
-  const MeasuredInplane& measured = p.measured;
-  return fit_over_seeds(
-      p.fit_seeds, inner,
-      [&](const FitInnerSettings& g) {
-        return noted_fit(p, g, inner, hooks, [&] {
-          return fit_inner_model(
-              "computed", fit_start_of(params, static_cast<int>(g.seed - inner.seed)),
-              [&](const std::vector<double>& x) {
-                stop_if_interrupted(hooks);
-                return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), g);
-              },
-              sample, g, measured, p.fit_options);
-        });
-      },
-      [&](const std::vector<double>& x, const FitInnerSettings& g) {
-        stop_if_interrupted(hooks);
-        return fit_rms_log(
-            computed_inner_curves(apply_spec_fit(p.spec, p.fit_names, x), sample, g, measured),
-            measured);
-      });
-}
+// A model's inner fiber table for parameters x at the inner settings g.
+using InnerTable =
+    std::function<TabulatedBsdfTable(const std::vector<double>& x, const FitInnerSettings& g)>;
 
-// The classic model (diffuse colour and roughness from 'start') fitted the same way.
-FitResult fit_classic(const VerifyPlan& p, const WovenSample& sample, const FitInnerSettings& inner,
-                      const VerifyHooks& hooks, const Rgb& start_diffuse,
-                      const MicrofacetDistribution& start, double ior) {
-  const std::vector<FitParameter> params = classic_fit_parameters(start_diffuse, start.alpha);
+// One model fitted at the plan's inner seeds, each fit from its own start (fit_over_seeds,
+// fit_start_of); its optima judged by the same inner model at every seed, without a proposal.
+FitResult fit_model(const VerifyPlan& p, const std::string& model,
+                    const std::vector<FitParameter>& params, const InnerTable& table_of,
+                    const WovenSample& sample, const FitInnerSettings& inner,
+                    const VerifyHooks& hooks) {
   const MeasuredInplane& measured = p.measured;
-  const MicrofacetModel model = start.model;
   return fit_over_seeds(
       p.fit_seeds, inner,
       [&](const FitInnerSettings& g) {
         return noted_fit(p, g, inner, hooks, [&] {
           return fit_inner_model(
-              "classic", fit_start_of(params, static_cast<int>(g.seed - inner.seed)),
+              model, fit_start_of(params, static_cast<int>(g.seed - inner.seed)),
               [&](const std::vector<double>& x) {
                 stop_if_interrupted(hooks);
-                return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, g);
+                return table_of(x, g);
               },
               sample, g, measured, p.fit_options);
         });
       },
       [&](const std::vector<double>& x, const FitInnerSettings& g) {
         stop_if_interrupted(hooks);
-        return fit_rms_log(
-            classic_inner_curves(Rgb(x[0], x[1], x[2]), {model, x[3]}, ior, sample, g, measured),
-            measured);
+        return fit_rms_log(inner_fabric_curves(sample, table_of(x, g), g, measured), measured);
       });
 }
 
@@ -140,11 +116,22 @@ bool fit_verify_models(const VerifyPlan& p, const WovenSample& sample, const Ver
   FitResult computed, classic;
   try {
     hooks.note("\nweft: fitting the computed model (" + p.request.fiber + ")\n");
-    computed = fit_computed(p, sample, inner, hooks);
+    computed = fit_model(
+        p, "computed", spec_fit_parameters(p.spec, p.fit_names),
+        [&](const std::vector<double>& x, const FitInnerSettings& g) {
+          return computed_inner_fiber_table(apply_spec_fit(p.spec, p.fit_names, x), g);
+        },
+        sample, inner, hooks);
     note_kept(hooks, computed);
     hooks.note("weft: fitting the classic model\n");
-    classic = fit_classic(p, sample, inner, hooks, report.classic_reflectance,
-                          base.classic_distribution, base.classic_ior);
+    const MicrofacetDistribution& start = base.classic_distribution;
+    const double ior = base.classic_ior;
+    classic = fit_model(
+        p, "classic", classic_fit_parameters(report.classic_reflectance, start.alpha),
+        [&](const std::vector<double>& x, const FitInnerSettings& g) {
+          return classic_inner_fiber_table(Rgb(x[0], x[1], x[2]), {start.model, x[3]}, ior, g);
+        },
+        sample, inner, hooks);
     note_kept(hooks, classic);
   } catch (const FitInterrupted&) {
     return false;
