@@ -12,6 +12,7 @@
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/recorded_paths.h"
 #include "weft/materials/classic_fiber.h"
+#include "weft/verify/figures.h"
 
 namespace weft {
 
@@ -294,12 +295,10 @@ void set_restart_spread(FitResult& last, const std::vector<FitParameter>& given,
                         const std::vector<std::vector<double>>& restart_optima) {
   for (size_t k = 0; k < given.size(); ++k) {
     last.parameters[k].parameter = given[k];
-    const size_t n = restart_optima.size();
-    if (n < 2) continue;
-    double mean = 0, ss = 0;
-    for (const auto& o : restart_optima) mean += o[k] / static_cast<double>(n);
-    for (const auto& o : restart_optima) ss += (o[k] - mean) * (o[k] - mean);
-    last.parameters[k].sigma_restarts = std::sqrt(ss / static_cast<double>(n - 1));
+    if (restart_optima.size() < 2) continue;
+    std::vector<double> v;
+    for (const auto& o : restart_optima) v.push_back(o[k]);
+    last.parameters[k].sigma_restarts = sample_sd(v);
   }
 }
 
@@ -378,10 +377,9 @@ namespace {
 
 // Mean and sample standard deviation (NaN for fewer than two) of 'v'.
 std::pair<double, double> mean_and_sd(const std::vector<double>& v) {
-  double mean = 0, ss = 0;
-  for (double x : v) mean += x / static_cast<double>(v.size());
-  for (double x : v) ss += (x - mean) * (x - mean);
-  return {mean, v.size() < 2 ? std::nan("") : std::sqrt(ss / static_cast<double>(v.size() - 1))};
+  double sum = 0;
+  for (double x : v) sum += x;
+  return {sum / static_cast<double>(v.size()), v.size() < 2 ? std::nan("") : sample_sd(v)};
 }
 
 }  // namespace
