@@ -7,8 +7,8 @@
 #             noise per channel, CPU seconds x (noise / 1 %)^2, over WEFT_SEEDS seeds;
 #   bake      the fiber bake (`weft bench bake red-cotton`): photons per band and CPU seconds for a
 #             1 % table error, the baseline's default against this tree's variants
-#             WEFT_BAKE_VARIANTS (default plain+mirror, the default bake, and
-#             nee+mirror+s4+strat, its fewest-photons options);
+#             WEFT_BAKE_VARIANTS (default plain+mirror, mirror folding alone, and
+#             nee+mirror+s4+strat, the default bake: its fewest-photons options);
 #   render    the path tracer's rays per second over the same rays through bare Embree
 #             (`weft bench render`, ratio_replay), both bundled benchmark scenes;
 #   backlit   the fiber-level render lit from behind and in front (scripts/fiber-render-noise.sh,
@@ -88,7 +88,7 @@ if [[ $goals == *,bake,* ]]; then
   echo "== fiber bake (bench bake, 4 seeds)"
   timed "bake-before" "$old" bench bake red-cotton --photons 2000,8000,32000 --seeds 4 \
     --threads "$threads" --json
-  # This tree's default bake (mirror folding), and its fewest-photons options.
+  # Mirror folding alone, and this tree's default bake (its fewest-photons options).
   timed "bake-after" "$new" bench bake red-cotton --photons 2000,8000,32000 --seeds 4 \
     --threads "$threads" --json --estimators "${WEFT_BAKE_VARIANTS:-plain+mirror,nee+mirror+s4+strat}"
 fi

@@ -37,6 +37,7 @@ int report_fiber_bake(const FiberTableBakeResult& r, const FiberSpec& spec,
                      {"surface_sampling_excess", b.surface_sampling_excess},
                      {"expected_exit_excess", b.expected_exit_excess},
                      {"energy_balance", b.energy_balance},
+                     {"energy_scale", b.energy_scale},
                      {"table_energy", b.energy_table}});
   nlohmann::json j = {{"output", output},
                       {"spec", spec.name},
@@ -227,7 +228,8 @@ void add_bake_command(CLI::App& app, Commands& commands) {
   fiber
       ->add_option("--estimator", opt->estimator,
                    "how exits are tallied: plain (one by one) or nee (next-event estimation at "
-                   "every scattering; smooth boundary, direct route); default plain")
+                   "every scattering, the table scaled to the walks' own exits; smooth boundary, "
+                   "direct route); default nee where it applies")
       ->check(CLI::IsMember({"plain", "nee"}));
   fiber->add_flag("--mirror-fold,!--no-mirror-fold", opt->mirror_fold,
                   "average every cell with its images under the fiber's mirror symmetries "
@@ -240,7 +242,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
   fiber
       ->add_option("--entry", opt->entry,
                    "how photons' entries are drawn: random or stratified (randomised Sobol' "
-                   "points per task; direct route); default random")
+                   "points per task; direct route); default stratified on the direct route")
       ->check(CLI::IsMember({"random", "stratified"}));
   fiber->add_option("--seed", opt->seed, "random seed");
   fiber

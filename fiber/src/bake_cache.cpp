@@ -28,8 +28,10 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
       // so entries baked with them keep their names and are never read for other options.
       (o.weight_mode == WeightMode::absorption_weight ? "|absorption_weight" : "") +
       (o.route == FiberBakeRoute::kBssrdf ? "|bssrdf" : "") +
+      // "|walk_energy": next-event tables scaled to the walk's exits, never read for the
+      // unscaled ones baked before.
       (o.estimator != FiberExitEstimator::kPlain
-           ? std::string("|") + fiber_exit_estimator_name(o.estimator)
+           ? std::string("|") + fiber_exit_estimator_name(o.estimator) + "|walk_energy"
            : "") +
       (o.mirror_fold ? "|mirror_fold" : "") +
       (o.surface_samples != 1 ? "|surface_samples" + std::to_string(o.surface_samples) : "") +
@@ -45,7 +47,7 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
 std::string volume_albedo_metadata(const FiberTableBakeResult& r) {
   Spectrum s{};
   for (const auto& b : r.bands)
-    if (b.band >= 0 && b.band < kNumBands) s[b.band] = b.exit_fraction - b.surface_fraction;
+    if (b.band >= 0 && b.band < kNumBands) s[b.band] = b.walk_exit_fraction() - b.surface_fraction;
   std::string out;
   char buf[40];
   for (double v : s) {

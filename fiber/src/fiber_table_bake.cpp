@@ -173,8 +173,10 @@ std::map<std::string, std::string> fiber_table_metadata(const FiberSpec& spec,
   };
   // Only when not the default, so tables of the paper's model keep their header.
   if (spec.boundary != FiberBoundary::kSmooth) m["boundary"] = fiber_boundary_name(spec.boundary);
-  if (o.estimator != FiberExitEstimator::kPlain)
+  if (o.estimator != FiberExitEstimator::kPlain) {
     m["exit_estimator"] = fiber_exit_estimator_name(o.estimator);
+    m["energy"] = "the walk's own exits";
+  }
   if (o.mirror_fold) m["mirror_fold"] = "yes";
   if (o.surface_samples != 1) m["surface_samples"] = std::to_string(o.surface_samples);
   if (o.entry != FiberEntrySampling::kRandom) m["entry"] = fiber_entry_sampling_name(o.entry);
@@ -182,6 +184,11 @@ std::map<std::string, std::string> fiber_table_metadata(const FiberSpec& spec,
 }
 
 }  // namespace
+
+double fiber_walk_energy_scale(const FiberBandState& st) {
+  if (st.exit_excess == 0 || !(st.exit > 0)) return 1;
+  return (st.exit - st.exit_excess) / st.exit;
+}
 
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
                                       const ProgressCallback& progress) {
@@ -226,10 +233,12 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
       s.expected_exit_excess = st.exit_excess * inv;
       s.energy_balance = s.exit_fraction + s.absorbed_fraction + s.roulette_net + s.lost_fraction -
                          s.surface_sampling_excess - s.expected_exit_excess;
-      s.energy_table = st.energy * inv;
+      s.energy_scale = fiber_walk_energy_scale(st);
+      s.energy_table = st.energy * inv * s.energy_scale;
       // The photon-weighted mean of the passes' sums, then cell averages.
       std::vector<double> mean_sum(st.weighted_sum.size());
-      for (size_t k = 0; k < mean_sum.size(); ++k) mean_sum[k] = st.weighted_sum[k] * inv;
+      for (size_t k = 0; k < mean_sum.size(); ++k)
+        mean_sum[k] = st.weighted_sum[k] * inv * s.energy_scale;
       if (o.mirror_fold) mean_sum = fold_fiber_mirror_symmetry(R, mean_sum);
       band_f[band] = TabulatedBsdfTable::averages_from_weighted_sums(R, mean_sum);
     }

@@ -223,7 +223,7 @@ std::string metrics_without_seconds(const fs::path& report) {
 }  // namespace
 
 // --fiber TABLE: the classic baseline's colour from the table alone. Its total albedo is the
-// bake's exit fraction (the bake's own energy_table check), so the table's albedo minus the
+// walks' exit fraction (the bake's own energy_table check), so the table's albedo minus the
 // classic Cook-Torrance lobe's must equal the spec path's volume albedo, exit - surface, up to the
 // difference between the lobe's albedo (0.0729 for this Beckmann 0.35 surface of index 1.557,
 // docs/verify.md) and the bake's surface fraction of the same surface, whose standard error at
@@ -240,7 +240,7 @@ TEST(CliVerify, FiberTableGivesTheClassicColourFromItsAlbedo) {
       bake.table, {weft::MicrofacetModel::kBeckmann, 0.35}, 1.557, 1, 0);
   weft::Spectrum volume{};
   for (const auto& band : bake.bands) {
-    volume[band.band] = band.exit_fraction - band.surface_fraction;
+    volume[band.band] = band.walk_exit_fraction() - band.surface_fraction;
     EXPECT_NEAR(derived[band.band], volume[band.band], 0.0065) << "band " << band.band;
   }
   // The classic reflectance is the volume albedo over the share past the lobe (classic.h), and

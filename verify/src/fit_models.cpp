@@ -184,7 +184,15 @@ FiberTableBakeOptions verify_bake_options(const FiberSpec& spec, int resolution,
   b.seed = seed;
   b.threads = threads;
   b.spectral = !fit_inner;
-  if (fit_inner) b.weight_mode = WeightMode::absorption_weight;
+  if (fit_inner) {
+    // The fit's inner bake keeps plain exits, one surface sample and random entries: next-event
+    // inner bakes made the fits spread more (docs/verify.md), and its photons per band are the
+    // fit's own (FitInnerSettings).
+    b.weight_mode = WeightMode::absorption_weight;
+    b.estimator = FiberExitEstimator::kPlain;
+    b.surface_samples = 1;
+    b.entry = FiberEntrySampling::kRandom;
+  }
   return b;
 }
 

@@ -141,11 +141,12 @@ Rgb parse_classic_albedo(const std::string& text) {
 
 namespace {
 
-// Measured (docs/verify.md "Time"): red-cotton's full bake, 1.2 us per photon per core
-// (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default quality, computed
+// Measured (docs/verify.md "Time"): red-cotton's full bake at the bake's defaults (next-event
+// estimation and 4 surface samples), 9.1-11 s of CPU for 50 000 photons in each of 33 bands, so
+// 6 us per photon (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default quality, computed
 // and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so 18 us per
 // particle; the plots and the rest, about 10 s of CPU whatever the quality.
-constexpr double kTypicalSecondsPerPhoton = 1.2e-6;
+constexpr double kTypicalSecondsPerPhoton = 6e-6;
 constexpr double kTypicalSecondsPerParticle = 18e-6;
 constexpr double kTypicalFixedSeconds = 10;
 // The fiber-level renders (docs/verify.md "Renders"): 23 s of CPU at default quality for the four

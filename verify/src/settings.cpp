@@ -21,7 +21,7 @@ VerifySettings verify_settings(VerifyQuality q) {
   // The default's photons are FiberTableBakeOptions{}'s; what a row omits keeps its default.
   static const VerifySettings kDraft{.quality = VerifyQuality::kDraft,
                                      .resolution = 6,
-                                     .fiber_photons_per_band = 20000,
+                                     .fiber_photons_per_band = 5000,
                                      .particles_per_bin = 4000,
                                      .batches = 2,
                                      .summation_samples = 4,
@@ -31,7 +31,7 @@ VerifySettings verify_settings(VerifyQuality q) {
                                      .weave_render_spp = 4};
   static const VerifySettings kDefault{.quality = VerifyQuality::kDefault,
                                        .resolution = 8,
-                                       .fiber_photons_per_band = 200000,
+                                       .fiber_photons_per_band = 50000,
                                        .particles_per_bin = 64000,
                                        .batches = 4,
                                        .summation_samples = 8,
@@ -41,7 +41,7 @@ VerifySettings verify_settings(VerifyQuality q) {
                                        .weave_render_spp = 16};
   static const VerifySettings kPublication{.quality = VerifyQuality::kPublication,
                                            .resolution = 12,
-                                           .fiber_photons_per_band = 1000000,
+                                           .fiber_photons_per_band = 250000,
                                            .particles_per_bin = 256000,
                                            .batches = 8,
                                            .summation_samples = 16,

@@ -25,7 +25,7 @@ inline constexpr uint64_t kMaxPhotonsPerBand = uint64_t{1} << 40;
 // The defaults here are the only ones: `weft bake fiber` and the bake cache start from them.
 struct FiberTableBakeOptions {
   int resolution = 8;  // R x R equal-area bins per direction
-  uint64_t photons_per_band = 200000;
+  uint64_t photons_per_band = 50000;
   uint64_t seed = 1;
   int threads = 0;       // 0 = all cores; results do not depend on it
   bool spectral = true;  // 33 bands, else linear sRGB (D65) from the 33 bands
@@ -39,18 +39,18 @@ struct FiberTableBakeOptions {
   // finished pass (results depend on it, not on threads).
   uint64_t passes = 8;
   // Variance reduction (docs/fiber-bsdf.md, "Fewer photons for the same noise"); all unbiased.
-  // The default folds mirror images only: 4x fewer photons for the same table error at no cost
-  // per photon, and a table's energy stays exact. Next-event estimation (with surface samples and
-  // stratified entries: 20x fewer photons, 4x less CPU) adds noise to the energy itself, which
-  // puts a lossless fiber's table above a total albedo of 1 at few photons (docs/PERFORMANCE.md).
+  // The defaults are the fewest photons for a table error measured (docs/PERFORMANCE.md):
+  // next-event estimation, mirror folding, four surface samples and stratified entries, 20x fewer
+  // photons than the plain bake and about 4x the CPU per photon; a next-event table is scaled to
+  // the walk's own exits, so its energy is a plain bake's (FiberBandSummary::energy_scale).
   // How exits are tallied: one by one (plain), or by next-event estimation (smooth boundary only).
-  FiberExitEstimator estimator = FiberExitEstimator::kPlain;
+  FiberExitEstimator estimator = FiberExitEstimator::kNextEvent;
   // Average every cell pair with its images under the fiber's mirror symmetries.
   bool mirror_fold = true;
   // Surface-lobe directions drawn per photon (smooth boundary only; FiberSurfaceModel::samples).
-  int surface_samples = 1;
+  int surface_samples = 4;
   // How photons' entries are drawn (FiberEntrySampling; direct route only).
-  FiberEntrySampling entry = FiberEntrySampling::kRandom;
+  FiberEntrySampling entry = FiberEntrySampling::kStratified;
 };
 
 // The defaults for a spec and route: FiberTableBakeOptions{}, less the variance reductions that do
@@ -72,7 +72,15 @@ struct FiberBandSummary {
   double surface_sampling_excess = 0;  // sampled minus tabulated surface albedo (mean zero)
   double expected_exit_excess = 0;     // next-event estimated minus traced exits (mean zero)
   double energy_balance = 0;  // exit + absorbed + roulette + lost - both excesses: 1 to rounding
-  double energy_table = 0;    // table energy sum / pi: equals exit_fraction (white furnace)
+  // The factor the table was scaled by so that its energy is the walk's own exits, (exit_fraction
+  // - expected_exit_excess) / exit_fraction; 1 for plain exits (docs/fiber-bsdf.md, "The
+  // energy of a next-event table").
+  double energy_scale = 1;
+  double energy_table = 0;  // table energy sum / pi: walk_exit_fraction() (white furnace)
+  // What the photons' own walks sent out (surface + volume): exit_fraction for plain exits, the
+  // exits that next-event estimation stands for otherwise. A lossless fiber's is 1 less what was
+  // lost, plus the surface lobe's sampling excess.
+  double walk_exit_fraction() const { return exit_fraction - expected_exit_excess; }
   uint64_t photons = 0;
   uint64_t scattering_events = 0;
 };
@@ -129,6 +137,14 @@ struct FiberBandsResult {
 FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOptions& options,
                                    const FiberBandWork& work,
                                    const ProgressCallback& progress = no_progress());
+
+// The factor a band's table is scaled by: the walks' own exits over the tallied ones, 1 with
+// plain exits. Next-event estimation tallies expected exits, whose sum scatters about the walks'
+// own (mean zero, noise 1/sqrt(N)), so a lossless fiber's table would land above a total albedo
+// of 1 as often as below; scaled, it has the energy a plain bake would have, its books exact, for
+// a ratio estimator's bias of order 1/N, far below the cells' noise (docs/fiber-bsdf.md, "The
+// energy of a next-event table"). Plain tables keep their bits.
+double fiber_walk_energy_scale(const FiberBandState& band);
 
 // The table and summary from the states of all kNumBands bands.
 FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
