@@ -485,3 +485,28 @@ TEST(VerifyFit, AnInterruptStopsTheFitAtItsNextEvaluation) {
   EXPECT_TRUE(report.fits.empty());
   EXPECT_NE(notes.find("inner seed 1 (1 of 3)"), std::string::npos) << notes;
 }
+
+// The run's fiber bake takes the bake's defaults (next-event estimation, four surface samples,
+// stratified entries); the fit's inner bake keeps plain exits, one surface sample and random
+// entries, with absorption as a weight and RGB bands (docs/verify.md, "What the measurement
+// determines").
+TEST(VerifyFit, InnerBakeKeepsPlainExitsWhereTheRunTakesTheBakesDefaults) {
+  const weft::FiberSpec spec = weft::load_fiber_spec("red-cotton");
+  const weft::FiberTableBakeOptions defaults = weft::fiber_bake_defaults(spec);
+  const auto run = weft::verify_bake_options(spec, 6, 5000, 3, 2, false);
+  EXPECT_EQ(run.estimator, defaults.estimator);
+  EXPECT_EQ(run.estimator, weft::FiberExitEstimator::kNextEvent);
+  EXPECT_EQ(run.surface_samples, defaults.surface_samples);
+  EXPECT_EQ(run.entry, defaults.entry);
+  EXPECT_EQ(run.weight_mode, weft::WeightMode::implicit_capture);
+  EXPECT_TRUE(run.spectral);
+  const auto inner = weft::verify_bake_options(spec, 6, 5000, 3, 2, true);
+  EXPECT_EQ(inner.estimator, weft::FiberExitEstimator::kPlain);
+  EXPECT_EQ(inner.surface_samples, 1);
+  EXPECT_EQ(inner.entry, weft::FiberEntrySampling::kRandom);
+  EXPECT_TRUE(inner.mirror_fold);
+  EXPECT_EQ(inner.weight_mode, weft::WeightMode::absorption_weight);
+  EXPECT_FALSE(inner.spectral);
+  EXPECT_EQ(inner.photons_per_band, 5000u);
+  EXPECT_EQ(inner.resolution, 6);
+}
