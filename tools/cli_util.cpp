@@ -165,10 +165,12 @@ void check_fiber_bake(const FiberTableBakeOptions& o, uint64_t bands,
                       const FiberBakeSource& source) {
   check_memory(fiber_table_bake_bytes(o), source.file, source.resolution_field,
                "a bake at resolution " + std::to_string(o.resolution));
-  check_long_work(static_cast<double>(o.photons_per_band) * static_cast<double>(bands),
-                  kMinSecondsPerPhoton, o.threads, source.file, source.photons_field,
-                  std::to_string(o.photons_per_band) + " photons per band",
-                  "0.5 us per photon per core at least");
+  const double per_photon = fiber_bake_min_seconds_per_photon(o);
+  char rate[64];
+  std::snprintf(rate, sizeof rate, "%.2g us per photon per core at least", per_photon * 1e6);
+  check_long_work(static_cast<double>(o.photons_per_band) * static_cast<double>(bands), per_photon,
+                  o.threads, source.file, source.photons_field,
+                  std::to_string(o.photons_per_band) + " photons per band", rate);
 }
 
 void check_fabric_bake(const std::string& method, int resolution, uint64_t bins_traced,

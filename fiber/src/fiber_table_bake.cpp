@@ -185,6 +185,12 @@ std::map<std::string, std::string> fiber_table_metadata(const FiberSpec& spec,
 
 }  // namespace
 
+double fiber_bake_min_seconds_per_photon(const FiberTableBakeOptions& o) {
+  return o.estimator == FiberExitEstimator::kNextEvent && o.surface_samples >= 4
+             ? kMinSecondsPerNextEventPhoton
+             : kMinSecondsPerPhoton;
+}
+
 double fiber_walk_energy_scale(const FiberBandState& st) {
   if (st.exit_excess == 0 || !(st.exit > 0)) return 1;
   return (st.exit - st.exit_excess) / st.exit;

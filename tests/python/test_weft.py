@@ -185,8 +185,9 @@ def test_quiet_by_default_progress_on_request(capfd):
 
 
 def test_long_work_needs_yes_long():
-    # 2^40 photons per band x 33 bands at 0.5 us per photon per core (fiber_table_bake.h
-    # kMinSecondsPerPhoton) is years on any machine: refused before any work.
+    # 2^40 photons per band x 33 bands at 2.1 us per photon per core with the bake's defaults
+    # (fiber_table_bake.h fiber_bake_min_seconds_per_photon) is years on any machine: refused
+    # before any work.
     with pytest.raises(weft.Error, match=r"field 'photons'.*pass yes_long=True"):
         weft.bake_fiber("red-cotton", photons=2**40, resolution=4)
 

@@ -151,6 +151,12 @@ TEST(CliBadInput, LongBakesNeedConfirmation) {
   // 1e12 photons per band: 33e12 photons at >= 0.5 us each is years on any machine here.
   const CliRun r = run("bake fiber red-cotton --photons 1000000000000 -o t.exr", dir);
   expect_error(r, {"--photons", "would take at least", "--yes-long"}, dir / "t.exr");
+  // The bound follows the options (fiber_table_bake.h): 2.1 us per photon with the defaults'
+  // next-event estimation and four surface samples, 0.5 us with plain exits.
+  EXPECT_NE(r.err.find("2.1 us per photon per core at least"), std::string::npos) << r.err;
+  const CliRun plain =
+      run("bake fiber red-cotton --photons 1000000000000 --estimator plain -o t.exr", dir);
+  expect_error(plain, {"--photons", "0.5 us per photon per core at least"}, dir / "t.exr");
   // --yes-long passes that check (after the subcommand too); the memory budget then refuses (at
   // its floor of 0.05 GB, cli_util.h kMinMemoryGb, a bake at resolution 16 needs 178 MB).
   expect_error(run("bake fiber red-cotton --photons 1000000000000 --resolution 16 -o t.exr "

@@ -102,6 +102,12 @@ double fiber_table_bake_bytes(const FiberTableBakeOptions& options);
 // events) took 0.41x the time per photon of red-cotton here, whose full bake PERFORMANCE.md gives
 // as 1.2 us per photon per core; so 0.5 us. Denser media take longer.
 inline constexpr double kMinSecondsPerPhoton = 0.5e-6;
+// The same bound for a bake's options: with next-event estimation and at least four surface
+// samples (the defaults), the same particle-free fiber took 4.3x the CPU per photon of plain exits
+// with one sample (2.97 against 0.69 us, 2026-12-04, docs/PERFORMANCE.md), so 2.1 us; other
+// options cost at least what plain exits do.
+inline constexpr double kMinSecondsPerNextEventPhoton = 2.1e-6;
+double fiber_bake_min_seconds_per_photon(const FiberTableBakeOptions& options);
 
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
                                       const ProgressCallback& progress = no_progress());
