@@ -196,6 +196,16 @@ double fiber_walk_energy_scale(const FiberBandState& st) {
   return (st.exit - st.exit_excess) / st.exit;
 }
 
+std::vector<double> fiber_band_averages(const FiberBandState& st, int resolution, bool mirror_fold,
+                                        double scale) {
+  // The photon-weighted mean of the passes' sums, then cell averages.
+  const double inv = 1.0 / static_cast<double>(st.photons);
+  std::vector<double> mean_sum(st.weighted_sum.size());
+  for (size_t k = 0; k < mean_sum.size(); ++k) mean_sum[k] = st.weighted_sum[k] * inv * scale;
+  if (mirror_fold) mean_sum = fold_fiber_mirror_symmetry(resolution, mean_sum);
+  return TabulatedBsdfTable::averages_from_weighted_sums(resolution, mean_sum);
+}
+
 FiberTableBakeResult bake_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
                                       const ProgressCallback& progress) {
   const FiberBandsResult r = trace_fiber_bands(spec, o, FiberBandWork{}, progress);
@@ -241,12 +251,7 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
                          s.surface_sampling_excess - s.expected_exit_excess;
       s.energy_scale = fiber_walk_energy_scale(st);
       s.energy_table = st.energy * inv * s.energy_scale;
-      // The photon-weighted mean of the passes' sums, then cell averages.
-      std::vector<double> mean_sum(st.weighted_sum.size());
-      for (size_t k = 0; k < mean_sum.size(); ++k)
-        mean_sum[k] = st.weighted_sum[k] * inv * s.energy_scale;
-      if (o.mirror_fold) mean_sum = fold_fiber_mirror_symmetry(R, mean_sum);
-      band_f[band] = TabulatedBsdfTable::averages_from_weighted_sums(R, mean_sum);
+      band_f[band] = fiber_band_averages(st, R, o.mirror_fold, s.energy_scale);
     }
     result.bands.push_back(s);
   }

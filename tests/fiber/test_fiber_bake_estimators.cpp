@@ -130,11 +130,8 @@ TEST(FiberTableBake, TheDefaultsScaledToTheWalksExitsEstimateThePlainTable) {
       const double scale = m == 1 ? fiber_walk_energy_scale(b) : 1.0;
       if (m != 0)
         largest_change = std::max(largest_change, std::abs(fiber_walk_energy_scale(b) - 1));
-      std::vector<double> mean_sum(b.weighted_sum.size());
-      for (size_t c = 0; c < mean_sum.size(); ++c) mean_sum[c] = b.weighted_sum[c] / n * scale;
-      mean_sum = fold_fiber_mirror_symmetry(resolution, mean_sum);
       FiberBandTable t;
-      t.f = TabulatedBsdfTable::averages_from_weighted_sums(resolution, mean_sum);
+      t.f = fiber_band_averages(b, resolution, true, scale);
       exit[m].push_back((m == 1 ? b.exit - b.exit_excess : b.exit) / n);
       absorbed[m].push_back(b.absorbed / n);
       return t;

@@ -152,6 +152,11 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
 // energy of a next-event table"). Plain tables keep their bits.
 double fiber_walk_energy_scale(const FiberBandState& band);
 
+// A band's cell averages (the table's values for that band) from its running sums over photons
+// > 0, each sum times 'scale' (fiber_walk_energy_scale), mirror-folded if asked.
+std::vector<double> fiber_band_averages(const FiberBandState& band, int resolution,
+                                        bool mirror_fold, double scale);
+
 // The table and summary from the states of all kNumBands bands.
 FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& options,
                                         const std::vector<FiberBandState>& bands, bool cancelled);
