@@ -6,11 +6,13 @@
 #include <fstream>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "weft/core/error.h"
 #include "weft/core/job_part.h"
+#include "weft/core/params.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
 
@@ -144,22 +146,26 @@ FiberBandState decode_fiber_band(const std::vector<double>& v, FiberExitEstimato
 }  // namespace
 
 int merge_fiber_bake(const JobPart& all, const std::string& output, bool json) {
-  const FiberSpec spec = parse_fiber_spec(all.extra.at("spec").get<std::string>(),
-                                          all.extra.at("spec_file").get<std::string>());
-  if (fiber_spec_hash_hex(spec) != all.job.at("spec_hash").get<std::string>())
+  // The parts are a user's files: every setting is read through the checks a job file gets, so
+  // a corrupt or crafted part is refused naming the setting, never cast out of range.
+  ParamReader extra(all.extra, "", "extra"), job(all.job, "", "job");
+  const FiberSpec spec = parse_fiber_spec(extra.string("spec"), extra.string("spec_file"));
+  if (fiber_spec_hash_hex(spec) != job.string("spec_hash"))
     throw Error("", "spec", "the parts' spec does not match their spec hash");
+  constexpr uint64_t kAny = std::numeric_limits<uint64_t>::max();
   FiberTableBakeOptions o;
-  o.resolution = all.job.at("resolution").get<int>();
-  o.photons_per_band = all.job.at("photons_per_band").get<uint64_t>();
-  o.seed = all.job.at("seed").get<uint64_t>();
-  o.spectral = all.job.at("spectral").get<bool>();
-  o.route = all.job.at("route") == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf;
-  o.max_events_per_photon = all.job.at("max_events_per_photon").get<uint64_t>();
-  o.passes = all.job.at("passes").get<uint64_t>();
-  o.estimator = parse_fiber_exit_estimator(all.job.value("estimator", "plain"), "estimator");
-  o.mirror_fold = all.job.value("mirror_fold", false);
-  o.surface_samples = all.job.value("surface_samples", 1);
-  o.entry = parse_fiber_entry_sampling(all.job.value("entry", "random"), "entry");
+  o.resolution = static_cast<int>(job.count("resolution", 2, TabulatedBsdfTable::kMaxResolution));
+  o.photons_per_band = job.count("photons_per_band", 1, kAny);
+  o.seed = job.count("seed", 0, kAny);
+  o.spectral = job.boolean("spectral", false);
+  o.route = job.choice("route", "", {"direct", "bssrdf"}) == "direct" ? FiberBakeRoute::kDirect
+                                                                      : FiberBakeRoute::kBssrdf;
+  o.max_events_per_photon = job.count("max_events_per_photon", 1, kAny);
+  o.passes = job.count("passes", 1, kAny);
+  o.estimator = parse_fiber_exit_estimator(job.string("estimator", "plain"), "estimator");
+  o.mirror_fold = job.boolean("mirror_fold", false);
+  o.surface_samples = static_cast<int>(job.count("surface_samples", 1, 1, 1024));
+  o.entry = parse_fiber_entry_sampling(job.string("entry", "random"), "entry");
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
   std::vector<FiberBandState> states;
   for (const auto& [band, v] : all.units) {

@@ -531,9 +531,9 @@ int merge_fabric_bake(const JobPart& all, const std::string& output, const std::
                 "the parts carry no weave tally: bake them with --weave-out to have one");
   if (weave && std::filesystem::path(weave_out).extension() != ".exr")
     throw Error(weave_out, "--weave-out", "the weave table must be written to a .exr file");
-  FabricRaytraceResult r = assemble_fabric_job(all, all.job.at("resolution").get<int>());
+  FabricRaytraceResult r = assemble_fabric_job(all);
   TabulatedBsdfTable& t = r.table;
-  t.metadata["sample"] = all.job.at("sample").get<std::string>();
+  t.metadata["sample"] = ParamReader(all.job, "", "job").string("sample");
   t.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;  // as bake fabric writes
   t.write_exr(output);
   nlohmann::json j = {{"output", output}, {"method", "raytrace"}, {"parts_merged", true}};

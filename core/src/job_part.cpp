@@ -97,34 +97,21 @@ JobPart read_job_part(const std::filesystem::path& path) {
   JobPart p;
   try {
     const auto h = parse_json(line, file);
-    p.command = h.at("command").get<std::string>();
-    p.job = h.at("job");
-    p.units_total = h.at("units_total").get<uint64_t>();
-    p.shard = {h.at("shard").get<uint32_t>(), h.at("shards").get<uint32_t>()};
+    ParamReader r(h, file, "");
+    p.command = r.string("command");
+    p.job = r.at("job");
     // The counts before anything is sized or looped over by them.
-    if (p.units_total > kMaxJobUnits)
-      throw Error(file, "units_total",
-                  std::to_string(p.units_total) + " is more than a job has (at most " +
-                      std::to_string(kMaxJobUnits) + ")");
-    if (p.shard.count > kMaxShards)
-      throw Error(file, "shards",
-                  std::to_string(p.shard.count) + " is more than a job is cut into (at most " +
-                      std::to_string(kMaxShards) + ")");
+    p.units_total = r.count("units_total", 0, kMaxJobUnits);
+    p.shard.count = static_cast<uint32_t>(r.count("shards", 1, kMaxShards));
+    p.shard.index = static_cast<uint32_t>(r.count("shard", 0, p.shard.count - 1));
     p.checkpoint = h.at("checkpoint").get<bool>();
-    p.extra = h.at("extra");
+    p.extra = r.at("extra");
     // A unit is listed once at most: a longer list is refused before it is converted.
-    if (h.at("units").size() > p.units_total || h.at("unit_doubles").size() > p.units_total)
-      throw Error(file, "units", "lists more units than units_total");
-    const auto units = h.at("units").get<std::vector<uint64_t>>();
-    const auto sizes = h.at("unit_doubles").get<std::vector<uint64_t>>();
+    const auto units = r.counts("units", p.units_total, 0, p.units_total - 1);
+    const auto sizes = r.counts("unit_doubles", p.units_total, 0, size / sizeof(double));
     if (units.size() != sizes.size()) throw Error(file, "units", "does not match unit_doubles");
-    if (p.shard.count < 1 || p.shard.index >= p.shard.count)
-      throw Error(file, "shard", "must lie in [0, shards)");
     uint64_t doubles = 0;
     for (size_t i = 0; i < units.size(); ++i) {
-      if (units[i] >= p.units_total) throw Error(file, "units", "a unit beyond units_total");
-      if (sizes[i] > size / sizeof(double))
-        throw Error(file, "unit_doubles", "larger than the file");
       doubles += sizes[i];
     }
     const uint64_t payload_at = static_cast<uint64_t>(in.tellg());

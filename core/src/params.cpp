@@ -174,27 +174,26 @@ int64_t ParamReader::integer(const std::string& key, int64_t fallback, int64_t l
 }
 
 uint64_t ParamReader::count(const std::string& key, uint64_t lo, uint64_t hi) {
-  const nlohmann::json& v = at(key);
-  if (v.is_number_unsigned()) {
-    const uint64_t x = v.get<uint64_t>();
-    if (x < lo || x > hi)
-      throw Error(file_, field(key),
-                  "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
-                      std::to_string(x));
-    return x;
-  }
-  // Negative integers, integral doubles (1e5) and everything else go through the checks below.
-  const double d = check_number(v, field(key), -1e300, 1e300);
-  if (d != std::floor(d)) throw Error(file_, field(key), "must be an integer, got " + fmt(d));
-  if (d < static_cast<double>(lo) || d > static_cast<double>(hi))
-    throw Error(
-        file_, field(key),
-        "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + fmt(d));
-  return static_cast<uint64_t>(d);
+  return check_count(at(key), field(key), lo, hi);
 }
 
 uint64_t ParamReader::count(const std::string& key, uint64_t fallback, uint64_t lo, uint64_t hi) {
   return has(key) ? count(key, lo, hi) : fallback;
+}
+
+std::vector<uint64_t> ParamReader::counts(const std::string& key, size_t max_size, uint64_t lo,
+                                          uint64_t hi) {
+  const nlohmann::json& v = at(key);
+  if (!v.is_array()) throw Error(file_, field(key), "must be an array of whole numbers");
+  if (v.size() > max_size)
+    throw Error(file_, field(key),
+                "has " + std::to_string(v.size()) + " entries, at most " +
+                    std::to_string(max_size) + " allowed");
+  std::vector<uint64_t> out;
+  out.reserve(v.size());
+  for (size_t i = 0; i < v.size(); ++i)
+    out.push_back(check_count(v[i], field(key) + "[" + std::to_string(i) + "]", lo, hi));
+  return out;
 }
 
 bool ParamReader::boolean(const std::string& key, bool fallback) {
@@ -287,6 +286,30 @@ int64_t ParamReader::check_integer(const nlohmann::json& v, const std::string& n
     throw Error(file_, name,
                 "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
                     std::to_string(x));
+  return x;
+}
+
+uint64_t ParamReader::check_count(const nlohmann::json& v, const std::string& name, uint64_t lo,
+                                  uint64_t hi) const {
+  auto out_of_range = [&](const std::string& got) {
+    return Error(
+        file_, name,
+        "must lie in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], got " + got);
+  };
+  if (v.is_number_unsigned()) {
+    const uint64_t x = v.get<uint64_t>();
+    if (x < lo || x > hi) throw out_of_range(std::to_string(x));
+    return x;
+  }
+  // Negative integers, integral doubles (1e5) and everything else: checked as doubles before
+  // any conversion, so an out-of-range value never reaches a cast.
+  const double d = check_number(v, name, -1e300, 1e300);
+  if (d != std::floor(d)) throw Error(file_, name, "must be an integer, got " + fmt(d));
+  // 2^64 itself compares equal to hi = 2^64 - 1 as a double, and would overflow the cast.
+  if (d < static_cast<double>(lo) || d > static_cast<double>(hi) || d >= 0x1p64)
+    throw out_of_range(fmt(d));
+  const auto x = static_cast<uint64_t>(d);
+  if (x > hi) throw out_of_range(fmt(d));
   return x;
 }
 

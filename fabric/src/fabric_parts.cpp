@@ -11,6 +11,7 @@
 #include <iostream>
 
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 #include "weft/fabric/weave_tally.h"
 
 namespace weft {
@@ -74,19 +75,22 @@ JobPart fabric_job(const FiberTables& fibers, const WovenSample& sample,
 constexpr size_t kBookValues = 5 + 7;
 
 // The weave a job's parts carry (positions 0: none): sizes from the job, the repeat from extra.
+// Parts are a user's files: each value is checked as a job file's would be before it is used.
 WeaveShape weave_shape_of(const JobPart& all) {
   WeaveShape w;
   if (!all.job.contains("weave_positions")) return w;
-  const auto p = all.job.at("weave_positions").get<std::vector<int>>();
-  const auto repeat = all.extra.at("weave_repeat_m").get<std::vector<double>>();
-  w.resolution = all.job.at("weave_resolution").get<int>();
-  if (p.size() != 2 || p[0] < 1 || p[0] > WeaveTable::kMaxPositions || p[1] < 1 ||
-      p[1] > WeaveTable::kMaxPositions || w.resolution < 1 ||
-      w.resolution > TabulatedBsdfTable::kMaxResolution)
-    throw Error("", "weave_positions", "not the weave tally's positions and resolution");
-  if (repeat.size() != 2) throw Error("", "weave_repeat_m", "expected the repeat's two sizes");
-  w.positions_u = p[0], w.positions_v = p[1];
-  w.repeat_u_m = repeat[0], w.repeat_v_m = repeat[1];
+  ParamReader job(all.job, "", "job"), extra(all.extra, "", "extra");
+  const auto p = job.counts("weave_positions", 2, 1, WeaveTable::kMaxPositions);
+  w.resolution =
+      static_cast<int>(job.count("weave_resolution", 1, TabulatedBsdfTable::kMaxResolution));
+  if (p.size() != 2) throw Error("", "job.weave_positions", "expected the repeat's two counts");
+  if (!extra.at("weave_repeat_m").is_array() || extra.at("weave_repeat_m").size() != 2)
+    throw Error("", "extra.weave_repeat_m", "expected the repeat's two sizes");
+  w.positions_u = static_cast<int>(p[0]), w.positions_v = static_cast<int>(p[1]);
+  w.repeat_u_m =
+      extra.check_number(extra.at("weave_repeat_m")[0], "extra.weave_repeat_m[0]", 1e-9, 1.0);
+  w.repeat_v_m =
+      extra.check_number(extra.at("weave_repeat_m")[1], "extra.weave_repeat_m[1]", 1e-9, 1.0);
   return w;
 }
 
@@ -97,11 +101,19 @@ void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t rou
   t.metadata["roulette_kills"] = std::to_string(roulette_kills);
 }
 
-FabricRaytraceResult assemble_fabric_job(const JobPart& all, int resolution) {
-  FabricRaytraceResult r =
-      assemble_fabric_bins(all.units, 0, all.units_total, resolution,
-                           all.extra.at("channels").get<int>(), weave_shape_of(all));
-  r.table.metadata = all.extra.at("metadata").get<std::map<std::string, std::string>>();
+FabricRaytraceResult assemble_fabric_job(const JobPart& all) {
+  ParamReader job(all.job, "", "job"), extra(all.extra, "", "extra");
+  const auto resolution =
+      static_cast<int>(job.count("resolution", 1, TabulatedBsdfTable::kMaxResolution));
+  const auto channels = static_cast<int>(extra.count("channels", 1, kNumBands));
+  FabricRaytraceResult r = assemble_fabric_bins(all.units, 0, all.units_total, resolution, channels,
+                                                weave_shape_of(all));
+  const nlohmann::json& metadata = extra.at("metadata");
+  if (!metadata.is_object()) throw Error("", "extra.metadata", "must be an object of strings");
+  for (const auto& [key, value] : metadata.items()) {
+    if (!value.is_string()) throw Error("", "extra.metadata." + key, "must be a string");
+    r.table.metadata[key] = value.get<std::string>();
+  }
   record_particle_counts(r.table, r.splits, r.roulette_kills);
   if (r.weave.positions_u > 0) describe_weave(r.table, r.weave);
   return r;
@@ -132,6 +144,15 @@ int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins) {
 FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<double>>& units,
                                           uint64_t first_unit, uint64_t bins, int resolution,
                                           int channels, const WeaveShape& weave) {
+  // The shape before anything is sized by it: the table's own limits, and one unit per bin.
+  if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
+    throw Error("", "resolution",
+                "must lie in [1, " + std::to_string(TabulatedBsdfTable::kMaxResolution) + "]");
+  if (channels != 3 && channels != kNumBands)
+    throw Error("", "channels", "need 3 (RGB) or " + std::to_string(kNumBands) + " channels");
+  if (bins != static_cast<uint64_t>(DirectionGrid{resolution}.bins()))
+    throw Error("", "units_total",
+                "not the bins of a table of resolution " + std::to_string(resolution));
   FabricRaytraceResult r;
   TabulatedBsdfTable& t = r.table;
   t.resolution = resolution;
@@ -242,7 +263,7 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     return std::nullopt;
   }
   std::filesystem::remove(checkpoint_path(output));
-  return assemble_fabric_job(done, r.resolution);
+  return assemble_fabric_job(done);
 }
 
 nlohmann::json raytrace_summary(const FabricRaytraceResult& res) {

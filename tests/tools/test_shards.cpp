@@ -222,6 +222,80 @@ TEST(Shards, MergeRefusesMissingDuplicateAndForeignParts) {
   EXPECT_EQ(run_weft({"merge", p2, p0, p1, "-o", out.string()}, dir), 0) << slurp(dir / "stderr");
 }
 
+// A part whose header's job or extra is edited (a corrupt or crafted part): each setting is read
+// through the checks a job file gets, so a merge refuses it naming the setting, with exit 2 and
+// no output, instead of casting 1e30 to an int or sizing a table by a crafted count.
+TEST(Shards, MergeRefusesPartsWithCraftedSettings) {
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = dir / "fiber.exr";
+  ASSERT_EQ(run_weft(split("bake fiber red-cotton --photons 200 --resolution 2 --passes 1 "
+                           "--quiet --bands rgb -o " +
+                           fiber.string()),
+                     dir),
+            0)
+      << slurp(dir / "stderr");
+  // Two shards of each job (a whole run writes its output, not a part).
+  auto shards = [&](const std::string& args, const std::string& name) {
+    std::vector<fs::path> parts;
+    for (const char* k : {"0/2", "1/2"}) {
+      parts.push_back(dir / (name + std::to_string(parts.size())));
+      EXPECT_EQ(run_weft(split(args + " --shard " + k + " -o " + parts.back().string()), dir), 0)
+          << slurp(dir / "stderr");
+    }
+    return parts;
+  };
+  const auto fiber_parts = shards(
+      "bake fiber red-cotton --photons 200 --resolution 2 --passes 1 --quiet --bands rgb", "f");
+  const auto fabric_parts = shards(
+      "bake fabric --method raytrace -R 2 --samples 64 --quiet --fiber " + fiber.string(), "r");
+  // The parts with one header value replaced in each: the magic line, the edited header, the
+  // payload.
+  auto edited = [&](const std::vector<fs::path>& parts, const std::string& object,
+                    const std::string& key, const nlohmann::json& value) {
+    std::vector<std::string> out = {"merge"};
+    for (const fs::path& part : parts) {
+      const std::string bytes = slurp(part);
+      const size_t first = bytes.find('\n'), second = bytes.find('\n', first + 1);
+      nlohmann::json h = nlohmann::json::parse(bytes.substr(first + 1, second - first - 1));
+      h[object][key] = value;
+      out.push_back((dir / ("crafted-" + part.filename().string())).string());
+      std::ofstream(out.back(), std::ios::binary)
+          << bytes.substr(0, first + 1) << h.dump() << bytes.substr(second);
+    }
+    return out;
+  };
+  const fs::path out = dir / "out.exr";
+  const std::vector<std::string> to_out = {"-o", out.string()};
+  struct Case {
+    const std::vector<fs::path>& parts;
+    std::string object, key;
+    nlohmann::json value;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {fiber_parts, "job", "resolution", 1e30, "job.resolution"},
+      {fiber_parts, "job", "seed", -1, "job.seed"},
+      {fiber_parts, "job", "photons_per_band", 0.5, "job.photons_per_band"},
+      {fiber_parts, "job", "surface_samples", 1e9, "job.surface_samples"},
+      {fiber_parts, "job", "route", "sideways", "job.route"},
+      {fabric_parts, "job", "resolution", 3, "units_total"},
+      {fabric_parts, "job", "resolution", 1e30, "job.resolution"},
+      {fabric_parts, "extra", "channels", 1e30, "extra.channels"},
+      {fabric_parts, "extra", "channels", 4, "channels"},
+      {fabric_parts, "extra", "metadata", {{"spec", 1}}, "extra.metadata.spec"},
+      {fabric_parts, "job", "sample", 7, "job.sample"}};
+  for (const Case& c : cases) {
+    EXPECT_EQ(run_weft(edited(c.parts, c.object, c.key, c.value) + to_out, dir), 2)
+        << c.key << " = " << c.value.dump() << ": " << slurp(dir / "stderr");
+    const std::string err = slurp(dir / "stderr");
+    EXPECT_NE(err.find(c.says), std::string::npos) << c.key << ": " << err;
+    EXPECT_FALSE(fs::exists(out));
+  }
+  // Parts edited to what they held merge.
+  EXPECT_EQ(run_weft(edited(fabric_parts, "extra", "channels", 3) + to_out, dir), 0)
+      << slurp(dir / "stderr");
+}
+
 // SIGKILL at random moments (seeded: the same moments every run), each run continuing from the
 // checkpoint the killed one left, then a last run to the end: the bytes of an uninterrupted run.
 // Delays are uniform over [0, 1.2 x] the uninterrupted run's time, however loaded the machine.

@@ -3,6 +3,7 @@
 #include "weft/verify/plan.h"
 
 #include <algorithm>
+#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -143,9 +144,9 @@ namespace {
 
 // Measured (docs/verify.md "Time"): red-cotton's full bake at the bake's defaults (next-event
 // estimation and 4 surface samples), 9.1-11 s of CPU for 50 000 photons in each of 33 bands, so
-// 6 us per photon (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default quality, computed
-// and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so 18 us per
-// particle; the plots and the rest, about 10 s of CPU whatever the quality.
+// 6 us per photon (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default
+// quality, computed and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so
+// 18 us per particle; the plots and the rest, about 10 s of CPU whatever the quality.
 constexpr double kTypicalSecondsPerPhoton = 6e-6;
 constexpr double kTypicalSecondsPerParticle = 18e-6;
 constexpr double kTypicalFixedSeconds = 10;
@@ -254,8 +255,11 @@ VerifyRequest verify_job_request(const JobPart& all, const std::string& output) 
   o.pattern = opt.at("pattern").get<std::string>();
   o.wif = opt.at("wif").get<std::string>();
   o.quality = opt.at("quality").get<std::string>();
-  o.seed = opt.at("seed").get<uint64_t>();
-  o.threads = all.extra.value("threads", 0);
+  // Parts are a user's files: the numbers are checked before they are converted.
+  o.seed =
+      ParamReader(opt, "", "job.options").count("seed", 0, std::numeric_limits<uint64_t>::max());
+  o.threads =
+      static_cast<int>(ParamReader(all.extra, "", "extra").integer("threads", 0, 0, 1 << 16));
   o.output = output;
   return o;
 }

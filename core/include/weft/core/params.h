@@ -65,6 +65,9 @@ class ParamReader {
   int64_t integer(const std::string& key, int64_t fallback, int64_t lo, int64_t hi);
   uint64_t count(const std::string& key, uint64_t lo, uint64_t hi);
   uint64_t count(const std::string& key, uint64_t fallback, uint64_t lo, uint64_t hi);
+  // An array of at most max_size counts, each in [lo, hi]: the length is checked before any
+  // element is converted, and each element as count() checks it.
+  std::vector<uint64_t> counts(const std::string& key, size_t max_size, uint64_t lo, uint64_t hi);
   bool boolean(const std::string& key, bool fallback);
   // A non-empty string.
   std::string string(const std::string& key);
@@ -92,6 +95,8 @@ class ParamReader {
  private:
   int64_t check_integer(const nlohmann::json& v, const std::string& name, int64_t lo,
                         int64_t hi) const;
+  uint64_t check_count(const nlohmann::json& v, const std::string& name, uint64_t lo,
+                       uint64_t hi) const;
 
   const nlohmann::json& j_;
   std::string file_, path_;

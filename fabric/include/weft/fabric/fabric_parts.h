@@ -36,8 +36,9 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
 // weave tally of that shape. weft::Error naming a missing or malformed unit.
 void encode_fabric_bin(const FabricRaytraceResult& result, uint64_t bin, std::vector<double>& unit);
 int fabric_bin_channels(const std::vector<double>& unit, uint64_t bins);
-// The whole table (with the pieces' metadata and particle counts) of a merged job of every bin.
-FabricRaytraceResult assemble_fabric_job(const JobPart& all, int resolution);
+// The whole table (with the pieces' metadata and particle counts) of a merged job of every bin;
+// its resolution, channels and weave from the job, each checked before anything is sized.
+FabricRaytraceResult assemble_fabric_job(const JobPart& all);
 FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<double>>& units,
                                           uint64_t first_unit, uint64_t bins, int resolution,
                                           int channels, const WeaveShape& weave = {});
