@@ -2,6 +2,7 @@
 // keys are errors, never silent defaults.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <string>
 
 #include "test_util.h"
@@ -78,6 +79,32 @@ TEST(ParamReader, IntegersAndCountsAcceptIntegralNumbersOnly) {
   EXPECT_EQ(r.count("missing", 42, 0, 100), 42u);
   EXPECT_EQ(r.integer("missing", -1, -5, 5), -1);
   expect_error(error_of([&] { r.count("absent", 0, 10); }), "materials.seat.absent", "is required");
+}
+
+// An array of counts: its length is bounded before any element is read, and each element is
+// checked as count() checks one, so 2^64 or 1e30 (beyond every uint64_t) is refused, never cast.
+TEST(ParamReader, CountsAreAnArrayOfCheckedCounts) {
+  const json j = {{"ok", {0, 1e5, 7.0, 18446744073709551615u}},
+                  {"long", {1, 2, 3}},
+                  {"frac", {1, 2.5}},
+                  {"huge", {1, 1e30}},
+                  {"two64", {18446744073709551616.0}},
+                  {"neg", {-1}},
+                  {"text", {"1"}},
+                  {"scalar", 1}};
+  ParamReader r(j, "scene.json", "");
+  const uint64_t all = std::numeric_limits<uint64_t>::max();
+  EXPECT_EQ(r.counts("ok", 4, 0, all),
+            (std::vector<uint64_t>{0, 100000, 7, std::numeric_limits<uint64_t>::max()}));
+  expect_error(error_of([&] { r.counts("long", 2, 0, 10); }), "long",
+               "has 3 entries, at most 2 allowed");
+  expect_error(error_of([&] { r.counts("frac", 2, 0, 10); }), "frac[1]", "must be an integer");
+  expect_error(error_of([&] { r.counts("huge", 2, 0, all); }), "huge[1]", "must lie in");
+  expect_error(error_of([&] { r.counts("two64", 2, 0, all); }), "two64[0]", "must lie in");
+  expect_error(error_of([&] { r.counts("neg", 2, 0, 10); }), "neg[0]", "must lie in [0, 10]");
+  expect_error(error_of([&] { r.counts("text", 2, 0, 10); }), "text[0]", "must be a number");
+  expect_error(error_of([&] { r.counts("scalar", 2, 0, 10); }), "scalar",
+               "must be an array of whole numbers");
 }
 
 TEST(ParamReader, NumbersAreFiniteAndInRange) {
