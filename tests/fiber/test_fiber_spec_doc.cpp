@@ -43,11 +43,6 @@ std::set<std::string> documented_keys() {
   return keys;
 }
 
-// An object's path with the array indices left out: "species[1].size" -> "species[].size".
-std::string generic(const std::string& path) {
-  return std::regex_replace(path, std::regex(R"(\[[0-9]+\])"), "[]");
-}
-
 // The keys the parser knows in the object at 'ptr' of 'spec': an unknown key put there makes its
 // reader's finish() list them ("known here: a, b, c").
 std::vector<std::string> known_keys(nlohmann::json spec, const nlohmann::json::json_pointer& ptr) {

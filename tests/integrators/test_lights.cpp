@@ -263,9 +263,9 @@ TEST(Lights, DeltaLightsAddUp) {
     const RenderResult r = render(geometry.with_lights(one), *d.camera, s);
     for (size_t i = 0; i < sum.size(); ++i) sum[i] += r.image.rgb[i];
   };
-  add({{all.directional[0]}, {}, Rgb(0.0)});
-  add({{}, {all.points[0]}, Rgb(0.0)});
-  add({{}, {all.points[1]}, Rgb(0.0)});
+  add({{all.directional[0]}, {}, Rgb(0.0), {}});
+  add({{}, {all.points[0]}, Rgb(0.0), {}});
+  add({{}, {all.points[1]}, Rgb(0.0), {}});
   double total = 0;
   for (size_t i = 0; i < sum.size(); ++i) {
     total += sum[i];

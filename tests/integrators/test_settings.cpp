@@ -79,8 +79,9 @@ TEST(Settings, AbsentSectionsGiveTheDefaults) {
 TEST(Settings, BundledExampleSections) {
   const SceneDescription d = load_scene_description(kExamples / "lambert-plane.json");
   // rr_depth is not given: the default.
-  expect_render_keys(render_settings_from(d),
-                     {.width = 128, .height = 128, .spp = 16, .max_depth = 8, .seed = 1});
+  expect_render_keys(
+      render_settings_from(d),
+      {.width = 128, .height = 128, .spp = 16, .max_depth = 8, .seed = 1, .crop = {}});
   const GonioSettings g = gonio_settings_from(d);
   EXPECT_EQ(g.sample, "plane");
   EXPECT_EQ(g.light_zenith_deg, 30);
@@ -109,7 +110,8 @@ TEST(Settings, EveryRenderKey) {
                          .spp = 3,
                          .max_depth = 2,
                          .rr_depth = 1,
-                         .seed = 18446744073709551615ull});
+                         .seed = 18446744073709551615ull,
+                         .crop = {}});
 }
 
 TEST(Settings, EverySweepKey) {

@@ -254,7 +254,9 @@ TEST(TableBsdf, CellSamplingFollowsTheCellReadOfAPeakedTable) {
       const int n = 20000;
       for (int i = 0; i < n; ++i) {
         const auto s = bsdf.sample(wo, {rng.uniform(), rng.uniform()}, rng.uniform());
-        if (s) EXPECT_DOUBLE_EQ(s->pdf, bsdf.pdf(wo, s->wi));
+        if (s) {
+          EXPECT_DOUBLE_EQ(s->pdf, bsdf.pdf(wo, s->wi));
+        }
         const double w = s ? s->weight.g : 0;
         mean += w / n;
         worst[int(follow)] = std::max(worst[int(follow)], w / albedo);

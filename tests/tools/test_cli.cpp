@@ -326,7 +326,7 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   const std::string base = "bake fabric --fiber '" + fiber.string() +
                            "' --method raytrace --detail fiber -R 2 --samples 400 --quiet --json";
   std::map<std::string, uint64_t> splits;
-  for (const std::string& est : {"hero", "mean", "nee"}) {
+  for (const std::string est : {"hero", "mean", "nee"}) {
     const fs::path out = dir / (est + ".exr");
     const CliRun r = run(base + " --estimator " + est + " -o '" + out.string() + "'", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
