@@ -18,21 +18,28 @@ using weft::testing::fresh_test_dir;
 namespace weft {
 namespace {
 
-// A part file with the given header counts and no payload, as a hostile user writes one.
-fs::path crafted_part(const fs::path& dir, const std::string& name, uint64_t units_total,
-                      uint64_t shard, uint64_t shards) {
-  const nlohmann::json header = {{"command", "bake fiber"},
-                                 {"job", {{"seed", 1}}},
-                                 {"units_total", units_total},
-                                 {"shard", shard},
-                                 {"shards", shards},
-                                 {"checkpoint", false},
-                                 {"extra", nlohmann::json::object()},
-                                 {"units", nlohmann::json::array()},
-                                 {"unit_doubles", nlohmann::json::array()}};
-  const fs::path p = dir / name;
+// A part's header with the given counts and no units listed, as a hostile user writes one.
+nlohmann::json crafted_header(uint64_t units_total, uint64_t shard, uint64_t shards) {
+  return {{"command", "bake fiber"},
+          {"job", {{"seed", 1}}},
+          {"units_total", units_total},
+          {"shard", shard},
+          {"shards", shards},
+          {"checkpoint", false},
+          {"extra", nlohmann::json::object()},
+          {"units", nlohmann::json::array()},
+          {"unit_doubles", nlohmann::json::array()}};
+}
+
+// The part file of a header and no payload.
+fs::path write_part(const fs::path& p, const nlohmann::json& header) {
   std::ofstream(p, std::ios::binary) << "WEFT-PART 1\n" << header.dump() << "\n";
   return p;
+}
+
+fs::path crafted_part(const fs::path& dir, const std::string& name, uint64_t units_total,
+                      uint64_t shard, uint64_t shards) {
+  return write_part(dir / name, crafted_header(units_total, shard, shards));
 }
 
 double seconds_of(const std::function<void()>& f) {
@@ -53,17 +60,10 @@ TEST(JobPart, CraftedCountsAreRefusedAsTheHeaderIsRead) {
   EXPECT_LT(seconds_of([&] { e = error_of([&] { merge_job_parts({shards}); }); }), 1.0);
   EXPECT_NE(e.find(shards.string() + ": field 'shards'"), std::string::npos) << e;
   // A list of units longer than units_total is refused before it is converted.
-  const fs::path listed = dir / "listed.part";
-  nlohmann::json h = {{"command", "bake fiber"},
-                      {"job", {{"seed", 1}}},
-                      {"units_total", 2},
-                      {"shard", 0},
-                      {"shards", 1},
-                      {"checkpoint", false},
-                      {"extra", nlohmann::json::object()},
-                      {"units", {0, 1, 2}},
-                      {"unit_doubles", {0, 0, 0}}};
-  std::ofstream(listed, std::ios::binary) << "WEFT-PART 1\n" << h.dump() << "\n";
+  nlohmann::json h = crafted_header(2, 0, 1);
+  h["units"] = {0, 1, 2};
+  h["unit_doubles"] = {0, 0, 0};
+  const fs::path listed = write_part(dir / "listed.part", h);
   e = error_of([&] { read_job_part(listed); });
   EXPECT_NE(e.find(listed.string() + ": field 'units': has 3 entries, at most 2"),
             std::string::npos)
@@ -78,17 +78,10 @@ TEST(JobPart, CraftedCountsAreRefusedAsTheHeaderIsRead) {
 // each is refused naming the file and the entry.
 TEST(JobPart, CountsOutOfRangeAreRefusedBeforeTheyAreConverted) {
   const fs::path dir = fresh_test_dir();
-  const nlohmann::json valid = {{"command", "bake fiber"},
-                                {"job", {{"seed", 1}}},
-                                {"units_total", 2},
-                                {"shard", 0},
-                                {"shards", 1},
-                                {"checkpoint", false},
-                                {"extra", nlohmann::json::object()},
-                                {"units", {1}},
-                                {"unit_doubles", {0}}};
-  const fs::path ok = dir / "ok.part";
-  std::ofstream(ok, std::ios::binary) << "WEFT-PART 1\n" << valid.dump() << "\n";
+  nlohmann::json valid = crafted_header(2, 0, 1);
+  valid["units"] = {1};
+  valid["unit_doubles"] = {0};
+  const fs::path ok = write_part(dir / "ok.part", valid);
   EXPECT_EQ(read_job_part(ok).units.size(), 1u);
   struct Case {
     std::string field, shown;
@@ -107,8 +100,7 @@ TEST(JobPart, CountsOutOfRangeAreRefusedBeforeTheyAreConverted) {
   for (const Case& c : cases) {
     nlohmann::json h = valid;
     h[c.field] = c.value;
-    const fs::path p = dir / "crafted.part";
-    std::ofstream(p, std::ios::binary) << "WEFT-PART 1\n" << h.dump() << "\n";
+    const fs::path p = write_part(dir / "crafted.part", h);
     const std::string e = error_of([&] { read_job_part(p); });
     EXPECT_NE(e.find(p.string() + ": field '" + c.shown + "'"), std::string::npos)
         << c.value.dump() << ": " << e;
