@@ -88,9 +88,9 @@ WeaveShape weave_shape_of(const JobPart& all) {
     throw Error("", "extra.weave_repeat_m", "expected the repeat's two sizes");
   w.positions_u = static_cast<int>(p[0]), w.positions_v = static_cast<int>(p[1]);
   w.repeat_u_m =
-      extra.check_number(extra.at("weave_repeat_m")[0], "extra.weave_repeat_m[0]", 1e-9, 1.0);
+      extra.check_number(extra.at("weave_repeat_m")[0], "extra.weave_repeat_m[0]", 1e-9, 1e3);
   w.repeat_v_m =
-      extra.check_number(extra.at("weave_repeat_m")[1], "extra.weave_repeat_m[1]", 1e-9, 1.0);
+      extra.check_number(extra.at("weave_repeat_m")[1], "extra.weave_repeat_m[1]", 1e-9, 1e3);
   return w;
 }
 
