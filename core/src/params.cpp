@@ -211,6 +211,12 @@ std::string ParamReader::string(const std::string& key) {
   return s;
 }
 
+std::string ParamReader::string_or_empty(const std::string& key) {
+  const auto& v = at(key);
+  if (!v.is_string()) throw Error(file_, field(key), "must be a string");
+  return v.get<std::string>();
+}
+
 std::string ParamReader::string(const std::string& key, const std::string& fallback) {
   return has(key) ? string(key) : fallback;
 }

@@ -169,6 +169,11 @@ TEST(ParamReader, StringsChoicesBooleansAndVectors) {
   EXPECT_EQ(r.string("name"), "seat");
   EXPECT_EQ(r.string("none", "fallback"), "fallback");
   expect_error(error_of([&] { r.string("empty"); }), "materials.seat.empty", "must not be empty");
+  EXPECT_EQ(r.string_or_empty("empty"), "");
+  EXPECT_EQ(r.string_or_empty("name"), "seat");
+  expect_error(error_of([&] { r.string_or_empty("flag"); }), "materials.seat.flag",
+               "must be a string");
+  expect_error(error_of([&] { r.string_or_empty("none"); }), "materials.seat.none", "is required");
   const std::string msg = error_of([&] { r.choice("mode", "mis", {"mis", "lights_only"}); });
   expect_error(msg, "materials.seat.mode", "unknown value 'fast' (valid: mis, lights_only)");
   EXPECT_TRUE(r.boolean("on", false));

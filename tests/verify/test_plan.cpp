@@ -137,6 +137,34 @@ TEST(VerifyPlan, AJobsRequestPlansTheSameJob) {
   EXPECT_EQ(job_difference(job, verify_job(plan_verify(again), job.shard)), "");
 }
 
+// A part is a user's file: a merge that reads a verify job's options names the one of the wrong
+// type or missing, instead of the JSON library's message.
+TEST(VerifyPlan, AJobsRequestNamesABadOption) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.shard = "0/2";
+  const VerifyPlan p = plan_verify(r);
+  ASSERT_TRUE(p.shard);
+  const JobPart job = verify_job(p, *p.shard);
+  EXPECT_EQ(verify_job_request(job, "out").wif, "");  // an unset option is stored empty
+  for (const char* key :
+       {"fiber", "measured", "weave", "pattern", "wif", "quality", "colour_space"}) {
+    JobPart bad = job;
+    bad.job["options"][key] = 3;
+    EXPECT_NE(error_of([&] {
+                verify_job_request(bad, "out");
+              }).find(std::string("field 'job.options.") + key + "': must be a string"),
+              std::string::npos)
+        << key;
+  }
+  JobPart missing = job;
+  missing.job["options"].erase("quality");
+  EXPECT_NE(error_of([&] {
+              verify_job_request(missing, "out");
+            }).find("field 'job.options.quality': is required"),
+            std::string::npos);
+}
+
 TEST(VerifyPlan, EstimateGrowsWithTheFit) {
   VerifyRequest r;
   r.quality = "draft";

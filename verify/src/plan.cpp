@@ -247,17 +247,18 @@ JobPart verify_job(const VerifyPlan& p, Shard shard) {
 
 VerifyRequest verify_job_request(const JobPart& all, const std::string& output) {
   VerifyRequest o;
-  const auto& opt = all.job.at("options");
-  o.fiber = opt.at("fiber").get<std::string>();
-  o.measured = opt.at("measured").get<std::string>();
-  o.colour_space = opt.value("colour_space", "");
-  o.weave = opt.at("weave").get<std::string>();
-  o.pattern = opt.at("pattern").get<std::string>();
-  o.wif = opt.at("wif").get<std::string>();
-  o.quality = opt.at("quality").get<std::string>();
-  // Parts are a user's files: the numbers are checked before they are converted.
-  o.seed =
-      ParamReader(opt, "", "job.options").count("seed", 0, std::numeric_limits<uint64_t>::max());
+  // Parts are a user's files: every option is read through the reader, which names the field
+  // (job.options.fiber, ...) when it is missing or of the wrong type, and checks the numbers
+  // before they are converted.
+  ParamReader opt(all.job.at("options"), "", "job.options");
+  o.fiber = opt.string_or_empty("fiber");
+  o.measured = opt.string_or_empty("measured");
+  o.colour_space = opt.has("colour_space") ? opt.string_or_empty("colour_space") : "";
+  o.weave = opt.string_or_empty("weave");
+  o.pattern = opt.string_or_empty("pattern");
+  o.wif = opt.string_or_empty("wif");
+  o.quality = opt.string_or_empty("quality");
+  o.seed = opt.count("seed", 0, std::numeric_limits<uint64_t>::max());
   o.threads =
       static_cast<int>(ParamReader(all.extra, "", "extra").integer("threads", 0, 0, 1 << 16));
   o.output = output;

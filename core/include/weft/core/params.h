@@ -72,6 +72,8 @@ class ParamReader {
   // A non-empty string.
   std::string string(const std::string& key);
   std::string string(const std::string& key, const std::string& fallback);
+  // A string that may be empty (where the writer stores an unset option as ""); required.
+  std::string string_or_empty(const std::string& key);
   // One of 'valid'; the error lists them.
   std::string choice(const std::string& key, const std::string& fallback,
                      std::initializer_list<const char*> valid);
