@@ -163,6 +163,10 @@ TEST(VerifyPlan, AJobsRequestNamesABadOption) {
               verify_job_request(missing, "out");
             }).find("field 'job.options.quality': is required"),
             std::string::npos);
+  JobPart no_options = job;
+  no_options.job["options"] = "draft";
+  EXPECT_NE(error_of([&] { verify_job_request(no_options, "out"); }).find("field 'job.options'"),
+            std::string::npos);
 }
 
 TEST(VerifyPlan, EstimateGrowsWithTheFit) {

@@ -250,7 +250,7 @@ VerifyRequest verify_job_request(const JobPart& all, const std::string& output) 
   // Parts are a user's files: every option is read through the reader, which names the field
   // (job.options.fiber, ...) when it is missing or of the wrong type, and checks the numbers
   // before they are converted.
-  ParamReader opt(all.job.at("options"), "", "job.options");
+  ParamReader opt = ParamReader(all.job, "", "job").object("options");
   o.fiber = opt.string_or_empty("fiber");
   o.measured = opt.string_or_empty("measured");
   o.colour_space = opt.has("colour_space") ? opt.string_or_empty("colour_space") : "";
