@@ -204,9 +204,7 @@ bool ParamReader::boolean(const std::string& key, bool fallback) {
 }
 
 std::string ParamReader::string(const std::string& key) {
-  const auto& v = at(key);
-  if (!v.is_string()) throw Error(file_, field(key), "must be a string");
-  std::string s = v.get<std::string>();
+  std::string s = string_or_empty(key);
   if (s.empty()) throw Error(file_, field(key), "must not be empty");
   return s;
 }
