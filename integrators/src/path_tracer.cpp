@@ -1,11 +1,14 @@
 #include "weft/integrators/path_tracer.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
 #include <utility>
 
 #include "weft/core/error.h"
@@ -106,56 +109,109 @@ struct PathVertex {
   }
 };
 
-// One path from the camera: its radiance so far (L) and throughput (beta).
+// The camera ray's first hit when the caller has found it already.
+struct KnownFirstHit {
+  bool known = false;               // false: the path finds it
+  const SurfaceHit* hit = nullptr;  // null: the ray hits nothing
+};
+
+// A light sample's contribution to a path and what decides whether it arrives: a shadow ray, or
+// nothing (a sample that needs no ray, 'decided' 0 or 1 for unblocked or blocked).
+template <class Color>
+struct ShadowTest {
+  Color contribution = Color(0.0);
+  Ray ray;
+  int64_t ignore_fiber = kNoFiber;
+  int decided = -1;  // -1: trace 'ray'
+};
+
+// One path from the camera: its radiance so far (L) and throughput (beta). A vertex's light
+// samples are collected before their shadow rays are answered, so that a caller may answer the
+// first vertex's rays of several paths together (trace_camera_group); their light is added in
+// the lights' order either way, so the bits do not depend on it.
 template <class Shading>
 class PathTrace {
  public:
   using Color = typename Shading::Color;
+  // Light samples held at a vertex before their shadow rays are answered; a vertex with more
+  // answers the first ones itself, in order.
+  static constexpr int kHeldShadows = 4;
 
   PathTrace(const RenderScene& scene, const RenderSettings& settings, Rng& rng, RayCounts& rays,
             const RayObserver* on_ray)
       : scene_(scene), settings_(settings), rng_(rng), rays_(rays), on_ray_(on_ray) {}
 
   Rgb run(const Ray& camera_ray, int64_t* first_mesh) {
+    if (start(camera_ray, first_mesh, {})) {
+      answer_shadows(nullptr);
+      go_on();
+    }
+    return result();
+  }
+
+  // The first vertex, up to its light samples (held()); false: the path ended before them.
+  bool start(const Ray& camera_ray, int64_t* first_mesh, KnownFirstHit first) {
     ray_ = camera_ray;
     if (first_mesh) *first_mesh = -1;
-    // One record for every vertex: a hit overwrites all of it (RenderScene::intersect).
-    SurfaceHit hit;
-    for (int depth = 0;; ++depth) {
-      if (on_ray_) (*on_ray_)(ray_, false);
-      const bool found = scene_.intersect(ray_, &hit, ignore_fiber_);
-      if (!found) {
-        const LightHit escaped = LightHit::escaped_along(ray_.d);
-        for (const Light& light : scene_.lights()) add_found_light(light, escaped);
-        break;
-      }
-      if (depth == 0 && first_mesh) *first_mesh = hit.shape;
-      const Vec3 wo_world = -ray_.d;
-      if (const Light* light = scene_.surface_light(hit.shape))
-        add_found_light(*light, LightHit::on_surface(ray_.d, hit.shape, hit.prim, hit.ng, hit.t));
-      if (depth >= settings_.max_depth) break;
-
-      const PathVertex v{hit, scene_.bsdf_at(hit), hit.shading.to_local(wo_world),
-                         dot(wo_world, hit.ng)};
-      sample_lights(v);
-      if (!extend(v, depth)) break;
-    }
-    return Shading::to_rgb(L_);
+    return vertex(0, first, first_mesh);
   }
+  std::span<const ShadowTest<Color>> held() const { return {held_.test, size_t(n_held_)}; }
+  // The record the path's hits are written to: the caller's first hit may be found into it
+  // (start with KnownFirstHit{true, &record()}).
+  SurfaceHit& record() { return hit_; }
+  // Adds the held samples' light: blocked[i] (0 or 1) answers held()[i]'s ray; -1, or a null
+  // 'blocked', has it traced here.
+  void answer_shadows(const int8_t* blocked) {
+    for (int i = 0; i < n_held_; ++i) {
+      const ShadowTest<Color>& t = held_.test[i];
+      bool b;
+      if (t.decided >= 0)
+        b = t.decided != 0;
+      else if (blocked && blocked[i] >= 0)
+        b = blocked[i] != 0;
+      else
+        b = scene_.occluded(t.ray.o, t.ray.d, t.ray.tmax, t.ignore_fiber);
+      if (!b) L_ += t.contribution;
+    }
+    n_held_ = 0;
+  }
+  // After the held samples of the vertex at 'depth' are answered: the next vertex, its light
+  // samples held; false: the path ended.
+  bool advance(int depth) { return extend(*vertex_, depth) && vertex(depth + 1, {}, nullptr); }
+  // After start() and answer_shadows(): the rest of the path.
+  void go_on() {
+    for (int depth = 0; advance(depth); ++depth) answer_shadows(nullptr);
+  }
+  Rgb result() const { return Shading::to_rgb(L_); }
 
  private:
-  bool occluded(const Vec3& o, const Vec3& d, double tmax, int64_t ignore_fiber) {
-    ++rays_.shadow;
-    if (on_ray_) (*on_ray_)({o, d, tmax}, true);
-    return scene_.occluded(o, d, tmax, ignore_fiber);
+  // The vertex at 'depth' along ray_: the light its ray finds (a surface light, or the lights at
+  // infinity where it escapes) and its light samples, held. False: the path ends here.
+  bool vertex(int depth, KnownFirstHit first, int64_t* first_mesh) {
+    if (on_ray_) (*on_ray_)(ray_, false);
+    bool found;
+    if (first.known) {
+      found = first.hit != nullptr;
+      if (found && first.hit != &hit_) hit_ = *first.hit;
+    } else {
+      found = scene_.intersect(ray_, &hit_, ignore_fiber_);
+    }
+    if (!found) {
+      const LightHit escaped = LightHit::escaped_along(ray_.d);
+      for (const Light& light : scene_.lights()) add_found_light(light, escaped);
+      return false;
+    }
+    if (first_mesh) *first_mesh = hit_.shape;
+    const Vec3 wo_world = -ray_.d;
+    if (const Light* light = scene_.surface_light(hit_.shape))
+      add_found_light(*light, LightHit::on_surface(ray_.d, hit_.shape, hit_.prim, hit_.ng, hit_.t));
+    if (depth >= settings_.max_depth) return false;
+    vertex_.emplace(PathVertex{hit_, scene_.bsdf_at(hit_), hit_.shading.to_local(wo_world),
+                               dot(wo_world, hit_.ng)});
+    sample_lights(*vertex_);
+    return true;
   }
-  // Shadow ray from just off the surface (on the target's side) to just short of the target.
-  bool occluded_between(const SurfaceHit& h, const Vec3& target) {
-    const Vec3 o = h.spawn_origin(target - h.p);
-    const Vec3 to = target - o;
-    const double d = length(to);
-    return d > 0 && occluded(o, to / d, d * (1 - 1e-5), h.fiber);
-  }
+
   // Radiance from a light that the last BSDF sample found, weighted against next-event estimation
   // of the same light.
   void add_found_light(const Light& light, const LightHit& at) {
@@ -167,8 +223,8 @@ class PathTrace {
     L_ += beta_ * Shading::light(Le) * w;
   }
 
-  // Next-event estimation: one sample of every light; area lights and the environment weighted
-  // against BSDF sampling (lights.h states what a sample holds).
+  // Next-event estimation: one sample of every light, held with its shadow test; area lights and
+  // the environment weighted against BSDF sampling (lights.h states what a sample holds).
   void sample_lights(const PathVertex& v) {
     const SurfaceHit& hit = v.hit;
     for (const Light& light : scene_.lights()) {
@@ -193,26 +249,42 @@ class PathTrace {
       // strategy and takes the whole weight.
       const double w =
           delta || !use_mis_ || !agrees ? 1.0 : power_heuristic(ls->pdf, v.bsdf.pdf(v.wo, wi));
-      bool blocked;
-      if (lifted)
-        blocked = blocked_from_lift(v, lift, *ls);
-      else if (ls->at_infinity)
-        blocked = occluded(hit.spawn_origin(ls->wi), ls->wi, 1e300, hit.fiber);
-      else
-        blocked = occluded_between(hit, ls->p_light);
-      if (!blocked)
-        L_ += beta_ * f * Shading::light(ls->L) * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
+      ShadowTest<Color> t = shadow_test(v, lifted ? &lift : nullptr, *ls);
+      t.contribution =
+          beta_ * f * Shading::light(ls->L) * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
+      hold(std::move(t));
     }
   }
-  // Whether the light sample is hidden from the lifted point, off it on the viewer's side of the
-  // facet.
-  bool blocked_from_lift(const PathVertex& v, const Vec3& lift, const LightSample& ls) {
+  // The shadow test of light sample 'ls' at v: from just off the surface on the light's side, or
+  // from the lifted point off it on the viewer's side ('lift' non-null), to the light (at
+  // infinity, or just short of the sample's point).
+  ShadowTest<Color> shadow_test(const PathVertex& v, const Vec3* lift,
+                                const LightSample& ls) const {
     const SurfaceHit& hit = v.hit;
-    const Vec3 o = hit.p + lift + hit.ng * (v.wo_ng >= 0 ? hit.offset : -hit.offset);
-    if (ls.at_infinity) return occluded(o, ls.wi, 1e300, hit.fiber);
+    ShadowTest<Color> t;
+    t.ignore_fiber = hit.fiber;
+    const Vec3 o = lift ? hit.p + *lift + hit.ng * (v.wo_ng >= 0 ? hit.offset : -hit.offset)
+                        : hit.spawn_origin(ls.at_infinity ? ls.wi : ls.p_light - hit.p);
+    if (ls.at_infinity) {
+      t.ray = {o, ls.wi, 1e300};
+      return t;
+    }
     const Vec3 to = ls.p_light - o;
     const double d = length(to);
-    return !(d > 0) || occluded(o, to / d, d * (1 - 1e-5), hit.fiber);
+    if (!(d > 0)) {
+      t.decided = lift ? 1 : 0;  // a lifted point at the light counts as hidden
+      return t;
+    }
+    t.ray = {o, to / d, d * (1 - 1e-5)};
+    return t;
+  }
+  void hold(ShadowTest<Color>&& t) {
+    if (t.decided < 0) {
+      ++rays_.shadow;
+      if (on_ray_) (*on_ray_)(t.ray, true);
+    }
+    if (n_held_ == kHeldShadows) answer_shadows(nullptr);
+    std::construct_at(&held_.test[n_held_++], std::move(t));
   }
 
   // Continues the path by sampling the BSDF (and Russian roulette); false: the path ends.
@@ -252,7 +324,87 @@ class PathTrace {
   double prev_pdf_ = 0;
   // Rays that leave a fiber pass through it (its own fiber never occludes a point of it).
   int64_t ignore_fiber_ = kNoFiber;
+  // One record for every vertex: a hit overwrites all of it (RenderScene::intersect).
+  SurfaceHit hit_;
+  std::optional<PathVertex> vertex_;  // the last vertex, on hit_
+  // The first n_held_ are constructed (hold): a path starts without filling all four, whose
+  // stores showed in the render's profile.
+  union Held {
+    Held() {}
+    ShadowTest<Color> test[kHeldShadows];
+  } held_;
+  int n_held_ = 0;
 };
+
+// Answers the held shadow rays of the live paths of a group: those that ignore no fiber in
+// packets, the others one by one.
+template <class Trace>
+void answer_group_shadows(const RenderScene& scene, std::span<std::optional<Trace>> trace,
+                          const bool* alive) {
+  constexpr int kGroup = RenderScene::kPacketRays;
+  int8_t blocked[kGroup][Trace::kHeldShadows];
+  std::array<Ray, kGroup> packet;
+  std::array<int8_t*, kGroup> answer;
+  bool packet_blocked[kGroup];
+  int m = 0;
+  auto flush = [&] {
+    scene.occluded_coherent({packet.data(), size_t(m)}, packet_blocked);
+    for (int k = 0; k < m; ++k) *answer[k] = packet_blocked[k] ? 1 : 0;
+    m = 0;
+  };
+  for (size_t j = 0; j < trace.size(); ++j) {
+    if (!alive[j]) continue;
+    const auto held = trace[j]->held();
+    for (size_t i = 0; i < held.size(); ++i) {
+      blocked[j][i] = -1;
+      if (held[i].decided >= 0 || held[i].ignore_fiber != kNoFiber) continue;
+      packet[m] = held[i].ray;
+      answer[m++] = &blocked[j][i];
+      if (m == kGroup) flush();
+    }
+  }
+  if (m > 0) flush();
+  for (size_t j = 0; j < trace.size(); ++j)
+    if (alive[j]) trace[j]->answer_shadows(blocked[j]);
+}
+
+// The paths of up to RenderScene::kPacketRays camera rays of one pixel, each with its own stream
+// *rng[j]: their first hits found together, and those of their first vertices' shadow rays that
+// ignore no fiber answered together (RenderScene::intersect_coherent, occluded_coherent: the
+// rays start near each other, and a parallel or distant light's run nearly parallel); the rest
+// of each path as trace_path traces it. Each path does what trace_path does, in the same order,
+// so the bits are the same. out[j]: the path's colour; first_mesh[j] the shape its
+// camera ray meets (-1: none); when first_hits is not null, first_hits[j] is that hit, and
+// found[j] whether there is one.
+template <class Shading>
+void trace_camera_group(const RenderScene& scene, std::span<const Ray> rays, Rng* const* rng,
+                        const RenderSettings& s, RayCounts& counts, const RayObserver* on_ray,
+                        Rgb* out, int64_t* first_mesh, SurfaceHit* first_hits, bool* found) {
+  constexpr int kGroup = RenderScene::kPacketRays;
+  using Trace = PathTrace<Shading>;
+  const int n = static_cast<int>(rays.size());
+  std::array<std::optional<Trace>, kGroup> trace;
+  std::array<SurfaceHit*, kGroup> record;
+  for (int j = 0; j < n; ++j) {
+    trace[j].emplace(scene, s, *rng[j], counts, on_ray);
+    record[j] = &trace[j]->record();
+  }
+  scene.intersect_coherent(rays, record.data(), found);
+  bool alive[kGroup];
+  bool any = false;
+  for (int j = 0; j < n; ++j) {
+    if (first_hits && found[j]) first_hits[j] = *record[j];
+    alive[j] = trace[j]->start(rays[j], &first_mesh[j], {true, found[j] ? record[j] : nullptr});
+    any = any || alive[j];
+  }
+  // Deeper vertices are not taken in step: their rays are incoherent, and Embree's packets
+  // answered them no faster (docs/PERFORMANCE.md).
+  if (any) answer_group_shadows<Trace>(scene, {trace.data(), size_t(n)}, alive);
+  for (int j = 0; j < n; ++j) {
+    if (alive[j]) trace[j]->go_on();
+    out[j] = trace[j]->result();
+  }
+}
 
 }  // namespace
 
@@ -385,34 +537,58 @@ class WindowRender {
     if (!cancel_.load() && !progress_({"render", d, total_, "samples"})) cancel_.store(true);
   }
 
-  // Samples [k0, k1) of film pixel (x, y), added to 'acc'.
+  // Samples [k0, k1) of film pixel (x, y), added to 'acc', in groups whose camera rays and first
+  // shadow rays are traced together (trace_camera_group: the same bits as one by one).
   void sample_pixel(int x, int y, int k0, int k1, PixelSums& acc, RayCounts& rays,
                     uint64_t& nonfinite) const {
+    constexpr int kGroup = RenderScene::kPacketRays;
     const uint64_t pixel = uint64_t(y) * s_.width + x;
-    for (int k = k0; k < k1; ++k) {
-      Rng rng(s_.seed, pixel, uint64_t(k));
-      const double fx = (x + rng.uniform()) / s_.width, fy = (y + rng.uniform()) / s_.height;
-      const Ray ray = camera_.generate_ray(fx, fy, aspect_);
-      ++rays.camera;
-      int64_t first = -1;
-      Rgb L = trace_path(scene_, ray, s_, rng, rays, &first, on_ray_);
-      if (!finite(L)) {
-        ++nonfinite;
-        L = Rgb(0.0);
+    std::array<std::optional<Rng>, kGroup> rng;  // constructed per sample, not twice
+    std::array<Rng*, kGroup> streams;
+    std::array<Ray, kGroup> ray;
+    std::array<Rgb, kGroup> L;
+    std::array<int64_t, kGroup> first;
+    std::optional<std::array<SurfaceHit, kGroup>> hits;  // the camera rays' hits, for the AOVs
+    if (aov_) hits.emplace();
+    bool found[kGroup];
+    for (int g = k0; g < k1; g += kGroup) {
+      const int n = std::min(kGroup, k1 - g);
+      for (int j = 0; j < n; ++j) {
+        Rng& r = rng[j].emplace(s_.seed, pixel, uint64_t(g + j));
+        streams[j] = &r;
+        const double fx = (x + r.uniform()) / s_.width, fy = (y + r.uniform()) / s_.height;
+        ray[j] = camera_.generate_ray(fx, fy, aspect_);
+        ++rays.camera;
       }
-      acc.L[0] += L.r, acc.L[1] += L.g, acc.L[2] += L.b;
-      if (observers_.on_sample) observers_.on_sample(pixel, first, L);
-      if (aov_) add_aovs(ray, pixel, k, acc);
+      const std::span<const Ray> group(ray.data(), size_t(n));
+      SurfaceHit* first_hits = hits ? hits->data() : nullptr;
+      if (s_.spectral)
+        trace_camera_group<BandShading>(scene_, group, streams.data(), s_, rays, on_ray_, L.data(),
+                                        first.data(), first_hits, found);
+      else
+        trace_camera_group<RgbShading>(scene_, group, streams.data(), s_, rays, on_ray_, L.data(),
+                                       first.data(), first_hits, found);
+      for (int j = 0; j < n; ++j) {
+        if (!finite(L[j])) {
+          ++nonfinite;
+          L[j] = Rgb(0.0);
+        }
+        acc.L[0] += L[j].r, acc.L[1] += L[j].g, acc.L[2] += L[j].b;
+        if (observers_.on_sample) observers_.on_sample(pixel, first[j], L[j]);
+        if (aov_) add_aovs(ray[j], found[j] ? &(*hits)[j] : nullptr, pixel, g + j, acc);
+      }
     }
   }
 
-  // The albedo and normal passes of sample k of a pixel, whose camera ray is 'ray'.
-  void add_aovs(const Ray& ray, uint64_t pixel, int k, PixelSums& acc) const {
+  // The albedo and normal passes of sample k of a pixel, whose camera ray is 'ray' and meets
+  // 'first' (null: nothing).
+  void add_aovs(const Ray& ray, const SurfaceHit* first, uint64_t pixel, int k,
+                PixelSums& acc) const {
     // Its own stream (the sample index with the top bit set, never a render sample), so
     // asking for passes leaves the image's bits alone.
     Rng aov_rng(s_.seed, pixel, uint64_t(k) | (uint64_t(1) << 63));
-    SurfaceHit hit;
-    if (!scene_.intersect(ray, &hit, kNoFiber)) return;
+    if (!first) return;
+    const SurfaceHit& hit = *first;
     const Vec3 wo_world = -ray.d;
     if (s_.aov_normal) {
       const Vec3 n = dot(hit.shading.n, wo_world) < 0 ? -hit.shading.n : hit.shading.n;

@@ -70,6 +70,7 @@ struct RenderScene::Geometry {
   size_t triangles = 0, curve_segments = 0;
   int64_t fibers = 0;
   FiberGeometry fiber_geometry;
+  bool packets = false;  // the Embree library answers ray packets (rtcIntersect16)
 
   ~Geometry() {
     if (scene) rtcReleaseScene(scene);
@@ -114,6 +115,21 @@ RTCRayHit embree_ray(const Ray& ray) {
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
   return rh;
+}
+
+// The lanes of a packet query for 'rays', each as embree_ray sets it up; the lanes beyond them
+// repeat the first ray, switched off in 'valid'.
+static_assert(RenderScene::kPacketRays == 16, "packet queries are rtcIntersect16, rtcOccluded16");
+void packet_rays(std::span<const Ray> rays, RTCRay16& r, int* valid) {
+  for (int i = 0; i < RenderScene::kPacketRays; ++i) {
+    const bool used = size_t(i) < rays.size();
+    valid[i] = used ? -1 : 0;
+    const RTCRay one = embree_ray(used ? rays[i] : rays[0]).ray;
+    r.org_x[i] = one.org_x, r.org_y[i] = one.org_y, r.org_z[i] = one.org_z;
+    r.dir_x[i] = one.dir_x, r.dir_y[i] = one.dir_y, r.dir_z[i] = one.dir_z;
+    r.tnear[i] = one.tnear, r.tfar[i] = one.tfar;
+    r.mask[i] = one.mask, r.time[i] = one.time, r.flags[i] = one.flags;
+  }
 }
 
 FiberSegment segment_of(const CurveRecord& rec, uint32_t segment) {
@@ -334,6 +350,7 @@ RenderScene::Builder::Builder(const SceneDescription& desc, const RenderSceneOpt
   geo_->device = rtcNewDevice(nullptr);
   if (!geo_->device) throw Error(desc.source, "", "cannot create the Embree device");
   rtcSetDeviceErrorFunction(geo_->device, on_embree_error, &geo_->errors);
+  geo_->packets = rtcGetDeviceProperty(geo_->device, RTC_DEVICE_PROPERTY_RAY_STREAM_SUPPORTED) != 0;
   geo_->scene = rtcNewScene(geo_->device);
   rtcSetSceneFlags(geo_->scene, RTC_SCENE_FLAG_ROBUST);  // watertight: no leaks along shared edges
   rtcSetSceneBuildQuality(geo_->scene, RTC_BUILD_QUALITY_HIGH);
@@ -639,40 +656,73 @@ bool RenderScene::intersect(const Ray& ray, SurfaceHit* hit, int64_t ignore_fibe
   FiberQueryContext ctx(ignore_fiber, ends ? &*ends : nullptr);
   rtcIntersect1(geo_->scene, &ctx.embree, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
-  hit->t = rh.ray.tfar;
-  hit->shape = rh.hit.geomID;
-  if (rh.hit.instID[0] == RTC_INVALID_GEOMETRY_ID && rh.hit.geomID < geo_->meshes.size()) {
-    const Geometry::MeshRecord& m = geo_->meshes[rh.hit.geomID];
-    triangle_hit(*m.mesh, m.unit_normals, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit);
-    hit->fiber = kNoFiber;
-    hit->segment = 0;
-    return true;
+  record_hit(ray, {rh.hit.geomID, rh.hit.instID[0], rh.hit.primID, rh.hit.u, rh.hit.v, rh.ray.tfar},
+             hit);
+  return true;
+}
+
+void RenderScene::intersect_coherent(std::span<const Ray> rays, SurfaceHit* const* hits,
+                                     bool* found) const {
+  if (rays.size() > size_t(kPacketRays))
+    throw Error("", "intersect_coherent", "more rays than a packet holds");
+  // Embree built without packets answers rtcIntersect16 with an error and no hits.
+  if (rays.size() < 2 || !geo_->packets) {
+    for (size_t i = 0; i < rays.size(); ++i) found[i] = intersect(rays[i], hits[i]);
+    return;
   }
-  if (geo_->mesh_scene && rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID &&
-      rh.hit.instID[0] >= geo_->first_mesh_instance) {
-    const Vec3& shift = geo_->mesh_shifts[rh.hit.instID[0] - geo_->first_mesh_instance];
-    const Geometry::MeshRecord& m = geo_->meshes[rh.hit.geomID];
-    triangle_hit(*m.mesh, m.unit_normals, rh.hit.primID, rh.hit.u, rh.hit.v, ray, hit, &shift);
+  RTCRayHit16 rh;  // 64-byte aligned by its type, as rtcIntersect16 requires
+  alignas(64) int valid[kPacketRays];
+  packet_rays(rays, rh.ray, valid);
+  for (int i = 0; i < kPacketRays; ++i) {
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  FiberQueryContext ctx(kNoFiber, nullptr);
+  ctx.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcIntersect16(valid, geo_->scene, &ctx.embree, &rh);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    found[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    if (found[i])
+      record_hit(rays[i],
+                 {rh.hit.geomID[i], rh.hit.instID[0][i], rh.hit.primID[i], rh.hit.u[i], rh.hit.v[i],
+                  rh.ray.tfar[i]},
+                 hits[i]);
+  }
+}
+
+void RenderScene::record_hit(const Ray& ray, const EmbreeHit& h, SurfaceHit* hit) const {
+  hit->t = h.t;
+  hit->shape = h.geom;
+  if (h.inst == RTC_INVALID_GEOMETRY_ID && h.geom < geo_->meshes.size()) {
+    const Geometry::MeshRecord& m = geo_->meshes[h.geom];
+    triangle_hit(*m.mesh, m.unit_normals, h.prim, h.u, h.v, ray, hit);
     hit->fiber = kNoFiber;
     hit->segment = 0;
-    return true;
+    return;
+  }
+  if (geo_->mesh_scene && h.inst != RTC_INVALID_GEOMETRY_ID &&
+      h.inst >= geo_->first_mesh_instance) {
+    const Vec3& shift = geo_->mesh_shifts[h.inst - geo_->first_mesh_instance];
+    const Geometry::MeshRecord& m = geo_->meshes[h.geom];
+    triangle_hit(*m.mesh, m.unit_normals, h.prim, h.u, h.v, ray, hit, &shift);
+    hit->fiber = kNoFiber;
+    hit->segment = 0;
+    return;
   }
   // Round curves are hit inside the curve scene's instance, where geomID is the curve set.
-  const bool instanced = rh.hit.instID[0] != RTC_INVALID_GEOMETRY_ID;
-  const size_t set = instanced ? rh.hit.geomID : rh.hit.geomID - geo_->meshes.size();
+  const bool instanced = h.inst != RTC_INVALID_GEOMETRY_ID;
+  const size_t set = instanced ? h.geom : h.geom - geo_->meshes.size();
   hit->shape = static_cast<uint32_t>(geo_->meshes.size() + set);
   const CurveRecord& rec = geo_->curve_sets[set];
   if (rec.tubes) {
-    triangle_hit(rec.tubes->mesh, rec.tube_unit_normals, rh.hit.primID, rh.hit.u, rh.hit.v, ray,
-                 hit);
-    hit->segment = rec.tubes->triangle_segment[rh.hit.primID];
+    triangle_hit(rec.tubes->mesh, rec.tube_unit_normals, h.prim, h.u, h.v, ray, hit);
+    hit->segment = rec.tubes->triangle_segment[h.prim];
   } else {
-    hit->segment = rh.hit.primID;
+    hit->segment = h.prim;
     curve_hit(segment_of(rec, hit->segment), hit->t, ray, hit);
     hit->prim = hit->segment;
   }
   hit->fiber = rec.first_fiber + rec.segments.curve[hit->segment];
-  return true;
 }
 
 RTCSceneTy* RenderScene::embree_scene() const {
@@ -684,20 +734,26 @@ bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax,
   const std::optional<FiberEnds> ends =
       ignore_fiber == kNoFiber ? std::nullopt : fiber_ends(ignore_fiber);  // most queries: none
   FiberQueryContext ctx(ignore_fiber, ends ? &*ends : nullptr);
-  RTCRay r;
-  r.org_x = static_cast<float>(origin.x);
-  r.org_y = static_cast<float>(origin.y);
-  r.org_z = static_cast<float>(origin.z);
-  r.dir_x = static_cast<float>(dir.x);
-  r.dir_y = static_cast<float>(dir.y);
-  r.dir_z = static_cast<float>(dir.z);
-  r.tnear = 0.0f;
-  r.tfar = tmax > 3e38 ? INFINITY : static_cast<float>(tmax);
-  r.mask = 0xFFFFFFFFu;
-  r.time = 0.0f;
-  r.flags = 0;
+  RTCRay r = embree_ray({origin, dir, tmax}).ray;
   rtcOccluded1(geo_->scene, &ctx.embree, &r);
   return r.tfar < 0;  // Embree sets tfar to -inf on a hit
+}
+
+void RenderScene::occluded_coherent(std::span<const Ray> rays, bool* blocked) const {
+  if (rays.size() > size_t(kPacketRays))
+    throw Error("", "occluded_coherent", "more rays than a packet holds");
+  if (rays.size() < 2 || !geo_->packets) {
+    for (size_t i = 0; i < rays.size(); ++i)
+      blocked[i] = occluded(rays[i].o, rays[i].d, rays[i].tmax);
+    return;
+  }
+  RTCRay16 r;  // 64-byte aligned by its type, as rtcOccluded16 requires
+  alignas(64) int valid[kPacketRays];
+  packet_rays(rays, r, valid);
+  FiberQueryContext ctx(kNoFiber, nullptr);
+  ctx.embree.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+  rtcOccluded16(valid, geo_->scene, &ctx.embree, &r);
+  for (size_t i = 0; i < rays.size(); ++i) blocked[i] = r.tfar[i] < 0;
 }
 
 const Bsdf& RenderScene::bsdf(const SurfaceHit& hit) const {

@@ -8,6 +8,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/rng.h"
 #include "weft/integrators/image.h"
 #include "weft/integrators/masked_render.h"
 #include "weft/integrators/path_tracer.h"
@@ -60,6 +61,41 @@ TEST(Render, BitIdenticalAtAnyThreadCount) {
   const RenderResult c = render(scene, *d.camera, other);
   EXPECT_NE(0, std::memcmp(a.render.image.rgb.data(), c.image.rgb.data(),
                            a.render.image.rgb.size() * sizeof(float)));
+}
+
+// A render traces a pixel's camera rays, and their first shadow rays, together (packets of
+// RenderScene::kPacketRays); each pixel is still, bit for bit, the mean of its samples' paths
+// traced one by one (trace_path), each from its own stream. 19 samples: a full packet and a
+// part of one; five point lights besides the parallel light and the environment: more light
+// samples at a vertex than a path holds for a packet (PathTrace::kHeldShadows).
+TEST(Render, PixelsAreTheirPathsTracedOneByOne) {
+  SceneDescription d = woven();
+  for (int k = 0; k < 5; ++k)
+    d.lights.points.push_back({Vec3{0.004 * (k - 2), 0.01, 0.003 * (k % 2)}, Rgb(1e-5 * (k + 1))});
+  const RenderScene scene(d);
+  RenderSettings s = small(2);
+  s.width = 11, s.height = 9, s.spp = 19;
+  const RenderResult r = render(scene, *d.camera, s);
+  const double aspect = double(s.width) / s.height;
+  double total = 0;
+  for (int y = 0; y < s.height; ++y)
+    for (int x = 0; x < s.width; ++x) {
+      const uint64_t pixel = uint64_t(y) * s.width + x;
+      double sum[3] = {0, 0, 0};
+      for (int k = 0; k < s.spp; ++k) {
+        Rng rng(s.seed, pixel, uint64_t(k));
+        const double fx = (x + rng.uniform()) / s.width, fy = (y + rng.uniform()) / s.height;
+        RayCounts rays;
+        const Rgb L = trace_path(scene, d.camera->generate_ray(fx, fy, aspect), s, rng, rays);
+        sum[0] += L.r, sum[1] += L.g, sum[2] += L.b;
+      }
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_EQ(r.image.rgb[3 * pixel + c], static_cast<float>(sum[c] * (1.0 / s.spp)))
+            << "pixel " << x << ", " << y << " channel " << c;
+        total += sum[c];
+      }
+    }
+  EXPECT_GT(total, 0);
 }
 
 TEST(Render, ObserversSeeEverySampleAndRay) {
