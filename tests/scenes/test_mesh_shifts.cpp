@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "lambert_scene.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -20,14 +21,8 @@ using namespace weft;
 
 namespace {
 
-const std::filesystem::path kWif = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/data/wif";
-
-SceneDescription lambert(SceneDescription d) {
-  MaterialBinding any;
-  any.type = "lambert";
-  d.default_material = any;
-  return d;
-}
+using weft::testing::all_lambert;
+using weft::testing::kWifDir;
 
 TEST(MeshShifts, InstancedTilesHoldTheSampleOnceAtTheCopiesShifts) {
   const WovenSample y = make_woven_sample(red_cotton_weave_options());
@@ -61,10 +56,10 @@ TEST(MeshShifts, InstancedTilesHoldTheSampleOnceAtTheCopiesShifts) {
 // bits.
 TEST(MeshShifts, InstancedTilesTraceLikeStoredCopies) {
   WeaveOptions o;
-  o.wif = (kWif / "54235-plain.wif").string();
+  o.wif = (kWifDir / "54235-plain.wif").string();
   const WovenSample y = make_woven_sample(o);
-  const RenderScene copies(lambert(tiled_woven_description(y, 1, 1, "tiled")));
-  const RenderScene inst(lambert(tiled_woven_description(y, 1, 1, "tiled", true)));
+  const RenderScene copies(all_lambert(tiled_woven_description(y, 1, 1, "tiled")));
+  const RenderScene inst(all_lambert(tiled_woven_description(y, 1, 1, "tiled", true)));
   EXPECT_EQ(inst.triangle_count(), copies.triangle_count() / 9);
   const double px = y.summary.period_x_mm * 1e-3, pz = y.summary.period_z_mm * 1e-3;
   const double top = y.summary.y_max_mm * 1e-3 + 1e-4, bottom = y.summary.y_min_mm * 1e-3 - 1e-4;
@@ -119,7 +114,7 @@ TEST(MeshShifts, EmissiveMeshesAreNotShifted) {
 TEST(MeshShifts, SampleSizeCountsTheSampleBeforeBuildingIt) {
   for (const char* draft : {"54235-plain.wif", "8452.wif"}) {
     WeaveOptions o;
-    o.wif = (kWif / draft).string();
+    o.wif = (kWifDir / draft).string();
     const WovenSampleSize z = woven_sample_size(o);
     EXPECT_EQ(z.detail, "yarn");
     EXPECT_EQ(z.sides, 16);

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "lambert_scene.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
 #include "weft/scenes/description.h"
@@ -19,14 +20,8 @@ using namespace weft;
 
 namespace {
 
-const std::filesystem::path kWif = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/data/wif";
-
-SceneDescription lambert(SceneDescription d) {
-  MaterialBinding any;
-  any.type = "lambert";
-  d.default_material = any;
-  return d;
-}
+using weft::testing::all_lambert;
+using weft::testing::kWifDir;
 
 bool same_bits(double a, double b) {
   return std::memcmp(&a, &b, sizeof a) == 0;
@@ -112,7 +107,7 @@ TEST(PacketQueries, AMeshWithVertexNormalsAnswersAsOneByOne) {
   for (auto& m : make_weave(p))
     d.meshes.push_back(std::make_shared<const TriangleMesh>(std::move(m)));
   ASSERT_FALSE(d.meshes[0]->normals.empty());
-  const RenderScene scene(lambert(d));
+  const RenderScene scene(all_lambert(d));
   const Bounds3 b = scene.bounds();
   const Vec3 h = 0.5 * (b.hi - b.lo);  // the patch is centred on the origin, normal along y
   const Tally t = compare_packets(scene, 0.9 * h.x, 0.9 * h.z, b.hi.y + 0.1 * h.x, 1);
@@ -124,11 +119,11 @@ TEST(PacketQueries, AMeshWithVertexNormalsAnswersAsOneByOne) {
 
 TEST(PacketQueries, InstancedCopiesFibersAndTubesAnswerAsOneByOne) {
   WeaveOptions o;
-  o.wif = (kWif / "54235-plain.wif").string();
+  o.wif = (kWifDir / "54235-plain.wif").string();
   const WovenSample y = make_woven_sample(o);
   const double px = y.summary.period_x_mm * 1e-3, pz = y.summary.period_z_mm * 1e-3;
   const double top = y.summary.y_max_mm * 1e-3 + 1e-4;
-  const RenderScene inst(lambert(tiled_woven_description(y, 1, 1, "tiled", true)));
+  const RenderScene inst(all_lambert(tiled_woven_description(y, 1, 1, "tiled", true)));
   const Tally ti = compare_packets(inst, 0.8 * px, 0.8 * pz, top, 2);
   EXPECT_GT(ti.hits, 500);
   EXPECT_GT(ti.blocked, 20);
@@ -137,7 +132,7 @@ TEST(PacketQueries, InstancedCopiesFibersAndTubesAnswerAsOneByOne) {
   WeaveOptions f = o;
   f.detail = "fiber";
   const SceneDescription fibers =
-      lambert(tiled_woven_description(make_woven_sample(f), 0, 0, "tiled"));
+      all_lambert(tiled_woven_description(make_woven_sample(f), 0, 0, "tiled"));
   for (const auto type : {FiberGeometry::Type::curves, FiberGeometry::Type::tubes}) {
     RenderSceneOptions options;
     options.fiber_geometry = FiberGeometry{type};
