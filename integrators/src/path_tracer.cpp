@@ -109,10 +109,10 @@ struct PathVertex {
   }
 };
 
-// The camera ray's first hit when the caller has found it already.
+// Whether the caller has found the camera ray's first hit already, into PathTrace::record().
 struct KnownFirstHit {
-  bool known = false;               // false: the path finds it
-  const SurfaceHit* hit = nullptr;  // null: the ray hits nothing
+  bool known = false;  // false: the path traces the camera ray itself
+  bool found = false;  // whether the ray hits anything (record() holds the hit)
 };
 
 // A light sample's contribution to a path and what decides whether it arrives: a shadow ray, or
@@ -156,8 +156,8 @@ class PathTrace {
     return vertex(0, first, first_mesh);
   }
   std::span<const ShadowTest<Color>> held() const { return {held_.test, size_t(n_held_)}; }
-  // The record the path's hits are written to: the caller's first hit may be found into it
-  // (start with KnownFirstHit{true, &record()}).
+  // The record the path's hits are written to: the caller may find the first hit into it
+  // (then start with KnownFirstHit{true, found}).
   SurfaceHit& record() { return hit_; }
   // Adds the held samples' light: blocked[i] (0 or 1) answers held()[i]'s ray; -1, or a null
   // 'blocked', has it traced here.
@@ -190,12 +190,10 @@ class PathTrace {
   bool vertex(int depth, KnownFirstHit first, int64_t* first_mesh) {
     if (on_ray_) (*on_ray_)(ray_, false);
     bool found;
-    if (first.known) {
-      found = first.hit != nullptr;
-      if (found && first.hit != &hit_) hit_ = *first.hit;
-    } else {
+    if (first.known)
+      found = first.found;
+    else
       found = scene_.intersect(ray_, &hit_, ignore_fiber_);
-    }
     if (!found) {
       const LightHit escaped = LightHit::escaped_along(ray_.d);
       for (const Light& light : scene_.lights()) add_found_light(light, escaped);
@@ -394,7 +392,7 @@ void trace_camera_group(const RenderScene& scene, std::span<const Ray> rays, Rng
   bool any = false;
   for (int j = 0; j < n; ++j) {
     if (first_hits && found[j]) first_hits[j] = *record[j];
-    alive[j] = trace[j]->start(rays[j], &first_mesh[j], {true, found[j] ? record[j] : nullptr});
+    alive[j] = trace[j]->start(rays[j], &first_mesh[j], {true, found[j]});
     any = any || alive[j];
   }
   // Deeper vertices are not taken in step: their rays are incoherent, and Embree's packets
