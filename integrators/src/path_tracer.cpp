@@ -175,12 +175,10 @@ class PathTrace {
     }
     n_held_ = 0;
   }
-  // After the held samples of the vertex at 'depth' are answered: the next vertex, its light
-  // samples held; false: the path ended.
-  bool advance(int depth) { return extend(*vertex_, depth) && vertex(depth + 1, {}, nullptr); }
-  // After start() and answer_shadows(): the rest of the path.
+  // After start() and answer_shadows(): the rest of the path, a vertex at a time.
   void go_on() {
-    for (int depth = 0; advance(depth); ++depth) answer_shadows(nullptr);
+    for (int depth = 0; extend(*vertex_, depth) && vertex(depth + 1, {}, nullptr); ++depth)
+      answer_shadows(nullptr);
   }
   Rgb result() const { return Shading::to_rgb(L_); }
 
