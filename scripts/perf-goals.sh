@@ -10,7 +10,9 @@
 #             WEFT_BAKE_VARIANTS (default plain+mirror, mirror folding alone, and
 #             nee+mirror+s4+strat, the default bake: its fewest-photons options);
 #   render    the path tracer's rays per second over the same rays through bare Embree
-#             (`weft bench render`, ratio_replay), both bundled benchmark scenes;
+#             (`weft bench render`, ratio_replay), both bundled benchmark scenes, the median of
+#             WEFT_RENDER_RUNS (default 3) runs of each program in turns, with their range (the
+#             ratio of one run spreads by about 0.05 on a shared machine);
 #   backlit   the fiber-level render lit from behind and in front (scripts/fiber-render-noise.sh,
 #             16 spp, a spectral red-cotton table at R = 8, 200 000 photons, baked once by the
 #             baseline): pixel noise of two seeds and CPU seconds, so noise at equal time follows;
@@ -94,10 +96,14 @@ if [[ $goals == *,bake,* ]]; then
 fi
 
 if [[ $goals == *,render,* ]]; then
-  echo "== path tracer against bare Embree (bench render)"
-  for who in before after; do
-    bin=$old && [ $who = after ] && bin=$new
-    timed "render-$who" "$bin" bench render --threads "$threads" --json
+  runs=${WEFT_RENDER_RUNS:-3}
+  echo "== path tracer against bare Embree (bench render, $runs runs each in turns)"
+  rm -f "$out"/render-before-*.out "$out"/render-after-*.out
+  for run in $(seq 1 "$runs"); do
+    for who in before after; do
+      bin=$old && [ $who = after ] && bin=$new
+      timed "render-$who-$run" "$bin" bench render --threads "$threads" --json
+    done
   done
 fi
 

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """The table of scripts/perf-goals.sh: reads the programs' outputs in OUT and writes OUT/goals.md
 and OUT/goals.json. Usage: perf_goals_table.py OUT BASELINE_REVISION SEEDS"""
+import glob
 import json
 import os
+import statistics
 import sys
 
 TARGET = 0.01  # relative noise or error the goals are stated at
@@ -70,12 +72,21 @@ def bake(out):
 
 
 def render(out):
+    """The median over the runs of each program of its ratio_replay per scene, with the range."""
+    ratios = {}
+    for who in ("before", "after"):
+        runs = sorted(glob.glob(os.path.join(out, "render-%s-*.out" % who)))
+        for path in runs:
+            for s in read_json(path)["scenes"]:
+                ratios.setdefault((who, s["name"]), []).append(s["ratio_replay"])
     rows = []
-    before = read_json(os.path.join(out, "render-before.out"))["scenes"]
-    after = read_json(os.path.join(out, "render-after.out"))["scenes"]
-    for b, a in zip(before, after):
-        rows.append(("path tracer / bare Embree, %s" % a["name"], b["ratio_replay"], a["ratio_replay"],
-                     a["ratio_replay"] / b["ratio_replay"]))
+    names = [name for who, name in ratios if who == "after"]
+    for name in names:
+        b, a = ratios[("before", name)], ratios[("after", name)]
+        mb, ma = statistics.median(b), statistics.median(a)
+        rows.append(("path tracer / bare Embree, %s (median of %d runs in turns; before %.2f–%.2f, "
+                     "after %.2f–%.2f)" % (name, len(a), min(b), max(b), min(a), max(a)),
+                     mb, ma, ma / mb))
     return rows
 
 
@@ -128,7 +139,7 @@ def main():
         rows += raytrace(out, seeds)
     if have(out, "bake-after"):
         rows += bake(out)
-    if have(out, "render-after"):
+    if have(out, "render-after-1"):
         rows += render(out)
     if have_backlit(out):
         rows += backlit(out)

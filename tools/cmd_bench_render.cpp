@@ -31,6 +31,11 @@ void add_bench_render_command(CLI::App& bench, Commands& commands) {
   sub->add_option("--rays", o->bench.diffuse_rays, "diffuse rays for the Embree measurement")
       ->check(CLI::Range(1024, 1 << 26))
       ->capture_default_str();
+  sub->add_option("--repeats", o->bench.repeats,
+                  "times each measurement is made; figures are medians, the replay ratio with its "
+                  "range")
+      ->check(CLI::Range(1, kMaxBenchRepeats))
+      ->capture_default_str();
   sub->add_flag("--json", o->json, "JSON output");
   commands.push_back(
       {sub, [o] {
@@ -57,6 +62,9 @@ void add_bench_render_command(CLI::App& bench, Commands& commands) {
                                  {"ratio", r.ratio},
                                  {"embree_replay_rays_per_s", r.embree_replay_rays_per_s},
                                  {"ratio_replay", r.ratio_replay},
+                                 {"ratio_replay_min", r.ratio_replay_min},
+                                 {"ratio_replay_max", r.ratio_replay_max},
+                                 {"repeats", r.repeats},
                                  {"path_rays_per_s_1thread", r.path_rays_per_s_1thread},
                                  {"speedup", r.speedup},
                                  {"machine_speedup", r.machine_speedup}};
@@ -71,9 +79,11 @@ void add_bench_render_command(CLI::App& bench, Commands& commands) {
            for (const auto& r : results)
              std::printf(
                  "%-12s %9zu tris  embree %.3g rays/s  path %.3g rays/s  ratio %.2f  "
-                 "replay ratio %.2f  speed-up 1->%d threads %.2fx (machine %.2fx)\n",
+                 "replay ratio %.2f (%.2f-%.2f over %d)  speed-up 1->%d threads %.2fx (machine "
+                 "%.2fx)\n",
                  r.name.c_str(), r.triangles, r.embree_rays_per_s, r.path_rays_per_s, r.ratio,
-                 r.ratio_replay, opt.threads, r.speedup, r.machine_speedup);
+                 r.ratio_replay, r.ratio_replay_min, r.ratio_replay_max, r.repeats, opt.threads,
+                 r.speedup, r.machine_speedup);
          }
          return 0;
        }});

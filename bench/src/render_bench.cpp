@@ -5,8 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "weft/core/distribution.h"
+#include "weft/core/error.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
@@ -115,6 +118,13 @@ double arithmetic_seconds(int threads) {
   return sum > 0 ? s : 0;
 }
 
+// The median of a non-empty list (the mean of the middle two for an even count).
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 struct PathRate {
   double all = 0, intersect = 0;
 };
@@ -194,6 +204,10 @@ SceneDescription weave_bench_scene(const WeaveParams& params) {
 
 RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::string& name,
                                      const RenderBenchOptions& o) {
+  if (o.repeats < 1 || o.repeats > kMaxBenchRepeats)
+    throw Error(
+        "", "repeats",
+        "must be 1 to " + std::to_string(kMaxBenchRepeats) + ", not " + std::to_string(o.repeats));
   RenderBenchResult r;
   r.name = name;
   auto t0 = Clock::now();
@@ -213,23 +227,31 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
     observers.on_ray = [&](const Ray& ray, bool shadow) { log.push_back(to_embree(ray, shadow)); };
     render(scene, cam, s, no_progress(), observers);
   }
-  // Best of two runs each: the machines are shared, and the best run is the least disturbed one.
-  for (int rep = 0; rep < 2; ++rep) {
-    r.machine_speedup =
-        std::max(r.machine_speedup, arithmetic_seconds(1) / arithmetic_seconds(o.threads));
-    r.embree_replay_rays_per_s =
-        std::max(r.embree_replay_rays_per_s, replay_rate(scene, log, o.threads));
-    r.embree_rays_per_s = std::max(r.embree_rays_per_s, embree_rate(scene, rays, o.threads));
-    const PathRate one = path_rate(scene, cam, o, 1);
-    const PathRate many = path_rate(scene, cam, o, o.threads);
-    r.path_rays_per_s_1thread = std::max(r.path_rays_per_s_1thread, one.all);
-    if (many.all > r.path_rays_per_s) {
-      r.path_rays_per_s = many.all;
-      r.path_intersect_rays_per_s = many.intersect;
-    }
+  // Repeats of every measurement, the tracer's run right after its rays' replay so that both see
+  // the same machine: the ratio is taken within each repeat and the median and range reported, the
+  // rates as their medians (the machines are shared; a run's neighbour may slow either side).
+  std::vector<double> replay, embree, one, many, many_intersect, machine, ratio;
+  for (int rep = 0; rep < o.repeats; ++rep) {
+    machine.push_back(arithmetic_seconds(1) / arithmetic_seconds(o.threads));
+    embree.push_back(embree_rate(scene, rays, o.threads));
+    one.push_back(path_rate(scene, cam, o, 1).all);
+    replay.push_back(replay_rate(scene, log, o.threads));
+    const PathRate m = path_rate(scene, cam, o, o.threads);
+    many.push_back(m.all);
+    many_intersect.push_back(m.intersect);
+    ratio.push_back(m.all / replay.back());
   }
+  r.repeats = o.repeats;
+  r.machine_speedup = median(machine);
+  r.embree_rays_per_s = median(embree);
+  r.embree_replay_rays_per_s = median(replay);
+  r.path_rays_per_s_1thread = median(one);
+  r.path_rays_per_s = median(many);
+  r.path_intersect_rays_per_s = median(many_intersect);
   r.ratio = r.path_rays_per_s / r.embree_rays_per_s;
-  r.ratio_replay = r.path_rays_per_s / r.embree_replay_rays_per_s;
+  r.ratio_replay = median(ratio);
+  r.ratio_replay_min = *std::min_element(ratio.begin(), ratio.end());
+  r.ratio_replay_max = *std::max_element(ratio.begin(), ratio.end());
   r.speedup = r.path_rays_per_s / r.path_rays_per_s_1thread;
   return r;
 }

@@ -120,3 +120,27 @@ TEST(FiberBench, BothRepresentationsOfTheSameFibersAreMeasured) {
   EXPECT_LT(std::abs(rows[0].one_fiber_total_error), 4 * rows[0].one_fiber_noise);
   EXPECT_LT(rows[0].one_fiber_rms_error, 4 * rows[0].one_fiber_noise);
 }
+
+// The ratio to the replay is taken within each repeat: its median lies in its range, which is
+// reported, and a repeat count out of range is refused before any work.
+TEST(RenderBench, ReportsTheMedianRatioAndItsRangeOverTheRepeats) {
+  WeaveParams p;
+  p.yarns = 4, p.segments = 16, p.sides = 4;
+  const SceneDescription d = weave_bench_scene(p);
+  RenderBenchOptions o;
+  o.diffuse_rays = 4096;
+  o.render.width = o.render.height = 16;
+  o.render.spp = 2;
+  o.repeats = 3;
+  const RenderBenchResult r = bench_render_scene(d, "tiny", o);
+  EXPECT_EQ(r.repeats, 3);
+  EXPECT_GT(r.ratio_replay_min, 0);
+  EXPECT_LE(r.ratio_replay_min, r.ratio_replay);
+  EXPECT_LE(r.ratio_replay, r.ratio_replay_max);
+  EXPECT_GT(r.path_rays_per_s, 0);
+  EXPECT_GT(r.embree_replay_rays_per_s, 0);
+  for (const int bad : {0, -1, kMaxBenchRepeats + 1}) {
+    o.repeats = bad;
+    EXPECT_THROW(bench_render_scene(d, "tiny", o), Error) << bad;
+  }
+}

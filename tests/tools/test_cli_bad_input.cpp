@@ -404,6 +404,8 @@ TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
            {"bake fabric -R 2 --samples 4294967297 -o out.exr", "--samples"},
            {"bake fabric -R 2 --samples 0 -o out.exr", "--samples"},
            {"bench bake --target nan", "--target"},
+           {"bench render --repeats 0", "--repeats"},
+           {"bench render --repeats 1001", "--repeats"},
        }) {
     const CliRun r = run(c.args, dir);
     EXPECT_NE(r.exit_code, 0) << c.args;

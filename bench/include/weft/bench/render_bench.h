@@ -28,9 +28,14 @@ EmbreeRay to_embree(const Ray& ray, bool shadow);
 double embree_hit_distance(const RenderScene& scene, const EmbreeRay& ray);
 bool embree_occluded(const RenderScene& scene, const EmbreeRay& ray);
 
+inline constexpr int kMaxBenchRepeats = 1000;
+
 struct RenderBenchOptions {
   size_t diffuse_rays = 1 << 20;  // for the Embree baseline
   int threads = 2;  // the "many threads" side of the speed-up and of the throughput ratios
+  // Times every measurement is made (1 to kMaxBenchRepeats): the ratios are taken within each
+  // repeat, the figures reported as medians, the ratio to the replay with its range as well.
+  int repeats = 5;
   // The path-traced image (its own 'threads' is replaced: 1, then 'threads'); its seed also seeds
   // the diffuse rays.
   RenderSettings render;
@@ -48,7 +53,9 @@ struct RenderBenchResult {
   // 'threads' threads): the like-for-like baseline, so ratio_replay is the share of the path
   // tracer's time that Embree takes.
   double embree_replay_rays_per_s = 0;
-  double ratio_replay = 0;
+  double ratio_replay = 0;  // the median over the repeats of the ratio within each
+  double ratio_replay_min = 0, ratio_replay_max = 0;  // its range over the repeats
+  int repeats = 0;
   double path_rays_per_s_1thread = 0;
   double speedup = 0;  // path_rays_per_s / path_rays_per_s_1thread
   // The same 1 -> 'threads' speed-up for pure arithmetic tasks, measured in the same run: what the
