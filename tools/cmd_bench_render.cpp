@@ -65,6 +65,10 @@ void add_bench_render_command(CLI::App& bench, Commands& commands) {
                                  {"ratio_replay_min", r.ratio_replay_min},
                                  {"ratio_replay_max", r.ratio_replay_max},
                                  {"repeats", r.repeats},
+                                 {"ray_packets", r.ray_packets},
+                                 {"path_rays_per_s_one_by_one", r.path_rays_per_s_one_by_one},
+                                 {"ratio_replay_one_by_one", r.ratio_replay_one_by_one},
+                                 {"packet_gain", r.packet_gain},
                                  {"path_rays_per_s_1thread", r.path_rays_per_s_1thread},
                                  {"speedup", r.speedup},
                                  {"machine_speedup", r.machine_speedup}};
@@ -79,11 +83,12 @@ void add_bench_render_command(CLI::App& bench, Commands& commands) {
            for (const auto& r : results)
              std::printf(
                  "%-12s %9zu tris  embree %.3g rays/s  path %.3g rays/s  ratio %.2f  "
-                 "replay ratio %.2f (%.2f-%.2f over %d)  speed-up 1->%d threads %.2fx (machine "
-                 "%.2fx)\n",
+                 "replay ratio %.2f (%.2f-%.2f over %d; %.2f without packets, which buy "
+                 "%.2fx)  speed-up 1->%d threads %.2fx (machine %.2fx)\n",
                  r.name.c_str(), r.triangles, r.embree_rays_per_s, r.path_rays_per_s, r.ratio,
-                 r.ratio_replay, r.ratio_replay_min, r.ratio_replay_max, r.repeats, opt.threads,
-                 r.speedup, r.machine_speedup);
+                 r.ratio_replay, r.ratio_replay_min, r.ratio_replay_max, r.repeats,
+                 r.ratio_replay_one_by_one, r.packet_gain, opt.threads, r.speedup,
+                 r.machine_speedup);
          }
          return 0;
        }});

@@ -230,7 +230,10 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
   // Repeats of every measurement, the tracer's run right after its rays' replay so that both see
   // the same machine: the ratio is taken within each repeat and the median and range reported, the
   // rates as their medians (the machines are shared; a run's neighbour may slow either side).
+  // The same render with a pixel's coherent rays answered one by one: what packets buy here.
+  const RenderScene single = scene.with_ray_packets(false);
   std::vector<double> replay, embree, one, many, many_intersect, machine, ratio;
+  std::vector<double> single_rate, single_ratio, packet_gain;
   for (int rep = 0; rep < o.repeats; ++rep) {
     machine.push_back(arithmetic_seconds(1) / arithmetic_seconds(o.threads));
     embree.push_back(embree_rate(scene, rays, o.threads));
@@ -240,6 +243,9 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
     many.push_back(m.all);
     many_intersect.push_back(m.intersect);
     ratio.push_back(m.all / replay.back());
+    single_rate.push_back(path_rate(single, cam, o, o.threads).all);
+    single_ratio.push_back(single_rate.back() / replay.back());
+    packet_gain.push_back(m.all / single_rate.back());
   }
   r.repeats = o.repeats;
   r.machine_speedup = median(machine);
@@ -252,6 +258,10 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
   r.ratio_replay = median(ratio);
   r.ratio_replay_min = *std::min_element(ratio.begin(), ratio.end());
   r.ratio_replay_max = *std::max_element(ratio.begin(), ratio.end());
+  r.ray_packets = scene.ray_packets();
+  r.path_rays_per_s_one_by_one = median(single_rate);
+  r.ratio_replay_one_by_one = median(single_ratio);
+  r.packet_gain = median(packet_gain);
   r.speedup = r.path_rays_per_s / r.path_rays_per_s_1thread;
   return r;
 }

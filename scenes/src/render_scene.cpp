@@ -604,6 +604,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   b.add_curve_sets();
   b.instance_curve_scene();
   geo_ = b.finish();
+  packets_ = geo_->packets;
   set_lights(desc.lights);
   find_woven_meshes(desc);
 }
@@ -666,7 +667,7 @@ void RenderScene::intersect_coherent(std::span<const Ray> rays, SurfaceHit* cons
   if (rays.size() > size_t(kPacketRays))
     throw Error("", "intersect_coherent", "more rays than a packet holds");
   // Embree built without packets answers rtcIntersect16 with an error and no hits.
-  if (rays.size() < 2 || !geo_->packets) {
+  if (rays.size() < 2 || !packets_) {
     for (size_t i = 0; i < rays.size(); ++i) found[i] = intersect(rays[i], hits[i]);
     return;
   }
@@ -742,7 +743,7 @@ bool RenderScene::occluded(const Vec3& origin, const Vec3& dir, double tmax,
 void RenderScene::occluded_coherent(std::span<const Ray> rays, bool* blocked) const {
   if (rays.size() > size_t(kPacketRays))
     throw Error("", "occluded_coherent", "more rays than a packet holds");
-  if (rays.size() < 2 || !geo_->packets) {
+  if (rays.size() < 2 || !packets_) {
     for (size_t i = 0; i < rays.size(); ++i)
       blocked[i] = occluded(rays[i].o, rays[i].d, rays[i].tmax);
     return;
@@ -838,9 +839,16 @@ FiberGeometry RenderScene::fiber_geometry() const {
 RenderScene RenderScene::with_lights(const Lights& lights) const {
   RenderScene r;
   r.geo_ = geo_;
+  r.packets_ = packets_;
   r.woven_ = woven_;
   r.weave_on_ = weave_on_;
   r.set_lights(lights);
+  return r;
+}
+
+RenderScene RenderScene::with_ray_packets(bool on) const {
+  RenderScene r = *this;
+  r.packets_ = on && geo_->packets;
   return r;
 }
 

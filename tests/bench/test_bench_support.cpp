@@ -122,7 +122,8 @@ TEST(FiberBench, BothRepresentationsOfTheSameFibersAreMeasured) {
 }
 
 // The ratio to the replay is taken within each repeat: its median lies in its range, which is
-// reported, and a repeat count out of range is refused before any work.
+// reported, the render without packets is measured too, and a repeat count out of range is
+// refused before any work.
 TEST(RenderBench, ReportsTheMedianRatioAndItsRangeOverTheRepeats) {
   WeaveParams p;
   p.yarns = 4, p.segments = 16, p.sides = 4;
@@ -139,6 +140,10 @@ TEST(RenderBench, ReportsTheMedianRatioAndItsRangeOverTheRepeats) {
   EXPECT_LE(r.ratio_replay, r.ratio_replay_max);
   EXPECT_GT(r.path_rays_per_s, 0);
   EXPECT_GT(r.embree_replay_rays_per_s, 0);
+  // The same render with the packets off is measured beside it.
+  EXPECT_GT(r.path_rays_per_s_one_by_one, 0);
+  EXPECT_GT(r.ratio_replay_one_by_one, 0);
+  EXPECT_GT(r.packet_gain, 0);
   for (const int bad : {0, -1, kMaxBenchRepeats + 1}) {
     o.repeats = bad;
     EXPECT_THROW(bench_render_scene(d, "tiny", o), Error) << bad;

@@ -98,6 +98,26 @@ TEST(Render, PixelsAreTheirPathsTracedOneByOne) {
   EXPECT_GT(total, 0);
 }
 
+// With the packets off (RenderScene::with_ray_packets, the bench's comparison) every query goes
+// one by one and the image keeps its bits; the switch survives a change of lights.
+TEST(Render, RayPacketsOffGiveTheSameImage) {
+  const SceneDescription d = woven();
+  const RenderScene scene(d);
+  const RenderScene single = scene.with_ray_packets(false);
+  EXPECT_FALSE(single.ray_packets());
+  EXPECT_FALSE(single.with_lights(d.lights).ray_packets());
+  EXPECT_EQ(scene.with_ray_packets(true).ray_packets(), scene.ray_packets());
+  const RenderResult a = render(scene, *d.camera, small(2));
+  const RenderResult b = render(single, *d.camera, small(2));
+  double total = 0;
+  for (float v : a.image.rgb) total += v;
+  EXPECT_GT(total, 0);
+  ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
+  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(),
+                           a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(a.rays.total(), b.rays.total());
+}
+
 TEST(Render, ObserversSeeEverySampleAndRay) {
   const SceneDescription d = woven();
   const RenderScene scene(d);

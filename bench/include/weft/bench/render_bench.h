@@ -56,6 +56,12 @@ struct RenderBenchResult {
   double ratio_replay = 0;  // the median over the repeats of the ratio within each
   double ratio_replay_min = 0, ratio_replay_max = 0;  // its range over the repeats
   int repeats = 0;
+  // The same render with the packets off (RenderScene::with_ray_packets: the same image): its
+  // rays per second, its ratio to the replay and the ratio of the two renders' rates, medians
+  // over the repeats. ray_packets: whether this machine's Embree answers packets at all (when
+  // not, both renders go one by one and the gain is 1 within noise).
+  bool ray_packets = false;
+  double path_rays_per_s_one_by_one = 0, ratio_replay_one_by_one = 0, packet_gain = 0;
   double path_rays_per_s_1thread = 0;
   double speedup = 0;  // path_rays_per_s / path_rays_per_s_1thread
   // The same 1 -> 'threads' speed-up for pure arithmetic tasks, measured in the same run: what the

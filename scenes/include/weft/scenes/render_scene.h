@@ -161,6 +161,12 @@ class RenderScene {
   const Light* surface_light(uint32_t shape) const;
   // The same scene lit by 'lights' instead of the description's (emissive surfaces still emit).
   RenderScene with_lights(const Lights& lights) const;
+  // The same scene with intersect_coherent and occluded_coherent answering through Embree's
+  // packet queries (on: the default, where the Embree library has them) or one ray at a time
+  // (off). Every answer, and so every image, is the same bits either way; what packets buy
+  // depends on the machine (docs/PERFORMANCE.md), and `weft bench render` measures it.
+  RenderScene with_ray_packets(bool on) const;
+  bool ray_packets() const { return packets_; }
 
   size_t mesh_count() const;
   size_t shape_count() const;          // meshes, then curve sets (SurfaceHit::shape)
@@ -187,6 +193,7 @@ class RenderScene {
   // woven_ and the levels as built (render_scene_weave.cpp).
   void find_woven_meshes(const SceneDescription& desc);
   std::shared_ptr<const Geometry> geo_;
+  bool packets_ = false;  // coherent queries go to Embree as packets (with_ray_packets)
   std::vector<WovenMesh> woven_;
   // Per mesh: its weave when at the weave level, else null; empty when none is (the common case:
   // bsdf_at then tests one size).
