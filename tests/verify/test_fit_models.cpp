@@ -233,9 +233,33 @@ TEST(VerifyFit, RaytraceFitRecentresItsProposalAndConverges) {
   EXPECT_LT(r.objective, std::sqrt(ss / floor.size()));
   EXPECT_EQ(r.parameters[0].parameter.start, 1.0);  // the given start, not a restart's
   EXPECT_LE(r.evaluations, options.max_evaluations + 2);
-  // Two restarts or more: their spread is reported beside the Gauss-Newton sigma.
-  EXPECT_TRUE(std::isfinite(r.parameters[0].sigma_restarts));
-  EXPECT_GT(r.parameters[0].sigma_restarts, 0);
+  // With two restarts or more their spread is reported beside the Gauss-Newton sigma, with fewer
+  // none. How many a seed takes depends on the machine (its floating point and Embree's kernels
+  // change the trace's noise): seed 5 restarted twice on one 2-core machine and once on another.
+  // A noisier inner model (a third of the particles) moves its optimum more from one proposal
+  // to the next, so its searches restart more; its seeds are tried until one restarts twice.
+  auto spread_reported = [](const weft::FitResult& f) {
+    const double s = f.parameters[0].sigma_restarts;
+    if (f.restarts < 2) return std::isnan(s);
+    return std::isfinite(s) && s > 0;
+  };
+  EXPECT_TRUE(spread_reported(r)) << r.restarts << " restarts";
+  int most_restarts = r.restarts;
+  for (const uint64_t seed : {2, 4, 1, 3}) {
+    if (most_restarts >= 2) break;
+    weft::FitInnerSettings again = inner;
+    again.particles_per_bin = 100;
+    again.seed = seed;
+    const weft::FitResult f = weft::fit_inner_model(
+        "computed", weft::spec_fit_parameters(spec, names),
+        [&](const std::vector<double>& x) {
+          return weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), again);
+        },
+        sample, again, measured, options);
+    EXPECT_TRUE(spread_reported(f)) << "seed " << seed << ": " << f.restarts << " restarts";
+    most_restarts = std::max(most_restarts, f.restarts);
+  }
+  EXPECT_GE(most_restarts, 2);
 }
 
 // The classic model's four (diffuse colour per channel, roughness) from its own synthetic

@@ -373,6 +373,7 @@ FitResult fit_inner_model(
     for (size_t k = 0; k < parameters.size(); ++k) parameters[k].start = last.parameters[k].value;
   }
   set_restart_spread(last, given, restart_optima);
+  last.restarts = static_cast<int>(restart_optima.size());
   last.objective_start = first.objective_start;
   last.start_metrics = first.start_metrics;
   last.evaluations = evaluations;

@@ -97,7 +97,11 @@ struct FitResult {
   CurveMetrics start_metrics, fitted_metrics;  // the inner model's absolute metrics
   int evaluations = 0;
   bool converged = false;  // the tolerance was met before max_evaluations
-  std::string method;      // fit_method_name of the search
+  // The ray-trace inner model's searches after the first (fit_inner_model re-centres its proposal
+  // on the last optimum and searches again until the optimum settles); 0 for the other inner
+  // models. sigma_restarts needs two.
+  int restarts = 0;
+  std::string method;  // fit_method_name of the search
   double seconds = 0;
   // The fits at each inner seed (fit_over_seeds), the chosen one (this result's) first.
   std::vector<SeedFit> seed_fits;
