@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "flat_sheet.h"
 #include "raytrace_test_util.h"
@@ -89,21 +90,59 @@ TEST(FabricRaytrace, NextEventEstimateIsReciprocalAndItsNoiseHonest) {
 }
 
 TEST(FabricRaytrace, NextEventEstimateOfALosslessFabricConservesEnergy) {
-  // The white furnace: the lossless fiber of EnergyAtMostOnePerIncidentBin. Per incident bin
-  // the table's albedo is 1 at most within its noise and close to it (a bin's particles share
-  // 2002 / 13 directions, so a bin's albedo spreads more than the hero estimator's: 0.93 to 0.95
-  // at four bins of another count), 0.97 or more over all bins (FiberLevelSampleLeaksNoEnergy: the
-  // grazing lines absorb under 0.5 %); the particles' own exits (the books) are no longer what the
-  // table adds up, only its expectation: within 4 standard errors of it.
+  // The white furnace: the lossless fiber of EnergyAtMostOnePerIncidentBin, four seeds. Per
+  // incident bin the table's albedo is 1 at most within its noise and close to it (a bin's
+  // particles share 2002 / 13 directions, so a bin's albedo spreads more than the hero
+  // estimator's: 0.93 to 0.95 at four bins of another count), 0.97 or more over all bins
+  // (FiberLevelSampleLeaksNoEnergy: the grazing lines absorb under 0.5 %); the particles' own
+  // exits (the books) are no longer what the table adds up, only its expectation.
+  //
+  // The standard errors are the seeds' spread, not the cells': a scattering's next event books
+  // into many cells of its bin at once, so the cells' errors are correlated and their sum as
+  // independent (bin_energy's sigma) understates a bin's spread, by a factor of 1.7 to 2.1 over
+  // four sets of four seeds (2026-12-04; with one seed and that sum the worst of the 18 bins sat
+  // 3.4 to 5.7 of it from the books, seed by seed, and this test failed on one machine). Over all
+  // bins (independent: each has its own particles) the table's albedo is the books' within 4
+  // standard errors of the seeds' spread; per bin within 5 of the spread pooled over the bins in
+  // proportion to the cells' sum (the bins' own inflation differs around the pooled one: the z's
+  // rms over the bins was 1.5 in that run).
   const auto fiber = uniform_fiber(4, 0.5 * kInvPi);
-  const auto r = raytrace_fabric_table(default_sample("fiber"), fiber, nee_options(3, 2002));
-  double mean = 0;
-  for (int i = 0; i < r.table.bins(); ++i) {
-    const BinEnergy e = bin_energy(r, i);
-    EXPECT_LE(e.albedo, 1 + 4 * e.sigma) << "bin " << i;
-    EXPECT_GT(e.albedo, 0.9) << "bin " << i;
-    EXPECT_NEAR(e.albedo, e.exited, 4 * e.sigma + 0.01) << "bin " << i;
-    mean += e.albedo / r.table.bins();
+  constexpr int kSeeds = 4;
+  std::vector<std::vector<BinEnergy>> e(kSeeds);
+  for (int k = 0; k < kSeeds; ++k) {
+    FabricRaytraceOptions o = nee_options(3, 2002);
+    o.seed = uint64_t(k + 1);
+    const auto r = raytrace_fabric_table(default_sample("fiber"), fiber, o);
+    for (int i = 0; i < r.table.bins(); ++i) e[k].push_back(bin_energy(r, i));
+  }
+  const size_t bins = e[0].size();
+  std::vector<double> albedo(bins), diff(bins), diff_var(bins), stated2(bins);
+  for (size_t i = 0; i < bins; ++i) {
+    for (int k = 0; k < kSeeds; ++k) {
+      albedo[i] += e[k][i].albedo / kSeeds;
+      diff[i] += (e[k][i].albedo - e[k][i].exited) / kSeeds;
+      stated2[i] += e[k][i].sigma * e[k][i].sigma / kSeeds;
+    }
+    for (int k = 0; k < kSeeds; ++k)
+      diff_var[i] += std::pow(e[k][i].albedo - e[k][i].exited - diff[i], 2) / (kSeeds - 1);
+  }
+  double all_diff = 0, all_var = 0, ratio2 = 0, mean = 0;
+  for (size_t i = 0; i < bins; ++i) {
+    all_diff += diff[i] / double(bins);
+    all_var += diff_var[i] / kSeeds / double(bins * bins);
+    ratio2 += diff_var[i] / stated2[i] / double(bins);
+    mean += albedo[i] / double(bins);
+  }
+  EXPECT_NEAR(all_diff, 0.0, 4 * std::sqrt(all_var));
+  // The cells' sum understates, and not by an order of magnitude.
+  const double factor = std::sqrt(ratio2);
+  EXPECT_GT(factor, 0.8);
+  EXPECT_LT(factor, 3.0);
+  for (size_t i = 0; i < bins; ++i) {
+    const double se = factor * std::sqrt(stated2[i] / kSeeds);  // of the seeds' mean
+    EXPECT_LE(albedo[i], 1 + 4 * se) << "bin " << i;
+    EXPECT_GT(albedo[i], 0.9) << "bin " << i;
+    EXPECT_NEAR(diff[i], 0.0, 5 * se) << "bin " << i;
   }
   EXPECT_GT(mean, 0.97);
   EXPECT_LE(mean, 1.01);
