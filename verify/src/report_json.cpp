@@ -198,6 +198,7 @@ nlohmann::json fit_json(const FitResult& f, const std::vector<ModelCurves>& mode
                       {"inner_start", metrics_json(f.start_metrics)},
                       {"inner_fitted", metrics_json(f.fitted_metrics)},
                       {"evaluations", f.evaluations},
+                      {"restarts", f.restarts},
                       {"converged", f.converged},
                       {"seeds", seed_fits_json(f)},
                       {"seconds", f.seconds}};
