@@ -230,7 +230,8 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
   // Repeats of every measurement, the tracer's run right after its rays' replay so that both see
   // the same machine: the ratio is taken within each repeat and the median and range reported, the
   // rates as their medians (the machines are shared; a run's neighbour may slow either side).
-  // The same render with a pixel's coherent rays answered one by one: what packets buy here.
+  // Each repeat also renders with a pixel's coherent rays answered one by one ('single'): what
+  // the packets buy on this machine.
   const RenderScene single = scene.with_ray_packets(false);
   std::vector<double> replay, embree, one, many, many_intersect, machine, ratio;
   std::vector<double> single_rate, single_ratio, packet_gain;

@@ -212,12 +212,15 @@ TEST(VerifyFit, RaytraceFitRecentresItsProposalAndConverges) {
   const weft::MeasuredInplane measured = synthetic(weft::computed_inner_curves(
       weft::apply_spec_fit(spec, names, {1.8}), sample, inner, geometry));
   const weft::FitOptions options;  // the defaults, as weft verify --fit uses them
-  const weft::FitResult r = weft::fit_inner_model(
-      "computed", weft::spec_fit_parameters(spec, names),
-      [&](const std::vector<double>& x) {
-        return weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), inner);
-      },
-      sample, inner, measured, options);
+  auto fit = [&](const weft::FitInnerSettings& settings) {
+    return weft::fit_inner_model(
+        "computed", weft::spec_fit_parameters(spec, names),
+        [&](const std::vector<double>& x) {
+          return weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), settings);
+        },
+        sample, settings, measured, options);
+  };
+  const weft::FitResult r = fit(inner);
   ASSERT_EQ(r.parameters.size(), 1u);
   EXPECT_TRUE(r.converged);
   EXPECT_GT(r.objective_start, 0.2);  // the first search's start, far from the truth
@@ -250,12 +253,7 @@ TEST(VerifyFit, RaytraceFitRecentresItsProposalAndConverges) {
     weft::FitInnerSettings again = inner;
     again.particles_per_bin = 100;
     again.seed = seed;
-    const weft::FitResult f = weft::fit_inner_model(
-        "computed", weft::spec_fit_parameters(spec, names),
-        [&](const std::vector<double>& x) {
-          return weft::computed_inner_fiber_table(weft::apply_spec_fit(spec, names, x), again);
-        },
-        sample, again, measured, options);
+    const weft::FitResult f = fit(again);
     EXPECT_TRUE(spread_reported(f)) << "seed " << seed << ": " << f.restarts << " restarts";
     most_restarts = std::max(most_restarts, f.restarts);
   }
