@@ -1,5 +1,6 @@
 #pragma once
-// Helpers every test executable may use: a fresh folder per test, the message of a weft::Error,
+// Helpers every test executable may use: the bundled example scenes, a file written and read whole,
+// a fresh folder per test, the message of a weft::Error, a relative difference,
 // and the mean of repeated samples with its standard error.
 #include <gtest/gtest.h>
 
@@ -15,12 +16,26 @@
 
 namespace weft::testing {
 
+// The bundled example scenes.
+inline const std::filesystem::path kExamples =
+    std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/examples";
+
 // An empty folder for the running test, under the build folder: <build>/test_tmp/<suite>.<test>.
 // One per test, because ctest runs the tests of one executable as parallel processes.
 // The whole of a file, as bytes.
+// |a - b| relative to the reference b.
+inline double relative_difference(double a, double b) {
+  return std::abs(a - b) / std::abs(b);
+}
+
 inline std::string slurp(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// 'text' written to 'p', replacing it.
+inline void write_file(const std::filesystem::path& p, const std::string& text) {
+  std::ofstream(p) << text;
 }
 
 inline std::filesystem::path fresh_test_dir() {

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/job_part.h"
 #include "weft/core/params.h"
@@ -321,8 +322,7 @@ void add_bake_command(CLI::App& app, Commands& commands) {
              return 130;
            }
          }
-         const double seconds =
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+         const double seconds = seconds_since(start);
          if (!shard.whole()) {
            if (traced.cancelled) {
              std::fprintf(stderr, "\nweft: interrupted; no part written%s\n",

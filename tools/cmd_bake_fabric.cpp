@@ -13,6 +13,7 @@
 
 #include "bake_fabric_fibers.h"
 #include "commands.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 #include "weft/fabric/fabric_parts.h"
@@ -381,8 +382,7 @@ int run(const BakeFabricOptions& o) {
     }
     table = sum_fabric_table(fiber, s, progress);
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = seconds_since(t0);
   table.metadata["sample"] = sample.summary.source + " (" + sample.summary.detail + ")";
   table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
   if (!note.empty()) table.metadata["note"] = note;

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/fiber/fiber_layer.h"
 #include "weft/fiber/transport_batch.h"
@@ -56,8 +57,7 @@ nlohmann::json run_aspect(const FlattenOptions& o, const FiberSpec& spec, const 
       photons += band.photons;
     }
   }
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double seconds = seconds_since(t0);
   const size_t n = runs.size();
   const int rings = o.layer.rings, k45 = std::min(rings - 1, rings / 2);
   nlohmann::json ratio, reflected, transmitted;

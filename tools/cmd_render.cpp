@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "commands.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/progress.h"
 #include "weft/fiber/bake_cache.h"
@@ -175,8 +176,7 @@ void add_render_command(CLI::App& app, Commands& commands) {
          const auto t0 = std::chrono::steady_clock::now();
          const RenderJobResult r =
              render_to_files(desc, job, progress_bar(o->quiet), checked_fiber_table_resolver());
-         const double sec =
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+         const double sec = seconds_since(t0);
          if (const int code = report_render_outcome(r, "render")) return code;
          const double rays_per_s = sec > 0 ? r.rays.total() / sec : 0;
          if (!o->quiet) {

@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "plot_util.h"
 #include "weft/core/atomic_file.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/verify/plan.h"
 #include "weft/verify/report.h"
@@ -30,10 +31,6 @@ struct VerifyCliOptions {
   // Options given that a suite's fabrics set themselves.
   std::vector<std::string> per_fabric_given;
 };
-
-double since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 // The time it will take, before it starts; above an hour (at the fastest rates) needs --yes-long.
 void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
@@ -172,7 +169,7 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
   } else if (o.json) {
     std::cout << verify_metrics_json(out.report);
   } else {
-    print_summary(p, out.report, since(t_all));
+    print_summary(p, out.report, seconds_since(t_all));
   }
   return 0;
 }
@@ -244,7 +241,7 @@ int run_suite(const VerifyCliOptions& o) {
     std::cout << verify_suite_json(suite, rows);
   else
     std::printf("%s: %zu fabrics, quality %s, %.1f s\n%s", base.output.c_str(), rows.size(),
-                base.quality.c_str(), since(t_all), verify_suite_text(rows).c_str());
+                base.quality.c_str(), seconds_since(t_all), verify_suite_text(rows).c_str());
   return failed ? 1 : 0;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <ctime>
 
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 
 namespace weft {
@@ -74,9 +75,7 @@ BakeBenchResult bench_bake(const FiberSpec& spec, const BakeBenchOptions& option
     }
     BakeBenchRun run;
     run.photons_per_band = count;
-    run.seconds_per_bake =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() /
-        options.seeds;
+    run.seconds_per_bake = seconds_since(start) / options.seeds;
     run.cpu_seconds_per_bake =
         static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC / options.seeds;
     run.relative_rms_error = moments.relative_rms_error();

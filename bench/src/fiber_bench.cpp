@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "weft/bench/render_bench.h"
+#include "weft/core/clock.h"
 #include "weft/core/distribution.h"
 #include "weft/core/frame.h"
 #include "weft/core/math.h"
@@ -18,10 +19,7 @@
 namespace weft {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using Clock = SteadyClock;
 
 struct FiberRay {
   Ray ray;

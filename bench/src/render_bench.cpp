@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/clock.h"
 #include "weft/core/distribution.h"
 #include "weft/core/error.h"
 #include "weft/core/frame.h"
@@ -22,10 +23,7 @@
 namespace weft {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
+using Clock = SteadyClock;
 
 // Diffuse rays as a path tracer's bounces from opaque surfaces see them: from area-uniform surface
 // points, cosine distributed about the geometric normal on the side the vertex normals face (a

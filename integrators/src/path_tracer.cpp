@@ -11,6 +11,7 @@
 #include <span>
 #include <utility>
 
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/parallel.h"
@@ -469,8 +470,7 @@ class WindowRender {
       pass(n, n + 1, &sums);
       if (cancel_.load()) break;
       ++n;
-      const double elapsed =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      const double elapsed = seconds_since(start);
       if (elapsed >= s_.time_limit_s) break;
     }
     out_.spp_done = n;

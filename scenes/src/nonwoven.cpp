@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "weave_internal.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/params.h"
@@ -333,7 +334,7 @@ WovenSample make_nonwoven_sample(const WeaveOptions& options) {
   WovenSample s;
   s.fibers = cut_into_tile(m, fibers);
   summarise(m, attempts, s);
-  s.summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.summary.seconds = seconds_since(t0);
   return s;
 }
 

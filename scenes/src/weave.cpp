@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "weave_internal.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/params.h"
@@ -707,7 +708,7 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
   }
   s.y_min_mm = ylo / kMetresPerMm;
   s.y_max_mm = yhi / kMetresPerMm;
-  s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  s.seconds = seconds_since(t0);
   return out;
 }
 

@@ -9,6 +9,7 @@
 
 #include "mutate.h"
 #include "test_util.h"
+#include "weft/core/clock.h"
 #include "weft/core/job_part.h"
 
 namespace fs = std::filesystem;
@@ -45,7 +46,7 @@ fs::path crafted_part(const fs::path& dir, const std::string& name, uint64_t uni
 double seconds_of(const std::function<void()>& f) {
   const auto t0 = std::chrono::steady_clock::now();
   f();
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return seconds_since(t0);
 }
 
 // units_total 2^40 and 4e9 shards: the merge looped over every shard (and listed the missing ones

@@ -44,9 +44,9 @@ inline TabulatedBsdfTable uniform_fiber(int resolution, double f) {
   return fiber_table(resolution, [f](const Vec3& wo, const Vec3&) { return wo.z > 0 ? f : 0.0; });
 }
 
-// The bundled red-cotton sample at yarn or fiber detail.
-inline WovenSample default_sample(const char* detail = "yarn") {
-  WeaveOptions o;
+// The bundled red-cotton sample at yarn or fiber detail, with 'extra' options over it.
+inline WovenSample default_sample(const char* detail = "yarn", const WeaveOptions& extra = {}) {
+  WeaveOptions o = extra;
   o.detail = detail;
   return make_woven_sample(overlay(red_cotton_weave_options(), o));
 }

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "raytrace_test_util.h"
 #include "test_util.h"
 #include "weft/core/math.h"
 #include "weft/fabric/fabric_summation.h"
@@ -29,15 +30,8 @@ TabulatedBsdfTable lambert_fiber(int resolution, double rho) {
 // fiber receives uniformly into its outer hemisphere, f = 1 / (2 pi) for any light and views above
 // the point. Lossless: per unit length the fiber intercepts 2 R |w_i,perp| of the beam, and its
 // points return int_B |cos theta_i(B)| d phi R * int f cos_o d w_o = 4 R |w_i,perp| * 1/2.
-TabulatedBsdfTable uniform_fiber(int resolution) {
-  auto t = TabulatedBsdfTable::from_function(
-      resolution, 3,
-      [&](const Vec3& wo, const Vec3&, std::span<double> v) {
-        v[0] = v[1] = v[2] = wo.z > 0 ? 0.5 * kInvPi : 0.0;
-      },
-      2, 1);
-  t.kind = "fiber";
-  return t;
+TabulatedBsdfTable lossless_uniform_fiber(int resolution) {
+  return weft::testing::uniform_fiber(resolution, 0.5 * kInvPi);
 }
 
 // The visible-layer method at a table resolution, samples per cell and points per circumference.
@@ -53,8 +47,8 @@ FabricSummationOptions visible(int resolution, int samples_per_cell, int circumf
 }  // namespace
 
 TEST(FabricSummation, PaperSumTransmitsLightFromBelowOnlyAndTheViewReadingShowsIt) {
-  // uniform_fiber sends 1/2 of the light from either side of a point out through it. On top of
-  // the cloth, the paper's sum then passes light from below to views above (f = 1 / (2 pi),
+  // lossless_uniform_fiber sends 1/2 of the light from either side of a point out through it. On
+  // top of the cloth, the paper's sum then passes light from below to views above (f = 1 / (2 pi),
   // transmittance 1/2 seen from above), and nothing below the cloth (light from above is never
   // transmitted, the underside is black): not reciprocal. directional_albedo reads light from a
   // direction, directional_albedo_seen_from what a view gathers; `weft bake fabric` reported the
@@ -62,7 +56,7 @@ TEST(FabricSummation, PaperSumTransmitsLightFromBelowOnlyAndTheViewReadingShowsI
   FabricSummationOptions o;
   o.resolution = 4;
   o.samples_per_cell = 2;
-  const auto t = sum_fabric_table(uniform_fiber(4), o);
+  const auto t = sum_fabric_table(lossless_uniform_fiber(4), o);
   const DirectionGrid g = t.grid();
   for (int k = 0; k < g.bins(); ++k) {
     const auto from = t.directional_albedo(k), seen = t.directional_albedo_seen_from(k);
@@ -112,7 +106,7 @@ TEST(FabricSummation, VisibleLayerConservesEnergyAndTransmitsThroughTheUnderside
   // only removes light): directional albedo <= 1 for light from above; and the uniform fiber sends
   // light out of the layer's underside, which the paper's sum cannot.
   FabricSummationOptions o = visible(4, 2, 32);
-  const auto fab = sum_fabric_table(uniform_fiber(8), o);
+  const auto fab = sum_fabric_table(lossless_uniform_fiber(8), o);
   const DirectionGrid g = fab.grid();
   for (int i = 0; i < g.bins(); ++i) {
     const auto a = fab.directional_albedo(i);
@@ -121,7 +115,7 @@ TEST(FabricSummation, VisibleLayerConservesEnergyAndTransmitsThroughTheUnderside
   EXPECT_GT(fab.directional_albedo(g.bin_of({0, 0, 1})).transmittance[0], 0.05);
   FabricSummationOptions paper = o;
   paper.method = FabricSummation::kPaper;
-  EXPECT_EQ(sum_fabric_table(uniform_fiber(8), paper)
+  EXPECT_EQ(sum_fabric_table(lossless_uniform_fiber(8), paper)
                 .directional_albedo(g.bin_of({0, 0, 1}))
                 .transmittance[0],
             0.0);
@@ -136,7 +130,7 @@ TEST(FabricSummation, TurningTheFibersTurnsTheTable) {
   ox.top = ox.bottom = {{{1, 0, 0}, 1}};
   FabricSummationOptions oy = ox;
   oy.top = oy.bottom = {{{0, 1, 0}, 1}};
-  const auto fiber = uniform_fiber(8);
+  const auto fiber = lossless_uniform_fiber(8);
   auto turn = [](const Vec3& w) { return Vec3{w.y, -w.x, w.z}; };  // y -> x
   std::vector<double> a(3), b(3);
   for (const auto& [wo, wi] :
@@ -156,24 +150,26 @@ TEST(FabricSummation, TurningTheFibersTurnsTheTable) {
 TEST(FabricSummation, BitIdenticalAtOneAndTwoThreads) {
   FabricSummationOptions o = visible(3, 2, 16);
   o.threads = 1;
-  const auto a = sum_fabric_table(uniform_fiber(4), o);
+  const auto a = sum_fabric_table(lossless_uniform_fiber(4), o);
   o.threads = 2;
-  const auto b = sum_fabric_table(uniform_fiber(4), o);
+  const auto b = sum_fabric_table(lossless_uniform_fiber(4), o);
   EXPECT_EQ(a.values, b.values);
 }
 
 TEST(FabricSummation, RejectsBadOptionsAndTables) {
   FabricSummationOptions o;
   o.resolution = 0;
-  EXPECT_NE(
-      weft::testing::error_of([&] { sum_fabric_table(uniform_fiber(2), o); }).find("resolution"),
-      std::string::npos);
+  EXPECT_NE(weft::testing::error_of([&] {
+              sum_fabric_table(lossless_uniform_fiber(2), o);
+            }).find("resolution"),
+            std::string::npos);
   o = {};
   o.top = {{{0, 0, 0}, 1}};
-  EXPECT_NE(
-      weft::testing::error_of([&] { sum_fabric_table(uniform_fiber(2), o); }).find("orientations"),
-      std::string::npos);
-  auto fabric = uniform_fiber(2);
+  EXPECT_NE(weft::testing::error_of([&] {
+              sum_fabric_table(lossless_uniform_fiber(2), o);
+            }).find("orientations"),
+            std::string::npos);
+  auto fabric = lossless_uniform_fiber(2);
   fabric.kind = "fabric";
   EXPECT_NE(weft::testing::error_of([&] { sum_fabric_table(fabric, FabricSummationOptions{}); }),
             "");

@@ -6,6 +6,7 @@
 #include <array>
 #include <string>
 
+#include "raytrace_test_util.h"
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -33,11 +34,7 @@ TabulatedBsdfTable coloured_fiber(int resolution, std::array<double, 3> albedo) 
 }
 
 // The bundled red-cotton sample (a plain weave) at yarn or fiber detail.
-WovenSample sample_at(const char* detail) {
-  WeaveOptions o;
-  o.detail = detail;
-  return make_woven_sample(overlay(red_cotton_weave_options(), o));
-}
+using weft::testing::default_sample;
 
 FabricRaytraceOptions options(uint64_t particles_per_bin) {
   FabricRaytraceOptions o;
@@ -50,7 +47,7 @@ FabricRaytraceOptions options(uint64_t particles_per_bin) {
 // Red warp, grey weft: the cloth's albedo in every channel lies strictly between the all-red and
 // the all-grey cloth's, well inside (each direction shows about half of the cloth).
 void expect_two_colour_cloth_between(const char* detail, uint64_t particles) {
-  const WovenSample sample = sample_at(detail);
+  const WovenSample sample = default_sample(detail);
   const auto red = coloured_fiber(4, {0.9, 0.2, 0.2}), grey = coloured_fiber(4, {0.6, 0.6, 0.6});
   const FabricRaytraceOptions o = options(particles);
   const auto all_red = raytrace_fabric_table(sample, red, o).table.total_albedo();
@@ -100,7 +97,7 @@ TEST(FiberTables, TwoColourFiberClothLiesBetweenItsColours) {
 // greatest z). Expected ratio: the grey yarn's G/R albedo over the red one's, 1 / 0.22, diluted by
 // light that scattered between the yarns; the test asks for 2.
 TEST(FiberTables, TwoColourDraftShowsItsPatternInTheWeaveTable) {
-  const WovenSample sample = sample_at("yarn");
+  const WovenSample sample = default_sample("yarn");
   const auto red = coloured_fiber(4, {0.9, 0.2, 0.2}), grey = coloured_fiber(4, {0.6, 0.6, 0.6});
   constexpr int kR = 3, kPositions = 8;  // odd R: a bin centred on the normal
   const DirectionGrid grid{kR};
@@ -140,7 +137,7 @@ TEST(FiberTables, EqualTablesAreTheSingleTableTraceBitForBit) {
   // Two table objects of equal values (one checksum) are one table: the same bits and metadata as
   // the single-table call, at both details.
   for (const char* detail : {"yarn", "fiber"}) {
-    const WovenSample sample = sample_at(detail);
+    const WovenSample sample = default_sample(detail);
     const auto a = coloured_fiber(4, {0.9, 0.2, 0.2}), b = coloured_fiber(4, {0.9, 0.2, 0.2});
     const FabricRaytraceOptions o = options(200);
     const auto single = raytrace_fabric_table(sample, a, o);
@@ -155,7 +152,7 @@ TEST(FiberTables, EveryYarnOnTheSecondTableIsThatTablesTraceBitForBit) {
   // Two distinct tables, every yarn mapped to the second: the per-yarn path looks each hit's table
   // up (the next-event draws' too), and none of the first table's values may leak into the trace.
   for (const char* detail : {"yarn", "fiber"}) {
-    const WovenSample sample = sample_at(detail);
+    const WovenSample sample = default_sample(detail);
     const auto red = coloured_fiber(4, {0.9, 0.2, 0.2}), grey = coloured_fiber(4, {0.6, 0.6, 0.6});
     FiberTables f = fiber_tables_by_direction(sample, red, grey);
     for (int& k : f.table_of_yarn) k = 1;
@@ -171,7 +168,7 @@ TEST(FiberTables, EveryYarnOnTheSecondTableIsThatTablesTraceBitForBit) {
 }
 
 TEST(FiberTables, BadTablesAndMapsAreRefusedByName) {
-  const WovenSample sample = sample_at("yarn");
+  const WovenSample sample = default_sample("yarn");
   const auto red = coloured_fiber(4, {0.9, 0.2, 0.2}), coarse = coloured_fiber(2, {0.5, 0.5, 0.5});
   const FabricRaytraceOptions o = options(10);
   auto message = [&](const FiberTables& f, const FabricRaytraceOptions& opt) {

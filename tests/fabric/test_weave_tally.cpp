@@ -6,6 +6,7 @@
 #include <cmath>
 #include <string>
 
+#include "raytrace_test_util.h"
 #include "test_util.h"
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
@@ -36,11 +37,7 @@ TabulatedBsdfTable lossy_fiber(int resolution) {
   return t;
 }
 
-WovenSample sample_at(const char* detail, const WeaveOptions& extra = {}) {
-  WeaveOptions o = extra;
-  o.detail = detail;
-  return make_woven_sample(overlay(red_cotton_weave_options(), o));
-}
+using weft::testing::default_sample;
 
 FabricRaytraceOptions weave_options(int resolution, uint64_t particles, int pu, int pv,
                                     int weave_resolution) {
@@ -87,7 +84,7 @@ constexpr StraightThrough kStraightThrough[] = {StraightThrough::exact, Straight
 }  // namespace
 
 TEST(WeaveTally, PositionMeanIsTheTablesCoarseAverage) {
-  const WovenSample sample = sample_at("yarn");
+  const WovenSample sample = default_sample("yarn");
   const auto fiber = lossy_fiber(3);
   // Nested grids (R 4 over 2) and not (R 3 over 2), positions not square, hero and nee exits; the
   // straight-through light computed (its rays booked by position too) and sampled.
@@ -126,7 +123,7 @@ TEST(WeaveTally, NoiseMatchesTheSpreadOfIndependentRuns) {
   // Two seeds' booked values B = m x the position mean differ by sqrt(2) x the stated relative
   // noise (weighted as it is: D_i D_o over the coarse cells), within 25 % (as the table's noise is
   // checked in test_fabric_raytrace.cpp); with the hero estimator and with nee's launch blocks.
-  const WovenSample sample = sample_at("yarn");
+  const WovenSample sample = default_sample("yarn");
   const auto fiber = lossy_fiber(3);
   for (const int next_event_rays : {0, 1}) {
     FabricRaytraceOptions o = weave_options(4, 4000, 4, 4, 2);
@@ -186,7 +183,7 @@ TEST(WeaveTally, GapsBetweenYarnsTransmitStraightThrough) {
   open.pattern = "plain";
   open.warp_spacing_mm = open.weft_spacing_mm = 0.4;
   open.warp_width_mm = open.weft_width_mm = 0.2;
-  const WovenSample sample = sample_at("yarn", open);
+  const WovenSample sample = default_sample("yarn", open);
   // Light from straight above: the incident bin holding the normal (odd R: its centre), and the
   // coarse cell of the light leaving straight down (the weave at the table's R, so that coarse
   // cell is as narrow as the table's).
@@ -226,7 +223,7 @@ TEST(WeaveTally, GapsBetweenYarnsTransmitStraightThrough) {
 }
 
 TEST(WeaveTally, BitIdenticalAtAnyThreadCountAndInParts) {
-  const WovenSample sample = sample_at("fiber");
+  const WovenSample sample = default_sample("fiber");
   const auto fiber = lossy_fiber(3);
   FabricRaytraceOptions o = weave_options(2, 300, 3, 3, 1);
   o.threads = 1;
@@ -257,7 +254,7 @@ TEST(WeaveTally, BitIdenticalAtAnyThreadCountAndInParts) {
 }
 
 TEST(WeaveTally, BadOptionsAreRefusedByName) {
-  const WovenSample sample = sample_at("yarn");
+  const WovenSample sample = default_sample("yarn");
   const auto fiber = lossy_fiber(3);
   auto refused_field = [&](const FabricRaytraceOptions& o) -> std::string {
     try {

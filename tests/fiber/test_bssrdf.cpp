@@ -33,7 +33,7 @@ BssrdfGrid grid() {
   return g;
 }
 
-TaskBatch batch(uint64_t photons, uint64_t seed, int threads = 2) {
+TaskBatch bssrdf_batch(uint64_t photons, uint64_t seed, int threads = 2) {
   return weft::testing::batch_options(photons, seed, threads, 4096);
 }
 
@@ -74,7 +74,7 @@ TEST(Bssrdf, MatchedNonScatteringFiberHitsOneCellExactly) {
     const BssrdfGrid g = grid();
     const BssrdfResult r = simulate_bssrdf(
         fiber(mua, 0, 0, 1.0), g, BssrdfIncidence::from({std::sin(alpha), 0, std::cos(alpha)}),
-        batch(20000, 1));
+        bssrdf_batch(20000, 1));
     const double weight = std::exp(-mua * 2 * kRadius / std::cos(alpha));
     const int iu = g.u_bins / 2;  // u = pi
     const double v = -2 * kRadius * std::tan(alpha);
@@ -110,8 +110,8 @@ TEST(Bssrdf, MatchedNonScatteringFiberHitsOneCellExactly) {
 TEST(Bssrdf, NormalIncidenceBouncesAlongTheDiameter) {
   const double mua = 0.02, n = 1.557;
   const BssrdfGrid g = grid();
-  const BssrdfResult r =
-      simulate_bssrdf(fiber(mua, 0, 0, n), g, BssrdfIncidence::from({0, 0, 1}), batch(100000, 2));
+  const BssrdfResult r = simulate_bssrdf(fiber(mua, 0, 0, n), g, BssrdfIncidence::from({0, 0, 1}),
+                                         bssrdf_batch(100000, 2));
   const double rf = fresnel_dielectric(1.0, 1.0, n), a = std::exp(-2 * mua * kRadius);
   const double opposite = (1 - rf) * (1 - rf) * a / (1 - rf * rf * a * a);
   const double back = (1 - rf) * (1 - rf) * rf * a * a / (1 - rf * rf * a * a);
@@ -131,7 +131,8 @@ TEST(Bssrdf, NormalIncidenceBouncesAlongTheDiameter) {
 TEST(Bssrdf, ScatteringFiberEnergyAndMirrorSymmetry) {
   const BssrdfGrid g = grid();
   const FiberBandPhysics ph = fiber(0.005, 0.05, 0.8, 1.557);
-  const BssrdfResult r = simulate_bssrdf(ph, g, BssrdfIncidence::from({0, 0, 1}), batch(200000, 3));
+  const BssrdfResult r =
+      simulate_bssrdf(ph, g, BssrdfIncidence::from({0, 0, 1}), bssrdf_batch(200000, 3));
   const double all = exited(r, all_cells).mean;
   EXPECT_NEAR(all + fraction(r, r.overflow), fraction(r, r.books.exited), 1e-12);
   EXPECT_GT(r.overflow, 0.0);
@@ -159,8 +160,8 @@ TEST(Bssrdf, ScatteringFiberEnergyAndMirrorSymmetry) {
     EXPECT_TRUE(weft::testing::within_sigma(a, b.mean, 4.5, b.std_error)) << "direction " << d;
   }
   // The mirror must be a real constraint: an oblique light tilted along b breaks it.
-  const BssrdfResult t =
-      simulate_bssrdf(ph, g, BssrdfIncidence::from(normalize(Vec3{0, 0.7, 0.7})), batch(50000, 5));
+  const BssrdfResult t = simulate_bssrdf(ph, g, BssrdfIncidence::from(normalize(Vec3{0, 0.7, 0.7})),
+                                         bssrdf_batch(50000, 5));
   const MeanEstimate plus = exited(t, [&](int u, int, int) { return u > 0 && u < nu / 2; });
   const MeanEstimate minus = exited(t, [&](int u, int, int) { return u > nu / 2; });
   EXPECT_GT(std::abs(plus.mean - minus.mean), 6 * std::hypot(plus.std_error, minus.std_error));
@@ -169,8 +170,8 @@ TEST(Bssrdf, ScatteringFiberEnergyAndMirrorSymmetry) {
 TEST(Bssrdf, SameBitsAtOneAndTwoThreads) {
   const FiberBandPhysics ph = fiber(0.005, 0.05, 0.8, 1.557);
   const BssrdfIncidence in = BssrdfIncidence::from(normalize(Vec3{0.3, 0.2, 0.9}));
-  const BssrdfResult a = simulate_bssrdf(ph, grid(), in, batch(20000, 4, 1));
-  const BssrdfResult b = simulate_bssrdf(ph, grid(), in, batch(20000, 4, 2));
+  const BssrdfResult a = simulate_bssrdf(ph, grid(), in, bssrdf_batch(20000, 4, 1));
+  const BssrdfResult b = simulate_bssrdf(ph, grid(), in, bssrdf_batch(20000, 4, 2));
   ASSERT_EQ(a.exit_weight.size(), b.exit_weight.size());
   EXPECT_TRUE(a.exit_weight == b.exit_weight);
   EXPECT_TRUE(a.exit_weight2 == b.exit_weight2);
@@ -179,8 +180,10 @@ TEST(Bssrdf, SameBitsAtOneAndTwoThreads) {
   BssrdfGrid g = grid();
   g.v_bins = 1;
   g.v_range = kTransportInfinity;
-  const BssrdfResult c = simulate_bssrdf(ph, g, BssrdfIncidence::binned(4, 4), batch(20000, 4, 1));
-  const BssrdfResult d = simulate_bssrdf(ph, g, BssrdfIncidence::binned(4, 4), batch(20000, 4, 2));
+  const BssrdfResult c =
+      simulate_bssrdf(ph, g, BssrdfIncidence::binned(4, 4), bssrdf_batch(20000, 4, 1));
+  const BssrdfResult d =
+      simulate_bssrdf(ph, g, BssrdfIncidence::binned(4, 4), bssrdf_batch(20000, 4, 2));
   EXPECT_TRUE(c.exit_weight == d.exit_weight);
   EXPECT_TRUE(c.flux_in == d.flux_in);
 }
@@ -195,7 +198,7 @@ TEST(Bssrdf, BinnedIncidenceCoversTheLitHemisphereWithFluxCosine) {
   g.direction_resolution = 2;
   const int ns = 4, npsi = 3;
   const BssrdfResult r =
-      simulate_bssrdf(ph, g, BssrdfIncidence::binned(ns, npsi), batch(120000, 7));
+      simulate_bssrdf(ph, g, BssrdfIncidence::binned(ns, npsi), bssrdf_batch(120000, 7));
   double flux = 0;
   uint64_t n = 0;
   for (int b = 0; b < ns * npsi; ++b) {
@@ -212,7 +215,7 @@ TEST(Bssrdf, BinnedIncidenceCoversTheLitHemisphereWithFluxCosine) {
 TEST(Bssrdf, BadInputIsRejectedWithTheFieldNamed) {
   auto message_of = [](const BssrdfGrid& g, const BssrdfIncidence& in) {
     return weft::testing::error_of(
-        [&] { simulate_bssrdf(fiber(0.005, 0.05, 0.8, 1.557), g, in, batch(10, 1)); });
+        [&] { simulate_bssrdf(fiber(0.005, 0.05, 0.8, 1.557), g, in, bssrdf_batch(10, 1)); });
   };
   const BssrdfIncidence normal = BssrdfIncidence::from({0, 0, 1});
   EXPECT_NE(message_of(grid(), BssrdfIncidence::from({0, 0, -1})).find("incident"),

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/medium.h"
@@ -20,6 +21,8 @@
 using namespace weft;
 
 namespace {
+
+using weft::testing::relative_difference;
 
 // A fiber of radius 5 um, host n = 1.5 absorbing 0.01 / um, with one species of particles of index
 // 2 + i k and the given sizes at volume fraction 0.01; built as a value, since parsing is not
@@ -42,10 +45,6 @@ FiberSpec one_species_spec(const SizeDistribution& size, double particle_k) {
   return s;
 }
 
-double rel(double a, double b) {
-  return std::abs(a - b) / std::abs(b);
-}
-
 }  // namespace
 
 TEST(FiberMedium, MonodisperseSpeciesMatchesClosedForm) {
@@ -55,7 +54,7 @@ TEST(FiberMedium, MonodisperseSpeciesMatchesClosedForm) {
     const double wl = band_wavelength_nm(band);
     const MieResult r = mie_sphere_physical(2.0, 0.0, 1.5, 0.2, wl);
     const double n = 0.01 / (4.0 / 3.0 * std::numbers::pi * 0.008);
-    EXPECT_LE(rel(m.mu_s_per_um, n * std::numbers::pi * 0.04 * r.qsca), 1e-12);
+    EXPECT_LE(relative_difference(m.mu_s_per_um, n * std::numbers::pi * 0.04 * r.qsca), 1e-12);
     EXPECT_EQ(m.mu_a_particles_per_um, 0.0);
     EXPECT_NEAR(m.mu_a_host_per_um, 0.99 * 0.01, 1e-15);
     EXPECT_NEAR(m.albedo, m.mu_s_per_um / (m.mu_s_per_um + m.mu_a_per_um), 1e-15);
@@ -75,10 +74,10 @@ TEST(FiberMedium, LognormalAndAbsorbingSpecies) {
                                      band_wavelength_nm(10), mu, {64});
   const double mean_volume =
       4.0 / 3.0 * std::numbers::pi * std::pow(0.15, 3) * std::exp(4.5 * 0.09);
-  EXPECT_LE(rel(e.mean_volume_um3, mean_volume), 1e-6);
+  EXPECT_LE(relative_difference(e.mean_volume_um3, mean_volume), 1e-6);
   const double n = 0.01 / mean_volume;
-  EXPECT_LE(rel(m.mu_s_per_um, n * e.mean_csca_um2), 1e-5);
-  EXPECT_LE(rel(m.mu_a_particles_per_um, n * e.mean_cabs_um2), 1e-5);
+  EXPECT_LE(relative_difference(m.mu_s_per_um, n * e.mean_csca_um2), 1e-5);
+  EXPECT_LE(relative_difference(m.mu_a_particles_per_um, n * e.mean_cabs_um2), 1e-5);
   EXPECT_GT(m.mu_a_particles_per_um, 0.0);
 }
 

@@ -23,7 +23,7 @@ CylinderBeamSetup beam(const TransportMedium& m, double radius, double n_out, co
   return {.medium = m, .radius = radius, .n_outside = n_out, .direction = dir, .options = {}};
 }
 
-TaskBatch batch(uint64_t photons, uint64_t seed, int threads = 2) {
+TaskBatch cylinder_batch(uint64_t photons, uint64_t seed, int threads = 2) {
   return weft::testing::batch_options(photons, seed, threads, 1024);
 }
 
@@ -132,8 +132,8 @@ TEST(TransportCylinder, BeamEntryPointsCoverTheLitSide) {
 TEST(TransportCylinder, MatchedAbsorbingCylinderFollowsBeerLambertChords) {
   const double r = 10, mua = 0.05;  // um, 1/um: optical radius 0.5
   const BeamFate exact = non_scattering_cylinder(mua, r, 1.0, 1.0, {0, 0, -1});
-  const CylinderBeamResult res =
-      simulate_cylinder_beam(beam(medium(mua, 0, 0, 1.0), r, 1.0, {0, 0, -1}), batch(200000, 31));
+  const CylinderBeamResult res = simulate_cylinder_beam(
+      beam(medium(mua, 0, 0, 1.0), r, 1.0, {0, 0, -1}), cylinder_batch(200000, 31));
   EXPECT_EQ(res.specular.mean, 0.0);
   EXPECT_TRUE(within_sigma(res.exited, exact.exited, 3));
   EXPECT_TRUE(within_sigma(res.absorbed, exact.absorbed, 3));
@@ -168,7 +168,7 @@ void for_each_mismatched_beam(Check&& check) {
 TEST(TransportCylinder, MismatchedAbsorbingCylinderMatchesBounceSeries) {
   for_each_mismatched_beam(
       [](CylinderBeamSetup& s, const BeamFate& exact, const Vec3& dir, WeightMode) {
-        const CylinderBeamResult res = simulate_cylinder_beam(s, batch(150000, 32));
+        const CylinderBeamResult res = simulate_cylinder_beam(s, cylinder_batch(150000, 32));
         EXPECT_TRUE(within_sigma(res.specular, exact.specular, 3)) << dir;
         EXPECT_TRUE(within_sigma(res.exited, exact.exited, 3)) << dir;
         EXPECT_TRUE(within_sigma(res.absorbed, exact.absorbed, 3)) << dir;
@@ -183,9 +183,9 @@ TEST(TransportCylinder, MismatchedAbsorbingCylinderMatchesBounceSeries) {
 TEST(TransportCylinder, ExpectedExitsMatchTheBounceSeries) {
   for_each_mismatched_beam(
       [](CylinderBeamSetup& s, const BeamFate& exact, const Vec3& dir, WeightMode mode) {
-        const CylinderBeamResult plain = simulate_cylinder_beam(s, batch(40000, 34));
+        const CylinderBeamResult plain = simulate_cylinder_beam(s, cylinder_batch(40000, 34));
         s.options.expected_exits = true;
-        const CylinderBeamResult res = simulate_cylinder_beam(s, batch(40000, 34));
+        const CylinderBeamResult res = simulate_cylinder_beam(s, cylinder_batch(40000, 34));
         EXPECT_TRUE(within_sigma(res.exited, exact.exited, 3)) << dir;
         EXPECT_NEAR(res.energy_imbalance, 0, 1e-12);
         // Measured: 0.11-0.15 of plain; with absorption as a weight plain draws no absorption
@@ -200,7 +200,8 @@ TEST(TransportCylinder, ExpectedExitsMatchTheBounceSeries) {
 TEST(TransportCylinder, NonAbsorbingCylinderReturnsAllEnergy) {
   for (double g : {0.0, 0.8, -0.5}) {
     const CylinderBeamResult res = simulate_cylinder_beam(
-        beam(medium(0, 0.2, g, 1.557), 10, 1.0, normalize(Vec3{0.4, 0.2, -0.9})), batch(20000, 33));
+        beam(medium(0, 0.2, g, 1.557), 10, 1.0, normalize(Vec3{0.4, 0.2, -0.9})),
+        cylinder_batch(20000, 33));
     EXPECT_EQ(res.absorbed.mean, 0.0);
     EXPECT_EQ(res.lost.mean, 0.0);
     EXPECT_NEAR(res.specular.mean + res.exited.mean, 1.0, 1e-12);
@@ -258,9 +259,9 @@ TEST(TransportCylinder, TrappedPhotonIsCappedAndReported) {
 TEST(TransportCylinder, AnalogAndImplicitCaptureAgree) {
   CylinderBeamSetup s =
       beam(medium(0.01, 0.1, 0.8, 1.557), 10, 1.0, normalize(Vec3{0.3, -0.2, -0.9}));
-  const CylinderBeamResult implicit = simulate_cylinder_beam(s, batch(100000, 34));
+  const CylinderBeamResult implicit = simulate_cylinder_beam(s, cylinder_batch(100000, 34));
   s.options.mode = WeightMode::analog;
-  const CylinderBeamResult analog = simulate_cylinder_beam(s, batch(100000, 35));
+  const CylinderBeamResult analog = simulate_cylinder_beam(s, cylinder_batch(100000, 35));
   EXPECT_TRUE(within_sigma(implicit.exited, analog.exited.mean, 3, analog.exited.std_error));
   EXPECT_TRUE(within_sigma(implicit.absorbed, analog.absorbed.mean, 3, analog.absorbed.std_error));
   EXPECT_NEAR(implicit.specular.mean, analog.specular.mean, 5 * implicit.specular.std_error);
@@ -269,8 +270,8 @@ TEST(TransportCylinder, AnalogAndImplicitCaptureAgree) {
 TEST(TransportCylinder, SameBitsAtOneAndTwoThreads) {
   const CylinderBeamSetup s =
       beam(medium(0.005, 0.05, 0.8, 1.557), 10, 1.0, normalize(Vec3{0.2, 0.1, -1}));
-  const CylinderBeamResult a = simulate_cylinder_beam(s, batch(40000, 36, 1));
-  const CylinderBeamResult b = simulate_cylinder_beam(s, batch(40000, 36, 2));
+  const CylinderBeamResult a = simulate_cylinder_beam(s, cylinder_batch(40000, 36, 1));
+  const CylinderBeamResult b = simulate_cylinder_beam(s, cylinder_batch(40000, 36, 2));
   for (auto [x, y] : {std::pair{a.exited, b.exited}, std::pair{a.absorbed, b.absorbed},
                       std::pair{a.specular, b.specular}}) {
     EXPECT_EQ(std::memcmp(&x.mean, &y.mean, sizeof(double)), 0);
@@ -283,7 +284,7 @@ TEST(TransportCylinder, SameBitsAtOneAndTwoThreads) {
 TEST(TransportCylinder, Extremes) {
   {  // optically huge: mu_t r = 1e4, albedo 0.99; roulette ends every walk
     const CylinderBeamResult res = simulate_cylinder_beam(
-        beam(medium(10, 990, 0.8, 1.557), 10, 1.0, {0, 0, -1}), batch(1000, 37));
+        beam(medium(10, 990, 0.8, 1.557), 10, 1.0, {0, 0, -1}), cylinder_batch(1000, 37));
     EXPECT_NEAR(res.energy_imbalance, 0, 1e-12);
     EXPECT_EQ(res.lost.mean, 0.0);
     EXPECT_GT(res.absorbed.mean, 0.5);
@@ -292,26 +293,26 @@ TEST(TransportCylinder, Extremes) {
   {  // optically huge and non-absorbing: the cap bounds the runtime, its weight is reported
     CylinderBeamSetup s = beam(medium(0, 1000, 0.0, 1.557), 10, 1.0, {0, 0, -1});
     s.options.max_events = 20000;
-    const CylinderBeamResult res = simulate_cylinder_beam(s, batch(500, 38));
+    const CylinderBeamResult res = simulate_cylinder_beam(s, cylinder_batch(500, 38));
     EXPECT_NEAR(res.specular.mean + res.exited.mean + res.lost.mean, 1.0, 1e-12);
     EXPECT_GT(res.exited.mean, 0.5);
   }
   {  // mu_a huge: absorbed at once
     const CylinderBeamResult res = simulate_cylinder_beam(
-        beam(medium(1e12, 1, 0.0, 1.557), 10, 1.0, {0, 0, -1}), batch(2000, 39));
+        beam(medium(1e12, 1, 0.0, 1.557), 10, 1.0, {0, 0, -1}), cylinder_batch(2000, 39));
     EXPECT_NEAR(res.specular.mean + res.absorbed.mean, 1.0, 1e-12);
     EXPECT_LT(res.exited.mean, 1e-9);
   }
   {  // mu_s -> 0
     const CylinderBeamResult res = simulate_cylinder_beam(
-        beam(medium(0, 1e-12, 0.0, 1.557), 10, 1.0, {0, 0, -1}), batch(2000, 40));
+        beam(medium(0, 1e-12, 0.0, 1.557), 10, 1.0, {0, 0, -1}), cylinder_batch(2000, 40));
     EXPECT_NEAR(res.specular.mean + res.exited.mean, 1.0, 1e-12);
   }
   {  // grazing: the beam 89.9 degrees from the cross-section, almost along the axis
     const double a = deg_to_rad(89.9);
     const CylinderBeamResult res = simulate_cylinder_beam(
         beam(medium(0.005, 0.05, 0.8, 1.557), 10, 1.0, {std::sin(a), 0, -std::cos(a)}),
-        batch(5000, 41));
+        cylinder_batch(5000, 41));
     EXPECT_GT(res.specular.mean, 0.98);
     for (const MeanEstimate& e : {res.exited, res.absorbed})
       EXPECT_TRUE(std::isfinite(e.mean) && e.mean >= 0 && e.mean <= 1 &&
@@ -322,7 +323,7 @@ TEST(TransportCylinder, Extremes) {
 
 TEST(TransportCylinder, BadInputIsRejectedWithTheFieldNamed) {
   auto message_of = [](const CylinderBeamSetup& s) {
-    return weft::testing::error_of([&] { simulate_cylinder_beam(s, batch(10, 1)); });
+    return weft::testing::error_of([&] { simulate_cylinder_beam(s, cylinder_batch(10, 1)); });
   };
   EXPECT_NE(message_of(beam(medium(1, 1, 0, 1.5), 0, 1, {0, 0, -1})).find("radius"),
             std::string::npos);

@@ -27,7 +27,7 @@ SlabSetup make_slab(double mua, double mus, double g, double n, double thickness
   return s;
 }
 
-TaskBatch batch(uint64_t photons, uint64_t seed, int threads = 2) {
+TaskBatch slab_batch(uint64_t photons, uint64_t seed, int threads = 2) {
   return weft::testing::batch_options(photons, seed, threads, 2048);
 }
 
@@ -86,7 +86,7 @@ struct HFunction {
 // Here in mm: mu_a = 1/mm, mu_s = 9/mm, d = 0.2 mm.
 TEST(TransportSlab, McmlVanDeHulstMatchedSlab) {
   const SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
-  const SlabResult r = simulate_slab(s, batch(1000000, 11));
+  const SlabResult r = simulate_slab(s, slab_batch(1000000, 11));
   EXPECT_EQ(r.specular.mean, 0.0);
   EXPECT_TRUE(within_sigma(r.rd, 0.09739, 3));
   EXPECT_TRUE(within_sigma(r.tt, 0.66096, 3));
@@ -109,7 +109,7 @@ TEST(TransportSlab, TabulatedPhaseFunctionReproducesHgSlab) {
   }
   SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
   s.medium.phase = PhaseFunction::tabulated(mu, p);
-  const SlabResult r = simulate_slab(s, batch(400000, 27));
+  const SlabResult r = simulate_slab(s, slab_batch(400000, 27));
   EXPECT_TRUE(within_sigma(r.rd, 0.09739, 3));
   EXPECT_TRUE(within_sigma(r.tt, 0.66096, 3));
 }
@@ -119,7 +119,7 @@ TEST(TransportSlab, TabulatedPhaseFunctionReproducesHgSlab) {
 // Rsp = 0.04, Rd = 0.220348 +- 0.000916 (A = 0.739652). Rsp is exactly ((1.5-1)/(1.5+1))^2.
 TEST(TransportSlab, McmlMismatchedSemiInfinite) {
   const SlabSetup s = make_slab(1, 9, 0.0, 1.5, kTransportInfinity);
-  const SlabResult r = simulate_slab(s, batch(100000, 12));
+  const SlabResult r = simulate_slab(s, slab_batch(100000, 12));
   EXPECT_NEAR(r.specular.mean, 0.04, 1e-15);
   EXPECT_TRUE(within_sigma(r.rd, 0.220348, 3, 0.000916));
   EXPECT_EQ(r.tt.mean, 0.0);
@@ -139,7 +139,7 @@ TEST(TransportSlab, ChandrasekharPlaneAlbedoIsotropic) {
     const double reference = 1 - h(mu0) * std::sqrt(1 - a);
     SlabSetup s = make_slab(1, 9, 0.0, 1.0, kTransportInfinity);
     s.incidence_rad = std::acos(mu0);
-    const SlabResult r = simulate_slab(s, batch(60000, 13));
+    const SlabResult r = simulate_slab(s, slab_batch(60000, 13));
     EXPECT_TRUE(within_sigma(r.rd, reference, 3)) << "mu0 = " << mu0 << " H = " << h(mu0);
   }
 }
@@ -165,7 +165,7 @@ TEST(TransportSlab, NonScatteringSlabWithFresnelIsExact) {
   for (WeightMode mode :
        {WeightMode::implicit_capture, WeightMode::analog, WeightMode::absorption_weight}) {
     s.options.mode = mode;
-    const SlabResult r = simulate_slab(s, batch(200000, 14));
+    const SlabResult r = simulate_slab(s, slab_batch(200000, 14));
     EXPECT_NEAR(r.specular.mean, r0, 1e-12);
     EXPECT_TRUE(within_sigma(r.tb, tb, 3));
     EXPECT_TRUE(within_sigma(r.rb, rb, 3));
@@ -181,7 +181,7 @@ TEST(TransportSlab, NonScatteringSlabWithFresnelIsExact) {
 TEST(TransportSlab, NonAbsorbingSlabConservesEnergyExactly) {
   SlabSetup s = make_slab(0, 20, 0.8, 1.33, 0.3);
   s.incidence_rad = deg_to_rad(30);
-  const SlabResult r = simulate_slab(s, batch(20000, 15));
+  const SlabResult r = simulate_slab(s, slab_batch(20000, 15));
   EXPECT_EQ(r.absorbed.mean, 0.0);
   EXPECT_EQ(r.roulette.mean, 0.0);
   EXPECT_EQ(r.lost.mean, 0.0);
@@ -195,7 +195,7 @@ TEST(TransportSlab, NonAbsorbingSlabConservesEnergyExactly) {
 TEST(TransportSlab, NonAbsorbingSemiInfiniteReflectsEverything) {
   SlabSetup s = make_slab(0, 10, 0.5, 1.0, kTransportInfinity);
   s.options.max_events = 20000;
-  const SlabResult r = simulate_slab(s, batch(4000, 16));
+  const SlabResult r = simulate_slab(s, slab_batch(4000, 16));
   EXPECT_NEAR(r.rd.mean + r.rb.mean + r.lost.mean, 1.0, 1e-12);
   EXPECT_LT(r.lost.mean, 0.05);  // P(return after > 2e4 events) is a few percent at most
   EXPECT_EQ(r.absorbed.mean, 0.0);
@@ -206,7 +206,7 @@ TEST(TransportSlab, NonAbsorbingSemiInfiniteReflectsEverything) {
 TEST(TransportSlab, EnergyBookkeepingWithAbsorptionAndRoulette) {
   SlabSetup s = make_slab(0.5, 30, 0.9, 1.45, 2.0);
   s.n_below = 1.33;
-  const SlabResult r = simulate_slab(s, batch(20000, 17));
+  const SlabResult r = simulate_slab(s, slab_batch(20000, 17));
   EXPECT_NEAR(r.energy_imbalance, 0, 1e-12);
   EXPECT_GT(r.absorbed.mean, 0.1);
   EXPECT_GT(r.roulette.std_error, 0.0);  // roulette did play
@@ -217,9 +217,9 @@ TEST(TransportSlab, EnergyBookkeepingWithAbsorptionAndRoulette) {
 TEST(TransportSlab, AnalogAndImplicitCaptureAgree) {
   SlabSetup s = make_slab(2, 10, 0.7, 1.4, 0.4);
   s.incidence_rad = deg_to_rad(20);
-  const SlabResult implicit = simulate_slab(s, batch(100000, 18));
+  const SlabResult implicit = simulate_slab(s, slab_batch(100000, 18));
   s.options.mode = WeightMode::analog;
-  const SlabResult analog = simulate_slab(s, batch(100000, 19));
+  const SlabResult analog = simulate_slab(s, slab_batch(100000, 19));
   EXPECT_EQ(analog.roulette.mean, 0.0);
   for (auto [a, b] :
        {std::pair{implicit.rd, analog.rd}, std::pair{implicit.td, analog.td},
@@ -233,7 +233,7 @@ TEST(TransportSlab, AnalogAndImplicitCaptureAgree) {
 TEST(TransportSlab, AbsorptionWeightMatchesVanDeHulstSlab) {
   SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
   s.options.mode = WeightMode::absorption_weight;
-  const SlabResult r = simulate_slab(s, batch(400000, 21));
+  const SlabResult r = simulate_slab(s, slab_batch(400000, 21));
   EXPECT_TRUE(within_sigma(r.rd, 0.09739, 3));
   EXPECT_TRUE(within_sigma(r.tt, 0.66096, 3));
   EXPECT_EQ(r.roulette.mean, 0.0);
@@ -243,8 +243,8 @@ TEST(TransportSlab, AbsorptionWeightMatchesVanDeHulstSlab) {
 TEST(TransportSlab, SameBitsAtOneAndTwoThreads) {
   SlabSetup s = make_slab(1, 9, 0.75, 1.37, 0.3);
   s.incidence_rad = deg_to_rad(10);
-  const SlabResult a = simulate_slab(s, batch(30000, 20, 1));
-  const SlabResult b = simulate_slab(s, batch(30000, 20, 2));
+  const SlabResult a = simulate_slab(s, slab_batch(30000, 20, 1));
+  const SlabResult b = simulate_slab(s, slab_batch(30000, 20, 2));
   for (auto [x, y] : {std::pair{a.rd, b.rd}, std::pair{a.tt, b.tt},
                       std::pair{a.absorbed, b.absorbed}, std::pair{a.roulette, b.roulette}}) {
     EXPECT_EQ(std::memcmp(&x.mean, &y.mean, sizeof(double)), 0);
@@ -252,14 +252,14 @@ TEST(TransportSlab, SameBitsAtOneAndTwoThreads) {
   }
   EXPECT_EQ(a.scatterings, b.scatterings);
   // A different seed gives a different answer (the seed reaches the streams).
-  const SlabResult c = simulate_slab(s, batch(30000, 21, 2));
+  const SlabResult c = simulate_slab(s, slab_batch(30000, 21, 2));
   EXPECT_NE(a.rd.mean, c.rd.mean);
 }
 
 // Cancellation keeps whole tasks: the result equals a run of exactly the photons done.
 TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   SlabSetup s = make_slab(1, 9, 0.75, 1.0, 0.2);
-  TaskBatch b = batch(200000, 22, 2);
+  TaskBatch b = slab_batch(200000, 22, 2);
   b.tasks_per_wave = 3;
   int calls = 0;
   b.progress = [&](const ProgressUpdate& u) {
@@ -269,7 +269,7 @@ TEST(TransportSlab, CancellationKeepsWhatIsDone) {
   const SlabResult cut = simulate_slab(s, b);
   EXPECT_TRUE(cut.cancelled);
   EXPECT_EQ(cut.photons, 6u * 2048u);
-  TaskBatch whole = batch(cut.photons, 22, 1);
+  TaskBatch whole = slab_batch(cut.photons, 22, 1);
   const SlabResult ref = simulate_slab(s, whole);
   EXPECT_FALSE(ref.cancelled);
   EXPECT_EQ(cut.rd.mean, ref.rd.mean);
@@ -284,13 +284,13 @@ TEST(TransportSlab, CancellationKeepsWhatIsDone) {
 // Extremes stay finite and bounded.
 TEST(TransportSlab, Extremes) {
   {  // mu_s -> 0: pure absorption, Beer-Lambert through a matched slab
-    const SlabResult r = simulate_slab(make_slab(1, 1e-12, 0.9, 1.0, 1.0), batch(50000, 23));
+    const SlabResult r = simulate_slab(make_slab(1, 1e-12, 0.9, 1.0, 1.0), slab_batch(50000, 23));
     EXPECT_TRUE(within_sigma(r.tb, std::exp(-1.0), 3));
     EXPECT_LT(r.rd.mean, 1e-6);
   }
   {  // mu_a huge: everything that enters is absorbed at once
     SlabSetup s = make_slab(1e12, 1, 0.0, 1.5, 1.0);
-    const SlabResult r = simulate_slab(s, batch(5000, 24));
+    const SlabResult r = simulate_slab(s, slab_batch(5000, 24));
     EXPECT_NEAR(r.absorbed.mean, 0.96, 1e-12);
     EXPECT_NEAR(r.specular.mean, 0.04, 1e-12);
     EXPECT_LT(r.rd.mean + r.tt.mean, 1e-9);
@@ -298,7 +298,7 @@ TEST(TransportSlab, Extremes) {
   {  // grazing incidence at 89.9 degrees
     SlabSetup s = make_slab(0.5, 10, 0.8, 1.5, 1.0);
     s.incidence_rad = deg_to_rad(89.9);
-    const SlabResult r = simulate_slab(s, batch(20000, 25));
+    const SlabResult r = simulate_slab(s, slab_batch(20000, 25));
     EXPECT_NEAR(r.specular.mean, fresnel_dielectric(std::cos(s.incidence_rad), 1.0, 1.5), 1e-12);
     EXPECT_GT(r.specular.mean, 0.98);
     for (const MeanEstimate& e : {r.rd, r.tt, r.absorbed}) {
@@ -311,7 +311,7 @@ TEST(TransportSlab, Extremes) {
     SlabSetup s = make_slab(0.5, 10, 0.8, 1.2, 1.0);
     s.n_above = 1.6;
     s.incidence_rad = deg_to_rad(60);  // critical angle asin(1.2/1.6) = 48.6 deg
-    const SlabResult r = simulate_slab(s, batch(1000, 26));
+    const SlabResult r = simulate_slab(s, slab_batch(1000, 26));
     EXPECT_EQ(r.specular.mean, 1.0);
     EXPECT_EQ(r.rd.mean + r.tt.mean + r.absorbed.mean, 0.0);
   }
@@ -319,7 +319,7 @@ TEST(TransportSlab, Extremes) {
 
 TEST(TransportSlab, BadInputIsRejectedWithTheFieldNamed) {
   auto message_of = [](const SlabSetup& s) {
-    return weft::testing::error_of([&] { simulate_slab(s, batch(10, 1)); });
+    return weft::testing::error_of([&] { simulate_slab(s, slab_batch(10, 1)); });
   };
   SlabSetup s = make_slab(-1, 1, 0, 1, 1);
   EXPECT_NE(message_of(s).find("mu_a"), std::string::npos);
@@ -340,7 +340,7 @@ TEST(TransportSlab, BadInputIsRejectedWithTheFieldNamed) {
   s = make_slab(1, 1, 0, 1, 1);
   s.options.roulette_survival = 0;
   EXPECT_NE(message_of(s).find("roulette_survival"), std::string::npos);
-  TaskBatch b = batch(10, 1);
+  TaskBatch b = slab_batch(10, 1);
   b.items_per_task = 0;
   EXPECT_THROW(simulate_slab(make_slab(1, 1, 0, 1, 1), b), Error);
 }

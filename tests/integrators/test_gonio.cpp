@@ -19,7 +19,7 @@
 using namespace weft;
 
 namespace {
-const std::filesystem::path kExamples = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/examples";
+using weft::testing::kExamples;
 
 SceneDescription plane(const nlohmann::json& reflectance) {
   SceneDescription d = load_scene_description(kExamples / "lambert-plane.json");

@@ -20,12 +20,8 @@ using namespace weft;
 namespace fs = std::filesystem;
 
 namespace {
-SceneDescription woven() {
-  return weft::testing::lit_woven_patch();
-}
-RenderSettings small(int threads) {
-  return weft::testing::small_render_settings(threads);
-}
+using weft::testing::lit_woven_patch;
+using weft::testing::small_render_settings;
 
 fs::path fresh_dir(const std::string& name) {
   const fs::path dir = fs::temp_directory_path() / name;
@@ -36,15 +32,15 @@ fs::path fresh_dir(const std::string& name) {
 }  // namespace
 
 TEST(Render, BitIdenticalAtAnyThreadCount) {
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   const RenderScene scene(d);
   const std::vector<uint8_t> mask = d.select_object("warp");
-  const MaskedRender a = render_masked(scene, *d.camera, small(1), mask);
+  const MaskedRender a = render_masked(scene, *d.camera, small_render_settings(1), mask);
   double total = 0;
   for (float v : a.render.image.rgb) total += v;
   ASSERT_GT(total, 0);
   for (int threads : {2, 0}) {  // 0 = all cores
-    const MaskedRender b = render_masked(scene, *d.camera, small(threads), mask);
+    const MaskedRender b = render_masked(scene, *d.camera, small_render_settings(threads), mask);
     const auto &ia = a.render.image.rgb, &ib = b.render.image.rgb;
     ASSERT_EQ(ia.size(), ib.size());
     EXPECT_EQ(0, std::memcmp(ia.data(), ib.data(), ia.size() * sizeof(float)));
@@ -53,10 +49,10 @@ TEST(Render, BitIdenticalAtAnyThreadCount) {
     EXPECT_EQ(a.render.rays.total(), b.render.rays.total());
   }
   // The mask only observes: the image is render()'s.
-  const RenderResult plain = render(scene, *d.camera, small(2));
+  const RenderResult plain = render(scene, *d.camera, small_render_settings(2));
   EXPECT_EQ(plain.image.rgb, a.render.image.rgb);
   // A different seed gives a different image (the comparison above can fail).
-  RenderSettings other = small(1);
+  RenderSettings other = small_render_settings(1);
   other.seed = 6;
   const RenderResult c = render(scene, *d.camera, other);
   EXPECT_NE(0, std::memcmp(a.render.image.rgb.data(), c.image.rgb.data(),
@@ -69,11 +65,11 @@ TEST(Render, BitIdenticalAtAnyThreadCount) {
 // part of one; five point lights besides the parallel light and the environment: more light
 // samples at a vertex than a path holds for a packet (PathTrace::kHeldShadows).
 TEST(Render, PixelsAreTheirPathsTracedOneByOne) {
-  SceneDescription d = woven();
+  SceneDescription d = lit_woven_patch();
   for (int k = 0; k < 5; ++k)
     d.lights.points.push_back({Vec3{0.004 * (k - 2), 0.01, 0.003 * (k % 2)}, Rgb(1e-5 * (k + 1))});
   const RenderScene scene(d);
-  RenderSettings s = small(2);
+  RenderSettings s = small_render_settings(2);
   s.width = 11, s.height = 9, s.spp = 19;
   const RenderResult r = render(scene, *d.camera, s);
   const double aspect = double(s.width) / s.height;
@@ -101,27 +97,27 @@ TEST(Render, PixelsAreTheirPathsTracedOneByOne) {
 // With the packets off (RenderScene::with_ray_packets, the bench's comparison) every query goes
 // one by one and the image keeps its bits; the switch survives a change of lights.
 TEST(Render, RayPacketsOffGiveTheSameImage) {
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   const RenderScene scene(d);
   const RenderScene single = scene.with_ray_packets(false);
   EXPECT_FALSE(single.ray_packets());
   EXPECT_FALSE(single.with_lights(d.lights).ray_packets());
   EXPECT_EQ(scene.with_ray_packets(true).ray_packets(), scene.ray_packets());
-  const RenderResult a = render(scene, *d.camera, small(2));
-  const RenderResult b = render(single, *d.camera, small(2));
+  const RenderResult a = render(scene, *d.camera, small_render_settings(2));
+  const RenderResult b = render(single, *d.camera, small_render_settings(2));
   double total = 0;
   for (float v : a.image.rgb) total += v;
   EXPECT_GT(total, 0);
   ASSERT_EQ(a.image.rgb.size(), b.image.rgb.size());
-  EXPECT_EQ(0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(),
-                           a.image.rgb.size() * sizeof(float)));
+  EXPECT_EQ(
+      0, std::memcmp(a.image.rgb.data(), b.image.rgb.data(), a.image.rgb.size() * sizeof(float)));
   EXPECT_EQ(a.rays.total(), b.rays.total());
 }
 
 TEST(Render, ObserversSeeEverySampleAndRay) {
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   const RenderScene scene(d);
-  const RenderSettings s = small(2);
+  const RenderSettings s = small_render_settings(2);
   std::vector<uint32_t> samples(size_t(s.width) * s.height, 0);
   std::vector<double> sums(3 * samples.size(), 0.0);
   std::atomic<uint64_t> rays{0}, shadow_rays{0};
@@ -158,10 +154,10 @@ TEST(Render, CancellationWritesNothing) {
   RenderJob job;
   job.exr = dir / "out.exr";
   job.png = dir / "out.png";
-  job.settings = small(2);
+  job.settings = small_render_settings(2);
   int calls = 0;
   const RenderJobResult r =
-      render_to_files(woven(), job, [&](const ProgressUpdate&) { return ++calls < 2; });
+      render_to_files(lit_woven_patch(), job, [&](const ProgressUpdate&) { return ++calls < 2; });
   EXPECT_TRUE(r.cancelled);
   EXPECT_TRUE(fs::is_empty(dir));  // no output, no temporary left behind
   fs::remove_all(dir);
@@ -169,16 +165,16 @@ TEST(Render, CancellationWritesNothing) {
 
 TEST(Render, OutputsRoundTrip) {
   const fs::path dir = fresh_dir("weft_test_outputs");
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   RenderJob job;
   job.exr = dir / "out.exr";
   job.png = dir / "out.png";
   job.mask = dir / "mask.exr";
   job.mask_object = "weft";
-  job.settings = small(2);
+  job.settings = small_render_settings(2);
   const RenderJobResult r = render_to_files(d, job);
   ASSERT_FALSE(r.cancelled);
-  const RenderResult direct = render(RenderScene(d), *d.camera, small(1));
+  const RenderResult direct = render(RenderScene(d), *d.camera, small_render_settings(1));
   const Image back = read_image(job.exr);
   ASSERT_EQ(back.width, 45);
   ASSERT_EQ(back.height, 37);
@@ -194,15 +190,15 @@ TEST(Render, OutputsRoundTrip) {
 TEST(Render, BadOutputsFailBeforeRendering) {
   const fs::path dir = fresh_dir("weft_test_badout");
   RenderJob job;
-  job.settings = small(1);
+  job.settings = small_render_settings(1);
   job.exr = dir / "out.tif";  // .exr, .png or .hdr only
-  EXPECT_THROW(render_to_files(woven(), job), Error);
+  EXPECT_THROW(render_to_files(lit_woven_patch(), job), Error);
   job.exr = dir / "missing" / "out.exr";
-  EXPECT_THROW(render_to_files(woven(), job), Error);
+  EXPECT_THROW(render_to_files(lit_woven_patch(), job), Error);
   job.exr = dir / "out.exr";
   job.mask = dir / "mask.exr";
   job.mask_object = "no such object";
-  EXPECT_THROW(render_to_files(woven(), job), Error);
+  EXPECT_THROW(render_to_files(lit_woven_patch(), job), Error);
   EXPECT_TRUE(fs::is_empty(dir));
   fs::remove_all(dir);
 }

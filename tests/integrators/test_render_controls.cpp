@@ -25,12 +25,8 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-SceneDescription woven() {
-  return weft::testing::lit_woven_patch();
-}
-RenderSettings small(int threads) {
-  return weft::testing::small_render_settings(threads);
-}
+using weft::testing::lit_woven_patch;
+using weft::testing::small_render_settings;
 
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
@@ -44,10 +40,10 @@ std::string bytes_of(const fs::path& p) {
 }  // namespace
 
 TEST(RenderControls, CropWindowHoldsTheSamePixelsAsTheWholeRender) {
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   const RenderScene scene(d);
-  const RenderResult full = render(scene, *d.camera, small(1));
-  RenderSettings s = small(2);
+  const RenderResult full = render(scene, *d.camera, small_render_settings(1));
+  RenderSettings s = small_render_settings(2);
   s.crop = PixelWindow{7, 30, 5, 21};  // across tile borders (tiles of 16)
   const RenderResult crop = render(scene, *d.camera, s);
   ASSERT_EQ(crop.image.width, 23);
@@ -71,11 +67,11 @@ TEST(RenderControls, CropWindowHoldsTheSamePixelsAsTheWholeRender) {
 }
 
 TEST(RenderControls, CropOutsideTheFilmIsAnError) {
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   const RenderScene scene(d);
   for (const PixelWindow w : {PixelWindow{0, 46, 0, 37}, PixelWindow{5, 5, 0, 37},
                               PixelWindow{-1, 10, 0, 37}, PixelWindow{0, 10, 20, 10}}) {
-    RenderSettings s = small(1);
+    RenderSettings s = small_render_settings(1);
     s.crop = w;
     EXPECT_NE(error_of([&] { render(scene, *d.camera, s); }).find("x0 < x1 <= width"),
               std::string::npos);
@@ -83,21 +79,21 @@ TEST(RenderControls, CropOutsideTheFilmIsAnError) {
 }
 
 TEST(RenderControls, TimeLimitEndsAfterWholePasses) {
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   const RenderScene scene(d);
   // A limit that every pass exceeds: one pass, the same bits as a render of 1 sample per pixel.
-  RenderSettings s = small(2);
+  RenderSettings s = small_render_settings(2);
   s.time_limit_s = 1e-9;
   const RenderResult one_pass = render(scene, *d.camera, s);
   EXPECT_EQ(one_pass.spp_done, 1);
-  RenderSettings one = small(1);
+  RenderSettings one = small_render_settings(1);
   one.spp = 1;
   EXPECT_TRUE(same_bits(one_pass.image.rgb, render(scene, *d.camera, one).image.rgb));
   // A limit never reached: every pass, the same bits as the render without a limit.
   s.time_limit_s = 1e9;
   const RenderResult all = render(scene, *d.camera, s);
   EXPECT_EQ(all.spp_done, 3);
-  const RenderResult plain = render(scene, *d.camera, small(1));
+  const RenderResult plain = render(scene, *d.camera, small_render_settings(1));
   EXPECT_EQ(plain.spp_done, 3);
   EXPECT_TRUE(same_bits(all.image.rgb, plain.image.rgb));
   EXPECT_FALSE(same_bits(all.image.rgb, one_pass.image.rgb));  // the comparisons can fail
@@ -127,7 +123,7 @@ TEST(RenderControls, AlbedoAndNormalOfALambertPlane) {
         {"half_height", 1}}}};
   const SceneDescription d = parse_scene_description(j, ".", "plane.json");
   const RenderScene scene(d);
-  RenderSettings s = small(2);
+  RenderSettings s = small_render_settings(2);
   s.aov_albedo = s.aov_normal = true;
   const RenderResult r = render(scene, *d.camera, s);
   ASSERT_EQ(r.albedo.width, s.width);
@@ -140,14 +136,14 @@ TEST(RenderControls, AlbedoAndNormalOfALambertPlane) {
       ASSERT_NEAR(r.normal.at(x, y).g, 1.0, 1e-6);
     }
   // The passes only observe: the image is the one rendered without them.
-  EXPECT_TRUE(same_bits(r.image.rgb, render(scene, *d.camera, small(1)).image.rgb));
-  EXPECT_TRUE(render(scene, *d.camera, small(1)).albedo.rgb.empty());
+  EXPECT_TRUE(same_bits(r.image.rgb, render(scene, *d.camera, small_render_settings(1)).image.rgb));
+  EXPECT_TRUE(render(scene, *d.camera, small_render_settings(1)).albedo.rgb.empty());
 }
 
 TEST(RenderControls, AlbedoAndNormalPassesAreDeterministicOnTheWovenPatch) {
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   const RenderScene scene(d);
-  RenderSettings a = small(1), b = small(0);
+  RenderSettings a = small_render_settings(1), b = small_render_settings(0);
   a.aov_albedo = a.aov_normal = b.aov_albedo = b.aov_normal = true;
   const RenderResult ra = render(scene, *d.camera, a), rb = render(scene, *d.camera, b);
   EXPECT_TRUE(same_bits(ra.albedo.rgb, rb.albedo.rgb));
@@ -164,7 +160,7 @@ TEST(RenderControls, AlbedoAndNormalPassesAreDeterministicOnTheWovenPatch) {
 
 TEST(RenderControls, ExrIsTheSameBytesOnEveryRunAndCarriesMetadata) {
   const fs::path dir = fresh_test_dir();
-  SceneDescription d = woven();
+  SceneDescription d = lit_woven_patch();
   d.source = "/somewhere/woven.json";
   // A perspective view of the patch from above and aside, at about twice its size.
   const Bounds3 box = d.object_bounds("");
@@ -174,7 +170,7 @@ TEST(RenderControls, ExrIsTheSameBytesOnEveryRunAndCarriesMetadata) {
                              {0, 1, 0});
   d.camera->yfov_rad = deg_to_rad(35);
   RenderJob job;
-  job.settings = small(2);
+  job.settings = small_render_settings(2);
   job.settings.seed = 77;
   job.exr = dir / "a.exr";
   render_to_files(d, job);
@@ -220,9 +216,9 @@ TEST(RenderControls, ExrIsTheSameBytesOnEveryRunAndCarriesMetadata) {
 
 TEST(RenderControls, PassesAreFilesWithTheImagesMetadata) {
   const fs::path dir = fresh_test_dir();
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   RenderJob job;
-  job.settings = small(2);
+  job.settings = small_render_settings(2);
   job.exr = dir / "out.exr";
   job.albedo = dir / "out.albedo.exr";
   job.normal = dir / "out.normal.exr";
@@ -232,15 +228,15 @@ TEST(RenderControls, PassesAreFilesWithTheImagesMetadata) {
   EXPECT_EQ(read_image_metadata(*job.albedo).at("weft:content"), "albedo");
   EXPECT_EQ(read_image_metadata(*job.normal).at("weft:spp"), 3);
   // The image is the one rendered without passes.
-  const RenderResult plain = render(RenderScene(d), *d.camera, small(1));
+  const RenderResult plain = render(RenderScene(d), *d.camera, small_render_settings(1));
   EXPECT_TRUE(same_bits(read_image(job.exr).rgb, plain.image.rgb));
 }
 
 TEST(RenderControls, CroppedExrKeepsItsPlaceOnTheFilm) {
   const fs::path dir = fresh_test_dir();
-  const SceneDescription d = woven();
+  const SceneDescription d = lit_woven_patch();
   RenderJob job;
-  job.settings = small(2);
+  job.settings = small_render_settings(2);
   job.settings.crop = PixelWindow{3, 20, 10, 30};
   job.exr = dir / "crop.exr";
   render_to_files(d, job);
@@ -255,9 +251,9 @@ TEST(RenderControls, CroppedExrKeepsItsPlaceOnTheFilm) {
 
 TEST(RenderControls, OutputsThatClashAreRefusedBeforeRendering) {
   const fs::path dir = fresh_test_dir();
-  SceneDescription d = woven();
+  SceneDescription d = lit_woven_patch();
   RenderJob job;
-  job.settings = small(1);
+  job.settings = small_render_settings(1);
   job.exr = dir / "out.exr";
   job.albedo = dir / "out.exr";
   EXPECT_NE(error_of([&] { render_to_files(d, job); }).find("is also the output file"),

@@ -16,7 +16,7 @@ using nlohmann::json;
 
 namespace {
 
-const std::filesystem::path kExamples = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/examples";
+using weft::testing::kExamples;
 
 json quad_scene() {
   return {{"objects",

@@ -7,15 +7,16 @@
 #include <cmath>
 #include <filesystem>
 
+#include "test_util.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
-#include "weft/integrators/gonio.h"
-#include "weft/integrators/path_tracer.h"
-#include "weft/materials/bsdf_table.h"
 #include "weft/fiber/fiber_bake.h"
 #include "weft/fiber/fiber_physics.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/medium.h"
+#include "weft/integrators/gonio.h"
+#include "weft/integrators/path_tracer.h"
+#include "weft/materials/bsdf_table.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 
@@ -23,7 +24,7 @@ using namespace weft;
 namespace fs = std::filesystem;
 
 namespace {
-const fs::path kExamples = fs::path(WEFT_SOURCE_DIR) / "scenes/examples";
+using weft::testing::kExamples;
 
 // One file per test: ctest runs tests as parallel processes.
 fs::path lambert_table(double rho) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 
+#include "lambert_scene.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
@@ -42,9 +43,7 @@ std::map<uint32_t, Vec3> fiber_directions(const FiberCurves& f) {
   return dir;
 }
 
-std::string error_of(const WeaveOptions& o) {
-  return weft::testing::error_of([&] { make_woven_sample(o); });
-}
+using weft::testing::woven_sample_error;
 
 }  // namespace
 
@@ -157,19 +156,19 @@ TEST(Nonwoven, BadParametersAreErrorsNamingTheField) {
   for (const auto& [field, change] : cases) {
     WeaveOptions o = small_mat();
     change(o);
-    const std::string e = error_of(o);
+    const std::string e = woven_sample_error(o);
     EXPECT_NE(e.find("field '" + field + "'"), std::string::npos) << field << ": " << e;
   }
   // A mat option with a woven pattern.
   WeaveOptions woven;
   woven.areal_density_gsm = 100;
-  EXPECT_NE(error_of(woven).find("field 'areal-density-gsm'"), std::string::npos);
+  EXPECT_NE(woven_sample_error(woven).find("field 'areal-density-gsm'"), std::string::npos);
   // A mat too dense to place: no free height in 2000 tries, named by the thickness.
   WeaveOptions dense = small_mat();
   dense.thickness_mm.reset();
   dense.solidity = 0.5;
   dense.fiber_length_mm = 0.3;
-  const std::string e = error_of(dense);
+  const std::string e = woven_sample_error(dense);
   EXPECT_NE(e.find("field 'solidity'"), std::string::npos) << e;
   EXPECT_NE(e.find("does not fit"), std::string::npos) << e;
 }

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 
+#include "lambert_scene.h"
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/scenes/weave.h"
@@ -15,7 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const fs::path kWifDir = fs::path(WEFT_SOURCE_DIR) / "scenes/data/wif";
+using weft::testing::kWifDir;
 
 // The bundled 2 x 2 plain draft at fiber detail, nothing else given: its threads (0.185 mm
 // spacing, scenes/data/wif/README.md) are narrower than red cotton's, so the default packing
@@ -27,9 +28,7 @@ WeaveOptions small_draft() {
   return o;
 }
 
-std::string error_of(const WeaveOptions& o) {
-  return weft::testing::error_of([&] { make_woven_sample(o); });
-}
+using weft::testing::woven_sample_error;
 
 }  // namespace
 
@@ -50,7 +49,7 @@ TEST(Packing, SectionThatFitsOnlyLessTakesTheDensestThatFits) {
   EXPECT_EQ(same.fibers.points, s.fibers.points);
   EXPECT_TRUE(same.summary.notes.empty());
   o.fibers_per_yarn = warp.fibers + 1;
-  const std::string e = error_of(o);
+  const std::string e = woven_sample_error(o);
   EXPECT_NE(e.find("field 'fibers-per-yarn'"), std::string::npos) << e;
   EXPECT_NE(e.find("at most " + std::to_string(warp.fibers) + " fibers"), std::string::npos) << e;
 }
@@ -58,7 +57,7 @@ TEST(Packing, SectionThatFitsOnlyLessTakesTheDensestThatFits) {
 TEST(Packing, ExplicitPackingThatDoesNotFitIsAnError) {
   WeaveOptions o = small_draft();
   o.packing = 0.55;  // the default, but given
-  const std::string e = error_of(o);
+  const std::string e = woven_sample_error(o);
   EXPECT_NE(e.find("field 'packing'"), std::string::npos) << e;
   EXPECT_NE(e.find("at most"), std::string::npos) << e;
 }

@@ -12,7 +12,7 @@
 using namespace weft;
 
 namespace {
-std::string error_of(const std::string& spec) {
+std::string pattern_error(const std::string& spec) {
   return weft::testing::error_of([&] { parse_weave_pattern(spec); });
 }
 }  // namespace
@@ -86,21 +86,21 @@ TEST(WeavePattern, SatinHasOneInterlacingPerThreadAndValidMove) {
 }
 
 TEST(WeavePattern, ImpossibleAndMalformedPatternsAreErrors) {
-  EXPECT_NE(error_of("satin:6").find("no 6-harness satin"), std::string::npos)
-      << error_of("satin:6");
-  EXPECT_NE(error_of("satin:4").find("satin"), std::string::npos);
-  EXPECT_NE(error_of("satin:8/2").find("move number 2"), std::string::npos);  // gcd(2, 8) = 2
-  EXPECT_NE(error_of("satin:7/1").find("not valid"), std::string::npos);
-  EXPECT_NE(error_of("twill:0/2").find("twill"), std::string::npos);
-  EXPECT_NE(error_of("twill:2").find("unknown pattern"), std::string::npos);
-  EXPECT_NE(error_of("twill:a/2").find("not an integer"), std::string::npos);
-  EXPECT_NE(error_of("twill:2/99999").find("twill"), std::string::npos);
-  EXPECT_NE(error_of("basket").find("unknown pattern"), std::string::npos);
-  EXPECT_NE(error_of("satin:").find("not an integer"), std::string::npos);
-  EXPECT_NE(error_of("plain").find(""), std::string::npos);
-  EXPECT_EQ(error_of("plain"), "");
+  EXPECT_NE(pattern_error("satin:6").find("no 6-harness satin"), std::string::npos)
+      << pattern_error("satin:6");
+  EXPECT_NE(pattern_error("satin:4").find("satin"), std::string::npos);
+  EXPECT_NE(pattern_error("satin:8/2").find("move number 2"), std::string::npos);  // gcd(2, 8) = 2
+  EXPECT_NE(pattern_error("satin:7/1").find("not valid"), std::string::npos);
+  EXPECT_NE(pattern_error("twill:0/2").find("twill"), std::string::npos);
+  EXPECT_NE(pattern_error("twill:2").find("unknown pattern"), std::string::npos);
+  EXPECT_NE(pattern_error("twill:a/2").find("not an integer"), std::string::npos);
+  EXPECT_NE(pattern_error("twill:2/99999").find("twill"), std::string::npos);
+  EXPECT_NE(pattern_error("basket").find("unknown pattern"), std::string::npos);
+  EXPECT_NE(pattern_error("satin:").find("not an integer"), std::string::npos);
+  EXPECT_NE(pattern_error("plain").find(""), std::string::npos);
+  EXPECT_EQ(pattern_error("plain"), "");
   // The field is named.
-  EXPECT_NE(error_of("basket").find("field 'pattern'"), std::string::npos);
+  EXPECT_NE(pattern_error("basket").find("field 'pattern'"), std::string::npos);
 }
 
 TEST(WeavePattern, FloatingThreadsAndTransposition) {

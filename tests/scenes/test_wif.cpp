@@ -10,6 +10,7 @@
 
 #include "mutate.h"
 #include "test_util.h"
+#include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/rng.h"
 #include "weft/scenes/weave.h"
@@ -64,7 +65,7 @@ std::string replace(std::string text, const std::string& from, const std::string
   return text;
 }
 
-std::string error_of(const std::string& text) {
+std::string wif_error(const std::string& text) {
   return weft::testing::error_of([&] { parse_wif(text, "draft.wif"); });
 }
 
@@ -187,7 +188,7 @@ TEST(Wif, MalformedDraftsAreErrorsNamingFileSectionAndKey) {
   };
   for (const Case& c : cases) {
     const std::string text = replace(kSmall, c.from, c.to);
-    const std::string e = error_of(text);
+    const std::string e = wif_error(text);
     if (c.to == "[WEFT]\nThreads=20000") {
       // ...a valid size (the draft then lacks indices 5.., an error of its own).
       EXPECT_NE(e.find("[TREADLING] 5"), std::string::npos) << e;
@@ -200,7 +201,7 @@ TEST(Wif, MalformedDraftsAreErrorsNamingFileSectionAndKey) {
   const std::string huge =
       replace(replace(kSmall, "Threads=4\nUnits=Millimeters", "Threads=20000\nUnits=Millimeters"),
               "[WEFT]\nThreads=4", "[WEFT]\nThreads=20000");
-  const std::string e = error_of(huge);
+  const std::string e = wif_error(huge);
   EXPECT_NE(e.find("exceeds the limit"), std::string::npos) << e;
   // Files: unreadable and missing.
   EXPECT_THROW(read_wif(kWif / "no-such.wif"), Error);
@@ -277,17 +278,17 @@ TEST(Wif, ManyKeysAreLinearAndBounded) {
   const std::string full = kSmall + "[PRIVATE]\nK1=1\n" + keys;
   const auto t0 = std::chrono::steady_clock::now();
   EXPECT_EQ(parse_wif(full, "many.wif").warp.size(), 4u);
-  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
-  const std::string e = error_of(kSmall + "[PRIVATE]\nK0=1\nK1=1\n" + keys);
+  EXPECT_LT(seconds_since(t0), 2.0);
+  const std::string e = wif_error(kSmall + "[PRIVATE]\nK0=1\nK1=1\n" + keys);
   EXPECT_NE(e.find("[PRIVATE] K" + std::to_string(kWifMaxSectionKeys) + "'"), std::string::npos)
       << e;
   EXPECT_NE(e.find("keys in the section"), std::string::npos) << e;
-  const std::string twice = error_of(kSmall + "[PRIVATE]\nK65536=2\n" + keys);
+  const std::string twice = wif_error(kSmall + "[PRIVATE]\nK65536=2\n" + keys);
   EXPECT_NE(twice.find("[PRIVATE] K65536': key appears twice"), std::string::npos) << twice;
   // Sections are bounded too (each is a map entry).
   std::string sections;
   for (size_t k = 0; k <= kWifMaxSections; ++k) sections += "[S" + std::to_string(k) + "]\n";
-  EXPECT_NE(error_of(sections + kSmall).find("more than 1024 sections"), std::string::npos);
+  EXPECT_NE(wif_error(sections + kSmall).find("more than 1024 sections"), std::string::npos);
 }
 
 // A NUL byte (a binary file renamed .wif), a thread thinner than a fiber and a draft where no
@@ -295,8 +296,8 @@ TEST(Wif, ManyKeysAreLinearAndBounded) {
 TEST(Wif, BinaryThinAndUninterlacedDraftsAreRefused) {
   std::string nul = kSmall;
   nul[kSmall.find("Shafts")] = '\0';
-  EXPECT_NE(error_of(nul).find("draft.wif: field 'line 5': a NUL byte"), std::string::npos)
-      << error_of(nul);
+  EXPECT_NE(wif_error(nul).find("draft.wif: field 'line 5': a NUL byte"), std::string::npos)
+      << wif_error(nul);
   // 1e-9 cm = 1e-5 um; the per-thread override is checked the same way.
   using Case = std::tuple<std::string, std::string, std::string>;
   for (const auto& [from, to, field] :
@@ -304,7 +305,7 @@ TEST(Wif, BinaryThinAndUninterlacedDraftsAreRefused) {
         Case{"Units=Inches\nSpacing=0.01", "Units=Centimeters\nSpacing=1e-9", "[WEFT] SPACING"},
         Case{"Thickness=0.008", "Thickness=0.00001", "[WEFT] THICKNESS"},
         Case{"[THREADING]", "[WEFT SPACING]\n2=0.00000001\n[THREADING]", "[WEFT SPACING] 2"}}) {
-    const std::string e = error_of(replace(kSmall, from, to));
+    const std::string e = wif_error(replace(kSmall, from, to));
     EXPECT_NE(e.find("draft.wif: field '" + field + "'"), std::string::npos) << to << ": " << e;
     EXPECT_NE(e.find("thinner than one fiber"), std::string::npos) << to << ": " << e;
   }

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <set>
 
+#include "lambert_scene.h"
 #include "mesh_checks.h"
 #include "swapped_weave.h"
 #include "test_util.h"
@@ -96,9 +97,7 @@ double worst_overlap(const WovenSample& s, int n) {
   return worst;
 }
 
-std::string error_of(const WeaveOptions& o) {
-  return weft::testing::error_of([&] { make_woven_sample(o); });
-}
+using weft::testing::woven_sample_error;
 
 // Minimum distance between segments of distinct curves by brute force over all pairs and the
 // nine nearest periodic images: the reference for the grid search.
@@ -628,7 +627,7 @@ TEST(Woven, BundledSampleDescriptionIsTheDefault) {
 
 TEST(Woven, BadParametersAreErrorsNamingTheField) {
   auto expect = [](const WeaveOptions& o, const std::string& field) {
-    const std::string e = error_of(o);
+    const std::string e = woven_sample_error(o);
     EXPECT_NE(e.find("field '" + field + "'"), std::string::npos) << field << ": " << e;
   };
   // Each case changes the defaults once; its error must name the field.
@@ -660,12 +659,12 @@ TEST(Woven, BadParametersAreErrorsNamingTheField) {
   o.detail = "fiber";
   o.packing = 0.6;
   expect(o, "packing");
-  EXPECT_NE(error_of(o).find("at most"), std::string::npos);
+  EXPECT_NE(woven_sample_error(o).find("at most"), std::string::npos);
   // A missing draft is named.
   o = defaults();
   o.wif = "/no/such/draft.wif";
   o.pattern.reset();
-  EXPECT_NE(error_of(o).find("/no/such/draft.wif"), std::string::npos);
+  EXPECT_NE(woven_sample_error(o).find("/no/such/draft.wif"), std::string::npos);
   // Absurd sizes are refused from an estimate, before anything is allocated.
   o = defaults();
   o.repeats_x = o.repeats_z = 1000;

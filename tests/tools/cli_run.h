@@ -32,4 +32,11 @@ inline CliRun run_weft_cli(const std::string& args, const std::filesystem::path&
   return r;
 }
 
+// The same run from inside 'dir': relative paths and the bake cache (./.weft-cache) are the
+// test's own.
+inline CliRun run_weft_cli_in(const std::string& args, const std::filesystem::path& dir,
+                              const std::string& prefix = "") {
+  return run_weft_cli(args, dir, "cd '" + dir.string() + "' && " + prefix);
+}
+
 }  // namespace weft::testing

@@ -27,19 +27,15 @@ namespace {
 using weft::testing::CliRun;
 using weft::testing::slurp;
 
-CliRun run(const std::string& args, const fs::path& dir, const std::string& prefix = "") {
-  return weft::testing::run_weft_cli(args, dir, prefix);
-}
+using weft::testing::run_weft_cli;
 
-void write(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-}
+using weft::testing::write_file;
 
 // Runs 'args' with '-o output' and expects a refusal: exit code 2, an error that mentions 'part',
 // and nothing at 'output'. Returns the run for more checks of its message.
 CliRun expect_refused(const std::string& args, const fs::path& output, const std::string& part,
                       const fs::path& dir) {
-  const CliRun r = run(args + " -o '" + output.string() + "'", dir);
+  const CliRun r = run_weft_cli(args + " -o '" + output.string() + "'", dir);
   EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(part), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(output));
@@ -63,10 +59,10 @@ const char* kGoodSpec = R"({"name": "cli-test", "fiber_radius_um": 6,
 TEST(Cli, BakeFiberWritesTableAndJsonSummary) {
   const fs::path dir = fresh_test_dir();
   const fs::path out = dir / "fiber.exr";
-  const CliRun r =
-      run("bake fiber red-cotton --photons 60 --resolution 2 --passes 2 --json --quiet -o '" +
-              out.string() + "'",
-          dir);
+  const CliRun r = run_weft_cli(
+      "bake fiber red-cotton --photons 60 --resolution 2 --passes 2 --json --quiet -o '" +
+          out.string() + "'",
+      dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key : {"photons", "scattering_events", "events_per_s", "per_band", "spec_hash"})
@@ -109,7 +105,7 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
   for (const auto& c : cases) {
     SCOPED_TRACE(c.name);
     const fs::path spec = dir / (c.name + ".json");
-    write(spec, c.text);
+    write_file(spec, c.text);
     const CliRun r = expect_refused("bake fiber '" + spec.string() + "' --photons 10 --quiet",
                                     dir / (c.name + ".exr"), spec.filename().string(), dir);
     if (!c.expect_in_error.empty()) {
@@ -126,22 +122,25 @@ TEST(Cli, BadSpecsNameTheFieldExitNonZeroAndWriteNothing) {
 
 TEST(Cli, BadNumbersOnTheCommandLineAreRejected) {
   const fs::path dir = fresh_test_dir();
-  EXPECT_NE(run("bake fiber red-cotton --resolution 1 -o '" + (dir / "a.exr").string() + "'", dir)
+  EXPECT_NE(run_weft_cli(
+                "bake fiber red-cotton --resolution 1 -o '" + (dir / "a.exr").string() + "'", dir)
                 .exit_code,
             0);
   EXPECT_NE(
-      run("bake fiber red-cotton --photons 0 -o '" + (dir / "b.exr").string() + "'", dir).exit_code,
+      run_weft_cli("bake fiber red-cotton --photons 0 -o '" + (dir / "b.exr").string() + "'", dir)
+          .exit_code,
       0);
   EXPECT_NE(
-      run("bake fiber red-cotton --bands xyz -o '" + (dir / "c.exr").string() + "'", dir).exit_code,
+      run_weft_cli("bake fiber red-cotton --bands xyz -o '" + (dir / "c.exr").string() + "'", dir)
+          .exit_code,
       0);
   EXPECT_FALSE(fs::exists(dir / "a.exr"));
-  const CliRun mie = run("mie --m-re nan --m-im 0 --x 10 --json", dir);
+  const CliRun mie = run_weft_cli("mie --m-re nan --m-im 0 --x 10 --json", dir);
   EXPECT_EQ(mie.exit_code, 2) << mie.err;
-  const CliRun slab =
-      run("slab --mua-per-mm -1 --mus-per-mm 10 --g 0.9 --n-slab 1.4 --thickness-mm 1 "
-          "--photons 10 --seed 1 --json",
-          dir);
+  const CliRun slab = run_weft_cli(
+      "slab --mua-per-mm -1 --mus-per-mm 10 --g 0.9 --n-slab 1.4 --thickness-mm 1 "
+      "--photons 10 --seed 1 --json",
+      dir);
   EXPECT_NE(slab.exit_code, 0);
   EXPECT_NE(slab.err.find("mua"), std::string::npos) << slab.err;
 }
@@ -153,7 +152,7 @@ TEST(Cli, InterruptedBakeLeavesACompleteTableOrNone) {
   // and writes nothing (exit 130). Never a partial file.
   const fs::path dir = fresh_test_dir();
   const fs::path out = dir / "fiber.exr";
-  const CliRun r = run(
+  const CliRun r = run_weft_cli(
       "bake fiber white-cotton --photons 100000000 --passes 100000 --resolution 2 --quiet -o '" +
           out.string() + "'",
       dir, "timeout --preserve-status -s INT 2 ");
@@ -180,13 +179,13 @@ TEST(Cli, TableInfoReportsTheAlbedoForLightFromTheNormal) {
   // The figures are the library's (TabulatedBsdfTable::directional_albedo), printed per channel.
   const fs::path dir = fresh_test_dir();
   const fs::path table = dir / "lambert.exr";
-  const CliRun bake =
-      run("table bake lambert --params '{\"reflectance\": 0.5}' -R 8 --spp 4 "
-          "--quiet -o '" +
-              table.string() + "'",
-          dir);
+  const CliRun bake = run_weft_cli(
+      "table bake lambert --params '{\"reflectance\": 0.5}' -R 8 --spp 4 "
+      "--quiet -o '" +
+          table.string() + "'",
+      dir);
   ASSERT_EQ(bake.exit_code, 0) << bake.err;
-  const CliRun info = run("table info --json '" + table.string() + "'", dir);
+  const CliRun info = run_weft_cli("table info --json '" + table.string() + "'", dir);
   ASSERT_EQ(info.exit_code, 0) << info.err;
   const auto j = nlohmann::json::parse(info.out);
   const auto t = weft::TabulatedBsdfTable::read_exr(table);
@@ -223,10 +222,10 @@ TEST(Cli, BakeFabricSummationReportsTheTransmittanceSeenFromAbove) {
       2, 1);
   fiber.kind = "fiber";
   fiber.write_exr(dir / "fiber.exr");
-  const CliRun r =
-      run("bake fabric --method summation -R 4 --samples 2 --quiet --json --fiber '" +
-              (dir / "fiber.exr").string() + "' -o '" + (dir / "fabric.exr").string() + "'",
-          dir);
+  const CliRun r = run_weft_cli(
+      "bake fabric --method summation -R 4 --samples 2 --quiet --json --fiber '" +
+          (dir / "fiber.exr").string() + "' -o '" + (dir / "fabric.exr").string() + "'",
+      dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (int c = 0; c < 3; ++c) {
@@ -254,7 +253,7 @@ TEST(Cli, MieRangeErrorsNameTheField) {
       {"--x 1", "'--m-re'"},  // required with --x: the command's own rule
   };
   for (const auto& c : cases) {
-    const CliRun r = run("mie " + c.args + " --json", dir);
+    const CliRun r = run_weft_cli("mie " + c.args + " --json", dir);
     EXPECT_EQ(r.exit_code, 2) << c.args << ": " << r.err;
     EXPECT_NE(r.err.find(c.field), std::string::npos) << c.args << ": " << r.err;
     EXPECT_TRUE(r.out.empty()) << c.args;
@@ -264,8 +263,8 @@ TEST(Cli, MieRangeErrorsNameTheField) {
 TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
   const fs::path dir = fresh_test_dir();
   // Defaults (the bundled red-cotton poplin), fiber detail, JSON summary.
-  const CliRun fib =
-      run("weave --detail fiber --repeats 2x1 --json -o '" + (dir / "f.glb").string() + "'", dir);
+  const CliRun fib = run_weft_cli(
+      "weave --detail fiber --repeats 2x1 --json -o '" + (dir / "f.glb").string() + "'", dir);
   ASSERT_EQ(fib.exit_code, 0) << fib.err;
   const auto j = nlohmann::json::parse(fib.out);
   EXPECT_EQ(j["detail"], "fiber");
@@ -274,14 +273,14 @@ TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
   EXPECT_GE(j["min_fiber_distance_um"].get<double>(), 16 * 0.99);
   EXPECT_TRUE(fs::exists(dir / "f.glb"));
   // The legacy options still make the open patch.
-  const CliRun legacy =
-      run("weave --yarns 2 --segments 8 --sides 4 -o '" + (dir / "l.gltf").string() + "'", dir);
+  const CliRun legacy = run_weft_cli(
+      "weave --yarns 2 --segments 8 --sides 4 -o '" + (dir / "l.gltf").string() + "'", dir);
   EXPECT_EQ(legacy.exit_code, 0) << legacy.err;
   expect_refused("weave --yarns 2 --detail fiber", dir / "m.gltf", "detail", dir);
   // A malformed draft: error naming file, section and key; non-zero exit; nothing written.
-  write(dir / "bad.wif",
-        "[WEAVING]\nShafts=2\nTreadles=2\n[WARP]\nThreads=2\n[WEFT]\nThreads=2\n"
-        "[THREADING]\n1=1\n2=3\n[TIEUP]\n1=1\n2=2\n[TREADLING]\n1=1\n2=2\n");
+  write_file(dir / "bad.wif",
+             "[WEAVING]\nShafts=2\nTreadles=2\n[WARP]\nThreads=2\n[WEFT]\nThreads=2\n"
+             "[THREADING]\n1=1\n2=3\n[TIEUP]\n1=1\n2=2\n[TREADLING]\n1=1\n2=2\n");
   const CliRun bad = expect_refused("weave --wif '" + (dir / "bad.wif").string() + "'",
                                     dir / "b.glb", "bad.wif", dir);
   EXPECT_NE(bad.err.find("[THREADING] 2"), std::string::npos) << bad.err;
@@ -293,8 +292,8 @@ TEST(Cli, WeaveWritesSamplesAndRefusesBadInput) {
 
 TEST(Cli, SceneCarSeatWritesTheSeatAndRefusesBadInput) {
   const fs::path dir = fresh_test_dir();
-  const CliRun r =
-      run("scene car-seat --cell-mm 20 --json -o '" + (dir / "seat.glb").string() + "'", dir);
+  const CliRun r = run_weft_cli(
+      "scene car-seat --cell-mm 20 --json -o '" + (dir / "seat.glb").string() + "'", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["scene"], "car-seat");
@@ -305,7 +304,7 @@ TEST(Cli, SceneCarSeatWritesTheSeatAndRefusesBadInput) {
   EXPECT_TRUE(fs::exists(dir / "seat.glb"));
   expect_refused("scene car-seat", dir / "seat.obj", "must end in .gltf or .glb", dir);
   const CliRun small =
-      run("scene car-seat --cell-mm 0.5 -o '" + (dir / "s.glb").string() + "'", dir);
+      run_weft_cli("scene car-seat --cell-mm 0.5 -o '" + (dir / "s.glb").string() + "'", dir);
   EXPECT_NE(small.exit_code, 0);
   EXPECT_NE(small.err.find("cell-mm"), std::string::npos) << small.err;
   EXPECT_FALSE(fs::exists(dir / "s.glb"));
@@ -318,17 +317,18 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   // by name before any work, with nothing written.
   const fs::path dir = fresh_test_dir();
   const fs::path fiber = dir / "fiber.exr";
-  ASSERT_EQ(run("bake fiber red-cotton --photons 2000 --resolution 3 --bands rgb --quiet -o '" +
-                    fiber.string() + "'",
-                dir)
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      run_weft_cli("bake fiber red-cotton --photons 2000 --resolution 3 --bands rgb --quiet -o '" +
+                       fiber.string() + "'",
+                   dir)
+          .exit_code,
+      0);
   const std::string base = "bake fabric --fiber '" + fiber.string() +
                            "' --method raytrace --detail fiber -R 2 --samples 400 --quiet --json";
   std::map<std::string, uint64_t> splits;
   for (const std::string est : {"hero", "mean", "nee"}) {
     const fs::path out = dir / (est + ".exr");
-    const CliRun r = run(base + " --estimator " + est + " -o '" + out.string() + "'", dir);
+    const CliRun r = run_weft_cli(base + " --estimator " + est + " -o '" + out.string() + "'", dir);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     const auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j.at("estimator"), est);
@@ -355,7 +355,7 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   EXPECT_GT(splits["hero"], 0u);
   EXPECT_EQ(splits["mean"], 0u);
   const fs::path low = dir / "low.exr";
-  const CliRun r = run(base + " --split-threshold 0.25 -o '" + low.string() + "'", dir);
+  const CliRun r = run_weft_cli(base + " --split-threshold 0.25 -o '" + low.string() + "'", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j.at("split_threshold").get<double>(), 0.25);
@@ -369,7 +369,7 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   expect_refused(base + " --estimator hero --next-event-rays 2", out, "--next-event-rays", dir);
   expect_refused(base + " --launch-lattice 5", out, "--launch-lattice", dir);
   // An unknown name is the option parser's refusal (its own exit code), naming the option.
-  const CliRun fancy = run(base + " --estimator fancy -o '" + out.string() + "'", dir);
+  const CliRun fancy = run_weft_cli(base + " --estimator fancy -o '" + out.string() + "'", dir);
   EXPECT_NE(fancy.exit_code, 0);
   EXPECT_NE(fancy.err.find("--estimator"), std::string::npos) << fancy.err;
   EXPECT_FALSE(fs::exists(out));
@@ -382,7 +382,7 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
   // passes straight through alone (grey: the same in every channel), what met a fiber is booked
   // as lost, and the table says it was cut.
   const fs::path cut = dir / "cut.exr";
-  const CliRun c = run(base + " --max-scatterings 1 -o '" + cut.string() + "'", dir);
+  const CliRun c = run_weft_cli(base + " --max-scatterings 1 -o '" + cut.string() + "'", dir);
   ASSERT_EQ(c.exit_code, 0) << c.err;
   const auto jc = nlohmann::json::parse(c.out);
   EXPECT_GT(jc.at("lost").get<double>(), 0.1);
@@ -394,7 +394,7 @@ TEST(Cli, BakeFabricEstimatorAndSplitThresholdAreOptionsAndItsCountsAreReported)
     ASSERT_EQ(tc.values[v], tc.values[v + 1]) << v;
     ASSERT_EQ(tc.values[v], tc.values[v + 2]) << v;
   }
-  const CliRun zero = run(base + " --max-scatterings 0 -o '" + out.string() + "'", dir);
+  const CliRun zero = run_weft_cli(base + " --max-scatterings 0 -o '" + out.string() + "'", dir);
   EXPECT_NE(zero.exit_code, 0);  // the option parser's refusal, naming the option
   EXPECT_NE(zero.err.find("--max-scatterings"), std::string::npos) << zero.err;
   EXPECT_FALSE(fs::exists(out));
@@ -405,20 +405,23 @@ TEST(Cli, ExportWritesTheFormatItsExtensionNamesAndRefusesOthers) {
   // its summary, its output guard and its errors naming the option.
   const fs::path dir = fresh_test_dir();
   const fs::path table = dir / "lambert.exr";
-  ASSERT_EQ(run("table bake lambert --params '{\"reflectance\": 0.5}' -R 4 --spp 1 --quiet -o '" +
+  ASSERT_EQ(run_weft_cli(
+                "table bake lambert --params '{\"reflectance\": 0.5}' -R 4 --spp 1 --quiet -o '" +
                     table.string() + "'",
                 dir)
                 .exit_code,
             0);
   const fs::path out = dir / "lambert.mbsdf";
-  const CliRun ok = run("export --json '" + table.string() + "' -o '" + out.string() + "'", dir);
+  const CliRun ok =
+      run_weft_cli("export --json '" + table.string() + "' -o '" + out.string() + "'", dir);
   ASSERT_EQ(ok.exit_code, 0) << ok.err;
   const auto j = nlohmann::json::parse(ok.out);
   EXPECT_EQ(j["format"], "MDL .mbsdf");
   EXPECT_FALSE(j["dropped"].empty());
   EXPECT_TRUE(fs::exists(out));
   for (const std::string bad : {"lambert.txt", "no-folder/lambert.bsdf"}) {
-    const CliRun r = run("export '" + table.string() + "' -o '" + (dir / bad).string() + "'", dir);
+    const CliRun r =
+        run_weft_cli("export '" + table.string() + "' -o '" + (dir / bad).string() + "'", dir);
     EXPECT_EQ(r.exit_code, 2) << r.err;
     EXPECT_NE(r.err.find("--output"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / bad));

@@ -23,11 +23,7 @@ namespace {
 
 using weft::testing::CliRun;
 
-// Runs weft with 'args' in 'dir' (its working folder; stdout and stderr kept there); 'prefix' goes
-// before the command in the shell (e.g. a ulimit).
-CliRun run(const std::string& args, const fs::path& dir, const std::string& prefix = "") {
-  return weft::testing::run_weft_cli(args, dir, "cd '" + dir.string() + "' && " + prefix);
-}
+using weft::testing::run_weft_cli_in;
 
 // 'text' with the first 'from' replaced by 'to' (which must be there).
 std::string replaced(const std::string& text, const std::string& from, const std::string& to) {
@@ -36,12 +32,10 @@ std::string replaced(const std::string& text, const std::string& from, const std
   return at == std::string::npos ? text : text.substr(0, at) + to + text.substr(at + from.size());
 }
 
-void write(const fs::path& p, const std::string& text) {
-  std::ofstream(p) << text;
-}
+using weft::testing::write_file;
 
-const std::string kExamples = std::string(WEFT_SOURCE_DIR) + "/scenes/examples";
-const std::string kPlane = kExamples + "/lambert-plane.json";
+using weft::testing::kExamples;
+const std::string kPlane = (kExamples / "lambert-plane.json").string();
 
 // Expects a weft::Error: exit 2, every one of 'parts' in the message, and no file 'output'.
 void expect_error(const CliRun& r, std::initializer_list<const char*> parts,
@@ -62,32 +56,33 @@ TEST(CliBadInput, NegativeOrOctalSeedIsRefused) {
   const fs::path dir = fresh_test_dir();
   // CLI11 read "-5" as 2^64 - 5 and "010" as 8, and the render ran.
   for (const char* seed : {"-5", "010", "1e3", "18446744073709551616"}) {
-    const CliRun r = run("render '" + kPlane + "' -o out.exr --spp 1 --seed " + seed, dir);
+    const CliRun r =
+        run_weft_cli_in("render '" + kPlane + "' -o out.exr --spp 1 --seed " + seed, dir);
     EXPECT_NE(r.exit_code, 0) << seed;
     EXPECT_NE(r.err.find("seed"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.exr"));
   }
-  const CliRun bake = run("bake fiber red-cotton -o t.exr --seed -1", dir);
+  const CliRun bake = run_weft_cli_in("bake fiber red-cotton -o t.exr --seed -1", dir);
   EXPECT_NE(bake.exit_code, 0);
   EXPECT_NE(bake.err.find("seed"), std::string::npos) << bake.err;
 }
 
 TEST(CliBadInput, TableWrittenAsPngIsRefusedBeforeTheWork) {
   const fs::path dir = fresh_test_dir();
-  expect_error(run("table bake lambert -R 2 -o table.png", dir), {"table.png", ".exr"},
+  expect_error(run_weft_cli_in("table bake lambert -R 2 -o table.png", dir), {"table.png", ".exr"},
                dir / "table.png");
   // Refused before the bake: 10^9 photons per band would otherwise run for hours first.
-  expect_error(run("bake fiber red-cotton --photons 1000000000 -o table.png", dir),
+  expect_error(run_weft_cli_in("bake fiber red-cotton --photons 1000000000 -o table.png", dir),
                {"table.png", "--output", "must end in .exr"}, dir / "table.png");
 }
 
 TEST(CliBadInput, SweepViewListWithAStrayCommaOrTooFineAStepIsRefused) {
   const fs::path dir = fresh_test_dir();
   for (const char* views : {"0,10,", "0,,10", ",0"})
-    expect_error(run("sweep '" + kPlane + "' -o s.csv --view-zenith-deg " + views, dir),
+    expect_error(run_weft_cli_in("sweep '" + kPlane + "' -o s.csv --view-zenith-deg " + views, dir),
                  {"--view-zenith-deg", "stray comma"}, dir / "s.csv");
   // A step of 1e-7 asked for 8e8 views and died of std::bad_alloc.
-  expect_error(run("sweep '" + kPlane + "' -o s.csv --view-zenith-deg 0:80:1e-7", dir),
+  expect_error(run_weft_cli_in("sweep '" + kPlane + "' -o s.csv --view-zenith-deg 0:80:1e-7", dir),
                {"--view-zenith-deg", "8e+08 values, more than 100000"}, dir / "s.csv");
   // The same in a scene's sweep section names the JSON field.
   std::ifstream in(kPlane);
@@ -96,25 +91,26 @@ TEST(CliBadInput, SweepViewListWithAStrayCommaOrTooFineAStepIsRefused) {
   std::string scene = ss.str();
   const std::string step = "\"step\": 10";
   scene = replaced(scene, step, "\"step\": 1e-6");
-  write(dir / "plane.json", scene);
-  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
-  expect_error(run("sweep plane.json -o s.csv", dir),
+  write_file(dir / "plane.json", scene);
+  fs::copy_file(kExamples / "lambert-plane.gltf", dir / "lambert-plane.gltf");
+  expect_error(run_weft_cli_in("sweep plane.json -o s.csv", dir),
                {"plane.json", "sweep.view_zenith_deg.step", "more than 100000"}, dir / "s.csv");
 }
 
 TEST(CliBadInput, HugeNumberAndDeepNestingInASceneAreClearErrors) {
   const fs::path dir = fresh_test_dir();
-  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
+  fs::copy_file(kExamples / "lambert-plane.gltf", dir / "lambert-plane.gltf");
   // Was "internal error" (nlohmann's out_of_range escaped).
-  write(dir / "big.json",
-        R"({"gltf": "lambert-plane.gltf", "lights": [{"type": "parallel", "irradiance": 1e400}]})");
-  expect_error(run("render big.json -o out.exr", dir),
+  write_file(
+      dir / "big.json",
+      R"({"gltf": "lambert-plane.gltf", "lights": [{"type": "parallel", "irradiance": 1e400}]})");
+  expect_error(run_weft_cli_in("render big.json -o out.exr", dir),
                {"big.json: field 'lights[0].irradiance': number 1e400 is out of range"},
                dir / "out.exr");
   // Was a segfault (unbounded recursion).
-  write(dir / "deep.json", std::string(100000, '['));
-  expect_error(run("render deep.json -o out.exr", dir), {"deep.json", "nested deeper than 128"},
-               dir / "out.exr");
+  write_file(dir / "deep.json", std::string(100000, '['));
+  expect_error(run_weft_cli_in("render deep.json -o out.exr", dir),
+               {"deep.json", "nested deeper than 128"}, dir / "out.exr");
 }
 
 TEST(CliBadInput, ExtremeFiberSpecsAreRefusedNamingTheField) {
@@ -129,40 +125,41 @@ TEST(CliBadInput, ExtremeFiberSpecsAreRefusedNamingTheField) {
     "size": {"distribution": "lognormal", "median_radius_um": MEDIAN, "sigma": 0.3}})";
   auto with_median = [&](const std::string& m) { return replaced(voids, "MEDIAN", m); };
   // Each of these ran for hours without a word.
-  write(dir / "median.json", spec("1.5", with_median("1e4")));
-  expect_error(run("bake fiber median.json -o t.exr", dir),
+  write_file(dir / "median.json", spec("1.5", with_median("1e4")));
+  expect_error(run_weft_cli_in("bake fiber median.json -o t.exr", dir),
                {"median.json", "species[0].size.median_radius_um", "half the fiber radius"},
                dir / "t.exr");
-  write(dir / "host.json", spec("1e6", with_median("0.2")));
-  expect_error(run("bake fiber host.json -o t.exr", dir), {"host.json", "host.n", "[1, 3]"},
-               dir / "t.exr");
+  write_file(dir / "host.json", spec("1e6", with_median("0.2")));
+  expect_error(run_weft_cli_in("bake fiber host.json -o t.exr", dir),
+               {"host.json", "host.n", "[1, 3]"}, dir / "t.exr");
   std::string many;
   for (int i = 0; i < 1000; ++i) {
     if (i) many += ",";
     many += with_median("0.2");
   }
-  write(dir / "species.json", spec("1.5", many));
-  expect_error(run("bake fiber species.json -o t.exr", dir),
+  write_file(dir / "species.json", spec("1.5", many));
+  expect_error(run_weft_cli_in("bake fiber species.json -o t.exr", dir),
                {"species.json", "'species'", "1000 species, more than 16"}, dir / "t.exr");
 }
 
 TEST(CliBadInput, LongBakesNeedConfirmation) {
   const fs::path dir = fresh_test_dir();
   // 1e12 photons per band: 33e12 photons at >= 0.5 us each is years on any machine here.
-  const CliRun r = run("bake fiber red-cotton --photons 1000000000000 -o t.exr", dir);
+  const CliRun r = run_weft_cli_in("bake fiber red-cotton --photons 1000000000000 -o t.exr", dir);
   expect_error(r, {"--photons", "would take at least", "--yes-long"}, dir / "t.exr");
   // The bound follows the options (fiber_table_bake.h): 2.1 us per photon with the defaults'
   // next-event estimation and four surface samples, 0.5 us with plain exits.
   EXPECT_NE(r.err.find("2.1 us per photon per core at least"), std::string::npos) << r.err;
-  const CliRun plain =
-      run("bake fiber red-cotton --photons 1000000000000 --estimator plain -o t.exr", dir);
+  const CliRun plain = run_weft_cli_in(
+      "bake fiber red-cotton --photons 1000000000000 --estimator plain -o t.exr", dir);
   expect_error(plain, {"--photons", "0.5 us per photon per core at least"}, dir / "t.exr");
   // --yes-long passes that check (after the subcommand too); the memory budget then refuses (at
   // its floor of 0.05 GB, cli_util.h kMinMemoryGb, a bake at resolution 16 needs 178 MB).
-  expect_error(run("bake fiber red-cotton --photons 1000000000000 --resolution 16 -o t.exr "
-                   "--yes-long --max-memory-gb 0.05",
-                   dir),
-               {"--resolution", "needs about", "allowed by --max-memory-gb"}, dir / "t.exr");
+  expect_error(
+      run_weft_cli_in("bake fiber red-cotton --photons 1000000000000 --resolution 16 -o t.exr "
+                      "--yes-long --max-memory-gb 0.05",
+                      dir),
+      {"--resolution", "needs about", "allowed by --max-memory-gb"}, dir / "t.exr");
 }
 
 // Renders, sweeps and ray-traced fabric tables estimate their time before starting, from a lower
@@ -173,18 +170,19 @@ TEST(CliBadInput, LongRendersSweepsAndRayTracesNeedConfirmation) {
   const fs::path dir = fresh_test_dir();
   // 4096^2 pixels x 10^6 spp x 0.05 us = 8.4e5 core-seconds: over an hour on up to 233 cores.
   expect_error(
-      run("render " + kPlane + " --width 4096 --height 4096 --spp 1000000 -o t.exr", dir),
+      run_weft_cli_in("render " + kPlane + " --width 4096 --height 4096 --spp 1000000 -o t.exr",
+                      dir),
       {"lambert-plane.json", "spp", "would take at least", "us per path sample", "--yes-long"},
       dir / "t.exr");
   // 15 views, each with its white reference, of 4096^2 pixels at 10^6 spp.
   expect_error(
-      run("sweep " + kPlane + " --spp 1000000 --resolution 4096 -o t.csv", dir),
+      run_weft_cli_in("sweep " + kPlane + " --spp 1000000 --resolution 4096 -o t.csv", dir),
       {"lambert-plane.json", "spp", "a sweep of 15 views", "would take at least", "--yes-long"},
       dir / "t.csv");
   // 128 incident bins x 2^36 particles x 0.25 us: 2.2e6 core-seconds. Refused before the fiber
   // table is baked, so no bake cache appears either.
   expect_error(
-      run("bake fabric --method raytrace -R 8 --samples 68719476736 -o t.exr", dir),
+      run_weft_cli_in("bake fabric --method raytrace -R 8 --samples 68719476736 -o t.exr", dir),
       {"--samples", "128 incident bins", "would take at least", "us per particle", "--yes-long"},
       dir / "t.exr");
   EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
@@ -215,7 +213,7 @@ TEST(CliBadInput, WeaveTableOptionsAreNamedBeforeAnyWork) {
            {raytrace + "--weave-out w.exr --weave-resolution 0", {"--weave-resolution"}},
            {raytrace + "--weave-out t.exr", {"t.exr", "--weave-out"}},
        }) {
-    const CliRun r = run(c.args, dir);
+    const CliRun r = run_weft_cli_in(c.args, dir);
     EXPECT_NE(r.exit_code, 0) << c.args;
     for (const char* p : c.parts)
       EXPECT_NE(r.err.find(p), std::string::npos) << c.args << "\n" << r.err;
@@ -230,18 +228,19 @@ TEST(CliBadInput, MemoryBudgetRefusesBeforeAllocating) {
   // A bake at R = 32 holds 33 bands of 2048^2 doubles twice: 2.3 GB even for one photon (the
   // measured peak of `weft bake fiber red-cotton --resolution 32 --photons 1 --bands rgb` was
   // 2.34 GB resident).
-  expect_error(run("--max-memory-gb 1 bake fiber red-cotton --resolution 32 --photons 1 "
-                   "--bands rgb -o t.exr",
-                   dir),
-               {"--resolution", "a bake at resolution 32 needs about 2.3 GB"}, dir / "t.exr");
+  expect_error(
+      run_weft_cli_in("--max-memory-gb 1 bake fiber red-cotton --resolution 32 --photons 1 "
+                      "--bands rgb -o t.exr",
+                      dir),
+      {"--resolution", "a bake at resolution 32 needs about 2.3 GB"}, dir / "t.exr");
   // A 16384^2 render with a mask: 68 bytes a pixel (the image, and the mask's counts, sums and
   // squares), 18.3 GB.
-  expect_error(run("render '" + kPlane +
-                       "' --width 16384 --height 16384 --mask m.exr --mask-object plane "
-                       "-o out.exr --max-memory-gb 4",
-                   dir),
-               {"lambert-plane.json", "width x height", "with a mask needs about 18.3 GB"},
-               dir / "out.exr");
+  expect_error(
+      run_weft_cli_in("render '" + kPlane +
+                          "' --width 16384 --height 16384 --mask m.exr --mask-object plane "
+                          "-o out.exr --max-memory-gb 4",
+                      dir),
+      {"lambert-plane.json", "width x height", "with a mask needs about 18.3 GB"}, dir / "out.exr");
   EXPECT_FALSE(fs::exists(dir / "m.exr"));
 }
 
@@ -249,16 +248,17 @@ TEST(CliBadInput, OutOfMemoryIsAClearErrorNotACrash) {
   const fs::path dir = fresh_test_dir();
   // The budget raised past what a 3 GB address space allows: the allocation fails, and main()
   // turns std::bad_alloc into exit code 2 with a message.
-  const CliRun r = run("render '" + kPlane +
-                           "' --width 16384 --height 16384 --mask m.exr --mask-object plane "
-                           "-o out.exr --max-memory-gb 100 --quiet",
-                       dir, "ulimit -v 3000000 && ");
+  const CliRun r =
+      run_weft_cli_in("render '" + kPlane +
+                          "' --width 16384 --height 16384 --mask m.exr --mask-object plane "
+                          "-o out.exr --max-memory-gb 100 --quiet",
+                      dir, "ulimit -v 3000000 && ");
   expect_error(r, {"out of memory"}, dir / "out.exr");
 }
 
 TEST(CliBadInput, ExrAttributeClaimingMoreThanTheFileIsRefusedBeforeReading) {
   const fs::path dir = fresh_test_dir();
-  ASSERT_EQ(run("table bake lambert -R 2 -o t.exr --quiet", dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli_in("table bake lambert -R 2 -o t.exr --quiet", dir).exit_code, 0);
   // Make the "units" string attribute claim 1.9 GB (OpenEXR allocated that before its error).
   std::string bytes = slurp(dir / "t.exr");
   ASSERT_LT(bytes.size(), 4096u);
@@ -269,7 +269,7 @@ TEST(CliBadInput, ExrAttributeClaimingMoreThanTheFileIsRefusedBeforeReading) {
   for (int i = 0; i < 4; ++i) bytes[at + key.size() + i] = static_cast<char>(claim >> (8 * i));
   std::ofstream(dir / "bad.exr", std::ios::binary) << bytes;
   // Under a 1 GB address space the old reader died of std::bad_alloc; now it never asks.
-  const CliRun r = run("table info bad.exr", dir, "ulimit -v 1000000 && ");
+  const CliRun r = run_weft_cli_in("table info bad.exr", dir, "ulimit -v 1000000 && ");
   expect_error(r, {"bad.exr", "field 'units'", "claims 1900000000 bytes"}, dir / "none");
 }
 
@@ -278,7 +278,7 @@ TEST(CliBadInput, ExrAttributeClaimingMoreThanTheFileIsRefusedBeforeReading) {
 // fill it, 10 s and 1.5 GB per input.
 TEST(CliBadInput, ExrTableClaimingMorePixelsThanTheFileHoldsIsRefused) {
   const fs::path dir = fresh_test_dir();
-  ASSERT_EQ(run("table bake lambert -R 2 -o t.exr --quiet", dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli_in("table bake lambert -R 2 -o t.exr --quiet", dir).exit_code, 0);
   std::string bytes = slurp(dir / "t.exr");
   auto set_int = [&](const std::string& key, size_t offset, int32_t v) {
     const size_t at = bytes.find(key);
@@ -291,7 +291,7 @@ TEST(CliBadInput, ExrTableClaimingMorePixelsThanTheFileHoldsIsRefused) {
   set_int(std::string("dataWindow") + '\0' + "box2i" + '\0', 12, 2047);  // max.y
   bytes += std::string(4096, '\0');  // room for the line offsets of 2048 lines
   std::ofstream(dir / "big.exr", std::ios::binary) << bytes;
-  expect_error(run("table info big.exr", dir),
+  expect_error(run_weft_cli_in("table info big.exr", dir),
                {"big.exr", "field 'resolution'", "50331648 bytes of pixels", "can hold"},
                dir / "none");
 }
@@ -303,7 +303,7 @@ TEST(CliBadInput, ExrTableClaimingMorePixelsThanTheFileHoldsIsRefused) {
 TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
   const fs::path dir = fresh_test_dir();
   fs::copy_file(kPlane, dir / "plane.json");
-  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
+  fs::copy_file(kExamples / "lambert-plane.gltf", dir / "lambert-plane.gltf");
   const std::string sweep = " sweep plane.json -o s.csv";
   struct Case {
     std::string options;
@@ -319,18 +319,18 @@ TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
        }) {
     for (const char* dry : {"", " --dry-run"}) {
       const std::string args = std::string("slurm --shards 2") + dry + " " + c.options + sweep;
-      const CliRun r = run(args, dir);
+      const CliRun r = run_weft_cli_in(args, dir);
       expect_error(r, {c.option}, dir / "s.csv.slurm");
       EXPECT_EQ(r.out.find("#SBATCH"), std::string::npos) << r.out;
     }
   }
   // A newline in the wrapped command's output path, in any of its arguments.
-  expect_error(run("slurm --shards 2 sweep plane.json -o 's\n.csv'", dir), {"'-o'"},
+  expect_error(run_weft_cli_in("slurm --shards 2 sweep plane.json -o 's\n.csv'", dir), {"'-o'"},
                dir / "s\n.csv.slurm");
-  expect_error(run("slurm --shards 2 sweep plane.json --sample 'a\nb' -o s.csv", dir),
+  expect_error(run_weft_cli_in("slurm --shards 2 sweep plane.json --sample 'a\nb' -o s.csv", dir),
                {"--sample", "control character"}, dir / "s.csv.slurm");
   // Valid values go into the scripts as given (Slurm's time formats, a partition list).
-  const CliRun ok = run(
+  const CliRun ok = run_weft_cli_in(
       "slurm --shards 2 --dry-run --time 2-12 --partition cpu,long --account lab_1" + sweep, dir);
   ASSERT_EQ(ok.exit_code, 0) << ok.err;
   for (const char* line :
@@ -339,7 +339,7 @@ TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
   EXPECT_FALSE(fs::exists(dir / "s.csv.slurm"));
   // More shards than the sweep's 16 units (15 views and the normal-incidence reference): the
   // check runs the last shard, which has work, and writes no part of its own.
-  const CliRun many = run(std::string("slurm --shards 40 --dry-run") + sweep, dir);
+  const CliRun many = run_weft_cli_in(std::string("slurm --shards 40 --dry-run") + sweep, dir);
   ASSERT_EQ(many.exit_code, 0) << many.err;
   EXPECT_EQ(many.out.find("views "), std::string::npos) << many.out;
   EXPECT_FALSE(fs::exists(dir / "s.csv.slurm"));
@@ -349,21 +349,22 @@ TEST(CliBadInput, SlurmRefusesValuesThatWouldChangeItsScripts) {
 TEST(CliBadInput, SlurmChecksTheWrappedCommandBeforeWritingScripts) {
   const fs::path dir = fresh_test_dir();
   fs::copy_file(kPlane, dir / "plane.json");
-  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
+  fs::copy_file(kExamples / "lambert-plane.gltf", dir / "lambert-plane.gltf");
   // Refused by the wrapped command's own parser, its own checks and the output guard.
-  expect_error(run("slurm --shards 2 bake fiber red-cotton --photons -5 -o t.exr", dir),
+  expect_error(run_weft_cli_in("slurm --shards 2 bake fiber red-cotton --photons -5 -o t.exr", dir),
                {"--photons"}, dir / "t.exr.slurm");
-  expect_error(run("slurm --shards 2 bake fiber nonesuch -o t.exr", dir), {"nonesuch"},
+  expect_error(run_weft_cli_in("slurm --shards 2 bake fiber nonesuch -o t.exr", dir), {"nonesuch"},
                dir / "t.exr.slurm");
   // A summation cannot be sharded: only the ray trace can.
-  expect_error(run("slurm --shards 2 bake fabric -R 2 -o t.exr", dir), {"--method raytrace"},
-               dir / "t.exr.slurm");
-  expect_error(run("slurm --shards 2 sweep plane.json -o lambert-plane.gltf", dir),
+  expect_error(run_weft_cli_in("slurm --shards 2 bake fabric -R 2 -o t.exr", dir),
+               {"--method raytrace"}, dir / "t.exr.slurm");
+  expect_error(run_weft_cli_in("slurm --shards 2 sweep plane.json -o lambert-plane.gltf", dir),
                {"lambert-plane.gltf", "refusing to overwrite"}, dir / "lambert-plane.gltf.slurm");
-  expect_error(run("slurm --shards 2 sweep plane.json --spp 0 -o s.csv", dir), {"--spp"},
-               dir / "s.csv.slurm");
+  expect_error(run_weft_cli_in("slurm --shards 2 sweep plane.json --spp 0 -o s.csv", dir),
+               {"--spp"}, dir / "s.csv.slurm");
   // Work that a shard would refuse without --yes-long.
-  expect_error(run("slurm --shards 2 bake fiber red-cotton --photons 1000000000000 -o t.exr", dir),
+  expect_error(run_weft_cli_in(
+                   "slurm --shards 2 bake fiber red-cotton --photons 1000000000000 -o t.exr", dir),
                {"--photons", "--yes-long"}, dir / "t.exr.slurm");
   // The scene's files are untouched and nothing was written beside them.
   EXPECT_EQ(slurp(dir / "plane.json"), slurp(kPlane));
@@ -379,7 +380,7 @@ TEST(CliBadInput, SlurmChecksTheWrappedCommandBeforeWritingScripts) {
 // is refused naming the option, before any work (no output).
 TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
   const fs::path dir = fresh_test_dir();
-  ASSERT_EQ(run("table bake lambert -R 2 --spp 1 -o a.exr --quiet", dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli_in("table bake lambert -R 2 --spp 1 -o a.exr --quiet", dir).exit_code, 0);
   const std::string render = "render '" + kPlane + "' -o out.exr --quiet ";
   const std::string sweep = "sweep '" + kPlane + "' -o out.exr --quiet ";
   struct Case {
@@ -407,15 +408,16 @@ TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
            {"bench render --repeats 0", "--repeats"},
            {"bench render --repeats 1001", "--repeats"},
        }) {
-    const CliRun r = run(c.args, dir);
+    const CliRun r = run_weft_cli_in(c.args, dir);
     EXPECT_NE(r.exit_code, 0) << c.args;
     EXPECT_NE(r.err.find(c.option), std::string::npos) << c.args << "\n" << r.err;
     EXPECT_FALSE(fs::exists(dir / "out.exr")) << c.args;
   }
   // In range the same options still run (the floor of the budget is 0.05 GB).
-  EXPECT_EQ(
-      run("--max-memory-gb 0.05 table bake lambert -R 2 --spp 1 -o out.exr --quiet", dir).exit_code,
-      0);
+  EXPECT_EQ(run_weft_cli_in(
+                "--max-memory-gb 0.05 table bake lambert -R 2 --spp 1 -o out.exr --quiet", dir)
+                .exit_code,
+            0);
 }
 
 namespace {
@@ -441,15 +443,15 @@ TEST(CliBadInput, HugeOrDegenerateMeasuredTableIsRefusedBeforeAnyWork) {
   const fs::path dir = fresh_test_dir();
   std::string table = "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n";
   for (int i = 0; i <= 180; ++i) table += std::to_string(i * 0.25) + ",0,0.1,0.1,0.1\n";
-  write(dir / "m.csv", table);
-  expect_error(run("verify --measured m.csv --quality draft -o rep", dir),
+  write_file(dir / "m.csv", table);
+  expect_error(run_weft_cli_in("verify --measured m.csv --quality draft -o rep", dir),
                {"m.csv: field 'line 182 theta_i_deg'", "more than 180 incidences"}, dir / "rep");
   EXPECT_EQ(slurp(dir / "m.csv"), table);
   EXPECT_EQ(left_behind(dir, {"m.csv"}), std::vector<std::string>{});
-  write(dir / "m.csv",
-        "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n"
-        "0,0,0.1,1e300,0.1\n");
-  expect_error(run("verify --measured m.csv --quality draft -o rep", dir),
+  write_file(dir / "m.csv",
+             "theta_i_deg,theta_o_deg,nbrdf_beta_R,nbrdf_beta_G,nbrdf_beta_B\n"
+             "0,0,0.1,1e300,0.1\n");
+  expect_error(run_weft_cli_in("verify --measured m.csv --quality draft -o rep", dir),
                {"m.csv: field 'line 2 nbrdf_beta_G'", "absurd"}, dir / "rep");
   EXPECT_EQ(left_behind(dir, {"m.csv"}), std::vector<std::string>{});
 }
@@ -463,11 +465,11 @@ TEST(CliBadInput, BakeOnFirstUseNeedsConfirmationLikeADirectBake) {
   const std::string scene = replaced(
       slurp(kPlane), R"({"type": "lambert", "params": {"reflectance": 0.5}})",
       R"({"type": "fiber_table", "params": {"spec": "red-cotton", "photons": 1000000000000}})");
-  write(dir / "scene.json",
-        replaced(scene, "lambert-plane.gltf", kExamples + "/lambert-plane.gltf"));
+  write_file(dir / "scene.json",
+             replaced(scene, "lambert-plane.gltf", (kExamples / "lambert-plane.gltf").string()));
   for (const std::string output : {"t.exr", "t.csv"}) {
     const std::string command = (output == "t.exr" ? "render" : "sweep");
-    expect_error(run(command + " scene.json -o " + output, dir),
+    expect_error(run_weft_cli_in(command + " scene.json -o " + output, dir),
                  {"scene.json", "materials.plane.params.photons", "1000000000000 photons per band",
                   "would take at least", "--yes-long"},
                  dir / output);
@@ -480,10 +482,11 @@ TEST(CliBadInput, BakeOnFirstUseNeedsConfirmationLikeADirectBake) {
 // ran with no estimate; now it is refused before the fiber table is baked.
 TEST(CliBadInput, LongSummationNeedsConfirmation) {
   const fs::path dir = fresh_test_dir();
-  expect_error(run("bake fabric --method summation-visible -R 32 --samples 4096 -o t.exr", dir),
-               {"--samples", "a summation-visible of 4194304 cell pairs x 4096 direction pairs",
-                "would take at least", "5 us per direction pair", "--yes-long"},
-               dir / "t.exr");
+  expect_error(
+      run_weft_cli_in("bake fabric --method summation-visible -R 32 --samples 4096 -o t.exr", dir),
+      {"--samples", "a summation-visible of 4194304 cell pairs x 4096 direction pairs",
+       "would take at least", "5 us per direction pair", "--yes-long"},
+      dir / "t.exr");
   EXPECT_FALSE(fs::exists(dir / ".weft-cache"));
 }
 
@@ -498,13 +501,14 @@ TEST(CliBadInput, FabricSceneOverTheMemoryBudgetIsRefusedNamingTheDraft) {
   const fs::path dir = fresh_test_dir();
   const std::string draft = std::string(WEFT_SOURCE_DIR) + "/scenes/data/wif/8452.wif";
   for (const char* method : {"raytrace", "summation-visible"})
-    expect_error(run(std::string("--max-memory-gb 0.2 bake fabric --method ") + method +
-                         " -R 1 --wif '" + draft + "' -o t.exr",
-                     dir),
+    expect_error(run_weft_cli_in(std::string("--max-memory-gb 0.2 bake fabric --method ") + method +
+                                     " -R 1 --wif '" + draft + "' -o t.exr",
+                                 dir),
                  {"8452.wif", "field '--detail'", "the scene at yarn detail", "needs about",
                   "allowed by --max-memory-gb"},
                  dir / "t.exr");
-  expect_error(run("--max-memory-gb 3 bake fabric --method raytrace --detail fiber -R 1 --wif '" +
+  expect_error(run_weft_cli_in(
+                   "--max-memory-gb 3 bake fabric --method raytrace --detail fiber -R 1 --wif '" +
                        draft + "' -o t.exr",
                    dir),
                {"8452.wif", "the scene at fiber detail", "needs about 9.7 GB"}, dir / "t.exr");

@@ -22,15 +22,12 @@ namespace {
 
 const fs::path kWifDir = fs::path(WEFT_SOURCE_DIR) / "scenes" / "data" / "wif";
 
-// Runs in 'dir': relative paths and the bake cache (./.weft-cache) are the test's own.
-CliRun run(const std::string& args, const fs::path& dir) {
-  return weft::testing::run_weft_cli(args, dir, "cd '" + dir.string() + "' && ");
-}
+using weft::testing::run_weft_cli_in;
 
 // Expects 'args -o out' refused (exit 2) with 'part' in the error and nothing written.
 void expect_refused(const std::string& args, const std::string& part, const fs::path& dir) {
   const fs::path out = dir / "refused.exr";
-  const CliRun r = run(args + " -o '" + out.string() + "'", dir);
+  const CliRun r = run_weft_cli_in(args + " -o '" + out.string() + "'", dir);
   EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
   EXPECT_NE(r.err.find(part), std::string::npos) << args << "\n" << r.err;
   EXPECT_FALSE(fs::exists(out));
@@ -39,10 +36,10 @@ void expect_refused(const std::string& args, const std::string& part, const fs::
 // A small fiber table of a preset (RGB, R = 3), baked into dir.
 fs::path small_fiber(const std::string& preset, const fs::path& dir) {
   const fs::path out = dir / (preset + ".exr");
-  const CliRun r =
-      run("bake fiber " + preset + " --photons 2000 --resolution 3 --bands rgb --quiet -o '" +
-              out.string() + "'",
-          dir);
+  const CliRun r = run_weft_cli_in("bake fiber " + preset +
+                                       " --photons 2000 --resolution 3 --bands rgb --quiet -o '" +
+                                       out.string() + "'",
+                                   dir);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   return out;
 }
@@ -60,16 +57,18 @@ TEST(CliFabricFibers, OneFiberPerYarnIsTheSingleFiberRunAndTwoAreNamed) {
       "bake fabric --method raytrace --detail yarn -R 2 --samples 300 --quiet --json";
   const fs::path single = dir / "single.exr", same = dir / "same.exr", two = dir / "two.exr";
   ASSERT_EQ(
-      run(base + " --fiber '" + red.string() + "' -o '" + single.string() + "'", dir).exit_code, 0);
-  ASSERT_EQ(run(base + " --warp-fiber '" + red.string() + "' --weft-fiber '" + red.string() +
-                    "' -o '" + same.string() + "'",
-                dir)
+      run_weft_cli_in(base + " --fiber '" + red.string() + "' -o '" + single.string() + "'", dir)
+          .exit_code,
+      0);
+  ASSERT_EQ(run_weft_cli_in(base + " --warp-fiber '" + red.string() + "' --weft-fiber '" +
+                                red.string() + "' -o '" + same.string() + "'",
+                            dir)
                 .exit_code,
             0);
   EXPECT_EQ(slurp(single), slurp(same));  // byte for byte, metadata included
-  const CliRun r = run(base + " --fiber '" + red.string() + "' --weft-fiber '" + white.string() +
-                           "' -o '" + two.string() + "'",
-                       dir);
+  const CliRun r = run_weft_cli_in(base + " --fiber '" + red.string() + "' --weft-fiber '" +
+                                       white.string() + "' -o '" + two.string() + "'",
+                                   dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("fiber_tables").size(), 2u);
@@ -82,9 +81,9 @@ TEST(CliFabricFibers, OneFiberPerYarnIsTheSingleFiberRunAndTwoAreNamed) {
   // The summation takes one fiber: the same one per yarn is that fiber, two are refused.
   const std::string sum = "bake fabric --method summation -R 2 --samples 2 --quiet";
   const fs::path summed = dir / "summed.exr";
-  EXPECT_EQ(run(sum + " --warp-fiber '" + red.string() + "' --weft-fiber '" + red.string() +
-                    "' -o '" + summed.string() + "'",
-                dir)
+  EXPECT_EQ(run_weft_cli_in(sum + " --warp-fiber '" + red.string() + "' --weft-fiber '" +
+                                red.string() + "' -o '" + summed.string() + "'",
+                            dir)
                 .exit_code,
             0);
   expect_refused(sum + " --fiber '" + red.string() + "' --warp-fiber '" + white.string() + "'",
@@ -101,7 +100,7 @@ TEST(CliFabricFibers, ThreadColoursBakeOneFiberPerColourOfTheDraft) {
       "bake fabric --method raytrace --detail yarn -R 2 --samples 300 "
       "--quiet --json --fiber clear.json --wif '" +
       draft + "'";
-  const CliRun r = run(base + " --thread-colours -o dyed.exr", dir);
+  const CliRun r = run_weft_cli_in(base + " --thread-colours -o dyed.exr", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("fiber_tables").size(), 2u);
@@ -109,7 +108,7 @@ TEST(CliFabricFibers, ThreadColoursBakeOneFiberPerColourOfTheDraft) {
   EXPECT_EQ(j.at("fiber_tables")[0].at("name"), "#c81e1e");
   EXPECT_EQ(j.at("fiber_tables")[0].at("spec"), "clear #c81e1e");
   EXPECT_EQ(j.at("fiber_tables")[1].at("spec"), "clear");
-  const CliRun plain = run(base + " -o plain.exr", dir);
+  const CliRun plain = run_weft_cli_in(base + " -o plain.exr", dir);
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   const auto a = weft::TabulatedBsdfTable::read_exr(dir / "dyed.exr").total_albedo();
   const auto b = weft::TabulatedBsdfTable::read_exr(dir / "plain.exr").total_albedo();

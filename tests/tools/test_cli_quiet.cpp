@@ -17,7 +17,7 @@ using weft::testing::run_weft_cli;
 
 namespace {
 
-const std::string kExamples = std::string(WEFT_SOURCE_DIR) + "/scenes/examples";
+using weft::testing::kExamples;
 
 // Runs 'args' with and without --quiet: both succeed, the quiet run's stderr is empty and the
 // other's is not; returns the quiet run.
@@ -46,7 +46,7 @@ TEST(CliQuiet, MediumAndBakes) {
 
 TEST(CliQuiet, Sweep) {
   const fs::path dir = fresh_test_dir();
-  expect_quiet("sweep '" + kExamples +
+  expect_quiet("sweep '" + kExamples.string() +
                    "/lambert-plane.json' --light-zenith-deg 30 --view-zenith-deg -30:30:30 "
                    "--spp 1 --resolution 8 -o '" +
                    (dir / "s.csv").string() + "'",

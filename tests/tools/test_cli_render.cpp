@@ -26,14 +26,12 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-const fs::path kExamples = fs::path(WEFT_SOURCE_DIR) / "scenes/examples";
+using weft::testing::kExamples;
 
 using weft::testing::CliRun;
 using weft::testing::slurp;
 
-CliRun run(const std::string& args, const fs::path& dir) {
-  return weft::testing::run_weft_cli(args, dir);
-}
+using weft::testing::run_weft_cli;
 
 bool contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;
@@ -78,9 +76,9 @@ fs::path scene_with_cameras(const fs::path& dir) {
 
 TEST(CliRender, DefineOverridesAMaterialParameter) {
   const fs::path dir = fresh_test_dir();
-  ASSERT_EQ(run(plane(dir / "half.exr"), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "half.exr"), dir).exit_code, 0);
   const CliRun r =
-      run(plane(dir / "quarter.exr", "-D materials.plane.params.reflectance=0.25"), dir);
+      run_weft_cli(plane(dir / "quarter.exr", "-D materials.plane.params.reflectance=0.25"), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   // Direct light on a lone Lambert plane is reflectance / pi x E cos: halving the reflectance
   // halves every pixel exactly (a power of two).
@@ -94,10 +92,10 @@ TEST(CliRender, DefineOverridesAMaterialParameter) {
   }
   EXPECT_GT(lit, 0);
   // render.spp reaches the render settings (--spp not given).
-  const CliRun s = run("render '" + (kExamples / "lambert-plane.json").string() +
-                           "' --width 8 --height 8 -D render.spp=3 --quiet --json -o '" +
-                           (dir / "spp.exr").string() + "'",
-                       dir);
+  const CliRun s = run_weft_cli("render '" + (kExamples / "lambert-plane.json").string() +
+                                    "' --width 8 --height 8 -D render.spp=3 --quiet --json -o '" +
+                                    (dir / "spp.exr").string() + "'",
+                                dir);
   ASSERT_EQ(s.exit_code, 0) << s.err;
   EXPECT_EQ(nlohmann::json::parse(s.out).at("spp"), 3);
 }
@@ -110,7 +108,7 @@ TEST(CliRender, DefineErrorsNameTheKeyAndTheFileAndWriteNothing) {
         {"render.spp=many", "is a number in the description, but 'many' is text"},
         {"lights[3].irradiance=2", "has 1 entry (indices 0 to 0)"},
         {"render.spp", "is not key=value"}}) {
-    const CliRun r = run(plane(dir / "out.exr", "-D " + define), dir);
+    const CliRun r = run_weft_cli(plane(dir / "out.exr", "-D " + define), dir);
     EXPECT_EQ(r.exit_code, 2) << define;
     EXPECT_TRUE(contains(r.err, part)) << r.err;
     if (define.find('=') != std::string::npos) {
@@ -125,7 +123,7 @@ TEST(CliRender, CameraByNameOrIndexAndTheErrorListsThem) {
   const fs::path dir = fresh_test_dir();
   const fs::path scene = scene_with_cameras(dir);
   auto render_with = [&](const std::string& camera, const fs::path& out) {
-    return run(
+    return run_weft_cli(
         "render '" + scene.string() + "' --quiet --camera " + camera + " -o '" + out.string() + "'",
         dir);
   };
@@ -153,8 +151,8 @@ TEST(CliRender, CameraByNameOrIndexAndTheErrorListsThem) {
 
 TEST(CliRender, CropIsTheSameWindowOfTheWholeRender) {
   const fs::path dir = fresh_test_dir();
-  ASSERT_EQ(run(plane(dir / "full.exr"), dir).exit_code, 0);
-  const CliRun r = run(plane(dir / "crop.exr", "--crop 3,17,2,11"), dir);
+  ASSERT_EQ(run_weft_cli(plane(dir / "full.exr"), dir).exit_code, 0);
+  const CliRun r = run_weft_cli(plane(dir / "crop.exr", "--crop 3,17,2,11"), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const weft::Image full = weft::read_image(dir / "full.exr"),
                     crop = weft::read_image(dir / "crop.exr");
@@ -166,7 +164,7 @@ TEST(CliRender, CropIsTheSameWindowOfTheWholeRender) {
   for (int y = 0; y < 9; ++y)
     for (int x = 0; x < 14; ++x) ASSERT_EQ(crop.at(x, y).g, full.at(3 + x, 2 + y).g);
   for (const std::string bad : {"3,17,2", "3,30,2,11", "5,3,2,11", "a,b,c,d", "1.5,3,2,11"}) {
-    const CliRun b = run(plane(dir / "bad.exr", "--crop " + bad), dir);
+    const CliRun b = run_weft_cli(plane(dir / "bad.exr", "--crop " + bad), dir);
     EXPECT_EQ(b.exit_code, 2) << bad;
     EXPECT_TRUE(contains(b.err, "--crop")) << b.err;
     EXPECT_FALSE(fs::exists(dir / "bad.exr"));
@@ -175,10 +173,10 @@ TEST(CliRender, CropIsTheSameWindowOfTheWholeRender) {
 
 TEST(CliRender, ExposureScalesThePreviewOnly) {
   const fs::path dir = fresh_test_dir();
-  const CliRun r = run(
+  const CliRun r = run_weft_cli(
       plane(dir / "out.exr", "--exposure 1 --preview '" + (dir / "out.png").string() + "'"), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  ASSERT_EQ(run(plane(dir / "plain.exr"), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "plain.exr"), dir).exit_code, 0);
   const weft::Image exr = weft::read_image(dir / "out.exr"),
                     png = weft::read_image(dir / "out.png");
   EXPECT_EQ(exr.rgb, weft::read_image(dir / "plain.exr").rgb);  // the EXR is unchanged
@@ -193,11 +191,12 @@ TEST(CliRender, ExposureScalesThePreviewOnly) {
 
 TEST(CliRender, OutputFormatFollowsTheExtension) {
   const fs::path dir = fresh_test_dir();
-  ASSERT_EQ(run(plane(dir / "out.exr", "--preview '" + (dir / "preview.png").string() + "'"), dir)
+  ASSERT_EQ(run_weft_cli(
+                plane(dir / "out.exr", "--preview '" + (dir / "preview.png").string() + "'"), dir)
                 .exit_code,
             0);
-  ASSERT_EQ(run(plane(dir / "out.png"), dir).exit_code, 0);
-  ASSERT_EQ(run(plane(dir / "out.hdr"), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "out.png"), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "out.hdr"), dir).exit_code, 0);
   const weft::Image exr = weft::read_image(dir / "out.exr"),
                     png = weft::read_image(dir / "out.png"),
                     hdr = weft::read_image(dir / "out.hdr");
@@ -212,7 +211,7 @@ TEST(CliRender, OutputFormatFollowsTheExtension) {
     for (int c = 0; c < 3; ++c) ASSERT_NEAR(hdr.rgb[i + c], exr.rgb[i + c], top / 128) << i;
   }
   // Another extension is refused before any work, naming the output.
-  const CliRun bad = run(plane(dir / "out.tif"), dir);
+  const CliRun bad = run_weft_cli(plane(dir / "out.tif"), dir);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_TRUE(contains(bad.err, ".png or .hdr")) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "out.tif"));
@@ -220,7 +219,7 @@ TEST(CliRender, OutputFormatFollowsTheExtension) {
 
 TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
   const fs::path dir = fresh_test_dir();
-  const CliRun r = run(plane(dir / "out.exr", "--time-limit 1e-9 --json", 64), dir);
+  const CliRun r = run_weft_cli(plane(dir / "out.exr", "--time-limit 1e-9 --json", 64), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out).at("spp_done"), 1);
   const nlohmann::json m = weft::read_image_metadata(dir / "out.exr");
@@ -228,7 +227,7 @@ TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
   EXPECT_EQ(m.at("weft:spp_requested"), 64);
   EXPECT_TRUE(m.contains("weft:time_limit_s"));
   // One pass is a render of 1 sample per pixel.
-  ASSERT_EQ(run(plane(dir / "one.exr", "", 1), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "one.exr", "", 1), dir).exit_code, 0);
   EXPECT_EQ(weft::read_image(dir / "out.exr").rgb, weft::read_image(dir / "one.exr").rgb);
 }
 
@@ -237,9 +236,9 @@ TEST(CliRender, TimeLimitWritesWholePassesAndSaysHowMany) {
 // coloured reflectance is refused, naming the material, with nothing written.
 TEST(CliRender, SpectralRendersGreyScenesAndRefusesRgbColours) {
   const fs::path dir = fresh_test_dir();
-  const CliRun a = run(plane(dir / "spectral.exr", "--spectral", 11), dir);
+  const CliRun a = run_weft_cli(plane(dir / "spectral.exr", "--spectral", 11), dir);
   ASSERT_EQ(a.exit_code, 0) << a.err;
-  ASSERT_EQ(run(plane(dir / "rgb.exr", "", 11), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "rgb.exr", "", 11), dir).exit_code, 0);
   const auto s = weft::read_image(dir / "spectral.exr"), r = weft::read_image(dir / "rgb.exr");
   ASSERT_EQ(s.rgb.size(), r.rgb.size());
   // A grey spectrum reduces to the reduction's white, the sum of the band weights (1 to 1e-3: the
@@ -252,9 +251,9 @@ TEST(CliRender, SpectralRendersGreyScenesAndRefusesRgbColours) {
   EXPECT_TRUE(contains(
       weft::read_image_metadata(dir / "spectral.exr").at("weft:content").get<std::string>(),
       "33 bands"));
-  const CliRun bad =
-      run(plane(dir / "red.exr", "--spectral -D materials.plane.params.reflectance=[0.5,0.2,0.1]"),
-          dir);
+  const CliRun bad = run_weft_cli(
+      plane(dir / "red.exr", "--spectral -D materials.plane.params.reflectance=[0.5,0.2,0.1]"),
+      dir);
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_TRUE(contains(bad.err, "materials.plane")) << bad.err;
   EXPECT_TRUE(contains(bad.err, "lambert")) << bad.err;
@@ -263,14 +262,14 @@ TEST(CliRender, SpectralRendersGreyScenesAndRefusesRgbColours) {
 
 TEST(CliRender, AovPassesAreFilesBesideTheImage) {
   const fs::path dir = fresh_test_dir();
-  const CliRun r = run(plane(dir / "out.exr", "--aov albedo,normal"), dir);
+  const CliRun r = run_weft_cli(plane(dir / "out.exr", "--aov albedo,normal"), dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const weft::Image albedo = weft::read_image(dir / "out.albedo.exr");
   const weft::Image normal = weft::read_image(dir / "out.normal.exr");
   // The plane (reflectance 0.5, normal +y) fills the bundled camera's view.
   EXPECT_NEAR(albedo.at(12, 10).r, 0.5, 1e-6);
   EXPECT_NEAR(normal.at(12, 10).g, 1.0, 1e-6);
-  const CliRun bad = run(plane(dir / "bad.exr", "--aov albedo,depth"), dir);
+  const CliRun bad = run_weft_cli(plane(dir / "bad.exr", "--aov albedo,depth"), dir);
   EXPECT_EQ(bad.exit_code, 2);
   EXPECT_TRUE(contains(bad.err, "unknown pass 'depth' (valid: albedo, normal)")) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad.exr"));
@@ -278,8 +277,8 @@ TEST(CliRender, AovPassesAreFilesBesideTheImage) {
 
 TEST(CliRender, ExrIsBitIdenticalAcrossRuns) {
   const fs::path dir = fresh_test_dir();
-  ASSERT_EQ(run(plane(dir / "a.exr"), dir).exit_code, 0);
-  ASSERT_EQ(run(plane(dir / "b.exr", "--threads 1"), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "a.exr"), dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli(plane(dir / "b.exr", "--threads 1"), dir).exit_code, 0);
   const std::string a = slurp(dir / "a.exr"), b = slurp(dir / "b.exr");
   ASSERT_GT(a.size(), 500u);
   EXPECT_TRUE(a == b) << "the two renders' files differ";
@@ -295,9 +294,9 @@ TEST(CliRender, ExrIsBitIdenticalAcrossRuns) {
 TEST(CliRender, ProgressInALogIsPlainLinesWithUnits) {
   const fs::path dir = fresh_test_dir();
   const CliRun r =
-      run("render '" + (kExamples / "lambert-plane.json").string() +
-              "' --width 24 --height 20 --spp 2 -o '" + (dir / "out.exr").string() + "'",
-          dir);
+      run_weft_cli("render '" + (kExamples / "lambert-plane.json").string() +
+                       "' --width 24 --height 20 --spp 2 -o '" + (dir / "out.exr").string() + "'",
+                   dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err.find('\r'), std::string::npos) << r.err;
   EXPECT_TRUE(contains(r.err, "render  100.0%")) << r.err;
@@ -359,10 +358,10 @@ TEST(CliRender, JsonReportsTheWeaveLevelChosenPerObject) {
                              {"params", {{"file", "fabric.exr"}, {"weave", "weave.exr"}}}};
   d.erase("sweep");
   std::ofstream(dir / "woven.json") << d.dump(2);
-  const CliRun near = run("render '" + (dir / "woven.json").string() +
-                              "' --width 24 --height 20 --spp 1 --quiet --json -o '" +
-                              (dir / "out.exr").string() + "'",
-                          dir);
+  const CliRun near = run_weft_cli("render '" + (dir / "woven.json").string() +
+                                       "' --width 24 --height 20 --spp 1 --quiet --json -o '" +
+                                       (dir / "out.exr").string() + "'",
+                                   dir);
   ASSERT_EQ(near.exit_code, 0) << near.err;
   const nlohmann::json j = nlohmann::json::parse(near.out);
   ASSERT_EQ(j["weave_levels"].size(), 1u) << near.out;
@@ -370,11 +369,11 @@ TEST(CliRender, JsonReportsTheWeaveLevelChosenPerObject) {
   EXPECT_EQ(j["weave_levels"][0]["level"], "weave");
   EXPECT_EQ(j["weave_levels"][0]["setting"], "auto");
   EXPECT_GE(j["weave_levels"][0]["repeat_pixels"].get<double>(), 9.0);  // 0.5 m at <= 5 cm a px
-  const CliRun strict =
-      run("render '" + (dir / "woven.json").string() +
-              "' --width 24 --height 20 --spp 1 --quiet --json -o '" + (dir / "out.exr").string() +
-              "' -D materials.plane.params.weave_min_pixels=1000",
-          dir);
+  const CliRun strict = run_weft_cli("render '" + (dir / "woven.json").string() +
+                                         "' --width 24 --height 20 --spp 1 --quiet --json -o '" +
+                                         (dir / "out.exr").string() +
+                                         "' -D materials.plane.params.weave_min_pixels=1000",
+                                     dir);
   ASSERT_EQ(strict.exit_code, 0) << strict.err;
   EXPECT_EQ(nlohmann::json::parse(strict.out)["weave_levels"][0]["level"], "table");
 }

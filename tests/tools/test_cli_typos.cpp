@@ -17,9 +17,7 @@ using weft::testing::fresh_test_dir;
 
 namespace {
 
-CliRun run(const std::string& args, const fs::path& dir) {
-  return weft::testing::run_weft_cli(args, dir, "cd '" + dir.string() + "' && ");
-}
+using weft::testing::run_weft_cli_in;
 
 const std::string kScene = std::string(WEFT_SOURCE_DIR) + "/scenes/examples/lambert-plane.json";
 
@@ -54,12 +52,12 @@ TEST(EditDistance, NearestNameOnlyWhenCloseEnough) {
 
 TEST(CliTypos, UnknownSubcommandSuggestsTheNearest) {
   const fs::path dir = fresh_test_dir();
-  expect_typo(run("rendr", dir), {"unknown command 'rendr'", "did you mean 'render'?"});
+  expect_typo(run_weft_cli_in("rendr", dir), {"unknown command 'rendr'", "did you mean 'render'?"});
   // A subcommand of a group.
-  expect_typo(run("bake fibr red-cotton -o t.exr", dir),
+  expect_typo(run_weft_cli_in("bake fibr red-cotton -o t.exr", dir),
               {"unknown command 'fibr' for 'weft bake'", "did you mean 'fiber'?"});
   // Nothing near: no guess.
-  const CliRun far = run("zzzzzz", dir);
+  const CliRun far = run_weft_cli_in("zzzzzz", dir);
   expect_typo(far, {"unknown command 'zzzzzz'"});
   EXPECT_EQ(far.err.find("did you mean"), std::string::npos) << far.err;
 }
@@ -67,33 +65,34 @@ TEST(CliTypos, UnknownSubcommandSuggestsTheNearest) {
 TEST(CliTypos, UnknownFlagIsNamedAloneWithTheNearest) {
   const fs::path dir = fresh_test_dir();
   // The typo's value takes the scene's place: CLI11 listed the scene file as unexpected too.
-  const CliRun r = run("render --preveiw p.png '" + kScene + "' -o out.exr", dir);
+  const CliRun r = run_weft_cli_in("render --preveiw p.png '" + kScene + "' -o out.exr", dir);
   expect_typo(r, {"unknown option '--preveiw' for 'weft render'", "did you mean '--preview'?"});
   EXPECT_EQ(r.err.find("lambert-plane.json"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find("p.png"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(dir / "out.exr"));
   // A typo with '=' and one that leaves a required option unset.
-  expect_typo(run("verify --qualty=draft -o v", dir),
+  expect_typo(run_weft_cli_in("verify --qualty=draft -o v", dir),
               {"unknown option '--qualty'", "did you mean '--quality'?"});
-  expect_typo(run("render '" + kScene + "' --ouptut out.exr", dir),
+  expect_typo(run_weft_cli_in("render '" + kScene + "' --ouptut out.exr", dir),
               {"unknown option '--ouptut'", "did you mean '--output'?"});
   // A global option before the subcommand.
-  expect_typo(run("--max-memroy-gb 3 medium red-cotton", dir),
+  expect_typo(run_weft_cli_in("--max-memroy-gb 3 medium red-cotton", dir),
               {"unknown option '--max-memroy-gb'", "did you mean '--max-memory-gb'?"});
 }
 
 TEST(CliTypos, QuietRenderPrintsNothingOnStderr) {
   const fs::path dir = fresh_test_dir();
   // The bundled plane (a parallel light and an environment) at the smallest settings.
-  const CliRun r = run("render '" + kScene +
-                           "' -o out.exr -D render.width=8 -D render.height=8 -D render.spp=1 "
-                           "--quiet",
-                       dir);
+  const CliRun r =
+      run_weft_cli_in("render '" + kScene +
+                          "' -o out.exr -D render.width=8 -D render.height=8 -D render.spp=1 "
+                          "--quiet",
+                      dir);
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.err, "");
   EXPECT_TRUE(fs::exists(dir / "out.exr"));
   // Without --quiet the lights are described (so the check above could fail).
-  const CliRun loud = run(
+  const CliRun loud = run_weft_cli_in(
       "render '" + kScene + "' -o out2.exr -D render.width=8 -D render.height=8 -D render.spp=1",
       dir);
   EXPECT_EQ(loud.exit_code, 0) << loud.err;

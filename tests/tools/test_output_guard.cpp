@@ -22,11 +22,9 @@ using weft::testing::slurp;
 namespace {
 
 const std::string kSource = WEFT_SOURCE_DIR;
-const std::string kExamples = kSource + "/scenes/examples";
+using weft::testing::kExamples;
 
-CliRun run(const std::string& args, const fs::path& dir) {
-  return weft::testing::run_weft_cli(args, dir, "cd '" + dir.string() + "' && ");
-}
+using weft::testing::run_weft_cli_in;
 
 // Every name under 'dir' but the run's stdout and stderr.
 std::set<std::string> listing(const fs::path& dir) {
@@ -44,7 +42,7 @@ void expect_refused(const fs::path& dir, const std::string& args, const std::str
                     const std::string& input) {
   const std::string before = slurp(dir / input);
   const std::set<std::string> files = listing(dir);
-  const CliRun r = run(args, dir);
+  const CliRun r = run_weft_cli_in(args, dir);
   EXPECT_EQ(r.exit_code, 2) << args << "\n" << r.err;
   EXPECT_NE(r.err.find("weft: error: "), std::string::npos) << r.err;
   EXPECT_NE(r.err.find(output + ": "), std::string::npos) << args << "\n" << r.err;
@@ -58,8 +56,8 @@ void expect_refused(const fs::path& dir, const std::string& args, const std::str
 // that fiber table.
 fs::path scene_with_fiber_table() {
   const fs::path dir = fresh_test_dir();
-  fs::copy_file(kExamples + "/lambert-plane.gltf", dir / "lambert-plane.gltf");
-  EXPECT_EQ(run("table bake lambert -R 2 --spp 1 -o t.exr --quiet", dir).exit_code, 0);
+  fs::copy_file(kExamples / "lambert-plane.gltf", dir / "lambert-plane.gltf");
+  EXPECT_EQ(run_weft_cli_in("table bake lambert -R 2 --spp 1 -o t.exr --quiet", dir).exit_code, 0);
   std::ofstream(dir / "s.json") << R"({"gltf": "lambert-plane.gltf",
     "materials": {"plane": {"type": "fiber_table", "params": {"file": "t.exr"}}},
     "lights": [{"type": "parallel", "irradiance": 1.0, "zenith_deg": 30}],
@@ -98,7 +96,8 @@ TEST(OutputGuard, SweepAndMergeRefuseTheirInputs) {
   expect_refused(dir, "sweep s.json -o t.exr --quiet", "t.exr", "t.exr");
   // A merge reads the parts and, through their job, every input the shards read.
   for (const char* k : {"0", "1"})
-    ASSERT_EQ(run(std::string("sweep s.json --shard ") + k + "/2 -o p" + k + ".part --quiet", dir)
+    ASSERT_EQ(run_weft_cli_in(
+                  std::string("sweep s.json --shard ") + k + "/2 -o p" + k + ".part --quiet", dir)
                   .exit_code,
               0);
   expect_refused(dir, "merge p0.part p1.part -o t.exr", "t.exr", "t.exr");
@@ -109,14 +108,15 @@ TEST(OutputGuard, BakesRefuseTheirSpecTableAndDraft) {
   const fs::path dir = fresh_test_dir();
   fs::copy_file(kSource + "/fiber/presets/red-cotton.json", dir / "spec.json");
   fs::copy_file(kSource + "/scenes/data/wif/54235-plain.wif", dir / "d.wif");
-  ASSERT_EQ(run("table bake lambert -R 2 --spp 1 -o t.exr --quiet", dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli_in("table bake lambert -R 2 --spp 1 -o t.exr --quiet", dir).exit_code, 0);
   expect_refused(dir, "bake fiber spec.json -o spec.json", "spec.json", "spec.json");
   expect_refused(dir, "bake fabric --fiber t.exr -R 2 -o t.exr --quiet", "t.exr", "t.exr");
   expect_refused(dir, "bake fabric --fiber t.exr -R 2 --wif d.wif -o d.wif --quiet", "d.wif",
                  "d.wif");
   // A merge of fiber-bake parts reads the spec file they name.
   for (const char* k : {"0", "1"})
-    ASSERT_EQ(run(std::string("bake fiber spec.json --resolution 2 --photons 20 --bands rgb ") +
+    ASSERT_EQ(run_weft_cli_in(
+                  std::string("bake fiber spec.json --resolution 2 --photons 20 --bands rgb ") +
                       "--shard " + k + "/2 -o f" + k + ".part --quiet",
                   dir)
                   .exit_code,
@@ -132,8 +132,8 @@ TEST(OutputGuard, WeaveAndCompareRefuseTheirInputs) {
   expect_refused(dir, "weave --sample sample.json -o sample.json", "sample.json", "sample.json");
   // The WIF the sample file names is read too.
   expect_refused(dir, "weave --sample sample.json -o d.wif", "d.wif", "d.wif");
-  ASSERT_EQ(run("table bake lambert -R 2 --spp 1 -o a.exr --quiet", dir).exit_code, 0);
-  ASSERT_EQ(run("table bake lambert -R 2 --spp 2 -o b.exr --quiet", dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli_in("table bake lambert -R 2 --spp 1 -o a.exr --quiet", dir).exit_code, 0);
+  ASSERT_EQ(run_weft_cli_in("table bake lambert -R 2 --spp 2 -o b.exr --quiet", dir).exit_code, 0);
   expect_refused(dir, "compare a.exr b.exr --csv a.exr", "a.exr", "a.exr");
   expect_refused(dir, "compare a.exr b.exr --plot b.exr", "b.exr", "b.exr");
   // table bake of a table material: the table its parameters name is an input.
@@ -174,7 +174,8 @@ TEST(OutputGuard, ConcurrentComparePlotsDrawTheirOwnCurves) {
   fs::create_directory(dir / "tmp");
   for (const char* r : {"0.2", "0.4", "0.6", "0.8"})
     ASSERT_EQ(
-        run(std::string("table bake lambert -R 2 --spp 1 --quiet --params '{\"reflectance\": ") +
+        run_weft_cli_in(
+            std::string("table bake lambert -R 2 --spp 1 --quiet --params '{\"reflectance\": ") +
                 r + "}' -o t" + r + ".exr",
             dir)
             .exit_code,
@@ -184,7 +185,8 @@ TEST(OutputGuard, ConcurrentComparePlotsDrawTheirOwnCurves) {
   const std::string env = "export TMPDIR='" + (dir / "tmp").string() + "'; ";
   for (size_t i = 0; i < pairs.size(); ++i)
     ASSERT_EQ(
-        run("compare " + pairs[i] + " --plot alone" + std::to_string(i) + ".png", dir).exit_code,
+        run_weft_cli_in("compare " + pairs[i] + " --plot alone" + std::to_string(i) + ".png", dir)
+            .exit_code,
         0);
   std::string together;
   for (size_t i = 0; i < pairs.size(); ++i)

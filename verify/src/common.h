@@ -1,9 +1,10 @@
 #pragma once
 // Small helpers that several of verify/src's files share (private to the library).
-#include <chrono>
 #include <cstdio>
 #include <sstream>
 #include <string>
+
+#include "weft/core/clock.h"
 
 namespace weft {
 
@@ -12,10 +13,6 @@ inline std::string fmt(double v, int digits = 3) {
   char b[64];
   std::snprintf(b, sizeof b, "%.*g", digits, v);
   return b;
-}
-
-inline double seconds_since(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
 // Text made safe for an HTML page.

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "common.h"
 #include "weft/verify/suite.h"
 
 namespace weft {
@@ -104,23 +105,6 @@ nlohmann::json suite_row_json(const SuiteRow& r) {
       r.metrics.value("fabric_table_gamut_clipped_components", 0);
   if (r.metrics.contains("verdict")) j["verdict"] = r.metrics.at("verdict");
   return j;
-}
-
-std::string html_escape(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (c == '<')
-      out += "&lt;";
-    else if (c == '>')
-      out += "&gt;";
-    else if (c == '&')
-      out += "&amp;";
-    else if (c == '"')
-      out += "&quot;";
-    else
-      out += c;
-  }
-  return out;
 }
 
 std::string fixed3(const nlohmann::json& v) {
