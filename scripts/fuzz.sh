@@ -43,6 +43,7 @@ with_tests=OFF
 # Line tables are all a sanitizer's stack trace needs, and compile faster than full debug info.
 cmake -S . -B "$build" -G Ninja -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" -DWEFT_FUZZ=ON \
+  -DCMAKE_UNITY_BUILD=ON \
   -DWEFT_BUILD_TESTS="$with_tests" -DWEFT_BUILD_BENCH=OFF >/dev/null
 cmake --build "$build" -j "${WEFT_JOBS:-2}" --target "${harnesses[@]}" "${tests[@]}"
 # The test programs run two at a time (each mostly on one thread); any failure stops the script.
