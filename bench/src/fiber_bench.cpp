@@ -19,8 +19,6 @@
 namespace weft {
 namespace {
 
-using Clock = SteadyClock;
-
 struct FiberRay {
   Ray ray;
   int64_t fiber = kNoFiber;
@@ -114,7 +112,7 @@ std::vector<FiberBenchRow> bench_fibers(const FiberBenchOptions& o) {
     r.geometry = name_of(g);
     RenderSceneOptions so;
     so.fiber_geometry = g;
-    auto t0 = Clock::now();
+    auto t0 = SteadyClock::now();
     const RenderScene scene(patch, so);
     r.build_s = seconds_since(t0);
     r.fibers = scene.fiber_count();
@@ -124,7 +122,7 @@ std::vector<FiberBenchRow> bench_fibers(const FiberBenchOptions& o) {
     for (int rep = 0; rep < 2; ++rep) {
       const uint64_t chunk = 4096, chunks = (rays.size() + chunk - 1) / chunk;
       std::vector<uint64_t> hits(chunks, 0);
-      t0 = Clock::now();
+      t0 = SteadyClock::now();
       parallel_for(chunks, o.threads, [&](uint64_t c) {
         uint64_t h = 0;
         SurfaceHit hit;
@@ -139,7 +137,7 @@ std::vector<FiberBenchRow> bench_fibers(const FiberBenchOptions& o) {
       r.hit_fraction = double(total) / rays.size();
       RenderSettings rs = o.render;
       rs.threads = o.threads;
-      t0 = Clock::now();
+      t0 = SteadyClock::now();
       const RenderResult img = render(scene, *patch.camera, rs);
       r.path_rays_per_s = std::max(r.path_rays_per_s, img.rays.total() / seconds_since(t0));
     }

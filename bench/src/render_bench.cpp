@@ -23,8 +23,6 @@
 namespace weft {
 namespace {
 
-using Clock = SteadyClock;
-
 // Diffuse rays as a path tracer's bounces from opaque surfaces see them: from area-uniform surface
 // points, cosine distributed about the geometric normal on the side the vertex normals face (a
 // random side where the mesh has no normals).
@@ -74,7 +72,7 @@ template <class Query>
 double query_rate(size_t n, int threads, Query query) {
   const uint64_t chunk = 4096, chunks = (n + chunk - 1) / chunk;
   std::vector<uint64_t> hits(chunks, 0);
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   parallel_for(chunks, threads, [&](uint64_t c) {
     uint64_t h = 0;
     const size_t end = std::min<size_t>(n, (c + 1) * chunk);
@@ -103,7 +101,7 @@ double replay_rate(const RenderScene& scene, const std::vector<EmbreeRay>& log, 
 // Seconds for a fixed amount of floating-point work split into tasks, on 'threads' threads.
 double arithmetic_seconds(int threads) {
   std::vector<double> out(64);
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   parallel_for(64, threads, [&](uint64_t task) {
     Rng rng(1, task);
     double x = rng.uniform();
@@ -130,7 +128,7 @@ PathRate path_rate(const RenderScene& scene, const Camera& cam, const RenderBenc
                    int threads) {
   RenderSettings s = o.render;
   s.threads = threads;
-  const auto t0 = Clock::now();
+  const auto t0 = SteadyClock::now();
   const RenderResult r = render(scene, cam, s);
   const double sec = seconds_since(t0);
   return {r.rays.total() / sec, (r.rays.camera + r.rays.bounce) / sec};
@@ -208,7 +206,7 @@ RenderBenchResult bench_render_scene(const SceneDescription& desc, const std::st
         "must be 1 to " + std::to_string(kMaxBenchRepeats) + ", not " + std::to_string(o.repeats));
   RenderBenchResult r;
   r.name = name;
-  auto t0 = Clock::now();
+  auto t0 = SteadyClock::now();
   const RenderScene scene(desc);
   r.build_s = seconds_since(t0);
   r.triangles = scene.triangle_count();
