@@ -55,12 +55,10 @@ py::dict verify(VerifyArgs a) {
   hooks.interrupted = [progress] { return progress.interrupted(); };
   hooks.note = [progress](const std::string& line) { progress.note(line); };
   const std::string output = a.request.output;
+  const int threads = a.request.threads;
   if (a.plots)
-    hooks.draw = [output](const std::filesystem::path& staging) {
-      cli::run_plot_script("plot_verify.py",
-                           {(staging / "inplane.csv").string(), (staging / "metrics.json").string(),
-                            staging.string()},
-                           output);
+    hooks.draw = [output, threads](const std::filesystem::path& staging) {
+      cli::plot_verify_figures(staging, output, threads);
     };
   VerifyOutcome out;
   {

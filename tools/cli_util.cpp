@@ -15,10 +15,10 @@
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <sstream>
-#include <thread>
 
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
+#include "weft/core/parallel.h"
 #include "weft/core/params.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fabric_summation.h"
@@ -211,8 +211,7 @@ double render_bytes(int width, int height, bool preview, bool mask) {
 
 void check_long_work(double units, double seconds_per_unit, int threads, const std::string& file,
                      const std::string& field, const std::string& what, const std::string& rate) {
-  const unsigned cores = threads > 0 ? static_cast<unsigned>(threads)
-                                     : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = static_cast<unsigned>(threads > 0 ? threads : hardware_threads());
   const double seconds = units * seconds_per_unit / cores;
   const std::string basis = rate + ", " + std::to_string(cores) + (cores == 1 ? " core" : " cores");
   if (seconds > kLongWorkSeconds && !run_limits().yes_long)

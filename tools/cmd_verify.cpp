@@ -129,10 +129,7 @@ VerifyOutcome run_checked(const VerifyCliOptions& o, const VerifyPlan& p,
     if (!o.quiet) std::fputs(line.c_str(), stderr);
   };
   hooks.draw = [&](const std::filesystem::path& staging) {
-    run_plot_script(
-        "plot_verify.py",
-        {(staging / "inplane.csv").string(), (staging / "metrics.json").string(), staging.string()},
-        r.output);
+    plot_verify_figures(staging, r.output, r.threads);
   };
   hooks.started = t_all;
   return run_verify_plan(p, hooks, all);

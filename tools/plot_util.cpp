@@ -5,6 +5,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/install_paths.h"
+#include "weft/core/parallel.h"
 
 namespace weft::cli {
 namespace {
@@ -44,6 +45,15 @@ void run_plot_script(const std::string& script, const std::vector<std::string>& 
   for (const auto& a : args) cmd.append(" ").append(quoted(a));
   if (std::system(cmd.c_str()) != 0)
     throw Error(output.string(), "", "the plot script failed (" + script + ")");
+}
+
+void plot_verify_figures(const std::filesystem::path& staging, const std::filesystem::path& output,
+                         int threads) {
+  const int jobs = threads > 0 ? threads : hardware_threads();
+  run_plot_script("plot_verify.py",
+                  {"--jobs", std::to_string(jobs), (staging / "inplane.csv").string(),
+                   (staging / "metrics.json").string(), staging.string()},
+                  output);
 }
 
 }  // namespace weft::cli

@@ -11,4 +11,10 @@ namespace weft::cli {
 void run_plot_script(const std::string& script, const std::vector<std::string>& args,
                      const std::filesystem::path& output);
 
+// The figures of a verify report (tools/plot_verify.py) from the inplane.csv and metrics.json in
+// 'staging', into it, drawn in as many processes as 'threads' (0: all cores): a figure takes
+// about a second, most of a draft run's time. Errors name 'output'.
+void plot_verify_figures(const std::filesystem::path& staging, const std::filesystem::path& output,
+                         int threads);
+
 }  // namespace weft::cli

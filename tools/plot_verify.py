@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Plots of `weft verify`: beta / pi against the view zenith, one figure per incidence.
 
-Usage: plot_verify.py [--describe LAYOUT.json] INPLANE.csv METRICS.json OUT_DIR
+Usage: plot_verify.py [--describe LAYOUT.json] [--jobs N] INPLANE.csv METRICS.json OUT_DIR
 
 Reads the long-form inplane.csv of `weft verify` (theta_i_deg, view_zenith_deg, model, channel,
 beta, beta_err, beta_norm, norm_factor; view > 0 on the mirror side, the paper's Fig. 7) and
@@ -11,13 +11,18 @@ one figure per incidence, one column per channel; the top row with the paper's n
 <= 0 or not finite cannot be drawn there: they are masked and counted in the panel's title). One
 legend per figure, below the panels; the mirror direction (view = theta_i) marked and labelled on
 every panel. Error bars: one standard error (beta_err). --describe writes the layout as JSON
-(files, axis scales, legend and axes boxes, mirror labels, masked points) for the tests. Run
-with /usr/bin/python3 (weft does): only it is known to have matplotlib.
+(files, axis scales, legend and axes boxes, mirror labels, masked points) for the tests. --jobs
+draws the figures in that many processes (default 1; weft passes its thread count): a figure
+takes about a second, most of a draft run's time, and each is drawn alone, so the files and the
+layout are the same for any count. Run with /usr/bin/python3 (weft does): only it is known to
+have matplotlib.
 """
 import argparse
+import concurrent.futures
 import csv
 import json
 import math
+import multiprocessing
 import os
 import sys
 
@@ -160,16 +165,35 @@ def incidence_figure(data, models, labels, ti, out_dir):
     return entry
 
 
+def draw_all(data, models, labels, incidences, out_dir, jobs):
+    """Every incidence's figure, in 'jobs' processes (forked: each starts with the data read);
+    the layout entries in the incidences' order."""
+    draw = [(data, models, labels, ti, out_dir) for ti in incidences]
+    if jobs <= 1 or len(incidences) <= 1:
+        return [incidence_figure(*d) for d in draw]
+    context = multiprocessing.get_context("fork")
+    with concurrent.futures.ProcessPoolExecutor(min(jobs, len(draw)), mp_context=context) as pool:
+        return list(pool.map(incidence_figure, *zip(*draw)))
+
+
+def positive(text):
+    n = int(text)
+    if n < 1:
+        raise argparse.ArgumentTypeError(f"must be at least 1, not {n}")
+    return n
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("inplane")
     p.add_argument("metrics")
     p.add_argument("out_dir")
     p.add_argument("--describe", help="write the figures' layout here as JSON")
+    p.add_argument("--jobs", type=positive, default=1, help="processes drawing the figures")
     a = p.parse_args()
     data, models, labels = read_inputs(a.inplane, a.metrics)
     incidences = sorted({k[0] for k in data})
-    figures = [incidence_figure(data, models, labels, ti, a.out_dir) for ti in incidences]
+    figures = draw_all(data, models, labels, incidences, a.out_dir, a.jobs)
     if a.describe:
         with open(a.describe, "w") as f:
             json.dump({"figures": figures}, f, indent=1)

@@ -1,7 +1,8 @@
 // The figures of `weft verify` as tools/plot_verify.py lays them out, read from its --describe
 // JSON: one figure per incidence (files sorted by incidence), the absolute row on a log axis with
 // the values it cannot draw counted, one legend per figure outside every panel, the mirror
-// direction labelled on every panel. Skipped where /usr/bin/python3 has no matplotlib.
+// direction labelled on every panel; the same figures from several processes. Skipped where
+// /usr/bin/python3 has no matplotlib.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -55,7 +56,40 @@ bool overlap(const nlohmann::json& a, const nlohmann::json& b) {
          a[1].get<double>() < b[3].get<double>() && b[1].get<double>() < a[3].get<double>();
 }
 
+// The command that plots 'dir''s inputs into 'out' with 'extra' options.
+std::string plot_command(const fs::path& dir, const fs::path& out, const std::string& extra) {
+  return "/usr/bin/python3 '" + std::string(WEFT_SOURCE_DIR) + "/tools/plot_verify.py' " + extra +
+         " '" + (dir / "inplane.csv").string() + "' '" + (dir / "metrics.json").string() + "' '" +
+         out.string() + "' 2>/dev/null";
+}
+
 }  // namespace
+
+// Figures drawn in several processes (weft passes its thread count) are the ones drawn in one:
+// the same PNG bytes, the same layout in the incidences' order. A count below one is refused.
+TEST(PlotVerify, ProcessesDrawTheSameFigures) {
+  if (!has_matplotlib()) GTEST_SKIP() << "/usr/bin/python3 has no matplotlib";
+  const fs::path dir = fresh_test_dir();
+  write_inputs(dir);
+  for (const char* sub : {"one", "three"}) fs::create_directories(dir / sub);
+  const std::string one =
+      plot_command(dir, dir / "one", "--describe '" + (dir / "one.json").string() + "'");
+  const std::string three = plot_command(
+      dir, dir / "three", "--jobs 3 --describe '" + (dir / "three.json").string() + "'");
+  ASSERT_EQ(std::system(one.c_str()), 0) << one;
+  ASSERT_EQ(std::system(three.c_str()), 0) << three;
+  EXPECT_EQ(nlohmann::json::parse(slurp(dir / "one.json")),
+            nlohmann::json::parse(slurp(dir / "three.json")));
+  for (const char* png : {"inplane-00.0deg.png", "inplane-30.0deg.png"}) {
+    const std::string a = slurp(dir / "one" / png), b = slurp(dir / "three" / png);
+    EXPECT_GT(a.size(), 1000u) << png;
+    EXPECT_TRUE(a == b) << png;
+  }
+  fs::create_directories(dir / "none");
+  const std::string zero = plot_command(dir, dir / "none", "--jobs 0");
+  EXPECT_NE(std::system(zero.c_str()), 0) << zero;
+  EXPECT_TRUE(fs::is_empty(dir / "none"));
+}
 
 TEST(PlotVerify, OneReadableFigurePerIncidence) {
   if (!has_matplotlib()) GTEST_SKIP() << "/usr/bin/python3 has no matplotlib";

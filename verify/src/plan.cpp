@@ -5,10 +5,10 @@
 #include <algorithm>
 #include <limits>
 #include <sstream>
-#include <thread>
 
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
+#include "weft/core/parallel.h"
 #include "weft/core/params.h"
 #include "weft/materials/cook_torrance.h"
 
@@ -173,7 +173,7 @@ constexpr double kTypicalSecondsPerClassicSample = 1.25e-6;
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
                                size_t fit_params, int fit_seeds) {
   VerifyEstimate e;
-  e.cores = std::max(1u, s.threads > 0 ? unsigned(s.threads) : std::thread::hardware_concurrency());
+  e.cores = static_cast<unsigned>(s.threads > 0 ? s.threads : hardware_threads());
   const double bins = 2.0 * s.resolution * s.resolution;
   const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
   // Computed and classic, each 'particles_per_bin' per incident bin over all batches.
