@@ -169,11 +169,16 @@ def draw_all(data, models, labels, incidences, out_dir, jobs):
     """Every incidence's figure, in 'jobs' processes (forked: each starts with the data read);
     the layout entries in the incidences' order."""
     draw = [(data, models, labels, ti, out_dir) for ti in incidences]
-    if jobs <= 1 or len(incidences) <= 1:
-        return [incidence_figure(*d) for d in draw]
-    context = multiprocessing.get_context("fork")
-    with concurrent.futures.ProcessPoolExecutor(min(jobs, len(draw)), mp_context=context) as pool:
-        return list(pool.map(incidence_figure, *zip(*draw)))
+    if jobs > 1 and len(incidences) > 1:
+        try:
+            context = multiprocessing.get_context("fork")
+            with concurrent.futures.ProcessPoolExecutor(min(jobs, len(draw)),
+                                                        mp_context=context) as pool:
+                return list(pool.map(incidence_figure, *zip(*draw)))
+        except (OSError, concurrent.futures.BrokenExecutor) as e:
+            # No processes here (a container without /dev/shm, a worker killed): one will do.
+            print(f"plot_verify: drawing in this process alone ({e})", file=sys.stderr)
+    return [incidence_figure(*d) for d in draw]
 
 
 def positive(text):

@@ -56,17 +56,20 @@ bool overlap(const nlohmann::json& a, const nlohmann::json& b) {
          a[1].get<double>() < b[3].get<double>() && b[1].get<double>() < a[3].get<double>();
 }
 
-// The command that plots 'dir''s inputs into 'out' with 'extra' options.
-std::string plot_command(const fs::path& dir, const fs::path& out, const std::string& extra) {
-  return "/usr/bin/python3 '" + std::string(WEFT_SOURCE_DIR) + "/tools/plot_verify.py' " + extra +
-         " '" + (dir / "inplane.csv").string() + "' '" + (dir / "metrics.json").string() + "' '" +
+// The command that plots 'dir''s inputs into 'out' with 'extra' options, the script run by
+// 'python' (a command line).
+std::string plot_command(const fs::path& dir, const fs::path& out, const std::string& extra,
+                         const std::string& python = "/usr/bin/python3") {
+  return python + " '" + std::string(WEFT_SOURCE_DIR) + "/tools/plot_verify.py' " + extra + " '" +
+         (dir / "inplane.csv").string() + "' '" + (dir / "metrics.json").string() + "' '" +
          out.string() + "' 2>/dev/null";
 }
 
 }  // namespace
 
 // Figures drawn in several processes (weft passes its thread count) are the ones drawn in one:
-// the same PNG bytes, the same layout in the incidences' order. A count below one is refused.
+// the same PNG bytes, the same layout in the incidences' order; where processes cannot be
+// started, the script draws them itself. A count below one is refused.
 TEST(PlotVerify, ProcessesDrawTheSameFigures) {
   if (!has_matplotlib()) GTEST_SKIP() << "/usr/bin/python3 has no matplotlib";
   const fs::path dir = fresh_test_dir();
@@ -85,6 +88,21 @@ TEST(PlotVerify, ProcessesDrawTheSameFigures) {
     EXPECT_GT(a.size(), 1000u) << png;
     EXPECT_TRUE(a == b) << png;
   }
+  // Where no process can be started (a container without /dev/shm, say), this one draws them
+  // all: a wrapper runs the script with multiprocessing refusing.
+  std::ofstream(dir / "no_processes.py") << "import multiprocessing, runpy, sys\n"
+                                            "def refuse(*args, **kwargs):\n"
+                                            "    raise OSError(38, 'Function not implemented')\n"
+                                            "multiprocessing.get_context = refuse\n"
+                                            "sys.argv = sys.argv[1:]\n"
+                                            "runpy.run_path(sys.argv[0], run_name='__main__')\n";
+  fs::create_directories(dir / "alone");
+  const std::string alone =
+      plot_command(dir, dir / "alone", "--jobs 3",
+                   "/usr/bin/python3 '" + (dir / "no_processes.py").string() + "'");
+  ASSERT_EQ(std::system(alone.c_str()), 0) << alone;
+  for (const char* png : {"inplane-00.0deg.png", "inplane-30.0deg.png"})
+    EXPECT_TRUE(slurp(dir / "one" / png) == slurp(dir / "alone" / png)) << png;
   fs::create_directories(dir / "none");
   const std::string zero = plot_command(dir, dir / "none", "--jobs 0");
   EXPECT_NE(std::system(zero.c_str()), 0) << zero;
