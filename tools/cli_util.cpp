@@ -211,7 +211,7 @@ double render_bytes(int width, int height, bool preview, bool mask) {
 
 void check_long_work(double units, double seconds_per_unit, int threads, const std::string& file,
                      const std::string& field, const std::string& what, const std::string& rate) {
-  const unsigned cores = static_cast<unsigned>(threads > 0 ? threads : hardware_threads());
+  const auto cores = static_cast<unsigned>(thread_count(threads));
   const double seconds = units * seconds_per_unit / cores;
   const std::string basis = rate + ", " + std::to_string(cores) + (cores == 1 ? " core" : " cores");
   if (seconds > kLongWorkSeconds && !run_limits().yes_long)

@@ -49,11 +49,11 @@ void run_plot_script(const std::string& script, const std::vector<std::string>& 
 
 void plot_verify_figures(const std::filesystem::path& staging, const std::filesystem::path& output,
                          int threads) {
-  const int jobs = threads > 0 ? threads : hardware_threads();
-  run_plot_script("plot_verify.py",
-                  {"--jobs", std::to_string(jobs), (staging / "inplane.csv").string(),
-                   (staging / "metrics.json").string(), staging.string()},
-                  output);
+  run_plot_script(
+      "plot_verify.py",
+      {"--jobs", std::to_string(thread_count(threads)), (staging / "inplane.csv").string(),
+       (staging / "metrics.json").string(), staging.string()},
+      output);
 }
 
 }  // namespace weft::cli

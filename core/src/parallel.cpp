@@ -11,9 +11,13 @@ int hardware_threads() {
   return tbb::info::default_concurrency();
 }
 
+int thread_count(int threads) {
+  return threads > 0 ? threads : hardware_threads();
+}
+
 void parallel_for(uint64_t count, int threads, const std::function<void(uint64_t)>& fn) {
   if (count == 0) return;
-  const int n = threads > 0 ? threads : hardware_threads();
+  const int n = thread_count(threads);
   if (n == 1) {
     for (uint64_t i = 0; i < count; ++i) fn(i);
     return;

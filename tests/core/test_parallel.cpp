@@ -60,3 +60,11 @@ TEST(ParallelFor, ExceptionsPropagate) {
 TEST(ParallelFor, HardwareThreadsIsPositive) {
   EXPECT_GE(hardware_threads(), 1);
 }
+
+// A request's threads: as asked, or every core for 0 (the options' "0 = all cores").
+TEST(ParallelFor, ThreadCountIsTheRequestOrEveryCore) {
+  EXPECT_EQ(thread_count(3), 3);
+  EXPECT_EQ(thread_count(1), 1);
+  EXPECT_EQ(thread_count(0), hardware_threads());
+  EXPECT_EQ(thread_count(-1), hardware_threads());
+}

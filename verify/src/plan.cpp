@@ -173,7 +173,7 @@ constexpr double kTypicalSecondsPerClassicSample = 1.25e-6;
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
                                size_t fit_params, int fit_seeds) {
   VerifyEstimate e;
-  e.cores = static_cast<unsigned>(s.threads > 0 ? s.threads : hardware_threads());
+  e.cores = static_cast<unsigned>(thread_count(s.threads));
   const double bins = 2.0 * s.resolution * s.resolution;
   const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
   // Computed and classic, each 'particles_per_bin' per incident bin over all batches.

@@ -14,5 +14,7 @@ void parallel_for(uint64_t count, int threads, const std::function<void(uint64_t
 
 // Number of hardware threads.
 int hardware_threads();
+// The threads a request for 'threads' runs on: 'threads', or all cores for 0 (or less).
+int thread_count(int threads);
 
 }  // namespace weft

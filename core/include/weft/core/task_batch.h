@@ -44,7 +44,7 @@ TaskBatchStatus run_batch(const TaskBatch& batch, Run&& run, Merge&& merge) {
   batch.validate();
   const uint64_t per_task = batch.items_per_task;
   const uint64_t tasks = batch.items / per_task + (batch.items % per_task != 0 ? 1 : 0);
-  const int threads = batch.threads > 0 ? batch.threads : hardware_threads();
+  const int threads = thread_count(batch.threads);
   const uint64_t wave =
       batch.tasks_per_wave > 0 ? batch.tasks_per_wave : 8 * static_cast<uint64_t>(threads);
   TaskBatchStatus status;
