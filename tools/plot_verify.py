@@ -166,19 +166,29 @@ def incidence_figure(data, models, labels, ti, out_dir):
 
 
 def draw_all(data, models, labels, incidences, out_dir, jobs):
-    """Every incidence's figure, in 'jobs' processes (forked: each starts with the data read);
-    the layout entries in the incidences' order."""
-    draw = [(data, models, labels, ti, out_dir) for ti in incidences]
+    """Every incidence's figure, in 'jobs' processes; the layout entries in the incidences' order.
+    The drawers are forked after the inputs are read, so each is handed an incidence alone."""
+    def draw(ti):
+        return incidence_figure(data, models, labels, ti, out_dir)
     if jobs > 1 and len(incidences) > 1:
+        global _draw_forked
+        _draw_forked = draw
         try:
             context = multiprocessing.get_context("fork")
-            with concurrent.futures.ProcessPoolExecutor(min(jobs, len(draw)),
+            with concurrent.futures.ProcessPoolExecutor(min(jobs, len(incidences)),
                                                         mp_context=context) as pool:
-                return list(pool.map(incidence_figure, *zip(*draw)))
+                return list(pool.map(_draw_in_child, incidences))
         except (OSError, concurrent.futures.BrokenExecutor) as e:
             # No processes here (a container without /dev/shm, a worker killed): one will do.
             print(f"plot_verify: drawing in this process alone ({e})", file=sys.stderr)
-    return [incidence_figure(*d) for d in draw]
+    return [draw(ti) for ti in incidences]
+
+
+_draw_forked = None  # draw_all's drawer, which a forked child inherits
+
+
+def _draw_in_child(ti):
+    return _draw_forked(ti)
 
 
 def positive(text):
