@@ -66,6 +66,7 @@ PYBIND11_MODULE(weft, m) {
   });
   m.def("presets", &weft::fiber_preset_names, "The bundled fiber presets' names.");
   bind_table(m);
-  bind_bake(m);
+  bind_bake_fiber(m);
+  bind_bake_fabric(m);
   bind_verify(m);
 }

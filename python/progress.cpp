@@ -1,10 +1,10 @@
 // The progress, Ctrl-C and run limits of a long call from Python (weft_python.h).
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <mutex>
 #include <thread>
 
-#include "cli_util.h"
 #include "weft/core/error.h"
 #include "weft_python.h"
 
@@ -90,17 +90,11 @@ ProgressCallback CallProgress::callback() {
   };
 }
 
-void check_with_limits(bool yes_long, const std::function<void()>& check) {
-  cli::RunLimits& limits = cli::run_limits();
-  const cli::RunLimits before = limits;
-  limits.yes_long = yes_long;
-  try {
-    check();
-  } catch (...) {
-    limits = before;
-    throw;
-  }
-  limits = before;
+RunLimits call_limits(bool yes_long) {
+  RunLimits l;
+  l.yes_long = yes_long;
+  l.announce = [](const std::string& line) { std::fprintf(stderr, "weft: %s\n", line.c_str()); };
+  return l;
 }
 
 }  // namespace weft::python

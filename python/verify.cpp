@@ -10,10 +10,10 @@
 #include <optional>
 #include <sstream>
 
-#include "cli_util.h"
-#include "plot_util.h"
 #include "weft/core/error.h"
+#include "weft/core/output_guard.h"
 #include "weft/verify/plan.h"
+#include "weft/verify/plot_scripts.h"
 #include "weft/verify/report.h"
 #include "weft/verify/whole_run.h"
 #include "weft_python.h"
@@ -31,15 +31,15 @@ struct VerifyArgs {
 VerifyPlan checked_plan(const VerifyArgs& a) {
   const VerifyRequest& r = a.request;
   const VerifyPlan p = plan_verify(r);
-  cli::validate_output_paths(
-      {}, {{p.measured_path, "measured"}, {r.weave, "weave"}, {r.wif, "wif"}, {r.fiber, "fiber"}},
+  const RunLimits limits = call_limits(a.yes_long);
+  validate_output_paths(
+      limits, {},
+      {{p.measured_path, "measured"}, {r.weave, "weave"}, {r.wif, "wif"}, {r.fiber, "fiber"}},
       {{r.output, "output"}});
   check_verify_output(r.output);
-  check_with_limits(a.yes_long, [&] {
-    cli::check_long_work(estimate_verify(p).least, 1.0, p.settings.threads, "", "quality",
-                         "weft verify at quality " + r.quality + (r.fit ? " with fit" : ""),
-                         kVerifyLeastRates);
-  });
+  check_long_work(limits, estimate_verify(p).least, 1.0, p.settings.threads, "", "quality",
+                  "weft verify at quality " + r.quality + (r.fit ? " with fit" : ""),
+                  kVerifyLeastRates);
   return p;
 }
 
@@ -58,7 +58,7 @@ py::dict verify(VerifyArgs a) {
   const int threads = a.request.threads;
   if (a.plots)
     hooks.draw = [output, threads](const std::filesystem::path& staging) {
-      cli::plot_verify_figures(staging, output, threads);
+      plot_verify_figures(staging, output, threads);
     };
   VerifyOutcome out;
   {

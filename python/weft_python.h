@@ -6,10 +6,13 @@
 
 #include <functional>
 #include <memory>
+#include <nlohmann/json.hpp>
 #include <string>
 
 #include "weft/core/progress.h"
+#include "weft/core/run_limits.h"
 #include "weft/fiber/fiber_spec.h"
+#include "weft/fiber/fiber_table_bake.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/tabulated_bsdf.h"
 
@@ -51,16 +54,21 @@ class CallProgress {
   std::shared_ptr<State> state_;
 };
 
-// Runs 'check' (a front end's check before long work, tools/cli_util.h) with the run limits of
-// this call: yes_long lets work past an hour's estimate start (its error, in Python's words,
-// names yes_long=True).
-void check_with_limits(bool yes_long, const std::function<void()>& check);
+// The run limits of one call (core/run_limits.h): yes_long lets work past an hour's estimate
+// start (its error, in Python's words, names yes_long=True); long work is announced on stderr.
+RunLimits call_limits(bool yes_long);
 
 // A spec argument: a dict (the spec's JSON), or a file path or a preset name.
 FiberSpec fiber_spec_argument(const py::object& spec);
+// The JSON text of a Python dict, by Python's json (its numbers as Python writes them).
+nlohmann::json dict_json(const py::dict& d, const std::string& what);
+// A fiber bake, checked (memory, time: check_fiber_bake) and run without the GIL.
+Table bake_fiber_checked(const FiberSpec& spec, const FiberTableBakeOptions& o, bool yes_long,
+                         bool print);
 
 void bind_table(py::module_& m);
-void bind_bake(py::module_& m);
+void bind_bake_fiber(py::module_& m);
+void bind_bake_fabric(py::module_& m);
 void bind_verify(py::module_& m);
 
 }  // namespace weft::python

@@ -21,12 +21,13 @@ bool is_table_file(const std::string& fiber) {
 
 // The table of a spec baked once into ./.weft-cache (RGB); 'source' names it in the checks.
 TabulatedBsdfTable cached_table(const FiberSpec& spec, const std::string& source,
-                                const std::string& option, const ProgressCallback& progress) {
+                                const std::string& option, const RunLimits& limits,
+                                const ProgressCallback& progress) {
   FiberTableBakeOptions o = fiber_bake_defaults(spec);
   o.spectral = false;
   return TabulatedBsdfTable::read_exr(
       cached_fiber_table(".weft-cache", spec, o, progress, nullptr, [&] {
-        check_fiber_bake(o, kNumBands, {source, option, option});
+        check_fiber_bake(limits, o, kNumBands, {source, option, option});
       }));
 }
 
@@ -64,8 +65,8 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
   for (size_t k = 0; k < colours.size(); ++k) {
     const std::string name = srgb_hex(colours[k]);
     const std::string option = "--thread-colours " + name;
-    f.held.push_back(
-        cached_table(thread_colour_spec(base, colours[k], option), option, option, progress));
+    f.held.push_back(cached_table(thread_colour_spec(base, colours[k], option), option, option,
+                                  o.limits, progress));
     f.map.tables[k] = &f.held.back();
     f.map.names.push_back(name);
   }
@@ -75,9 +76,9 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
 }  // namespace
 
 TabulatedBsdfTable fiber_table(const std::string& fiber, const std::string& option,
-                               const ProgressCallback& progress) {
+                               const RunLimits& limits, const ProgressCallback& progress) {
   if (is_table_file(fiber)) return TabulatedBsdfTable::read_exr(fiber);
-  return cached_table(load_fiber_spec(fiber), fiber, option, progress);
+  return cached_table(load_fiber_spec(fiber), fiber, option, limits, progress);
 }
 
 bool per_yarn_fibers(const FabricFiberOptions& o) {
@@ -109,16 +110,17 @@ FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& 
   FabricFibers f;
   if (!per_yarn_fibers(o)) {
     const std::string& only = o.warp_fiber.empty() ? o.fiber : o.warp_fiber;
-    f.held.push_back(fiber_table(only, only == o.fiber ? "--fiber" : "--warp-fiber", progress));
+    f.held.push_back(
+        fiber_table(only, only == o.fiber ? "--fiber" : "--warp-fiber", o.limits, progress));
     f.map.tables = {&f.held.back()};
     return f;
   }
-  const TabulatedBsdfTable& warp =
-      f.held.emplace_back(fiber_table(o.warp_fiber.empty() ? o.fiber : o.warp_fiber,
-                                      o.warp_fiber.empty() ? "--fiber" : "--warp-fiber", progress));
-  const TabulatedBsdfTable& weft =
-      f.held.emplace_back(fiber_table(o.weft_fiber.empty() ? o.fiber : o.weft_fiber,
-                                      o.weft_fiber.empty() ? "--fiber" : "--weft-fiber", progress));
+  const TabulatedBsdfTable& warp = f.held.emplace_back(
+      fiber_table(o.warp_fiber.empty() ? o.fiber : o.warp_fiber,
+                  o.warp_fiber.empty() ? "--fiber" : "--warp-fiber", o.limits, progress));
+  const TabulatedBsdfTable& weft = f.held.emplace_back(
+      fiber_table(o.weft_fiber.empty() ? o.fiber : o.weft_fiber,
+                  o.weft_fiber.empty() ? "--fiber" : "--weft-fiber", o.limits, progress));
   f.map = fiber_tables_by_direction(sample, warp, weft);
   return f;
 }

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "weft/core/progress.h"
+#include "weft/core/run_limits.h"
 #include "weft/fabric/fabric_raytrace.h"
 
 namespace weft::cli {
@@ -15,6 +16,7 @@ struct FabricFiberOptions {
   std::string fiber, warp_fiber, weft_fiber;  // warp/weft: "" = --fiber
   bool thread_colours = false;
   std::string draft;  // the WIF draft (--wif, or the one --weave names); "" when none
+  RunLimits limits;   // a bake on first use is checked under these
 };
 
 // The most distinct thread colours --thread-colours takes (a fiber table baked for each).
@@ -41,6 +43,6 @@ FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& 
 // One fiber table: a table file (.exr), or a fiber spec or preset baked once into ./.weft-cache
 // (RGB); 'option' names it in the bake's checks.
 TabulatedBsdfTable fiber_table(const std::string& fiber, const std::string& option,
-                               const ProgressCallback& progress);
+                               const RunLimits& limits, const ProgressCallback& progress);
 
 }  // namespace weft::cli

@@ -267,10 +267,10 @@ void add_bake_command(CLI::App& app, Commands& commands) {
   fiber->add_flag("--quiet", opt->quiet, "no progress bar");
 
   commands.push_back(
-      {fiber, [opt] {
-         run_limits().quiet = opt->quiet;
+      {fiber, [opt](const RunLimits& program) {
+         const RunLimits limits = quieted(program, opt->quiet);
          validate_output_paths(
-             {{opt->output, "--output"}, {checkpoint_path(opt->output), "checkpoint"}},
+             limits, {{opt->output, "--output"}, {checkpoint_path(opt->output), "checkpoint"}},
              {{opt->spec, "fiber spec"}});
          // A shard writes a part file for `weft merge`, not a table.
          if (opt->shard.empty()) TabulatedBsdfTable::check_output_path(opt->output, "--output");
@@ -310,12 +310,12 @@ void add_bake_command(CLI::App& app, Commands& commands) {
                cp.units[range.first + i] = encode_fiber_band(states[i], o.estimator);
              write_job_part(checkpoint_path(opt->output), cp);
            };
-         check_fiber_bake(o, range.last - range.first, {"", "--photons", "--resolution"});
+         check_fiber_bake(limits, o, range.last - range.first, {"", "--photons", "--resolution"});
          const auto start = std::chrono::steady_clock::now();
          FiberBandsResult traced;
          if (range.last > range.first) {
            try {
-             traced = trace_fiber_bands(spec, o, work, progress_bar(opt->quiet));
+             traced = trace_fiber_bands(spec, o, work, progress_bar(limits, opt->quiet));
            } catch (const Error&) {
              if (!interrupted()) throw;
              std::fprintf(stderr, "\nweft: interrupted before any photon; nothing was written\n");

@@ -16,6 +16,7 @@
 #include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
+#include "weft/fabric/fabric_bake.h"
 #include "weft/fabric/fabric_parts.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fabric_summation.h"
@@ -74,10 +75,10 @@ constexpr int kFittingTessellations[] = {12, 8, 6, 4};
 // default take the finest coarser one that fits instead, said in 'note', unless the run is one
 // piece of a job ('may_coarsen' false: every piece must trace the same sample, whatever memory
 // its machine has); 'bytes' gets the estimate.
-WeaveOptions fitted_weave_options(WeaveOptions w, const std::string& draft, bool may_coarsen,
-                                  std::string* note, double* bytes) {
+WeaveOptions fitted_weave_options(const RunLimits& limits, WeaveOptions w, const std::string& draft,
+                                  bool may_coarsen, std::string* note, double* bytes) {
   WovenSampleSize z = woven_sample_size(w);
-  const double budget = memory_budget_bytes();
+  const double budget = memory_budget_bytes(limits);
   if (may_coarsen && z.detail == "yarn" && !w.sides && !w.segments_per_crossing && budget > 0 &&
       fabric_scene_bytes(z) > budget)
     for (const int n : kFittingTessellations) {
@@ -96,7 +97,7 @@ WeaveOptions fitted_weave_options(WeaveOptions w, const std::string& draft, bool
     }
   const bool yarn = z.detail == "yarn";
   *bytes = fabric_scene_bytes(z);
-  check_memory(*bytes, draft, "--detail",
+  check_memory(limits, *bytes, draft, "--detail",
                "the scene at " + z.detail + " detail (" +
                    ParamReader::fmt(yarn ? z.triangles : z.curve_points) +
                    (yarn ? " triangles" : " curve points") + ")");
@@ -106,14 +107,14 @@ WeaveOptions fitted_weave_options(WeaveOptions w, const std::string& draft, bool
 // The sample's options, its scene's memory checked (fitted_weave_options) where the method builds
 // one: the summations of the paper's method need only the sample's name. 'draft_in_weave': the
 // WIF draft the --weave file names.
-WeaveOptions sample_options(const BakeFabricOptions& o, const std::string& draft_in_weave,
-                            std::string* note, double* bytes) {
+WeaveOptions sample_options(const RunLimits& limits, const BakeFabricOptions& o,
+                            const std::string& draft_in_weave, std::string* note, double* bytes) {
   if (o.method == "summation") return weave_options(o);
   const std::string draft = !o.wif.empty()            ? o.wif
                             : !draft_in_weave.empty() ? draft_in_weave
                                                       : o.weave;
-  const WeaveOptions w =
-      fitted_weave_options(weave_options(o), draft, o.shard.empty() && !o.resume, note, bytes);
+  const WeaveOptions w = fitted_weave_options(limits, weave_options(o), draft,
+                                              o.shard.empty() && !o.resume, note, bytes);
   if (!note->empty()) std::fprintf(stderr, "weft: %s\n", note->c_str());
   return w;
 }
@@ -200,13 +201,14 @@ FabricRaytraceOptions raytrace_options(const BakeFabricOptions& o) {
 
 // The work's time from a lower bound of its rate, before any (check_fabric_bake): a ray trace's
 // incident bins are those of its shard.
-void check_fabric_work(const BakeFabricOptions& o) {
+void check_fabric_work(const RunLimits& limits, const BakeFabricOptions& o) {
   const uint64_t bins = static_cast<uint64_t>(DirectionGrid{o.resolution}.bins());
   const UnitRange r =
       o.method == "raytrace"
           ? shard_units(bins, o.shard.empty() ? Shard{} : parse_shard(o.shard, "--shard"))
           : UnitRange{0, bins};
-  check_fabric_bake(o.method, o.resolution, r.last - r.first, o.samples, o.threads, "--samples");
+  check_fabric_bake(limits, value_of(kFabricMethods, o.method, "", "--method"), o.resolution,
+                    r.last - r.first, o.samples, o.threads, "--samples");
 }
 
 // The ray tracer's options given to a summation, and a summation's sample count, refused.
@@ -236,11 +238,12 @@ void check_method_options(const BakeFabricOptions& o) {
 
 // The scene's memory and the weave tally's (weave_tally_bytes) against the budget, once the
 // fiber table's channels are known; the tally's bytes (0 without it).
-double check_weave_memory(const FabricRaytraceOptions& r, int channels, double scene_bytes) {
+double check_weave_memory(const RunLimits& limits, const FabricRaytraceOptions& r, int channels,
+                          double scene_bytes) {
   if (r.weave_positions_u == 0) return 0;
   const double bytes = weave_tally_bytes(r.resolution, r.weave_resolution, r.weave_positions_u,
                                          r.weave_positions_v, channels);
-  check_memory(scene_bytes + bytes, "", "--weave-positions",
+  check_memory(limits, scene_bytes + bytes, "", "--weave-positions",
                "the scene and the weave tally of " + std::to_string(r.weave_positions_u) + "x" +
                    std::to_string(r.weave_positions_v) + " positions at resolution " +
                    std::to_string(r.weave_resolution) + " (" + format_bytes(bytes) + ")");
@@ -299,17 +302,19 @@ int part_written(const BakeFabricOptions& o, int code) {
   return code;
 }
 
-int run(const BakeFabricOptions& o) {
-  run_limits().quiet = o.quiet;
+int run(const BakeFabricOptions& o, const RunLimits& program) {
+  const RunLimits limits = quieted(program, o.quiet);
   check_method_options(o);
   const FabricRaytraceOptions r =
       o.method == "raytrace" ? raytrace_options(o) : FabricRaytraceOptions{};
   // The WIF draft a weave options file names is read too.
   const std::string weave_wif = o.weave.empty() ? "" : read_weave_options(o.weave).wif.value_or("");
-  const FabricFiberOptions fiber_options{o.fiber, o.warp_fiber, o.weft_fiber, o.thread_colours,
-                                         o.wif.empty() ? weave_wif : o.wif};
+  const FabricFiberOptions fiber_options{
+      o.fiber, o.warp_fiber, o.weft_fiber, o.thread_colours, o.wif.empty() ? weave_wif : o.wif,
+      limits};
   check_fabric_fiber_options(fiber_options, o.method);
-  validate_output_paths({{o.output, "--output"},
+  validate_output_paths(limits,
+                        {{o.output, "--output"},
                          {checkpoint_path(o.output), "checkpoint"},
                          {o.weave_out, "--weave-out"}},
                         {{o.fiber, "fiber table or spec"},
@@ -321,15 +326,15 @@ int run(const BakeFabricOptions& o) {
                          {".weft-cache", "fiber-table bake cache"}});
   if (std::filesystem::path(o.output).extension() != ".exr" && o.shard.empty())
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
-  check_fabric_work(o);
+  check_fabric_work(limits, o);
   std::string note;
   double scene_bytes = 0;
-  const WeaveOptions weave = sample_options(o, weave_wif, &note, &scene_bytes);
-  const auto progress = progress_bar(o.quiet);
+  const WeaveOptions weave = sample_options(limits, o, weave_wif, &note, &scene_bytes);
+  const auto progress = progress_bar(limits, o.quiet);
   const WovenSample sample = make_woven_sample(weave);
   const FabricFibers fibers = load_fabric_fibers(fiber_options, sample, progress);
   const TabulatedBsdfTable& fiber = fibers.first();
-  const double weave_bytes = check_weave_memory(r, fiber.channels, scene_bytes);
+  const double weave_bytes = check_weave_memory(limits, r, fiber.channels, scene_bytes);
   const auto t0 = std::chrono::steady_clock::now();
   const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
   TabulatedBsdfTable table;
@@ -516,7 +521,7 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
                 "from a checkpoint an earlier run left there");
   sub->add_flag("--json", o->json, "print a JSON summary");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
-  commands.push_back({sub, [o] { return run(*o); }});
+  commands.push_back({sub, [o](const RunLimits& l) { return run(*o, l); }});
 }
 
 int merge_fabric_bake(const JobPart& all, const std::string& output, const std::string& weave_out,

@@ -135,7 +135,7 @@ void add_bench_bake_command(CLI::App& bench, Commands& commands) {
       ->capture_default_str();
   cmd->add_flag("--json", opt->json, "print JSON");
   commands.push_back(
-      {cmd, [opt] {
+      {cmd, [opt](const RunLimits&) {
          const FiberSpec spec = load_fiber_spec(opt->spec);
          BakeBenchOptions o = opt->bench;
          if (!opt->photons.empty()) {

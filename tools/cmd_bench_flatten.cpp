@@ -149,7 +149,7 @@ void add_bench_flatten_command(CLI::App& bench, Commands& commands) {
   cmd->add_flag("--lossless", o->lossless, "the spec's fiber without absorption (energy check)");
   cmd->add_option("--csv", o->csv, "write the rings: beta per channel and its standard error");
   commands.push_back(
-      {cmd, [o] {
+      {cmd, [o](const RunLimits&) {
          const FiberSpec spec = load_fiber_spec(o->spec);
          FiberMedium medium = build_fiber_medium(spec);
          if (o->lossless)

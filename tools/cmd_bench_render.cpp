@@ -38,7 +38,7 @@ void add_bench_render_command(CLI::App& bench, Commands& commands) {
       ->capture_default_str();
   sub->add_flag("--json", o->json, "JSON output");
   commands.push_back(
-      {sub, [o] {
+      {sub, [o](const RunLimits&) {
          const RenderBenchOptions& opt = o->bench;
          std::vector<RenderBenchResult> results;
          if (!o->scene.empty()) {

@@ -6,10 +6,10 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
-#include "plot_util.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/materials/table_compare.h"
+#include "weft/verify/plot_scripts.h"
 
 namespace weft::cli {
 namespace {
@@ -24,8 +24,8 @@ nlohmann::json to_json(const TableDifference& d) {
   return {{"rel_rms", d.rel_rms}, {"max_rel", d.max_rel}, {"cells", d.cells}};
 }
 
-int run_compare(const CompareCliOptions& o) {
-  validate_output_paths({{o.plot, "--plot"}, {o.csv, "--csv"}},
+int run_compare(const CompareCliOptions& o, const RunLimits& limits) {
+  validate_output_paths(limits, {{o.plot, "--plot"}, {o.csv, "--csv"}},
                         {{o.a, "table A"}, {o.b, "table B"}});
   const auto a = TabulatedBsdfTable::read_exr(o.a);
   const auto b = TabulatedBsdfTable::read_exr(o.b);
@@ -89,7 +89,7 @@ void add_compare_command(CLI::App& app, Commands& commands) {
                   "max_rel counts cells at least this fraction of A's mean value")
       ->check(finite_range(0.0, 1e6))
       ->capture_default_str();
-  commands.push_back({sub, [o] { return run_compare(*o); }});
+  commands.push_back({sub, [o](const RunLimits& l) { return run_compare(*o, l); }});
 }
 
 }  // namespace weft::cli

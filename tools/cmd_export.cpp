@@ -16,9 +16,9 @@ struct ExportCliOptions {
   bool json = false;
 };
 
-int run_export(const ExportCliOptions& o) {
+int run_export(const ExportCliOptions& o, const RunLimits& limits) {
   check_export_path(o.output, "--output");
-  validate_output_paths({{o.output, "--output"}}, {{o.table, "table"}});
+  validate_output_paths(limits, {{o.output, "--output"}}, {{o.table, "table"}});
   const auto table = TabulatedBsdfTable::read_exr(o.table);
   ExportOptions options;
   options.name = o.name.empty() ? std::filesystem::path(o.table).stem().string() : o.name;
@@ -54,7 +54,7 @@ void add_export_command(CLI::App& app, Commands& commands) {
   sub->add_option("-o,--output", o->output, "output: .bsdf, .mbsdf, .gltf or .glb")->required();
   sub->add_option("--name", o->name, "material name (default: the table's file name)");
   sub->add_flag("--json", o->json, "print the summary as JSON");
-  commands.push_back({sub, [o] { return run_export(*o); }});
+  commands.push_back({sub, [o](const RunLimits& l) { return run_export(*o, l); }});
 }
 
 }  // namespace weft::cli

@@ -29,7 +29,7 @@ void add_merge_command(CLI::App& app, Commands& commands) {
                   "table (.exr)");
   sub->add_flag("--json", o->json, "print the command's summary as JSON");
   commands.push_back(
-      {sub, [o] {
+      {sub, [o](const RunLimits& limits) {
          const JobPart all =
              merge_job_parts(std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
          // A verify report is a folder, replaced whole.
@@ -42,9 +42,10 @@ void add_merge_command(CLI::App& app, Commands& commands) {
          if (!o->weave_out.empty() && all.command != "bake fabric")
            throw Error(o->weave_out, "--weave-out", "only bake fabric parts carry a weave tally");
          if (all.command == "verify")
-           validate_output_paths({}, inputs, {{o->output, "--output"}});
+           validate_output_paths(limits, {}, inputs, {{o->output, "--output"}});
          else
-           validate_output_paths({{o->output, "--output"}, {o->weave_out, "--weave-out"}}, inputs);
+           validate_output_paths(limits, {{o->output, "--output"}, {o->weave_out, "--weave-out"}},
+                                 inputs);
          if (all.command == "verify") return merge_verify(all, o->output, o->json);
          if (all.command == "bake fiber") return merge_fiber_bake(all, o->output, o->json);
          if (all.command == "bake fabric")

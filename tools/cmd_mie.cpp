@@ -174,7 +174,7 @@ struct MediumCliOptions {
   bool json = false, quiet = false;
 };
 
-int run_medium(const MediumCliOptions& o) {
+int run_medium(const MediumCliOptions& o, const RunLimits& limits) {
   const FiberSpec spec = load_fiber_spec(o.spec);
   std::vector<int> bands;
   if (!o.wavelengths.empty()) {
@@ -190,7 +190,7 @@ int run_medium(const MediumCliOptions& o) {
   if (o.threads < 0) throw Error("", "--threads", "must be >= 0");
   MediumOptions mo;
   mo.threads = o.threads;
-  const FiberMedium m = build_fiber_medium(spec, bands, mo, progress_bar(o.quiet));
+  const FiberMedium m = build_fiber_medium(spec, bands, mo, progress_bar(limits, o.quiet));
 
   nlohmann::json out = {{"name", m.spec_name},
                         {"hash", m.spec_hash},
@@ -242,7 +242,7 @@ void add_mie_command(CLI::App& app, Commands& commands) {
   sub->add_option("--angles-deg", o->angles_deg,
                   "scattering angles a:b:step or a,b,c (degrees) for S1, S2 and p(theta)");
   sub->add_flag("--json", o->json, "print JSON");
-  commands.push_back({sub, [o] { return run_mie(*o); }});
+  commands.push_back({sub, [o](const RunLimits&) { return run_mie(*o); }});
 }
 
 void add_medium_command(CLI::App& app, Commands& commands) {
@@ -255,7 +255,7 @@ void add_medium_command(CLI::App& app, Commands& commands) {
   sub->add_option("--threads", o->threads, "threads (0 = all cores)");
   sub->add_flag("--json", o->json, "print JSON");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
-  commands.push_back({sub, [o] { return run_medium(*o); }});
+  commands.push_back({sub, [o](const RunLimits& l) { return run_medium(*o, l); }});
 }
 
 }  // namespace weft::cli

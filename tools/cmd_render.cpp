@@ -107,8 +107,8 @@ void add_render_command(CLI::App& app, Commands& commands) {
                 "nothing on stderr but warnings and errors (no lights, progress or summary)");
   sub->add_flag("--json", o->json, "print a JSON summary on stdout");
   commands.push_back(
-      {sub, [o, seed] {
-         run_limits().quiet = o->quiet;
+      {sub, [o, seed](const RunLimits& program) {
+         const RunLimits limits = quieted(program, o->quiet);
          if (!o->mask.empty() && o->mask_object.empty())
            throw Error("", "--mask-object", "is required with --mask");
          std::vector<SceneOverride> overrides;
@@ -155,8 +155,9 @@ void add_render_command(CLI::App& app, Commands& commands) {
          if (job.mask) outputs.push_back({*job.mask, "--mask"});
          if (job.albedo) outputs.push_back({*job.albedo, "--aov albedo"});
          if (job.normal) outputs.push_back({*job.normal, "--aov normal"});
-         validate_output_paths(outputs, scene_inputs(o->scene, desc));
-         check_memory(render_bytes(job.settings.width, job.settings.height, job.png.has_value(),
+         validate_output_paths(limits, outputs, scene_inputs(o->scene, desc));
+         check_memory(limits,
+                      render_bytes(job.settings.width, job.settings.height, job.png.has_value(),
                                    job.mask.has_value()),
                       o->scene, "width x height",
                       "a " + std::to_string(job.settings.width) + " x " +
@@ -167,15 +168,15 @@ void add_render_command(CLI::App& app, Commands& commands) {
            const auto& c = job.settings.crop;
            const double pixels = c ? double(c->width()) * c->height()
                                    : double(job.settings.width) * job.settings.height;
-           check_long_work(pixels * job.settings.spp, kMinSecondsPerPathSample,
+           check_long_work(limits, pixels * job.settings.spp, kMinSecondsPerPathSample,
                            job.settings.threads, o->scene, "spp",
                            "a render of " + std::to_string(int64_t(pixels)) + " pixels at " +
                                std::to_string(job.settings.spp) + " spp",
                            "0.05 us per path sample per core at least");
          }
          const auto t0 = std::chrono::steady_clock::now();
-         const RenderJobResult r =
-             render_to_files(desc, job, progress_bar(o->quiet), checked_fiber_table_resolver());
+         const RenderJobResult r = render_to_files(desc, job, progress_bar(limits, o->quiet),
+                                                   checked_fiber_table_resolver(limits));
          const double sec = seconds_since(t0);
          if (const int code = report_render_outcome(r, "render")) return code;
          const double rays_per_s = sec > 0 ? r.rays.total() / sec : 0;

@@ -16,8 +16,8 @@ struct SceneOptions {
   bool json = false;
 };
 
-int run_car_seat(const SceneOptions& o) {
-  validate_output_paths({{o.output, "--output"}}, {});
+int run_car_seat(const SceneOptions& o, const RunLimits& limits) {
+  validate_output_paths(limits, {{o.output, "--output"}}, {});
   const CarSeat seat = make_car_seat(o.seat);
   write_car_seat_gltf(o.output, seat, o.seat);
   if (o.json) {
@@ -61,7 +61,7 @@ void add_scene_command(CLI::App& app, Commands& commands) {
       ->check(CLI::Range(1.0, 10.0))
       ->capture_default_str();
   seat->add_flag("--json", o->json, "print a JSON summary");
-  commands.push_back({seat, [o] { return run_car_seat(*o); }});
+  commands.push_back({seat, [o](const RunLimits& l) { return run_car_seat(*o, l); }});
 }
 
 }  // namespace weft::cli

@@ -70,14 +70,14 @@ SlabSetup make_setup(const SlabOptions& o) {
   return s;
 }
 
-int run_slab(const SlabOptions& o) {
+int run_slab(const SlabOptions& o, const RunLimits& limits) {
   const SlabSetup setup = make_setup(o);
   TaskBatch batch;
   batch.items = static_cast<uint64_t>(o.photons);
   batch.seed = o.seed;
   batch.threads = o.threads;
   batch.items_per_task = static_cast<uint64_t>(o.photons_per_task);
-  batch.progress = progress_bar(o.quiet);
+  batch.progress = progress_bar(limits, o.quiet);
   const SlabResult r = simulate_slab(setup, batch);
 
   const std::pair<const char*, MeanEstimate> values[] = {{"rsp", r.specular},
@@ -156,7 +156,7 @@ void add_slab_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--analog", o->analog, "analog absorption instead of implicit capture");
   sub->add_flag("--json", o->json, "print JSON");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
-  commands.push_back({sub, [o] { return run_slab(*o); }});
+  commands.push_back({sub, [o](const RunLimits& l) { return run_slab(*o, l); }});
 }
 
 }  // namespace weft::cli

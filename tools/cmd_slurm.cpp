@@ -97,29 +97,24 @@ std::string sbatch_value(const std::string& s) {
   return s.find(' ') == std::string::npos ? s : "\"" + s + "\"";
 }
 
-// Parses and runs the wrapped command line with run_limits().check_only: the same parser and
-// every check the command makes before its work, none of the work (progress_bar stops it).
-void check_wrapped_command(const std::vector<std::string>& args) {
-  const RunLimits saved = run_limits();
+// Parses and runs the wrapped command line check-only (RunLimits::check_only): the same parser
+// and every check the command makes before its work, none of the work (work_starts stops it).
+// Returns the inputs the command guards.
+std::vector<NamedPath> check_wrapped_command(const std::vector<std::string>& args) {
   const auto program = make_program();
   std::vector<std::string> reversed(args.rbegin(), args.rend());
+  auto inputs = std::make_shared<std::vector<NamedPath>>();
   try {
     program->app.parse(reversed);
-    run_limits().check_only = true;
-    const int code = run_program(*program);
-    run_limits() = saved;
+    const int code = run_program(*program, inputs);
     if (code != 0)
       throw Error("", "command",
                   "the wrapped command stops with exit code " + std::to_string(code));
   } catch (const WorkWouldStart&) {
-    run_limits() = saved;
   } catch (const CLI::ParseError& e) {
-    run_limits() = saved;
     throw Error("", "command", std::string("the wrapped command: ") + e.what());
-  } catch (...) {
-    run_limits() = saved;
-    throw;
   }
+  return *inputs;
 }
 
 // The output's folder is created for the check (the shards' part files go there) and removed
@@ -154,7 +149,8 @@ void check_slurm_values(const SlurmOptions& o, const std::vector<std::string>& a
 
 // The scripts of a wrapped command line 'args' (checked before any is written), submitted or
 // printed.
-int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
+int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args,
+              const RunLimits& limits) {
   const bool verify = !args.empty() && args[0] == "verify";
   if (args.size() < 2 || !((args[0] == "bake" && (args[1] == "fiber" || args[1] == "fabric")) ||
                            args[0] == "sweep" || verify))
@@ -182,7 +178,7 @@ int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
   if (verify)
     check_verify_output(out_abs);
   else
-    validate_output_paths({{out_abs, "--output"}}, {});
+    validate_output_paths(limits, {{out_abs, "--output"}}, {});
   check_sbatch_path(dir);
   const std::string name = "weft-" + out_abs.filename().string();
   const int n = o.shards;
@@ -198,9 +194,7 @@ int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
   ScriptFolder folder(dir);
   // That shard's command, checked as it will run; then the scripts, the parts and
   // the output against every file it reads.
-  const size_t seen = guarded_inputs().size();
-  check_wrapped_command(last);
-  const std::vector<NamedPath> inputs(guarded_inputs().begin() + seen, guarded_inputs().end());
+  const std::vector<NamedPath> inputs = check_wrapped_command(last);
   std::vector<NamedPath> outputs = {{dir / "array.sh", "array script"},
                                     {dir / "merge.sh", "merge script"}};
   for (int k = 0; k < n; ++k) outputs.push_back({part(k), "part file"});
@@ -208,7 +202,7 @@ int run_slurm(const SlurmOptions& o, const std::vector<std::string>& args) {
   if (!weave_out.empty()) outputs.push_back({fs::absolute(weave_out), "--weave-out"});
   std::vector<NamedPath> folders = {{dir, "script folder"}};
   if (verify) folders.push_back({out_abs, "--output"});
-  validate_output_paths(outputs, inputs, folders);
+  validate_output_paths(limits, outputs, inputs, folders);
 
   auto directives = [&](const std::string& job_name, const std::string& log) {
     std::string s = "#!/bin/bash\n#SBATCH --job-name=" + sbatch_value(job_name) +
@@ -288,7 +282,8 @@ void add_slurm_command(CLI::App& app, Commands& commands) {
   sub->footer(
       "Example: weft slurm --shards 8 --partition cpu bake fiber spec.json -o fiber.exr "
       "--photons 1000000\n         weft slurm --shards 16 verify --quality publication -o report");
-  commands.push_back({sub, [o, sub] { return run_slurm(*o, sub->remaining()); }});
+  commands.push_back(
+      {sub, [o, sub](const RunLimits& l) { return run_slurm(*o, sub->remaining(), l); }});
 }
 
 }  // namespace weft::cli

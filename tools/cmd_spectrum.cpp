@@ -19,7 +19,7 @@ void add_spectrum_command(CLI::App& app, Commands& commands) {
   sub->add_option("values", opt->values, "33 reflectance values, 390..710 nm in 10 nm steps")
       ->required();
   commands.push_back(
-      {sub, [opt] {
+      {sub, [opt](const RunLimits&) {
          if (opt->values.size() != kNumBands)
            throw Error("", "values",
                        "expected 33 values, got " + std::to_string(opt->values.size()));

@@ -207,8 +207,8 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--quiet", o->quiet, "no progress bar and no lights on stderr");
   sub->add_flag("--json", o->json, "also print the rows as JSON on stdout");
   commands.push_back(
-      {sub, [o, lz, la, va, irr, seed] {
-         run_limits().quiet = o->quiet;
+      {sub, [o, lz, la, va, irr, seed](const RunLimits& program) {
+         const RunLimits limits = quieted(program, o->quiet);
          const SceneDescription desc = load_scene_reporting_warnings(o->scene, {}, o->quiet);
          GonioSettings g = gonio_settings_from(desc);
          if (lz->count())
@@ -236,7 +236,7 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          if (seed->count()) g.seed = o->seed;
          g.threads = o->threads;
          validate_output_paths(
-             {{o->output, "--output"}, {checkpoint_path(o->output), "checkpoint"}},
+             limits, {{o->output, "--output"}, {checkpoint_path(o->output), "checkpoint"}},
              scene_inputs(o->scene, desc));
          const Shard shard = o->shard.empty() ? Shard{} : parse_shard(o->shard, "--shard");
          const JobPart job = sweep_job(o->scene, desc, g, shard);
@@ -253,12 +253,12 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          const bool partial = !shard.whole() || o->resume;
          if (partial) g.units = todo;
          // Each view renders the sample, and the white reference unless --no-white-check.
-         check_long_work(double(todo.size()) * (g.white_check ? 2 : 1) * g.width * g.height * g.spp,
-                         kMinSecondsPerPathSample, g.threads, o->scene, "spp",
-                         "a sweep of " + std::to_string(todo.size()) + " views of " +
-                             std::to_string(g.width) + " x " + std::to_string(g.height) +
-                             " pixels at " + std::to_string(g.spp) + " spp",
-                         "0.05 us per path sample per core at least");
+         check_long_work(
+             limits, double(todo.size()) * (g.white_check ? 2 : 1) * g.width * g.height * g.spp,
+             kMinSecondsPerPathSample, g.threads, o->scene, "spp",
+             "a sweep of " + std::to_string(todo.size()) + " views of " + std::to_string(g.width) +
+                 " x " + std::to_string(g.height) + " pixels at " + std::to_string(g.spp) + " spp",
+             "0.05 us per path sample per core at least");
          auto part_of = [&](const GonioResult& r, bool checkpoint) {
            JobPart p = job;
            p.checkpoint = checkpoint;
@@ -273,7 +273,8 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
            };
          GonioResult r;
          if (!partial || !todo.empty()) {
-           r = run_gonio(desc, g, progress_bar(o->quiet), checked_fiber_table_resolver(), on_unit);
+           r = run_gonio(desc, g, progress_bar(limits, o->quiet),
+                         checked_fiber_table_resolver(limits), on_unit);
            if (const int code = report_render_outcome(r, "sweep")) return code;
          }
          if (!shard.whole()) {

@@ -61,11 +61,12 @@ struct BakeOptions {
   bool quiet = false, json = false;
 };
 
-int run_bake(const BakeOptions& o) {
+int run_bake(const BakeOptions& o, const RunLimits& limits) {
   const nlohmann::json params = parse_json(o.params, "--params");
   // Fail before the work, not after it; the files the parameters name (a table, a measured
   // network) are inputs.
-  validate_output_paths({{o.output, "--output"}}, json_named_files(params, "--params file"));
+  validate_output_paths(limits, {{o.output, "--output"}},
+                        json_named_files(params, "--params file"));
   TabulatedBsdfTable::check_output_path(o.output, "--output");
   MaterialContext ctx;
   ctx.field_prefix = "--params";
@@ -76,7 +77,7 @@ int run_bake(const BakeOptions& o) {
         const Rgb f = bsdf.eval(wo, wi);
         v[0] = f.r, v[1] = f.g, v[2] = f.b;
       },
-      o.samples, o.seed, o.threads, progress_bar(o.quiet));
+      o.samples, o.seed, o.threads, progress_bar(limits, o.quiet));
   t.kind = o.kind;
   const std::string spec = o.type + " " + params.dump();
   t.metadata = {{"source", "analytic " + spec},
@@ -108,7 +109,7 @@ void add_table_command(CLI::App& app, Commands& commands) {
       table->add_subcommand("info", "Validate a table and print its header and figures");
   info_cmd->add_option("file", info->file, "table .exr")->required();
   info_cmd->add_flag("--json", info->json, "print JSON with stable keys");
-  commands.push_back({info_cmd, [info] { return run_info(*info); }});
+  commands.push_back({info_cmd, [info](const RunLimits&) { return run_info(*info); }});
 
   auto bake = std::make_shared<BakeOptions>();
   auto* bake_cmd = table->add_subcommand(
@@ -127,7 +128,7 @@ void add_table_command(CLI::App& app, Commands& commands) {
   bake_cmd->add_option("-o,--output", bake->output, "output .exr")->required();
   bake_cmd->add_flag("--quiet", bake->quiet, "no progress bar");
   bake_cmd->add_flag("--json", bake->json, "print a JSON summary");
-  commands.push_back({bake_cmd, [bake] { return run_bake(*bake); }});
+  commands.push_back({bake_cmd, [bake](const RunLimits& l) { return run_bake(*bake, l); }});
 }
 
 }  // namespace weft::cli

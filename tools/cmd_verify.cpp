@@ -11,11 +11,11 @@
 
 #include "cli_util.h"
 #include "commands.h"
-#include "plot_util.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/clock.h"
 #include "weft/core/error.h"
 #include "weft/verify/plan.h"
+#include "weft/verify/plot_scripts.h"
 #include "weft/verify/report.h"
 #include "weft/verify/suite.h"
 #include "weft/verify/whole_run.h"
@@ -30,6 +30,7 @@ struct VerifyCliOptions {
   std::string suite_file;  // empty: the bundled suite
   // Options given that a suite's fabrics set themselves.
   std::vector<std::string> per_fabric_given;
+  RunLimits limits;  // the program's, under --quiet
 };
 
 // The time it will take, before it starts; above an hour (at the fastest rates) needs --yes-long.
@@ -43,7 +44,7 @@ void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
                  r.quality.c_str(), r.fit ? " with --fit" : "", e.photons * 1e-6,
                  e.particles * 1e-6, format_seconds(e.typical / e.cores).c_str(), e.cores,
                  format_seconds(e.typical).c_str(), format_seconds(e.least / e.cores).c_str());
-  check_long_work(e.least, 1.0, p.settings.threads, "", "--quality",
+  check_long_work(o.limits, e.least, 1.0, p.settings.threads, "", "--quality",
                   "weft verify at quality " + r.quality + (r.fit ? " with --fit" : ""),
                   kVerifyLeastRates);
 }
@@ -123,7 +124,7 @@ VerifyOutcome run_checked(const VerifyCliOptions& o, const VerifyPlan& p,
                           std::chrono::steady_clock::time_point t_all, const JobPart* all) {
   const VerifyRequest& r = p.request;
   VerifyHooks hooks;
-  hooks.progress = progress_bar(o.quiet);
+  hooks.progress = progress_bar(o.limits, o.quiet);
   hooks.interrupted = interrupted;
   hooks.note = [&](const std::string& line) {
     if (!o.quiet) std::fputs(line.c_str(), stderr);
@@ -146,9 +147,9 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
                                          {r.wif, "WIF draft"},
                                          {r.fiber, "fiber table or spec"}};
   if (p.shard) {
-    validate_output_paths({{r.output, "-o"}}, inputs);
+    validate_output_paths(o.limits, {{r.output, "-o"}}, inputs);
   } else {
-    validate_output_paths({}, inputs, {{r.output, "-o"}});
+    validate_output_paths(o.limits, {}, inputs, {{r.output, "-o"}});
     check_verify_output(r.output);
     if (!all) check_verify_time(o, p);  // a merge's ray traces are done
   }
@@ -188,7 +189,7 @@ int run_suite(const VerifyCliOptions& o) {
     inputs.push_back({f.wif, f.name + "'s WIF draft"});
     inputs.push_back({f.fiber, f.name + "'s fiber table or spec"});
   }
-  validate_output_paths({}, inputs, {{base.output, "-o"}});
+  validate_output_paths(o.limits, {}, inputs, {{base.output, "-o"}});
   check_suite_output(base.output);
   std::vector<VerifyPlan> plans;
   VerifyEstimate total;
@@ -204,7 +205,7 @@ int run_suite(const VerifyCliOptions& o) {
                  "weft verify --suite: %zu fabrics of %s, quality %s: about %s on %u cores\n",
                  plans.size(), suite.file.string().c_str(), base.quality.c_str(),
                  format_seconds(total.typical / total.cores).c_str(), total.cores);
-  check_long_work(total.least, 1.0, base.threads, "", "--quality",
+  check_long_work(o.limits, total.least, 1.0, base.threads, "", "--quality",
                   "weft verify --suite at quality " + base.quality, kVerifyLeastRates);
   std::filesystem::create_directories(base.output);
   std::vector<SuiteRow> rows;
@@ -314,8 +315,8 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                 "a report per fabric in -o DIR and one page over them (index.html, suite.json)");
   sub->add_option("--suite-file", o->suite_file, "a suite file in place of the bundled one")
       ->each([o](const std::string&) { o->suite = true; });
-  commands.push_back({sub, [o, sub] {
-                        run_limits().quiet = o->quiet;
+  commands.push_back({sub, [o, sub](const RunLimits& program) {
+                        o->limits = quieted(program, o->quiet);
                         if (!o->suite) return run(*o);
                         for (const char* name : {"--measured", "--fiber", "--weave", "--pattern",
                                                  "--wif", "--shard", "--fit", "--classic-albedo"})

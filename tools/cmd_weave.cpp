@@ -32,7 +32,7 @@ void parse_repeats(const std::string& text, int& nx, int& nz) {
 
 // The open-mesh patch of earlier versions; its options cannot be mixed with the sample's.
 int run_legacy(const CLI::App& sub, WeaveParams p, const WeaveOptions& w, bool sides_given,
-               const std::string& output, bool json) {
+               const std::string& output, bool json, const RunLimits& limits) {
   for (const char* name : {"--sample", "--wif", "--detail", "--repeats", "--warp-spacing-mm",
                            "--weft-spacing-mm", "--yarn-width-mm", "--yarn-thickness-mm",
                            "--fibers-per-yarn", "--packing", "--segments-per-crossing"})
@@ -40,7 +40,7 @@ int run_legacy(const CLI::App& sub, WeaveParams p, const WeaveOptions& w, bool s
       throw Error("", std::string(name).substr(2),
                   "cannot be combined with the legacy open-mesh options (--yarns, "
                   "--yarn-radius-mm, --spacing-mm, --segments, --amplitude-mm)");
-  validate_output_paths({{output, "--output"}}, {});
+  validate_output_paths(limits, {{output, "--output"}}, {});
   p.pattern = w.pattern.value_or("plain");
   if (sides_given) p.sides = *w.sides;
   const auto meshes = make_weave(p);
@@ -136,10 +136,10 @@ void add_weave_command(CLI::App& app, Commands& commands) {
   sub->add_flag("--json", o->json, "print a JSON summary");
   sub->add_flag("--quiet", o->quiet, "the summary only: no notes (errors are still printed)");
   commands.push_back(
-      {sub, [o, sub, sides, yarns, radius, spacing, segments, amplitude] {
+      {sub, [o, sub, sides, yarns, radius, spacing, segments, amplitude](const RunLimits& limits) {
          if (yarns->count() || radius->count() || spacing->count() || segments->count() ||
              amplitude->count())
-           return run_legacy(*sub, o->legacy, o->w, sides->count() > 0, o->output, o->json);
+           return run_legacy(*sub, o->legacy, o->w, sides->count() > 0, o->output, o->json, limits);
          // Unset options come from --sample, else from the bundled sample (or a WIF draft's sizes).
          WeaveOptions given = o->w;
          if (!o->repeats.empty()) {
@@ -172,7 +172,7 @@ void add_weave_command(CLI::App& app, Commands& commands) {
              o->sample.empty() ? WeaveOptions{} : read_weave_options(o->sample);
          const WeaveOptions options = overlay(base, given);
          validate_output_paths(
-             {{o->output, "--output"}},
+             limits, {{o->output, "--output"}},
              {{o->sample, "sample description"}, {options.wif.value_or(""), "WIF draft"}});
          const WovenSample sample = make_woven_sample(options);
          write_woven(o->output, sample);

@@ -32,9 +32,12 @@ struct Program {
   bool yes_long = false;
 };
 std::unique_ptr<Program> make_program();
-// Sets run_limits() from the global options and runs the subcommand the parse chose: its exit
-// code. weft::Error and other exceptions propagate.
-int run_program(const Program& p);
+// Runs, under the limits of the global options (program_limits), the subcommand the parse chose:
+// its exit code. weft::Error and other exceptions propagate. With 'check_only_inputs' the run only
+// checks (RunLimits::check_only: WorkWouldStart where the work would start) and collects there the
+// inputs the command guards (weft slurm's check of the command it wraps).
+int run_program(const Program& p,
+                std::shared_ptr<std::vector<NamedPath>> check_only_inputs = nullptr);
 
 // Each command's merge (in its cmd_*.cpp): writes 'output' from all units of its job and prints
 // the command's summary. Returns the exit code.

@@ -40,11 +40,12 @@ std::unique_ptr<Program> make_program() {
   return p;
 }
 
-int run_program(const Program& p) {
-  run_limits().max_memory_bytes = p.max_memory_gb * 1e9;
-  run_limits().yes_long = p.yes_long;
+int run_program(const Program& p, std::shared_ptr<std::vector<NamedPath>> check_only_inputs) {
+  RunLimits limits = program_limits(p.max_memory_gb, p.yes_long);
+  limits.check_only = check_only_inputs != nullptr;
+  limits.guarded_inputs = std::move(check_only_inputs);
   for (const auto& c : p.commands)
-    if (c.app->parsed()) return c.run();
+    if (c.app->parsed()) return c.run(limits);
   return 1;
 }
 

@@ -5,12 +5,12 @@
 namespace weft {
 namespace {
 
-using Matrix = std::array<uint32_t, 32>;
+using GeneratorMatrix = std::array<uint32_t, 32>;
 
 // Direction numbers v_k (k = 1 .. 32, as 32-bit fractions) of a dimension with primitive
 // polynomial of degree s, inner coefficients a (Joe and Kuo's encoding) and initial m_1 .. m_s.
-constexpr Matrix direction_numbers(int s, uint32_t a, std::array<uint32_t, 4> m) {
-  Matrix v{};
+constexpr GeneratorMatrix direction_numbers(int s, uint32_t a, std::array<uint32_t, 4> m) {
+  GeneratorMatrix v{};
   for (int k = 0; k < s; ++k) v[k] = m[k] << (31 - k);
   for (int k = s; k < 32; ++k) {
     v[k] = v[k - s] ^ (v[k - s] >> s);
@@ -20,14 +20,14 @@ constexpr Matrix direction_numbers(int s, uint32_t a, std::array<uint32_t, 4> m)
   return v;
 }
 
-constexpr Matrix van_der_corput() {
-  Matrix v{};
+constexpr GeneratorMatrix van_der_corput() {
+  GeneratorMatrix v{};
   for (int k = 0; k < 32; ++k) v[k] = 1u << (31 - k);
   return v;
 }
 
 // Dimensions 1 .. 5 from Joe and Kuo's new-joe-kuo-6.21201 table (d = 2 .. 6).
-constexpr std::array<Matrix, ScrambledSobol::kDimensions> kMatrices = {
+constexpr std::array<GeneratorMatrix, ScrambledSobol::kDimensions> kMatrices = {
     van_der_corput(),
     direction_numbers(1, 0, {1}),
     direction_numbers(2, 1, {1, 3}),

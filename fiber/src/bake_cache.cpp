@@ -176,4 +176,23 @@ FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir, FiberBa
   };
 }
 
+void check_fiber_bake(const RunLimits& limits, const FiberTableBakeOptions& o, uint64_t bands,
+                      const FiberBakeSource& source) {
+  check_memory(limits, fiber_table_bake_bytes(o), source.file, source.resolution_field,
+               "a bake at resolution " + std::to_string(o.resolution));
+  const double per_photon = fiber_bake_min_seconds_per_photon(o);
+  char rate[64];
+  std::snprintf(rate, sizeof rate, "%.2g us per photon per core at least", per_photon * 1e6);
+  check_long_work(limits, static_cast<double>(o.photons_per_band) * static_cast<double>(bands),
+                  per_photon, o.threads, source.file, source.photons_field,
+                  std::to_string(o.photons_per_band) + " photons per band", rate);
+}
+
+FiberTableResolver checked_fiber_table_resolver(const RunLimits& limits) {
+  return fiber_table_resolver({},
+                              [limits](const FiberTableBakeOptions& o, const FiberBakeSource& s) {
+                                check_fiber_bake(limits, o, kNumBands, s);
+                              });
+}
+
 }  // namespace weft

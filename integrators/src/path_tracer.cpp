@@ -637,6 +637,12 @@ class WindowRender {
 
 }  // namespace
 
+double render_bytes(int width, int height, bool preview, bool mask) {
+  const double per_pixel = 3 * sizeof(float) + (preview ? 3 : 0) +
+                           (mask ? sizeof(uint32_t) + 6 * sizeof(double) + sizeof(float) : 0);
+  return double(width) * double(height) * per_pixel;
+}
+
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
                     const ProgressCallback& progress, const RenderObservers& observers) {
   check_render_settings(s);

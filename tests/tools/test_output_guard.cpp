@@ -1,4 +1,4 @@
-// The output guard (cli_util.h validate_output_paths), command by command: an output that is a
+// The output guard (core/output_guard.h validate_output_paths), command by command: an output that is a
 // file the job reads (the path itself, a symbolic or a hard link to it, or a derived output such
 // as render's OUT.albedo.exr) or a folder output that holds one is refused before any work: exit 2,
 // a message naming both, the input's bytes unchanged and nothing left behind in the folder.

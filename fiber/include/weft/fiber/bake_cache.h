@@ -7,6 +7,7 @@
 #include <functional>
 #include <string>
 
+#include "weft/core/run_limits.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
 #include "weft/materials/registry.h"
@@ -53,5 +54,14 @@ using FiberBakeCheck = std::function<void(const FiberTableBakeOptions&, const Fi
 // not when the table is cached; its error propagates as it is.
 FiberTableResolver fiber_table_resolver(std::filesystem::path cache_dir = {},
                                         FiberBakeCheck check = {});
+
+// The checks before a fiber bake, the same for `weft bake fiber`, a bake on first use and Python:
+// its memory (check_memory, fiber_table_bake_bytes) and its time for 'bands' bands
+// (check_long_work at fiber_bake_min_seconds_per_photon), naming the source's file and fields.
+void check_fiber_bake(const RunLimits& limits, const FiberTableBakeOptions& options, uint64_t bands,
+                      const FiberBakeSource& source);
+// The fiber-table resolver of every command that renders a scene: fiber_table_resolver (bake on
+// first use) with check_fiber_bake under 'limits' before a bake.
+FiberTableResolver checked_fiber_table_resolver(const RunLimits& limits);
 
 }  // namespace weft

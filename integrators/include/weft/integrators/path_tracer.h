@@ -64,6 +64,10 @@ struct RenderOutcome {
   bool cancelled = false;          // the progress callback asked to stop; results are partial
 };
 
+// The per-pixel buffers of a render: the image (3 floats), the sRGB preview (3 bytes) and a
+// masked render's hit counts, sums and squares (3 + 3 doubles) and coverage (a float).
+double render_bytes(int width, int height, bool preview, bool mask);
+
 struct RenderResult : RenderOutcome {
   Image image;  // mean radiance per pixel, linear RGB (the crop window's pixels when cropped)
   // Samples per pixel in 'image': settings.spp, or fewer whole passes when the time limit ended

@@ -49,6 +49,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/atomic_file.h"
 #include "weft/core/spectrum.h"
 #include "weft/scenes/camera.h"
 #include "weft/scenes/curves.h"
@@ -148,5 +149,14 @@ NamedCamera select_camera(const SceneDescription& desc, const std::string& which
 SceneDescription parse_scene_description(const nlohmann::json& j,
                                          const std::filesystem::path& base_dir,
                                          const std::string& source);
+
+// Every file a render or sweep of the description at 'scene' reads: the description, its glTF
+// files and buffers and environment maps, and what its materials name (tables, measured networks,
+// fiber specs; a preset name is no file). Relative names resolve as the registry and the bake
+// cache resolve them.
+std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
+                                                     const SceneDescription& d);
+// The same named for the output guard, with the scene's fiber-table bake cache folder.
+std::vector<NamedPath> scene_inputs(const std::string& scene, const SceneDescription& d);
 
 }  // namespace weft

@@ -1,4 +1,4 @@
-#include "plot_util.h"
+#include "weft/verify/plot_scripts.h"
 
 #include <cstdlib>
 #include <system_error>
@@ -7,7 +7,7 @@
 #include "weft/core/install_paths.h"
 #include "weft/core/parallel.h"
 
-namespace weft::cli {
+namespace weft {
 namespace {
 
 // A shell word: in single quotes, each ' written as '\''.
@@ -56,4 +56,4 @@ void plot_verify_figures(const std::filesystem::path& staging, const std::filesy
       output);
 }
 
-}  // namespace weft::cli
+}  // namespace weft

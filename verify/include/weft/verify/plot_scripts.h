@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-namespace weft::cli {
+namespace weft {
 
 // Runs tools/<script> with the arguments; weft::Error naming the output when it cannot.
 void run_plot_script(const std::string& script, const std::vector<std::string>& args,
@@ -17,4 +17,4 @@ void run_plot_script(const std::string& script, const std::vector<std::string>& 
 void plot_verify_figures(const std::filesystem::path& staging, const std::filesystem::path& output,
                          int threads);
 
-}  // namespace weft::cli
+}  // namespace weft
