@@ -295,13 +295,15 @@ void add_bake_command(CLI::App& app, Commands& commands) {
          FiberBandWork work;
          work.first_band = static_cast<int>(range.first);
          work.last_band = static_cast<int>(range.last);
-         if (const auto cp = load_checkpoint(opt->output, job, opt->resume)) {
+         std::vector<std::string> warnings;
+         if (const auto cp = load_checkpoint(opt->output, job, opt->resume, warnings)) {
            for (const auto& [band, v] : cp->units)
              work.start.push_back(decode_fiber_band(v, o.estimator));
            if (work.start.size() != range.last - range.first)
              throw Error(checkpoint_path(opt->output).string(), "units",
                          "does not hold every band of the shard");
          }
+         for (const auto& w : warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
          if (opt->resume)
            work.on_pass = [&](const std::vector<FiberBandState>& states) {
              JobPart cp = job;

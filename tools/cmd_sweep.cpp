@@ -242,8 +242,10 @@ void add_sweep_command(CLI::App& app, Commands& commands) {
          const JobPart job = sweep_job(o->scene, desc, g, shard);
          const UnitRange range = shard_units(job.units_total, shard);
          GonioResult done;  // the units of a checkpoint
-         if (const auto cp = load_checkpoint(o->output, job, o->resume))
+         std::vector<std::string> warnings;
+         if (const auto cp = load_checkpoint(o->output, job, o->resume, warnings))
            for (const auto& [u, v] : cp->units) decode_sweep_unit(u, v, g, done);
+         for (const auto& w : warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
          std::vector<size_t> todo;
          for (uint64_t u = range.first; u < range.last; ++u) {
            bool have = u == g.view_zenith_deg.size() && done.beta_normal.has_value();

@@ -175,7 +175,7 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& output) {
 }
 
 std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
-                                       bool resume) {
+                                       bool resume, std::vector<std::string>& warnings) {
   const auto path = checkpoint_path(output);
   if (!resume || !std::filesystem::exists(path)) return std::nullopt;
   JobPart p;
@@ -183,7 +183,7 @@ std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, cons
     p = read_job_part(path);
   } catch (const Error&) {
     // Written atomically, so a bad checkpoint was damaged afterwards: start over.
-    std::fprintf(stderr, "weft: warning: %s is unreadable; starting afresh\n", path.c_str());
+    warnings.push_back(path.string() + " is unreadable; starting afresh");
     return std::nullopt;
   }
   if (!p.checkpoint || !p.same_job(job) || p.shard.index != job.shard.index) {
@@ -193,6 +193,14 @@ std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, cons
         path.string(), "",
         "is the checkpoint of another job (" + why + "): remove it or run without --resume");
   }
+  return p;
+}
+
+std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
+                                       bool resume) {
+  std::vector<std::string> warnings;
+  auto p = load_checkpoint(output, job, resume, warnings);
+  for (const auto& w : warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
   return p;
 }
 

@@ -454,14 +454,21 @@ void check_fiber_energy(const TabulatedBsdfTable& t, const std::string& field) {
     }
 }
 
+// A table that draws or weighs the trace's steps in place of another fiber table (a proposal, or
+// the fiber re-weighting recorded paths): valid, a fiber table of the other's resolution and
+// channels, since the steps index both alike, and no more than lossless.
+void check_fiber_stand_in(const TabulatedBsdfTable& t, int resolution, int channels,
+                          const std::string& field, const char* mismatch) {
+  t.validate("");
+  if (t.kind != "fiber" || t.resolution != resolution || t.channels != channels)
+    throw Error("", field, mismatch);
+  check_fiber_energy(t, field);
+}
+
 void check_proposal(const TabulatedBsdfTable& proposal, const TabulatedBsdfTable& fiber) {
-  proposal.validate("");
-  if (proposal.kind != "fiber" || proposal.resolution != fiber.resolution ||
-      proposal.channels != fiber.channels)
-    throw Error("", "proposal",
-                "the proposal must be a fiber table of the traced table's resolution and "
-                "channels");
-  check_fiber_energy(proposal, "proposal");
+  check_fiber_stand_in(proposal, fiber.resolution, fiber.channels, "proposal",
+                       "the proposal must be a fiber table of the traced table's resolution and "
+                       "channels");
 }
 
 // The exits' sums of weights and of their squares, per table value (cell pair and channel).
@@ -803,13 +810,9 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
 // each task's steps replayed into its tally, the tallies summed and tabulated as the trace does.
 FabricRaytraceResult reweight(const RecordedFabricPaths& p, const TabulatedBsdfTable& fiber,
                               int threads) {
-  fiber.validate("");
-  if (fiber.kind != "fiber" || fiber.resolution != p.fiber_resolution ||
-      fiber.channels != p.channels)
-    throw Error("", "fiber",
-                "the table re-weighting recorded paths must be a fiber table of the proposal's "
-                "resolution and channels");
-  check_fiber_energy(fiber, "fiber");
+  check_fiber_stand_in(fiber, p.fiber_resolution, p.channels, "fiber",
+                       "the table re-weighting recorded paths must be a fiber table of the "
+                       "proposal's resolution and channels");
   std::optional<LineAlbedo> tube;
   if (p.yarn_tubes) tube.emplace(fiber);
   const DirectionGrid grid{p.options.resolution};

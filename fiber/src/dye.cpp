@@ -4,19 +4,11 @@
 #include <nlohmann/json.hpp>
 #include <numbers>
 
+#include "embedded_json.h"
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 
 namespace weft {
-namespace detail {
-// Generated at configure time from fiber/data/dyes/*.json (see fiber/CMakeLists.txt).
-struct FiberDyeText {
-  const char* name;
-  const char* json;
-};
-extern const FiberDyeText kFiberDyes[];
-extern const int kNumFiberDyes;
-}  // namespace detail
 
 DyeSpectrum parse_dye_spectrum(const std::string& json_text, const std::string& file) {
   const nlohmann::json root = parse_json(json_text, file);

@@ -7,20 +7,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "embedded_json.h"
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
 #include "weft/core/params.h"
 
 namespace weft {
-namespace detail {
-// Generated at configure time from fiber/presets/*.json (see fiber/CMakeLists.txt).
-struct FiberPresetText {
-  const char* name;
-  const char* json;
-};
-extern const FiberPresetText kFiberPresets[];
-extern const int kNumFiberPresets;
-}  // namespace detail
 
 namespace {
 

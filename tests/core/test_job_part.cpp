@@ -148,6 +148,38 @@ TEST(JobPart, StalePartIsRefusedNamingItsFile) {
   EXPECT_NE(e.find("setting 'photons' differs"), std::string::npos) << e;
 }
 
+// A damaged checkpoint is passed over (the run starts afresh) and its warning reaches the caller
+// as a value, for the front end to show: the library itself prints nothing.
+TEST(JobPart, UnreadableCheckpointIsReportedToTheCaller) {
+  const fs::path dir = fresh_test_dir();
+  JobPart job;
+  job.command = "bake fiber";
+  job.job = {{"seed", 1}};
+  job.units_total = 2;
+  job.shard = {0, 1};
+  const fs::path out = dir / "table.exr";
+  std::ofstream(checkpoint_path(out), std::ios::binary) << "WEFT-PART 1\nnot json\n";
+  std::vector<std::string> warnings;
+  ::testing::internal::CaptureStderr();
+  const auto damaged = load_checkpoint(out, job, true, warnings);
+  EXPECT_EQ(::testing::internal::GetCapturedStderr(), "");
+  EXPECT_FALSE(damaged.has_value());
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_EQ(warnings[0], checkpoint_path(out).string() + " is unreadable; starting afresh");
+  // Without --resume the checkpoint is not read, and a readable one of this job has nothing to
+  // report.
+  warnings.clear();
+  EXPECT_FALSE(load_checkpoint(out, job, false, warnings).has_value());
+  JobPart saved = job;
+  saved.checkpoint = true;
+  saved.units[1] = {0.5};
+  write_job_part(checkpoint_path(out), saved);
+  const auto resumed = load_checkpoint(out, job, true, warnings);
+  ASSERT_TRUE(resumed.has_value());
+  EXPECT_EQ(resumed->units.at(1), std::vector<double>{0.5});
+  EXPECT_TRUE(warnings.empty());
+}
+
 // Random byte edits of a valid part file (its magic line, JSON header and raw doubles), seeded:
 // every mutant is read or refused with a weft::Error naming the file.
 TEST(JobPart, ByteMutationsAreReadOrRefusedNeverCrash) {

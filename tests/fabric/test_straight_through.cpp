@@ -28,6 +28,14 @@ WovenSample half_sheet() {
   return s;
 }
 
+// The half sheet ready to trace: its scene, the repeat's slab, and the R = 4 grid of kBins.
+struct HalfSheetTrace {
+  WovenSample sample = half_sheet();
+  RenderScene scene{tiled_geometry(sample)};
+  RepeatSlab slab = repeat_slab_of(sample);
+  DirectionGrid grid{4};
+};
+
 // The incident bins whose straight-through cell the tests look at: normal, oblique, near the
 // horizon, from above and from below (R = 4).
 constexpr int kBins[] = {0, 5, 10, 15, 16, 21, 31};
@@ -40,10 +48,8 @@ TEST(StraightThrough, HalfASheetPassesHalfTheLightOfEveryIncidentBin) {
   // one cell of the direction continued: within 4 of the stated standard errors, which are small:
   // what remains is the spread of |cos theta_i| over the directions drawn, at most 2 % of the
   // power in the grazing bins.
-  const WovenSample sample = half_sheet();
-  const RenderScene scene(tiled_geometry(sample));
-  const RepeatSlab slab = repeat_slab_of(sample);
-  const DirectionGrid grid{4};
+  const HalfSheetTrace t;
+  const auto& [sample, scene, slab, grid] = t;
   const auto d = grid.cosine_weighted_areas();
   const StraightThroughPlan plan = straight_through_plan(4000);
   for (const int bin : kBins) {
@@ -88,10 +94,8 @@ TEST(StraightThrough, PlanHasAtLeastOneRayPerParticleOnFibonacciLattices) {
 }
 
 TEST(StraightThrough, StreamsAreTheSeedsAndBinsOwn) {
-  const WovenSample sample = half_sheet();
-  const RenderScene scene(tiled_geometry(sample));
-  const RepeatSlab slab = repeat_slab_of(sample);
-  const DirectionGrid grid{4};
+  const HalfSheetTrace t;
+  const auto& [sample, scene, slab, grid] = t;
   const StraightThroughPlan plan = straight_through_plan(500);
   const auto a = straight_through_of_bin(scene, slab, grid, 5, plan, 1, 100000);
   const auto b = straight_through_of_bin(scene, slab, grid, 5, plan, 1, 100000);
@@ -108,10 +112,8 @@ TEST(StraightThrough, ItsRaysAreBookedWhereTheyCrossTheMidPlane) {
   // every ray that passes crosses it at x > 0, in the weave's position cells iu = 2, 3 of 4 along
   // x (weave_tally.h: u counted from the repeat's least x). Over the positions, the weave's cells
   // hold the table cell's power; the table cell keeps its bits (the weave draws nothing more).
-  const WovenSample sample = half_sheet();
-  const RenderScene scene(tiled_geometry(sample));
-  const RepeatSlab slab = repeat_slab_of(sample);
-  const DirectionGrid grid{4};
+  const HalfSheetTrace t;
+  const auto& [sample, scene, slab, grid] = t;
   const StraightThroughPlan plan = straight_through_plan(1000);
   FabricRaytraceOptions o;
   o.resolution = 4;

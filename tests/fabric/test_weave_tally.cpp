@@ -41,9 +41,7 @@ using weft::testing::default_sample;
 
 FabricRaytraceOptions weave_options(int resolution, uint64_t particles, int pu, int pv,
                                     int weave_resolution) {
-  FabricRaytraceOptions o;
-  o.resolution = resolution;
-  o.particles_per_bin = particles;
+  FabricRaytraceOptions o = weft::testing::options(resolution, particles);
   o.weave_positions_u = pu;
   o.weave_positions_v = pv;
   o.weave_resolution = weave_resolution;

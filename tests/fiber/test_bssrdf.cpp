@@ -23,14 +23,12 @@ FiberBandPhysics fiber(double mua, double mus, double g, double n) {
 // The subsurface BSSRDF with standard errors, on an odd direction grid (R = 5: the plane y = 0
 // of an exit direction lies inside a bin, not on an edge).
 BssrdfGrid grid() {
-  BssrdfGrid g;
-  g.u_bins = 32;
-  g.v_bins = 21;
-  g.v_range = 60;
-  g.direction_resolution = 5;
-  g.surface_in_table = false;
-  g.keep_squares = true;
-  return g;
+  return {.u_bins = 32,
+          .v_bins = 21,
+          .v_range = 60,
+          .direction_resolution = 5,
+          .surface_in_table = false,
+          .keep_squares = true};
 }
 
 TaskBatch bssrdf_batch(uint64_t photons, uint64_t seed, int threads = 2) {

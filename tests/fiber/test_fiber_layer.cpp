@@ -36,15 +36,13 @@ MediumBand synthetic_band(double mu_a, double mu_s) {
 }
 
 FiberLayerSettings small_layer(double aspect, uint64_t photons) {
-  FiberLayerSettings s;
-  s.aspect = aspect;
-  s.rows = 4;
-  s.fibers_per_row = 4;
-  s.pitch_um = 34;
-  s.tilt_spread_deg = 20;
-  s.photons_per_band = photons;
-  s.threads = 2;
-  return s;
+  return {.aspect = aspect,
+          .rows = 4,
+          .fibers_per_row = 4,
+          .pitch_um = 34,
+          .tilt_spread_deg = 20,
+          .photons_per_band = photons,
+          .threads = 2};
 }
 
 }  // namespace

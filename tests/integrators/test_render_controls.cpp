@@ -7,7 +7,6 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 
 #include "test_util.h"
 #include "weft/core/error.h"
@@ -19,22 +18,13 @@
 #include "woven_patch.h"
 
 using namespace weft;
+using namespace weft::testing;
 namespace fs = std::filesystem;
-using weft::testing::error_of;
-using weft::testing::fresh_test_dir;
 
 namespace {
 
-using weft::testing::lit_woven_patch;
-using weft::testing::small_render_settings;
-
 bool same_bits(const std::vector<float>& a, const std::vector<float>& b) {
   return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(float)) == 0;
-}
-
-std::string bytes_of(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 
 }  // namespace
@@ -177,7 +167,7 @@ TEST(RenderControls, ExrIsTheSameBytesOnEveryRunAndCarriesMetadata) {
   job.exr = dir / "b.exr";
   job.settings.threads = 1;
   render_to_files(d, job);
-  const std::string a = bytes_of(dir / "a.exr"), b = bytes_of(dir / "b.exr");
+  const std::string a = slurp(dir / "a.exr"), b = slurp(dir / "b.exr");
   ASSERT_GT(a.size(), 1000u);
   EXPECT_EQ(a, b);  // no date, no host: the same bytes
 

@@ -18,18 +18,11 @@
 #include "weft/materials/bsdf_table.h"
 
 namespace fs = std::filesystem;
-// Each test works in its own folder under the build folder, not in the shared temporary folder,
-// where another build's tests running at the same time would use the same names.
-using weft::testing::fresh_test_dir;
+// Each test works in its own folder under the build folder (fresh_test_dir), not in the shared
+// temporary folder, where another build's tests running at the same time would use the same names.
+using namespace weft::testing;
 
 namespace {
-
-using weft::testing::CliRun;
-using weft::testing::slurp;
-
-using weft::testing::run_weft_cli;
-
-using weft::testing::write_file;
 
 // Runs 'args' with '-o output' and expects a refusal: exit code 2, an error that mentions 'part',
 // and nothing at 'output'. Returns the run for more checks of its message.

@@ -22,16 +22,9 @@
 #include "weft/materials/weave_table.h"
 
 namespace fs = std::filesystem;
-using weft::testing::fresh_test_dir;
+using namespace weft::testing;
 
 namespace {
-
-using weft::testing::kExamples;
-
-using weft::testing::CliRun;
-using weft::testing::slurp;
-
-using weft::testing::run_weft_cli;
 
 bool contains(const std::string& s, const std::string& part) {
   return s.find(part) != std::string::npos;

@@ -65,6 +65,12 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& output);
 
 // The checkpoint to continue from, if --resume was given and one of this job is there. A
 // checkpoint of another job is an error naming it (the user removes it or changes the output).
+// An unreadable checkpoint is passed over (the run starts afresh) with a warning appended to
+// 'warnings', "<file> is unreadable; starting afresh", for the front end to show.
+std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
+                                       bool resume, std::vector<std::string>& warnings);
+// The same, the warning printed on stderr as "weft: warning: ...". Only for the callers not yet
+// handed a list by their own caller (fabric_parts.cpp); new code uses the form above.
 std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
                                        bool resume);
 
