@@ -18,6 +18,7 @@
 #include "weft/verify/plot_scripts.h"
 #include "weft/verify/report.h"
 #include "weft/verify/suite.h"
+#include "weft/verify/summary_text.h"
 #include "weft/verify/whole_run.h"
 
 namespace weft::cli {
@@ -35,105 +36,28 @@ struct VerifyCliOptions {
 
 // The time it will take, before it starts; above an hour (at the fastest rates) needs --yes-long.
 void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
-  const VerifyRequest& r = o.request;
-  const VerifyEstimate e = estimate_verify(p);
-  if (!o.quiet)
-    std::fprintf(stderr,
-                 "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on "
-                 "%u cores (%s of CPU; at least %s)\n",
-                 r.quality.c_str(), r.fit ? " with --fit" : "", e.photons * 1e-6,
-                 e.particles * 1e-6, format_seconds(e.typical / e.cores).c_str(), e.cores,
-                 format_seconds(e.typical).c_str(), format_seconds(e.least / e.cores).c_str());
-  check_long_work(o.limits, e.least, 1.0, p.settings.threads, "", "--quality",
+  const VerifyRequest& r = p.request;
+  if (!o.quiet) std::fputs(verify_estimate_text(p).c_str(), stderr);
+  check_long_work(o.limits, estimate_verify(p).least, 1.0, p.settings.threads, "", "--quality",
                   "weft verify at quality " + r.quality + (r.fit ? " with --fit" : ""),
                   kVerifyLeastRates);
 }
 
-// "0.308 +- 0.005 [0.29..0.35]": a figure, its seed standard error, its range over the fits.
-std::string figure_text(const FigureSamples& f) {
-  char b[96];
-  std::snprintf(b, sizeof b, "%.3f +- %.3f", f.value(), f.seed_se());
-  std::string t = b;
-  if (f.mean.size() > 1) {
-    std::snprintf(b, sizeof b, " [%.2f..%.2f]", f.fit_min(), f.fit_max());
-    t += b;
-  }
-  return t;
-}
-
-// The verdict, then the headline figures of each model with their uncertainty.
-void print_verdict(const VerifyReport& report) {
-  const std::vector<Verdict> verdicts = verify_verdicts(report);
-  std::printf("  verdict:\n");
-  for (int f = 0; f < 3; ++f) {
-    const std::string note =
-        f == kAbsoluteFigure ? not_comparable_note(report.measured.colour_space) : "";
-    std::printf("   %s%s\n", figure_label(static_cast<FigureKind>(f)).c_str(),
-                note.empty() ? "" : (" -- " + note).c_str());
-    for (const Verdict& v : verdicts)
-      if (v.figure == kFigureKeys[f]) std::printf("    - %s\n", v.text.c_str());
-  }
-  std::printf(
-      "  %-36s %-28s %-28s %-28s\n", "RMS log (+- seed SE [over fits])", "shape",
-      "paper's one-point",
-      absolute_comparable(report.measured.colour_space) ? "absolute" : "absolute (not comparable)");
-  for (const auto& m : report.models)
-    if (!m.figures.fits.empty())
-      std::printf("  %-36s %-28s %-28s %-28s\n", m.label.c_str(),
-                  figure_text(m.figures.figure[kShapeFigure]).c_str(),
-                  figure_text(m.figures.figure[kPaperFigure]).c_str(),
-                  figure_text(m.figures.figure[kAbsoluteFigure]).c_str());
-}
-
-// The verdict and the figures, the metrics of each model against the measurement, and the fits.
-void print_summary(const VerifyPlan& p, const VerifyReport& report, double seconds) {
-  std::printf("%s: %zu incidences, quality %s, %.1f s\n", p.request.output.c_str(),
-              p.measured.curves.size(), p.request.quality.c_str(), seconds);
-  print_verdict(report);
-  std::printf("  %-36s %10s %10s %10s %10s\n", "RMS vs measured", "log norm", "rel norm", "log abs",
-              "rel abs");
-  for (const std::string key : {"computed_raytrace", "computed_summation", "classic",
-                                "computed_raytrace_fitted", "classic_fitted"}) {
-    const auto m = std::find_if(report.models.begin(), report.models.end(),
-                                [&](const ModelCurves& c) { return c.key == key; });
-    if (m != report.models.end())
-      std::printf("  %-36s %10.3f %10.3f %10.3f %10.3f\n", m->label.c_str(),
-                  m->normalized_overall.rms_log, m->normalized_overall.rms_rel,
-                  m->absolute_overall.rms_log, m->absolute_overall.rms_rel);
-  }
-  for (const auto& f : report.fits) {
-    std::printf("  fit %s: inner rms_log %.3f -> %.3f, %d evaluations, %.1f s", f.model.c_str(),
-                f.objective_start, f.objective, f.evaluations, f.seconds);
-    if (f.seed_fits.size() > 1)
-      std::printf(", kept seed %llu of %zu fits",
-                  static_cast<unsigned long long>(f.seed_fits.front().seed), f.seed_fits.size());
-    std::printf(":");
-    for (const auto& fp : f.parameters) {
-      std::printf(" %s %.4g +- %.2g%s", fp.parameter.name.c_str(), fp.value, fp.sigma,
-                  fp.at_bound ? " (at bound)" : "");
-      // The spread over the seeds' fits: what the measurement leaves undetermined shows here.
-      if (std::isfinite(fp.sigma_seeds))
-        std::printf(" [fits %.4g..%.4g]", fp.seeds_lo, fp.seeds_hi);
-    }
-    std::printf("\n");
-  }
-}
-
-// The run of a checked plan, with the progress bar and the plots.
-VerifyOutcome run_checked(const VerifyCliOptions& o, const VerifyPlan& p,
-                          std::chrono::steady_clock::time_point t_all, const JobPart* all) {
+// The hooks of a run: the progress bar, the notes unless --quiet, the plots.
+VerifyHooks verify_hooks(const VerifyCliOptions& o, const VerifyPlan& p,
+                         std::chrono::steady_clock::time_point t_all) {
   const VerifyRequest& r = p.request;
   VerifyHooks hooks;
   hooks.progress = progress_bar(o.limits, o.quiet);
   hooks.interrupted = interrupted;
-  hooks.note = [&](const std::string& line) {
-    if (!o.quiet) std::fputs(line.c_str(), stderr);
+  hooks.note = [quiet = o.quiet](const std::string& line) {
+    if (!quiet) std::fputs(line.c_str(), stderr);
   };
-  hooks.draw = [&](const std::filesystem::path& staging) {
-    plot_verify_figures(staging, r.output, r.threads);
+  hooks.draw = [output = r.output, threads = r.threads](const std::filesystem::path& staging) {
+    plot_verify_figures(staging, output, threads);
   };
   hooks.started = t_all;
-  return run_verify_plan(p, hooks, all);
+  return hooks;
 }
 
 // The whole run, a shard of it, or the merge of a sharded one ('all': every unit of its ray
@@ -153,7 +77,7 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
     check_verify_output(r.output);
     if (!all) check_verify_time(o, p);  // a merge's ray traces are done
   }
-  const VerifyOutcome out = run_checked(o, p, t_all, all);
+  const VerifyOutcome out = run_verify_plan(p, verify_hooks(o, p, t_all), all);
   if (out.cancelled) {
     std::fprintf(stderr, "\nweft: verify cancelled; nothing was written\n");
     return 130;
@@ -167,7 +91,7 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
   } else if (o.json) {
     std::cout << verify_metrics_json(out.report);
   } else {
-    print_summary(p, out.report, seconds_since(t_all));
+    std::fputs(verify_summary_text(p, out.report, seconds_since(t_all)).c_str(), stdout);
   }
   return 0;
 }
@@ -179,68 +103,35 @@ int run_suite(const VerifyCliOptions& o) {
   if (!o.per_fabric_given.empty())
     throw Error("", o.per_fabric_given.front(),
                 "is set per fabric by the suite file; not with --suite");
-  const VerifyRequest& base = o.request;
-  const VerifySuite suite = read_verify_suite(
-      o.suite_file.empty() ? bundled_verify_suite() : std::filesystem::path(o.suite_file));
-  std::vector<NamedPath> inputs = {{suite.file.string(), "suite file"}};
-  for (const SuiteFabric& f : suite.fabrics) {
-    inputs.push_back({f.measured, f.name + "'s measured CSV"});
-    inputs.push_back({f.weave, f.name + "'s weave options"});
-    inputs.push_back({f.wif, f.name + "'s WIF draft"});
-    inputs.push_back({f.fiber, f.name + "'s fiber table or spec"});
-  }
-  validate_output_paths(o.limits, {}, inputs, {{base.output, "-o"}});
-  check_suite_output(base.output);
-  std::vector<VerifyPlan> plans;
-  VerifyEstimate total;
-  for (const SuiteFabric& f : suite.fabrics) {
-    plans.push_back(plan_verify(suite_request(f, base, base.output)));
-    const VerifyEstimate e = estimate_verify(plans.back());
-    total.typical += e.typical;
-    total.least += e.least;
-    total.cores = e.cores;
-  }
-  if (!o.quiet)
-    std::fprintf(stderr,
-                 "weft verify --suite: %zu fabrics of %s, quality %s: about %s on %u cores\n",
-                 plans.size(), suite.file.string().c_str(), base.quality.c_str(),
-                 format_seconds(total.typical / total.cores).c_str(), total.cores);
-  check_long_work(o.limits, total.least, 1.0, base.threads, "", "--quality",
-                  "weft verify --suite at quality " + base.quality, kVerifyLeastRates);
-  std::filesystem::create_directories(base.output);
-  std::vector<SuiteRow> rows;
-  bool failed = false;
-  for (size_t k = 0; k < plans.size(); ++k) {
-    SuiteRow row{suite.fabrics[k], nullptr, ""};
+  const VerifySuitePlan plan = plan_verify_suite(o.request, o.suite_file, o.limits);
+  if (!o.quiet) std::fputs(verify_suite_estimate_text(plan).c_str(), stderr);
+  check_verify_suite_time(plan, o.limits);
+  VerifySuiteHooks hooks;
+  hooks.fabric = [&](size_t k) {
+    return verify_hooks(o, plan.plans[k], std::chrono::steady_clock::now());
+  };
+  hooks.starting = [&](size_t k) {
     if (!o.quiet)
-      std::fprintf(stderr, "weft verify --suite: fabric %zu of %zu, %s\n", k + 1, plans.size(),
-                   row.fabric.name.c_str());
-    try {
-      const VerifyOutcome out = run_checked(o, plans[k], std::chrono::steady_clock::now(), nullptr);
-      if (out.cancelled) {
-        std::fprintf(stderr,
-                     "\nweft: verify --suite cancelled; the finished fabrics' reports "
-                     "stay, the suite's page was not written\n");
-        return 130;
-      }
-      row.metrics = nlohmann::json::parse(verify_metrics_json(out.report));
-    } catch (const Error& e) {
-      row.error = e.what();
-      failed = true;
-      std::fprintf(stderr, "weft: %s: %s\n", row.fabric.name.c_str(), e.what());
-    }
-    rows.push_back(std::move(row));
+      std::fprintf(stderr, "weft verify --suite: fabric %zu of %zu, %s\n", k + 1, plan.plans.size(),
+                   plan.suite.fabrics[k].name.c_str());
+  };
+  hooks.failed = [&](size_t k, const std::string& error) {
+    std::fprintf(stderr, "weft: %s: %s\n", plan.suite.fabrics[k].name.c_str(), error.c_str());
+  };
+  const VerifySuiteOutcome out = run_verify_suite(plan, hooks);
+  if (out.cancelled) {
+    std::fprintf(stderr,
+                 "\nweft: verify --suite cancelled; the finished fabrics' reports stay, the "
+                 "suite's page was not written\n");
+    return 130;
   }
-  write_text_atomically(std::filesystem::path(base.output) / "suite.json",
-                        verify_suite_json(suite, rows));
-  write_text_atomically(std::filesystem::path(base.output) / "index.html",
-                        verify_suite_html(suite, rows));
+  const VerifyRequest& base = o.request;
   if (o.json)
-    std::cout << verify_suite_json(suite, rows);
+    std::cout << verify_suite_json(plan.suite, out.rows);
   else
-    std::printf("%s: %zu fabrics, quality %s, %.1f s\n%s", base.output.c_str(), rows.size(),
-                base.quality.c_str(), seconds_since(t_all), verify_suite_text(rows).c_str());
-  return failed ? 1 : 0;
+    std::printf("%s: %zu fabrics, quality %s, %.1f s\n%s", base.output.c_str(), out.rows.size(),
+                base.quality.c_str(), seconds_since(t_all), verify_suite_text(out.rows).c_str());
+  return out.failed ? 1 : 0;
 }
 
 }  // namespace

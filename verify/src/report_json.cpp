@@ -277,7 +277,7 @@ nlohmann::json renders_json(const std::vector<VerifyRender>& images) {
 
 }  // namespace
 
-std::string verify_metrics_json(const VerifyReport& r) {
+nlohmann::json verify_metrics(const VerifyReport& r) {
   nlohmann::json j;
   j["report"] = "weft verify";
   j["measured"] = r.measured.file;
@@ -330,7 +330,11 @@ std::string verify_metrics_json(const VerifyReport& r) {
   j["classic_source"] = r.classic_source;
   j["fabric_table_gamut_clipped_components"] = r.fabric_table_gamut_clipped;
   j["raytrace_relative_noise"] = r.raytrace_relative_noise;
-  return j.dump(2) + "\n";
+  return j;
+}
+
+std::string verify_metrics_json(const VerifyReport& r) {
+  return verify_metrics(r).dump(2) + "\n";
 }
 
 }  // namespace weft

@@ -3,6 +3,7 @@
 // holds them, written whole or not at all.
 #include <filesystem>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,8 @@ namespace weft {
 // The report's files, as text: the long-form curves CSV and metrics JSON (stable keys,
 // docs/verify.md), and the offline HTML page embedding the given images (file name -> bytes).
 std::string verify_inplane_csv(const VerifyReport& report);
+// metrics.json as a value (verify_metrics_json is its text).
+nlohmann::json verify_metrics(const VerifyReport& report);
 std::string verify_metrics_json(const VerifyReport& report);
 std::string verify_index_html(const VerifyReport& report,
                               const std::vector<std::pair<std::string, std::string>>& images);

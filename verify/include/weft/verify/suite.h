@@ -5,11 +5,14 @@
 // into a folder of the suite's output, and the page and suite.json are made from their
 // metrics.json files.
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
+#include "weft/core/run_limits.h"
 #include "weft/verify/plan.h"
+#include "weft/verify/whole_run.h"
 
 namespace weft {
 
@@ -60,5 +63,37 @@ std::string verify_suite_text(const std::vector<SuiteRow>& rows);
 // The suite's output folder must not exist, be empty, or hold an earlier suite (its suite.json
 // says so); weft::Error naming it otherwise.
 void check_suite_output(const std::filesystem::path& dir);
+
+// A suite run's plan: every fabric planned (inputs read and checked), the output guard over all
+// their inputs and the output folder checked, the whole suite's time estimated, before any work.
+struct VerifySuitePlan {
+  VerifySuite suite;
+  VerifyRequest base;  // quality, seed, threads and the output folder
+  std::vector<VerifyPlan> plans;
+  VerifyEstimate total;
+};
+// 'suite_file' empty: the bundled suite.
+VerifySuitePlan plan_verify_suite(const VerifyRequest& base, const std::string& suite_file,
+                                  const RunLimits& limits);
+// "weft verify --suite: N fabrics of FILE, quality Q: about T on C cores\n".
+std::string verify_suite_estimate_text(const VerifySuitePlan& plan);
+// The suite's time at the fastest rates: above an hour needs limits.yes_long (check_long_work).
+void check_verify_suite_time(const VerifySuitePlan& plan, const RunLimits& limits);
+
+struct VerifySuiteHooks {
+  // The hooks of fabric k's run (its progress, plots, notes).
+  std::function<VerifyHooks(size_t k)> fabric;
+  // Before fabric k's run, and when it failed (the suite goes on with the next).
+  std::function<void(size_t k)> starting = [](size_t) {};
+  std::function<void(size_t k, const std::string& error)> failed = [](size_t, const std::string&) {
+  };
+};
+struct VerifySuiteOutcome {
+  bool cancelled = false;  // the finished fabrics' reports stay; the page was not written
+  bool failed = false;     // some fabric failed (its row holds the error)
+  std::vector<SuiteRow> rows;
+};
+// One report per fabric in the output folder, then suite.json and index.html over them.
+VerifySuiteOutcome run_verify_suite(const VerifySuitePlan& plan, const VerifySuiteHooks& hooks);
 
 }  // namespace weft
