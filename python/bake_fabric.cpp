@@ -1,17 +1,17 @@
-// weft.bake_fabric: the fabric tables (fabric/), with the checks `weft bake fabric` makes before
-// the work and the GIL released while the libraries work.
+// weft.bake_fabric: the fabric library's bake (fabric/fabric_bake.h) with the request of `weft
+// bake fabric`, its keyword arguments the command's options and their defaults the request's, the
+// GIL released while the library works.
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
 #include <filesystem>
 #include <optional>
+#include <string>
+#include <variant>
 
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 #include "weft/fabric/fabric_bake.h"
-#include "weft/fabric/fabric_parts.h"
-#include "weft/fabric/fabric_raytrace.h"
-#include "weft/fabric/fabric_summation.h"
 #include "weft/fiber/fiber_table_bake.h"
 #include "weft/scenes/weave.h"
 #include "weft_python.h"
@@ -20,134 +20,125 @@ namespace weft::python {
 
 namespace {
 
-// bake_fabric's fiber: a Table, a table file (.exr), or a spec baked here at the bake's defaults
-// in RGB (as `weft bake fabric --fiber SPEC` bakes one into its cache).
-Table fabric_fiber(const py::object& fiber, bool yes_long, bool print) {
-  if (py::isinstance<Table>(fiber)) return fiber.cast<Table>();
-  if (py::isinstance<py::str>(fiber) ||
-      py::isinstance(fiber, py::module_::import("os").attr("PathLike"))) {
-    const std::filesystem::path p = fiber.cast<std::filesystem::path>();
-    if (p.extension() == ".exr") return Table(TabulatedBsdfTable::read_exr(p));
-  }
+bool is_path(const py::object& x) {
+  return py::isinstance<py::str>(x) ||
+         py::isinstance(x, py::module_::import("os").attr("PathLike"));
+}
+
+// The fiber into the request: a Table as it is, a table file (.exr) or a spec named for the
+// library. A spec (a dict, or a name without --thread-colours, which dyes it) is baked here in
+// memory once the plan has passed (baked_fiber), not into the bake cache.
+void request_fiber(const py::object& fiber, FabricBakeRequest& r) {
+  r.fiber.clear();
+  if (py::isinstance<Table>(fiber))
+    r.fiber_table = fiber.cast<Table>().shared();
+  else if (is_path(fiber))
+    r.fiber = fiber.cast<std::filesystem::path>().string();
+  else if (r.thread_colours)
+    throw Error("", "--thread-colours",
+                "dyes a fiber spec or preset given by its name or file, not a dict");
+}
+
+std::shared_ptr<const TabulatedBsdfTable> baked_fiber(const py::object& fiber,
+                                                      const FabricBakeRequest& r, bool print) {
+  if (r.fiber_table || r.thread_colours) return r.fiber_table;
+  if (is_path(fiber) && std::filesystem::path(r.fiber).extension() == ".exr") return nullptr;
   const FiberSpec spec = fiber_spec_argument(fiber);
   FiberTableBakeOptions o = fiber_bake_defaults(spec);
   o.spectral = false;
-  return bake_fiber_checked(spec, o, yes_long, print);
+  return bake_fiber_checked(spec, o, r.limits.yes_long, print).shared();
 }
 
-// The woven sample: the bundled poplin, a weave options file or dict (`weft weave`'s options),
-// with a pattern or WIF draft and the detail over it.
-WovenSample woven_sample(const py::object& sample, const std::optional<std::string>& pattern,
-                         const std::optional<std::string>& wif, const std::string& detail) {
-  WeaveOptions base;
+// The woven sample's options: None (the bundled poplin), a weave options file or a dict of them.
+void request_sample(const py::object& sample, FabricBakeRequest& r) {
   if (py::isinstance<py::dict>(sample)) {
     const nlohmann::json j = dict_json(sample.cast<py::dict>(), "sample");
-    ParamReader r(j, "sample", "");
-    base = read_weave_options(r, std::filesystem::current_path());
+    ParamReader reader(j, "sample", "");
+    r.weave_options = read_weave_options(reader, std::filesystem::current_path());
   } else if (!sample.is_none()) {
-    base = read_weave_options(sample.cast<std::filesystem::path>());
+    r.weave = sample.cast<std::filesystem::path>().string();
   }
-  if (pattern && wif) throw Error("", "wif", "give either pattern or wif, not both");
-  WeaveOptions given;
-  given.pattern = pattern;
-  given.wif = wif;
-  given.detail = detail;
-  return make_woven_sample(overlay(base, given));
 }
 
-std::vector<FiberOrientation> orientations(const std::vector<Vec3>& tangents) {
-  std::vector<FiberOrientation> out;
-  for (const Vec3& t : tangents) out.push_back({t, 1.0});
-  return out;
-}
+using Positions = std::variant<int, std::string>;
 
-struct FabricBakeArgs {
-  std::string method = "summation", detail = "yarn";
-  std::optional<std::string> pattern, wif;
-  int resolution = 8, threads = 0;
-  std::optional<uint64_t> samples;
-  uint64_t seed = 1;
-};
-
-// The table by the method asked for, without the GIL.
-TabulatedBsdfTable fabric_table(const TabulatedBsdfTable& fiber, const WovenSample& sample,
-                                const FabricBakeArgs& a, const ProgressCallback& progress) {
-  if (a.method == "raytrace") {
-    FabricRaytraceOptions r;
-    r.resolution = a.resolution;
-    if (a.samples) r.particles_per_bin = *a.samples;
-    r.seed = a.seed;
-    r.threads = a.threads;
-    r.validate();
-    py::gil_scoped_release release;
-    FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, r, progress);
-    record_particle_counts(res.table, res.splits, res.roulette_kills);
-    return std::move(res.table);
-  }
-  FabricSummationOptions s;
-  s.method = a.method == "summation" ? FabricSummation::kPaper : FabricSummation::kVisible;
-  s.resolution = a.resolution;
-  if (a.samples) s.samples_per_cell = static_cast<int>(*a.samples);  // checked in bake_fabric
-  s.seed = a.seed;
-  s.threads = a.threads;
-  if (s.method == FabricSummation::kVisible) {
-    s.top = orientations(visible_fiber_tangents(sample, true));
-    s.bottom = orientations(visible_fiber_tangents(sample, false));
-  }
-  s.validate();
-  py::gil_scoped_release release;
-  return sum_fabric_table(fiber, s, progress);
-}
-
-Table bake_fabric(const py::object& fiber, const py::object& sample, const FabricBakeArgs& a,
-                  bool yes_long, bool print) {
-  if (a.method != "summation" && a.method != "summation-visible" && a.method != "raytrace")
-    throw Error("", "method",
-                "must be 'summation', 'summation-visible' or 'raytrace', got '" + a.method + "'");
-  if (a.detail != "yarn" && a.detail != "fiber")
-    throw Error("", "detail", "must be 'yarn' or 'fiber', got '" + a.detail + "'");
-  if (a.resolution < 1 || a.resolution > TabulatedBsdfTable::kMaxResolution)
-    throw Error("", "resolution", "must be in [1, 32], got " + std::to_string(a.resolution));
-  // Checked before narrowing to the summation's int (2^32 + 1 would wrap to 1).
-  if (a.method != "raytrace" && a.samples && (*a.samples < 1 || *a.samples > 4096))
-    throw Error("", "samples",
-                "a summation takes 1 to 4096 direction pairs per cell pair, got " +
-                    std::to_string(*a.samples));
-  const uint64_t bins = static_cast<uint64_t>(DirectionGrid{a.resolution}.bins());
-  check_fabric_bake(call_limits(yes_long), value_of(kFabricMethods, a.method, "", "method"),
-                    a.resolution, bins, a.samples, a.threads, "samples");
-  const Table fiber_table = fabric_fiber(fiber, yes_long, print);
-  const WovenSample woven = woven_sample(sample, a.pattern, a.wif, a.detail);
+Table bake_fabric(const py::object& fiber, const py::object& sample, FabricBakeRequest r,
+                  bool print) {
+  request_fiber(fiber, r);
+  request_sample(sample, r);
+  FabricBakePlan plan = plan_fabric_bake(r);
+  plan.fibers.fiber_table = baked_fiber(fiber, plan.request, print);
   CallProgress progress(print);
-  TabulatedBsdfTable table = fabric_table(fiber_table.get(), woven, a, progress.callback());
+  FabricBakeResult result;
+  {
+    py::gil_scoped_release release;
+    result = run_fabric_bake(plan, {progress.callback()});
+  }
   progress.raise_if_interrupted();
-  table.metadata["sample"] = woven.summary.source + " (" + woven.summary.detail + ")";
-  table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION + " (python)";
-  return Table(std::move(table));
+  return Table(std::move(result.table));
 }
 
 }  // namespace
 
 void bind_bake_fabric(py::module_& m) {
+  const FabricBakeRequest d;
   m.def(
       "bake_fabric",
-      [](const py::object& fiber, const std::string& method, const py::object& sample,
+      [](const py::object& fiber, const std::string& method, std::optional<std::string> warp_fiber,
+         std::optional<std::string> weft_fiber, bool thread_colours, const py::object& sample,
          std::optional<std::string> pattern, std::optional<std::string> wif,
-         const std::string& detail, int resolution, std::optional<uint64_t> samples, uint64_t seed,
-         int threads, bool yes_long, bool progress) {
-        FabricBakeArgs a{method,  detail, std::move(pattern), std::move(wif), resolution, threads,
-                         samples, seed};
-        return bake_fabric(fiber, sample, a, yes_long, progress);
+         const std::string& detail, int resolution, std::optional<uint64_t> samples,
+         std::optional<std::string> estimator, std::optional<int> next_event_rays,
+         std::optional<int> launch_lattice, std::optional<std::string> straight_through,
+         std::optional<double> split_threshold, std::optional<int> max_scatterings,
+         std::optional<std::filesystem::path> weave_out, std::optional<Positions> weave_positions,
+         std::optional<int> weave_resolution, uint64_t seed, int threads, bool yes_long,
+         bool progress) {
+        FabricBakeRequest r;
+        r.method = method;
+        r.warp_fiber = warp_fiber.value_or(""), r.weft_fiber = weft_fiber.value_or("");
+        r.thread_colours = thread_colours;
+        r.pattern = pattern.value_or(""), r.wif = wif.value_or("");
+        r.detail = detail;
+        r.resolution = resolution;
+        r.samples = samples;
+        r.estimator = std::move(estimator);
+        r.next_event_rays = next_event_rays, r.launch_lattice = launch_lattice;
+        r.straight_through = std::move(straight_through);
+        r.split_threshold = split_threshold, r.max_scatterings = max_scatterings;
+        if (weave_out) r.weave_out = weave_out->string();
+        if (weave_positions)
+          r.weave_positions = std::visit(
+              [](const auto& p) {
+                if constexpr (std::is_same_v<std::decay_t<decltype(p)>, int>)
+                  return std::to_string(p);
+                else
+                  return p;
+              },
+              *weave_positions);
+        r.weave_resolution = weave_resolution;
+        r.seed = seed, r.threads = threads;
+        r.front_end = "python";
+        r.limits = call_limits(yes_long);
+        return bake_fabric(fiber, sample, std::move(r), progress);
       },
-      py::arg("fiber"), py::arg("method") = "summation", py::kw_only(),
-      py::arg("sample") = py::none(), py::arg("pattern") = py::none(), py::arg("wif") = py::none(),
-      py::arg("detail") = "yarn", py::arg("resolution") = 8, py::arg("samples") = py::none(),
-      py::arg("seed") = 1, py::arg("threads") = 0, py::arg("yes_long") = false,
-      py::arg("progress") = false,
-      "A fabric table from a fiber table (a Table, a .exr file, or a spec baked in RGB at the "
-      "bake's defaults) and a woven sample (None: the bundled poplin; a weave options file or "
-      "dict), by 'summation' (the paper's), 'summation-visible' or 'raytrace', as `weft bake "
-      "fabric` does.");
+      py::arg("fiber") = d.fiber, py::arg("method") = d.method, py::kw_only(),
+      py::arg("warp_fiber") = py::none(), py::arg("weft_fiber") = py::none(),
+      py::arg("thread_colours") = d.thread_colours, py::arg("sample") = py::none(),
+      py::arg("pattern") = py::none(), py::arg("wif") = py::none(), py::arg("detail") = d.detail,
+      py::arg("resolution") = d.resolution, py::arg("samples") = py::none(),
+      py::arg("estimator") = py::none(), py::arg("next_event_rays") = py::none(),
+      py::arg("launch_lattice") = py::none(), py::arg("straight_through") = py::none(),
+      py::arg("split_threshold") = py::none(), py::arg("max_scatterings") = py::none(),
+      py::arg("weave_out") = py::none(), py::arg("weave_positions") = py::none(),
+      py::arg("weave_resolution") = py::none(), py::arg("seed") = d.seed,
+      py::arg("threads") = d.threads, py::arg("yes_long") = false, py::arg("progress") = false,
+      "A fabric table, as `weft bake fabric` makes it (its options are the keyword arguments, with "
+      "its defaults): from a fiber (a Table, a .exr file, or a spec baked in RGB at the bake's "
+      "defaults; warp_fiber, weft_fiber and thread_colours' dyes are baked into ./.weft-cache as "
+      "the command bakes them) and a woven sample (None: the bundled poplin; a weave options file "
+      "or dict), by 'summation' (the paper's), 'summation-visible' or 'raytrace'. weave_out: the "
+      "ray trace's weave table is written there.");
 }
 
 }  // namespace weft::python

@@ -27,6 +27,7 @@ class Table {
   explicit Table(TabulatedBsdfTable table)
       : table_(std::make_shared<const TabulatedBsdfTable>(std::move(table))) {}
   const TabulatedBsdfTable& get() const { return *table_; }
+  std::shared_ptr<const TabulatedBsdfTable> shared() const { return table_; }
   // TabulatedBsdfData::prepare's result, made once (the GIL guards it).
   const TabulatedBsdf& bsdf() const;
 

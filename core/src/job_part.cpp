@@ -196,14 +196,6 @@ std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, cons
   return p;
 }
 
-std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
-                                       bool resume) {
-  std::vector<std::string> warnings;
-  auto p = load_checkpoint(output, job, resume, warnings);
-  for (const auto& w : warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
-  return p;
-}
-
 JobPart merge_job_parts(const std::vector<std::filesystem::path>& paths) {
   if (paths.empty()) throw Error("", "parts", "no parts given");
   JobPart all;

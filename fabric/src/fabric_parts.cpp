@@ -6,9 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
-#include <iostream>
 
 #include "weft/core/error.h"
 #include "weft/core/params.h"
@@ -50,7 +48,7 @@ JobPart fabric_job(const FiberTables& fibers, const WovenSample& sample,
            {"seed", r.seed},
            {"max_scatterings", r.max_scatterings},
            {"roulette_threshold", r.roulette_threshold},
-           {"estimator", channel_sampling_name(r.channel_sampling)},
+           {"estimator", name_of(kChannelSamplingNames, r.channel_sampling)},
            {"split_threshold", r.split_threshold},
            {"max_copies_per_particle", r.max_copies_per_particle},
            {"program_version", WEFT_VERSION}};
@@ -59,7 +57,7 @@ JobPart fabric_job(const FiberTables& fibers, const WovenSample& sample,
   if (r.next_event_rays > 0) p.job["next_event_rays"] = r.next_event_rays;
   if (r.launch_lattice > 1) p.job["launch_lattice"] = r.launch_lattice;
   if (r.straight_through != StraightThrough::sampled)
-    p.job["straight_through"] = straight_through_name(r.straight_through);
+    p.job["straight_through"] = name_of(kStraightThroughNames, r.straight_through);
   if (r.weave_positions_u > 0) {  // the parts carry the weave tally (weave_tally.h)
     p.job["weave_positions"] = {r.weave_positions_u, r.weave_positions_v};
     p.job["weave_resolution"] = r.weave_resolution;
@@ -191,26 +189,21 @@ FabricRaytraceResult assemble_fabric_bins(const std::map<uint64_t, std::vector<d
   return r;
 }
 
-std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
-    const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
-    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
-    bool resume, const ProgressCallback& progress, int* exit_code) {
-  return raytrace_fabric_in_pieces(sample, inputs, FiberTables{{&fiber}, {}, {}, {}}, r, output,
-                                   shard_text, resume, progress, exit_code);
-}
-
-std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
+FabricPiecesOutcome raytrace_fabric_in_pieces(
     const WovenSample& sample, const nlohmann::json& inputs, const FiberTables& given,
     const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
-    bool resume, const ProgressCallback& progress, int* exit_code) {
-  *exit_code = 0;
+    bool resume, const ProgressCallback& progress,
+    const std::function<void(const std::string&)>& warning) {
+  FabricPiecesOutcome outcome;
   const Shard shard = shard_text.empty() ? Shard{} : parse_shard(shard_text, "--shard");
   if (given.tables.size() > 1) validate_fiber_tables(given, sample);
   const FiberTables fibers = given.tables.size() > 1 ? distinct_fiber_tables(given) : given;
   JobPart job = fabric_job(fibers, sample, inputs, r, shard);
   const UnitRange range = shard_units(job.units_total, shard);
   JobPart done = job;
-  if (const auto cp = load_checkpoint(output, job, resume)) done = *cp;
+  std::vector<std::string> warnings;
+  if (const auto cp = load_checkpoint(output, job, resume, warnings)) done = *cp;
+  for (const std::string& w : warnings) warning(w);
   done.checkpoint = true;
   // Pieces of about an eighth of the range between checkpoints; the whole range without them.
   const uint64_t step = resume ? std::max<uint64_t>(1, (range.last - range.first + 7) / 8)
@@ -227,10 +220,8 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
     piece.bin_count = static_cast<int>(b - a);
     const FabricRaytraceResult res = trace(sample, fibers, piece, progress);
     if (res.cancelled) {
-      std::fprintf(stderr, "\nweft: bake cancelled; %s\n",
-                   resume ? "--resume continues from the last checkpoint" : "nothing was written");
-      *exit_code = 130;
-      return std::nullopt;
+      outcome.cancelled = true;
+      return outcome;
     }
     for (uint64_t u = a; u < b; ++u) encode_fabric_bin(res, u, done.units[u]);
     done.extra = {{"channels", res.table.channels}, {"metadata", res.table.metadata}};
@@ -256,14 +247,14 @@ std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
   if (!shard.whole()) {
     write_job_part(output, done);
     std::filesystem::remove(checkpoint_path(output));
-    std::printf("incident bins %llu..%llu (shard %u/%u) -> %s\n",
-                static_cast<unsigned long long>(range.first),
-                static_cast<unsigned long long>(range.last), shard.index, shard.count,
-                output.c_str());
-    return std::nullopt;
+    outcome.part_written = true;
+    outcome.units = range;
+    outcome.shard = shard;
+    return outcome;
   }
   std::filesystem::remove(checkpoint_path(output));
-  return assemble_fabric_job(done);
+  outcome.result = assemble_fabric_job(done);
+  return outcome;
 }
 
 nlohmann::json raytrace_summary(const FabricRaytraceResult& res) {

@@ -70,14 +70,6 @@ double fabric_scene_bytes(const WovenSampleSize& z) {
   return kFabricSceneBaseBytes + tubes + fibers;
 }
 
-const char* channel_sampling_name(ChannelSampling s) {
-  return s == ChannelSampling::mean ? "mean" : "hero";
-}
-
-const char* straight_through_name(StraightThrough s) {
-  return s == StraightThrough::sampled ? "sampled" : "exact";
-}
-
 void FabricRaytraceOptions::validate() const {
   if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
     throw Error("", "resolution",
@@ -547,13 +539,14 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
       {"fiber_checksum", fiber.checksum()},
       {"particles_per_bin", std::to_string(o.particles_per_bin)},
       {"seed", std::to_string(o.seed)},
-      {"estimator", o.next_event_rays > 0 ? "nee" : channel_sampling_name(o.channel_sampling)},
+      {"estimator",
+       o.next_event_rays > 0 ? "nee" : name_of(kChannelSamplingNames, o.channel_sampling)},
       {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
   if (o.proposal) table.metadata["proposal_checksum"] = o.proposal->checksum();
   if (o.next_event_rays > 0) table.metadata["next_event_rays"] = std::to_string(o.next_event_rays);
   if (o.launch_lattice > 1) table.metadata["launch_lattice"] = std::to_string(o.launch_lattice);
   if (o.straight_through != StraightThrough::sampled)
-    table.metadata["straight_through"] = straight_through_name(o.straight_through);
+    table.metadata["straight_through"] = name_of(kStraightThroughNames, o.straight_through);
   // A table of paths cut short says so (only then, so that other tables keep their bytes).
   if (o.max_scatterings != FabricRaytraceOptions{}.max_scatterings)
     table.metadata["max_scatterings"] = std::to_string(o.max_scatterings);

@@ -88,7 +88,7 @@ TEST(WeaveTally, PositionMeanIsTheTablesCoarseAverage) {
   // straight-through light computed (its rays booked by position too) and sampled.
   for (const StraightThrough st : kStraightThrough)
     for (const auto& [r, rw] : {std::pair{4, 2}, std::pair{3, 2}}) {
-      SCOPED_TRACE(straight_through_name(st));
+      SCOPED_TRACE(name_of(kStraightThroughNames, st));
       FabricRaytraceOptions o = weave_options(r, 400, 4, 3, rw);
       o.straight_through = st;
       const auto hero = raytrace_fabric_table(sample, fiber, o);
@@ -196,7 +196,7 @@ TEST(WeaveTally, GapsBetweenYarnsTransmitStraightThrough) {
   // The light through the gaps computed (its rays booked where they cross the mid-plane) and
   // sampled (the particles that meet nothing booked there).
   for (const StraightThrough st : kStraightThrough) {
-    SCOPED_TRACE(straight_through_name(st));
+    SCOPED_TRACE(name_of(kStraightThroughNames, st));
     o.straight_through = st;
     const auto res = raytrace_fabric_table(sample, lossy_fiber(3), o);
     int gaps = 0, covered = 0;

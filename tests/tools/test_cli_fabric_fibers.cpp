@@ -1,5 +1,5 @@
 // `weft bake fabric` with per-yarn fibers (--warp-fiber, --weft-fiber) and a WIF draft's
-// --thread-colours (tools/bake_fabric_fibers.h): one fiber given per yarn is the single-fiber run
+// --thread-colours (fabric/fabric_fibers.h): one fiber given per yarn is the single-fiber run
 // byte for byte, two differ and are named in the summary, the draft's colours become one baked
 // fiber each, and every misuse is refused by the option's name before any work.
 #include <gtest/gtest.h>

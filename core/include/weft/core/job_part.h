@@ -69,10 +69,6 @@ std::filesystem::path checkpoint_path(const std::filesystem::path& output);
 // 'warnings', "<file> is unreadable; starting afresh", for the front end to show.
 std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
                                        bool resume, std::vector<std::string>& warnings);
-// The same, the warning printed on stderr as "weft: warning: ...". Only for the callers not yet
-// handed a list by their own caller (fabric_parts.cpp); new code uses the form above.
-std::optional<JobPart> load_checkpoint(const std::filesystem::path& output, const JobPart& job,
-                                       bool resume);
 
 // The content of a job's input files, for its identity: {"<file>": "<FNV-1a 64 hex>"}, so that a
 // file changed after a part or checkpoint was written makes it another job. weft::Error naming a

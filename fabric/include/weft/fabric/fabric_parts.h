@@ -1,6 +1,7 @@
 #pragma once
 // The fiber-level ray trace in pieces (`weft bake fabric --method raytrace --shard/--resume`,
 // `weft merge`): parts of incident bins, checkpoints, and the table assembled from them.
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -13,21 +14,28 @@ namespace weft {
 // The ray tracer's splits and roulette kills in the table's metadata (whole runs and merges).
 void record_particle_counts(TabulatedBsdfTable& t, uint64_t splits, uint64_t roulette_kills);
 
-// With --shard K/N: traces the shard's incident bins and writes them as a part to 'output'
-// (returns nothing). 'inputs' (input_file_hashes of the weave options and draft) joins the job's
-// identity. With --resume: checkpoints every finished piece beside 'output' and starts
-// from a checkpoint left there; a whole table is returned for the caller to write. A cancelled
-// run returns nothing with exit code 130.
-std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
-    const WovenSample& sample, const nlohmann::json& inputs, const TabulatedBsdfTable& fiber,
-    const FabricRaytraceOptions& r, const std::string& output, const std::string& shard,
-    bool resume, const ProgressCallback& progress, int* exit_code);
-// The same with per-yarn fiber tables (fabric_raytrace.h): the distinct tables' checksums and the
-// maps join the job's identity (one distinct table: the single-table job, its identity unchanged).
-std::optional<FabricRaytraceResult> raytrace_fabric_in_pieces(
+// What a ray trace in pieces did: returned the whole table ('result'), wrote a shard's part
+// (incident bins 'units' of shard 'shard' to the output), or was cancelled (nothing written; with
+// --resume the last checkpoint stays to continue from).
+struct FabricPiecesOutcome {
+  std::optional<FabricRaytraceResult> result;
+  bool cancelled = false;
+  bool part_written = false;
+  UnitRange units;
+  Shard shard;
+};
+
+// With --shard K/N: traces the shard's incident bins and writes them as a part to 'output'.
+// 'inputs' (input_file_hashes of the weave options and draft) joins the job's identity, and so do
+// per-yarn fiber tables' checksums and maps (one distinct table: the single-table job, its
+// identity unchanged). With --resume: checkpoints every finished piece beside 'output' and starts
+// from a checkpoint left there (an unreadable one is passed over, said through 'warning'); a
+// whole table is returned for the caller to write.
+FabricPiecesOutcome raytrace_fabric_in_pieces(
     const WovenSample& sample, const nlohmann::json& inputs, const FiberTables& fibers,
     const FabricRaytraceOptions& r, const std::string& output, const std::string& shard,
-    bool resume, const ProgressCallback& progress, int* exit_code);
+    bool resume, const ProgressCallback& progress,
+    const std::function<void(const std::string&)>& warning);
 
 // The unit of incident bin 'bin' of a ray trace (its row of the table, its books and noise, every
 // value with its exact bits); the channels of such a unit for a table of 'bins' bins; and the

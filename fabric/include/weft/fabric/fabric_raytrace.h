@@ -30,6 +30,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/names.h"
 #include "weft/core/progress.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/materials/weave_table.h"
@@ -46,8 +47,11 @@ namespace weft {
 // compare with: in a strongly coloured fabric the dominant channel's weights grow along multiply
 // scattered paths and it is far noisier than the others).
 enum class ChannelSampling { spectral_mis, mean };
-// The names the command line and the table's metadata use: "hero" (spectral_mis) and "mean".
-const char* channel_sampling_name(ChannelSampling s);
+// The names the table's metadata and a part's job use.
+inline constexpr NameTable<ChannelSampling, 2> kChannelSamplingNames{{
+    {ChannelSampling::spectral_mis, "hero", "hero channel, MIS over channels"},
+    {ChannelSampling::mean, "mean", "the channels' mean"},
+}};
 
 // The light that passes straight through the gaps between the fibers (meeting none) leaves along
 // its launch direction, into one cell per incident bin. exact: its expectation is computed
@@ -55,8 +59,11 @@ const char* channel_sampling_name(ChannelSampling s);
 // the particles book only what meets a fiber; sampled: the particles book it too (the estimator
 // before the option, bit for bit). Both are unbiased; exact removes that cell's hit-or-miss noise.
 enum class StraightThrough { exact, sampled };
-// The names the command line and the table's metadata use: "exact", "sampled".
-const char* straight_through_name(StraightThrough s);
+// The names the command line and the table's metadata use, in the command line's order.
+inline constexpr NameTable<StraightThrough, 2> kStraightThroughNames{{
+    {StraightThrough::exact, "exact", "computed"},
+    {StraightThrough::sampled, "sampled", "booked by the particles"},
+}};
 
 // The estimator's revision, raised whenever a change alters its results for the same options: it
 // is part of a sharded or resumed run's identity (parts of another revision are refused, not

@@ -1,8 +1,9 @@
 #pragma once
-// The fiber tables of `weft bake fabric`: the one --fiber, or one per yarn: --warp-fiber and
-// --weft-fiber, or a WIF draft's --thread-colours, each colour a dye of --fiber
+// The fiber tables of a fabric bake (fabric_bake.h): the one --fiber, or one per yarn: --warp-fiber
+// and --weft-fiber, or a WIF draft's --thread-colours, each colour a dye of --fiber
 // (fiber/thread_colour.h; docs/fabric-bsdf.md "Per-yarn fibers").
 #include <deque>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -10,10 +11,12 @@
 #include "weft/core/run_limits.h"
 #include "weft/fabric/fabric_raytrace.h"
 
-namespace weft::cli {
+namespace weft {
 
 struct FabricFiberOptions {
   std::string fiber, warp_fiber, weft_fiber;  // warp/weft: "" = --fiber
+  // --fiber's table when the caller holds it already (Python's Table): 'fiber' then only names it.
+  std::shared_ptr<const TabulatedBsdfTable> fiber_table;
   bool thread_colours = false;
   std::string draft;  // the WIF draft (--wif, or the one --weave names); "" when none
   RunLimits limits;   // a bake on first use is checked under these
@@ -23,8 +26,8 @@ struct FabricFiberOptions {
 inline constexpr int kMaxThreadColours = 8;
 
 // Checked before any work: the options that need a ray trace, a draft, or exclude each other
-// (weft::Error naming the option). 'method' is --method.
-void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& method);
+// (weft::Error naming the option). 'raytrace': --method raytrace.
+void check_fabric_fiber_options(const FabricFiberOptions& o, bool raytrace);
 // True when the run traces more than one fiber (per-yarn tables may still turn out equal).
 bool per_yarn_fibers(const FabricFiberOptions& o);
 
@@ -32,6 +35,7 @@ bool per_yarn_fibers(const FabricFiberOptions& o);
 // the ray trace takes (one table, every yarn on it, without per-yarn options).
 struct FabricFibers {
   std::deque<TabulatedBsdfTable> held;
+  std::shared_ptr<const TabulatedBsdfTable> given;  // FabricFiberOptions::fiber_table
   FiberTables map;
   const TabulatedBsdfTable& first() const { return *map.tables.at(0); }
   // Per table: its name, checksum and spec name (for --json).
@@ -42,7 +46,7 @@ FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& 
 
 // One fiber table: a table file (.exr), or a fiber spec or preset baked once into ./.weft-cache
 // (RGB); 'option' names it in the bake's checks.
-TabulatedBsdfTable fiber_table(const std::string& fiber, const std::string& option,
-                               const RunLimits& limits, const ProgressCallback& progress);
+TabulatedBsdfTable named_fiber_table(const std::string& fiber, const std::string& option,
+                                     const RunLimits& limits, const ProgressCallback& progress);
 
-}  // namespace weft::cli
+}  // namespace weft

@@ -1,18 +1,17 @@
-#include "bake_fabric_fibers.h"
+#include "weft/fabric/fabric_fibers.h"
 
 #include <algorithm>
 #include <filesystem>
 
-#include "cli_util.h"
 #include "weft/core/error.h"
 #include "weft/fiber/bake_cache.h"
 #include "weft/fiber/thread_colour.h"
 #include "weft/scenes/wif.h"
 
-namespace weft::cli {
+namespace weft {
 namespace {
 
-bool is_table_file(const std::string& fiber) {
+bool is_fiber_table_file(const std::string& fiber) {
   std::error_code ec;
   return std::filesystem::path(fiber).extension() == ".exr" ||
          (std::filesystem::is_regular_file(fiber, ec) && fiber.size() > 4 &&
@@ -20,9 +19,9 @@ bool is_table_file(const std::string& fiber) {
 }
 
 // The table of a spec baked once into ./.weft-cache (RGB); 'source' names it in the checks.
-TabulatedBsdfTable cached_table(const FiberSpec& spec, const std::string& source,
-                                const std::string& option, const RunLimits& limits,
-                                const ProgressCallback& progress) {
+TabulatedBsdfTable cached_fabric_fiber(const FiberSpec& spec, const std::string& source,
+                                       const std::string& option, const RunLimits& limits,
+                                       const ProgressCallback& progress) {
   FiberTableBakeOptions o = fiber_bake_defaults(spec);
   o.spectral = false;
   return TabulatedBsdfTable::read_exr(
@@ -49,7 +48,7 @@ void check_draft_colours(const FabricFiberOptions& o) {
                     " distinct colours ([WARP COLORS], [WEFT COLORS]); --thread-colours takes at "
                     "most " +
                     std::to_string(kMaxThreadColours) + ", a fiber table baked for each");
-  if (is_table_file(o.fiber))
+  if (o.fiber_table || is_fiber_table_file(o.fiber))
     throw Error("", "--fiber",
                 "--thread-colours dyes a fiber spec or preset (its host absorption), not a "
                 "table: give a spec or preset such as white-cotton");
@@ -65,8 +64,8 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
   for (size_t k = 0; k < colours.size(); ++k) {
     const std::string name = srgb_hex(colours[k]);
     const std::string option = "--thread-colours " + name;
-    f.held.push_back(cached_table(thread_colour_spec(base, colours[k], option), option, option,
-                                  o.limits, progress));
+    f.held.push_back(cached_fabric_fiber(thread_colour_spec(base, colours[k], option), option,
+                                         option, o.limits, progress));
     f.map.tables[k] = &f.held.back();
     f.map.names.push_back(name);
   }
@@ -75,10 +74,10 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
 
 }  // namespace
 
-TabulatedBsdfTable fiber_table(const std::string& fiber, const std::string& option,
-                               const RunLimits& limits, const ProgressCallback& progress) {
-  if (is_table_file(fiber)) return TabulatedBsdfTable::read_exr(fiber);
-  return cached_table(load_fiber_spec(fiber), fiber, option, limits, progress);
+TabulatedBsdfTable named_fiber_table(const std::string& fiber, const std::string& option,
+                                     const RunLimits& limits, const ProgressCallback& progress) {
+  if (is_fiber_table_file(fiber)) return TabulatedBsdfTable::read_exr(fiber);
+  return cached_fabric_fiber(load_fiber_spec(fiber), fiber, option, limits, progress);
 }
 
 bool per_yarn_fibers(const FabricFiberOptions& o) {
@@ -87,7 +86,7 @@ bool per_yarn_fibers(const FabricFiberOptions& o) {
   return o.thread_colours || warp != weft;
 }
 
-void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& method) {
+void check_fabric_fiber_options(const FabricFiberOptions& o, bool raytrace) {
   if (o.thread_colours && (!o.warp_fiber.empty() || !o.weft_fiber.empty()))
     throw Error("", "--thread-colours",
                 "give either --thread-colours or --warp-fiber/--weft-fiber, not both");
@@ -98,11 +97,23 @@ void check_fabric_fiber_options(const FabricFiberOptions& o, const std::string& 
   const std::string option = o.thread_colours        ? "--thread-colours"
                              : !o.warp_fiber.empty() ? "--warp-fiber"
                                                      : "--weft-fiber";
-  if (method != "raytrace")
+  if (!raytrace)
     throw Error("", option,
                 "the summations take one fiber for the whole cloth; per-yarn fibers need "
                 "--method raytrace");
 }
+
+namespace {
+
+// One yarn's table: --fiber's own where the caller holds it, else loaded or baked.
+const TabulatedBsdfTable& yarn_fiber_table(const FabricFiberOptions& o, FabricFibers& f,
+                                           const std::string& name, const std::string& option,
+                                           const ProgressCallback& progress) {
+  if (o.fiber_table && option == "--fiber") return *(f.given = o.fiber_table);
+  return f.held.emplace_back(named_fiber_table(name, option, o.limits, progress));
+}
+
+}  // namespace
 
 FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& sample,
                                 const ProgressCallback& progress) {
@@ -110,17 +121,16 @@ FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& 
   FabricFibers f;
   if (!per_yarn_fibers(o)) {
     const std::string& only = o.warp_fiber.empty() ? o.fiber : o.warp_fiber;
-    f.held.push_back(
-        fiber_table(only, only == o.fiber ? "--fiber" : "--warp-fiber", o.limits, progress));
-    f.map.tables = {&f.held.back()};
+    f.map.tables = {
+        &yarn_fiber_table(o, f, only, only == o.fiber ? "--fiber" : "--warp-fiber", progress)};
     return f;
   }
-  const TabulatedBsdfTable& warp = f.held.emplace_back(
-      fiber_table(o.warp_fiber.empty() ? o.fiber : o.warp_fiber,
-                  o.warp_fiber.empty() ? "--fiber" : "--warp-fiber", o.limits, progress));
-  const TabulatedBsdfTable& weft = f.held.emplace_back(
-      fiber_table(o.weft_fiber.empty() ? o.fiber : o.weft_fiber,
-                  o.weft_fiber.empty() ? "--fiber" : "--weft-fiber", o.limits, progress));
+  const TabulatedBsdfTable& warp =
+      yarn_fiber_table(o, f, o.warp_fiber.empty() ? o.fiber : o.warp_fiber,
+                       o.warp_fiber.empty() ? "--fiber" : "--warp-fiber", progress);
+  const TabulatedBsdfTable& weft =
+      yarn_fiber_table(o, f, o.weft_fiber.empty() ? o.fiber : o.weft_fiber,
+                       o.weft_fiber.empty() ? "--fiber" : "--weft-fiber", progress);
   f.map = fiber_tables_by_direction(sample, warp, weft);
   return f;
 }
@@ -137,4 +147,4 @@ nlohmann::json FabricFibers::summary() const {
   return list;
 }
 
-}  // namespace weft::cli
+}  // namespace weft
