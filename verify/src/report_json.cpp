@@ -3,6 +3,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
+#include "weft/verify/models.h"
 #include "weft/verify/report.h"
 
 namespace weft {
@@ -115,36 +116,31 @@ nlohmann::json models_json(const VerifyReport& r) {
 
 // The headline figures at the top level: computed is the fiber-level ray trace.
 void add_headline_figures(nlohmann::json& j, const std::vector<ModelCurves>& models) {
-  const std::pair<const char*, const char*> shape_keys[] = {
-      {"computed_raytrace", "computed"},
-      {"computed_summation", "summation"},
-      {"classic", "classic"},
-      {"computed_raytrace_fitted", "computed_fitted"},
-      {"classic_fitted", "classic_fitted"}};
   for (const auto& m : models)
-    for (const auto& [key, name] : shape_keys)
-      if (m.key == key && !m.figures.fits.empty()) {
+    for (const VerifyModelNames& names : kVerifyModels)
+      if (m.key == names.key && !m.figures.fits.empty()) {
+        const char* name = names.headline;
         const ShapeFigure& s = m.figures.shape;
         j[std::string(name) + "_shape_rms_log"] = number_json(s.rms_log);
         j[std::string(name) + "_shape_gain"] = {number_json(s.gain.r), number_json(s.gain.g),
                                                 number_json(s.gain.b)};
       }
   for (const auto& m : models) {
-    if (m.key == "computed_raytrace") {
+    if (m.key == verify_model_key(VerifyModel::kComputedRaytrace)) {
       j["computed_rms_log"] = m.normalized_overall.rms_log;
       j["computed_rms_log_absolute"] = m.absolute_overall.rms_log;
       j["computed_rms_rel"] = m.normalized_overall.rms_rel;
       j["computed_rms_rel_absolute"] = m.absolute_overall.rms_rel;
     }
-    if (m.key == "computed_raytrace_fitted") {
+    if (m.key == verify_model_key(VerifyModel::kComputedRaytraceFitted)) {
       j["computed_fitted_rms_log_absolute"] = m.absolute_overall.rms_log;
       j["computed_fitted_rms_log"] = m.normalized_overall.rms_log;
     }
-    if (m.key == "classic_fitted") {
+    if (m.key == verify_model_key(VerifyModel::kClassicFitted)) {
       j["classic_fitted_rms_log_absolute"] = m.absolute_overall.rms_log;
       j["classic_fitted_rms_log"] = m.normalized_overall.rms_log;
     }
-    if (m.key == "classic") {
+    if (m.key == verify_model_key(VerifyModel::kClassic)) {
       j["classic_rms_log"] = m.normalized_overall.rms_log;
       j["classic_rms_log_absolute"] = m.absolute_overall.rms_log;
       j["classic_rms_rel"] = m.normalized_overall.rms_rel;
@@ -203,7 +199,9 @@ nlohmann::json fit_json(const FitResult& f, const std::vector<ModelCurves>& mode
                       {"seeds", seed_fits_json(f)},
                       {"seconds", f.seconds}};
   // The fitted parameters at the run's quality (the same ray trace as the unfitted curves).
-  const std::string key = f.model == "computed" ? "computed_raytrace_fitted" : f.model + "_fitted";
+  const std::string key = f.model == "computed"
+                              ? verify_model_key(VerifyModel::kComputedRaytraceFitted)
+                              : f.model + "_fitted";
   for (const auto& m : models)
     if (m.key == key)
       e["at_run_quality"] = {{"model", key},

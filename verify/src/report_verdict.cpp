@@ -1,20 +1,22 @@
 // The report's verdicts: which models are compared, and their names in words.
 #include <algorithm>
 
+#include "weft/verify/models.h"
 #include "weft/verify/report.h"
 
 namespace weft {
 
 std::string verdict_model_name(const std::string& key) {
+  for (const VerifyModelNames& m : kVerifyModels)
+    if (key == m.key) return std::string("the ") + m.verdict;
+  // A model of no row ("computed_summation_fitted"): its base's name, fitted.
   const std::string fitted = "_fitted";
   const bool is_fitted = key.size() > fitted.size() &&
                          key.compare(key.size() - fitted.size(), fitted.size(), fitted) == 0;
   const std::string base = is_fitted ? key.substr(0, key.size() - fitted.size()) : key;
-  std::string name = base;
-  if (base == "computed_raytrace") name = "computed model (ray trace)";
-  if (base == "computed_summation") name = "computed model (paper's summation)";
-  if (base == "classic") name = "classic model";
-  return std::string("the ") + (is_fitted ? "fitted " : "") + name;
+  for (const VerifyModelNames& m : kVerifyModels)
+    if (base == m.key) return std::string("the fitted ") + m.verdict;
+  return "the " + std::string(is_fitted ? "fitted " : "") + base;
 }
 
 std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
@@ -23,10 +25,11 @@ std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
                                  [&](const ModelCurves& m) { return m.key == key; });
     return it == r.models.end() ? nullptr : &*it;
   };
+  using M = VerifyModel;
   const std::pair<const char*, const char*> pairs[] = {
-      {"computed_raytrace", "classic"},
-      {"computed_summation", "classic"},
-      {"computed_raytrace_fitted", "classic_fitted"}};
+      {verify_model_key(M::kComputedRaytrace), verify_model_key(M::kClassic)},
+      {verify_model_key(M::kComputedSummation), verify_model_key(M::kClassic)},
+      {verify_model_key(M::kComputedRaytraceFitted), verify_model_key(M::kClassicFitted)}};
   std::vector<Verdict> out;
   for (int f = 0; f < 3; ++f)
     for (const auto& [ka, kb] : pairs) {

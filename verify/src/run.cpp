@@ -11,6 +11,7 @@
 #include "weft/materials/classic_fiber.h"
 #include "weft/verify/classic.h"
 #include "weft/verify/inplane.h"
+#include "weft/verify/models.h"
 
 namespace weft {
 namespace {
@@ -191,7 +192,8 @@ void add_computed_raytrace(VerifyReport& rep, const TracedCurves& computed, cons
     table_to_rgb(computed.mean, &clip);
     rep.fabric_table_gamut_clipped = clip.components;
   }
-  rep.models.push_back(model_curves("computed_raytrace", "computed (fiber-level ray trace)",
+  rep.models.push_back(model_curves(verify_model(VerifyModel::kComputedRaytrace).key,
+                                    verify_model(VerifyModel::kComputedRaytrace).label,
                                     computed.beta, computed.err, computed.batches));
   rep.computed_fabric = computed.mean;
   rep.computed_fiber = in.fiber;
@@ -202,7 +204,8 @@ void add_computed_raytrace(VerifyReport& rep, const TracedCurves& computed, cons
 ModelCurves summation_curves(const TabulatedBsdfTable& summation, const MeasuredInplane& measured,
                              int azimuths) {
   const TabulatedBsdfTable rgb = table_to_rgb(summation);
-  ModelCurves m = model_curves("computed_summation", "computed (paper's summation)", {}, {});
+  ModelCurves m = model_curves(verify_model(VerifyModel::kComputedSummation).key,
+                               verify_model(VerifyModel::kComputedSummation).label, {}, {});
   for (const auto& c : measured.curves) {
     m.beta.push_back(inplane_beta(rgb, c.theta_i_deg, c.view_deg, azimuths));
     m.beta_err.emplace_back(c.view_deg.size(), Rgb());
@@ -344,8 +347,9 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
     return rep;
   }
   rep.seconds["raytrace_classic"] = seconds_since(t0);
-  rep.models.push_back(
-      model_curves("classic", "classic (Lambert + Cook-Torrance)", cl.beta, cl.err, cl.batches));
+  rep.models.push_back(model_curves(verify_model(VerifyModel::kClassic).key,
+                                    verify_model(VerifyModel::kClassic).label, cl.beta, cl.err,
+                                    cl.batches));
   rep.classic_fabric = std::move(cl.mean);
   rep.classic_fiber = classic.table;
   rep.measured_nbrdf = measured_network(measured);

@@ -4,22 +4,22 @@
 #include <sstream>
 
 #include "common.h"
+#include "weft/verify/models.h"
 #include "weft/verify/suite.h"
 
 namespace weft {
 namespace {
 
-// The models a suite row shows, with the prefix of their headline keys in metrics.json.
+// The models a suite row shows (the first three of kVerifyModels: no fitted ones).
 struct SuiteModel {
   const char* key;     // metrics.json "models" key
   const char* prefix;  // of the headline keys
   const char* label;
 };
-constexpr SuiteModel kSuiteModels[] = {
-    {"computed_raytrace", "computed", "computed (ray trace)"},
-    {"computed_summation", "summation", "computed (paper's summation)"},
-    {"classic", "classic", "classic (Lambert + Cook-Torrance)"},
-};
+constexpr SuiteModel suite_model(size_t k) {
+  return {kVerifyModels[k].key, kVerifyModels[k].headline, kVerifyModels[k].short_label};
+}
+constexpr SuiteModel kSuiteModels[] = {suite_model(0), suite_model(1), suite_model(2)};
 
 // A number of a JSON object, or NaN when absent or not a number.
 double number_at(const nlohmann::json& j, const nlohmann::json::json_pointer& p) {
@@ -67,8 +67,9 @@ std::string shape_closer(const nlohmann::json& metrics) {
   if (!metrics.contains(p) || !metrics.at(p).is_array()) return "";
   for (const auto& v : metrics.at(p)) {
     const std::string a = v.value("a", ""), b = v.value("b", "");
-    const bool pair = (a == "computed_raytrace" && b == "classic") ||
-                      (a == "classic" && b == "computed_raytrace");
+    const std::string computed = verify_model_key(VerifyModel::kComputedRaytrace),
+                      classic = verify_model_key(VerifyModel::kClassic);
+    const bool pair = (a == computed && b == classic) || (a == classic && b == computed);
     if (!pair) continue;
     if (!v.value("resolved", false)) return "unresolved";
     return v.value("closer", "") == "classic" ? "classic" : "computed";

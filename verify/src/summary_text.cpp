@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "weft/core/run_limits.h"
+#include "weft/verify/models.h"
 #include "weft/verify/report.h"
 
 namespace weft {
@@ -96,8 +97,8 @@ std::string verify_summary_text(const VerifyPlan& p, const VerifyReport& report,
   verdict_text(out, report);
   append(out, "  %-36s %10s %10s %10s %10s\n", "RMS vs measured", "log norm", "rel norm", "log abs",
          "rel abs");
-  for (const std::string key : {"computed_raytrace", "computed_summation", "classic",
-                                "computed_raytrace_fitted", "classic_fitted"}) {
+  for (const VerifyModelNames& names : kVerifyModels) {
+    const std::string key = names.key;
     const auto m = std::find_if(report.models.begin(), report.models.end(),
                                 [&](const ModelCurves& c) { return c.key == key; });
     if (m != report.models.end())
