@@ -79,17 +79,13 @@ ProgressCallback progress_bar(const RunLimits& limits, bool quiet) {
   };
 }
 
-SceneDescription load_scene_reporting_warnings(const std::string& path,
-                                               const std::vector<SceneOverride>& overrides,
-                                               bool quiet) {
-  SceneDescription desc = load_scene_description(path, overrides);
+void report_scene_loaded(const SceneDescription& desc, bool quiet) {
   for (const auto& w : desc.warnings) std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
-  if (quiet) return desc;
+  if (quiet) return;
   // What the lights are, in the renderer's units (glTF photometric values were converted).
   for (const auto& n : desc.notes) std::fprintf(stderr, "weft: %s\n", n.c_str());
   for (const auto& l : describe_lights(desc.lights))
     std::fprintf(stderr, "weft: light: %s\n", l.c_str());
-  return desc;
 }
 
 int report_render_outcome(const RenderOutcome& r, const std::string& what) {
@@ -145,48 +141,6 @@ CLI::Validator finite_range(double lo, double hi) {
 CLI::Validator non_empty() {
   return CLI::Validator(
       [](std::string& s) -> std::string { return s.empty() ? "must not be empty" : ""; }, "");
-}
-
-std::vector<double> parse_range(const std::string& text, const std::string& option_name,
-                                size_t max_count) {
-  auto to_number = [&](const std::string& s) {
-    if (const auto v = finite_number(s)) return *v;
-    throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
-  };
-  std::vector<double> out;
-  if (text.find(':') != std::string::npos) {
-    std::vector<std::string> parts;
-    std::stringstream ss(text);
-    std::string p;
-    while (std::getline(ss, p, ':')) parts.push_back(p);
-    if (parts.size() != 3)
-      throw Error("", option_name, "range must be a:b:step, got '" + text + "'");
-    const double a = to_number(parts[0]), b = to_number(parts[1]), step = to_number(parts[2]);
-    if (!(step > 0) || b < a) throw Error("", option_name, "range needs a <= b and step > 0");
-    const double count = std::floor((b - a) / step + 1e-9) + 1;  // finite: a, b and step are
-    if (count > static_cast<double>(max_count))
-      throw Error("", option_name,
-                  "range '" + text + "' has " + ParamReader::fmt(count) + " values, more than " +
-                      std::to_string(max_count));
-    const long n = static_cast<long>(count) - 1;
-    for (long i = 0; i <= n; ++i) out.push_back(a + step * i);
-    return out;
-  }
-  std::stringstream ss(text);
-  std::string p;
-  // getline drops a trailing empty item ("1,2,"): count the commas, refuse every empty item.
-  const size_t items = static_cast<size_t>(std::count(text.begin(), text.end(), ',')) + 1;
-  if (items > max_count)
-    throw Error(
-        "", option_name,
-        "lists " + std::to_string(items) + " values, more than " + std::to_string(max_count));
-  while (std::getline(ss, p, ',')) {
-    if (p.empty()) break;
-    out.push_back(to_number(p));
-  }
-  if (out.size() != items)
-    throw Error("", option_name, "'" + text + "' has an empty item (a stray comma)");
-  return out;
 }
 
 }  // namespace weft::cli

@@ -42,11 +42,9 @@ ProgressCallback progress_bar(const RunLimits& limits, bool quiet);
 void install_interrupt_handler();
 bool interrupted();
 
-// The scene description at 'path' with "-D key=value" overrides applied (description.h), its
-// warnings printed on stderr (commands that render it); unless 'quiet', its notes and lights too.
-SceneDescription load_scene_reporting_warnings(const std::string& path,
-                                               const std::vector<SceneOverride>& overrides,
-                                               bool quiet);
+// A scene description just loaded (commands that render it): its warnings on stderr; unless
+// 'quiet', its notes and lights too.
+void report_scene_loaded(const SceneDescription& desc, bool quiet);
 // The end of a render on stderr, alike for every command that renders: a cancelled run says that
 // 'what' wrote nothing and gives exit code 130; dropped non-finite samples are a warning.
 // Returns the exit code to stop with, or 0 to go on to the outputs.
@@ -71,11 +69,5 @@ CLI::Validator finite_range(double lo, double hi);
 CLI::Validator non_empty();
 // The floor of --max-memory-gb: below it no command can run (the memory budget, RunLimits).
 inline constexpr double kMinMemoryGb = 0.05;
-
-// Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers; at most
-// max_count of them (a range's count is checked before the list is built), no empty items.
-inline constexpr size_t kMaxRangeCount = 100000;
-std::vector<double> parse_range(const std::string& text, const std::string& option_name,
-                                size_t max_count = kMaxRangeCount);
 
 }  // namespace weft::cli

@@ -1,7 +1,9 @@
 #include "weft/core/params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 #include <vector>
 
 #include "weft/core/error.h"
@@ -122,6 +124,48 @@ std::optional<double> finite_number(const std::string& text) {
   }
   if (used == 0 || used != text.size() || !std::isfinite(v)) return std::nullopt;
   return v;
+}
+
+std::vector<double> parse_range(const std::string& text, const std::string& option_name,
+                                size_t max_count) {
+  auto to_number = [&](const std::string& s) {
+    if (const auto v = finite_number(s)) return *v;
+    throw Error("", option_name, "'" + text + "' is not a number or range a:b:step");
+  };
+  std::vector<double> out;
+  if (text.find(':') != std::string::npos) {
+    std::vector<std::string> parts;
+    std::stringstream ss(text);
+    std::string p;
+    while (std::getline(ss, p, ':')) parts.push_back(p);
+    if (parts.size() != 3)
+      throw Error("", option_name, "range must be a:b:step, got '" + text + "'");
+    const double a = to_number(parts[0]), b = to_number(parts[1]), step = to_number(parts[2]);
+    if (!(step > 0) || b < a) throw Error("", option_name, "range needs a <= b and step > 0");
+    const double count = std::floor((b - a) / step + 1e-9) + 1;  // finite: a, b and step are
+    if (count > static_cast<double>(max_count))
+      throw Error("", option_name,
+                  "range '" + text + "' has " + ParamReader::fmt(count) + " values, more than " +
+                      std::to_string(max_count));
+    const long n = static_cast<long>(count) - 1;
+    for (long i = 0; i <= n; ++i) out.push_back(a + step * i);
+    return out;
+  }
+  std::stringstream ss(text);
+  std::string p;
+  // getline drops a trailing empty item ("1,2,"): count the commas, refuse every empty item.
+  const size_t items = static_cast<size_t>(std::count(text.begin(), text.end(), ',')) + 1;
+  if (items > max_count)
+    throw Error(
+        "", option_name,
+        "lists " + std::to_string(items) + " values, more than " + std::to_string(max_count));
+  while (std::getline(ss, p, ',')) {
+    if (p.empty()) break;
+    out.push_back(to_number(p));
+  }
+  if (out.size() != items)
+    throw Error("", option_name, "'" + text + "' has an empty item (a stray comma)");
+  return out;
 }
 
 nlohmann::json parse_json(std::string_view text, const std::string& file) {

@@ -39,6 +39,13 @@ nlohmann::json parse_json(std::string_view text, const std::string& file);
 // that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
 std::optional<double> finite_number(const std::string& text);
 
+// Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers; at most
+// max_count of them (a range's count is checked before the list is built), no empty items.
+// weft::Error naming 'option_name' otherwise.
+inline constexpr size_t kMaxRangeCount = 100000;
+std::vector<double> parse_range(const std::string& text, const std::string& option_name,
+                                size_t max_count = kMaxRangeCount);
+
 class ParamReader {
  public:
   // 'file' names the source in errors; 'path' is the JSON path of this object ("" at the root).
