@@ -43,6 +43,23 @@ VerifyPlan checked_plan(const VerifyArgs& a) {
   return p;
 }
 
+// The fit's options over the request's defaults; each one that differs from its default counts as
+// given, and plan_verify refuses it without fit=True (as the command refuses --fit-* without --fit).
+void set_fit_options(VerifyRequest& r, const std::string& params, int evaluations,
+                     const std::string& inner, int seeds, const std::string& method) {
+  const VerifyRequest d;
+  r.fit_params_given = params != d.fit_params;
+  r.fit_evaluations_given = evaluations != d.fit_evaluations;
+  r.fit_inner_given = inner != d.fit_inner;
+  r.fit_seeds_given = seeds != d.fit_seeds;
+  r.fit_method_given = method != d.fit_method;
+  r.fit_params = params;
+  r.fit_evaluations = evaluations;
+  r.fit_inner = inner;
+  r.fit_seeds = seeds;
+  r.fit_method = method;
+}
+
 py::dict verify(VerifyArgs a) {
   if (a.request.output.empty())
     a.request.output = py::module_::import("tempfile")
@@ -88,7 +105,8 @@ void bind_verify(py::module_& m) {
          const std::optional<std::string>& colour_space, const std::optional<std::string>& weave,
          const std::optional<std::string>& pattern, const std::optional<std::string>& wif,
          uint64_t seed, int threads, const std::optional<std::string>& classic_albedo, bool fit,
-         bool plots, bool yes_long, bool progress) {
+         const std::string& fit_params, int fit_evaluations, const std::string& fit_inner,
+         int fit_seeds, const std::string& fit_method, bool plots, bool yes_long, bool progress) {
         VerifyArgs a;
         VerifyRequest& r = a.request;
         r.quality = quality;
@@ -103,17 +121,23 @@ void bind_verify(py::module_& m) {
         r.threads = threads;
         r.classic_albedo = classic_albedo.value_or("");
         r.fit = fit;
+        set_fit_options(r, fit_params, fit_evaluations, fit_inner, fit_seeds, fit_method);
         a.plots = plots;
         a.yes_long = yes_long;
         a.progress = progress;
         return verify(std::move(a));
       },
-      py::arg("quality") = "draft", py::kw_only(), py::arg("output") = py::none(),
+      py::arg("quality") = VerifyRequest{}.quality, py::kw_only(), py::arg("output") = py::none(),
       py::arg("fiber") = VerifyRequest{}.fiber, py::arg("measured") = py::none(),
       py::arg("colour_space") = py::none(), py::arg("weave") = py::none(),
       py::arg("pattern") = py::none(), py::arg("wif") = py::none(),
       py::arg("seed") = VerifyRequest{}.seed, py::arg("threads") = 0,
-      py::arg("classic_albedo") = py::none(), py::arg("fit") = false, py::arg("plots") = true,
+      py::arg("classic_albedo") = py::none(), py::arg("fit") = false,
+      py::arg("fit_params") = VerifyRequest{}.fit_params,
+      py::arg("fit_evaluations") = VerifyRequest{}.fit_evaluations,
+      py::arg("fit_inner") = VerifyRequest{}.fit_inner,
+      py::arg("fit_seeds") = VerifyRequest{}.fit_seeds,
+      py::arg("fit_method") = VerifyRequest{}.fit_method, py::arg("plots") = true,
       py::arg("yes_long") = false, py::arg("progress") = false,
       "`weft verify` (docs/verify.md): the computed fabric, the paper's summation and the "
       "classic model against a measurement. Writes the report folder 'output' (default: a new "
