@@ -1,5 +1,5 @@
-// weft.bake_fiber: the fiber bake (fiber/fiber_table_bake.h), with the checks `weft bake fiber`
-// makes before the work and the GIL released while the library works.
+// weft.bake_fiber: the fiber bake's request (fiber/fiber_bake_request.h), planned with the checks
+// `weft bake fiber` makes before the work and run with the GIL released.
 #include <pybind11/stl.h>
 #include <pybind11/stl/filesystem.h>
 
@@ -8,6 +8,7 @@
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 #include "weft/fiber/bake_cache.h"
+#include "weft/fiber/fiber_bake_request.h"
 #include "weft/fiber/fiber_table_bake.h"
 #include "weft_python.h"
 
@@ -18,45 +19,6 @@ nlohmann::json dict_json(const py::dict& d, const std::string& what) {
   const std::string text = py::module_::import("json").attr("dumps")(d).cast<std::string>();
   return parse_json(text, what);
 }
-
-namespace {
-
-struct FiberBakeArgs {
-  uint64_t photons = FiberTableBakeOptions{}.photons_per_band;
-  int resolution = FiberTableBakeOptions{}.resolution;
-  uint64_t seed = FiberTableBakeOptions{}.seed, passes = FiberTableBakeOptions{}.passes;
-  int threads = 0;
-  std::string bands = "spectral", route = "direct";
-};
-
-// The options of a bake, each checked against the range `weft bake fiber` allows, over the
-// spec's and route's defaults (fiber_bake_defaults).
-FiberTableBakeOptions fiber_bake_options(const FiberSpec& spec, const FiberBakeArgs& a) {
-  if (a.photons < 1 || a.photons > kMaxPhotonsPerBand)
-    throw Error("", "photons", "must be in [1, 2^40], got " + std::to_string(a.photons));
-  if (a.resolution < 2 || a.resolution > TabulatedBsdfTable::kMaxResolution)
-    throw Error("", "resolution",
-                "must be in [2, " + std::to_string(TabulatedBsdfTable::kMaxResolution) + "], got " +
-                    std::to_string(a.resolution));
-  if (a.passes < 1 || a.passes > (uint64_t{1} << 20))
-    throw Error("", "passes", "must be in [1, 2^20], got " + std::to_string(a.passes));
-  if (a.threads < 0) throw Error("", "threads", "must be 0 (all cores) or more");
-  if (a.bands != "spectral" && a.bands != "rgb")
-    throw Error("", "bands", "must be 'spectral' or 'rgb', got '" + a.bands + "'");
-  if (a.route != "direct" && a.route != "bssrdf")
-    throw Error("", "route", "must be 'direct' or 'bssrdf', got '" + a.route + "'");
-  FiberTableBakeOptions o = fiber_bake_defaults(
-      spec, a.route == "direct" ? FiberBakeRoute::kDirect : FiberBakeRoute::kBssrdf);
-  o.photons_per_band = a.photons;
-  o.resolution = a.resolution;
-  o.seed = a.seed;
-  o.passes = a.passes;
-  o.threads = a.threads;
-  o.spectral = a.bands == "spectral";
-  return o;
-}
-
-}  // namespace
 
 Table bake_fiber_checked(const FiberSpec& spec, const FiberTableBakeOptions& o, bool yes_long,
                          bool print) {
@@ -74,9 +36,25 @@ Table bake_fiber_checked(const FiberSpec& spec, const FiberTableBakeOptions& o, 
 
 namespace {
 
-Table bake_fiber(const py::object& spec, const FiberBakeArgs& a, bool yes_long, bool print) {
-  const FiberSpec s = fiber_spec_argument(spec);
-  return bake_fiber_checked(s, fiber_bake_options(s, a), yes_long, print);
+// A request's bake: planned (every check of `weft bake fiber`) and run without the GIL.
+Table bake_fiber(const py::object& spec, FiberBakeRequest r, bool yes_long, bool print) {
+  if (py::isinstance<py::dict>(spec))
+    r.spec_read = fiber_spec_argument(spec);
+  else
+    r.spec = py::isinstance<py::str>(spec) ? spec.cast<std::string>()
+                                           : spec.cast<std::filesystem::path>().string();
+  r.limits = call_limits(yes_long);
+  const FiberBakePlan plan = plan_fiber_bake(r);
+  CallProgress progress(print);
+  FiberBakeHooks hooks{progress.callback(), [&progress] { return progress.interrupted(); }};
+  FiberBakeOutcome out;
+  {
+    py::gil_scoped_release release;
+    out = run_fiber_bake(plan, hooks);
+  }
+  progress.raise_if_interrupted();
+  out.table->table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION + " (python)";
+  return Table(std::move(out.table->table));
 }
 
 }  // namespace
@@ -89,22 +67,28 @@ FiberSpec fiber_spec_argument(const py::object& spec) {
 }
 
 void bind_bake_fiber(py::module_& m) {
+  const FiberBakeRequest d;
   m.def(
       "bake_fiber",
       [](const py::object& spec, uint64_t photons, int resolution, uint64_t seed, int threads,
-         const std::string& bands, const std::string& route, uint64_t passes, bool yes_long,
-         bool progress) {
-        return bake_fiber(spec, {photons, resolution, seed, passes, threads, bands, route},
-                          yes_long, progress);
+         const std::string& bands, const std::string& route, uint64_t passes,
+         std::optional<std::string> estimator, bool mirror_fold, std::optional<int> surface_samples,
+         std::optional<std::string> entry, bool yes_long, bool progress) {
+        FiberBakeRequest r;
+        r.photons = photons, r.resolution = resolution, r.seed = seed, r.threads = threads;
+        r.bands = bands, r.route = route, r.passes = passes, r.estimator = estimator;
+        r.mirror_fold = mirror_fold, r.surface_samples = surface_samples, r.entry = entry;
+        return bake_fiber(spec, std::move(r), yes_long, progress);
       },
-      py::arg("spec"), py::kw_only(), py::arg("photons") = FiberTableBakeOptions{}.photons_per_band,
-      py::arg("resolution") = FiberTableBakeOptions{}.resolution,
-      py::arg("seed") = FiberTableBakeOptions{}.seed, py::arg("threads") = 0,
-      py::arg("bands") = "spectral", py::arg("route") = "direct",
-      py::arg("passes") = FiberTableBakeOptions{}.passes, py::arg("yes_long") = false,
-      py::arg("progress") = false,
+      py::arg("spec"), py::kw_only(), py::arg("photons") = d.photons,
+      py::arg("resolution") = d.resolution, py::arg("seed") = d.seed,
+      py::arg("threads") = d.threads, py::arg("bands") = d.bands, py::arg("route") = d.route,
+      py::arg("passes") = d.passes, py::arg("estimator") = d.estimator,
+      py::arg("mirror_fold") = d.mirror_fold, py::arg("surface_samples") = d.surface_samples,
+      py::arg("entry") = d.entry, py::arg("yes_long") = false, py::arg("progress") = false,
       "Bakes a fiber spec (a dict, a spec file or a preset name) into a fiber table, as `weft "
-      "bake fiber` does. Work estimated above an hour needs yes_long=True.");
+      "bake fiber` does; estimator, surface_samples and entry None: the spec's and route's "
+      "default. Work estimated above an hour needs yes_long=True.");
 }
 
 }  // namespace weft::python

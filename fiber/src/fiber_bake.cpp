@@ -96,13 +96,11 @@ struct DirectTally {
 }  // namespace
 
 const char* fiber_entry_sampling_name(FiberEntrySampling e) {
-  return e == FiberEntrySampling::kStratified ? "stratified" : "random";
+  return name_of(kFiberEntrySamplings, e);
 }
 
 FiberEntrySampling parse_fiber_entry_sampling(const std::string& name, const std::string& field) {
-  for (const auto e : {FiberEntrySampling::kRandom, FiberEntrySampling::kStratified})
-    if (name == fiber_entry_sampling_name(e)) return e;
-  throw Error("", field, "unknown entry sampling '" + name + "' (random or stratified)");
+  return value_of(kFiberEntrySamplings, name, "", field);
 }
 
 double fiber_table_energy(const FiberBandTable& table) {

@@ -87,13 +87,11 @@ TransportMedium fiber_band_medium(const MediumBand& mb) {
 }
 
 const char* fiber_exit_estimator_name(FiberExitEstimator e) {
-  return e == FiberExitEstimator::kNextEvent ? "nee" : "plain";
+  return name_of(kFiberExitEstimators, e);
 }
 
 FiberExitEstimator parse_fiber_exit_estimator(const std::string& name, const std::string& field) {
-  for (const auto e : {FiberExitEstimator::kPlain, FiberExitEstimator::kNextEvent})
-    if (name == fiber_exit_estimator_name(e)) return e;
-  throw Error("", field, "unknown exit estimator '" + name + "' (plain or nee)");
+  return value_of(kFiberExitEstimators, name, "", field);
 }
 
 TransportOptions fiber_band_transport_options(const FiberBandPhysics& fiber,

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdio>
 #include <mutex>
 
 #include "weft/core/error.h"
@@ -98,6 +99,49 @@ FiberMedium build_fiber_medium(const FiberSpec& spec, std::span<const int> bands
   });
   if (cancelled.load()) throw Error("", "", "cancelled");
   return m;
+}
+
+MediumPlan plan_medium(const MediumRequest& request) {
+  MediumPlan p;
+  p.spec = load_fiber_spec(request.spec);
+  for (double w : request.wavelengths_nm) {
+    const double b = (w - kFirstBandNm) / kBandStepNm;
+    const long bi = std::lround(b);
+    if (std::abs(b - bi) > 1e-9 || bi < 0 || bi >= kNumBands) {
+      char nm[32];
+      std::snprintf(nm, sizeof nm, "%g", w);
+      throw Error(
+          "", "--wavelengths-nm",
+          std::string("wavelength ") + nm + " nm is not a band centre (390, 400, ..., 710)");
+    }
+    p.bands.push_back(static_cast<int>(bi));
+  }
+  if (request.threads < 0) throw Error("", "--threads", "must be >= 0");
+  p.options.threads = request.threads;
+  return p;
+}
+
+nlohmann::json run_medium(const MediumPlan& p, const ProgressCallback& progress) {
+  const FiberMedium m = build_fiber_medium(p.spec, p.bands, p.options, progress);
+  nlohmann::json out = {{"name", m.spec_name},
+                        {"hash", m.spec_hash},
+                        {"fiber_radius_um", m.fiber_radius_um},
+                        {"roughness",
+                         {{"distribution", microfacet_model_name(p.spec.roughness_distribution)},
+                          {"alpha", p.spec.roughness_alpha}}}};
+  nlohmann::json arr = nlohmann::json::array();
+  for (const auto& b : m.bands)
+    arr.push_back({{"wavelength_nm", b.wavelength_nm},
+                   {"host_n", b.host_n},
+                   {"mu_s_per_um", b.mu_s_per_um},
+                   {"mu_a_per_um", b.mu_a_per_um},
+                   {"mu_a_host_per_um", b.mu_a_host_per_um},
+                   {"mu_a_particles_per_um", b.mu_a_particles_per_um},
+                   {"albedo", b.albedo},
+                   {"g", b.g},
+                   {"g_table", b.phase.mean_cosine()}});
+  out["bands"] = arr;
+  return out;
 }
 
 }  // namespace weft

@@ -19,6 +19,7 @@
 #include "weft/core/rng.h"
 #include "weft/core/sphere_mapping.h"
 #include "weft/fiber/bake_cache.h"
+#include "weft/fiber/fiber_bake_request.h"
 #include "weft/fiber/fiber_table_bake.h"
 #include "weft/materials/cook_torrance.h"
 #include "weft/materials/registry.h"
@@ -703,4 +704,42 @@ TEST(FiberTableBake, RoughDielectricBoundaryDirectAndBssrdfRoutesAgree) {
   const FiberBandPhysics ph = fiber_band_physics(spec, mb);
   const auto [direct, bssrdf] = bake_both_routes(ph);
   EXPECT_LE(count_outliers(direct.mean, direct.se, bssrdf.mean, bssrdf.se, 4.5), 1);
+}
+
+// weft bake fiber's plan (fiber_bake_request.h): the front end's spelling of an option names it,
+// the spec is read before the options are checked (so a missing spec wins), and a shard's range
+// and a whole bake's defaults come from the spec and route.
+TEST(FiberTableBake, RequestPlanNamesTheFrontEndsOptionsInOrder) {
+  FiberBakeRequest r;
+  r.spec = "red-cotton";
+  r.resolution = 1;
+  EXPECT_NE(error_of([&] { plan_fiber_bake(r); }).find("field 'resolution': must be in [2, 32]"),
+            std::string::npos);
+  r.option_prefix = "--";
+  r.resolution = 4;
+  r.surface_samples = 0;
+  EXPECT_NE(error_of([&] { plan_fiber_bake(r); }).find("field '--surface-samples'"),
+            std::string::npos);
+  r.spec = "no-such-preset";
+  EXPECT_NE(error_of([&] { plan_fiber_bake(r); }).find("no-such-preset"), std::string::npos);
+  r.spec = "red-cotton";
+  r.surface_samples.reset();
+  r.route = "bssrdf";
+  r.estimator = "nee";
+  // The options' consistency is the bake's own check (before any photon, as the CLI had it).
+  const FiberBakePlan nee = plan_fiber_bake(r);
+  EXPECT_NE(error_of([&] { run_fiber_bake(nee); }).find("field 'estimator'"), std::string::npos);
+  r.estimator.reset();
+  const FiberBakePlan p = plan_fiber_bake(r);
+  EXPECT_EQ(p.options.estimator, FiberExitEstimator::kPlain);  // the route's default
+  EXPECT_EQ(p.options.entry, FiberEntrySampling::kRandom);
+  EXPECT_TRUE(p.shard.whole());
+  EXPECT_EQ(p.bands.last - p.bands.first, static_cast<uint64_t>(kNumBands));
+  r.route = "direct";
+  r.shard = "1/2";
+  r.output = "part.weft-part";
+  const FiberBakePlan s = plan_fiber_bake(r);
+  EXPECT_EQ(s.options.estimator, FiberExitEstimator::kNextEvent);
+  EXPECT_EQ(s.bands.first, shard_units(kNumBands, {1, 2}).first);
+  EXPECT_EQ(s.job.command, "bake fiber");
 }

@@ -26,9 +26,9 @@
 #include <optional>
 #include <vector>
 
-#include "weft/materials/bsdf_table.h"
 #include "weft/fiber/fiber_physics.h"
 #include "weft/fiber/transport_batch.h"
+#include "weft/materials/bsdf_table.h"
 
 namespace weft {
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/names.h"
 #include "weft/core/progress.h"
 #include "weft/fiber/fiber_physics.h"
 
@@ -18,8 +19,12 @@ namespace weft {
 // photons the points of a randomised Sobol' sequence (core/sobol.h), which stratifies them while
 // each photon's entry stays uniform, so the estimate stays unbiased (docs/fiber-bsdf.md).
 enum class FiberEntrySampling : uint8_t { kRandom, kStratified };
+inline constexpr NameTable<FiberEntrySampling, 2> kFiberEntrySamplings = {{
+    {FiberEntrySampling::kRandom, "random", "random entries"},
+    {FiberEntrySampling::kStratified, "stratified", "stratified entries"},
+}};
 const char* fiber_entry_sampling_name(FiberEntrySampling e);  // "random", "stratified"
-// Parses a name of fiber_entry_sampling_name; weft::Error naming 'field' otherwise.
+// Parses a name of kFiberEntrySamplings; weft::Error naming 'field' otherwise.
 FiberEntrySampling parse_fiber_entry_sampling(const std::string& name, const std::string& field);
 
 struct FiberBakeSettings {

@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/names.h"
 #include "weft/core/rng.h"
 #include "weft/core/vec.h"
 #include "weft/fiber/fiber_spec.h"
@@ -90,8 +91,12 @@ class SurfaceAlbedoTable {
 // estimation at every flight's start (TransportOptions::expected_exits; smooth boundary only).
 // Both are unbiased estimates of the same table (docs/fiber-bsdf.md).
 enum class FiberExitEstimator : uint8_t { kPlain, kNextEvent };
+inline constexpr NameTable<FiberExitEstimator, 2> kFiberExitEstimators = {{
+    {FiberExitEstimator::kPlain, "plain", "plain exits"},
+    {FiberExitEstimator::kNextEvent, "nee", "next-event estimation"},
+}};
 const char* fiber_exit_estimator_name(FiberExitEstimator e);  // "plain", "nee"
-// Parses a name of fiber_exit_estimator_name; weft::Error naming 'field' otherwise.
+// Parses a name of kFiberExitEstimators; weft::Error naming 'field' otherwise.
 FiberExitEstimator parse_fiber_exit_estimator(const std::string& name, const std::string& field);
 
 // One band of a spec. Boundary "smooth": the Cook-Torrance surface lobe at the band's host index,

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/names.h"
 #include "weft/core/progress.h"
 #include "weft/fiber/fiber_bake.h"
 #include "weft/fiber/fiber_physics.h"
@@ -18,6 +19,15 @@
 namespace weft {
 
 enum class FiberBakeRoute { kDirect, kBssrdf };
+inline constexpr NameTable<FiberBakeRoute, 2> kFiberBakeRoutes = {{
+    {FiberBakeRoute::kDirect, "direct", "direct (parallel beam)"},
+    {FiberBakeRoute::kBssrdf, "bssrdf", "BSSRDF (the paper's route)"},
+}};
+// The table's bands: spectral (33 bands) or RGB (FiberTableBakeOptions::spectral).
+inline constexpr NameTable<bool, 2> kFiberBakeBands = {{
+    {true, "spectral", "33 bands, 390-710 nm"},
+    {false, "rgb", "linear sRGB, D65"},
+}};
 
 // Upper bound on photons per band that any front end accepts (about a day of work per band).
 inline constexpr uint64_t kMaxPhotonsPerBand = uint64_t{1} << 40;

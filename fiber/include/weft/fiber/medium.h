@@ -11,6 +11,7 @@
 // (the dye) is added as alpha_host over the volume the host occupies. The phase function is the
 // sigma_sca-weighted average of the species' (number-averaged) phase functions, tabulated in
 // mu = cos theta on a grid that resolves the forward peak of the largest particles.
+#include <nlohmann/json.hpp>
 #include <span>
 #include <string>
 #include <vector>
@@ -57,5 +58,22 @@ MediumBand compute_medium_band(const FiberSpec& spec, int band, const MediumOpti
 FiberMedium build_fiber_medium(const FiberSpec& spec, std::span<const int> bands = {},
                                const MediumOptions& options = {},
                                const ProgressCallback& progress = {});
+
+// `weft medium` as a request: a spec file or preset, the band centres asked (empty: all 33 bands)
+// and the threads.
+struct MediumRequest {
+  std::string spec;
+  std::vector<double> wavelengths_nm;
+  int threads = MediumOptions{}.threads;
+};
+struct MediumPlan {
+  FiberSpec spec;
+  std::vector<int> bands;
+  MediumOptions options;
+};
+// weft::Error naming the option at fault ("--wavelengths-nm": not a band centre; "--threads").
+MediumPlan plan_medium(const MediumRequest& request);
+// The medium's bands, as the JSON `weft medium --json` prints.
+nlohmann::json run_medium(const MediumPlan& plan, const ProgressCallback& progress);
 
 }  // namespace weft
