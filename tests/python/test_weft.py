@@ -241,57 +241,6 @@ def test_bake_fabric_weave_table(rgb, tmp_path):
         weft.bake_fabric(rgb, "summation", estimator="nee", resolution=2)
 
 
-# The command's options that Python does not take (files the command writes, its printing), the
-# Python names of the others where they differ, and the defaults its help states in words.
-CLI_ONLY = {"help", "output", "shard", "resume", "json", "quiet"}
-PYTHON_ONLY = {"yes_long", "progress"}
-PYTHON_NAME = {"weave": "sample"}
-DEFAULT_IN_WORDS = {"threads": "0"}
-
-
-def split_top_level(text):
-    parts, depth, start = [], 0, 0
-    for i, ch in enumerate(text):
-        if ch in "[(":
-            depth += 1
-        elif ch in "])":
-            depth -= 1
-        if ch == "," and depth == 0:
-            parts.append(text[start:i].strip())
-            start = i + 1
-    return parts + [text[start:].strip()]
-
-
-@pytest.mark.skipif(not os.environ.get("WEFT_BINARY"), reason="needs WEFT_BINARY (ctest sets it)")
-def test_bake_fabric_takes_the_commands_options_and_defaults():
-    import re
-    import subprocess
-    help_text = subprocess.run([os.environ["WEFT_BINARY"], "bake", "fabric", "--help"],
-                               capture_output=True, text=True, check=True).stdout
-    cli = {}
-    for line in help_text.splitlines():
-        if not line.startswith("  -"):
-            continue
-        column = re.split(r"\s{2,}", line.strip())[0]
-        name = [n for n in column.split()[0].split(",") if n.startswith("--")][0][2:]
-        default = re.search(r"=(\S+)$", column)
-        cli[name.replace("-", "_")] = default.group(1) if default else None
-    signature = weft.bake_fabric.__doc__.splitlines()[0]
-    params = signature[signature.index("(") + 1:signature.rindex(") ->")]
-    python = {}
-    for p in split_top_level(params):
-        if p == "*":
-            continue
-        name, default = p.split(":", 1)[0], p.split(" = ", 1)[1]
-        python[name] = default.strip("'")
-    expected = {PYTHON_NAME.get(n, n): d for n, d in cli.items() if n not in CLI_ONLY}
-    assert set(expected) == set(python) - PYTHON_ONLY
-    for name, default in expected.items():
-        assert python[name] == (default or DEFAULT_IN_WORDS.get(name, python[name])), name
-        if default is None and name not in DEFAULT_IN_WORDS:
-            assert python[name] in ("None", "False"), name
-
-
 def test_verify_checks_its_arguments_first(tmp_path):
     with pytest.raises(weft.Error, match="quality"):
         weft.verify("bogus", output=tmp_path / "out")
