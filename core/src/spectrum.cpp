@@ -7,12 +7,14 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/colorimetry.h"
 #include "weft/core/error.h"
 
 namespace weft {
 namespace detail {
 extern const char* const kCieCmfCsv;
 extern const char* const kCieD65Csv;
+extern const char* const kCieCmf10Csv;
 }  // namespace detail
 
 namespace {
@@ -49,17 +51,26 @@ double band_average(const std::map<int, std::vector<double>>& rows, int band, si
   return sum / weight;
 }
 
+std::array<Xyz, kNumBands> cmf_band_table(const char* csv, const char* name) {
+  const auto rows = parse_csv(csv, 3, name);
+  std::array<Xyz, kNumBands> t{};
+  for (int b = 0; b < kNumBands; ++b)
+    t[b] = {band_average(rows, b, 0), band_average(rows, b, 1), band_average(rows, b, 2)};
+  return t;
+}
+
 }  // namespace
 
 const std::array<Xyz, kNumBands>& cie_cmf_bands() {
-  static const std::array<Xyz, kNumBands> table = [] {
-    const auto rows = parse_csv(detail::kCieCmfCsv, 3, "CIE_xyz_1931_2deg_360-830.csv");
-    std::array<Xyz, kNumBands> t{};
-    for (int b = 0; b < kNumBands; ++b)
-      t[b] = {band_average(rows, b, 0), band_average(rows, b, 1), band_average(rows, b, 2)};
-    return t;
-  }();
-  return table;
+  return cie_cmf_bands(Observer::kCie1931TwoDegree);
+}
+
+const std::array<Xyz, kNumBands>& cie_cmf_bands(Observer observer) {
+  static const std::array<Xyz, kNumBands> two =
+      cmf_band_table(detail::kCieCmfCsv, "CIE_xyz_1931_2deg_360-830.csv");
+  static const std::array<Xyz, kNumBands> ten =
+      cmf_band_table(detail::kCieCmf10Csv, "CIE_xyz_1964_10deg_360-830.csv");
+  return observer == Observer::kCie1964TenDegree ? ten : two;
 }
 
 const Spectrum& d65_bands() {
@@ -73,7 +84,11 @@ const Spectrum& d65_bands() {
 }
 
 Xyz reflectance_to_xyz_d65(const Spectrum& reflectance) {
-  const auto& cmf = cie_cmf_bands();
+  return reflectance_to_xyz_d65(reflectance, Observer::kCie1931TwoDegree);
+}
+
+Xyz reflectance_to_xyz_d65(const Spectrum& reflectance, Observer observer) {
+  const auto& cmf = cie_cmf_bands(observer);
   const auto& d65 = d65_bands();
   double x = 0, y = 0, z = 0, norm = 0;
   for (int b = 0; b < kNumBands; ++b) {

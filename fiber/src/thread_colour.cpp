@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <vector>
 
+#include "weft/core/colorimetry.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/optimize.h"
@@ -45,10 +46,6 @@ const std::vector<std::vector<double>>& blocks_to_rgb_inverse() {
   return inverse;
 }
 
-double srgb_to_linear(double v) {
-  return v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4);
-}
-
 }  // namespace
 
 ThreadDye thread_dye(const std::array<double, 3>& srgb, double fiber_radius_um,
@@ -64,7 +61,8 @@ ThreadDye thread_dye(const std::array<double, 3>& srgb, double fiber_radius_um,
   ThreadDye dye;
   std::array<double, 3> dark{};
   for (int k = 0; k < 3; ++k) {
-    for (int i = 0; i < 3; ++i) dark[k] += inv[k][i] * white[i] * (1 - srgb_to_linear(srgb[i]));
+    for (int i = 0; i < 3; ++i)
+      dark[k] += inv[k][i] * white[i] * (1 - srgb_gamma_to_linear(srgb[i]));
     dark[k] = std::clamp(dark[k], 0.0, 1.0);  // in [0, 1] but for rounding (the header)
   }
   const double chord_um = 0.5 * kPi * fiber_radius_um;
