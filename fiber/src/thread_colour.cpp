@@ -77,6 +77,12 @@ ThreadDye thread_dye(const std::array<double, 3>& srgb, double fiber_radius_um,
   return dye;
 }
 
+Spectrum thread_colour_block(int k) {
+  Spectrum s{};
+  for (int b = 0; b < kNumBands; ++b) s[b] = block(k, b);
+  return s;
+}
+
 FiberSpec thread_colour_spec(const FiberSpec& base, const std::array<double, 3>& srgb,
                              const std::string& field) {
   const ThreadDye dye = thread_dye(srgb, base.fiber_radius_um, field);

@@ -44,6 +44,9 @@ ThreadDye thread_dye(const std::array<double, 3>& srgb, double fiber_radius_um,
 FiberSpec thread_colour_spec(const FiberSpec& base, const std::array<double, 3>& srgb,
                              const std::string& field);
 
+// Block k of step 2 (0 red, 1 green, 2 blue) per band: the three sum to 1 at every band.
+Spectrum thread_colour_block(int k);
+
 // "#rrggbb" of a colour in [0, 1] (8 bits per component, rounded).
 std::string srgb_hex(const std::array<double, 3>& srgb);
 

@@ -1,0 +1,271 @@
+#include "weft/fiber/colour_match.h"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+
+#include "weft/core/error.h"
+#include "weft/core/optimize.h"
+#include "weft/fiber/dye.h"
+#include "weft/fiber/thread_colour.h"
+
+namespace weft {
+
+namespace {
+
+// Kubelka-Munk's reflectance of an opaque layer of K/S = x, in the form that keeps its digits
+// for large x: 1 + x - sqrt(x^2 + 2x) = 1 / (1 + x + sqrt(x^2 + 2x)).
+double kubelka_munk(double x) {
+  return 1.0 / (1.0 + x + std::sqrt(x * x + 2 * x));
+}
+
+// One band's model R = amplitude * KM(rate * mu).
+struct BandModel {
+  double amplitude = 0, rate = 0;
+  double at(double mu) const { return amplitude * kubelka_munk(rate * mu); }
+};
+
+// The model through (mu1, r1) and (mu2, r2), mu1 < mu2: KM(q mu1) / KM(q mu2) = r1 / r2 solved for
+// q by bisection in log q (the ratio rises from 1 at q = 0 to mu2 / mu1 as q grows). Readings
+// that do not fall with mu (noise where the dyes hardly absorb) give a flat model at their mean.
+BandModel fit_band(double mu1, double r1, double mu2, double r2) {
+  if (!(r1 > 0 && r2 > 0) || r1 <= r2) return {0.5 * (r1 + r2), 0};
+  const double want = std::log(r1 / r2);
+  double lo = std::log(1e-9 / mu2), hi = std::log(1e9 / std::max(mu2, 1e-12));
+  for (int k = 0; k < 100; ++k) {
+    const double mid = 0.5 * (lo + hi), q = std::exp(mid);
+    (std::log(kubelka_munk(q * mu1) / kubelka_munk(q * mu2)) < want ? lo : hi) = mid;
+  }
+  const double q = std::exp(0.5 * (lo + hi));
+  return {r1 / kubelka_munk(q * mu1), q};
+}
+
+// The absorption per band of each reading's fibre.
+using Absorptions = std::vector<Spectrum>;
+
+// Per band, the model through the reading 'anchor' and the reading nearest to it in log mu with
+// another mu; flat at the anchor's reflectance where none differs.
+std::vector<BandModel> band_models(const std::vector<ColourReading>& readings,
+                                   const Absorptions& mu, size_t anchor) {
+  constexpr double kTinyMu = 1e-6;  // per um: log distances stay finite at no absorption
+  std::vector<BandModel> models(kNumBands);
+  for (int b = 0; b < kNumBands; ++b) {
+    const double m0 = mu[anchor][b];
+    size_t other = anchor;
+    double nearest = 0;
+    for (size_t k = 0; k < readings.size(); ++k) {
+      const double d = std::abs(std::log((mu[k][b] + kTinyMu) / (m0 + kTinyMu)));
+      if (d > 1e-9 && (other == anchor || d < nearest)) other = k, nearest = d;
+    }
+    const double r0 = readings[anchor].reflectance[b];
+    if (other == anchor) {
+      models[b] = {r0, 0};
+      continue;
+    }
+    const double m1 = mu[other][b], r1 = readings[other].reflectance[b];
+    models[b] = m0 < m1 ? fit_band(m0, r0, m1, r1) : fit_band(m1, r1, m0, r0);
+  }
+  return models;
+}
+
+// The scales' map from the unit cube, logarithmic from 1e-4 of the largest scale to it.
+struct ScaleMap {
+  std::vector<double> max_scale;
+  static constexpr double kRange = 1e4;
+  std::vector<double> scale(const std::vector<double>& u) const {
+    std::vector<double> s(u.size());
+    for (size_t d = 0; d < u.size(); ++d) s[d] = max_scale[d] * std::pow(kRange, u[d] - 1);
+    return s;
+  }
+  std::vector<double> unit(const std::vector<double>& s) const {
+    std::vector<double> u(s.size());
+    for (size_t d = 0; d < s.size(); ++d)
+      u[d] = std::clamp(1 + std::log(std::max(s[d], 1e-300) / max_scale[d]) / std::log(kRange), 0.0,
+                        1.0);
+    return u;
+  }
+};
+
+// The residuals of a reflectance against the target: its CIELAB difference, and for a spectrum
+// target the band differences in percent too (a mixture should match the curve, not a metamer).
+std::vector<double> target_residuals(const ColourTarget& t, const Spectrum& r) {
+  const Lab lab = t.lab_of(r);
+  std::vector<double> out{lab.l - t.lab.l, lab.a - t.lab.a, lab.b - t.lab.b};
+  if (t.reflectance)
+    for (int b = 0; b < kNumBands; ++b) out.push_back(100 * (r[b] - (*t.reflectance)[b]));
+  return out;
+}
+
+struct ModelStep {
+  std::vector<double> scale;
+  double delta_e00 = 0;  // the model's own at its optimum
+};
+
+// The scales at which the band models' colour is nearest the target, from the best reading's.
+ModelStep model_step(const ColourMatch& m, const Spectrum& host_mu,
+                     const std::vector<BandModel>& models, const ScaleMap& map) {
+  const auto reflectance = [&](const std::vector<double>& s) {
+    Spectrum r{};
+    for (int b = 0; b < kNumBands; ++b) {
+      double mu = host_mu[b];
+      for (size_t d = 0; d < s.size(); ++d) mu += s[d] * m.basis.absorption_per_um[d][b];
+      r[b] = models[b].at(mu);
+    }
+    return r;
+  };
+  const ResidualFunction residuals = [&](const std::vector<double>& u) {
+    return target_residuals(m.target, reflectance(map.scale(u)));
+  };
+  OptimizeOptions o;
+  o.max_evaluations = 800;  // the model costs microseconds an evaluation
+  o.tolerance = 1e-6;
+  o.initial_step = 0.1;
+  // Nelder-Mead: the model's colour is not smooth where a scale meets its bound.
+  const OptimizeResult fit = nelder_mead(residuals, map.unit(m.best_reading().scale), o);
+  ModelStep step;
+  step.scale = map.scale(fit.u);
+  step.delta_e00 = delta_e00(m.target.lab, m.target.lab_of(reflectance(step.scale)));
+  return step;
+}
+
+bool same_scales(const std::vector<double>& a, const std::vector<double>& b) {
+  for (size_t d = 0; d < a.size(); ++d)
+    if (std::abs(a[d] - b[d]) > 1e-3 * std::max(std::abs(a[d]), std::abs(b[d]))) return false;
+  return true;
+}
+
+}  // namespace
+
+void ColourMatchOptions::validate() const {
+  if (!(tolerance_delta_e00 > 0 && tolerance_delta_e00 <= 50))
+    throw Error("", "tolerance_delta_e00", "must be in (0, 50]");
+  if (max_readings < 3 || max_readings > 64)
+    throw Error("", "max_readings", "must be in [3, 64]: two readings set the model up");
+}
+
+DyeBasis dye_basis(const FiberSpec& spec) {
+  DyeBasis basis;
+  if (spec.dyes.empty()) {
+    basis.recipe = false;
+    const double chord_um = kPi * spec.fiber_radius_um / 2;  // Cauchy's mean chord
+    for (int k = 0; k < 3; ++k) {
+      Spectrum a = thread_colour_block(k);
+      for (double& v : a) v *= std::log(2.0) / chord_um;
+      basis.names.push_back(k == 0 ? "red-absorber" : k == 1 ? "green-absorber" : "blue-absorber");
+      basis.absorption_per_um.push_back(a);
+      basis.initial_scale.push_back(1);
+      basis.max_scale.push_back(std::log(1 / kThreadMinReflectance) / std::log(2.0));
+    }
+    return basis;
+  }
+  for (const DyeComponent& c : spec.dyes) {
+    DyeComponent unit = c;
+    unit.concentration_owf_percent = 1;
+    basis.names.push_back(c.dye);
+    basis.absorption_per_um.push_back(
+        dye_absorption_per_um(bundled_dye(c.dye, spec.name, "host.dyes").epsilon_per_M_per_cm,
+                              dye_mol_per_L(unit, spec.density_g_cm3)));
+    basis.initial_scale.push_back(c.concentration_owf_percent);
+    basis.max_scale.push_back(kMaxDyeOwfPercent);
+  }
+  return basis;
+}
+
+FiberSpec with_dye_scale(const FiberSpec& base, const DyeBasis& basis,
+                         const std::vector<double>& scale) {
+  FiberSpec s = base;
+  if (basis.recipe) {
+    for (size_t d = 0; d < s.dyes.size(); ++d) s.dyes[d].concentration_owf_percent = scale[d];
+  } else {
+    for (size_t d = 0; d < scale.size(); ++d)
+      for (int b = 0; b < kNumBands; ++b)
+        s.host_absorption_per_um[b] += scale[d] * basis.absorption_per_um[d][b];
+  }
+  s.name = base.name + " dyed";
+  return s;
+}
+
+ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
+                         const ColourReadingFunction& read, const ColourMatchOptions& options) {
+  options.validate();
+  ColourMatch m;
+  m.target = target;
+  m.basis = dye_basis(base);
+  const size_t n = m.basis.names.size();
+  const ScaleMap map{m.basis.max_scale};
+  Absorptions mu;
+  // Takes a reading at 'scale'; false when interrupted.
+  const auto take = [&](const std::vector<double>& scale) {
+    const std::clock_t cpu0 = std::clock();
+    const FiberSpec spec = with_dye_scale(base, m.basis, scale);
+    const std::optional<Spectrum> r = read(spec);
+    if (!r) return false;
+    ColourReading reading{scale, *r, target.lab_of(*r), 0,
+                          static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC};
+    reading.delta_e00 = delta_e00(target.lab, reading.lab);
+    m.readings.push_back(reading);
+    mu.push_back(host_total_absorption_per_um(spec));
+    if (reading.delta_e00 < m.best_reading().delta_e00) m.best = m.readings.size() - 1;
+    return true;
+  };
+  const Spectrum host_mu =
+      host_total_absorption_per_um(with_dye_scale(base, m.basis, std::vector<double>(n, 0.0)));
+  double model_delta_e00 = 0;
+  bool stalled = false, interrupted = !take(m.basis.initial_scale);
+  if (!interrupted) interrupted = !take(std::vector<double>(n, 0.0));
+  while (!interrupted && !stalled && m.best_reading().delta_e00 > options.tolerance_delta_e00 &&
+         static_cast<int>(m.readings.size()) < options.max_readings) {
+    const ModelStep step =
+        model_step(m, host_mu, band_models(m.readings, mu, m.readings.size() - 1), map);
+    model_delta_e00 = step.delta_e00;
+    stalled = std::any_of(m.readings.begin(), m.readings.end(),
+                          [&](const ColourReading& r) { return same_scales(r.scale, step.scale); });
+    if (!stalled) interrupted = !take(step.scale);
+  }
+  m.cancelled = interrupted;
+  if (m.readings.empty()) return m;
+  m.reached = m.best_reading().delta_e00 <= options.tolerance_delta_e00;
+  m.outside_reach = !m.reached && !m.cancelled && model_delta_e00 > options.tolerance_delta_e00;
+  m.spec = with_dye_scale(base, m.basis, m.best_reading().scale);
+  return m;
+}
+
+nlohmann::json colour_match_summary(const ColourMatch& m) {
+  const auto lab = [](const Lab& c) { return nlohmann::json::array({c.l, c.a, c.b}); };
+  nlohmann::json j;
+  j["target"] = {
+      {"spec", m.target.spec},
+      {"lab", lab(m.target.lab)},
+      {"observer", m.target.observer == Observer::kCie1964TenDegree ? "CIE 1964 10 degrees"
+                                                                    : "CIE 1931 2 degrees"}};
+  j["basis"] = m.basis.recipe ? "the recipe's dyes (% owf)" : "thread-colour absorbers";
+  j["reached"] = m.reached;
+  j["outside_reach"] = m.outside_reach;
+  j["cancelled"] = m.cancelled;
+  if (m.readings.empty()) return j;
+  const ColourReading& best = m.best_reading();
+  j["achieved"] = {{"lab", lab(best.lab)}};
+  j["delta_e00"] = best.delta_e00;
+  j["dye_scale"] = nlohmann::json::array();
+  for (size_t d = 0; d < m.basis.names.size(); ++d) {
+    const double initial = m.basis.initial_scale[d];
+    j["dye_scale"].push_back({{"dye", m.basis.names[d]},
+                              {"scale", best.scale[d]},
+                              {"of_recipe", initial > 0 ? nlohmann::json(best.scale[d] / initial)
+                                                        : nlohmann::json(nullptr)}});
+  }
+  double cpu = 0;
+  j["readings"] = nlohmann::json::array();
+  for (const ColourReading& r : m.readings) {
+    cpu += r.cpu_seconds;
+    j["readings"].push_back({{"scale", r.scale},
+                             {"lab", lab(r.lab)},
+                             {"delta_e00", r.delta_e00},
+                             {"cpu_seconds", r.cpu_seconds}});
+  }
+  j["iterations"] = m.readings.size();
+  j["cpu_seconds"] = cpu;
+  return j;
+}
+
+}  // namespace weft

@@ -1,0 +1,125 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "weft/fiber/colour_match.h"
+#include "weft/fiber/dye.h"
+
+using namespace weft;
+
+namespace {
+
+// A cloth whose reflectance is not of the solver's Kubelka-Munk form: a surface reflection of 4 %
+// that no dye removes, over a diffuse part falling as exp(-2 sqrt(mu d)) (a thin layer's shape),
+// d = 16 um. The solver must converge on it through readings alone.
+Spectrum analytic_cloth(const FiberSpec& spec) {
+  const Spectrum mu = host_total_absorption_per_um(spec);
+  Spectrum r{};
+  for (int b = 0; b < kNumBands; ++b) r[b] = 0.04 + 0.6 * std::exp(-2 * std::sqrt(mu[b] * 16));
+  return r;
+}
+
+ColourReadingFunction counted(int& calls) {
+  return [&calls](const FiberSpec& spec) -> std::optional<Spectrum> {
+    ++calls;
+    return analytic_cloth(spec);
+  };
+}
+
+// The target: the analytic cloth of 'base' at these dye scales, as a CIELAB target.
+ColourTarget lab_target_of(const FiberSpec& base, const std::vector<double>& scale) {
+  const Lab lab = reflectance_to_lab(analytic_cloth(with_dye_scale(base, dye_basis(base), scale)),
+                                     Observer::kCie1931TwoDegree);
+  char spec[96];
+  std::snprintf(spec, sizeof spec, "lab:%.4f,%.4f,%.4f", lab.l, lab.a, lab.b);
+  return parse_colour_target(spec, "--colour");
+}
+
+}  // namespace
+
+TEST(ColourMatch, FindsTheRecipesDepthsOfAReachableColour) {
+  const FiberSpec red = load_fiber_spec("red-cotton");  // congo red 2 %, curcumin 0.2 % owf
+  for (const std::vector<double>& truth :
+       {std::vector<double>{0.3, 0.05}, std::vector<double>{6.0, 1.0}, {0.05, 0.4}}) {
+    int calls = 0;
+    const ColourMatch m = match_colour(red, lab_target_of(red, truth), counted(calls), {});
+    ASSERT_TRUE(m.reached) << truth[0] << ", " << truth[1] << ": " << m.best_reading().delta_e00;
+    EXPECT_LE(m.best_reading().delta_e00, 1.0);
+    EXPECT_FALSE(m.outside_reach);
+    EXPECT_LE(calls, 8);
+    EXPECT_EQ(calls, static_cast<int>(m.readings.size()));
+    // Two dyes and three colour coordinates: the depths are determined, to the tolerance's share.
+    EXPECT_NEAR(m.best_reading().scale[0] / truth[0], 1, 0.15);
+    EXPECT_EQ(m.spec.dyes[0].concentration_owf_percent, m.best_reading().scale[0]);
+  }
+}
+
+TEST(ColourMatch, SaysWhenTheDyesCannotReachTheTarget) {
+  // A blue from a red recipe: the nearest reachable colour is a reading, its distance stated.
+  const FiberSpec red = load_fiber_spec("red-cotton");
+  int calls = 0;
+  const ColourMatch m =
+      match_colour(red, parse_colour_target("lab:40,0,-45", "--colour"), counted(calls), {});
+  EXPECT_FALSE(m.reached);
+  EXPECT_TRUE(m.outside_reach);
+  EXPECT_FALSE(m.cancelled);
+  EXPECT_GT(m.best_reading().delta_e00, 10);
+  for (const ColourReading& r : m.readings) EXPECT_GE(r.delta_e00, m.best_reading().delta_e00);
+  const nlohmann::json j = colour_match_summary(m);
+  EXPECT_EQ(j["outside_reach"], true);
+  EXPECT_EQ(j["iterations"], m.readings.size());
+}
+
+TEST(ColourMatch, DyesAnUndyedFiberWithTheThreadColourAbsorbers) {
+  const FiberSpec white = load_fiber_spec("white-cotton");
+  ASSERT_TRUE(white.dyes.empty());
+  const DyeBasis basis = dye_basis(white);
+  EXPECT_FALSE(basis.recipe);
+  ASSERT_EQ(basis.names.size(), 3u);
+  int calls = 0;
+  const ColourMatch m =
+      match_colour(white, lab_target_of(white, {2.0, 0.5, 0.3}), counted(calls), {});
+  EXPECT_TRUE(m.reached) << m.best_reading().delta_e00;
+  EXPECT_LE(calls, 8);
+}
+
+TEST(ColourMatch, MatchesASpectrumWithTheRecipesMixture) {
+  // A spectrophotometer's reading of the analytic cloth at known depths, as a spectrum target:
+  // the mixture is recovered, not a metamer.
+  const FiberSpec red = load_fiber_spec("red-cotton");
+  const std::vector<double> truth{1.2, 0.6};
+  ColourTarget t;
+  t.spec = "spectrum:test";
+  t.kind = ColourTarget::Kind::kSpectrum;
+  t.observer = Observer::kCie1964TenDegree;
+  t.reflectance = analytic_cloth(with_dye_scale(red, dye_basis(red), truth));
+  t.lab = reflectance_to_lab(*t.reflectance, t.observer);
+  int calls = 0;
+  const ColourMatch m = match_colour(red, t, counted(calls), {});
+  ASSERT_TRUE(m.reached) << colour_match_summary(m).dump();
+  EXPECT_NEAR(m.best_reading().scale[0] / truth[0], 1, 0.05);
+  EXPECT_NEAR(m.best_reading().scale[1] / truth[1], 1, 0.05);
+}
+
+TEST(ColourMatch, AnInterruptedReadingEndsTheMatch) {
+  const FiberSpec red = load_fiber_spec("red-cotton");
+  int calls = 0;
+  const ColourMatch m = match_colour(red, parse_colour_target("lab:50,40,20", "--colour"),
+                                     [&](const FiberSpec& s) -> std::optional<Spectrum> {
+                                       if (++calls == 3) return std::nullopt;
+                                       return analytic_cloth(s);
+                                     },
+                                     {});
+  EXPECT_TRUE(m.cancelled);
+  EXPECT_FALSE(m.reached);
+  EXPECT_EQ(m.readings.size(), 2u);
+}
+
+TEST(ColourMatch, RefusesBadOptions) {
+  ColourMatchOptions o;
+  o.max_readings = 2;
+  EXPECT_THROW(o.validate(), Error);
+  o = {};
+  o.tolerance_delta_e00 = std::nan("");
+  EXPECT_THROW(o.validate(), Error);
+}
