@@ -34,14 +34,15 @@ void request_fiber(const py::object& fiber, FabricBakeRequest& r) {
     r.fiber_table = fiber.cast<Table>().shared();
   else if (is_path(fiber))
     r.fiber = fiber.cast<std::filesystem::path>().string();
-  else if (r.thread_colours)
-    throw Error("", "--thread-colours",
+  else if (r.thread_colours || !r.colour.empty())
+    throw Error("", r.thread_colours ? "--thread-colours" : "--colour",
                 "dyes a fiber spec or preset given by its name or file, not a dict");
 }
 
 std::shared_ptr<const TabulatedBsdfTable> baked_fiber(const py::object& fiber,
                                                       const FabricBakeRequest& r, bool print) {
-  if (r.fiber_table || r.thread_colours) return r.fiber_table;
+  // Thread colours and a colour match bake their own dyed fibers into the cache.
+  if (r.fiber_table || r.thread_colours || !r.colour.empty()) return r.fiber_table;
   if (is_path(fiber) && std::filesystem::path(r.fiber).extension() == ".exr") return nullptr;
   const FiberSpec spec = fiber_spec_argument(fiber);
   FiberTableBakeOptions o = fiber_bake_defaults(spec);
@@ -85,7 +86,8 @@ void bind_bake_fabric(py::module_& m) {
   m.def(
       "bake_fabric",
       [](const py::object& fiber, const std::string& method, std::optional<std::string> warp_fiber,
-         std::optional<std::string> weft_fiber, bool thread_colours, const py::object& sample,
+         std::optional<std::string> weft_fiber, bool thread_colours,
+         std::optional<std::string> colour, const py::object& sample,
          std::optional<std::string> pattern, std::optional<std::string> wif,
          const std::string& detail, int resolution, std::optional<uint64_t> samples,
          std::optional<std::string> estimator, std::optional<int> next_event_rays,
@@ -98,6 +100,7 @@ void bind_bake_fabric(py::module_& m) {
         r.method = method;
         r.warp_fiber = warp_fiber.value_or(""), r.weft_fiber = weft_fiber.value_or("");
         r.thread_colours = thread_colours;
+        r.colour = colour.value_or("");
         r.pattern = pattern.value_or(""), r.wif = wif.value_or("");
         r.detail = detail;
         r.resolution = resolution;
@@ -124,19 +127,23 @@ void bind_bake_fabric(py::module_& m) {
       },
       py::arg("fiber") = d.fiber, py::arg("method") = d.method, py::kw_only(),
       py::arg("warp_fiber") = py::none(), py::arg("weft_fiber") = py::none(),
-      py::arg("thread_colours") = d.thread_colours, py::arg("sample") = py::none(),
-      py::arg("pattern") = py::none(), py::arg("wif") = py::none(), py::arg("detail") = d.detail,
-      py::arg("resolution") = d.resolution, py::arg("samples") = py::none(),
-      py::arg("estimator") = py::none(), py::arg("next_event_rays") = py::none(),
-      py::arg("launch_lattice") = py::none(), py::arg("straight_through") = py::none(),
-      py::arg("split_threshold") = py::none(), py::arg("max_scatterings") = py::none(),
-      py::arg("weave_out") = py::none(), py::arg("weave_positions") = py::none(),
-      py::arg("weave_resolution") = py::none(), py::arg("seed") = d.seed,
-      py::arg("threads") = d.threads, py::arg("yes_long") = false, py::arg("progress") = false,
+      py::arg("thread_colours") = d.thread_colours, py::arg("colour") = py::none(),
+      py::arg("sample") = py::none(), py::arg("pattern") = py::none(), py::arg("wif") = py::none(),
+      py::arg("detail") = d.detail, py::arg("resolution") = d.resolution,
+      py::arg("samples") = py::none(), py::arg("estimator") = py::none(),
+      py::arg("next_event_rays") = py::none(), py::arg("launch_lattice") = py::none(),
+      py::arg("straight_through") = py::none(), py::arg("split_threshold") = py::none(),
+      py::arg("max_scatterings") = py::none(), py::arg("weave_out") = py::none(),
+      py::arg("weave_positions") = py::none(), py::arg("weave_resolution") = py::none(),
+      py::arg("seed") = d.seed, py::arg("threads") = d.threads, py::arg("yes_long") = false,
+      py::arg("progress") = false,
       "A fabric table, as `weft bake fabric` makes it (its options are the keyword arguments, with "
       "its defaults): from a fiber (a Table, a .exr file, or a spec baked in RGB at the bake's "
       "defaults; warp_fiber, weft_fiber and thread_colours' dyes are baked into ./.weft-cache as "
-      "the command bakes them) and a woven sample (None: the bundled poplin; a weave options file "
+      "the command bakes them; colour: the cloth's colour, 'srgb:#RRGGBB', 'lab:L,a,b', "
+      "'lab10:L,a,b' or "
+      "'spectrum:FILE.csv', the fiber's dyes scaled to meet it) and a woven sample (None: the "
+      "bundled poplin; a weave options file "
       "or dict), by 'summation' (the paper's), 'summation-visible' or 'raytrace'. weave_out: the "
       "ray trace's weave table is written there.");
 }

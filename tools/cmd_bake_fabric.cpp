@@ -149,6 +149,10 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
                   "raytrace: the warp yarns' fiber (table, spec or preset; default --fiber)");
   sub->add_option("--weft-fiber", o.weft_fiber,
                   "raytrace: the weft yarns' fiber (table, spec or preset; default --fiber)");
+  sub->add_option("--colour", o.colour,
+                  "the cloth's colour as a d/8 instrument reads it: srgb:#RRGGBB, lab:L,a,b, "
+                  "lab10:L,a,b or spectrum:FILE.csv; --fiber's dyes are scaled to meet it "
+                  "(docs/colour.md)");
   sub->add_flag("--thread-colours", o.thread_colours,
                 "raytrace: one fiber per thread colour of the WIF draft, --fiber dyed to the "
                 "colour (docs/fabric-bsdf.md; at most " +

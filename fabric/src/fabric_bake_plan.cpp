@@ -8,6 +8,7 @@
 #include "weft/core/output_guard.h"
 #include "weft/core/params.h"
 #include "weft/fabric/fabric_bake.h"
+#include "weft/fabric/fabric_colour.h"
 #include "weft/materials/bsdf_table.h"
 
 namespace weft {
@@ -231,6 +232,7 @@ FabricBakePlan plan_fabric_bake(const FabricBakeRequest& o) {
               .draft = o.wif.empty() ? weave_wif : o.wif,
               .limits = o.limits};
   check_fabric_fiber_options(p.fibers, p.method == FabricMethod::kRaytrace);
+  if (!o.colour.empty()) p.colour = check_fabric_colour(o, p.method);
   validate_output_paths(
       o.limits,
       {{o.output, "--output"},

@@ -9,6 +9,7 @@
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 #include "weft/fabric/fabric_bake.h"
+#include "weft/fabric/fabric_colour.h"
 #include "weft/fabric/fabric_parts.h"
 #include "weft/fabric/fabric_summation.h"
 #include "weft/fabric/weave_tally.h"
@@ -102,9 +103,11 @@ bool trace_fabric(const FabricBakePlan& p, const WovenSample& sample, const Fabr
   return true;
 }
 
-// The summations' table.
-TabulatedBsdfTable sum_fabric(const FabricBakePlan& p, const WovenSample& sample,
-                              const TabulatedBsdfTable& fiber, const ProgressCallback& progress) {
+}  // namespace
+
+TabulatedBsdfTable summed_fabric_table(const FabricBakePlan& p, const WovenSample& sample,
+                                       const TabulatedBsdfTable& fiber,
+                                       const ProgressCallback& progress) {
   const FabricBakeRequest& o = p.request;
   FabricSummationOptions s;
   s.method =
@@ -120,13 +123,24 @@ TabulatedBsdfTable sum_fabric(const FabricBakePlan& p, const WovenSample& sample
   return sum_fabric_table(fiber, s, progress);
 }
 
-}  // namespace
-
 FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks& hooks) {
   const FabricBakeRequest& o = p.request;
   FabricBakeResult out;
   const WovenSample sample = make_woven_sample(p.weave);
-  const FabricFibers fibers = load_fabric_fibers(p.fibers, sample, hooks.progress);
+  std::optional<FabricColourMatch> colour;
+  FabricFiberOptions fiber_options = p.fibers;
+  if (p.colour) {
+    colour = match_fabric_colour(p, sample, hooks.progress);
+    if (colour->match.cancelled) {
+      out.cancelled = true;
+      return out;
+    }
+    // Spectral: a dyed fibre's saturated colour has no RGB table (its linear sRGB leaves the
+    // gamut, a channel's albedo above 1).
+    fiber_options.fiber_table = std::make_shared<const TabulatedBsdfTable>(
+        colour_fiber_table(p, colour->match.spec, hooks.progress));
+  }
+  const FabricFibers fibers = load_fabric_fibers(fiber_options, sample, hooks.progress);
   const double weave_bytes =
       check_weave_memory(o.limits, p.raytrace, fibers.first().channels, p.scene_bytes);
   const auto t0 = std::chrono::steady_clock::now();
@@ -137,7 +151,7 @@ FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks&
     if (!trace_fabric(p, sample, fibers, weave_bytes, hooks, out, extra, noise_per_channel))
       return out;
   } else {
-    out.table = sum_fabric(p, sample, fibers.first(), hooks.progress);
+    out.table = summed_fabric_table(p, sample, fibers.first(), hooks.progress);
   }
   const double seconds = seconds_since(t0);
   TabulatedBsdfTable& table = out.table;
@@ -145,6 +159,7 @@ FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks&
   table.metadata["program_version"] =
       std::string("weft ") + WEFT_VERSION + (o.front_end.empty() ? "" : " (" + o.front_end + ")");
   if (!p.note.empty()) table.metadata["note"] = p.note;
+  if (colour) describe_colour_match(*colour, table, out);
   if (!o.output.empty()) table.write_exr(o.output);
   if (out.weave) {  // written after the fabric table, its metadata the table's as written
     describe_weave(table, *out.weave);
@@ -163,6 +178,7 @@ FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks&
     j["noise_cost"] =
         noise_cost_summary(noise_per_channel, p.raytrace.particles_per_bin, cpu_seconds);
   if (!p.note.empty()) j["notes"] = {p.note};
+  if (colour) j["colour_match"] = colour_summary(*colour, table);
   if (p.scene_bytes > 0) j["scene_memory_estimate_bytes"] = p.scene_bytes;
   return out;
 }

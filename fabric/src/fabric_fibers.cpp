@@ -9,7 +9,6 @@
 #include "weft/scenes/wif.h"
 
 namespace weft {
-namespace {
 
 bool is_fiber_table_file(const std::string& fiber) {
   std::error_code ec;
@@ -18,17 +17,7 @@ bool is_fiber_table_file(const std::string& fiber) {
           fiber.compare(fiber.size() - 4, 4, ".exr") == 0);
 }
 
-// The table of a spec baked once into ./.weft-cache (RGB); 'source' names it in the checks.
-TabulatedBsdfTable cached_fabric_fiber(const FiberSpec& spec, const std::string& source,
-                                       const std::string& option, const RunLimits& limits,
-                                       const ProgressCallback& progress) {
-  FiberTableBakeOptions o = fiber_bake_defaults(spec);
-  o.spectral = false;
-  return TabulatedBsdfTable::read_exr(
-      cached_fiber_table(".weft-cache", spec, o, progress, nullptr, [&] {
-        check_fiber_bake(limits, o, kNumBands, {source, option, option});
-      }));
-}
+namespace {
 
 // The draft states colours, at most kMaxThreadColours distinct ones, and --fiber is a spec.
 void check_draft_colours(const FabricFiberOptions& o) {
@@ -73,6 +62,17 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
 }
 
 }  // namespace
+
+TabulatedBsdfTable cached_fabric_fiber(const FiberSpec& spec, const std::string& source,
+                                       const std::string& option, const RunLimits& limits,
+                                       const ProgressCallback& progress) {
+  FiberTableBakeOptions o = fiber_bake_defaults(spec);
+  o.spectral = false;
+  return TabulatedBsdfTable::read_exr(
+      cached_fiber_table(".weft-cache", spec, o, progress, nullptr, [&] {
+        check_fiber_bake(limits, o, kNumBands, {source, option, option});
+      }));
+}
 
 TabulatedBsdfTable named_fiber_table(const std::string& fiber, const std::string& option,
                                      const RunLimits& limits, const ProgressCallback& progress) {

@@ -43,29 +43,45 @@ BandModel fit_band(double mu1, double r1, double mu2, double r2) {
 // The absorption per band of each reading's fibre.
 using Absorptions = std::vector<Spectrum>;
 
-// Per band, the model through the reading 'anchor' and the reading nearest to it in log mu with
-// another mu; flat at the anchor's reflectance where none differs.
-std::vector<BandModel> band_models(const std::vector<ColourReading>& readings,
-                                   const Absorptions& mu, size_t anchor) {
-  constexpr double kTinyMu = 1e-6;  // per um: log distances stay finite at no absorption
-  std::vector<BandModel> models(kNumBands);
-  for (int b = 0; b < kNumBands; ++b) {
-    const double m0 = mu[anchor][b];
-    size_t other = anchor;
-    double nearest = 0;
-    for (size_t k = 0; k < readings.size(); ++k) {
-      const double d = std::abs(std::log((mu[k][b] + kTinyMu) / (m0 + kTinyMu)));
-      if (d > 1e-9 && (other == anchor || d < nearest)) other = k, nearest = d;
-    }
-    const double r0 = readings[anchor].reflectance[b];
-    if (other == anchor) {
-      models[b] = {r0, 0};
-      continue;
-    }
-    const double m1 = mu[other][b], r1 = readings[other].reflectance[b];
-    models[b] = m0 < m1 ? fit_band(m0, r0, m1, r1) : fit_band(m1, r1, m0, r0);
+// One band's reflectance as a function of its absorption through every reading: between two
+// readings adjacent in mu the Kubelka-Munk model through both, beyond the ends the model
+// through the two outermost, flat where the readings share one mu. Exact at every reading, so
+// the steering sharpens as readings gather near the answer.
+struct BandCurve {
+  std::vector<double> mu;           // the readings' distinct absorptions, ascending
+  std::vector<double> reflectance;  // at each (the mean where readings share one)
+  std::vector<BandModel> pieces;    // pieces[i] between mu[i] and mu[i + 1]
+  double at(double m) const {
+    if (pieces.empty()) return reflectance.front();
+    const size_t i = std::upper_bound(mu.begin() + 1, mu.end() - 1, m) - mu.begin() - 1;
+    return pieces[i].at(m);
   }
-  return models;
+};
+
+std::vector<BandCurve> band_curves(const std::vector<ColourReading>& readings,
+                                   const Absorptions& mu) {
+  std::vector<BandCurve> curves(kNumBands);
+  for (int b = 0; b < kNumBands; ++b) {
+    std::vector<std::pair<double, double>> points;
+    for (size_t k = 0; k < readings.size(); ++k)
+      points.emplace_back(mu[k][b], readings[k].reflectance[b]);
+    std::sort(points.begin(), points.end());
+    BandCurve& c = curves[b];
+    int shared = 0;
+    for (const auto& [m, r] : points) {
+      if (!c.mu.empty() && std::abs(m - c.mu.back()) <= 1e-9 * std::max(m, 1e-9)) {
+        c.reflectance.back() = (c.reflectance.back() * (shared + 1) + r) / (shared + 2);
+        ++shared;
+        continue;
+      }
+      c.mu.push_back(m);
+      c.reflectance.push_back(r);
+      shared = 0;
+    }
+    for (size_t i = 0; i + 1 < c.mu.size(); ++i)
+      c.pieces.push_back(fit_band(c.mu[i], c.reflectance[i], c.mu[i + 1], c.reflectance[i + 1]));
+  }
+  return curves;
 }
 
 // The scales' map from the unit cube, logarithmic from 1e-4 of the largest scale to it.
@@ -96,14 +112,18 @@ std::vector<double> target_residuals(const ColourTarget& t, const Spectrum& r) {
   return out;
 }
 
+// How far one step may move a scale from the best reading's (a factor either way).
+constexpr double kTrustFactor = 8;
+
 struct ModelStep {
   std::vector<double> scale;
-  double delta_e00 = 0;  // the model's own at its optimum
+  double delta_e00 = 0;        // the model's own at its optimum
+  bool at_trust_edge = false;  // the optimum lies on the trust region's edge inside the cube
 };
 
 // The scales at which the band models' colour is nearest the target, from the best reading's.
 ModelStep model_step(const ColourMatch& m, const Spectrum& host_mu,
-                     const std::vector<BandModel>& models, const ScaleMap& map) {
+                     const std::vector<BandCurve>& models, const ScaleMap& map) {
   const auto reflectance = [&](const std::vector<double>& s) {
     Spectrum r{};
     for (int b = 0; b < kNumBands; ++b) {
@@ -113,17 +133,34 @@ ModelStep model_step(const ColourMatch& m, const Spectrum& host_mu,
     }
     return r;
   };
-  const ResidualFunction residuals = [&](const std::vector<double>& u) {
-    return target_residuals(m.target, reflectance(map.scale(u)));
+  // A trust region: the model is fitted where the best reading is, so it is searched only
+  // within a factor kTrustFactor of that reading's scales; the next reading refits it further on.
+  const std::vector<double> u_best = map.unit(m.best_reading().scale);
+  std::vector<double> lo(u_best.size()), hi(u_best.size()), v0(u_best.size());
+  const double reach = std::log(kTrustFactor) / std::log(ScaleMap::kRange);
+  for (size_t d = 0; d < u_best.size(); ++d) {
+    lo[d] = std::max(0.0, u_best[d] - reach);
+    hi[d] = std::min(1.0, u_best[d] + reach);
+    v0[d] = (u_best[d] - lo[d]) / (hi[d] - lo[d]);
+  }
+  const auto unit_of = [&](const std::vector<double>& v) {
+    std::vector<double> u(v.size());
+    for (size_t d = 0; d < v.size(); ++d) u[d] = lo[d] + v[d] * (hi[d] - lo[d]);
+    return u;
+  };
+  const ResidualFunction residuals = [&](const std::vector<double>& v) {
+    return target_residuals(m.target, reflectance(map.scale(unit_of(v))));
   };
   OptimizeOptions o;
   o.max_evaluations = 800;  // the model costs microseconds an evaluation
   o.tolerance = 1e-6;
   o.initial_step = 0.1;
   // Nelder-Mead: the model's colour is not smooth where a scale meets its bound.
-  const OptimizeResult fit = nelder_mead(residuals, map.unit(m.best_reading().scale), o);
+  const OptimizeResult fit = nelder_mead(residuals, v0, o);
   ModelStep step;
-  step.scale = map.scale(fit.u);
+  step.scale = map.scale(unit_of(fit.u));
+  for (size_t d = 0; d < fit.u.size(); ++d)
+    step.at_trust_edge |= (fit.u[d] < 1e-3 && lo[d] > 0) || (fit.u[d] > 1 - 1e-3 && hi[d] < 1);
   step.delta_e00 = delta_e00(m.target.lab, m.target.lab_of(reflectance(step.scale)));
   return step;
 }
@@ -210,14 +247,15 @@ ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
   };
   const Spectrum host_mu =
       host_total_absorption_per_um(with_dye_scale(base, m.basis, std::vector<double>(n, 0.0)));
-  double model_delta_e00 = 0;
+  ModelStep last_step;
   bool stalled = false, interrupted = !take(m.basis.initial_scale);
-  if (!interrupted) interrupted = !take(std::vector<double>(n, 0.0));
+  // The undyed reading anchors the model; a recipe already on target needs none.
+  if (!interrupted && m.best_reading().delta_e00 > options.tolerance_delta_e00)
+    interrupted = !take(std::vector<double>(n, 0.0));
   while (!interrupted && !stalled && m.best_reading().delta_e00 > options.tolerance_delta_e00 &&
          static_cast<int>(m.readings.size()) < options.max_readings) {
-    const ModelStep step =
-        model_step(m, host_mu, band_models(m.readings, mu, m.readings.size() - 1), map);
-    model_delta_e00 = step.delta_e00;
+    const ModelStep step = model_step(m, host_mu, band_curves(m.readings, mu), map);
+    last_step = step;
     stalled = std::any_of(m.readings.begin(), m.readings.end(),
                           [&](const ColourReading& r) { return same_scales(r.scale, step.scale); });
     if (!stalled) interrupted = !take(step.scale);
@@ -225,7 +263,9 @@ ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
   m.cancelled = interrupted;
   if (m.readings.empty()) return m;
   m.reached = m.best_reading().delta_e00 <= options.tolerance_delta_e00;
-  m.outside_reach = !m.reached && !m.cancelled && model_delta_e00 > options.tolerance_delta_e00;
+  // Outside reach: even the model, free to move, stays away from the target.
+  m.outside_reach = !m.reached && !m.cancelled && !last_step.at_trust_edge &&
+                    last_step.delta_e00 > options.tolerance_delta_e00;
   m.spec = with_dye_scale(base, m.basis, m.best_reading().scale);
   return m;
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/colour_target.h"
 #include "weft/core/job_part.h"
 #include "weft/core/names.h"
 #include "weft/core/progress.h"
@@ -55,6 +56,9 @@ struct FabricBakeRequest {
   std::shared_ptr<const TabulatedBsdfTable> fiber_table;
   std::string warp_fiber, weft_fiber;  // per-yarn fibers (raytrace); "" = fiber
   bool thread_colours = false;         // a fiber per colour of the WIF draft's threads
+  // The colour the cloth should have (core/colour_target.h): --fiber's dyes are scaled to meet
+  // it (fabric_colour.h); "" = the recipe as written.
+  std::string colour;
   std::string method = name_of(kFabricMethods, FabricMethod::kSummation);
   std::string weave;                          // woven sample options (.json); "" = bundled poplin
   std::optional<WeaveOptions> weave_options;  // in place of the file (Python's dict)
@@ -87,9 +91,10 @@ struct FabricBakePlan {
   FabricMethod method = FabricMethod::kSummation;
   FabricRaytraceOptions raytrace;  // the ray tracer's settings (its defaults for a summation)
   FabricFiberOptions fibers;
-  WeaveOptions weave;      // the sample's, its tessellation fitted to the memory budget
-  std::string note;        // why the tessellation was coarsened; "" when it was not
-  double scene_bytes = 0;  // the scene's memory estimate (0 for the paper's summation)
+  std::optional<ColourTarget> colour;  // the request's colour, parsed
+  WeaveOptions weave;                  // the sample's, its tessellation fitted to the memory budget
+  std::string note;                    // why the tessellation was coarsened; "" when it was not
+  double scene_bytes = 0;              // the scene's memory estimate (0 for the paper's summation)
 };
 
 // Every check before any work, in this order (the first error wins): the options that need
@@ -118,6 +123,12 @@ struct FabricBakeResult {
 // The run of a plan: the woven sample, the fiber tables (baked into ./.weft-cache on first use),
 // the table by the plan's method, written to the request's output and weave_out.
 FabricBakeResult run_fabric_bake(const FabricBakePlan& plan, const FabricBakeHooks& hooks);
+
+// A summation plan's table of 'sample' made of 'fiber' (the plan's method, resolution, samples,
+// seed and threads).
+TabulatedBsdfTable summed_fabric_table(const FabricBakePlan& plan, const WovenSample& sample,
+                                       const TabulatedBsdfTable& fiber,
+                                       const ProgressCallback& progress);
 
 // `weft merge` of a ray trace's parts ('all', merge_job_parts): the table written to 'output' and
 // the weave table to 'weave_out' (which the parts must carry exactly when given); the summary.

@@ -10,6 +10,7 @@
 #include "weft/core/progress.h"
 #include "weft/core/run_limits.h"
 #include "weft/fabric/fabric_raytrace.h"
+#include "weft/fiber/fiber_spec.h"
 
 namespace weft {
 
@@ -43,6 +44,14 @@ struct FabricFibers {
 };
 FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& sample,
                                 const ProgressCallback& progress);
+
+// Whether --fiber names a fiber table file (.exr) rather than a spec or preset.
+bool is_fiber_table_file(const std::string& fiber);
+// The RGB table of a spec, baked once into ./.weft-cache; 'source' and 'option' name it in the
+// bake's checks.
+TabulatedBsdfTable cached_fabric_fiber(const FiberSpec& spec, const std::string& source,
+                                       const std::string& option, const RunLimits& limits,
+                                       const ProgressCallback& progress);
 
 // One fiber table: a table file (.exr), or a fiber spec or preset baked once into ./.weft-cache
 // (RGB); 'option' names it in the bake's checks.

@@ -1,0 +1,216 @@
+#include "weft/fabric/fabric_colour.h"
+
+#include <fstream>
+
+#include "weft/core/atomic_file.h"
+#include "weft/core/direction_grid.h"
+#include "weft/core/error.h"
+#include "weft/core/hash.h"
+#include "weft/fiber/bake_cache.h"
+#include "weft/fiber/fiber_table_bake.h"
+
+namespace weft {
+
+namespace {
+
+// Bumped when a reading would change for the same inputs (stale cache entries are then unused).
+constexpr int kColourCacheVersion = 2;
+const std::filesystem::path kColourCacheDir = ".weft-cache";
+
+FiberTableBakeOptions reading_fiber_options(const FiberSpec& spec, const FabricBakePlan& p) {
+  FiberTableBakeOptions o = fiber_bake_defaults(spec);
+  o.spectral = true;  // the reading is a spectrum
+  o.resolution = p.request.resolution;
+  return o;
+}
+
+// What a reading depends on besides the fiber: the sample, the method and its settings.
+nlohmann::json reading_inputs(const FabricBakePlan& p, const WovenSample& sample) {
+  const FabricRaytraceOptions& r = p.raytrace;
+  nlohmann::json woven = nlohmann::json::parse(weave_summary_json(sample.summary, ""));
+  woven.erase("seconds");  // how long it took to make, not what it is
+  return {{"version", kColourCacheVersion},
+          {"sample", woven},
+          {"method", p.request.method},
+          {"resolution", p.request.resolution},
+          {"samples", p.request.samples ? nlohmann::json(*p.request.samples) : nullptr},
+          {"seed", p.request.seed},
+          {"raytrace",
+           {r.particles_per_bin, r.max_scatterings, r.roulette_threshold, r.split_threshold,
+            static_cast<int>(r.channel_sampling), static_cast<int>(r.straight_through),
+            r.next_event_rays, r.launch_lattice}}};
+}
+
+std::filesystem::path colour_cache_file(const FabricBakePlan& p, const WovenSample& sample,
+                                        const FiberSpec& base, const ColourTarget& target) {
+  const std::string key =
+      fiber_spec_hash_hex(base) + target.key() + reading_inputs(p, sample).dump();
+  return kColourCacheDir / ("colour-" + hex64(fnv1a64(key)) + ".json");
+}
+
+nlohmann::json readings_json(const ColourMatch& m) {
+  nlohmann::json list = nlohmann::json::array();
+  for (const ColourReading& r : m.readings)
+    list.push_back(
+        {{"scale", r.scale}, {"reflectance", r.reflectance}, {"cpu_seconds", r.cpu_seconds}});
+  return list;
+}
+
+// A cached match: its readings replayed through the solver (no reading is taken again).
+std::optional<ColourMatch> cached_match(const std::filesystem::path& file, const FiberSpec& base,
+                                        const ColourTarget& target) {
+  std::ifstream in(file);
+  if (!in) return std::nullopt;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    const nlohmann::json& readings = j.at("readings");
+    size_t next = 0;
+    bool replayed_all = true;
+    ColourMatch m = match_colour(base, target,
+                                 [&](const FiberSpec&) -> std::optional<Spectrum> {
+                                   if (next >= readings.size())
+                                     return replayed_all = false, std::nullopt;
+                                   return readings[next++].at("reflectance").get<Spectrum>();
+                                 },
+                                 {});
+    if (!replayed_all || next != readings.size()) return std::nullopt;
+    for (size_t k = 0; k < m.readings.size(); ++k) {
+      // The solver asked for the scales the entry's readings were taken at, or it is stale.
+      if (m.readings[k].scale != readings[k].at("scale").get<std::vector<double>>())
+        return std::nullopt;
+      m.readings[k].cpu_seconds = readings[k].at("cpu_seconds").get<double>();
+    }
+    return m;
+  } catch (const std::exception&) {
+    return std::nullopt;  // an unreadable entry is solved again and replaced
+  }
+}
+
+}  // namespace
+
+TabulatedBsdfTable colour_fiber_table(const FabricBakePlan& p, const FiberSpec& spec,
+                                      const ProgressCallback& progress) {
+  // Interrupted, the bake throws (nothing written); the command reports it as any bake's.
+  return TabulatedBsdfTable::read_exr(
+      cached_fiber_table(kColourCacheDir, spec, reading_fiber_options(spec, p), progress));
+}
+
+std::optional<Spectrum> fabric_d8_reading(const FabricBakePlan& p, const WovenSample& sample,
+                                          const FiberSpec& spec, const ProgressCallback& progress) {
+  const TabulatedBsdfTable fiber = colour_fiber_table(p, spec, progress);
+  const int normal_bin = fiber.grid().bin_of({0, 0, 1});
+  TabulatedBsdfTable table;
+  if (p.method == FabricMethod::kRaytrace) {
+    FabricRaytraceOptions r = p.raytrace;
+    r.first_bin = normal_bin;
+    r.bin_count = 1;
+    r.weave_positions_u = r.weave_positions_v = 0;
+    FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, r, progress);
+    if (res.cancelled) return std::nullopt;
+    table = std::move(res.table);
+  } else {
+    table = summed_fabric_table(p, sample, fiber, progress);
+  }
+  const auto albedo = table.directional_albedo(normal_bin);
+  Spectrum out{};
+  for (int b = 0; b < kNumBands; ++b) out[b] = albedo.reflectance[b];
+  return out;
+}
+
+FabricColourMatch match_fabric_colour(const FabricBakePlan& p, const WovenSample& sample,
+                                      const ProgressCallback& progress) {
+  const FiberSpec base = load_fiber_spec(p.request.fiber);
+  const ColourTarget& target = p.colour.value();
+  const std::filesystem::path file = colour_cache_file(p, sample, base, target);
+  if (std::optional<ColourMatch> m = cached_match(file, base, target)) return {std::move(*m), true};
+  ColourMatchOptions o;
+  o.max_readings = kFabricColourReadings;
+  ColourMatch m = match_colour(
+      base, target,
+      [&](const FiberSpec& spec) { return fabric_d8_reading(p, sample, spec, progress); }, o);
+  if (!m.cancelled) {
+    std::filesystem::create_directories(kColourCacheDir);
+    const nlohmann::json entry = {{"inputs", reading_inputs(p, sample)},
+                                  {"fiber_spec_hash", fiber_spec_hash_hex(base)},
+                                  {"target", target.spec},
+                                  {"readings", readings_json(m)}};
+    write_atomically(file, [&](const std::filesystem::path& tmp) {
+      std::ofstream(tmp) << entry.dump(1) << "\n";
+    });
+  }
+  return {std::move(m), false};
+}
+
+ColourTarget check_fabric_colour(const FabricBakeRequest& o, FabricMethod method) {
+  const ColourTarget target = parse_colour_target(o.colour, "--colour");
+  if (o.fiber_table || is_fiber_table_file(o.fiber))
+    throw Error(o.fiber, "--colour",
+                "--colour sets the depth of a fiber spec's dyes; a baked fiber table's colour is "
+                "fixed: give the spec or preset it was baked from");
+  if (o.thread_colours || !o.warp_fiber.empty() || !o.weft_fiber.empty())
+    throw Error("", "--colour",
+                "--colour dyes the one --fiber; per-yarn fibers (--warp-fiber, --weft-fiber, "
+                "--thread-colours) are not matched");
+  const FiberSpec spec = load_fiber_spec(o.fiber);
+  dye_basis(spec);  // the recipe's dyes exist (the spec's own check) and can be scaled
+  // The readings' time: a spectral fiber bake and, for a ray trace, one incident bin each.
+  FiberTableBakeOptions bake = reading_fiber_options(spec, FabricBakePlan{.request = o});
+  bake.photons_per_band *= kFabricColourReadings;
+  check_fiber_bake(o.limits, bake, kNumBands, {o.fiber, "--colour", "--colour"});
+  if (method == FabricMethod::kRaytrace)
+    check_fabric_bake(o.limits, method, o.resolution, kFabricColourReadings, o.samples, o.threads,
+                      "--colour");
+  return target;
+}
+
+}  // namespace weft
+
+namespace weft {
+
+Lab table_d8_lab(const TabulatedBsdfTable& table, const ColourTarget& target) {
+  const auto a = table.directional_albedo(table.grid().bin_of({0, 0, 1}));
+  if (table.channels == kNumBands) {
+    Spectrum r{};
+    for (int b = 0; b < kNumBands; ++b) r[b] = a.reflectance[b];
+    return target.lab_of(r);
+  }
+  return linear_srgb_to_lab({a.reflectance[0], a.reflectance[1], a.reflectance[2]});
+}
+
+nlohmann::json colour_summary(const FabricColourMatch& c, const TabulatedBsdfTable& table) {
+  nlohmann::json j = colour_match_summary(c.match);
+  j["cached"] = c.cached;
+  const Lab lab = table_d8_lab(table, c.match.target);
+  j["table"] = {{"lab", {lab.l, lab.a, lab.b}},
+                {"delta_e00", delta_e00(c.match.target.lab, lab)},
+                {"channels", table.channels == kNumBands ? "spectral" : "rgb"}};
+  return j;
+}
+
+void describe_colour_match(const FabricColourMatch& c, TabulatedBsdfTable& table,
+                           FabricBakeResult& out) {
+  const ColourMatch& m = c.match;
+  const ColourReading& best = m.best_reading();
+  char de[32];
+  std::snprintf(de, sizeof de, "%.2f", best.delta_e00);
+  table.metadata["colour"] = m.target.spec + " (CIEDE2000 " + de + " at normal incidence)";
+  std::string scales;
+  for (size_t d = 0; d < m.basis.names.size(); ++d) {
+    char v[64];
+    std::snprintf(v, sizeof v, "%s%s %.4g%s", d ? ", " : "", m.basis.names[d].c_str(),
+                  best.scale[d], m.basis.recipe ? " % owf" : "");
+    scales += v;
+  }
+  const std::string how =
+      c.cached ? "from the cache" : std::to_string(m.readings.size()) + " readings";
+  if (m.reached)
+    out.notes.push_back("colour " + m.target.spec + " reached: CIEDE2000 " + de + " (" + how +
+                        "); " + scales);
+  else
+    out.notes.push_back("colour " + m.target.spec +
+                        (m.outside_reach ? " is outside what the dyes can reach" : " not reached") +
+                        ": nearest " + format_lab(best.lab) + " at CIEDE2000 " + de + " (" + how +
+                        "); " + scales);
+}
+
+}  // namespace weft
