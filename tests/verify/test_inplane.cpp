@@ -42,11 +42,11 @@ TEST(VerifyInplane, InPlaneDirectionsFollowThePapersSign) {
   EXPECT_GT(b[1].r, 0.5);
 }
 
-// A spectral table that reflects only the 500 nm band (kNumBands from 400 nm in 10 nm steps,
-// core/spectrum.h): a cyan-green far outside the sRGB gamut, whose linear sRGB red is negative.
+// A spectral table that reflects only the 490 nm band (band 10: kNumBands from 390 nm in 10 nm
+// steps, core/spectrum.h): a cyan-green far outside the sRGB gamut, whose linear sRGB red is negative.
 // The reduction keeps it negative (nothing clipped), counts it, and the in-plane curves carry it.
 TEST(VerifyInplane, SaturatedSpectralTableKeepsItsNegativeComponents) {
-  constexpr int kBand = 10;  // 500 nm
+  constexpr int kBand = 10;  // 490 nm
   const TabulatedBsdfTable t = TabulatedBsdfTable::from_function(
       2, kNumBands,
       [](const Vec3&, const Vec3&, std::span<double> v) {

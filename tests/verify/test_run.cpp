@@ -117,7 +117,7 @@ TEST(VerifyRun, PaperFigureNotDefinedWhereTheModelsNormalBinIsEmpty) {
   EXPECT_NE(json.find("\"computed_rms_log\": null"), std::string::npos);
 }
 
-// A saturated fiber (it scatters only the 500 nm band, far outside the sRGB gamut: its linear
+// A saturated fiber (it scatters only the 490 nm band, far outside the sRGB gamut: its linear
 // sRGB red is negative): nothing is clipped, the out-of-gamut components are counted, and every
 // model's figures and the paper's factor are defined (the log figures floor what is not positive,
 // and count it).
@@ -127,7 +127,7 @@ TEST(VerifyRun, SaturatedColourIsNotClippedAndItsFiguresAreDefined) {
       2, kNumBands,
       [](const Vec3&, const Vec3&, std::span<double> v) {
         for (double& x : v) x = 0;
-        v[10] = 0.2 / kPi;  // 500 nm, total albedo 0.4
+        v[10] = 0.2 / kPi;  // 490 nm, total albedo 0.4
       },
       2, 1, 1);
   run.settings.threads = 2;
