@@ -139,5 +139,64 @@ TEST(VerifyFigures, SpreadOverBatchesAndOverTheMeasurementsFits) {
   EXPECT_EQ(d.figure[kAbsoluteFigure].seed_se(), 0.0);
 }
 
+TEST(VerifyFigures, FloorForLogRaisesEachChannelToAThousandthOfItsMaximum) {
+  // R: 2, -0.5, 0 (max 2, floor 0.002: two raised); G: no positive value, so the brightest
+  // channel's maximum (2) sets its floor, all three raised; B: 0.1..0.3, none below 0.0003.
+  const InplaneCurves c = {{Rgb(2, -1, 0.1), Rgb(-0.5, -2, 0.2), Rgb(0, -3, 0.3)}};
+  const LogFloored f = floor_for_log(c);
+  EXPECT_EQ(f.floored, 5u);
+  EXPECT_DOUBLE_EQ(f.curves[0][0].r, 2);
+  EXPECT_DOUBLE_EQ(f.curves[0][1].r, kLogFloorFraction * 2);
+  EXPECT_DOUBLE_EQ(f.curves[0][2].r, kLogFloorFraction * 2);
+  for (int v = 0; v < 3; ++v) EXPECT_DOUBLE_EQ(f.curves[0][v].g, kLogFloorFraction * 2);
+  EXPECT_DOUBLE_EQ(f.curves[0][2].b, 0.3);
+  // No light at all: no floor, nothing changed, the points stay excluded.
+  const LogFloored dark = floor_for_log({{Rgb(0.0), Rgb(-1.0)}});
+  EXPECT_EQ(dark.floored, 0u);
+  EXPECT_DOUBLE_EQ(dark.curves[0][1].g, -1);
+}
+
+TEST(VerifyFigures, SaturatedModelWithNegativeComponentsHasFiniteFigures) {
+  // A model outside the gamut: its green is negative at every point, its red negative at one
+  // (the normal point). Unfloored the paper's figure would not be defined; floored every figure
+  // is, and the points raised are counted.
+  const MeasuredInplane m = geometry({0, 30}, {-40, 0, 40});
+  InplaneCurves model = reference(m);
+  for (auto& curve : model)
+    for (auto& b : curve) b.g = -0.01;
+  model[0][1].r = -0.2;
+  EXPECT_TRUE(std::isnan(paper_figure(model, reference(m), {0, 1})));
+  const ModelFigures f = model_figures(model, {model, model}, m, {0, 1});
+  EXPECT_EQ(f.log_floored_points, 7u);  // six greens and one red
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_TRUE(std::isfinite(f.figure[k].value())) << kFigureKeys[k];
+    EXPECT_TRUE(std::isfinite(f.figure[k].seed_se())) << kFigureKeys[k];
+  }
+  EXPECT_EQ(f.shape.excluded, 0u);
+}
+
+TEST(VerifyFigures, MeasuredFitSpreadIsTheLargestFigureBetweenTwoFits) {
+  MeasuredInplane m = geometry({0}, {-40, 0, 40});
+  const InplaneCurves meas = reference(m);
+  // One fit: the spread is unknown.
+  for (double s : measured_fit_spread(m, {0, 1})) EXPECT_TRUE(std::isnan(s));
+  // Fits e^0.2 and e^-0.1 times the reference: absolute figures between the pairs 0.2, 0.1 and
+  // 0.3; a constant factor has shape and paper's figure 0.
+  m.other_fits.push_back({"up", offset(meas, [](size_t, size_t, int) { return 0.2; })});
+  m.other_fits.push_back({"down", offset(meas, [](size_t, size_t, int) { return -0.1; })});
+  const auto spread = measured_fit_spread(m, {0, 1});
+  EXPECT_NEAR(spread[kAbsoluteFigure], 0.3, 1e-12);
+  EXPECT_NEAR(spread[kShapeFigure], 0, 1e-12);
+  EXPECT_NEAR(spread[kPaperFigure], 0, 1e-12);
+  // A fit that bends (+-0.1 on the outer views) has a shape spread: RMS over 9 points of
+  // (0.1 - 0.2/3, -0.2/3, 0.1 - 0.2/3) after the gain, per channel the same.
+  m.other_fits.push_back(
+      {"bent", offset(meas, [](size_t, size_t v, int) { return v == 1 ? 0.0 : 0.1; })});
+  const double mean = 0.2 / 3, rms = std::sqrt((2 * (0.1 - mean) * (0.1 - mean) + mean * mean) / 3);
+  EXPECT_NEAR(measured_fit_spread(m, {0, 1})[kShapeFigure], rms, 1e-12);
+  EXPECT_EQ(normal_index(m)->view, 1u);
+  EXPECT_FALSE(normal_index(geometry({30}, {0})).has_value());
+}
+
 }  // namespace
 }  // namespace weft

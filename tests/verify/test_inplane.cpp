@@ -1,9 +1,11 @@
-// In-plane evaluation of a table (verify/inplane.h): a constant table's beta, the paper's sign.
+// In-plane evaluation of a table (verify/inplane.h): a constant table's beta, the paper's sign,
+// and a saturated spectral table reduced to linear sRGB without clipping.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "constant_table.h"
+#include "weft/core/math.h"
 #include "weft/verify/inplane.h"
 
 using weft::testing::constant_table;
@@ -38,6 +40,36 @@ TEST(VerifyInplane, InPlaneDirectionsFollowThePapersSign) {
   const auto b = inplane_beta(t, 45, {-45, 45}, 1);
   EXPECT_EQ(b[0].r, 0.0);
   EXPECT_GT(b[1].r, 0.5);
+}
+
+// A spectral table that reflects only the 490 nm band (band 10: kNumBands from 390 nm in 10 nm
+// steps, core/spectrum.h): a cyan-green far outside the sRGB gamut, whose linear sRGB red is negative.
+// The reduction keeps it negative (nothing clipped), counts it, and the in-plane curves carry it.
+TEST(VerifyInplane, SaturatedSpectralTableKeepsItsNegativeComponents) {
+  constexpr int kBand = 10;  // 490 nm
+  const TabulatedBsdfTable t = TabulatedBsdfTable::from_function(
+      2, kNumBands,
+      [](const Vec3&, const Vec3&, std::span<double> v) {
+        for (double& x : v) x = 0;
+        v[kBand] = 1 / kPi;
+      },
+      2, 1, 1);
+  const Rgb want = bands_to_linear_srgb([](int b) { return b == kBand ? 1 / kPi : 0.0; });
+  ASSERT_LT(want.r, 0);  // outside the gamut
+  OutOfGamut outside;
+  const TabulatedBsdfTable rgb = table_to_rgb(t, &outside);
+  ASSERT_EQ(rgb.channels, 3);
+  const size_t cells = rgb.values.size() / 3;
+  EXPECT_EQ(outside.components, cells);  // one negative component (red) per cell
+  EXPECT_NEAR(outside.largest, -want.r, 1e-6);
+  for (size_t c = 0; c < cells; ++c) EXPECT_NEAR(rgb.values[c * 3], want.r, 1e-6) << c;
+  MeasuredInplane m;
+  m.curves.push_back({0, {-30, 0, 30}, {Rgb(0.2), Rgb(0.2), Rgb(0.2)}});
+  const auto curves = table_curves(t, m, 3);
+  for (const Rgb& b : curves[0]) {
+    EXPECT_NEAR(b.r, kPi * want.r, 1e-5);  // beta = pi f, negative as f is
+    EXPECT_NEAR(b.g, kPi * want.g, 1e-5);
+  }
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 
 #include "constant_table.h"
 #include "test_util.h"
+#include "weft/core/math.h"
 #include "weft/materials/registry.h"
 #include "weft/verify/classic.h"
 #include "weft/verify/report.h"
@@ -76,8 +77,11 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
       ASSERT_EQ(mc.batch_beta.size(), 2u) << mc.key;
       EXPECT_EQ(mc.figures.fits, std::vector<std::string>{"nbrdf"});
       EXPECT_EQ(mc.figures.figure[kShapeFigure].batch.at(0).size(), 2u);
+      // The figures are of the curves floored for the logs (figures.h floor_for_log).
       EXPECT_EQ(mc.figures.shape.rms_log,
-                shape_figure(mc.beta, measured_fits(m)[0].beta, m).rms_log);
+                shape_figure(floor_for_log(mc.beta).curves,
+                             floor_for_log(measured_fits(m)[0].beta).curves, m)
+                    .rms_log);
     }
     EXPECT_EQ(r.colours[0].name, "computed fabric, reflection");
     r.seconds.clear();
@@ -93,9 +97,10 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
   EXPECT_NE(error_of([&] { run_verify(sample, in, m, s); }).find("theta_i_deg"), std::string::npos);
 }
 
-// A fiber that returns no light leaves the ray trace's normal bin empty: the paper's factor does
-// not exist there, so its figure is not defined (null in metrics.json) while the run and the
-// other model's figures go on (a deep dye at draft quality can empty that one bin in a channel).
+// A fiber that returns no light leaves the ray trace with no light in any channel: no floor
+// exists for its logs (figures.h floor_for_log), so the paper's factor and figure are not defined
+// (null in metrics.json) while the run and the other model's figures go on. (A channel with light
+// somewhere but an empty normal bin is floored and has its factor.)
 TEST(VerifyRun, PaperFigureNotDefinedWhereTheModelsNormalBinIsEmpty) {
   SmallRun run = small_run(0.0);
   run.settings.threads = 2;
@@ -110,6 +115,40 @@ TEST(VerifyRun, PaperFigureNotDefinedWhereTheModelsNormalBinIsEmpty) {
   EXPECT_TRUE(std::isfinite(classic.normalized_overall.rms_log));
   const std::string json = verify_metrics_json(r);
   EXPECT_NE(json.find("\"computed_rms_log\": null"), std::string::npos);
+}
+
+// A saturated fiber (it scatters only the 490 nm band, far outside the sRGB gamut: its linear
+// sRGB red is negative): nothing is clipped, the out-of-gamut components are counted, and every
+// model's figures and the paper's factor are defined (the log figures floor what is not positive,
+// and count it).
+TEST(VerifyRun, SaturatedColourIsNotClippedAndItsFiguresAreDefined) {
+  SmallRun run = small_run(0.0);
+  run.inputs.fiber = TabulatedBsdfTable::from_function(
+      2, kNumBands,
+      [](const Vec3&, const Vec3&, std::span<double> v) {
+        for (double& x : v) x = 0;
+        v[10] = 0.2 / kPi;  // 490 nm, total albedo 0.4
+      },
+      2, 1, 1);
+  run.settings.threads = 2;
+  const VerifyReport r = run_verify(run.sample, run.inputs, run.measured, run.settings);
+  EXPECT_EQ(r.fabric_table_gamut_clipped, 0u);
+  EXPECT_GT(r.fabric_table_out_of_gamut.components, 0u);
+  const ModelCurves& computed = r.models.at(0);
+  ASSERT_EQ(computed.key, "computed_raytrace");
+  EXPECT_GT(computed.figures.log_floored_points, 0u);
+  for (const ModelCurves& m : r.models) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_TRUE(std::isfinite(m.figures.figure[k].value())) << m.key << " " << kFigureKeys[k];
+      EXPECT_TRUE(std::isfinite(m.normalization[k])) << m.key;
+    }
+    EXPECT_TRUE(std::isfinite(m.normalized_overall.rms_log)) << m.key;
+  }
+  const auto j = verify_metrics(r);
+  EXPECT_EQ(j.at("fabric_table_gamut_clipped_components"), 0);
+  EXPECT_EQ(j.at("fabric_table_out_of_gamut_components"), r.fabric_table_out_of_gamut.components);
+  EXPECT_EQ(j.at("models").at("computed_raytrace").at("log_floored_points"),
+            computed.figures.log_floored_points);
 }
 
 }  // namespace

@@ -85,9 +85,10 @@ TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
   // The keys a report writes (docs/verify.md): figures per model with their uncertainty, and
   // the verdict per figure.
   good.metrics = nlohmann::json::parse(R"({"absolute_comparable": false,
-      "fabric_table_gamut_clipped_components": 12, "models": {
+      "fabric_table_gamut_clipped_components": 0,
+      "fabric_table_out_of_gamut_components": 1092, "models": {
       "computed_raytrace": {"shape": {"rms_log": 0.31}, "normalized": {"rms_log": 0.73},
-          "absolute": {"rms_log": 0.55},
+          "absolute": {"rms_log": 0.55}, "log_floored_points": 40,
           "uncertainty": {"shape": {"seed_se": 0.004, "fit_min": 0.28, "fit_max": 0.39}}},
       "classic": {"shape": {"rms_log": 0.66}, "normalized": {"rms_log": 0.75},
                   "absolute": {"rms_log": 1.5}}},
@@ -96,6 +97,25 @@ TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
                   "absolute": [{"a": "computed_raytrace", "b": "classic", "resolved": false,
                                 "text": "Absolute: not resolved"}]}})");
   SuiteRow bad{{"bad", "m.csv", "red-cotton", "", "", "", "", "k"}, nullptr, "the sample fails"};
+  // A tie, and a sample no model describes (a glossy film: every model above 1 in shape).
+  SuiteRow tie{{"tie", "m.csv", "red-cotton", "", "", "", "srgb", "k"}, {}, ""};
+  tie.metrics = nlohmann::json::parse(R"({"verdict": {"shape": [{"a": "computed_raytrace",
+      "b": "classic", "resolved": false, "tie": true, "text": "Shape: a tie"}]}})");
+  SuiteRow film{{"film", "m.csv", "red-cotton", "", "", "", "srgb", "k"}, {}, ""};
+  film.metrics = nlohmann::json::parse(R"({"verdict": {"no_model_describes": true,
+      "shape": [{"a": "computed_raytrace", "b": "classic", "resolved": false, "tie": false,
+                 "no_model_describes": true, "text": "Shape: no model here describes it"}]}})");
+  const auto all = nlohmann::json::parse(verify_suite_json(s, {good, bad, tie, film}));
+  EXPECT_EQ(all.at("fabrics")[2].at("shape_closer"), "tie");
+  EXPECT_EQ(all.at("fabrics")[3].at("shape_closer"), "no_model");
+  EXPECT_EQ(all.at("fabrics")[3].at("no_model_describes"), true);
+  EXPECT_EQ(all.at("shape_summary").at("tie"), 1);
+  EXPECT_EQ(all.at("shape_summary").at("no_model_describes"), 1);
+  EXPECT_EQ(all.at("shape_summary").at("unresolved"), 2);  // both name no closer model
+  const std::string all_html = verify_suite_html(s, {good, bad, tie, film});
+  EXPECT_NE(all_html.find("a tie on 1, no model describes the sample on 1 fabric(s)"),
+            std::string::npos);
+  EXPECT_NE(all_html.find("<b>No model here describes this sample.</b>"), std::string::npos);
   const auto j = nlohmann::json::parse(verify_suite_json(s, {good, bad}));
   EXPECT_EQ(j.at("report"), "weft verify suite");
   const auto& g = j.at("fabrics")[0].at("models");
@@ -118,7 +138,11 @@ TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
   EXPECT_NE(html.find("0.310 &plusmn; 0.004 <small>(fits 0.280&ndash;0.390)"), std::string::npos);
   EXPECT_NE(html.find("<small>(0.550)</small>"), std::string::npos);  // not comparable
   EXPECT_NE(html.find("Shape: computed wins"), std::string::npos);
-  EXPECT_NE(html.find("12 components clipped to the sRGB gamut"), std::string::npos);
+  EXPECT_NE(html.find("computed table: 0 components clipped, 1092 outside the sRGB gamut (kept), "
+                      "40 points floored"),
+            std::string::npos);
+  EXPECT_EQ(j.at("fabrics")[0].at("computed_gamut_clipped_components"), 0);
+  EXPECT_EQ(j.at("fabrics")[0].at("computed_out_of_gamut_components"), 1092);
   EXPECT_EQ(html.find("Absolute: not resolved"), std::string::npos);  // the shape verdicts only
   EXPECT_NE(html.find("computed closer on 1, classic closer on 0"), std::string::npos);
   EXPECT_NE(verify_suite_text({good, bad}).find("good: Shape: computed wins"), std::string::npos);

@@ -11,9 +11,17 @@ ColourEntry colour_of_spectrum(const std::string& name, const Spectrum& s,
   e.spectrum = s;
   e.note = note;
   e.rgb = xyz_to_linear_srgb(reflectance_to_xyz_d65(s));
-  Rgb c = e.rgb;
-  GamutClip().clip(c);
-  e.hsv = rgb_to_hsv(c);
+  // The RGB stays as it is; HSV has no meaning outside the gamut, so the H, S, V shown are of
+  // the colour with its negative components at 0, and the note says so.
+  Rgb shown = e.rgb;
+  GamutClip outside;
+  outside.clip(shown);
+  e.hsv = rgb_to_hsv(shown);
+  if (outside.components)
+    e.note += (e.note.empty() ? "" : "; ") +
+              std::string(
+                  "outside the sRGB gamut (RGB kept unclamped); H, S, V of it with its "
+                  "negative components at 0, for display");
   return e;
 }
 

@@ -101,6 +101,16 @@ double paper_figure(const InplaneCurves& model, const InplaneCurves& measured, N
   return absolute_figure(scaled(model, factor), measured);
 }
 
+namespace {
+// The three figures of 'model' against 'ref', in kFigureKeys order.
+std::array<double, 3> three_figures(const InplaneCurves& model, const InplaneCurves& ref,
+                                    const MeasuredInplane& geometry, NormalIndex normal) {
+  return {shape_figure(model, ref, geometry).rms_log, paper_figure(model, ref, normal),
+          absolute_figure(model, ref)};
+}
+
+}  // namespace
+
 double sample_sd(const std::vector<double>& values) {
   const size_t n = values.size();
   if (n < 2) return 0;
@@ -130,22 +140,71 @@ double FigureSamples::fit_max() const {
 ModelFigures model_figures(const InplaneCurves& mean, const std::vector<InplaneCurves>& batches,
                            const MeasuredInplane& measured, NormalIndex normal) {
   ModelFigures out;
-  const auto figures = [&](const InplaneCurves& model, const InplaneCurves& ref) {
-    return std::array<double, 3>{shape_figure(model, ref, measured).rms_log,
-                                 paper_figure(model, ref, normal), absolute_figure(model, ref)};
-  };
+  const LogFloored floored_mean = floor_for_log(mean);
+  out.log_floored_points = floored_mean.floored;
+  std::vector<InplaneCurves> floored_batches;
+  for (const auto& b : batches) floored_batches.push_back(floor_for_log(b).curves);
   for (const MeasuredFit& fit : measured_fits(measured)) {
+    const InplaneCurves ref = floor_for_log(fit.beta).curves;
     out.fits.push_back(fit.name);
-    if (out.fits.size() == 1) out.shape = shape_figure(mean, fit.beta, measured);
-    const auto f = figures(mean, fit.beta);
+    if (out.fits.size() == 1) out.shape = shape_figure(floored_mean.curves, ref, measured);
+    const auto f = three_figures(floored_mean.curves, ref, measured, normal);
     for (int k = 0; k < 3; ++k) {
       out.figure[k].mean.push_back(f[k]);
       if (!batches.empty()) out.figure[k].batch.emplace_back();
     }
-    for (const auto& b : batches) {
-      const auto fb = figures(b, fit.beta);
+    for (const auto& b : floored_batches) {
+      const auto fb = three_figures(b, ref, measured, normal);
       for (int k = 0; k < 3; ++k) out.figure[k].batch.back().push_back(fb[k]);
     }
+  }
+  return out;
+}
+
+std::array<double, 3> measured_fit_spread(const MeasuredInplane& measured, NormalIndex normal) {
+  std::array<double, 3> spread{kNaN, kNaN, kNaN};
+  std::vector<InplaneCurves> fits;
+  for (const MeasuredFit& fit : measured_fits(measured))
+    fits.push_back(floor_for_log(fit.beta).curves);
+  for (size_t a = 0; a < fits.size(); ++a)
+    for (size_t b = a + 1; b < fits.size(); ++b) {
+      const auto f = three_figures(fits[a], fits[b], measured, normal);
+      // A figure not defined between two fits leaves the spread undefined.
+      const bool first = a == 0 && b == 1;
+      for (int k = 0; k < 3; ++k)
+        spread[k] = first || std::isnan(f[k]) || std::isnan(spread[k]) ? (first ? f[k] : kNaN)
+                                                                       : std::max(spread[k], f[k]);
+    }
+  return spread;
+}
+
+std::optional<NormalIndex> normal_index(const MeasuredInplane& measured) {
+  for (size_t i = 0; i < measured.curves.size(); ++i)
+    for (size_t v = 0; v < measured.curves[i].view_deg.size(); ++v)
+      if (measured.curves[i].theta_i_deg == 0 && measured.curves[i].view_deg[v] == 0)
+        return NormalIndex{i, v};
+  return std::nullopt;
+}
+
+LogFloored floor_for_log(const InplaneCurves& curves) {
+  LogFloored out{curves, 0};
+  std::array<double, 3> channel_max{};
+  for (const auto& curve : curves)
+    for (const Rgb& b : curve)
+      for (int k = 0; k < 3; ++k) channel_max[k] = std::max(channel_max[k], b[k]);
+  const double largest = *std::max_element(channel_max.begin(), channel_max.end());
+  for (int k = 0; k < 3; ++k) {
+    // A channel with no positive value (a colour far outside the gamut) takes the brightest
+    // channel's maximum; curves with no light at all have no floor and stay excluded.
+    const double top = channel_max[k] > 0 ? channel_max[k] : largest;
+    if (!(top > 0)) continue;
+    const double floor = kLogFloorFraction * top;
+    for (auto& curve : out.curves)
+      for (Rgb& b : curve)
+        if (b[k] < floor) {
+          b[k] = floor;
+          ++out.floored;
+        }
   }
   return out;
 }

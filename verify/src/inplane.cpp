@@ -1,5 +1,6 @@
 #include "weft/verify/inplane.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -30,7 +31,7 @@ std::vector<Rgb> inplane_beta(const TabulatedBsdfTable& t, double theta_i_deg,
   return out;
 }
 
-TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& t, GamutClip* clip) {
+TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& t, OutOfGamut* out_of_gamut) {
   if (t.channels == 3) return t;
   if (t.channels != kNumBands) throw Error("", "channels", "neither RGB nor 33 bands");
   TabulatedBsdfTable o;
@@ -40,11 +41,15 @@ TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& t, GamutClip* clip) {
   o.metadata = t.metadata;
   const size_t cells = t.values.size() / kNumBands;
   o.values.resize(cells * 3);
-  GamutClip local;
   for (size_t c = 0; c < cells; ++c) {
     const float* v = &t.values[c * kNumBands];
     Rgb rgb = bands_to_linear_srgb([v](int b) { return v[b]; });
-    (clip ? *clip : local).clip(rgb);
+    if (out_of_gamut)
+      for (int k = 0; k < 3; ++k)
+        if (rgb[k] < 0) {
+          ++out_of_gamut->components;
+          out_of_gamut->largest = std::max(out_of_gamut->largest, -rgb[k]);
+        }
     o.values[c * 3] = static_cast<float>(rgb.r);
     o.values[c * 3 + 1] = static_cast<float>(rgb.g);
     o.values[c * 3 + 2] = static_cast<float>(rgb.b);

@@ -184,8 +184,14 @@ void html_colours(std::ostringstream& h, const VerifyReport& r) {
   }
   h << "</table>\n<p>Classic diffuse colour (linear sRGB): " << fmt(r.classic_reflectance.r) << ", "
     << fmt(r.classic_reflectance.g) << ", " << fmt(r.classic_reflectance.b) << " ("
-    << r.classic_clip.components << " components clipped to [0, 1]); from "
-    << html_escape(r.classic_source) << ".</p>\n";
+    << r.classic_clip.components
+    << " components clipped to [0, 1]: a fitted reflectance's physical bound); from "
+    << html_escape(r.classic_source)
+    << ".</p>\n<p>Computed fabric table in linear sRGB: " << r.fabric_table_gamut_clipped
+    << " components clipped; " << r.fabric_table_out_of_gamut.components
+    << " lie outside the sRGB gamut (below 0, largest magnitude "
+    << fmt(r.fabric_table_out_of_gamut.largest)
+    << ") and are kept as they are; the log figures floor them.</p>\n";
 }
 
 // The settings, seed and timings.

@@ -108,7 +108,8 @@ nlohmann::json models_json(const VerifyReport& r) {
                      {"absolute", metrics_json(m.absolute_overall)},
                      {"normalized", metrics_json(m.normalized_overall)},
                      {"per_incidence", per},
-                     {"uncertainty", uncertainty_json(m.figures, r.measured.colour_space)}};
+                     {"uncertainty", uncertainty_json(m.figures, r.measured.colour_space)},
+                     {"log_floored_points", m.figures.log_floored_points}};
     if (!m.figures.fits.empty()) models[m.key]["shape"] = shape_json(m.figures.shape, r.measured);
   }
   return models;
@@ -214,9 +215,23 @@ nlohmann::json verdict_json(const VerifyReport& r) {
   nlohmann::json v = {
       {"rule",
        "a is closer when its figure is below b's; resolved when the difference a - b has "
-       "one sign against every fit of the measurement and for every batch, and exceeds " +
+       "one sign against every fit of the measurement and for every batch, exceeds " +
            fmt(kVerdictSeedErrors, 2) +
-           " seed standard errors (paired batch differences) against every fit"}};
+           " seed standard errors (paired batch differences) against every fit, and exceeds the "
+           "measurement's own spread (measured_spread: the largest figure between two of its "
+           "fits; with one fit, spread unknown, min_bundled_fit_spread) against every fit; "
+           "otherwise a tie. Where every model's shape rms_log is above no_model_shape_rms_log, "
+           "no model describes the sample and none is named closer"}};
+  const VerifyVerdictContext context = verify_verdict_context(r);
+  nlohmann::json spread = nlohmann::json::object(), floor = nlohmann::json::object();
+  for (int k = 0; k < 3; ++k) {
+    spread[kFigureKeys[k]] = number_json(context.measured_spread[k]);
+    floor[kFigureKeys[k]] = kMinBundledFitSpread[k];
+  }
+  v["measured_spread"] = spread;
+  v["min_bundled_fit_spread"] = floor;
+  v["no_model_shape_rms_log"] = kNoModelShapeRmsLog;
+  v["no_model_describes"] = context.no_model_describes;
   for (const char* key : kFigureKeys) v[key] = nlohmann::json::array();
   for (const Verdict& d : verify_verdicts(r)) {
     nlohmann::json per_fit = nlohmann::json::array();
@@ -231,7 +246,12 @@ nlohmann::json verdict_json(const VerifyReport& r) {
                            {"same_sign_fits", d.same_sign_fits},
                            {"same_sign_batches", d.same_sign_batches},
                            {"exceeds_seed", d.exceeds_seed},
+                           {"measured_spread", number_json(d.measured_spread)},
+                           {"spread_required", number_json(d.spread_required)},
+                           {"exceeds_spread", d.exceeds_spread},
                            {"resolved", d.resolved},
+                           {"tie", d.tie},
+                           {"no_model_describes", d.no_model_describes},
                            {"comparable", d.comparable},
                            {"closer", d.resolved ? nlohmann::json(d.closer) : nlohmann::json()},
                            {"text", d.text}});
@@ -299,7 +319,13 @@ nlohmann::json verify_metrics(const VerifyReport& r) {
       "view equals the measured one";
   j["metrics"] =
       "rms_log: RMS of ln(model / measured); rms_rel: RMS of (model - measured) / "
-      "measured; over every view, incidence and channel where both are positive";
+      "measured; over every view, incidence and channel, each side's channel floored at "
+      "log_floor_fraction of its own maximum (linear sRGB is kept unclamped, so a saturated "
+      "colour has negative components: log_floored_points per model, measured_log_floored_points "
+      "for the reference fit); a channel with no positive value is excluded";
+  j["log_floor_fraction"] = kLogFloorFraction;
+  j["measured_log_floored_points"] =
+      r.measured.curves.empty() ? 0 : floor_for_log(measured_fits(r.measured).front().beta).floored;
   j["shape"] =
       "per model and channel one gain, ln g = mean of ln(measured / model) over the points where "
       "both are positive and |view| <= " +
@@ -310,7 +336,8 @@ nlohmann::json verify_metrics(const VerifyReport& r) {
       "per figure: seed_sd, the standard deviation of the figure over the ray trace's batches "
       "(each an independent seed), and seed_se = seed_sd / sqrt(batches), the standard error of "
       "the figure of their mean (shown after +-); per_fit, the figure against each fit of the "
-      "measurement (fit_min..fit_max: the measurement's own spread)";
+      "measurement (fit_min..fit_max: how far the figure moves with the reference; the verdict's "
+      "measured_spread is the figure between the measurement's fits themselves)";
   j["models"] = models_json(r);
   add_headline_figures(j, r.models);
   j["verdict"] = verdict_json(r);
@@ -327,6 +354,8 @@ nlohmann::json verify_metrics(const VerifyReport& r) {
   j["classic_reflectance_clipped_components"] = r.classic_clip.components;
   j["classic_source"] = r.classic_source;
   j["fabric_table_gamut_clipped_components"] = r.fabric_table_gamut_clipped;
+  j["fabric_table_out_of_gamut_components"] = r.fabric_table_out_of_gamut.components;
+  j["fabric_table_out_of_gamut_largest"] = r.fabric_table_out_of_gamut.largest;
   j["raytrace_relative_noise"] = r.raytrace_relative_noise;
   return j;
 }

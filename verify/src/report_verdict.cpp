@@ -19,6 +19,17 @@ std::string verdict_model_name(const std::string& key) {
   return "the " + std::string(is_fitted ? "fitted " : "") + base;
 }
 
+VerifyVerdictContext verify_verdict_context(const VerifyReport& r) {
+  VerifyVerdictContext c;
+  if (const auto normal = normal_index(r.measured))
+    c.measured_spread = measured_fit_spread(r.measured, *normal);
+  std::vector<double> shape;
+  for (const ModelCurves& m : r.models)
+    if (!m.figures.fits.empty()) shape.push_back(m.figures.figure[kShapeFigure].value());
+  c.no_model_describes = no_model_describes(shape);
+  return c;
+}
+
 std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
   const auto find = [&](const std::string& key) -> const ModelCurves* {
     const auto it = std::find_if(r.models.begin(), r.models.end(),
@@ -30,6 +41,7 @@ std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
       {verify_model_key(M::kComputedRaytrace), verify_model_key(M::kClassic)},
       {verify_model_key(M::kComputedSummation), verify_model_key(M::kClassic)},
       {verify_model_key(M::kComputedRaytraceFitted), verify_model_key(M::kClassicFitted)}};
+  const VerifyVerdictContext context = verify_verdict_context(r);
   std::vector<Verdict> out;
   for (int f = 0; f < 3; ++f)
     for (const auto& [ka, kb] : pairs) {
@@ -38,7 +50,8 @@ std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
       if (!a || !b || a->figures.fits.empty() || b->figures.fits.empty()) continue;
       const auto kind = static_cast<FigureKind>(f);
       Verdict v = compare_figure(kind, ka, verdict_model_name(ka), a->figures.figure[f], kb,
-                                 verdict_model_name(kb), b->figures.figure[f]);
+                                 verdict_model_name(kb), b->figures.figure[f],
+                                 {context.measured_spread[f], context.no_model_describes});
       if (kind == kAbsoluteFigure && !absolute_comparable(r.measured.colour_space)) {
         v.comparable = false;
         v.text += " [" + not_comparable_note(r.measured.colour_space) + "]";

@@ -121,8 +121,12 @@ ModelCurves model_curves(std::string key, std::string label, InplaneCurves beta,
 void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& normal_curve,
            size_t normal_view) {
   const size_t normal_incidence = static_cast<size_t>(&normal_curve - meas.curves.data());
-  const Rgb model0 = m.beta[normal_incidence][normal_view];
-  m.normalization = paper_normalization(model0, normal_curve.beta[normal_view]);
+  // Log metrics of values floored at a fraction of each channel's maximum (figures.h
+  // kLogFloorFraction): an out-of-gamut channel is kept negative, not clipped, in the curves.
+  const InplaneCurves model = floor_for_log(m.beta).curves;
+  const InplaneCurves reference = floor_for_log(measured_fits(meas).front().beta).curves;
+  const Rgb model0 = model[normal_incidence][normal_view];
+  m.normalization = paper_normalization(model0, reference[normal_incidence][normal_view]);
   // Without a factor in every channel the paper's figure is not defined (as in figures.h).
   const bool normalized = std::isfinite(m.normalization.r) && std::isfinite(m.normalization.g) &&
                           std::isfinite(m.normalization.b);
@@ -131,11 +135,10 @@ void score(ModelCurves& m, const MeasuredInplane& meas, const MeasuredCurve& nor
   for (size_t i = 0; i < meas.curves.size(); ++i) {
     MetricsAccumulator a, n;
     std::array<MetricsAccumulator, 3> ac, nc;
-    const auto& c = meas.curves[i];
-    for (size_t v = 0; v < c.view_deg.size(); ++v)
+    for (size_t v = 0; v < reference[i].size(); ++v)
       for (int k = 0; k < 3; ++k) {
-        ac[k].add(m.beta[i][v][k], c.beta[v][k]);
-        nc[k].add(m.beta[i][v][k] * m.normalization[k], c.beta[v][k]);
+        ac[k].add(model[i][v][k], reference[i][v][k]);
+        nc[k].add(model[i][v][k] * m.normalization[k], reference[i][v][k]);
       }
     auto& acm = m.absolute_channel.emplace_back();
     auto& ncm = m.normalized_channel.emplace_back();
@@ -169,29 +172,21 @@ NormalPoint check_run(const VerifyInputs& in, const MeasuredInplane& measured,
     throw Error("", "particles_per_bin", "fewer particles than batches");
   if (in.fiber.resolution != s.resolution)
     throw Error("", "fiber.resolution", "the fiber table's resolution differs from the settings'");
-  NormalPoint normal;
-  for (const auto& c : measured.curves)
-    if (c.theta_i_deg == 0)
-      for (size_t v = 0; v < c.view_deg.size(); ++v)
-        if (c.view_deg[v] == 0) {
-          normal.curve = &c;
-          normal.view = v;
-        }
-  if (!normal.curve)
+  const std::optional<NormalIndex> normal = normal_index(measured);
+  if (!normal)
     throw Error(measured.file, "theta_i_deg",
                 "no row at theta_i_deg = 0, theta_o_deg = 0 (the paper's normalization needs it)");
-  return normal;
+  return {&measured.curves[normal->incidence], normal->view};
 }
 
 // The computed fabric's ray trace in the report: its curves, noise, table and fiber table.
 void add_computed_raytrace(VerifyReport& rep, const TracedCurves& computed, const VerifyInputs& in,
                            const WovenSample& sample) {
   rep.raytrace_relative_noise = computed.relative_noise;
-  {
-    GamutClip clip;
-    table_to_rgb(computed.mean, &clip);
-    rep.fabric_table_gamut_clipped = clip.components;
-  }
+  // Nothing is clipped (table_to_rgb keeps negative components); what lies outside the gamut is
+  // counted.
+  table_to_rgb(computed.mean, &rep.fabric_table_out_of_gamut);
+  rep.fabric_table_gamut_clipped = 0;
   rep.models.push_back(model_curves(verify_model(VerifyModel::kComputedRaytrace).key,
                                     verify_model(VerifyModel::kComputedRaytrace).label,
                                     computed.beta, computed.err, computed.batches));

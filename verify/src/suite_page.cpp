@@ -6,6 +6,7 @@
 #include "common.h"
 #include "weft/verify/models.h"
 #include "weft/verify/suite.h"
+#include "weft/verify/verdict.h"
 
 namespace weft {
 namespace {
@@ -60,18 +61,22 @@ std::vector<std::string> verdict_texts(const nlohmann::json& metrics, const std:
   return texts;
 }
 
-// The shape verdict of the computed ray trace against the classic model: "computed", "classic"
-// or "unresolved"; empty when the report has no such verdict.
+// The shape verdict of the computed ray trace against the classic model: "computed", "classic",
+// "tie", "no_model" (no model describes the sample) or "unresolved" (a figure not defined);
+// empty when the report has no such verdict.
 std::string shape_closer(const nlohmann::json& metrics) {
   const nlohmann::json::json_pointer p("/verdict/shape");
   if (!metrics.contains(p) || !metrics.at(p).is_array()) return "";
+  const nlohmann::json::json_pointer none("/verdict/no_model_describes");
+  if (metrics.contains(none) && metrics.at(none).is_boolean() && metrics.at(none).get<bool>())
+    return "no_model";
   for (const auto& v : metrics.at(p)) {
     const std::string a = v.value("a", ""), b = v.value("b", "");
     const std::string computed = verify_model_key(VerifyModel::kComputedRaytrace),
                       classic = verify_model_key(VerifyModel::kClassic);
     const bool pair = (a == computed && b == classic) || (a == classic && b == computed);
     if (!pair) continue;
-    if (!v.value("resolved", false)) return "unresolved";
+    if (!v.value("resolved", false)) return v.value("tie", false) ? "tie" : "unresolved";
     return v.value("closer", "") == "classic" ? "classic" : "computed";
   }
   return "";
@@ -100,10 +105,17 @@ nlohmann::json suite_row_json(const SuiteRow& r) {
   j["absolute_comparable"] = r.metrics.value("absolute_comparable", true);
   j["shape_closer"] = shape_closer(r.metrics);
   j["shape_verdicts"] = verdict_texts(r.metrics, "shape");
-  // A deep dye's spectrum can leave the sRGB gamut: the table's clipped components then hold
-  // zero where the spectrum has light, and a channel's log figures compare clipped values.
+  // A deep dye's spectrum can leave the sRGB gamut: its negative components are kept (none
+  // clipped, unlike reports before) and the log figures floor them (figures.h).
   j["computed_gamut_clipped_components"] =
       r.metrics.value("fabric_table_gamut_clipped_components", 0);
+  j["computed_out_of_gamut_components"] =
+      r.metrics.value("fabric_table_out_of_gamut_components", 0);
+  j["computed_log_floored_points"] = finite_or_null(number_at(
+      r.metrics, nlohmann::json::json_pointer(std::string("/models/") +
+                                              verify_model_key(VerifyModel::kComputedRaytrace) +
+                                              "/log_floored_points")));
+  j["no_model_describes"] = shape_closer(r.metrics) == "no_model";
   if (r.metrics.contains("verdict")) j["verdict"] = r.metrics.at("verdict");
   return j;
 }
@@ -138,25 +150,35 @@ std::string joined(const nlohmann::json& texts, const std::string& separator) {
 
 // How many fabrics' shape verdicts (computed ray trace vs classic) went each way.
 nlohmann::json shape_summary(const nlohmann::json& rows) {
-  int computed = 0, classic = 0, unresolved = 0, not_run = 0;
+  int computed = 0, classic = 0, tie = 0, undefined = 0, no_model = 0, not_run = 0;
   for (const auto& row : rows) {
     const std::string c = row.value("shape_closer", "");
     (c == "computed"     ? computed
      : c == "classic"    ? classic
-     : c == "unresolved" ? unresolved
+     : c == "tie"        ? tie
+     : c == "unresolved" ? undefined
+     : c == "no_model"   ? no_model
                          : not_run)++;
   }
+  // "unresolved" (kept for the readers of earlier pages) counts every verdict that names no
+  // closer model: ties, undefined figures and samples no model describes.
   return {{"computed_closer", computed},
           {"classic_closer", classic},
-          {"unresolved", unresolved},
+          {"unresolved", tie + undefined + no_model},
+          {"tie", tie},
+          {"no_model_describes", no_model},
           {"without_verdict", not_run}};
 }
 
 std::string summary_sentence(const nlohmann::json& s) {
+  const int undefined =
+      s["unresolved"].get<int>() - s["tie"].get<int>() - s["no_model_describes"].get<int>();
   return "Shape, computed (ray trace) vs classic: computed closer on " +
          std::to_string(s["computed_closer"].get<int>()) + ", classic closer on " +
-         std::to_string(s["classic_closer"].get<int>()) + ", not resolved on " +
-         std::to_string(s["unresolved"].get<int>()) + " fabric(s)" +
+         std::to_string(s["classic_closer"].get<int>()) + ", a tie on " +
+         std::to_string(s["tie"].get<int>()) + ", no model describes the sample on " +
+         std::to_string(s["no_model_describes"].get<int>()) + " fabric(s)" +
+         (undefined ? ", not defined on " + std::to_string(undefined) : "") +
          (s["without_verdict"].get<int>()
               ? ", " + std::to_string(s["without_verdict"].get<int>()) + " without a verdict"
               : "") +
@@ -232,7 +254,17 @@ std::string verify_suite_html(const VerifySuite& suite, const std::vector<SuiteR
        "<b>paper's</b> "
        "one-point normalization (Voloboy et al. 2010: hinges on the normal-incidence, "
        "normal-view point); <b>absolute</b> (includes the colour level: comparable only where "
-       "model and measurement share a colour space).</p>\n<table>\n<tr><th rowspan=\"2\">fabric"
+       "model and measurement share a colour space). Linear sRGB is not clipped: a channel "
+       "outside the gamut is kept, and the logs floor each channel at "
+    << fmt(kLogFloorFraction)
+    << " of its own maximum (the points floored are counted). A verdict names a closer model "
+       "only when the difference exceeds "
+    << fmt(kVerdictSeedErrors)
+    << " seed standard errors and the measurement's own spread between its fits (with one "
+       "fit, spread unknown: the smallest such spread on the bundled MERL measurements); "
+       "otherwise it is a tie. Where every model's shape is above "
+    << fmt(kNoModelShapeRmsLog)
+    << ", no model here describes the sample.</p>\n<table>\n<tr><th rowspan=\"2\">fabric"
        "</th><th rowspan=\"2\">what is known</th>";
   for (const SuiteModel& model : kSuiteModels) h << "<th colspan=\"3\">" << model.label << "</th>";
   h << "<th rowspan=\"2\">verdict</th></tr>\n<tr>";
@@ -246,8 +278,11 @@ std::string verify_suite_html(const VerifySuite& suite, const std::vector<SuiteR
       << html_escape(r.fabric.known) << "<br><small>fiber " << html_escape(r.fabric.fiber)
       << "; colour space "
       << html_escape(r.fabric.colour_space.empty() ? "as the file says" : r.fabric.colour_space);
-    if (const int clipped = row.value("computed_gamut_clipped_components", 0); clipped > 0)
-      h << "; the computed table has " << clipped << " components clipped to the sRGB gamut";
+    h << "; computed table: " << row.value("computed_gamut_clipped_components", 0)
+      << " components clipped, " << row.value("computed_out_of_gamut_components", 0)
+      << " outside the sRGB gamut (kept)";
+    if (row["computed_log_floored_points"].is_number())
+      h << ", " << fmt(row["computed_log_floored_points"].get<double>(), 9) << " points floored";
     h << "</small></td>";
     if (row.contains("error")) {
       h << "<td colspan=\"" << 3 * std::size(kSuiteModels) + 1
@@ -258,7 +293,10 @@ std::string verify_suite_html(const VerifySuite& suite, const std::vector<SuiteR
       h << model_cell(
           row["models"].contains(model.key) ? row["models"][model.key] : nlohmann::json(),
           row["absolute_comparable"].get<bool>());
-    h << "<td>" << html_escape(joined(row["shape_verdicts"], "; ")) << "</td></tr>\n";
+    h << "<td>"
+      << (row["no_model_describes"].get<bool>() ? "<b>No model here describes this sample.</b> "
+                                                : "")
+      << html_escape(joined(row["shape_verdicts"], "; ")) << "</td></tr>\n";
   }
   nlohmann::json list = nlohmann::json::array();
   for (const auto& r : rows) list.push_back(suite_row_json(r));

@@ -34,7 +34,21 @@ std::string figure_text(const FigureSamples& f) {
 // The verdict, then the headline figures of each model with their uncertainty.
 void verdict_text(std::string& out, const VerifyReport& report) {
   const std::vector<Verdict> verdicts = verify_verdicts(report);
+  const VerifyVerdictContext context = verify_verdict_context(report);
   out += "  verdict:\n";
+  if (context.no_model_describes)
+    append(out,
+           "   no model here describes this sample (every model's shape RMS log is above %.3g): "
+           "none is named closer\n",
+           kNoModelShapeRmsLog);
+  out += "   the measurement's own spread between its fits:";
+  for (int f = 0; f < 3; ++f) {
+    if (std::isfinite(context.measured_spread[f]))
+      append(out, " %s %.3f", kFigureKeys[f], context.measured_spread[f]);
+    else
+      append(out, " %s unknown (one fit; %.3f required)", kFigureKeys[f], kMinBundledFitSpread[f]);
+  }
+  out += "\n";
   for (int f = 0; f < 3; ++f) {
     const std::string note =
         f == kAbsoluteFigure ? not_comparable_note(report.measured.colour_space) : "";
@@ -44,15 +58,16 @@ void verdict_text(std::string& out, const VerifyReport& report) {
       if (v.figure == kFigureKeys[f]) append(out, "    - %s\n", v.text.c_str());
   }
   append(
-      out, "  %-36s %-28s %-28s %-28s\n", "RMS log (+- seed SE [over fits])", "shape",
+      out, "  %-36s %-28s %-28s %-28s %s\n", "RMS log (+- seed SE [over fits])", "shape",
       "paper's one-point",
-      absolute_comparable(report.measured.colour_space) ? "absolute" : "absolute (not comparable)");
+      absolute_comparable(report.measured.colour_space) ? "absolute" : "absolute (not comparable)",
+      "floored");
   for (const auto& m : report.models)
     if (!m.figures.fits.empty())
-      append(out, "  %-36s %-28s %-28s %-28s\n", m.label.c_str(),
+      append(out, "  %-36s %-28s %-28s %-28s %zu\n", m.label.c_str(),
              figure_text(m.figures.figure[kShapeFigure]).c_str(),
              figure_text(m.figures.figure[kPaperFigure]).c_str(),
-             figure_text(m.figures.figure[kAbsoluteFigure]).c_str());
+             figure_text(m.figures.figure[kAbsoluteFigure]).c_str(), m.figures.log_floored_points);
 }
 
 // Each fit: its objective, evaluations and parameters with their spread over the seeds' fits.

@@ -25,6 +25,24 @@ int sign(double x) {
   return x > 0 ? 1 : (x < 0 ? -1 : 0);
 }
 
+// "above the measurement's own spread 0.06 between its 3 fits", or with one fit what stood in.
+std::string spread_words(const Verdict& v, const char* relation) {
+  if (std::isfinite(v.measured_spread))
+    return std::string(relation) + " the measurement's own spread " + fmt(v.measured_spread, 2) +
+           " between its " + std::to_string(v.difference_per_fit.size()) + " fits";
+  return "one fit: spread unknown; " + std::string(relation) + " " + fmt(v.spread_required, 2) +
+         ", the smallest spread between fits on the bundled MERL measurements";
+}
+
+// Why a defined difference is a tie, the first reason that holds.
+std::string tie_reason(const Verdict& v) {
+  if (v.difference == 0) return "no difference";
+  if (!v.same_sign_fits) return "the sign differs between the measurement's fits";
+  if (!v.exceeds_spread) return spread_words(v, "within");
+  if (!v.exceeds_seed) return "within " + fmt(kVerdictSeedErrors, 2) + " seed standard errors";
+  return "the sign differs between batches";
+}
+
 std::string verdict_text(const Verdict& v, FigureKind figure, const std::string& a_name,
                          const std::string& b_name) {
   // The closer model's figure first when resolved; else in the pair's order.
@@ -40,22 +58,19 @@ std::string verdict_text(const Verdict& v, FigureKind figure, const std::string&
   if (v.resolved) {
     const bool a_closer = v.closer == v.a;
     return figure_name(figure) + ": " + (a_closer ? a_name : b_name) + " is closer than " +
-           (a_closer ? b_name : a_name) + " (" + values + ", difference " + seed +
-           ", same sign against all " + fits + " of the measurement and every batch)";
+           (a_closer ? b_name : a_name) + " (" + values + ", difference " + seed + ", " +
+           spread_words(v, "above") + ", same sign against all " + fits +
+           " of the measurement and every batch)";
   }
-  std::string why;
+  const std::string pair = figure_name(figure) + ", " + a_name + " vs " + b_name;
   if (!std::isfinite(v.difference))
-    why = "a figure is not defined";
-  else if (!v.same_sign_fits)
-    why = "the sign differs between the measurement's fits";
-  else if (!v.exceeds_seed)
-    why = "within " + fmt(kVerdictSeedErrors, 2) + " seed standard errors";
-  else
-    why = "the sign differs between batches";
-  return figure_name(figure) + ", " + a_name + " vs " + b_name + ": not resolved (" + values +
-         ", difference (first minus second) " + fmt(v.difference, 2) + " +- " +
-         fmt(v.difference_seed_se, 1) + " seed, " + fmt(lo, 2) + ".." + fmt(hi, 2) +
-         " against the " + fits + " of the measurement; " + why + ")";
+    return pair + ": no verdict (" + values + "; a figure is not defined)";
+  if (v.no_model_describes)
+    return pair + ": no model here describes the sample (every model's shape RMS log is above " +
+           fmt(kNoModelShapeRmsLog, 2) + "), so none is named closer (" + values + ")";
+  return pair + ": a tie (" + values + ", difference (first minus second) " + fmt(v.difference, 2) +
+         " +- " + fmt(v.difference_seed_se, 1) + " seed, " + fmt(lo, 2) + ".." + fmt(hi, 2) +
+         " against the " + fits + " of the measurement; " + tie_reason(v) + ")";
 }
 
 }  // namespace
@@ -89,7 +104,7 @@ std::string figure_label(FigureKind figure) {
 
 Verdict compare_figure(FigureKind figure, const std::string& a_key, const std::string& a_name,
                        const FigureSamples& a, const std::string& b_key, const std::string& b_name,
-                       const FigureSamples& b) {
+                       const FigureSamples& b, const VerdictContext& context) {
   Verdict v;
   v.figure = kFigureKeys[figure];
   v.a = a_key;
@@ -98,7 +113,11 @@ Verdict compare_figure(FigureKind figure, const std::string& a_key, const std::s
   v.b_value = b.value();
   v.difference = v.a_value - v.b_value;
   const int s = sign(v.difference);
-  v.same_sign_fits = v.same_sign_batches = v.exceeds_seed = std::isfinite(v.difference) && s != 0;
+  v.measured_spread = context.measured_spread;
+  v.spread_required = std::isfinite(context.measured_spread) ? context.measured_spread
+                                                             : kMinBundledFitSpread[figure];
+  v.same_sign_fits = v.same_sign_batches = v.exceeds_seed = v.exceeds_spread =
+      std::isfinite(v.difference) && s != 0;
   for (size_t f = 0; f < a.mean.size() && f < b.mean.size(); ++f) {
     const double d = a.mean[f] - b.mean[f];
     v.difference_per_fit.push_back(d);
@@ -107,13 +126,27 @@ Verdict compare_figure(FigureKind figure, const std::string& a_key, const std::s
     const double se = db.empty() ? 0.0 : sample_sd(db) / std::sqrt(static_cast<double>(db.size()));
     if (f == 0) v.difference_seed_se = se;
     if (!(std::abs(d) > kVerdictSeedErrors * se)) v.exceeds_seed = false;
+    if (!(std::abs(d) > v.spread_required)) v.exceeds_spread = false;
     for (double x : db)
       if (!(sign(x) == s)) v.same_sign_batches = false;
   }
-  v.resolved = v.same_sign_fits && v.same_sign_batches && v.exceeds_seed;
+  v.no_model_describes = context.no_model_describes;
+  v.resolved = v.same_sign_fits && v.same_sign_batches && v.exceeds_seed && v.exceeds_spread &&
+               !v.no_model_describes;
+  v.tie = !v.resolved && std::isfinite(v.difference) && !v.no_model_describes;
   if (v.resolved) v.closer = s < 0 ? a_key : b_key;
   v.text = verdict_text(v, figure, a_name, b_name);
   return v;
+}
+
+bool no_model_describes(const std::vector<double>& shape_figures) {
+  bool any = false;
+  for (double f : shape_figures) {
+    if (std::isnan(f)) continue;  // not defined: describes nothing either way
+    if (!(f > kNoModelShapeRmsLog)) return false;
+    any = true;
+  }
+  return any;
 }
 
 }  // namespace weft

@@ -15,7 +15,7 @@ struct ColourEntry {
   // measurement's in its own RGB space.
   Rgb rgb;
   std::string colour_space = "linear sRGB";
-  Hsv hsv;  // of the RGB with negative components set to 0
+  Hsv hsv;  // of the RGB with negative components set to 0 (for display; the note says so)
   // Whether its absolute colour compares with the models' linear sRGB (a measurement in camera
   // RGB or an unknown space does not).
   bool comparable = true;

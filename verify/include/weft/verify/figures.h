@@ -6,6 +6,7 @@
 #include <array>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +42,21 @@ ShapeFigure shape_figure(const InplaneCurves& model, const InplaneCurves& measur
 struct NormalIndex {
   size_t incidence = 0, view = 0;
 };
+// The measurement's normal point; none where it has no row at theta_i = 0, view = 0.
+std::optional<NormalIndex> normal_index(const MeasuredInplane& measured);
+
+// Log figures need both sides positive. The models' linear sRGB is not clamped, so a saturated
+// colour outside the gamut has negative components, and a measurement may hold a dark point at
+// 0. Before any figure each side's channel is floored at kLogFloorFraction of that channel's own
+// maximum over its curves (scale-free, so the same for every model, gain and colour space); the
+// points floored are counted and reported. A channel with no positive value takes the brightest
+// channel's maximum; curves with no light at all have no floor, and their points stay excluded.
+inline constexpr double kLogFloorFraction = 1e-3;
+struct LogFloored {
+  InplaneCurves curves;
+  size_t floored = 0;  // components raised to their channel's floor
+};
+LogFloored floor_for_log(const InplaneCurves& curves);
 
 // RMS of ln(model / measured) over every point where both are positive: as computed (absolute),
 // and with the model scaled per channel to equal the measurement at the normal point (the
@@ -70,11 +86,20 @@ struct FigureSamples {
 struct ModelFigures {
   std::vector<std::string> fits;  // the measurement's fits, reference first
   std::array<FigureSamples, 3> figure;
-  ShapeFigure shape;  // the mean curves against the reference, in detail
+  ShapeFigure shape;              // the mean curves against the reference, in detail
+  size_t log_floored_points = 0;  // of the mean curves (floor_for_log)
 };
+// Every figure is of the curves floored by floor_for_log (the model's and each fit's).
 // 'batches': each batch's curves ([batch][incidence][view]); empty for a deterministic model.
 ModelFigures model_figures(const InplaneCurves& mean, const std::vector<InplaneCurves>& batches,
                            const MeasuredInplane& measured, NormalIndex normal);
+
+// The measurement's own spread on each figure (kFigureKeys order): the largest figure between two
+// of its fits, one taken as the model and the other as the reference (floored as above; the
+// figures are symmetric in the pair). An RMS of log ratios obeys the triangle inequality, so this
+// bounds how far a model's shape or absolute figure can move when another fit is the reference: a
+// difference between two models below it can turn with the choice of fit. NaN with one fit.
+std::array<double, 3> measured_fit_spread(const MeasuredInplane& measured, NormalIndex normal);
 
 // The sample standard deviation (n - 1) of 'values'; 0 for fewer than two.
 double sample_sd(const std::vector<double>& values);

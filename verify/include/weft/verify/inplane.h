@@ -27,10 +27,19 @@ namespace weft {
 std::vector<Rgb> inplane_beta(const TabulatedBsdfTable& rgb_table, double theta_i_deg,
                               const std::vector<double>& views_deg, int azimuths);
 
-// A spectral table (33 bands) as linear sRGB under D65 (core/spectrum.h bands_to_linear_srgb);
-// negative components (out of gamut) are set to 0 and counted in 'clip'. A 3-channel table is
+// What a spectral table's reduction to linear sRGB left outside the gamut: components below 0
+// (a saturated colour), kept as they are.
+struct OutOfGamut {
+  size_t components = 0;
+  double largest = 0;  // largest magnitude below 0
+};
+
+// A spectral table (33 bands) as linear sRGB under D65 (core/spectrum.h bands_to_linear_srgb),
+// unclamped: negative components of colours outside the gamut are kept (the metrics take them
+// as they are, figures.h kLogFloorFraction) and counted in 'out_of_gamut'. A 3-channel table is
 // returned as it is.
-TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& table, GamutClip* clip = nullptr);
+TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& table,
+                                OutOfGamut* out_of_gamut = nullptr);
 
 // beta [incidence][view] of an RGB or spectral table at the measurement's views.
 std::vector<std::vector<Rgb>> table_curves(const TabulatedBsdfTable& table,

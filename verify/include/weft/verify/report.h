@@ -1,8 +1,10 @@
 #pragma once
 // The report of a verification (docs/verify.md "Report"): its files as text, and the folder that
 // holds them, written whole or not at all.
+#include <array>
 #include <filesystem>
 #include <functional>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <utility>
@@ -26,6 +28,16 @@ std::string verify_index_html(const VerifyReport& report,
 // ray trace against the classic model, the paper's summation against the classic model, and the
 // fitted ray trace against the fitted classic model, each where both are in the report.
 std::vector<Verdict> verify_verdicts(const VerifyReport& report);
+// What the report's verdicts know beyond the models' figures: the measurement's own spread per
+// figure (kFigureKeys' order; NaN with one fit) and whether no model describes it (every
+// model's shape figure above kNoModelShapeRmsLog).
+struct VerifyVerdictContext {
+  std::array<double, 3> measured_spread{std::numeric_limits<double>::quiet_NaN(),
+                                        std::numeric_limits<double>::quiet_NaN(),
+                                        std::numeric_limits<double>::quiet_NaN()};
+  bool no_model_describes = false;
+};
+VerifyVerdictContext verify_verdict_context(const VerifyReport& report);
 // A model's name in the verdict's words ("computed (ray trace)", "classic, fitted").
 std::string verdict_model_name(const std::string& key);
 

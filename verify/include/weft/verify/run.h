@@ -27,6 +27,7 @@
 #include "weft/verify/colour.h"
 #include "weft/verify/figures.h"
 #include "weft/verify/fit.h"
+#include "weft/verify/inplane.h"
 #include "weft/verify/measured.h"
 #include "weft/verify/metrics.h"
 #include "weft/verify/render.h"
@@ -84,9 +85,11 @@ struct VerifyReport {
   std::string classic_source;  // VerifyInputs::classic_source
   std::map<std::string, double> seconds;
   std::string fiber_name, sample_name;
-  size_t fabric_table_gamut_clipped = 0;  // components of the computed table set to 0
-  double raytrace_relative_noise = 0;     // of the combined computed table (fabric_raytrace.h)
-  std::vector<FitResult> fits;            // with --fit: "computed", "classic"
+  size_t fabric_table_gamut_clipped = 0;  // components of the computed table set to 0: none now
+  // Components of the computed table's linear sRGB below 0 (a saturated colour), kept as they are.
+  OutOfGamut fabric_table_out_of_gamut;
+  double raytrace_relative_noise = 0;  // of the combined computed table (fabric_raytrace.h)
+  std::vector<FitResult> fits;         // with --fit: "computed", "classic"
   // What the renders show: the ray-traced fabric tables of the computed and the classic fiber
   // (the mean of the batches) and the measured BRDF's network, where the measurement has one
   // (nbrdf_weights.txt beside the table; empty: none).
