@@ -171,6 +171,8 @@ ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::fil
                {"sheen color B", fit.material.sheen_color.b},
                {"sheen roughness", fit.material.sheen_roughness},
                {"transmission", fit.material.transmission}};
+  if (g.transmission > 0 || g.diffuse_transmission > 0)
+    r.figures.push_back({"transmission straight-through peak", fit.transmission_peak});
   if (g.diffuse_transmission > 0) {
     r.figures.push_back({"diffuse transmission", g.diffuse_transmission});
     for (int c = 0; c < 3; ++c)

@@ -75,7 +75,7 @@ struct GltfFitOptions {
   double transmission_threshold = 0.05;  // mean transmittance above which transmission is written
   // Diffuse transmission unless the straight-through f exceeds this many times a Lambertian
   // BTDF's of the same albedo (mean over the upper view bins).
-  double diffuse_peak_max = 3;
+  double diffuse_peak_max = 10;
 };
 GltfFit fit_gltf_material(const TabulatedBsdfTable& table, const GltfFitOptions& options = {});
 
