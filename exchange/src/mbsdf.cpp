@@ -34,8 +34,8 @@ struct MbsdfGrid {
 
 // f in linear sRGB over the grid, light at theta_in on the side 'light_z' (+1 upper, -1 lower),
 // view at (theta_out, phi) on the side 'view_z'.
-MbsdfGrid sample_part(const TableView& view, const MbsdfOptions& o, double light_z, double view_z,
-                      GamutClip& clip) {
+MbsdfGrid sample_mbsdf_part(const TableView& view, const MbsdfOptions& o, double light_z,
+                            double view_z, GamutClip& clip) {
   MbsdfGrid g{o.theta_resolution, o.phi_resolution, {}};
   g.v.resize(static_cast<size_t>(g.nt * g.nt * g.np * 3));
   std::vector<double> f(static_cast<size_t>(view.channels()));
@@ -55,7 +55,7 @@ MbsdfGrid sample_part(const TableView& view, const MbsdfOptions& o, double light
 
 // The hemispherical albedo per theta_in and channel: f cos theta_out over the cells (exact
 // cos sin weights, phi over [0, pi] counted twice).
-std::vector<double> part_albedos(const MbsdfGrid& g) {
+std::vector<double> mbsdf_part_albedos(const MbsdfGrid& g) {
   std::vector<double> a(static_cast<size_t>(g.nt * 3), 0.0);
   const double dt = kPi / 2 / g.nt, dp = kPi / g.np;
   for (int ti = 0; ti < g.nt; ++ti)
@@ -70,8 +70,8 @@ std::vector<double> part_albedos(const MbsdfGrid& g) {
 // The largest difference per incidence and channel of the file's albedo from either direction's,
 // relative to the larger of the two directions (where that is not negligible, 1e-6 of its peak):
 // 0 for a reciprocal table, 1/2 for one that transmits one way only.
-double direction_error(const std::vector<double>& file, const std::vector<double>& down,
-                       const std::vector<double>& up) {
+double mbsdf_direction_error(const std::vector<double>& file, const std::vector<double>& down,
+                             const std::vector<double>& up) {
   double peak = 0;
   for (size_t k = 0; k < file.size(); ++k) peak = std::max({peak, down[k], up[k]});
   double worst = 0;
@@ -88,9 +88,10 @@ double direction_error(const std::vector<double>& file, const std::vector<double
 // up one table for both sides, averaged with its transpose (f(in, out) + f(out, in)) / 2. So the
 // file holds the mean of the table's two directions (light from above to a view below, light
 // from below to a view above), made reciprocal: what those renderers show, exactly.
-MbsdfGrid transmission_part(const TableView& view, const MbsdfOptions& o, GamutClip& clip,
-                            ExportReport& r) {
-  MbsdfGrid down = sample_part(view, o, 1, -1, clip), up = sample_part(view, o, -1, 1, clip);
+MbsdfGrid mbsdf_transmission_part(const TableView& view, const MbsdfOptions& o, GamutClip& clip,
+                                  ExportReport& r) {
+  MbsdfGrid down = sample_mbsdf_part(view, o, 1, -1, clip),
+            up = sample_mbsdf_part(view, o, -1, 1, clip);
   MbsdfGrid t{down.nt, down.np, std::vector<double>(down.v.size())};
   for (int ti = 0; ti < t.nt; ++ti)
     for (int to = 0; to < t.nt; ++to)
@@ -99,7 +100,8 @@ MbsdfGrid transmission_part(const TableView& view, const MbsdfOptions& o, GamutC
           t.at(ti, to, p, c) = (down.at(ti, to, p, c) + up.at(ti, to, p, c) +
                                 down.at(to, ti, p, c) + up.at(to, ti, p, c)) /
                                4;
-  const auto a_down = part_albedos(down), a_up = part_albedos(up), a_file = part_albedos(t);
+  const auto a_down = mbsdf_part_albedos(down), a_up = mbsdf_part_albedos(up),
+             a_file = mbsdf_part_albedos(t);
   const auto mean = [](const std::vector<double>& a) {
     double s = 0;
     for (double x : a) s += x;
@@ -108,7 +110,7 @@ MbsdfGrid transmission_part(const TableView& view, const MbsdfOptions& o, GamutC
   r.figures.push_back({"transmittance light from above (table)", mean(a_down)});
   r.figures.push_back({"transmittance light from below (table)", mean(a_up)});
   r.figures.push_back({"transmittance either way (file)", mean(a_file)});
-  const double error = direction_error(a_file, a_down, a_up);
+  const double error = mbsdf_direction_error(a_file, a_down, a_up);
   r.figures.push_back({"transmission direction error (max relative)", error});
   if (error > 0.01)
     r.notes.push_back(
@@ -118,7 +120,7 @@ MbsdfGrid transmission_part(const TableView& view, const MbsdfOptions& o, GamutC
   return t;
 }
 
-void append_part(const MbsdfGrid& g, bool transmission, std::string& out) {
+void append_mbsdf_part(const MbsdfGrid& g, bool transmission, std::string& out) {
   out += transmission ? "MBSDF_DATA_TRANSMISSION=\n" : "MBSDF_DATA_REFLECTION=\n";
   put_u32(out, 1);  // RGB
   put_u32(out, static_cast<uint32_t>(g.nt));
@@ -145,11 +147,11 @@ ExportReport write_mbsdf(const TabulatedBsdfTable& table, const std::filesystem:
   const TableView view(table, o.azimuths);
   ExportReport r{"MDL .mbsdf", {}, {}, {}};
   GamutClip clip;
-  const MbsdfGrid reflection = sample_part(view, o, 1, 1, clip);
-  const MbsdfGrid transmission = transmission_part(view, o, clip, r);
+  const MbsdfGrid reflection = sample_mbsdf_part(view, o, 1, 1, clip);
+  const MbsdfGrid transmission = mbsdf_transmission_part(view, o, clip, r);
   std::string bytes = "NVIDIA ARC MBSDF V1\n";
-  append_part(reflection, false, bytes);
-  append_part(transmission, true, bytes);
+  append_mbsdf_part(reflection, false, bytes);
+  append_mbsdf_part(transmission, true, bytes);
   write_text_atomically(path, bytes);
   r.dropped = {
       "reflection of light arriving from below (the file's reflection is the upper side's; MDL "
