@@ -225,6 +225,29 @@ TEST(GltfMaterial, TransmittingClothGetsKhrMaterialsDiffuseTransmission) {
   EXPECT_NEAR(material_of(j).diffuse_transmission, 0.5, 1e-6);
 }
 
+TEST(GltfMaterial, SeeThroughClothKeepsKhrMaterialsTransmission) {
+  // Transmission in a narrow lobe straight through (an open weave seen through its gaps):
+  // 3 cos^30 of the angle from -wo, plus a little reflection; its straight-through f is far above
+  // a Lambertian BTDF's of the same albedo, so glTF's specular BTDF is kept.
+  const auto table = TabulatedBsdfTable::from_function(
+      8, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const bool through = (wo.z > 0) != (wi.z > 0);
+        for (int c = 0; c < 3; ++c)
+          v[static_cast<size_t>(c)] =
+              through ? 3 * std::pow(std::max(0.0, -dot(wo, wi)), 30) : 0.2 / kPi;
+      },
+      2, 1);
+  const auto path = testing::fresh_test_dir() / "open.gltf";
+  const ExportReport report = export_table(table, path, {});
+  std::map<std::string, double> figures(report.figures.begin(), report.figures.end());
+  ASSERT_GT(figures.at("transmission straight-through peak"), 10);
+  const json j = json::parse(testing::slurp(path));
+  EXPECT_TRUE(contains(j.at("extensionsUsed"), "KHR_materials_transmission"));
+  EXPECT_FALSE(contains(j.at("extensionsUsed"), "KHR_materials_diffuse_transmission"));
+  EXPECT_GT(material_of(j).transmission, 0);
+}
+
 TEST(GltfMaterial, RedClothBackLightIsTheTablesTransmittedColour) {
   // A red cloth transmitting a red of its own (exchange_tables.h: tau per channel, Lambertian, so
   // the table's transmitted albedo is tau towards every view).
