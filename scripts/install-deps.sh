@@ -3,9 +3,11 @@
 # By default the build and run set (what scripts/demo.sh needs: the libraries, the compiler and
 # the plots' matplotlib); with --tests also what only the test suite needs (scripts/test.sh
 # passes it): Google Test and Google Benchmark, pybind11 and pytest for the Python module
-# (python/) and its tests, and slurm-wlm and munge for the single-node Slurm of
-# tests/tools/slurm_test.sh. Installs only the packages that are missing; skips apt
-# entirely when none is. --list prints the chosen set, one package a line, and installs nothing.
+# (python/) and its tests, slurm-wlm and munge for the single-node Slurm of
+# tests/tools/slurm_test.sh, and nodejs and npm for the glTF validator of the export tests
+# (scripts/install-gltf-validator.sh; only when no npm is on the PATH, which may come from another
+# source than Debian's). Installs only the packages that are missing; skips apt entirely when none
+# is. --list prints the chosen set, one package a line, and installs nothing.
 # Usage: install-deps.sh [--tests] [--list]
 set -euo pipefail
 build_run=(build-essential cmake ninja-build pkg-config
@@ -19,7 +21,10 @@ packages=("${build_run[@]}")
 list=0
 for a in "$@"; do
   case "$a" in
-    --tests) packages+=("${tests_only[@]}") ;;
+    --tests)
+      packages+=("${tests_only[@]}")
+      command -v npm >/dev/null || packages+=(nodejs npm)
+      ;;
     --list) list=1 ;;
     *)
       echo "install-deps: unknown option '$a' (usage: install-deps.sh [--tests] [--list])" >&2

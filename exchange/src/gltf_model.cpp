@@ -72,7 +72,7 @@ Rgb gltf_brdf(const GltfMaterial& m, const SheenAlbedo& e, const Vec3& wo, const
       1 / ((nl + std::sqrt(a2 + (1 - a2) * nl * nl)) * (nv + std::sqrt(a2 + (1 - a2) * nv * nv)));
   const double fresnel = 0.04 + 0.96 * std::pow(1 - vh, 5);
   const double spec = fresnel * vis * d;
-  const double diffuse = (1 - fresnel) * (1 - m.transmission) / kPi;
+  const double diffuse = (1 - fresnel) * (1 - m.transmission) * (1 - m.diffuse_transmission) / kPi;
   const double sheen = charlie_sheen(m.sheen_roughness, wo, wi);
   const double smax = m.sheen_color.max_component();
   const double scaling = std::min(1 - smax * e(nv), 1 - smax * e(nl));
@@ -80,6 +80,17 @@ Rgb gltf_brdf(const GltfMaterial& m, const SheenAlbedo& e, const Vec3& wo, const
   for (int c = 0; c < 3; ++c)
     f[c] = m.sheen_color[c] * sheen + (m.base_color[c] * diffuse + spec) * scaling;
   return f;
+}
+
+Rgb gltf_btdf(const GltfMaterial& m, const SheenAlbedo& e, const Vec3& wo, const Vec3& wi) {
+  if (wo.z <= 0 || wi.z >= 0 || m.diffuse_transmission <= 0) return {};
+  const Vec3 mirrored{wi.x, wi.y, -wi.z};
+  const double vh = std::abs(dot(wo, normalize(wo + mirrored)));
+  const double fresnel = 0.04 + 0.96 * std::pow(1 - vh, 5);
+  const double smax = m.sheen_color.max_component();
+  const double scaling = std::min(1 - smax * e(wo.z), 1 - smax * e(-wi.z));
+  return m.diffuse_transmission_color *
+         ((1 - fresnel) * (1 - m.transmission) * m.diffuse_transmission / kPi * scaling);
 }
 
 }  // namespace weft

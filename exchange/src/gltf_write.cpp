@@ -95,14 +95,25 @@ tinygltf::Material make_material(const GltfFit& fit, const std::string& name, do
   if (g.transmission > 0)
     mat.extensions["KHR_materials_transmission"] = tinygltf::Value(
         tinygltf::Value::Object{{"transmissionFactor", tinygltf::Value(g.transmission)}});
-  mat.extras = tinygltf::Value(tinygltf::Value::Object{
+  tinygltf::Value::Object extras{
       {"weft_fit_rms_log", tinygltf::Value(fit.rms_log)},
       {"weft_fit_points", tinygltf::Value(fit.points)},
       {"weft_fit_error",
        tinygltf::Value("RMS over view x light bin centres and RGB of log((f_gltf + eps) / "
                        "(f_table + eps)), eps = " +
                        std::to_string(eps) + " / sr")},
-      {"weft_source", tinygltf::Value(name)}});
+      {"weft_source", tinygltf::Value(name)}};
+  if (g.diffuse_transmission > 0) {
+    mat.extensions["KHR_materials_diffuse_transmission"] = tinygltf::Value(tinygltf::Value::Object{
+        {"diffuseTransmissionFactor", tinygltf::Value(g.diffuse_transmission)},
+        {"diffuseTransmissionColorFactor", rgb_value(g.diffuse_transmission_color)}});
+    extras["weft_transmission_fit_rms_rel"] = tinygltf::Value(fit.transmission_rms_rel);
+    extras["weft_transmission_fit_max_rel"] = tinygltf::Value(fit.transmission_max_rel);
+    extras["weft_transmission_fit_error"] = tinygltf::Value(
+        "relative error of the transmitted albedo (light from below reaching a view from above) "
+        "against the table's, over the upper view bins and RGB: RMS and largest");
+  }
+  mat.extras = tinygltf::Value(std::move(extras));
   return mat;
 }
 
@@ -119,6 +130,8 @@ ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::fil
   m.asset.generator = std::string("Weft ") + WEFT_VERSION + " (weft export)";
   m.extensionsUsed.push_back("KHR_materials_sheen");
   if (fit.material.transmission > 0) m.extensionsUsed.push_back("KHR_materials_transmission");
+  if (fit.material.diffuse_transmission > 0)
+    m.extensionsUsed.push_back("KHR_materials_diffuse_transmission");
   add_quad(m);
   m.materials.push_back(make_material(fit, name, options.epsilon_per_sr));
   std::ostringstream out;
@@ -129,10 +142,19 @@ ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::fil
   ExportReport r{"glTF 2.0", {}, {}, {}};
   r.dropped = {"the table's angular detail beyond the fitted lobes (see the fit's error)",
                "anisotropy", "the back side (one material for both sides)"};
-  if (fit.material.transmission > 0)
+  const GltfMaterial& g = fit.material;
+  if (g.diffuse_transmission > 0)
     r.notes.push_back(
-        "transmission written as KHR_materials_transmission (glTF's transmission "
-        "is a rough specular BTDF, not the fabric's diffuse one)");
+        "transmission written as KHR_materials_diffuse_transmission (a Lambertian BTDF with its "
+        "own colour, fitted to the table's transmitted albedo; viewers without the extension "
+        "show the cloth opaque)");
+  else if (g.transmission > 0)
+    r.notes.push_back(
+        "transmission written as KHR_materials_transmission: the table's transmission peaks "
+        "straight through (" +
+        std::to_string(fit.transmission_peak) +
+        " times a diffuse one's), which glTF's rough specular BTDF follows; it is tinted by the "
+        "base colour");
   else
     r.dropped.push_back("transmission (mean " + std::to_string(fit.transmittance) +
                         ", below the threshold)");
@@ -149,6 +171,16 @@ ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::fil
                {"sheen color B", fit.material.sheen_color.b},
                {"sheen roughness", fit.material.sheen_roughness},
                {"transmission", fit.material.transmission}};
+  if (g.transmission > 0 || g.diffuse_transmission > 0)
+    r.figures.push_back({"transmission straight-through peak", fit.transmission_peak});
+  if (g.diffuse_transmission > 0) {
+    r.figures.push_back({"diffuse transmission", g.diffuse_transmission});
+    for (int c = 0; c < 3; ++c)
+      r.figures.push_back(
+          {std::string("diffuse transmission color ") + "RGB"[c], g.diffuse_transmission_color[c]});
+    r.figures.push_back({"transmission fit RMS relative error", fit.transmission_rms_rel});
+    r.figures.push_back({"transmission fit max relative error", fit.transmission_max_rel});
+  }
   return r;
 }
 

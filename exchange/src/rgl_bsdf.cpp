@@ -92,6 +92,21 @@ UGrid estimate_ndf(const TableView& view, int nodes) {
   return ndf;
 }
 
+// The incidence angles: theta_k = (k / (count - 1))^2 * 90 deg, and 'grazing' more between the
+// last two, at theta_{n-2} + (90 deg - theta_{n-2}) (1 - (1 - t)^2), t = j / (grazing + 1).
+std::vector<double> incidence_angles(int count, int grazing) {
+  std::vector<double> theta;
+  for (int k = 0; k + 1 < count; ++k)
+    theta.push_back(u_to_theta(static_cast<double>(k) / (count - 1)));
+  const double last = theta.back();
+  for (int j = 1; j <= grazing; ++j) {
+    const double t = static_cast<double>(j) / (grazing + 1);
+    theta.push_back(last + (kPi / 2 - last) * (1 - sqr(1 - t)));
+  }
+  theta.push_back(kPi / 2);
+  return theta;
+}
+
 struct Slices {
   std::vector<float> vndf, luminance, values;  // [theta_i][...]
 };
@@ -142,9 +157,12 @@ void add_slice(const TableView& view, const RglOptions& o, const UGrid& ndf, dou
 
 void RglOptions::validate() const {
   if (theta_i_count < 2 || theta_i_count > 90) throw Error("", "theta_i_count", "must be 2..90");
-  if (ndf_resolution < 2 || (ndf_resolution - 1) % (theta_i_count - 1) != 0)
-    throw Error("", "ndf_resolution",
-                "(ndf_resolution - 1) must be a multiple of theta_i_count - 1");
+  if (grazing_theta_i < 0 || grazing_theta_i > 90)
+    throw Error("", "grazing_theta_i", "must be 0..90");
+  if (!(ndf_uniform_share >= 0 && ndf_uniform_share <= 1))
+    throw Error("", "ndf_uniform_share", "must be in [0, 1]");
+  if (ndf_resolution < 2 || ndf_resolution > 4096)
+    throw Error("", "ndf_resolution", "must be 2..4096");
   if (vndf_resolution < 2 || vndf_resolution > 512)
     throw Error("", "vndf_resolution", "must be 2..512");
   if (sample_resolution < 2 || sample_resolution > 256)
@@ -156,16 +174,18 @@ ExportReport write_rgl_bsdf(const TabulatedBsdfTable& table, const std::filesyst
                             const RglOptions& o) {
   o.validate();
   const TableView view(table, o.azimuths);
-  const UGrid ndf = estimate_ndf(view, o.ndf_resolution);
+  UGrid ndf = estimate_ndf(view, o.ndf_resolution);
+  for (double& d : ndf.v) d = (1 - o.ndf_uniform_share) * d + o.ndf_uniform_share / kPi;
   const UGrid sigma = projected_area(ndf);
-  const int nt = o.theta_i_count, stride = (o.ndf_resolution - 1) / (nt - 1);
+  const std::vector<double> angles = incidence_angles(o.theta_i_count, o.grazing_theta_i);
+  const int nt = static_cast<int>(angles.size());
   Slices s;
   std::vector<float> theta_i;
-  for (int k = 0; k < nt; ++k) {
-    // In double: pi/2 rounded to float lies below the horizon.
-    const double theta = u_to_theta(static_cast<double>(k) / (nt - 1));
+  for (double theta : angles) {
+    // In double: pi/2 rounded to float lies below the horizon. sigma as the renderers
+    // interpolate it, which they divide by.
     theta_i.push_back(static_cast<float>(theta));
-    add_slice(view, o, ndf, sigma.v[static_cast<size_t>(k * stride)], theta, s);
+    add_slice(view, o, ndf, sigma.at(std::sqrt(theta * 2 / kPi)), theta, s);
   }
   const auto u64 = [](int v) { return static_cast<uint64_t>(v); };
   const uint64_t ns = u64(o.sample_resolution), nv = u64(o.vndf_resolution);

@@ -1,5 +1,6 @@
 #pragma once
 // Small analytic tables for the export tests, with known exact answers.
+#include <algorithm>
 #include <cmath>
 #include <span>
 
@@ -50,6 +51,29 @@ inline TabulatedBsdfTable lobe_rgb(int resolution = 8) {
         const Vec3 h = normalize(wo + wi);
         const double lobe = 0.3 * (1 - h.z * h.z);
         v[0] = 0.6 / kPi + lobe, v[1] = 0.2 / kPi + lobe, v[2] = 0.1 / kPi + lobe;
+      },
+      2, 1);
+}
+
+// A cloth-like reflection on the upper side: a Lambertian base, a sheen towards grazing half
+// vectors and a back-scatter lobe around the retro direction that grows towards grazing, as woven
+// fabrics show (isotropic and reciprocal, so the export's isotropic average is the function).
+inline void fabric_reflection(const Vec3& wo, const Vec3& wi, std::span<double> v) {
+  const Vec3 h = normalize(wo + wi);
+  const double sheen = 0.4 * (1 - h.z * h.z);
+  const double back = 0.25 * std::pow(std::max(0.0, dot(wo, wi)), 8) / (wo.z + wi.z + 0.3);
+  const double base[3] = {0.55, 0.3, 0.15};
+  for (int c = 0; c < 3; ++c) v[static_cast<size_t>(c)] = base[c] / kPi + sheen + back;
+}
+inline TabulatedBsdfTable fabric_rgb(int resolution = 8) {
+  return TabulatedBsdfTable::from_function(
+      resolution, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        if (wo.z <= 0 || wi.z <= 0) {
+          v[0] = v[1] = v[2] = 0;
+          return;
+        }
+        fabric_reflection(wo, wi, v);
       },
       2, 1);
 }

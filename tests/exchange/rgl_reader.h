@@ -4,7 +4,11 @@
 // code with the writer: its own byte parsing of the tensor file, and the renderers' evaluation
 // f cos theta_o = spectra(R^-1(u_m)) D(u_m) / (4 sigma(u_wi)), where R^-1 inverts the VNDF's
 // continuous piecewise-bilinear warp (marginal CDF in y, conditional in x; each theta_i slice
-// normalized, then slices blended linearly in theta_i).
+// normalized, then slices blended linearly in theta_i). Checked against the format authors'
+// reader (powitacq.h, rgl-epfl/brdf-loader): it blends the normalized vndf slices and their CDFs
+// with the same linear weights in theta_i (clamped, the interval whose lower node is <= theta_i),
+// inverts the warp the same way, interpolates the values bilinearly without normalizing them,
+// and divides by 4 sigma(u_i) and multiplies by D(u_m) on the same two-row (u, phi) grids.
 #include <gtest/gtest.h>
 
 #include <algorithm>

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
+#include <map>
 
 #include "exchange_tables.h"
 #include "test_util.h"
@@ -146,6 +147,60 @@ TEST(Mbsdf, LobeTableValuesAreItsIsotropicAverageAtTheCellCentres) {
         }
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(part_albedo(r, ti, c), ref[c], 0.02 * ref[c]);
   }
+}
+
+// Lambertian transmission tau / pi for light from below reaching a view from above, none the
+// other way (and no reflection): a table that is not reciprocal.
+TabulatedBsdfTable one_way_table(const std::vector<double>& tau) {
+  return TabulatedBsdfTable::from_function(
+      4, 3,
+      [=](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        for (int c = 0; c < 3; ++c)
+          v[static_cast<size_t>(c)] = wo.z > 0 && wi.z < 0 ? tau[static_cast<size_t>(c)] / kPi : 0;
+      },
+      1, 1);
+}
+
+TEST(Mbsdf, OneWayTransmissionIsCarriedBothWaysAtItsMean) {
+  // MDL's measured BSDF holds one transmission table for light from either side (the MDL SDK
+  // orients the normal towards the viewer and averages f(in, out) with f(out, in)), so the file's
+  // transmission is the mean of the two directions: tau / (2 pi), where writing only the
+  // light-from-above half gave 0.
+  const std::vector<double> tau{0.6, 0.3, 0.1};
+  const auto path = testing::fresh_test_dir() / "one_way.mbsdf";
+  ExportOptions o;
+  o.mbsdf.theta_resolution = 12;
+  o.mbsdf.phi_resolution = 10;
+  const ExportReport report = export_table(one_way_table(tau), path, o);
+  const auto parts = read_mbsdf(path);
+  const auto& t = parts.at("MBSDF_DATA_TRANSMISSION=\n");
+  for (uint32_t ti = 0; ti < 12; ti += 3)
+    for (uint32_t to = 0; to < 12; to += 2)
+      for (uint32_t ph = 0; ph < 10; ph += 3)
+        for (int c = 0; c < 3; ++c) {
+          EXPECT_NEAR(t.at(ti, to, ph, c), tau[static_cast<size_t>(c)] / (2 * kPi), 1e-6);
+          // Reciprocal: the SDK's average with the transpose leaves the file's values as they are.
+          EXPECT_EQ(t.at(ti, to, ph, c), t.at(to, ti, ph, c));
+        }
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(part_albedo(t, 5, c), tau[static_cast<size_t>(c)] / 2, 1e-5);
+  // The report says how far the file is from each direction, relative to the larger: half the
+  // light either way where the table has all of it one way and none the other, so 50 %.
+  std::map<std::string, double> figures(report.figures.begin(), report.figures.end());
+  EXPECT_NEAR(figures.at("transmission direction error (max relative)"), 0.5, 1e-5);
+  EXPECT_NEAR(figures.at("transmittance light from above (table)"), 0.0, 1e-12);
+  EXPECT_NEAR(figures.at("transmittance light from below (table)"), (0.6 + 0.3 + 0.1) / 3, 1e-5);
+  EXPECT_FALSE(report.notes.empty());
+}
+
+TEST(Mbsdf, ReciprocalTransmissionIsWrittenAsTheTableHasIt) {
+  // The Lambertian transmits tau / pi both ways: the mean is the table, the stated error 0.
+  const std::vector<double> rho{0.2, 0.5, 0.8}, tau{0.3, 0.2, 0.1};
+  const auto path = testing::fresh_test_dir() / "t.mbsdf";
+  const ExportReport report = export_table(testing::lambert_table(4, rho, tau), path, {});
+  std::map<std::string, double> figures(report.figures.begin(), report.figures.end());
+  EXPECT_LT(figures.at("transmission direction error (max relative)"), 1e-5);
+  EXPECT_TRUE(report.notes.empty());
 }
 
 TEST(Mbsdf, SpectralTableIsWrittenAsRgb) {

@@ -3,6 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <iostream>
+#include <map>
 #include <set>
 
 #include "exchange_tables.h"
@@ -83,8 +85,8 @@ TEST(RglBsdf, LambertianEvaluatesToRhoOverPiTimesCosine) {
     for (int c = 0; c < 3; ++c) rel.push_back(std::abs(e.eval(v, l, c) / (rho[c] / kPi * l.z) - 1));
   }
   std::sort(rel.begin(), rel.end());
-  // The interpolation error of the 32 x 32 sample grid and 17 incidence angles: measured median
-  // 0.47 %, 95th percentile 3.1 % (the largest, 34 %, at grazing light and view).
+  // The interpolation error of the 48 x 48 sample grid and 21 incidence angles: measured median
+  // 0.24 %, 95th percentile 1.3 % (the largest, 35 %, at grazing light and view).
   EXPECT_LT(rel[rel.size() / 2], 0.01);
   EXPECT_LT(rel[rel.size() * 95 / 100], 0.05);
 }
@@ -142,6 +144,106 @@ TEST(RglBsdf, LobeTableAlbedoMatchesTheTable) {
         }
     for (int c = 0; c < 3; ++c)
       EXPECT_NEAR(export_albedo(e, v, c), ref[c], 0.02 * ref[c]) << deg << " deg, channel " << c;
+  }
+}
+
+// The export's target: the table's f cos theta_light averaged over the 16 rotations 2 pi k / 16
+// of both directions about the normal (rgl_bsdf.h), from the table's own interpolation.
+double table_f_cos(const TabulatedBsdfTable& t, const Vec3& v, const Vec3& l, int c) {
+  std::vector<double> f(static_cast<size_t>(t.channels));
+  double sum = 0;
+  for (int k = 0; k < 16; ++k) {
+    const double a = 2 * kPi * k / 16, ca = std::cos(a), sa = std::sin(a);
+    auto turn = [&](const Vec3& w) { return Vec3{ca * w.x - sa * w.y, sa * w.x + ca * w.y, w.z}; };
+    t.interpolate(turn(v), turn(l), f);
+    sum += f[static_cast<size_t>(c)];
+  }
+  return sum / 16 * l.z;
+}
+
+struct GrazingFigures {
+  double p95 = 0;                           // relative error of f cos over directions to 85 deg
+  double p95_beyond = 0, worst_beyond = 0;  // views at 85 .. 89.5 deg, lights to 89.5 deg
+  double retro85 = 0;               // relative error of the back-scatter, view and light at 85 deg
+  std::map<double, double> albedo;  // relative error of the albedo per view angle (deg)
+};
+
+// Views and lights to 85 deg (cos theta uniform), and the albedo towards views at 0 .. 89.5 deg,
+// each against the table (table_f_cos, the same 64 x 128 rule).
+GrazingFigures grazing_figures(const TabulatedBsdfTable& t, const RglEvaluator& e) {
+  GrazingFigures g;
+  Rng rng(11);
+  std::vector<double> rel;
+  const double span = 1 - std::cos(deg_to_rad(85));
+  for (int n = 0; n < 2000; ++n) {
+    const Vec3 v =
+        spherical_direction(std::acos(1 - span * rng.uniform()), 2 * kPi * rng.uniform());
+    const Vec3 l =
+        spherical_direction(std::acos(1 - span * rng.uniform()), 2 * kPi * rng.uniform());
+    for (int c = 0; c < 3; ++c)
+      rel.push_back(std::abs(e.eval(v, l, c) / table_f_cos(t, v, l, c) - 1));
+  }
+  std::sort(rel.begin(), rel.end());
+  g.p95 = rel[rel.size() * 95 / 100];
+  rel.clear();
+  const double c85 = std::cos(deg_to_rad(85)), c895 = std::cos(deg_to_rad(89.5));
+  for (int n = 0; n < 2000; ++n) {
+    const Vec3 v = spherical_direction(std::acos(c895 + (c85 - c895) * rng.uniform()), 0.0);
+    const Vec3 l =
+        spherical_direction(std::acos(1 - (1 - c895) * rng.uniform()), 2 * kPi * rng.uniform());
+    for (int c = 0; c < 3; ++c) {
+      const double ratio = e.eval(v, l, c) / table_f_cos(t, v, l, c);
+      rel.push_back(std::abs(ratio - 1));
+      g.worst_beyond = std::max({g.worst_beyond, ratio, 1 / ratio});
+    }
+  }
+  std::sort(rel.begin(), rel.end());
+  g.p95_beyond = rel[rel.size() * 95 / 100];
+  const Vec3 w85 = spherical_direction(deg_to_rad(85), 0.3);
+  g.retro85 = e.eval(w85, w85, 0) / table_f_cos(t, w85, w85, 0) - 1;
+  for (double deg : {0.0, 40.0, 70.0, 80.0, 82.5, 85.0, 89.0, 89.5}) {
+    const Vec3 v = spherical_direction(deg_to_rad(deg), 0.3);
+    double worst = 0;
+    for (int c = 0; c < 3; ++c) {
+      double ref = 0, got = 0;
+      for (int a = 0; a < 64; ++a)
+        for (int b = 0; b < 128; ++b) {
+          const Vec3 l = spherical_direction(std::acos((a + 0.5) / 64), 2 * kPi * (b + 0.5) / 128);
+          ref += table_f_cos(t, v, l, c);
+          got += e.eval(v, l, c);
+        }
+      const double r = got / ref - 1;
+      if (std::abs(r) > std::abs(worst)) worst = r;
+    }
+    g.albedo[deg] = worst;
+  }
+  return g;
+}
+
+void print_figures(const std::string& name, const GrazingFigures& g) {
+  std::cout << name << ": p95 to 85 deg " << 100 * g.p95 << " %; views 85-89.5 deg: p95 "
+            << 100 * g.p95_beyond << " %, worst factor " << g.worst_beyond
+            << "; back-scatter at 85 deg " << 100 * g.retro85 << " %; albedo";
+  for (const auto& [deg, r] : g.albedo) std::cout << " " << deg << " deg " << 100 * r << " %";
+  std::cout << "\n";
+}
+
+TEST(RglBsdf, LambertianAndFabricHoldTo85Degrees) {
+  // Against the table itself (table_f_cos): p95 of the relative error of f cos over views and
+  // lights to 85 deg at most 5 %, the albedo per view angle to 85 deg within 2 %. Measured:
+  // p95 1.9 % (Lambertian) and 3.7 % (fabric), albedo within 0.6 % to 89.5 deg; the writer with
+  // the paper's NDF estimate alone, 17 incidences and 32 x 32 samples gave p95 10 % and albedo
+  // -3 % at 80 deg, -16 % at 85 deg, -27 % at 89.5 deg. Beyond 85 deg: printed, not asserted.
+  for (const auto& [name, table] : {std::pair{std::string("lambert"), testing::lambert_rgb()},
+                                    std::pair{std::string("fabric"), testing::fabric_rgb()}}) {
+    const RglEvaluator e(export_and_read(table, name + ".bsdf"));
+    const GrazingFigures g = grazing_figures(table, e);
+    print_figures(name, g);
+    EXPECT_LE(g.p95, 0.05) << name;
+    for (const auto& [deg, r] : g.albedo) {
+      if (deg > 85) continue;
+      EXPECT_LE(std::abs(r), 0.02) << name << " " << deg << " deg";
+    }
   }
 }
 

@@ -15,6 +15,7 @@
 
 #include "cli_run.h"
 #include "test_util.h"
+#include "weft/core/math.h"
 #include "weft/materials/bsdf_table.h"
 
 namespace fs = std::filesystem;
@@ -419,4 +420,40 @@ TEST(Cli, ExportWritesTheFormatItsExtensionNamesAndRefusesOthers) {
     EXPECT_NE(r.err.find("--output"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / bad));
   }
+}
+
+TEST(Cli, ExportPrintsHowTransmissionIsCarried) {
+  // A red cloth transmitting a red of its own, Lambertian both ways (rho, tau per channel): the
+  // glTF gets the diffuse transmission with the fit's error, the .mbsdf both directions at their
+  // mean (here equal, so no error).
+  const fs::path dir = fresh_test_dir();
+  const fs::path table = dir / "red.exr";
+  const std::vector<double> rho{0.5, 0.1, 0.05}, tau{0.4, 0.08, 0.04};
+  weft::TabulatedBsdfTable::from_function(
+      4, 3,
+      [&](const weft::Vec3& wo, const weft::Vec3& wi, std::span<double> v) {
+        for (size_t c = 0; c < 3; ++c) v[c] = ((wo.z > 0) == (wi.z > 0) ? rho : tau)[c] / weft::kPi;
+      },
+      1, 1)
+      .write_exr(table);
+  const CliRun glb = run_weft_cli(
+      "export --json '" + table.string() + "' -o '" + (dir / "red.glb").string() + "'", dir);
+  ASSERT_EQ(glb.exit_code, 0) << glb.err;
+  const auto g = nlohmann::json::parse(glb.out);
+  EXPECT_GT(g["figures"]["diffuse transmission"].get<double>(), 0);
+  // The colour keeps the table's red: tau's channel ratios, within the fit's largest error.
+  const double err = g["figures"]["transmission fit max relative error"];
+  const double r = g["figures"]["diffuse transmission color R"],
+               gg = g["figures"]["diffuse transmission color G"];
+  EXPECT_NEAR(gg / r, tau[1] / tau[0], 2 * err * tau[1] / tau[0] + 1e-9);
+  EXPECT_EQ(g["figures"]["transmission"], 0.0);  // no KHR_materials_transmission
+  const std::string notes = g["notes"].dump();
+  EXPECT_NE(notes.find("KHR_materials_diffuse_transmission"), std::string::npos) << notes;
+  const CliRun mdl = run_weft_cli(
+      "export --json '" + table.string() + "' -o '" + (dir / "red.mbsdf").string() + "'", dir);
+  ASSERT_EQ(mdl.exit_code, 0) << mdl.err;
+  const auto m = nlohmann::json::parse(mdl.out);
+  EXPECT_LT(m["figures"]["transmission direction error (max relative)"].get<double>(), 1e-5);
+  EXPECT_NEAR(m["figures"]["transmittance either way (file)"].get<double>(),
+              (0.4 + 0.08 + 0.04) / 3, 1e-3);
 }

@@ -4,9 +4,16 @@
 // `measured` material read. The format holds one reflection lobe on the upper side, isotropic
 // here (phi_i has one value), in the paper's adaptive parameterization:
 //  - ndf D(theta_m) and sigma(theta_i) = int D(m) <m . w_i> dm on a grid of u = sqrt(2 theta / pi)
-//    (rows: phi in u, two identical rows). D is the paper's retro-reflection estimate: with
+//    (rows: phi in u, two identical rows). D is half the paper's retro-reflection estimate (with
 //    G2 ~ G1 = cos theta / sigma, f(w, w) = D(w) / (4 sigma(w) cos theta), solved for D by fixed
-//    point iteration from a flat surface (sigma = cos theta), normalized to int D cos = 1.
+//    point iteration from a flat surface (sigma = cos theta), normalized to int D cos = 1) and
+//    half a uniform 1 / pi. D only parameterizes the file (the renderers multiply the values
+//    back by it), and a cloth's estimate vanishes towards the horizon (D ~ sigma cos theta for a
+//    Lambertian): the values, which divide by D, then spike there, and sigma(90 deg) is so small
+//    that the renderers' blend of the warps of neighbouring incidences, linear in theta_i,
+//    over-weights the grazing one. The uniform half keeps both in bounds.
+//  - theta_i: the paper's (k / (count - 1))^2 90 deg, dense at normal incidence, and more between
+//    the last two (79 and 90 deg by default), where the warp changes fastest.
 //  - vndf: per theta_i, the visible normals' density D(m) <m . w_i> / sigma(w_i) in the
 //    (u_theta_m, u_phi_m - phi_i) square (times the square's Jacobian 2 pi^2 u sin theta_m).
 //  - luminance and rgb / spectra: per theta_i, on an n x n grid of the VNDF warp's sample space,
@@ -29,13 +36,15 @@
 namespace weft {
 
 struct RglOptions {
-  int theta_i_count = 17;      // incidence angles, theta_k = (k / (count - 1))^2 * 90 deg
-  int ndf_resolution = 65;     // ndf and sigma nodes in u; (this - 1) a multiple of the above - 1
-  int vndf_resolution = 48;    // vndf: n x n
-  int sample_resolution = 32;  // luminance and rgb / spectra: n x n
-  int azimuths = 16;           // rotations averaged for the isotropic table
-  std::string description;     // the file's 'description' field
-  void validate() const;       // weft::Error naming the field
+  int theta_i_count = 17;          // incidence angles, theta_k = (k / (count - 1))^2 * 90 deg
+  int grazing_theta_i = 4;         // more between the last two of those, denser towards 90 deg
+  double ndf_uniform_share = 0.5;  // of the ndf, a uniform one's (int D cos = 1 each)
+  int ndf_resolution = 65;         // ndf and sigma nodes in u
+  int vndf_resolution = 48;        // vndf: n x n
+  int sample_resolution = 48;      // luminance and rgb / spectra: n x n
+  int azimuths = 16;               // rotations averaged for the isotropic table
+  std::string description;         // the file's 'description' field
+  void validate() const;           // weft::Error naming the field
 };
 
 // Writes the file atomically; weft::Error naming the file and field on failure.
