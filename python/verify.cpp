@@ -32,10 +32,13 @@ VerifyPlan checked_plan(const VerifyArgs& a) {
   const VerifyRequest& r = a.request;
   const VerifyPlan p = plan_verify(r);
   const RunLimits limits = call_limits(a.yes_long);
-  validate_output_paths(
-      limits, {},
-      {{p.measured_path, "measured"}, {r.weave, "weave"}, {r.wif, "wif"}, {r.fiber, "fiber"}},
-      {{r.output, "output"}});
+  validate_output_paths(limits, {},
+                        {{p.measured_path, "measured"},
+                         {r.weave, "weave"},
+                         {r.wif, "wif"},
+                         {r.fiber, "fiber"},
+                         {p.weave.wif.value_or(""), "wif"}},
+                        {{r.output, "output"}});
   check_verify_output(r.output);
   check_long_work(limits, estimate_verify(p).least, 1.0, p.settings.threads, "", "quality",
                   "weft verify at quality " + r.quality + (r.fit ? " with fit" : ""),
@@ -44,7 +47,8 @@ VerifyPlan checked_plan(const VerifyArgs& a) {
 }
 
 // The fit's options over the request's defaults; each one that differs from its default counts as
-// given, and plan_verify refuses it without fit=True (as the command refuses --fit-* without --fit).
+// given, and plan_verify refuses it without fit=True (as the command refuses --fit-* without
+// --fit).
 void set_fit_options(VerifyRequest& r, const std::string& params, int evaluations,
                      const std::string& inner, int seeds, const std::string& method) {
   const VerifyRequest d;

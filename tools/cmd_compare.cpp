@@ -29,6 +29,7 @@ int run_compare(const CompareCliOptions& o, const RunLimits& limits) {
                         {{o.a, "table A"}, {o.b, "table B"}});
   const auto a = TabulatedBsdfTable::read_exr(o.a);
   const auto b = TabulatedBsdfTable::read_exr(o.b);
+  check_compare_reference(a, o.a);
   const TableComparison c = compare_tables(a, b, o.compare);
   const std::string curves = in_plane_csv(c, a.channel_names());
   if (!o.csv.empty()) write_text_atomically(o.csv, curves);

@@ -1,5 +1,6 @@
 // weft export: a table leaves Weft as a file other renderers read (docs/exchange.md): RGL .bsdf
 // (Mitsuba 3, pbrt-v4), MDL .mbsdf (Omniverse / Iray), glTF 2.0 material (.gltf / .glb).
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -20,6 +21,8 @@ int run_export(const ExportCliOptions& o, const RunLimits& limits) {
   check_export_path(o.output, "--output");
   validate_output_paths(limits, {{o.output, "--output"}}, {{o.table, "table"}});
   const auto table = TabulatedBsdfTable::read_exr(o.table);
+  for (const auto& w : export_table_warnings(table, o.table))
+    std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
   ExportOptions options;
   options.name = o.name.empty() ? std::filesystem::path(o.table).stem().string() : o.name;
   const ExportReport r = export_table(table, o.output, options);

@@ -34,7 +34,8 @@ void add_merge_command(CLI::App& app, Commands& commands) {
              merge_job_parts(std::vector<std::filesystem::path>(o->parts.begin(), o->parts.end()));
          // A verify report is a folder, replaced whole.
          // The parts, and every file the job names (the sweep's and the ray trace's hashed
-         // inputs, the fiber spec file, verify's options): what the shards read.
+         // inputs, the fiber tables and specs the parts record, verify's options): what the
+         // shards read.
          std::vector<NamedPath> inputs;
          for (const auto& p : o->parts) inputs.push_back({p, "part file"});
          for (const auto* j : {&all.job, &all.extra})
@@ -46,6 +47,14 @@ void add_merge_command(CLI::App& app, Commands& commands) {
          else
            validate_output_paths(limits, {{o->output, "--output"}, {o->weave_out, "--weave-out"}},
                                  inputs);
+         // Parts of files edited since would merge into an output of neither version.
+         if (const auto changed = changed_job_inputs(all); !changed.empty()) {
+           std::string list;
+           for (const auto& c : changed) list += (list.empty() ? "" : "; ") + c;
+           throw Error(o->parts.front(), "inputs",
+                       "the parts were computed from files that have changed since: " + list +
+                           "; run the shards again on the files as they are, or restore them");
+         }
          if (all.command == "verify") return merge_verify(all, o->output, o->json);
          if (all.command == "bake fiber") return merge_fiber_bake(all, o->output, o->json);
          if (all.command == "bake fabric")

@@ -55,6 +55,9 @@ int run_render(const RenderCliOptions& o, const RunLimits& program) {
   const RunLimits& limits = request.limits;
   ScenePlanHooks hooks;
   hooks.scene_loaded = [&](const SceneDescription& d) { report_scene_loaded(d, o.quiet); };
+  hooks.warning = [](const std::string& w) {
+    std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
+  };
   const RenderPlan plan = plan_render(request, hooks);
   const auto t0 = std::chrono::steady_clock::now();
   const RenderJobResult r =

@@ -59,6 +59,7 @@ class ScriptFolder {
     if (created_ && !keep_) fs::remove_all(dir_, ec);
   }
   void keep() { keep_ = true; }
+  bool created() const { return created_; }
 
  private:
   fs::path dir_;
@@ -86,8 +87,21 @@ int run_slurm(SlurmRequest o, const RunLimits& limits) {
     std::fputs(slurm_dry_run_text(scripts).c_str(), stdout);
     return 0;
   }
+  SlurmSubmission s;
+  try {
+    s = submit_slurm(scripts);
+  } catch (const Error&) {
+    // The array job's scripts were removed when nothing was submitted; a folder made for them
+    // goes too (the destructor), and the user is told. Otherwise the array job needs it.
+    std::error_code ec;
+    if (fs::exists(scripts.array_path, ec))
+      folder.keep();
+    else if (folder.created())
+      std::fprintf(stderr, "weft: slurm: removed %s, made for this submission\n",
+                   p.folder.string().c_str());
+    throw;
+  }
   folder.keep();
-  const SlurmSubmission s = submit_slurm(scripts);
   std::printf("submitted array job %s (%d shards) and merge job %s -> %s\n", s.array_job.c_str(),
               o.shards, s.merge_job.c_str(), p.output.c_str());
   return 0;

@@ -69,7 +69,8 @@ int run(const VerifyCliOptions& o, const JobPart* all = nullptr) {
   const std::vector<NamedPath> inputs = {{p.measured_path, "measured CSV"},
                                          {r.weave, "weave options"},
                                          {r.wif, "WIF draft"},
-                                         {r.fiber, "fiber table or spec"}};
+                                         {r.fiber, "fiber table or spec"},
+                                         {p.weave.wif.value_or(""), "WIF draft"}};
   if (p.shard) {
     validate_output_paths(o.limits, {{r.output, "-o"}}, inputs);
   } else {
@@ -208,6 +209,15 @@ void add_verify_command(CLI::App& app, Commands& commands) {
       ->each([o](const std::string&) { o->suite = true; });
   commands.push_back({sub, [o, sub](const RunLimits& program) {
                         o->limits = quieted(program, o->quiet);
+                        // A suite file is a suite run, with or without --suite; an empty name
+                        // would quietly be the bundled suite.
+                        if (sub->count("--suite-file") > 0) {
+                          if (o->suite_file.empty())
+                            throw Error("", "--suite-file",
+                                        "is empty: give a suite file, or --suite alone for the "
+                                        "bundled suite");
+                          o->suite = true;
+                        }
                         if (!o->suite) return run(*o);
                         for (const char* name : {"--measured", "--fiber", "--weave", "--pattern",
                                                  "--wif", "--shard", "--fit", "--classic-albedo"})

@@ -148,6 +148,24 @@ nlohmann::json input_file_hashes(const std::vector<std::filesystem::path>& files
   return out;
 }
 
+std::vector<std::string> changed_job_inputs(const JobPart& all) {
+  std::vector<std::string> changed;
+  auto check = [&](const nlohmann::json& files) {
+    if (!files.is_object()) return;
+    for (const auto& [file, then] : files.items()) {
+      std::error_code ec;
+      if (!then.is_string() || !std::filesystem::is_regular_file(file, ec)) continue;
+      const std::string now = input_file_hashes({file})[file].get<std::string>();
+      if (now != then.get<std::string>())
+        changed.push_back(file + " (checksum " + then.get<std::string>() + " in the parts, " + now +
+                          " now)");
+    }
+  };
+  if (all.job.contains("inputs")) check(all.job["inputs"]);
+  if (all.extra.contains(kPartInputFilesKey)) check(all.extra[kPartInputFilesKey]);
+  return changed;
+}
+
 std::string job_difference(const JobPart& then, const JobPart& now) {
   if (then.command != now.command)
     return "it is of `weft " + then.command + "`, not `weft " + now.command + "`";
@@ -214,6 +232,10 @@ JobPart merge_job_parts(const std::vector<std::filesystem::path>& paths) {
       throw Error(
           file, "job",
           "belongs to another job than " + paths[0].string() + " (" + job_difference(all, p) + ")");
+    } else if (p.extra.contains(kPartInputFilesKey) && p.extra[kPartInputFilesKey].is_object()) {
+      nlohmann::json& files = all.extra[kPartInputFilesKey];
+      if (!files.is_object()) files = nlohmann::json::object();
+      files.update(p.extra[kPartInputFilesKey]);
     }
     if (!shards_seen.insert(p.shard.index).second)
       throw Error(file, "shard",

@@ -55,8 +55,12 @@ void validate_output_paths(const RunLimits& limits, const std::vector<NamedPath>
     }
   }
   for (const auto& folder : folders)
-    for (const auto& in : present)
-      if (!folder.path.empty() && inside(in.path, folder.path)) refuse(folder, in, "holds");
+    for (const auto& in : present) {
+      if (folder.path.empty()) continue;
+      // A folder output named as an input file (a hard link has no folder to lie in).
+      if (same_file(folder.path, in.path)) refuse(folder, in, "is also");
+      if (inside(in.path, folder.path)) refuse(folder, in, "holds");
+    }
   // Each in an existing directory, not a directory, no two the same file.
   check_output_paths(outputs, {});
 }

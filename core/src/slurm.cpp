@@ -193,13 +193,27 @@ SlurmSubmission submit_slurm(const SlurmScripts& s) {
   const auto [id_text, status] =
       run_capture("sbatch --parsable " + shell_quote(s.array_path.string()));
   const std::string id = id_text.substr(0, id_text.find_first_of(";\n"));
-  if (status != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos)
-    throw Error(s.array_path.string(), "sbatch", "submission failed: " + id_text);
+  if (status != 0 || id.empty() || id.find_first_not_of("0123456789") != std::string::npos) {
+    // Nothing was submitted: the scripts would only mislead.
+    std::string removed;
+    for (const auto& f : {s.array_path, s.merge_path}) {
+      std::error_code ec;
+      if (std::filesystem::remove(f, ec)) removed += (removed.empty() ? "" : " and ") + f.string();
+    }
+    throw Error(s.array_path.string(), "sbatch",
+                "submission failed: " + id_text +
+                    (removed.empty() ? "" : "; nothing was submitted, removed " + removed));
+  }
   const auto [mid_text, mstatus] = run_capture("sbatch --parsable --dependency=afterok:" + id +
                                                " " + shell_quote(s.merge_path.string()));
   const std::string mid = mid_text.substr(0, mid_text.find_first_of(";\n"));
+  // The array job runs and needs its folder: the scripts stay, and the user is told.
   if (mstatus != 0 || mid.empty())
-    throw Error(s.merge_path.string(), "sbatch", "submission failed: " + mid_text);
+    throw Error(s.merge_path.string(), "sbatch",
+                "submission failed: " + mid_text + "; array job " + id +
+                    " was submitted without its merge and its scripts stay: cancel it (scancel " +
+                    id + ") or submit this script after it (sbatch --dependency=afterok:" + id +
+                    ")");
   return {id, mid};
 }
 

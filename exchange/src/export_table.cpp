@@ -1,5 +1,8 @@
 #include "weft/exchange/export_table.h"
 
+#include <algorithm>
+#include <sstream>
+
 #include "weft/core/error.h"
 
 namespace weft {
@@ -9,6 +12,22 @@ void check_export_path(const std::filesystem::path& path, const std::string& fie
   if (ext != ".bsdf" && ext != ".mbsdf" && ext != ".gltf" && ext != ".glb")
     throw Error(path.string(), field,
                 "unknown format '" + ext + "': the output ends in .bsdf, .mbsdf, .gltf or .glb");
+}
+
+std::vector<std::string> export_table_warnings(const TabulatedBsdfTable& table,
+                                               const std::string& source) {
+  double most = 0;
+  for (int b = 0; b < table.grid().bins(); ++b) {
+    const auto a = table.directional_albedo(b);
+    for (int c = 0; c < table.channels; ++c) most = std::max(most, a.total(c));
+  }
+  if (!(most > kExportAlbedoWarning)) return {};
+  std::ostringstream text;
+  text << source << ": the table returns up to " << most
+       << " times the light that arrives (directional albedo; a surface returns at most 1, "
+          "this check allows up to "
+       << kExportAlbedoWarning << " for noise): exported as it is; check the table's scale";
+  return {text.str()};
 }
 
 ExportReport export_table(const TabulatedBsdfTable& table, const std::filesystem::path& path,

@@ -46,6 +46,17 @@ nlohmann::json weave_summary(const FabricRaytraceResult& res, const std::string&
           {"relative_noise", res.weave_relative_noise}};
 }
 
+// The files a part records beside its identity (kPartInputFilesKey): the fiber tables or spec
+// files (a preset is no file) and the draft the weave options name.
+std::vector<std::filesystem::path> recorded_fabric_inputs(const FabricBakePlan& p) {
+  std::vector<std::filesystem::path> files;
+  for (const auto& f : {p.fibers.fiber, p.fibers.warp_fiber, p.fibers.weft_fiber, p.fibers.draft}) {
+    std::error_code ec;
+    if (!f.empty() && std::filesystem::is_regular_file(f, ec)) files.emplace_back(f);
+  }
+  return files;
+}
+
 // The ray trace's table: whole, or in pieces with a shard or resume. False when the run ends
 // without a table ('out' cancelled, or a shard's part written). Its summary keys go to 'extra',
 // and the noise per channel of a run whole in this process to 'noise'.
@@ -60,9 +71,9 @@ bool trace_fabric(const FabricBakePlan& p, const WovenSample& sample, const Fabr
     std::vector<std::filesystem::path> inputs;
     for (const auto& f : {o.weave, o.wif})
       if (!f.empty()) inputs.emplace_back(f);
-    FabricPiecesOutcome pieces =
-        raytrace_fabric_in_pieces(sample, input_file_hashes(inputs), fibers.map, r, o.output,
-                                  o.shard, o.resume, hooks.progress, hooks.warning);
+    FabricPiecesOutcome pieces = raytrace_fabric_in_pieces(
+        sample, input_file_hashes(inputs), fibers.map, r, o.output, o.shard, o.resume,
+        hooks.progress, hooks.warning, input_file_hashes(recorded_fabric_inputs(p)));
     out.cancelled = pieces.cancelled;
     if (pieces.part_written) {
       out.part_units = pieces.units;

@@ -193,7 +193,7 @@ FabricPiecesOutcome raytrace_fabric_in_pieces(
     const WovenSample& sample, const nlohmann::json& inputs, const FiberTables& given,
     const FabricRaytraceOptions& r, const std::string& output, const std::string& shard_text,
     bool resume, const ProgressCallback& progress,
-    const std::function<void(const std::string&)>& warning) {
+    const std::function<void(const std::string&)>& warning, const nlohmann::json& recorded_inputs) {
   FabricPiecesOutcome outcome;
   const Shard shard = shard_text.empty() ? Shard{} : parse_shard(shard_text, "--shard");
   if (given.tables.size() > 1) validate_fiber_tables(given, sample);
@@ -245,6 +245,7 @@ FabricPiecesOutcome raytrace_fabric_in_pieces(
   }
   done.checkpoint = false;
   if (!shard.whole()) {
+    if (!recorded_inputs.empty()) done.extra[kPartInputFilesKey] = recorded_inputs;
     write_job_part(output, done);
     std::filesystem::remove(checkpoint_path(output));
     outcome.part_written = true;

@@ -112,6 +112,12 @@ RenderPlan plan_render(const RenderRequest& q, const ScenePlanHooks& hooks) {
   hooks.scene_loaded(plan.description);
   set_render_outputs(q, plan.description, plan.job);
   plan.job.preview_exposure = std::exp2(q.exposure_ev);
+  // Only an 8-bit preview is exposed; an EXR or HDR keeps the linear values.
+  if (q.exposure_ev != 0 && !plan.job.png && plan.job.exr.extension() != ".png")
+    hooks.warning(
+        "--exposure does nothing here: it applies to a PNG (--preview, or an output "
+        "ending in .png), and " +
+        plan.job.exr.string() + " keeps the linear values");
   plan.job.settings = requested_render_settings(q, plan.description);
   plan.inputs = scene_inputs(q.scene, plan.description);
   check_render_resources(q, plan);

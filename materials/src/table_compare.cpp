@@ -27,8 +27,17 @@ std::string fmt(double v) {
 
 }  // namespace
 
+void check_compare_reference(const TabulatedBsdfTable& a, const std::string& file) {
+  for (float v : a.values)
+    if (v != 0) return;
+  throw Error(file, "values",
+              "the reference table holds no light (every value is 0): a relative difference "
+              "against it means nothing; give a reference with light as table A");
+}
+
 TableComparison compare_tables(const TabulatedBsdfTable& a, const TabulatedBsdfTable& b,
                                const CompareOptions& o) {
+  check_compare_reference(a, "");
   if (a.channels != b.channels)
     throw Error(
         "", "channels",

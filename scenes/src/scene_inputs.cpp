@@ -9,12 +9,13 @@ std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
   std::vector<std::filesystem::path> files{scene};
   files.insert(files.end(), d.files.begin(), d.files.end());
   auto add = [&](const MaterialBinding& b) {
-    for (const char* key : {"file", "spec"}) {
+    // "weave": a fabric_table's weave table, resolved as its "file".
+    for (const char* key : {"file", "spec", "weave"}) {
       if (!b.params.contains(key) || !b.params[key].is_string()) continue;
       std::filesystem::path f = b.params[key].get<std::string>();
       std::error_code ec;
       if (f.is_relative() &&
-          (std::string(key) == "file" || std::filesystem::exists(d.base_dir / f, ec)))
+          (std::string(key) != "spec" || std::filesystem::exists(d.base_dir / f, ec)))
         f = d.base_dir / f;
       // A missing table is the renderer's error to report, with its field.
       if (std::filesystem::is_regular_file(f, ec)) files.push_back(f);

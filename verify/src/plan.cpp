@@ -116,6 +116,9 @@ VerifyPlan plan_verify(const VerifyRequest& o) {
     if (!p.weave.fiber_density_g_cm3 && p.spec.density_g_cm3 > 0)
       p.weave.fiber_density_g_cm3 = p.spec.density_g_cm3;
   }
+  // The sample's pattern, draft and sizes checked now, not when the run comes to make it (a
+  // suite's later fabric after the earlier ones' work).
+  if (p.weave.pattern != kNonwovenPattern) (void)woven_sample_size(p.weave);
   plan_fit(o, p);
   if (!o.shard.empty()) p.shard = parse_shard(o.shard, "--shard");
   return p;

@@ -2,6 +2,7 @@
 #include <cstdio>
 
 #include "weft/core/atomic_file.h"
+#include "weft/core/error.h"
 #include "weft/core/output_guard.h"
 #include "weft/verify/report.h"
 #include "weft/verify/suite.h"
@@ -23,8 +24,19 @@ VerifySuitePlan plan_verify_suite(const VerifyRequest& base, const std::string& 
   }
   validate_output_paths(limits, {}, inputs, {{base.output, "-o"}});
   check_suite_output(base.output);
-  for (const SuiteFabric& f : p.suite.fabrics) {
-    p.plans.push_back(plan_verify(suite_request(f, base, base.output)));
+  for (size_t k = 0; k < p.suite.fabrics.size(); ++k) {
+    const SuiteFabric& f = p.suite.fabrics[k];
+    // Every fabric is planned before the first runs: the error says which one.
+    try {
+      p.plans.push_back(plan_verify(suite_request(f, base, base.output)));
+    } catch (const Error& e) {
+      throw Error(p.suite.file.string(), "fabrics[" + std::to_string(k) + "]",
+                  "'" + f.name + "': " + e.what());
+    }
+    // The draft a fabric's weave options name is read too.
+    if (p.plans.back().weave.wif)
+      validate_output_paths(limits, {}, {{*p.plans.back().weave.wif, f.name + "'s WIF draft"}},
+                            {{base.output, "-o"}});
     const VerifyEstimate e = estimate_verify(p.plans.back());
     p.total.typical += e.typical;
     p.total.least += e.least;

@@ -79,6 +79,17 @@ nlohmann::json input_file_hashes(const std::vector<std::filesystem::path>& files
 // refusal ("the content of scene.gltf differs", "setting 'spp' differs"); "" when they agree.
 std::string job_difference(const JobPart& then, const JobPart& now);
 
+// Where a part records, beside its job's identity, the files its job reads that the identity
+// holds only by checksum (a ray-traced fabric's fiber tables or specs, a draft its weave options
+// name): extra["input_files"], {"<file>": "<FNV-1a 64 hex>"} as input_file_hashes writes them.
+// merge_job_parts gathers every part's, and weft merge guards them and checks their content.
+inline constexpr const char* kPartInputFilesKey = "input_files";
+
+// The files a merged job recorded (the job's "inputs" and extra's kPartInputFilesKey) whose content
+// is no longer what the parts were computed from: "FILE (checksum A in the parts, B now)", one per
+// file. A file no longer there is passed over (parts may be merged on another machine).
+std::vector<std::string> changed_job_inputs(const JobPart& all);
+
 // Merges parts: all of one job, disjoint, together complete (the first missing shards are
 // named); weft::Error naming the file otherwise (a part of another job: the file and "job").
 // Returns the job (header of the first part) with every unit.

@@ -59,7 +59,8 @@ SlurmScripts slurm_scripts(const SlurmPlan& plan);
 std::string slurm_dry_run_text(const SlurmScripts& scripts);
 
 // Writes the scripts and submits them with sbatch; the two job ids. weft::Error naming the
-// script when a submission fails.
+// script when a submission fails: the array's (nothing submitted) after removing both scripts,
+// saying so; the merge's (the array job runs) with the scripts kept and the array job named.
 struct SlurmSubmission {
   std::string array_job, merge_job;
 };

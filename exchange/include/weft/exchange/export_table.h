@@ -22,6 +22,13 @@ struct ExportOptions {
 // before any work).
 void check_export_path(const std::filesystem::path& path, const std::string& field);
 
+// What a reader of the exported file should be told of the table itself: a table that returns
+// more light than arrives (a directional albedo above kExportAlbedoWarning, a table scaled by
+// mistake) is exported as it is, with a warning naming 'source' (the table's file).
+inline constexpr double kExportAlbedoWarning = 1.1;  // above 1 by Monte Carlo noise at most
+std::vector<std::string> export_table_warnings(const TabulatedBsdfTable& table,
+                                               const std::string& source);
+
 ExportReport export_table(const TabulatedBsdfTable& table, const std::filesystem::path& path,
                           const ExportOptions& options);
 

@@ -30,12 +30,15 @@ struct FabricPiecesOutcome {
 // per-yarn fiber tables' checksums and maps (one distinct table: the single-table job, its
 // identity unchanged). With --resume: checkpoints every finished piece beside 'output' and starts
 // from a checkpoint left there (an unreadable one is passed over, said through 'warning'); a
-// whole table is returned for the caller to write.
+// whole table is returned for the caller to write. 'recorded_inputs' (input_file_hashes of the
+// fiber tables or specs and a draft the weave options name) goes into a part's extra as
+// kPartInputFilesKey, outside its identity, for weft merge to guard and check.
 FabricPiecesOutcome raytrace_fabric_in_pieces(
     const WovenSample& sample, const nlohmann::json& inputs, const FiberTables& fibers,
     const FabricRaytraceOptions& r, const std::string& output, const std::string& shard,
     bool resume, const ProgressCallback& progress,
-    const std::function<void(const std::string&)>& warning);
+    const std::function<void(const std::string&)>& warning,
+    const nlohmann::json& recorded_inputs = nlohmann::json::object());
 
 // The unit of incident bin 'bin' of a ray trace (its row of the table, its books and noise, every
 // value with its exact bits); the channels of such a unit for a table of 'bins' bins; and the

@@ -42,7 +42,12 @@ struct CompareOptions {
   double view_step_deg = 5, view_max_deg = 85;
 };
 
-// Throws weft::Error when the tables differ in channel count or kind.
+// A reference of no light (every value 0) has no relative difference to measure against: every
+// comparison would read 0, identical. weft::Error naming 'file' and "values" then.
+void check_compare_reference(const TabulatedBsdfTable& a, const std::string& file);
+
+// Throws weft::Error when the tables differ in channel count or kind, or the reference A holds
+// no light (check_compare_reference).
 TableComparison compare_tables(const TabulatedBsdfTable& a, const TabulatedBsdfTable& b,
                                const CompareOptions& options = {});
 

@@ -151,7 +151,8 @@ SceneDescription parse_scene_description(const nlohmann::json& j,
                                          const std::string& source);
 
 // Every file a render or sweep of the description at 'scene' reads: the description, its glTF
-// files and buffers and environment maps, and what its materials name (tables, measured networks,
+// files and buffers and environment maps, and what its materials name (tables, a fabric table's
+// weave table, measured networks,
 // fiber specs; a preset name is no file). Relative names resolve as the registry and the bake
 // cache resolve them.
 std::vector<std::filesystem::path> scene_input_files(const std::string& scene,
