@@ -108,8 +108,9 @@ void bind_verify(py::module_& m) {
          const py::object& fiber, const std::optional<std::string>& measured,
          const std::optional<std::string>& colour_space, const std::optional<std::string>& weave,
          const std::optional<std::string>& pattern, const std::optional<std::string>& wif,
-         uint64_t seed, int threads, const std::optional<std::string>& classic_albedo, bool fit,
-         const std::string& fit_params, int fit_evaluations, const std::string& fit_inner,
+         uint64_t seed, int threads, const std::optional<std::string>& classic_albedo,
+         const std::optional<std::string>& colour, const std::optional<std::string>& colour_from,
+         bool fit, const std::string& fit_params, int fit_evaluations, const std::string& fit_inner,
          int fit_seeds, const std::string& fit_method, bool plots, bool yes_long, bool progress) {
         VerifyArgs a;
         VerifyRequest& r = a.request;
@@ -124,6 +125,8 @@ void bind_verify(py::module_& m) {
         r.seed = seed;
         r.threads = threads;
         r.classic_albedo = classic_albedo.value_or("");
+        r.colour = colour.value_or("");
+        r.colour_from = colour_from.value_or("");
         r.fit = fit;
         set_fit_options(r, fit_params, fit_evaluations, fit_inner, fit_seeds, fit_method);
         a.plots = plots;
@@ -136,7 +139,8 @@ void bind_verify(py::module_& m) {
       py::arg("colour_space") = py::none(), py::arg("weave") = py::none(),
       py::arg("pattern") = py::none(), py::arg("wif") = py::none(),
       py::arg("seed") = VerifyRequest{}.seed, py::arg("threads") = 0,
-      py::arg("classic_albedo") = py::none(), py::arg("fit") = false,
+      py::arg("classic_albedo") = py::none(), py::arg("colour") = py::none(),
+      py::arg("colour_from") = py::none(), py::arg("fit") = false,
       py::arg("fit_params") = VerifyRequest{}.fit_params,
       py::arg("fit_evaluations") = VerifyRequest{}.fit_evaluations,
       py::arg("fit_inner") = VerifyRequest{}.fit_inner,

@@ -11,6 +11,11 @@
 #      at normal incidence (same brightness, classic angular behaviour),
 #   4. summation (WEFT_SUMMATION=1, the default; 0 leaves it out): the paper's summed table from
 #      the same fiber table, on the same foam.
+# The computed and summation tables take the measured fabric's colour: the fiber's dyes are
+# scaled until each table's d/8 reading (its reflectance for light near the normal) meets the
+# measured one's (`weft bake fabric --colour measured:merl-red-fabric`, docs/colour.md); the
+# matched tables are spectral. WEFT_COLOUR sets another colour (any --colour form), "none" keeps
+# the fiber's recipe as written (as does a WEFT_FIBER that is a baked table, whose colour is fixed).
 # Top row: the whole seat; bottom row: a close-up camera 12 cm from the cushion's front piping
 # (a rendered close-up, not a crop), where one weave repeat spans about 18 pixels at 480 x 360.
 # Outputs in ${WEFT_OUT:-out/seat}/: seat.glb; per variant V the descriptions seat-V.json and
@@ -25,7 +30,8 @@
 # Environment: WEFT_OUT; WEFT_WIDTH, WEFT_HEIGHT, WEFT_SPP (every render; default the scene's
 # 480 x 360, 16 spp); WEFT_THREADS (0 = all); WEFT_BACKING; WEFT_PARTICLES (ray-trace particles
 # per incident bin, default 200000); WEFT_FIBER (the fiber table, spec or preset both fabric
-# tables are made from, default red-cotton); WEFT_SUMMATION; WEFT_WEAVE; WEFT_SEAT_CELL_MM (the seat's grid,
+# tables are made from, default red-cotton); WEFT_COLOUR (default measured:merl-red-fabric);
+# WEFT_SUMMATION; WEFT_WEAVE; WEFT_SEAT_CELL_MM (the seat's grid,
 # default 5); WEFT_BIN (the weft program, default ${WEFT_BUILD_DIR:-build}/tools/weft).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,6 +47,10 @@ threads=${WEFT_THREADS:-0}
 particles=${WEFT_PARTICLES:-200000}
 fiber=${WEFT_FIBER:-red-cotton}
 backing=${WEFT_BACKING:-0.6}
+colour=${WEFT_COLOUR:-measured:merl-red-fabric}
+[[ "$fiber" == *.exr ]] && [ -z "${WEFT_COLOUR:-}" ] && colour=none
+colour_args=()
+[ "$colour" != none ] && colour_args=(--colour "$colour")
 variants=(measured computed classic)
 [ "${WEFT_SUMMATION:-1}" != 0 ] && variants+=(summation)
 size_args=()
@@ -86,10 +96,11 @@ PY
 }
 weave_args=()
 [ "$weave" = 1 ] && weave_args=(--weave-out red-cotton-weave.exr)
-bake red-cotton-fabric fabric "$fiber raytrace fiber $particles weave=$weave" --method raytrace \
-  --detail fiber --samples "$particles" "${weave_args[@]}"
+bake red-cotton-fabric fabric "$fiber raytrace fiber $particles weave=$weave colour=$colour" \
+  --method raytrace --detail fiber --samples "$particles" "${weave_args[@]}" "${colour_args[@]}"
 [ "${WEFT_SUMMATION:-1}" != 0 ] &&
-  bake red-cotton-summation summation "$fiber summation" --method summation
+  bake red-cotton-summation summation "$fiber summation colour=$colour" --method summation \
+    "${colour_args[@]}"
 /usr/bin/python3 -c "
 import json; j = json.load(open('$out/fabric.json'))
 n = ' / '.join(f'{100 * x:.2f}' for x in j['relative_noise_per_channel'])
@@ -218,9 +229,11 @@ level=table
 repeat_px=$(/usr/bin/python3 -c "
 import json; p = json.load(open('$out/closeup-camera.json'))['repeat_px']
 print(f\"{p['z']:.0f}x{p['x']:.0f}\")")
+dyed=""
+[ "$colour" != none ] && dyed=", dyed to $colour d/8"
 declare -A names=([measured]="measured (MERL red fabric)"
-  [computed]="computed: ray trace, foam $backing" [classic]="classic (Lambert + Cook-Torrance)"
-  [summation]="summation (paper), foam $backing")
+  [computed]="computed: ray trace, foam $backing$dyed" [classic]="classic (Lambert + Cook-Torrance)"
+  [summation]="summation (paper), foam $backing$dyed")
 crop_w=$(( width * 120 / 480 > 1 ? width * 120 / 480 : 1 ))
 crop_h=$(( height * 90 / 360 > 1 ? height * 90 / 360 : 1 ))
 crop="${crop_w}x${crop_h}+$(( width * 140 / 480 ))+$(( height * 195 / 360 ))"

@@ -197,6 +197,13 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                   "the classic baseline's diffuse colour R,G,B (linear sRGB reflectances); "
                   "default: the spec's volume albedo, or for a fiber table its total albedo "
                   "minus the Cook-Torrance lobe's");
+  sub->add_option("--colour", r.colour,
+                  "the cloth's colour as a d/8 instrument reads it (srgb:#RRGGBB, lab:L,a,b, "
+                  "lab10:L,a,b, spectrum:FILE.csv, measured:NAME, table:FILE.exr): the spec's "
+                  "dyes are scaled to meet it before the run (docs/colour.md)");
+  sub->add_option("--colour-from", r.colour_from,
+                  "measured: the colour is the measurement's own d/8 reading, and the computed "
+                  "model's absolute figure is its calibrated one (computed_calibrated_rms_log)");
   sub->add_flag("--json", o->json, "print metrics.json on stdout");
   sub->add_flag("--quiet", o->quiet, "no progress bar");
   sub->add_option("--shard", r.shard,
@@ -219,8 +226,9 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                           o->suite = true;
                         }
                         if (!o->suite) return run(*o);
-                        for (const char* name : {"--measured", "--fiber", "--weave", "--pattern",
-                                                 "--wif", "--shard", "--fit", "--classic-albedo"})
+                        for (const char* name :
+                             {"--measured", "--fiber", "--weave", "--pattern", "--wif", "--shard",
+                              "--fit", "--classic-albedo", "--colour", "--colour-from"})
                           if (sub->count(name) > 0) o->per_fabric_given.push_back(name);
                         return run_suite(*o);
                       }});

@@ -27,11 +27,7 @@ ColourTarget srgb_target(const std::string& spec, const std::string& hex,
   Rgb linear;
   for (int k = 0; k < 3; ++k)
     linear[k] = srgb_gamma_to_linear(std::stoi(digits.substr(2 * k, 2), nullptr, 16) / 255.0);
-  ColourTarget t;
-  t.spec = spec;
-  t.kind = ColourTarget::Kind::kSrgb;
-  t.lab = linear_srgb_to_lab(linear);
-  return t;
+  return linear_srgb_target(linear, spec);
 }
 
 ColourTarget lab_target(const std::string& spec, const std::string& values, Observer observer,
@@ -154,6 +150,14 @@ Spectrum read_reflectance_csv(const std::string& file, const std::string& field)
   return s;
 }
 
+ColourTarget linear_srgb_target(const Rgb& linear, const std::string& spec) {
+  ColourTarget t;
+  t.spec = spec;
+  t.kind = ColourTarget::Kind::kSrgb;
+  t.lab = linear_srgb_to_lab(linear);
+  return t;
+}
+
 ColourTarget parse_colour_target(const std::string& spec, const std::string& field) {
   const size_t colon = spec.find(':');
   const std::string form = spec.substr(0, colon),
@@ -177,7 +181,8 @@ ColourTarget parse_colour_target(const std::string& spec, const std::string& fie
 }
 
 std::string ColourTarget::key() const {
-  std::string k = spec;
+  std::string k = spec + "," + ParamReader::fmt(lab.l) + "," + ParamReader::fmt(lab.a) + "," +
+                  ParamReader::fmt(lab.b);
   if (reflectance)
     for (double v : *reflectance) k += "," + ParamReader::fmt(v);
   return hex64(fnv1a64(k));

@@ -8,6 +8,7 @@
 #include "weft/core/hash.h"
 #include "weft/fiber/bake_cache.h"
 #include "weft/fiber/fiber_table_bake.h"
+#include "weft/materials/colour_reading.h"
 
 namespace weft {
 
@@ -27,10 +28,8 @@ FiberTableBakeOptions reading_fiber_options(const FiberSpec& spec, const FabricB
 // What a reading depends on besides the fiber: the sample, the method and its settings.
 nlohmann::json reading_inputs(const FabricBakePlan& p, const WovenSample& sample) {
   const FabricRaytraceOptions& r = p.raytrace;
-  nlohmann::json woven = nlohmann::json::parse(weave_summary_json(sample.summary, ""));
-  woven.erase("seconds");  // how long it took to make, not what it is
   return {{"version", kColourCacheVersion},
-          {"sample", woven},
+          {"sample", woven_sample_identity(sample)},
           {"method", p.request.method},
           {"resolution", p.request.resolution},
           {"samples", p.request.samples ? nlohmann::json(*p.request.samples) : nullptr},
@@ -41,10 +40,9 @@ nlohmann::json reading_inputs(const FabricBakePlan& p, const WovenSample& sample
             r.next_event_rays, r.launch_lattice}}};
 }
 
-std::filesystem::path colour_cache_file(const FabricBakePlan& p, const WovenSample& sample,
-                                        const FiberSpec& base, const ColourTarget& target) {
-  const std::string key =
-      fiber_spec_hash_hex(base) + target.key() + reading_inputs(p, sample).dump();
+std::filesystem::path colour_cache_file(const nlohmann::json& inputs, const FiberSpec& base,
+                                        const ColourTarget& target) {
+  const std::string key = fiber_spec_hash_hex(base) + target.key() + inputs.dump();
   return kColourCacheDir / ("colour-" + hex64(fnv1a64(key)) + ".json");
 }
 
@@ -88,6 +86,12 @@ std::optional<ColourMatch> cached_match(const std::filesystem::path& file, const
 
 }  // namespace
 
+nlohmann::json woven_sample_identity(const WovenSample& sample) {
+  nlohmann::json woven = nlohmann::json::parse(weave_summary_json(sample.summary, ""));
+  woven.erase("seconds");  // how long it took to make, not what it is
+  return woven;
+}
+
 TabulatedBsdfTable colour_fiber_table(const FabricBakePlan& p, const FiberSpec& spec,
                                       const ProgressCallback& progress) {
   // Interrupted, the bake throws (nothing written); the command reports it as any bake's.
@@ -95,42 +99,46 @@ TabulatedBsdfTable colour_fiber_table(const FabricBakePlan& p, const FiberSpec& 
       cached_fiber_table(kColourCacheDir, spec, reading_fiber_options(spec, p), progress));
 }
 
-std::optional<Spectrum> fabric_d8_reading(const FabricBakePlan& p, const WovenSample& sample,
-                                          const FiberSpec& spec, const ProgressCallback& progress) {
-  const TabulatedBsdfTable fiber = colour_fiber_table(p, spec, progress);
+std::optional<Spectrum> raytrace_d8_reading(const WovenSample& sample,
+                                            const TabulatedBsdfTable& fiber,
+                                            FabricRaytraceOptions r,
+                                            const ProgressCallback& progress) {
   const int normal_bin = fiber.grid().bin_of({0, 0, 1});
-  TabulatedBsdfTable table;
-  if (p.method == FabricMethod::kRaytrace) {
-    FabricRaytraceOptions r = p.raytrace;
-    r.first_bin = normal_bin;
-    r.bin_count = 1;
-    r.weave_positions_u = r.weave_positions_v = 0;
-    FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, r, progress);
-    if (res.cancelled) return std::nullopt;
-    table = std::move(res.table);
-  } else {
-    table = summed_fabric_table(p, sample, fiber, progress);
-  }
-  const auto albedo = table.directional_albedo(normal_bin);
+  r.first_bin = normal_bin;
+  r.bin_count = 1;
+  r.weave_positions_u = r.weave_positions_v = 0;
+  const FabricRaytraceResult res = raytrace_fabric_table(sample, fiber, r, progress);
+  if (res.cancelled) return std::nullopt;
+  const auto albedo = res.table.directional_albedo(normal_bin);
   Spectrum out{};
   for (int b = 0; b < kNumBands; ++b) out[b] = albedo.reflectance[b];
   return out;
 }
 
-FabricColourMatch match_fabric_colour(const FabricBakePlan& p, const WovenSample& sample,
-                                      const ProgressCallback& progress) {
-  const FiberSpec base = load_fiber_spec(p.request.fiber);
-  const ColourTarget& target = p.colour.value();
-  const std::filesystem::path file = colour_cache_file(p, sample, base, target);
+std::optional<Spectrum> fabric_d8_reading(const FabricBakePlan& p, const WovenSample& sample,
+                                          const FiberSpec& spec, const ProgressCallback& progress) {
+  const TabulatedBsdfTable fiber = colour_fiber_table(p, spec, progress);
+  if (p.method == FabricMethod::kRaytrace)
+    return raytrace_d8_reading(sample, fiber, p.raytrace, progress);
+  TabulatedBsdfTable table;
+  { table = summed_fabric_table(p, sample, fiber, progress); }
+  const auto albedo = table.directional_albedo(fiber.grid().bin_of({0, 0, 1}));
+  Spectrum out{};
+  for (int b = 0; b < kNumBands; ++b) out[b] = albedo.reflectance[b];
+  return out;
+}
+
+FabricColourMatch cached_colour_match(const nlohmann::json& inputs, const FiberSpec& base,
+                                      const ColourTarget& target,
+                                      const ColourReadingFunction& read) {
+  const std::filesystem::path file = colour_cache_file(inputs, base, target);
   if (std::optional<ColourMatch> m = cached_match(file, base, target)) return {std::move(*m), true};
   ColourMatchOptions o;
   o.max_readings = kFabricColourReadings;
-  ColourMatch m = match_colour(
-      base, target,
-      [&](const FiberSpec& spec) { return fabric_d8_reading(p, sample, spec, progress); }, o);
+  ColourMatch m = match_colour(base, target, read, o);
   if (!m.cancelled) {
     std::filesystem::create_directories(kColourCacheDir);
-    const nlohmann::json entry = {{"inputs", reading_inputs(p, sample)},
+    const nlohmann::json entry = {{"inputs", inputs},
                                   {"fiber_spec_hash", fiber_spec_hash_hex(base)},
                                   {"target", target.spec},
                                   {"readings", readings_json(m)}};
@@ -141,8 +149,15 @@ FabricColourMatch match_fabric_colour(const FabricBakePlan& p, const WovenSample
   return {std::move(m), false};
 }
 
+FabricColourMatch match_fabric_colour(const FabricBakePlan& p, const WovenSample& sample,
+                                      const ProgressCallback& progress) {
+  return cached_colour_match(
+      reading_inputs(p, sample), load_fiber_spec(p.request.fiber), p.colour.value(),
+      [&](const FiberSpec& spec) { return fabric_d8_reading(p, sample, spec, progress); });
+}
+
 ColourTarget check_fabric_colour(const FabricBakeRequest& o, FabricMethod method) {
-  const ColourTarget target = parse_colour_target(o.colour, "--colour");
+  const ColourTarget target = read_colour_target(o.colour, "--colour");
   if (o.fiber_table || is_fiber_table_file(o.fiber))
     throw Error(o.fiber, "--colour",
                 "--colour sets the depth of a fiber spec's dyes; a baked fiber table's colour is "

@@ -54,7 +54,7 @@ TabulatedBsdfTable lossless_table(int resolution) {
 
 // A lopsided, anisotropic, non-reciprocal, mostly transmitting sheet (like the summed fabric
 // tables, which transmit 0.6-0.8 of red).
-Rgb lumpy(const Vec3& wo, const Vec3& wi) {
+Rgb lumpy_backed(const Vec3& wo, const Vec3& wi) {
   const Vec3 m{-wo.x, -wo.y, wo.z};
   const double lobe = std::exp(-6 * length_squared(wi - m));
   const double same = 0.05 * (1 + 0.5 * wi.x + 0.3 * wo.y * wo.y) + 0.3 * lobe;
@@ -70,7 +70,7 @@ TabulatedBsdf backed(const TabulatedBsdfTable& t, const Rgb& rho_b, const Rgb& s
 }
 
 // int eval(wo, wi) |cos theta_i| dwi by the midpoint rule on a fine equal-area grid.
-Rgb albedo_by_quadrature(const Bsdf& b, const Vec3& wo) {
+Rgb backed_albedo_by_quadrature(const Bsdf& b, const Vec3& wo) {
   Rgb sum;
   const OctahedralSquareGrid grid{1, 768};
   const int m = grid.n * grid.subdivisions;
@@ -125,7 +125,7 @@ TEST(TableBacking, AlbedosAreTheIntegralsOfTheInterpolatedTable) {
   // tau(wo) (other_side interpolated) and the reflection albedo (same_side) against quadrature
   // of the bare table's eval over each hemisphere. The 8 x 8-point weights are exact to the
   // quadrature's error, ~1e-4 of the albedo.
-  const auto t = table_of(8, lumpy);
+  const auto t = table_of(8, lumpy_backed);
   const TabulatedBsdf bare{TabulatedBsdfData::prepare(t), Rgb(1.0)};
   for (const Vec3& wo : kUpperWos) {
     const auto [refl, trans] = albedos_by_side(bare, wo);
@@ -149,7 +149,7 @@ TEST(TableBacking, LosslessSheetOnANearlyWhiteBackingMatchesTheClosedFormAndStay
     const double expect = kA + rho * sqr(1 - kA) / (1 - rho * kA);
     uint64_t seed = 17;
     for (const Vec3& wo : kUpperWos) {
-      const Rgb q = albedo_by_quadrature(b, wo);
+      const Rgb q = backed_albedo_by_quadrature(b, wo);
       EXPECT_NEAR(q.g, expect, 2e-4) << "rho_b " << rho << " wo " << wo;
       EXPECT_LE(q.g, 1.0) << "rho_b " << rho << " wo " << wo;
       const auto mc = estimate_albedo(b, wo, 40000, seed++);
@@ -163,13 +163,13 @@ TEST(TableBacking, LumpySheetMatchesTheClosedFormByQuadrature) {
   // Not lossless, not reciprocal: albedo(wo) = R(wo) + rho_b / (1 - rho_b r_under) tau(wo) T_d,
   // with R, tau from the bare table's eval by quadrature, and r_under, T_d the diffuse albedos
   // the data holds (checked against quadrature in the test above, per direction).
-  const auto t = table_of(8, lumpy);
+  const auto t = table_of(8, lumpy_backed);
   const Rgb rho(0.6, 0.5, 0.4);
   const TabulatedBsdf b = backed(t, rho);
   const TabulatedBsdf bare{b.data, Rgb(1.0)};
   uint64_t seed = 99;
   for (const Vec3& wo : kUpperWos) {
-    const Rgb q = albedo_by_quadrature(b, wo);
+    const Rgb q = backed_albedo_by_quadrature(b, wo);
     const auto [refl, trans] = albedos_by_side(bare, wo);
     for (int c = 0; c < 3; ++c) {
       const double rb = rho[c];
@@ -183,7 +183,7 @@ TEST(TableBacking, LumpySheetMatchesTheClosedFormByQuadrature) {
 }
 
 TEST(TableBacking, ZeroBackingIsTheReflectionPartAndTheBackIsBlack) {
-  const auto t = table_of(8, lumpy);
+  const auto t = table_of(8, lumpy_backed);
   const TabulatedBsdf zero = backed(t, Rgb(0.0));
   const TabulatedBsdf bare{zero.data, Rgb(1.0)};
   const TabulatedBsdf half = backed(t, Rgb(0.5));
@@ -208,7 +208,7 @@ TEST(TableBacking, ZeroBackingIsTheReflectionPartAndTheBackIsBlack) {
 
 TEST(TableBacking, BackingTermIsReciprocal) {
   // Even on a non-reciprocal table: one tau for both directions.
-  const auto t = table_of(8, lumpy);
+  const auto t = table_of(8, lumpy_backed);
   const TabulatedBsdf b = backed(t, Rgb(0.7, 0.6, 0.5), Rgb(0.9, 1.0, 0.8));
   Rng rng(11);
   for (int n = 0; n < 1000; ++n) {
@@ -226,7 +226,7 @@ TEST(TableBacking, SamplingMatchesEvalAndPdfOnAMostlyTransmittingSheet) {
   // there): the table part is constant on fine cells (exact here), the cosine lobe is integrated
   // by the midpoint rule, whose error falls as h^2 (2.5e-4 at 8 points per cell side, 1.6e-5 at
   // 32). Then chi^2 of the samples against the pdf on the table's cells.
-  const auto t = table_of(8, lumpy);
+  const auto t = table_of(8, lumpy_backed);
   const TabulatedBsdf b = backed(t, Rgb(0.6));
   for (const Vec3& wo : kUpperWos) {
     double total = 0;
@@ -246,7 +246,7 @@ TEST(TableBacking, SamplingMatchesEvalAndPdfOnAMostlyTransmittingSheet) {
 }
 
 TEST(TableBacking, ParametersAreCheckedAndNamed) {
-  const MaterialContext ctx = context_with_tables(table_of(4, lumpy, 1));
+  const MaterialContext ctx = context_with_tables(table_of(4, lumpy_backed, 1));
   auto fails = [&](const std::string& type, const json& params, const std::string& what) {
     try {
       make_bsdf(type, params, ctx);

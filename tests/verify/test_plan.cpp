@@ -73,7 +73,15 @@ TEST(VerifyPlan, BadRequestsAreRefusedNamingTheOption) {
       {[](VerifyRequest& r) { r.classic_albedo = "0.3,0.2"; }, "--classic-albedo"},
       {[](VerifyRequest& r) { r.shard = "3/2"; }, "--shard"},
       {[](VerifyRequest& r) { r.colour_space = "xyz"; }, "field '--colour-space'"},
-      {[](VerifyRequest& r) { r.fiber = "no-such-fiber"; }, "no-such-fiber"}};
+      {[](VerifyRequest& r) { r.fiber = "no-such-fiber"; }, "no-such-fiber"},
+      {[](VerifyRequest& r) { r.colour = "lab:40,20,10", r.colour_from = "measured"; },
+       "field '--colour-from': give --colour or --colour-from, not both"},
+      {[](VerifyRequest& r) { r.colour_from = "swatch"; }, "must be 'measured', got 'swatch'"},
+      {[](VerifyRequest& r) { r.colour = "lab:40,20"; }, "field '--colour'"},
+      {[](VerifyRequest& r) { r.colour = "lab:40,20,10", r.fit = true; },
+       "the fit sets the colour itself"},
+      {[](VerifyRequest& r) { r.colour_from = "measured", r.shard = "0/2"; },
+       "would solve the colour in every shard"}};
   for (const auto& c : cases) {
     VerifyRequest r;
     r.quality = "draft";
@@ -81,6 +89,20 @@ TEST(VerifyPlan, BadRequestsAreRefusedNamingTheOption) {
     const std::string e = error_of([&] { plan_verify(r); });
     EXPECT_NE(e.find(c.words), std::string::npos) << c.words << ": " << e;
   }
+}
+
+// --colour-from measured reads the measurement's neural fit at 8 degrees: the bundled MERL red
+// fabric's reading is red (its red channel the largest) and a reflectance.
+TEST(VerifyPlan, ColourFromTheMeasurementIsItsD8Reading) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.colour_from = "measured";
+  const VerifyPlan p = plan_verify(r);
+  ASSERT_TRUE(p.colour);
+  EXPECT_EQ(p.colour->spec, "measured:merl-red-fabric");
+  EXPECT_GT(p.colour->lab.a, 20);  // red
+  EXPECT_GT(p.colour->lab.l, 10);
+  EXPECT_LT(p.colour->lab.l, 90);
 }
 
 // A dye's concentration moves the hue: a fit of it is refused against the bundled measurement,

@@ -10,6 +10,7 @@
 #include "weft/core/error.h"
 #include "weft/core/parallel.h"
 #include "weft/core/params.h"
+#include "weft/materials/colour_reading.h"
 #include "weft/materials/cook_torrance.h"
 
 namespace weft {
@@ -81,6 +82,35 @@ void plan_fit(const VerifyRequest& o, VerifyPlan& p) {
   }
 }
 
+// --colour or --colour-from, checked: the target, or none.
+std::optional<ColourTarget> plan_verify_colour(const VerifyRequest& o, const VerifyPlan& p) {
+  if (o.colour.empty() && o.colour_from.empty()) return std::nullopt;
+  const std::string option = o.colour.empty() ? "--colour-from" : "--colour";
+  if (!o.colour.empty() && !o.colour_from.empty())
+    throw Error("", "--colour-from", "give --colour or --colour-from, not both");
+  if (!o.colour_from.empty() && o.colour_from != "measured")
+    throw Error("", "--colour-from", "must be 'measured', got '" + o.colour_from + "'");
+  if (p.fiber_table)
+    throw Error(
+        o.fiber, option,
+        "sets the depth of a fiber spec's dyes; a baked fiber table's colour is fixed: give "
+        "the spec or preset it was baked from");
+  if (o.fit) throw Error("", option, "the fit sets the colour itself: give one or the other");
+  if (p.shard)
+    throw Error("", option,
+                "a sharded run would solve the colour in every shard: solve it once with `weft "
+                "bake fabric --colour` and verify its dyed spec");
+  if (!o.colour.empty()) return read_colour_target(o.colour, "--colour");
+  const std::filesystem::path net = p.measured_path.parent_path() / "nbrdf_weights.txt";
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(net, ec))
+    throw Error(p.measured_path.string(), "--colour-from",
+                "the measurement has no neural fit beside it (nbrdf_weights.txt): its d/8 reading "
+                "needs the whole BRDF; give its colour with --colour");
+  return linear_srgb_target(nbrdf_d8_reflectance(NbrdfNetwork::load(net)),
+                            "measured:" + p.measured_path.parent_path().filename().string());
+}
+
 }  // namespace
 
 VerifyPlan plan_verify(const VerifyRequest& o) {
@@ -121,6 +151,7 @@ VerifyPlan plan_verify(const VerifyRequest& o) {
   if (p.weave.pattern != kNonwovenPattern) (void)woven_sample_size(p.weave);
   plan_fit(o, p);
   if (!o.shard.empty()) p.shard = parse_shard(o.shard, "--shard");
+  p.colour = plan_verify_colour(o, p);
   return p;
 }
 

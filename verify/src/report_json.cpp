@@ -116,7 +116,8 @@ nlohmann::json models_json(const VerifyReport& r) {
 }
 
 // The headline figures at the top level: computed is the fiber-level ray trace.
-void add_headline_figures(nlohmann::json& j, const std::vector<ModelCurves>& models) {
+void add_headline_figures(nlohmann::json& j, const std::vector<ModelCurves>& models,
+                          bool calibrated) {
   for (const auto& m : models)
     for (const VerifyModelNames& names : kVerifyModels)
       if (m.key == names.key && !m.figures.fits.empty()) {
@@ -130,6 +131,9 @@ void add_headline_figures(nlohmann::json& j, const std::vector<ModelCurves>& mod
     if (m.key == verify_model_key(VerifyModel::kComputedRaytrace)) {
       j["computed_rms_log"] = m.normalized_overall.rms_log;
       j["computed_rms_log_absolute"] = m.absolute_overall.rms_log;
+      // Calibrated to the measurement's own d/8 reading, the absolute figure is the calibrated
+      // one: no per-channel gain after that one reading.
+      if (calibrated) j["computed_calibrated_rms_log"] = m.absolute_overall.rms_log;
       j["computed_rms_rel"] = m.normalized_overall.rms_rel;
       j["computed_rms_rel_absolute"] = m.absolute_overall.rms_rel;
     }
@@ -309,6 +313,7 @@ nlohmann::json verify_metrics(const VerifyReport& r) {
         "; the shape and the paper's normalized figures stay comparable (per-channel "
         "gains absorb the diagonal part of a change of RGB space)";
   j["fiber"] = r.fiber_name;
+  if (!r.colour_match.is_null()) j["colour_match"] = r.colour_match;
   j["sample"] = r.sample_name;
   const VerifySettings& s = r.settings;
   j["settings"] = settings_json(s);
@@ -339,7 +344,7 @@ nlohmann::json verify_metrics(const VerifyReport& r) {
       "measurement (fit_min..fit_max: how far the figure moves with the reference; the verdict's "
       "measured_spread is the figure between the measurement's fits themselves)";
   j["models"] = models_json(r);
-  add_headline_figures(j, r.models);
+  add_headline_figures(j, r.models, r.colour_calibrated);
   j["verdict"] = verdict_json(r);
   if (!r.fits.empty()) {
     nlohmann::json fit = nlohmann::json::object();

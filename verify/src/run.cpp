@@ -316,6 +316,8 @@ VerifyReport run_verify(const WovenSample& sample, const VerifyInputs& in,
   rep.measured = measured;
   rep.seconds = in.seconds;
   rep.fiber_name = in.fiber_name;
+  rep.colour_match = in.colour_match;
+  rep.colour_calibrated = in.colour_calibrated;
   rep.sample_name = in.sample_name;
   const auto t_all = std::chrono::steady_clock::now();
 

@@ -7,6 +7,7 @@
 #include "common.h"
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
+#include "weft/fabric/fabric_colour.h"
 #include "weft/fabric/fabric_parts.h"
 #include "weft/fabric/fabric_summation.h"
 #include "weft/fiber/bake_cache.h"
@@ -53,6 +54,40 @@ bool fiber_inputs(const VerifyPlan& p, VerifyInputs& in, const VerifyHooks& hook
     in.classic_source = "--classic-albedo; the spec's roughness and index at 550 nm";
   }
   return true;
+}
+
+// The colour match of a plan with a colour (docs/colour.md): readings of the computed model's
+// ray trace at the plan's settings (the first batch's seed, the normal's incident bin), each on
+// the spec's spectral fiber table through the bake cache, which the run then reuses. Nothing when
+// interrupted.
+std::optional<FabricColourMatch> verify_colour_match(const VerifyPlan& p, const WovenSample& sample,
+                                                     const VerifyHooks& hooks) {
+  const VerifySettings& s = p.settings;
+  const std::vector<VerifyTrace> traces = verify_traces(s);
+  const auto computed = std::find_if(traces.begin(), traces.end(), [](const VerifyTrace& t) {
+    return t.model == "computed";
+  });
+  const nlohmann::json inputs = {{"verify", quality_name(s.quality)},
+                                 {"resolution", s.resolution},
+                                 {"fiber_photons_per_band", s.fiber_photons_per_band},
+                                 {"particles_per_bin", computed->options.particles_per_bin},
+                                 {"seed", computed->options.seed},
+                                 {"sample", woven_sample_identity(sample)}};
+  try {
+    FabricColourMatch m = cached_colour_match(
+        inputs, p.spec, *p.colour, [&](const FiberSpec& spec) -> std::optional<Spectrum> {
+          const FiberTableBakeOptions b = verify_bake_options(
+              spec, s.resolution, s.fiber_photons_per_band, s.seed, s.threads, false);
+          const TabulatedBsdfTable fiber = TabulatedBsdfTable::read_exr(
+              cached_fiber_table(".weft-cache", spec, b, hooks.progress));
+          return raytrace_d8_reading(sample, fiber, computed->options, hooks.progress);
+        });
+    if (m.match.cancelled) return std::nullopt;
+    return m;
+  } catch (const Error&) {
+    if (hooks.interrupted()) return std::nullopt;
+    throw;
+  }
 }
 
 // The sample as the report names it, with what the generator chose (the densest packing that
@@ -162,13 +197,24 @@ VerifyOutcome run_verify_plan(const VerifyPlan& p, const VerifyHooks& hooks, con
   if (sample.summary.nonwoven || !sample.summary.notes.empty())
     hooks.note("weft: sample: " + in.sample_name + "\n");
   in.seconds["woven_sample"] = seconds_since(t0);
-  if (!fiber_inputs(p, in, hooks)) {
-    VerifyOutcome cancelled;
-    cancelled.cancelled = true;
-    return cancelled;
+  VerifyOutcome cancelled;
+  cancelled.cancelled = true;
+  // With a colour, the run verifies the spec dyed to it.
+  std::optional<VerifyPlan> dyed;
+  if (p.colour) {
+    const std::optional<FabricColourMatch> m = verify_colour_match(p, sample, hooks);
+    if (!m) return cancelled;
+    dyed = p;
+    dyed->spec = m->match.spec;
+    in.colour_match = colour_match_summary(m->match);
+    in.colour_match["cached"] = m->cached;
+    in.colour_calibrated = p.request.colour_from == "measured";
+    in.seconds["colour_match"] = seconds_since(t0) - in.seconds["woven_sample"];
   }
-  if (job) return run_shard(p, sample, in, *job, hooks);
-  return run_report(p, sample, in, hooks, all);
+  const VerifyPlan& run = dyed ? *dyed : p;
+  if (!fiber_inputs(run, in, hooks)) return cancelled;
+  if (job) return run_shard(run, sample, in, *job, hooks);
+  return run_report(run, sample, in, hooks, all);
 }
 
 }  // namespace weft

@@ -7,6 +7,7 @@
 //   lab10:L,a,b       CIELAB, D65, CIE 1964 10-degree observer (the textile trade's usual one)
 //   spectrum:FILE.csv a reflectance spectrum: rows of wavelength (nm), reflectance (0-1), as a
 //                     spectrophotometer exports them; a header line and '#' comments are skipped
+// and the forms that name a material (materials/colour_reading.h): measured:NAME, table:FILE.exr.
 #include <optional>
 #include <string>
 
@@ -21,7 +22,7 @@ struct ColourTarget {
   Lab lab;                                          // the target colour
   std::optional<Spectrum> reflectance;              // a spectrum target's, per band
   std::string file;                                 // a spectrum target's file
-  // Identifies the target in cache keys: the spec, and a spectrum's values.
+  // Identifies the target in cache keys: the spec, its Lab, and a spectrum's values.
   std::string key() const;
   // The colour of a reflectance spectrum as this target states colour (its observer; sRGB targets
   // are compared under the 2-degree observer, for which sRGB is defined).
@@ -36,6 +37,10 @@ inline constexpr size_t kMaxSpectrumRows = 100000, kMaxSpectrumFileBytes = 4u <<
 inline constexpr double kSpectrumMinStartNm = 400, kSpectrumMinEndNm = 700;
 // Reflectances above this are a percentage given as a fraction (fluorescent whites reach ~1.1).
 inline constexpr double kMaxSpectrumReflectance = 1.5;
+
+// A linear sRGB reading (e.g. a table's or a measurement's d/8 reflectance) as a target compared
+// like srgb: targets; 'spec' names where it came from.
+ColourTarget linear_srgb_target(const Rgb& linear, const std::string& spec);
 
 // Parses SPEC; weft::Error naming 'field' (and the file of a spectrum) and saying what is allowed.
 ColourTarget parse_colour_target(const std::string& spec, const std::string& field);

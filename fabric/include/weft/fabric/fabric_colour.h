@@ -21,15 +21,32 @@ inline constexpr int kFabricColourReadings = 8;
 std::optional<Spectrum> fabric_d8_reading(const FabricBakePlan& plan, const WovenSample& sample,
                                           const FiberSpec& spec, const ProgressCallback& progress);
 
+// What a reading depends on of the woven sample: its summary, without the time it took to make.
+nlohmann::json woven_sample_identity(const WovenSample& sample);
+
 // The spectral fiber table a reading of 'spec' uses (through the bake cache): the table a
 // matched bake traces, so that its normal's row is the reading's bit for bit.
 TabulatedBsdfTable colour_fiber_table(const FabricBakePlan& plan, const FiberSpec& spec,
                                       const ProgressCallback& progress);
 
+// The reading of the cloth of 'sample' made of a spectral 'fiber' table by a ray trace with
+// options 'r': the normal's incident bin alone. Nothing when interrupted.
+std::optional<Spectrum> raytrace_d8_reading(const WovenSample& sample,
+                                            const TabulatedBsdfTable& fiber,
+                                            FabricRaytraceOptions r,
+                                            const ProgressCallback& progress);
+
 struct FabricColourMatch {
   ColourMatch match;
   bool cached = false;  // read from the cache: no reading was taken
 };
+
+// The match of 'base' to 'target' by these readings, from ./.weft-cache/colour-<key>.json when
+// one with the same inputs ('inputs': what a reading depends on besides the fiber and the
+// target) was made before (its readings replayed, none taken), else solved and stored.
+FabricColourMatch cached_colour_match(const nlohmann::json& inputs, const FiberSpec& base,
+                                      const ColourTarget& target,
+                                      const ColourReadingFunction& read);
 
 // The plan's colour match, from ./.weft-cache/colour-<key>.json when one with the same inputs
 // (fiber spec, target, sample, method and settings) was made before, else solved and stored.

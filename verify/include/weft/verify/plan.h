@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "weft/core/colour_target.h"
 #include "weft/core/job_part.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
@@ -33,7 +34,13 @@ struct VerifyRequest {
   uint64_t seed = VerifySettings{}.seed;
   int threads = VerifySettings{}.threads;  // 0 = all cores; results do not depend on it
   std::string classic_albedo;              // "R,G,B" (empty: from the fiber)
-  std::string shard;                       // "K/N" (empty: the whole run)
+  // The cloth's colour (any --colour form, materials/colour_reading.h): the spec's dyes are
+  // scaled to meet it before the run (docs/colour.md); empty: the recipe as written.
+  std::string colour;
+  // "measured": the colour is the measurement's own d/8 reading (its neural fit at 8 degrees),
+  // and the computed model's absolute figure is then its calibrated one; empty: none.
+  std::string colour_from;
+  std::string shard;  // "K/N" (empty: the whole run)
   bool fit = false;
   std::string fit_params = spec_fit_parameter_list(",");  // every parameter
   int fit_evaluations = FitOptions{}.max_evaluations;
@@ -58,6 +65,7 @@ struct VerifyPlan {
   FiberSpec spec;                                 // when the fiber is a spec or preset
   std::optional<TabulatedBsdfTable> fiber_table;  // when it is a baked table (.exr)
   std::optional<Rgb> classic_albedo;
+  std::optional<ColourTarget> colour;  // --colour, or the measurement's reading (--colour-from)
   WeaveOptions weave;
   std::optional<Shard> shard;  // a sharded run's
   std::vector<std::string> fit_names;

@@ -53,6 +53,10 @@ struct VerifyInputs {
       "spec's roughness "
       "and index at 550 nm";
   std::map<std::string, double> seconds;  // timings of the caller's steps (fiber bake, ...)
+  // With a colour (VerifyRequest::colour): the match's summary (fiber/colour_match.h); whether it
+  // calibrates the computed model to the measurement's own reading (--colour-from measured).
+  nlohmann::json colour_match;
+  bool colour_calibrated = false;
 };
 
 // One model's curves: per measured incidence, beta at every measured view, and its standard
@@ -85,6 +89,8 @@ struct VerifyReport {
   std::string classic_source;  // VerifyInputs::classic_source
   std::map<std::string, double> seconds;
   std::string fiber_name, sample_name;
+  nlohmann::json colour_match;  // VerifyInputs::colour_match
+  bool colour_calibrated = false;
   size_t fabric_table_gamut_clipped = 0;  // components of the computed table set to 0: none now
   // Components of the computed table's linear sRGB below 0 (a saturated colour), kept as they are.
   OutOfGamut fabric_table_out_of_gamut;
