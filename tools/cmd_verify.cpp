@@ -38,6 +38,8 @@ struct VerifyCliOptions {
 void check_verify_time(const VerifyCliOptions& o, const VerifyPlan& p) {
   const VerifyRequest& r = p.request;
   if (!o.quiet) std::fputs(verify_estimate_text(p).c_str(), stderr);
+  check_memory(o.limits, estimate_verify(p).scene_bytes, r.wif.empty() ? r.weave : r.wif,
+               "--detail", "the ray-traced scene of the woven sample");
   check_long_work(o.limits, estimate_verify(p).least, 1.0, p.settings.threads, "", "--quality",
                   "weft verify at quality " + r.quality + (r.fit ? " with --fit" : ""),
                   kVerifyLeastRates);

@@ -662,48 +662,63 @@ TaskBatch batch_for(const Tracer& t, const ProgressCallback& progress) {
 // The exact straight-through part of the bins traced (FabricRaytraceOptions::straight_through),
 // per cell pair: the sum the particles of the bin would book there on average (per_bin times the
 // power per particle) and that sum's variance; empty when sampled. With the weave tally, the same
-// per WeaveSums cell into 'weave' (its sum and sum2 then hold the sum and its variance). A task
-// per bin (its streams are the bin's), the same at any thread count.
-CellSums straight_through_sums(const Tracer& t, WeaveSums& weave) {
+// per WeaveSums cell into 'weave' (its sum and sum2 then hold the sum and its variance). A bin's
+// rays go in slices of at most kStraightThroughRaysPerTask (its streams are the bin's, booked in
+// ray order: the same bits at any thread count and slice size), so that the progress callback is
+// asked between bounded pieces of work at any particles_per_bin; 'cancelled' set when it stops.
+constexpr uint64_t kStraightThroughRaysPerTask = 8192;
+CellSums straight_through_sums(const Tracer& t, WeaveSums& weave, const ProgressCallback& progress,
+                               bool& cancelled) {
   if (t.o.straight_through == StraightThrough::sampled) return {};
   const int bins = t.grid.bins();
   const int first = t.o.first_bin, count = (t.o.bin_count ? first + t.o.bin_count : bins) - first;
   const StraightThroughPlan plan = straight_through_plan(t.per_bin);
+  const uint64_t slices =
+      (plan.rays() + kStraightThroughRaysPerTask - 1) / kStraightThroughRaysPerTask;  // per bin
   const double n = static_cast<double>(t.per_bin);
   CellSums exact{std::vector<double>(static_cast<size_t>(bins) * bins, 0.0),
                  std::vector<double>(static_cast<size_t>(bins) * bins, 0.0)};
   TaskBatch batch;
-  batch.items = static_cast<uint64_t>(count);
+  batch.items = static_cast<uint64_t>(count) * slices;
   batch.seed = t.o.seed;
   batch.threads = t.o.threads;
   batch.items_per_task = 1;
+  batch.progress = progress;
+  batch.stage = "straight-through slices";
   if (t.weave) weave = weave_sums_for(*t.weave);
-  struct Bin {
-    int bin = 0;
-    std::vector<StraightThroughCell> table, weave;
+  StraightThroughBin bin_sums(plan.replicates);
+  const auto book_bin = [&](int bin) {
+    std::vector<StraightThroughCell> woven;
+    for (const StraightThroughCell& c : bin_sums.finish(t.weave ? &woven : nullptr)) {
+      exact.sum[c.cell] += n * c.power;
+      exact.sum2[c.cell] += n * n * c.variance;
+    }
+    bin_sums = StraightThroughBin(plan.replicates);
+    if (!t.weave) return;
+    // The power leaves in every channel alike (its launch weight |cos theta_i|).
+    const size_t nc = static_cast<size_t>(t.weave->channels);
+    const size_t row = static_cast<size_t>(bin) * t.weave->per_bin();
+    for (const StraightThroughCell& c : woven)
+      for (size_t k = row + c.cell * nc; k < row + (c.cell + 1) * nc; ++k) {
+        weave.sum[k] += n * c.power;
+        weave.sum2[k] += n * n * c.variance;
+      }
   };
-  run_batch<Bin>(
+  uint64_t merged = 0;
+  const TaskBatchStatus status = run_batch<std::vector<StraightThroughExit>>(
       batch,
-      [&](uint64_t, uint64_t item, uint64_t, Rng&, Bin& b) {
-        b.bin = first + static_cast<int>(item);
-        b.table = straight_through_of_bin(t.scene, t.slab, t.grid, b.bin, plan, t.o.seed,
-                                          100 * t.o.max_scatterings, t.weave, &b.weave);
+      [&](uint64_t, uint64_t item, uint64_t, Rng&, std::vector<StraightThroughExit>& exits) {
+        const int bin = first + static_cast<int>(item / slices);
+        const StraightThroughRays rays{
+            t.scene, t.slab, t.grid, bin, plan, t.o.seed, 100 * t.o.max_scatterings, t.weave};
+        exits = straight_through_slice(rays, item % slices * kStraightThroughRaysPerTask,
+                                       kStraightThroughRaysPerTask);
       },
-      [&](const Bin& b) {
-        for (const StraightThroughCell& c : b.table) {
-          exact.sum[c.cell] += n * c.power;
-          exact.sum2[c.cell] += n * n * c.variance;
-        }
-        if (!t.weave) return;
-        // The power leaves in every channel alike (its launch weight |cos theta_i|).
-        const size_t nc = static_cast<size_t>(t.weave->channels);
-        const size_t row = static_cast<size_t>(b.bin) * t.weave->per_bin();
-        for (const StraightThroughCell& c : b.weave)
-          for (size_t k = row + c.cell * nc; k < row + (c.cell + 1) * nc; ++k) {
-            weave.sum[k] += n * c.power;
-            weave.sum2[k] += n * n * c.variance;
-          }
+      [&](const std::vector<StraightThroughExit>& exits) {
+        bin_sums.add(exits, t.weave != nullptr);
+        if (++merged % slices == 0) book_bin(first + static_cast<int>(merged / slices) - 1);
       });
+  cancelled = status.cancelled;
   return exact;
 }
 
@@ -781,12 +796,16 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
         if (weave) add_weave_task(*weave, tally.weave, weave_sums);
         if (record) record->tasks.push_back(std::move(tally.path_ops));
       });
+  // A cancelled trace is discarded by every caller (a checkpoint keeps the pieces before it):
+  // stop here rather than compute the straight-through light of bins never traced.
   result.cancelled = status.cancelled;
+  if (result.cancelled) return result;
   std::vector<uint64_t> units(bins);
   const uint64_t per_task = batch_for(t, progress).items_per_task;
   for (int a = 0; a < bins; ++a) units[a] = sample_units(t, per_task, a);
   WeaveSums weave_exact;  // the computed straight-through light's part of the weave, if any
-  const CellSums exact = straight_through_sums(t, weave_exact);
+  const CellSums exact = straight_through_sums(t, weave_exact, progress, result.cancelled);
+  if (result.cancelled) return result;
   tabulate(sums, exact, t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);

@@ -98,36 +98,73 @@ StraightThroughPlan straight_through_plan(uint64_t particles_per_bin) {
   return plan;
 }
 
+std::vector<StraightThroughExit> straight_through_slice(const StraightThroughRays& q,
+                                                        uint64_t first, uint64_t count) {
+  const int n = q.plan.directions_per_side, m = q.plan.lattice_points, reps = q.plan.replicates;
+  const uint64_t per_direction = static_cast<uint64_t>(m);
+  const uint64_t per_replicate = static_cast<uint64_t>(n) * n * per_direction;
+  const double rays_per_replicate = static_cast<double>(n) * n * m;
+  std::vector<StraightThroughExit> exits;
+  uint64_t j = first;
+  const uint64_t end = std::min(first + count, per_replicate * static_cast<uint64_t>(reps));
+  while (j < end) {
+    const int r = static_cast<int>(j / per_replicate);
+    Rng rng(q.seed, kStraightThroughStream + static_cast<uint64_t>(q.bin) * reps + r);
+    // The replicate's stream from its start: 4 draws per direction before this slice's first.
+    const uint64_t first_direction = j % per_replicate / per_direction;
+    for (uint64_t d = 0; d < 4 * first_direction; ++d) (void)rng.uniform();
+    for (uint64_t dir = first_direction; dir < static_cast<uint64_t>(n) * n && j < end; ++dir) {
+      const int a = static_cast<int>(dir / n), b = static_cast<int>(dir % n);
+      // One direction per stratum of the bin's chart square (equal solid angles), drawn
+      // uniformly in it; the lattice's shift uniform over the repeat.
+      const double fx = (a + rng.uniform()) / n, fy = (b + rng.uniform()) / n;
+      const Vec3 wi = DirectionGrid::to_direction(q.grid.chart_point(q.bin, fx, fy));
+      const double sx = rng.uniform(), sz = rng.uniform();
+      const Vec3 shift{q.slab.x0 + q.slab.px * sx, 0, q.slab.z0 + q.slab.pz * sz};
+      for (uint64_t k = j % per_direction; k < per_direction && j < end; ++k, ++j) {
+        const Vec3 p = lattice_point(q.slab, shift, static_cast<int>(k), m);
+        const auto out = straight_exit(q.scene, q.slab, q.grid, q.bin, wi, p, q.max_wraps);
+        if (!out) continue;
+        exits.push_back({static_cast<uint32_t>(r), out->cell,
+                         q.weave ? weave_cell(*q.weave, q.grid, q.bin, *out) : 0,
+                         std::abs(wi.z) / rays_per_replicate});
+      }
+    }
+  }
+  return exits;
+}
+
+struct StraightThroughBin::Sums : ReplicateSums {};
+
+StraightThroughBin::StraightThroughBin(int replicates)
+    : table_(new Sums{{replicates, {}, {}, {}}}), woven_(new Sums{{replicates, {}, {}, {}}}) {}
+StraightThroughBin::~StraightThroughBin() = default;
+StraightThroughBin::StraightThroughBin(StraightThroughBin&&) noexcept = default;
+StraightThroughBin& StraightThroughBin::operator=(StraightThroughBin&&) noexcept = default;
+
+void StraightThroughBin::add(const std::vector<StraightThroughExit>& exits, bool weave) {
+  for (const StraightThroughExit& e : exits) {
+    table_->add(static_cast<int>(e.replicate), e.cell, e.power);
+    if (weave) woven_->add(static_cast<int>(e.replicate), e.weave_cell, e.power);
+  }
+}
+
+std::vector<StraightThroughCell> StraightThroughBin::finish(
+    std::vector<StraightThroughCell>* weave_cells) {
+  if (weave_cells) *weave_cells = woven_->estimates();
+  return table_->estimates();
+}
+
 std::vector<StraightThroughCell> straight_through_of_bin(
     const RenderScene& scene, const RepeatSlab& slab, const DirectionGrid& grid, int bin,
     const StraightThroughPlan& plan, uint64_t seed, int max_wraps, const WeaveLayout* weave,
     std::vector<StraightThroughCell>* weave_cells) {
-  const int n = plan.directions_per_side, m = plan.lattice_points, reps = plan.replicates;
-  const double rays_per_replicate = static_cast<double>(n) * n * m;
-  ReplicateSums table{reps, {}, {}, {}}, woven{reps, {}, {}, {}};
   const bool tally_weave = weave && weave_cells;
-  for (int r = 0; r < reps; ++r) {
-    Rng rng(seed, kStraightThroughStream + static_cast<uint64_t>(bin) * reps + r);
-    for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b) {
-        // One direction per stratum of the bin's chart square (equal solid angles), drawn
-        // uniformly in it; the lattice's shift uniform over the repeat.
-        const double fx = (a + rng.uniform()) / n, fy = (b + rng.uniform()) / n;
-        const Vec3 wi = DirectionGrid::to_direction(grid.chart_point(bin, fx, fy));
-        const double sx = rng.uniform(), sz = rng.uniform();
-        const Vec3 shift{slab.x0 + slab.px * sx, 0, slab.z0 + slab.pz * sz};
-        for (int k = 0; k < m; ++k) {
-          const Vec3 p = lattice_point(slab, shift, k, m);
-          const auto out = straight_exit(scene, slab, grid, bin, wi, p, max_wraps);
-          if (!out) continue;
-          const double power = std::abs(wi.z) / rays_per_replicate;
-          table.add(r, out->cell, power);
-          if (tally_weave) woven.add(r, weave_cell(*weave, grid, bin, *out), power);
-        }
-      }
-  }
-  if (tally_weave) *weave_cells = woven.estimates();
-  return table.estimates();
+  const StraightThroughRays rays{scene, slab, grid,      bin,
+                                 plan,  seed, max_wraps, tally_weave ? weave : nullptr};
+  StraightThroughBin sums(plan.replicates);
+  sums.add(straight_through_slice(rays, 0, plan.rays()), tally_weave);
+  return sums.finish(tally_weave ? weave_cells : nullptr);
 }
 
 }  // namespace weft::raytrace

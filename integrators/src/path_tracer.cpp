@@ -461,10 +461,12 @@ class WindowRender {
     out_.spp_done = s_.spp;
   }
   // One sample per pixel a pass until the time limit, so that the image is always a whole
-  // number of samples per pixel; the sums are kept between passes (72 bytes a pixel).
+  // number of samples per pixel; the sums are kept between passes (72 bytes a pixel), per tile,
+  // each made by its tile's first task: zeroing them all at once (a gigabyte at 4096 x 4096) took
+  // seconds in which a cancel went unseen.
   void render_timed() {
     const auto start = std::chrono::steady_clock::now();
-    std::vector<PixelSums> sums(npx_);
+    std::vector<std::vector<PixelSums>> sums(tiles_);
     int n = 0;
     while (n < s_.spp && !cancel_.load()) {
       pass(n, n + 1, &sums);
@@ -475,7 +477,12 @@ class WindowRender {
     }
     out_.spp_done = n;
     if (n > 0)
-      for (size_t i = 0; i < npx_; ++i) store(i, sums[i], 1.0 / n);
+      for (uint64_t tile = 0; tile < tiles_; ++tile) {
+        const TileBounds b = tile_bounds(tile);
+        for (int y = b.y0; y < b.y1; ++y)
+          for (int x = b.x0; x < b.x1; ++x)
+            store(size_t(y) * ww_ + x, sums[tile][b.index(x, y)], 1.0 / n);
+      }
   }
   RenderResult finish() {
     for (uint64_t t = 0; t < tiles_; ++t) {
@@ -498,18 +505,20 @@ class WindowRender {
   // the front end sees Ctrl-C) is reported every kPollSamples samples of a thread, within a pixel
   // too, so that a cancel stops within milliseconds however large a tile's work; a pixel's samples
   // are added in the same order either way, so the bits do not depend on it.
-  void pass(int k0, int k1, std::vector<PixelSums>* sums) {
+  void pass(int k0, int k1, std::vector<std::vector<PixelSums>>* sums) {
     parallel_for(tiles_, s_.threads, [&](uint64_t tile) {
       if (cancel_.load(std::memory_order_relaxed)) return;
-      const int x0 = int(tile % tx_) * s_.tile_size, y0 = int(tile / tx_) * s_.tile_size;
-      const int x1 = std::min(x0 + s_.tile_size, ww_), y1 = std::min(y0 + s_.tile_size, wh_);
+      const TileBounds b = tile_bounds(tile);
+      const int x0 = b.x0, y0 = b.y0, x1 = b.x1, y1 = b.y1;
+      std::vector<PixelSums>* tile_sums = sums ? &(*sums)[tile] : nullptr;
+      if (tile_sums && tile_sums->empty()) tile_sums->resize(size_t(x1 - x0) * (y1 - y0));
       RayCounts rays;
       uint64_t unreported = 0;
       for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
           const size_t i = size_t(y) * ww_ + x;
           PixelSums acc;
-          PixelSums& into = sums ? (*sums)[i] : acc;
+          PixelSums& into = tile_sums ? (*tile_sums)[b.index(x, y)] : acc;
           for (int k = k0; k < k1; k += kPollSamples) {
             const int k_end = k1 - k > kPollSamples ? k + kPollSamples : k1;
             sample_pixel(win_.x0 + x, win_.y0 + y, k, k_end, into, rays, tile_nonfinite_[tile]);
@@ -524,6 +533,16 @@ class WindowRender {
       tile_rays_[tile] += rays;
       report(unreported);
     });
+  }
+
+  // The film pixels [x0, x1) x [y0, y1) of a tile (window coordinates), and a pixel's index in it.
+  struct TileBounds {
+    int x0, y0, x1, y1;
+    size_t index(int x, int y) const { return size_t(y - y0) * (x1 - x0) + (x - x0); }
+  };
+  TileBounds tile_bounds(uint64_t tile) const {
+    const int x0 = int(tile % tx_) * s_.tile_size, y0 = int(tile / tx_) * s_.tile_size;
+    return {x0, y0, std::min(x0 + s_.tile_size, ww_), std::min(y0 + s_.tile_size, wh_)};
   }
 
   // 'samples' more done: tells the progress callback, which may ask to cancel.
@@ -637,10 +656,13 @@ class WindowRender {
 
 }  // namespace
 
-double render_bytes(int width, int height, bool preview, bool mask) {
-  const double per_pixel = 3 * sizeof(float) + (preview ? 3 : 0) +
+double render_bytes(const RenderSettings& s, bool preview, bool mask) {
+  const int images = 1 + (s.aov_albedo ? 1 : 0) + (s.aov_normal ? 1 : 0);
+  const double per_pixel = images * 3 * sizeof(float) +
+                           (s.time_limit_s > 0 ? sizeof(PixelSums) : 0) + (preview ? 3 : 0) +
                            (mask ? sizeof(uint32_t) + 6 * sizeof(double) + sizeof(float) : 0);
-  return double(width) * double(height) * per_pixel;
+  const PixelWindow win = s.crop.value_or(PixelWindow{0, s.width, 0, s.height});
+  return double(win.width()) * double(win.height()) * per_pixel;
 }
 
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,

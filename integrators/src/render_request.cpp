@@ -86,8 +86,11 @@ void check_render_resources(const RenderRequest& q, const RenderPlan& plan) {
   if (job.normal) outputs.push_back({*job.normal, "--aov normal"});
   validate_output_paths(q.limits, outputs, plan.inputs);
   const RenderSettings& s = job.settings;
-  check_memory(q.limits, render_bytes(s.width, s.height, job.png.has_value(), job.mask.has_value()),
-               q.scene, "width x height",
+  RenderSettings sized = s;  // with the passes the job writes (render_job turns them on)
+  sized.aov_albedo = sized.aov_albedo || job.albedo.has_value();
+  sized.aov_normal = sized.aov_normal || job.normal.has_value();
+  check_memory(q.limits, render_bytes(sized, job.png.has_value(), job.mask.has_value()), q.scene,
+               "width x height",
                "a " + std::to_string(s.width) + " x " + std::to_string(s.height) + " render" +
                    (job.mask ? " with a mask" : ""));
   // A time limit bounds the work itself.

@@ -10,6 +10,7 @@
 #include "weft/core/error.h"
 #include "weft/core/parallel.h"
 #include "weft/core/params.h"
+#include "weft/fabric/fabric_raytrace.h"
 #include "weft/materials/colour_reading.h"
 #include "weft/materials/cook_torrance.h"
 
@@ -247,8 +248,12 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
 }
 
 VerifyEstimate estimate_verify(const VerifyPlan& p) {
-  return estimate_verify(p.settings, !p.fiber_table, p.request.fit, p.fit_options.max_evaluations,
-                         p.fit_names.size(), p.fit_seeds);
+  VerifyEstimate e =
+      estimate_verify(p.settings, !p.fiber_table, p.request.fit, p.fit_options.max_evaluations,
+                      p.fit_names.size(), p.fit_seeds);
+  if (p.weave.pattern != kNonwovenPattern)
+    e.scene_bytes = fabric_scene_bytes(woven_sample_size(p.weave));
+  return e;
 }
 
 // ---- The sharded job -------------------------------------------------------------------------

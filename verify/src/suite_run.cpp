@@ -1,4 +1,5 @@
 // weft verify --suite's plan and run (suite.h): every fabric checked before the first runs.
+#include <algorithm>
 #include <cstdio>
 
 #include "weft/core/atomic_file.h"
@@ -41,6 +42,8 @@ VerifySuitePlan plan_verify_suite(const VerifyRequest& base, const std::string& 
     p.total.typical += e.typical;
     p.total.least += e.least;
     p.total.cores = e.cores;
+    // The fabrics run one after another: the largest scene is the suite's.
+    p.total.scene_bytes = std::max(p.total.scene_bytes, e.scene_bytes);
   }
   return p;
 }
@@ -55,6 +58,8 @@ std::string verify_suite_estimate_text(const VerifySuitePlan& p) {
 }
 
 void check_verify_suite_time(const VerifySuitePlan& p, const RunLimits& limits) {
+  check_memory(limits, p.total.scene_bytes, p.suite.file.string(), "weave",
+               "the largest fabric's ray-traced scene");
   check_long_work(limits, p.total.least, 1.0, p.base.threads, "", "--quality",
                   "weft verify --suite at quality " + p.base.quality, kVerifyLeastRates);
 }

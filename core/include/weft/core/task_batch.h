@@ -21,7 +21,7 @@ struct TaskBatch {
   uint64_t seed = 0;
   int threads = 0;                 // 0: all hardware threads
   uint64_t items_per_task = 4096;  // fixes the random streams: change it, change the bits
-  uint64_t tasks_per_wave = 0;     // 0: 8 per thread; lower it when tallies are large
+  uint64_t tasks_per_wave = 0;     // 0: 8 per core used; lower it when tallies are large
   ProgressCallback progress;       // may be empty
   std::string_view stage = "items";
 
@@ -45,8 +45,11 @@ TaskBatchStatus run_batch(const TaskBatch& batch, Run&& run, Merge&& merge) {
   const uint64_t per_task = batch.items_per_task;
   const uint64_t tasks = batch.items / per_task + (batch.items % per_task != 0 ? 1 : 0);
   const int threads = thread_count(batch.threads);
-  const uint64_t wave =
-      batch.tasks_per_wave > 0 ? batch.tasks_per_wave : 8 * static_cast<uint64_t>(threads);
+  // A wave is 8 tasks per core the threads run on, not per thread: more threads than cores share
+  // them, so a wave, and the time between two calls of the progress callback, stays the same.
+  const uint64_t wave = batch.tasks_per_wave > 0
+                            ? batch.tasks_per_wave
+                            : 8 * static_cast<uint64_t>(std::min(threads, hardware_threads()));
   TaskBatchStatus status;
   // A first report before any work starts the front end's clock and allows an early stop.
   if (batch.progress && !batch.progress(ProgressUpdate{batch.stage, 0, batch.items})) {

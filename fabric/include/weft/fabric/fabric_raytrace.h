@@ -192,6 +192,7 @@ struct FabricRaytraceResult {
   WeaveTable weave;
   std::vector<double> weave_mean;
   double weave_relative_noise = 0;
+  // The progress callback stopped the trace: the rest of the result is not filled in.
   bool cancelled = false;
 };
 

@@ -12,6 +12,7 @@
 // drawn replicates give its variance, which the table's standard error includes. The particles
 // then book only what meets a fiber: E[their part] + this = the sampled estimator's expectation.
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "weft/core/direction_grid.h"
@@ -55,5 +56,42 @@ std::vector<StraightThroughCell> straight_through_of_bin(
     const RenderScene& scene, const RepeatSlab& slab, const DirectionGrid& grid, int bin,
     const StraightThroughPlan& plan, uint64_t seed, int max_wraps,
     const WeaveLayout* weave = nullptr, std::vector<StraightThroughCell>* weave_cells = nullptr);
+
+// The same estimate in slices of its rays, so that a run can split a bin's rays into tasks of
+// bounded work (and poll for a cancel between them) with the same bits: a bin's rays are numbered
+// replicate by replicate, direction by direction, entry point by entry point; a slice traces rays
+// [first, first + count) into the exits it books, and StraightThroughBin::add takes the slices in
+// ray order and books them as straight_through_of_bin does.
+struct StraightThroughRays {
+  const RenderScene& scene;
+  const RepeatSlab& slab;
+  const DirectionGrid& grid;
+  int bin;
+  StraightThroughPlan plan;
+  uint64_t seed;
+  int max_wraps;
+  const WeaveLayout* weave = nullptr;  // with the weave tally: each exit's weave cell too
+};
+struct StraightThroughExit {
+  uint32_t replicate = 0;
+  uint64_t cell = 0, weave_cell = 0;
+  double power = 0;
+};
+std::vector<StraightThroughExit> straight_through_slice(const StraightThroughRays& rays,
+                                                        uint64_t first, uint64_t count);
+class StraightThroughBin {
+ public:
+  explicit StraightThroughBin(int replicates);
+  ~StraightThroughBin();
+  StraightThroughBin(StraightThroughBin&&) noexcept;
+  StraightThroughBin& operator=(StraightThroughBin&&) noexcept;
+  void add(const std::vector<StraightThroughExit>& exits, bool weave);
+  // The bin's cells (straight_through_of_bin's result) and, with the weave tally, its weave cells.
+  std::vector<StraightThroughCell> finish(std::vector<StraightThroughCell>* weave_cells);
+
+ private:
+  struct Sums;
+  std::unique_ptr<Sums> table_, woven_;
+};
 
 }  // namespace weft::raytrace

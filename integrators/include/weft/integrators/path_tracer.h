@@ -64,9 +64,11 @@ struct RenderOutcome {
   bool cancelled = false;          // the progress callback asked to stop; results are partial
 };
 
-// The per-pixel buffers of a render: the image (3 floats), the sRGB preview (3 bytes) and a
-// masked render's hit counts, sums and squares (3 + 3 doubles) and coverage (a float).
-double render_bytes(int width, int height, bool preview, bool mask);
+// The per-pixel buffers of a render of settings 's' (its crop window's pixels when cropped): the
+// image and each AOV pass (3 floats), a time-limited render's running sums (9 doubles), the sRGB
+// preview (3 bytes) and a masked render's hit counts, sums and squares (3 + 3 doubles) and
+// coverage (a float).
+double render_bytes(const RenderSettings& s, bool preview, bool mask);
 
 struct RenderResult : RenderOutcome {
   Image image;  // mean radiance per pixel, linear RGB (the crop window's pixels when cropped)

@@ -90,6 +90,9 @@ struct VerifyEstimate {
   double typical = 0, least = 0;  // CPU seconds
   double photons = 0, particles = 0;
   unsigned cores = 1;  // the run's threads, or the machine's cores
+  // The memory of the scene its ray traces fly through (fabric_scene_bytes of the sample's
+  // counts), the largest of a run; 0 for a nonwoven mat. A front end checks it (check_memory).
+  double scene_bytes = 0;
 };
 // The rates of 'least', in words.
 inline constexpr const char* kVerifyLeastRates =
