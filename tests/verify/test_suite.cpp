@@ -148,8 +148,9 @@ TEST(VerifySuite, SummaryReadsEachReportAndSaysWhyOneFailed) {
   EXPECT_NE(html.find("<a href=\"good/index.html\">good</a>"), std::string::npos);
   EXPECT_NE(html.find("failed: the sample fails"), std::string::npos);
   // Every model's figures, whole, in the shape cell's title; the verdict's text with them.
-  EXPECT_NE(html.find("computed (ray trace) 0.310 &plusmn; 0.004 (fits 0.280&ndash;0.390)"),
-            std::string::npos);
+  EXPECT_NE(
+      html.find("Figures: computed (ray trace) 0.310 &plusmn; 0.004 (fits 0.280&ndash;0.390)"),
+      std::string::npos);
   EXPECT_NE(html.find("title=\"Shape: computed wins "), std::string::npos);
   // Not comparable (camera RGB): said in words, the figures in brackets.
   EXPECT_NE(html.find("not comparable <small>(0.550 / 1.500)</small>"), std::string::npos);
@@ -263,7 +264,7 @@ TEST(VerifySuitePage, PathsAreShownRelativeNeverAbsolute) {
   std::vector<SuiteRow> rows;
   for (const SuiteFabric& f : bundled.fabrics) rows.push_back({f, nullptr, "not run here"});
   const std::string page = verify_suite_html(bundled, rows);
-  EXPECT_NE(page.find("fiber suite/cotton-blue.json &middot; weave "
+  EXPECT_NE(page.find("fiber suite/cotton-blue.json &middot; evans-blue 2 % owf &middot; weave "
                       "scenes/examples/red-cotton-weave.json"),
             std::string::npos);
   EXPECT_NE(page.find("Measured: materials/data/measured/merl-blue-fabric/inplane.csv"),

@@ -314,7 +314,7 @@ constexpr const char* kSuitePageCss =
     "td,th{border:1px solid #ccc;padding:1px 5px;line-height:1.3;white-space:nowrap;"
     "text-align:left}th{background:#f2f2f2;font-weight:600}"
     ".cut{display:inline-block;overflow:hidden;text-overflow:ellipsis;vertical-align:bottom}"
-    "td.name .cut{max-width:14em}td.known .cut{max-width:26em}td.failed .cut{max-width:60em}"
+    "td.name .cut{max-width:14em}td.known .cut{max-width:28em}td.failed .cut{max-width:60em}"
     "td.v{text-align:center}td.ch{font-size:11px;text-align:right;color:#333}"
     "small{font-size:11px}.computed{background:#c3e6c3}.classic{background:#f2c4c4}"
     ".tie,.no_model,.unresolved,.not_comparable,.none{background:#e2e2e2}"
@@ -371,8 +371,9 @@ std::string suite_verdict_cell(const nlohmann::json& row, const SuiteFigure& fig
   if (closer == "not_comparable") values = "(" + values + ")";
   const std::string texts = joined(verdict_texts(row, figure.key), " ");
   return "<td class=\"v " + (closer.empty() ? std::string("none") : closer) + "\" title=\"" +
-         html_escape(texts) + (texts.empty() ? "" : " ") + suite_figure_values(row, figure) +
-         "\">" + suite_verdict_word(closer) + " <small>" + values + "</small></td>";
+         html_escape(texts) + (texts.empty() ? "" : " ") +
+         "Figures: " + suite_figure_values(row, figure) + "\">" + suite_verdict_word(closer) +
+         " <small>" + values + "</small></td>";
 }
 
 // The computed and the classic model's shape error per channel, R G B each.
@@ -388,19 +389,20 @@ std::string suite_channel_cells(const nlohmann::json& row) {
   return out;
 }
 
-// What is known, short (fiber, weave or pattern, dyes), with the source's words, the measured
+// What is known, short (fiber, dyes, pattern, weave), with the source's words, the measured
 // file, the colour space and the computed table's gamut in the title.
 std::string suite_known_cell(const nlohmann::json& row) {
   const nlohmann::json& shown = row["shown"];
   std::string brief = "fiber " + html_escape(shown["fiber"].get<std::string>());
-  if (!shown["weave"].get<std::string>().empty())
-    brief += " &middot; weave " + html_escape(shown["weave"].get<std::string>());
-  if (!row["pattern"].get<std::string>().empty())
-    brief += " &middot; pattern " + html_escape(row["pattern"].get<std::string>());
-  if (!shown["wif"].get<std::string>().empty())
-    brief += " &middot; wif " + html_escape(shown["wif"].get<std::string>());
   if (!row["dyes"].get<std::string>().empty())
     brief += " &middot; " + html_escape(row["dyes"].get<std::string>());
+  if (!row["pattern"].get<std::string>().empty())
+    brief += " &middot; pattern " + html_escape(row["pattern"].get<std::string>());
+  // The files last: the weave is the same few for many fabrics, so the ellipsis may take it.
+  if (!shown["wif"].get<std::string>().empty())
+    brief += " &middot; wif " + html_escape(shown["wif"].get<std::string>());
+  if (!shown["weave"].get<std::string>().empty())
+    brief += " &middot; weave " + html_escape(shown["weave"].get<std::string>());
   const std::string space = row["colour_space"].get<std::string>();
   std::string title = row["known"].get<std::string>() +
                       " Measured: " + shown["measured"].get<std::string>() + ", colour space " +
