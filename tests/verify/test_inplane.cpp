@@ -43,8 +43,9 @@ TEST(VerifyInplane, InPlaneDirectionsFollowThePapersSign) {
 }
 
 // A spectral table that reflects only the 490 nm band (band 10: kNumBands from 390 nm in 10 nm
-// steps, core/spectrum.h): a cyan-green far outside the sRGB gamut, whose linear sRGB red is negative.
-// The reduction keeps it negative (nothing clipped), counts it, and the in-plane curves carry it.
+// steps, core/spectrum.h): a cyan-green far outside the sRGB gamut, whose linear sRGB red is
+// negative. The reduction keeps it negative (nothing clipped), counts it, and the in-plane curves
+// carry it.
 TEST(VerifyInplane, SaturatedSpectralTableKeepsItsNegativeComponents) {
   constexpr int kBand = 10;  // 490 nm
   const TabulatedBsdfTable t = TabulatedBsdfTable::from_function(

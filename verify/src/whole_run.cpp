@@ -64,9 +64,8 @@ std::optional<FabricColourMatch> verify_colour_match(const VerifyPlan& p, const 
                                                      const VerifyHooks& hooks) {
   const VerifySettings& s = p.settings;
   const std::vector<VerifyTrace> traces = verify_traces(s);
-  const auto computed = std::find_if(traces.begin(), traces.end(), [](const VerifyTrace& t) {
-    return t.model == "computed";
-  });
+  const auto computed = std::find_if(traces.begin(), traces.end(),
+                                     [](const VerifyTrace& t) { return t.model == "computed"; });
   const nlohmann::json inputs = {{"verify", quality_name(s.quality)},
                                  {"resolution", s.resolution},
                                  {"fiber_photons_per_band", s.fiber_photons_per_band},
