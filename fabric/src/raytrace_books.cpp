@@ -1,0 +1,140 @@
+// The fabric ray trace's parts that stand outside the trace itself (fabric_raytrace.h): the fiber
+// directions the summations see, the scene's memory estimate, the options' checks and the energy
+// books summed from each incident bin's.
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "weft/core/error.h"
+#include "weft/fabric/fabric_raytrace.h"
+#include "weft/fabric/raytrace_steps.h"
+#include "weft/scenes/render_scene.h"
+
+namespace weft {
+
+std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_above,
+                                         int rays_per_side) {
+  if (rays_per_side < 1 || rays_per_side > 4096)
+    throw Error("", "rays_per_side", "must lie in [1, 4096]");
+  const raytrace::RepeatSlab r = raytrace::repeat_slab_of(sample);
+  const RenderScene scene(raytrace::tiled_geometry(sample));
+  std::vector<Vec3> out;
+  for (int i = 0; i < rays_per_side; ++i)
+    for (int k = 0; k < rays_per_side; ++k) {
+      const Vec3 p{r.x0 + r.px * (i + 0.5) / rays_per_side, from_above ? r.y1 + 1e-6 : r.y0 - 1e-6,
+                   r.z0 + r.pz * (k + 0.5) / rays_per_side};
+      SurfaceHit h;
+      if (scene.intersect({p, {0, from_above ? -1.0 : 1.0, 0}, 1e300}, &h))
+        out.push_back(raytrace::world_to_cloth(h.shading.s));
+    }
+  return out;
+}
+
+namespace {
+// Measured with peak RSS (docs/PERFORMANCE.md, "Memory of the fabric scene"): what weft holds
+// before the scene (the fiber table, the program), and Embree's acceleration structure with its
+// build's scratch per triangle and per round curve segment at high build quality.
+constexpr double kFabricSceneBaseBytes = 150e6;
+constexpr double kFabricSceneBvhBytesPerTriangle = 100;
+constexpr double kFabricSceneBvhBytesPerSegment = 100;
+}  // namespace
+
+double fabric_scene_bytes(const WovenSampleSize& z) {
+  // Yarn tubes. The sample's mesh per vertex: position, normal, tangent (xyzw), uv floats; per
+  // triangle three indices; its vectors grown by push_back hold up to twice that, the
+  // description's copy exactly that. Embree's copy: 12 B per vertex, 12 B per triangle.
+  constexpr double kVertexBytes = 12 * sizeof(float), kTriangleBytes = 3 * sizeof(uint32_t);
+  constexpr double kEmbreeVertexBytes = 12, kEmbreeTriangleBytes = 12;
+  // Embree's acceleration structure over the triangles, with its build's scratch, at high build
+  // quality (render_scene.cpp): measured, docs/PERFORMANCE.md.
+  constexpr double kBvhTriangleBytes = kFabricSceneBvhBytesPerTriangle;
+  const double mesh = z.vertices * kVertexBytes + z.triangles * kTriangleBytes;
+  const double tubes = 3 * mesh + z.vertices * kEmbreeVertexBytes +
+                       z.triangles * (kEmbreeTriangleBytes + kBvhTriangleBytes);
+  // Fibers, copied nine times: per point 4 floats in the sample and its copies, 4 floats in
+  // Embree's buffer; per segment its index (4 B), neighbour flags (1 B), the segment index
+  // (first point and curve, 8 B) and the acceleration structure.
+  constexpr double kPointBytes = 4 * sizeof(float), kEmbreePointBytes = 4 * sizeof(float);
+  constexpr double kSegmentBytes = 4 + 1 + 8 + kFabricSceneBvhBytesPerSegment;
+  const double fibers =
+      z.curve_points * kPointBytes +
+      9 * (z.curve_points * (kPointBytes + kEmbreePointBytes) + z.curve_segments * kSegmentBytes);
+  return kFabricSceneBaseBytes + tubes + fibers;
+}
+
+void FabricRaytraceOptions::validate() const {
+  if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
+    throw Error("", "resolution",
+                "must lie in [1, " + std::to_string(TabulatedBsdfTable::kMaxResolution) + "]");
+  if (particles_per_bin < 1 || particles_per_bin > (uint64_t{1} << 36))
+    throw Error("", "samples", "particles per incident bin must lie in [1, 2^36]");
+  if (max_scatterings < 1) throw Error("", "max_scatterings", "must be >= 1");
+  if (!(roulette_threshold > 0 && roulette_threshold < 1))
+    throw Error("", "roulette_threshold", "must lie in (0, 1)");
+  if (!(split_threshold > roulette_threshold) || !std::isfinite(split_threshold))
+    throw Error("", "split_threshold", "must be finite and above roulette_threshold");
+  if (max_copies_per_particle < 1 || max_copies_per_particle > (1 << 20))
+    throw Error("", "max_copies_per_particle", "must lie in [1, 2^20]");
+  if (threads < 0) throw Error("", "threads", "must be >= 0");
+  if (next_event_rays < 0 || next_event_rays > kMaxNextEventRays)
+    throw Error("", "next_event_rays",
+                "must lie in [0, " + std::to_string(kMaxNextEventRays) + "]");
+  if (launch_lattice < 1 || launch_lattice > kMaxLaunchLattice)
+    throw Error("", "launch_lattice", "must lie in [1, " + std::to_string(kMaxLaunchLattice) + "]");
+  if (next_event_rays > 0 && channel_sampling == ChannelSampling::mean)
+    throw Error("", "next_event_rays", "the next-event estimate needs the hero estimator");
+  const int bins = DirectionGrid{resolution}.bins();
+  if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
+    throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
+  validate_weave_options(*this);
+}
+
+void FabricBinBooks::add(const FabricBinBooks& o) {
+  launched += o.launched, exited += o.exited, absorbed += o.absorbed, lost += o.lost;
+  roulette_net += o.roulette_net;
+  particles += o.particles, scatterings += o.scatterings, wraps += o.wraps, splits += o.splits;
+  roulette_kills += o.roulette_kills, tube_passes += o.tube_passes;
+  inside_hits += o.inside_hits;
+}
+
+void fabric_raytrace_totals(FabricRaytraceResult& r) {
+  FabricBinBooks all;
+  std::vector<double> noise2, signal2;
+  for (const FabricBinBooks& b : r.bin_books) {
+    all.add(b);
+    noise2.resize(std::max(noise2.size(), b.noise2.size()), 0.0);
+    signal2.resize(noise2.size(), 0.0);
+    for (size_t c = 0; c < b.noise2.size() && c < b.signal2.size(); ++c) {
+      noise2[c] += b.noise2[c];
+      signal2[c] += b.signal2[c];
+    }
+  }
+  r.particles = all.particles, r.scatterings = all.scatterings, r.wraps = all.wraps;
+  r.splits = all.splits;
+  r.inside_hits = all.inside_hits;
+  r.roulette_kills = all.roulette_kills, r.tube_passes = all.tube_passes;
+  r.splits_per_bin.assign(r.bin_books.size(), 0);
+  r.roulette_kills_per_bin.assign(r.bin_books.size(), 0);
+  for (size_t b = 0; b < r.bin_books.size(); ++b) {
+    r.splits_per_bin[b] = r.bin_books[b].splits;
+    r.roulette_kills_per_bin[b] = r.bin_books[b].roulette_kills;
+  }
+  r.exited = r.absorbed = r.lost = r.roulette_net = 0;
+  if (all.launched > 0) {
+    r.exited = all.exited / all.launched;
+    r.lost = all.lost / all.launched;
+    r.roulette_net = all.roulette_net / all.launched;
+    r.absorbed = all.absorbed / all.launched;
+  }
+  // Each channel on its own, and all together as weft compare's rel_rms sums them.
+  double all_noise2 = 0, all_signal2 = 0;
+  r.relative_noise_per_channel.assign(noise2.size(), 0.0);
+  for (size_t c = 0; c < noise2.size(); ++c) {
+    r.relative_noise_per_channel[c] = signal2[c] > 0 ? std::sqrt(noise2[c] / signal2[c]) : 0;
+    all_noise2 += noise2[c];
+    all_signal2 += signal2[c];
+  }
+  r.relative_noise = all_signal2 > 0 ? std::sqrt(all_noise2 / all_signal2) : 0.0;
+}
+
+}  // namespace weft
