@@ -137,15 +137,7 @@ Spectrum read_reflectance_csv(const std::string& file, const std::string& field)
                     kSpectrumHoldNm);
   Spectrum s{};
   for (int b = 0; b < kNumBands; ++b) {
-    // Trapezoid average over the band at 1 nm, as the CIE tables are averaged (spectrum.cpp).
-    const double centre = band_wavelength_nm(b);
-    double sum = 0, weight = 0;
-    for (int k = -5; k <= 5; ++k) {
-      const double w = (k == -5 || k == 5) ? 0.5 : 1.0;
-      sum += w * spectrum_at(rows, centre + k);
-      weight += w;
-    }
-    s[b] = sum / weight;
+    s[b] = band_mean_1nm(b, [&](int nm) { return spectrum_at(rows, nm); });
   }
   return s;
 }

@@ -39,16 +39,8 @@ std::map<int, std::vector<double>> parse_csv(const char* text, size_t columns, c
   return rows;
 }
 
-// Trapezoid average of a 1 nm table over [centre - 5, centre + 5] nm.
 double band_average(const std::map<int, std::vector<double>>& rows, int band, size_t column) {
-  const int centre = static_cast<int>(band_wavelength_nm(band));
-  double sum = 0, weight = 0;
-  for (int nm = centre - 5; nm <= centre + 5; ++nm) {
-    const double w = (nm == centre - 5 || nm == centre + 5) ? 0.5 : 1.0;
-    sum += w * rows.at(nm)[column];
-    weight += w;
-  }
-  return sum / weight;
+  return band_mean_1nm(band, [&](int nm) { return rows.at(nm)[column]; });
 }
 
 std::array<Xyz, kNumBands> cmf_band_table(const char* csv, const char* name) {
@@ -60,6 +52,17 @@ std::array<Xyz, kNumBands> cmf_band_table(const char* csv, const char* name) {
 }
 
 }  // namespace
+
+double band_mean_1nm(int band, const std::function<double(int nm)>& value_at_nm) {
+  const int centre = static_cast<int>(band_wavelength_nm(band));
+  double sum = 0, weight = 0;
+  for (int nm = centre - 5; nm <= centre + 5; ++nm) {
+    const double w = (nm == centre - 5 || nm == centre + 5) ? 0.5 : 1.0;
+    sum += w * value_at_nm(nm);
+    weight += w;
+  }
+  return sum / weight;
+}
 
 const std::array<Xyz, kNumBands>& cie_cmf_bands() {
   return cie_cmf_bands(Observer::kCie1931TwoDegree);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cstddef>
+#include <functional>
 
 #include "weft/core/componentwise.h"
 
@@ -64,6 +65,10 @@ inline constexpr bool kComponentWise<Rgb> = true;
 struct Hsv {
   double h = 0, s = 0, v = 0;  // each in [0, 1]
 };
+
+// A band's value from a 1 nm table: the trapezoid average of value_at_nm over [centre - 5,
+// centre + 5] nm (how the CIE tables and users' spectra are reduced to the bands).
+double band_mean_1nm(int band, const std::function<double(int nm)>& value_at_nm);
 
 // CIE 1931 2-degree colour matching functions averaged over each band (1 nm CIE data).
 const std::array<Xyz, kNumBands>& cie_cmf_bands();
