@@ -94,8 +94,13 @@ TEST(ColourMatch, MatchesASpectrumWithTheRecipesMixture) {
   t.observer = Observer::kCie1964TenDegree;
   t.reflectance = analytic_cloth(with_dye_scale(red, dye_basis(red), truth));
   t.lab = reflectance_to_lab(*t.reflectance, t.observer);
+  // Congo red's measured spectrum absorbs in the violet too (fiber/data/dyes/README.md), where
+  // curcumin does, so the two depths are told apart by smaller colour differences: the default
+  // tolerance (CIEDE2000 1) is met 8 % off the truth; a tighter one recovers the mixture.
+  ColourMatchOptions tight;
+  tight.tolerance_delta_e00 = 0.1;
   int calls = 0;
-  const ColourMatch m = match_colour(red, t, counted(calls), {});
+  const ColourMatch m = match_colour(red, t, counted(calls), tight);
   ASSERT_TRUE(m.reached) << colour_match_summary(m).dump();
   EXPECT_NEAR(m.best_reading().scale[0] / truth[0], 1, 0.05);
   EXPECT_NEAR(m.best_reading().scale[1] / truth[1], 1, 0.05);

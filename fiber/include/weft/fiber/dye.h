@@ -11,13 +11,19 @@
 //   mu_a(lambda) = ln(10) * epsilon(lambda) * c * 1e-4   per um
 // (epsilon in L mol^-1 cm^-1 is decadic and per cm; 1e-4 turns per cm into per um).
 //
-// Dye file layout (every key required):
+// Dye file layout (every key required, and the absorption as one of two keys):
 // {"name": "congo-red", "colour_index": "...", "use": "...", "formula": "...",
 //  "molar_mass_g_per_mol": 696.66, "solvent": "...", "source": "...",
-//  "bands": [{"lambda_max_nm": 500, "epsilon_max_per_M_per_cm": 48000, "fwhm_per_cm": 4700}]}
-// Each band is a Gaussian in wavenumber (the usual shape of a broad electronic absorption band):
+//  "spectrum_nm_epsilon_per_M_per_cm": [[380, 25371], [381, 25043], ...]}
+// A tabulated spectrum (a measured one, as the bundled dyes carry): rows of wavelength (nm,
+// increasing) and epsilon, joined linearly and averaged over each band; epsilon is 0 past the
+// table's ends, so a table stopping inside the bands must stop where its absorption has died away
+// (below kDyeSpectrumEndFraction of its peak). Or, where no spectrum is at hand, Gaussian bands:
+//  "bands": [{"lambda_max_nm": 500, "epsilon_max_per_M_per_cm": 48000, "fwhm_per_cm": 4700}]
+// each a Gaussian in wavenumber (the usual shape of a broad electronic absorption band), summed:
 //   epsilon(nu) = epsilon_max * exp(-4 ln 2 (nu - nu_max)^2 / fwhm^2),  nu = 1e7 / lambda_nm per
 //   cm.
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -30,7 +36,21 @@ struct DyeSpectrum {
   std::string colour_index;  // e.g. "C.I. Direct Red 28 ..."
   double molar_mass_g_per_mol = 0;
   Spectrum epsilon_per_M_per_cm{};  // decadic molar absorption coefficient per band
+  bool tabulated = false;           // from a tabulated spectrum (else from Gaussian bands)
 };
+
+// The tabulated spectrum's key and bounds. Spectrophotometers read 190-1100 nm; a 0.1 nm table of
+// that range has about 9000 rows, and 10 000 refuses absurd ones. The strongest dyes reach
+// epsilon of some 300 000 L/(mol cm) (cyanines); 1e6 refuses unit slips.
+inline constexpr const char* kDyeSpectrumKey = "spectrum_nm_epsilon_per_M_per_cm";
+inline constexpr size_t kMaxDyeSpectrumRows = 10000;
+inline constexpr double kMinDyeSpectrumNm = 190, kMaxDyeSpectrumNm = 1100;
+inline constexpr double kMaxDyeEpsilon = 1e6;
+// A table that stops inside the bands ends below this fraction of its peak (the bundled ones end
+// at 0.4 % at most: auramine O's at 600 nm).
+inline constexpr double kDyeSpectrumEndFraction = 0.01;
+// Gaussian bands in one file: a dye's visible and near-UV bands are a handful.
+inline constexpr size_t kMaxDyeGaussianBands = 16;
 
 // One dye of a recipe (the spec's host.dyes[i]).
 struct DyeComponent {
