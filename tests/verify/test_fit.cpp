@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "test_util.h"
+#include "weft/verify/figures.h"
 #include "weft/verify/fit.h"
 
 using weft::testing::error_of;
@@ -101,10 +102,34 @@ TEST(VerifyFit, ResidualsAreTheLogRatiosWhereTheMeasurementIsPositive) {
   const std::vector<std::vector<Rgb>> model = {{Rgb(1.0, 1.0, 0.0), Rgb(0.4)}};
   const std::vector<double> r = fit_residuals(model, m);
   ASSERT_EQ(r.size(), 5u);  // the measured zero is left out
+  // Above the floor (1e-3 of the channel's measured maximum) the residual is ln(x / m) exactly.
   EXPECT_DOUBLE_EQ(r[0], std::log(2.0));
-  EXPECT_DOUBLE_EQ(r[1], std::log(1e-6));  // a model zero is the penalty
+  // A model zero sits at half the floor.
+  EXPECT_DOUBLE_EQ(r[1], std::log(kLogFloorFraction * 0.5 / 2 / 0.5));
   EXPECT_DOUBLE_EQ(r[2], 0.0);
   EXPECT_NE(error_of([&] { fit_residuals({}, m); }).find("incidences"), std::string::npos);
+}
+
+// The floor is smooth and increasing: a negative (out-of-gamut) model value costs more than a
+// zero, the further out the more, with no jump at zero (the fit's objective stays smooth in a dye
+// that drives a channel through zero).
+TEST(VerifyFit, ResidualFloorIsSmoothAndIncreasingThroughZero) {
+  const double f = 1e-3;
+  EXPECT_EQ(smooth_log_floor(f, f), f);
+  EXPECT_EQ(smooth_log_floor(0.3, f), 0.3);
+  EXPECT_DOUBLE_EQ(smooth_log_floor(0, f), f / 2);
+  EXPECT_DOUBLE_EQ(smooth_log_floor(-98 * f, f), f / 100);  // out of gamut: f^2 / (2 f + |x|)
+  // Continuous in value and slope at the floor.
+  const double h = 1e-9;
+  EXPECT_NEAR((smooth_log_floor(f, f) - smooth_log_floor(f - h, f)) / h, 1.0, 1e-5);
+  double last = 0;
+  for (int k = -100; k <= 100; ++k) {
+    const double x = k * 1e-4, y = smooth_log_floor(x, f);
+    EXPECT_GT(y, last) << x;
+    // The step in ln y between neighbours is at most the step over the floor (0.1): no jump.
+    if (k > -100) EXPECT_LE(std::log(y / last), 0.1 + 1e-12) << x;
+    last = y;
+  }
 }
 
 TEST(VerifyFit, OptionsNameTheirField) {

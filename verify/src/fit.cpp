@@ -6,6 +6,7 @@
 
 #include "common.h"
 #include "weft/core/error.h"
+#include "weft/verify/figures.h"
 
 namespace weft {
 
@@ -36,10 +37,24 @@ void FitOptions::validate(size_t parameters) const {
   OptimizeOptions::validate();
 }
 
+double smooth_log_floor(double x, double floor) {
+  // x itself from the floor up, so the objective is the metrics' rms_log wherever both sides are
+  // above it; below, f^2 / (2 f - x): the same value and slope at f, positive and increasing, and
+  // its log falls only as ln |x| far out of gamut (a negative value), so a channel pushed through
+  // zero by a dye bends the objective without dominating it.
+  return x >= floor ? x : floor * floor / (2 * floor - x);
+}
+
 std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
                                   const MeasuredInplane& measured) {
   if (model.size() != measured.curves.size())
     throw Error(measured.file, "fit", "the model's incidences differ from the measurement's");
+  // Each channel's floor, on both sides as in the metrics, from the measurement's maximum, not
+  // the model's: it does not move with the parameters, so the objective stays smooth in them.
+  double top[3] = {0, 0, 0};
+  for (const auto& c : measured.curves)
+    for (const auto& b : c.beta)
+      for (int k = 0; k < 3; ++k) top[k] = std::max(top[k], b[k]);
   std::vector<double> r;
   for (size_t i = 0; i < model.size(); ++i) {
     const auto& c = measured.curves[i];
@@ -49,7 +64,8 @@ std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
       for (int k = 0; k < 3; ++k) {
         const double m = c.beta[v][k], x = model[i][v][k];
         if (!(m > 0)) continue;
-        r.push_back(x > 0 ? std::log(x / m) : std::log(1e-6));
+        const double f = kLogFloorFraction * top[k];
+        r.push_back(std::log(smooth_log_floor(x, f) / smooth_log_floor(m, f)));
       }
   }
   return r;

@@ -183,7 +183,9 @@ FiberTableBakeOptions verify_bake_options(const FiberSpec& spec, int resolution,
   b.photons_per_band = photons_per_band;
   b.seed = seed;
   b.threads = threads;
-  b.spectral = !fit_inner;
+  // Spectral in the fit too: an RGB bake of a saturated dye has no valid table (its linear-sRGB
+  // components leave [0, albedo]), and clipping them puts a kink in the objective.
+  b.spectral = true;
   if (fit_inner) {
     // The fit's inner bake keeps plain exits, one surface sample and random entries: next-event
     // inner bakes made the fits spread more (docs/verify.md), and its photons per band are the
@@ -220,8 +222,9 @@ std::string inner_step_name(const FitInnerSettings& f) {
 }  // namespace
 
 std::string computed_inner_model_name(const FitInnerSettings& f) {
-  return inner_step_name(f) + " of an RGB fiber bake (" + std::to_string(f.fiber_photons_per_band) +
-         " photons per band), seed " + std::to_string(f.seed) + " at every evaluation";
+  return inner_step_name(f) + " of a spectral fiber bake (" +
+         std::to_string(f.fiber_photons_per_band) + " photons per band), seed " +
+         std::to_string(f.seed) + " at every evaluation";
 }
 
 std::string classic_inner_model_name(const FitInnerSettings& f) {

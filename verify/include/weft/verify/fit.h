@@ -113,9 +113,16 @@ struct FitResult {
 // The RMS of fit_residuals: the fit's objective (rms_log, absolute) of a model's curves.
 double fit_rms_log(const std::vector<std::vector<Rgb>>& model, const MeasuredInplane& measured);
 
+// max(x, floor) made smooth: x from the floor up, floor^2 / (2 floor - x) below it (continuous in
+// value and slope, increasing in x, positive).
+double smooth_log_floor(double x, double floor);
+
 // The residuals the fit minimizes: ln(model / measured) at every view, incidence and channel
-// where the measurement is positive (the points of rms_log); a model value <= 0 counts as
-// ln(1e-6), a penalty, so the vector's length does not depend on the parameters.
+// where the measurement is positive (the points of rms_log), so the vector's length does not
+// depend on the parameters. Both values pass a smooth floor first, at kLogFloorFraction of
+// the measurement's own channel maximum (figures.h): an out-of-gamut (negative) component of a
+// spectral model's linear sRGB is penalized more the further out it is, with no kink or jump;
+// above the floor the residual is ln(model / measured) exactly.
 std::vector<double> fit_residuals(const std::vector<std::vector<Rgb>>& model,
                                   const MeasuredInplane& measured);
 
@@ -134,7 +141,8 @@ void add_fit_uncertainty(FitResult& res, const InplaneModel& inplane,
 
 // The inner model the fit evaluates (docs/verify.md), both with fixed seeds at every evaluation
 // (common random numbers):
-//   kRaytrace: the run's own pipeline (RGB fiber bake, then the fiber-level ray trace) with few
+//   kRaytrace: the run's own pipeline (spectral fiber bake, then the fiber-level ray trace) with
+//   few
 //     photons and particles; the bake treats absorption as a weight and the ray trace draws its
 //     paths from a proposal table re-centred on the optimum (verify/fit_models.h), so that the
 //     objective is smooth in the parameters at the fixed seed;
