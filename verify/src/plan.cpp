@@ -346,26 +346,26 @@ void classic_from_table(const std::string& file, const TabulatedBsdfTable& t,
   }
   const std::vector<double> diffuse =
       classic_diffuse_from_fiber_table(t, *rough, in.classic_ior, s.seed, s.threads);
-  Rgb rgb;
-  if (t.channels == kNumBands) {
-    for (int b = 0; b < kNumBands; ++b) in.volume_albedo[b] = diffuse[b];
-    rgb = bands_to_linear_srgb([&](int b) { return diffuse[b]; });
-  } else {
-    rgb = Rgb(diffuse[0], diffuse[1], diffuse[2]);
-  }
-  // As a reflectance of the light that gets past the lobe (classic.h).
+  // As a reflectance of the light that gets past the lobe (classic.h), checked where it is a
+  // reflectance: per band for a spectral table (its linear sRGB may leave the gamut for a
+  // saturated dye; verify_classic_fiber brings that to the classic model's RGB and reports it),
+  // per channel for an RGB one.
   const double entering = classic_entering_fraction(*rough, in.classic_ior);
-  for (int k = 0; k < 3; ++k) {
-    rgb[k] /= entering;
-    const double v = rgb[k];
+  for (size_t k = 0; k < diffuse.size(); ++k) {
+    const double v = diffuse[k] / entering;
     if (!(v >= 0 && v <= 1))
       throw Error(file, "--classic-albedo",
                   "the classic baseline's diffuse colour from the table (its total albedo minus "
                   "the Cook-Torrance lobe's, over what the lobe leaves) is " +
-                      std::to_string(v) + " in channel " + "RGB"[k] +
+                      std::to_string(v) + " in " +
+                      (t.channels == kNumBands ? "band " + std::to_string(k)
+                                               : std::string("channel ") + "RGB"[k]) +
                       ", not a reflectance in [0, 1]: give --classic-albedo R,G,B");
   }
-  if (t.channels != kNumBands) in.classic_diffuse = rgb;
+  if (t.channels == kNumBands)
+    for (int b = 0; b < kNumBands; ++b) in.volume_albedo[b] = diffuse[b];
+  else
+    in.classic_diffuse = Rgb(diffuse[0] / entering, diffuse[1] / entering, diffuse[2] / entering);
   in.classic_source =
       "the fiber table: its total albedo minus the classic Cook-Torrance lobe's, over what the "
       "lobe leaves, per " +
