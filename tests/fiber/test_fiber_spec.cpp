@@ -3,8 +3,10 @@
 // name a spec in caches and table headers (name and notes excluded).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 
 #include "test_util.h"
@@ -144,8 +146,9 @@ TEST(FiberSpec, LoadsFilesAndPresetsAndReportsMissingOnes) {
     EXPECT_NE(what.find("red-cotton"), std::string::npos) << what;  // lists the presets
   }
   const auto names = fiber_preset_names();
-  EXPECT_EQ(names, (std::vector<std::string>{"red-cotton", "white-cotton", "polyester-delustered",
-                                             "polyester-filament", "silk", "acrylic"}));
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"red-cotton", "white-cotton", "polyester-delustered",
+                                      "polyester-filament", "silk", "acrylic", "nylon-filament"}));
   for (const auto& n : names) EXPECT_EQ(load_fiber_spec(n).name, n);
   EXPECT_THROW(fiber_preset_json("blue-silk"), Error);
 }
@@ -230,8 +233,40 @@ TEST(FiberSpec, DensityIsOptionalCheckedAndNotHashed) {
   expect_error(edit("\"fiber_radius_um\": 5,", "\"fiber_radius_um\": 5, \"density_g_cm3\": 0,"),
                {"density_g_cm3"});
   // The presets the nonwoven and filament samples use carry their cited densities
-  // (docs/presets.md): PET 1.38, silk fibroin 1.35, acrylic 1.17 g/cm3.
+  // (docs/presets.md): PET 1.38, silk fibroin 1.35, acrylic 1.17, nylon 6,6 1.14 g/cm3 (Morton &
+  // Hearle, Physical Properties of Textile Fibres).
   EXPECT_EQ(load_fiber_spec("polyester-filament").density_g_cm3, 1.38);
   EXPECT_EQ(load_fiber_spec("silk").density_g_cm3, 1.35);
   EXPECT_EQ(load_fiber_spec("acrylic").density_g_cm3, 1.17);
+  EXPECT_EQ(load_fiber_spec("nylon-filament").density_g_cm3, 1.14);
+}
+
+TEST(FiberSpec, NylonFilamentIsPolyesterFilamentWithNylonsPhysics) {
+  // nylon-filament follows polyester-filament (docs/presets.md) and changes only what nylon 6,6
+  // changes. Host index: Morton & Hearle, Physical Properties of Textile Fibres, nylon 6,6
+  // n_par = 1.582, n_perp = 1.519; the orientation average (n_par + 2 n_perp) / 3 = 1.54, in every
+  // band, against PET's 1.60.
+  const FiberSpec nylon = load_fiber_spec("nylon-filament");
+  const FiberSpec pet = load_fiber_spec("polyester-filament");
+  for (int b = 0; b < kNumBands; ++b) {
+    EXPECT_NEAR(nylon.host_n[b], (1.582 + 2 * 1.519) / 3, 5e-4) << b;
+    EXPECT_EQ(nylon.host_absorption_per_um[b], 0.0) << b;  // transparent, as PET
+  }
+  // The same 83 dtex f72 yarn at nylon's 1.14 g/cm3: area = 1.153e-7 kg/m / 1140 kg/m3, r =
+  // sqrt(area / pi) = 5.67 um (PET's 1380 kg/m3 gives 5.16 um).
+  EXPECT_NEAR(nylon.fiber_radius_um, std::sqrt(83.0 / 72 * 1e-7 / 1140 / std::numbers::pi) * 1e6,
+              0.05);
+  // Semi-dull, 0.3 wt % rutile: 0.003/4.2 / (0.003/4.2 + 0.997/1.14) = 0.082 vol %, written to one
+  // significant digit as acrylic's 0.084 is; the particles themselves are PET's.
+  ASSERT_EQ(nylon.species.size(), 1u);
+  ASSERT_EQ(pet.species.size(), 1u);
+  EXPECT_NEAR(nylon.species[0].volume_fraction, 0.003 / 4.2 / (0.003 / 4.2 + 0.997 / 1.14), 5e-5);
+  EXPECT_EQ(nylon.species[0].n, pet.species[0].n);
+  EXPECT_EQ(nylon.species[0].size.radius_um, pet.species[0].size.radius_um);
+  EXPECT_EQ(nylon.species[0].size.kind, pet.species[0].size.kind);
+  EXPECT_EQ(nylon.species[0].size.sigma, pet.species[0].size.sigma);
+  // Surface: the same melt-spun, untextured filament (a modelling choice).
+  EXPECT_EQ(nylon.roughness_distribution, pet.roughness_distribution);
+  EXPECT_EQ(nylon.roughness_alpha, pet.roughness_alpha);
+  EXPECT_NE(fiber_spec_hash(nylon), fiber_spec_hash(pet));
 }
