@@ -6,7 +6,7 @@
 # (python/) and its tests, slurm-wlm and munge for the single-node Slurm of
 # tests/tools/slurm_test.sh, and nodejs and npm for the glTF validator of the export tests
 # (scripts/install-gltf-validator.sh; only when no npm is on the PATH, which may come from another
-# source than Debian's). Installs only the packages that are missing; skips apt entirely when none
+# source than Debian's), and chromium for the screenshot test of the HTML preview. Installs only the packages that are missing; skips apt entirely when none
 # is. --list prints the chosen set, one package a line, and installs nothing.
 # Usage: install-deps.sh [--tests] [--list]
 set -euo pipefail
@@ -15,7 +15,8 @@ build_run=(build-essential cmake ninja-build pkg-config
   libtinygltf-dev nlohmann-json3-dev libtbb-dev libcli11-dev
   python3-matplotlib python3-numpy)
 tests_only=(libgtest-dev libbenchmark-dev slurm-wlm munge
-  pybind11-dev python3-dev python3-pytest)  # the Python module (python/) and its tests
+  pybind11-dev python3-dev python3-pytest  # the Python module (python/) and its tests
+  chromium)  # headless, the screenshot test of weft export's HTML preview
 
 packages=("${build_run[@]}")
 list=0

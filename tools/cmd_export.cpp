@@ -1,5 +1,6 @@
 // weft export: a table leaves Weft as a file other renderers read (docs/exchange.md): RGL .bsdf
-// (Mitsuba 3, pbrt-v4), MDL .mbsdf (Omniverse / Iray), glTF 2.0 material (.gltf / .glb).
+// (Mitsuba 3, pbrt-v4), MDL .mbsdf (Omniverse / Iray), glTF 2.0 material (.gltf / .glb), or a
+// self-contained .html page previewing that material.
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -52,9 +53,11 @@ void add_export_command(CLI::App& app, Commands& commands) {
   auto* sub = app.add_subcommand(
       "export",
       "Export a table for other renderers: RGL .bsdf (Mitsuba 3, pbrt-v4), MDL .mbsdf, glTF "
-      "material (.gltf/.glb); prints what the format drops");
+      "material (.gltf/.glb), or an offline .html page previewing it; prints what the format "
+      "drops");
   sub->add_option("table", o->table, "table (.exr)")->required();
-  sub->add_option("-o,--output", o->output, "output: .bsdf, .mbsdf, .gltf or .glb")->required();
+  sub->add_option("-o,--output", o->output, "output: .bsdf, .mbsdf, .gltf, .glb or .html")
+      ->required();
   sub->add_option("--name", o->name, "material name (default: the table's file name)");
   sub->add_flag("--json", o->json, "print the summary as JSON");
   commands.push_back({sub, [o](const RunLimits& l) { return run_export(*o, l); }});

@@ -9,9 +9,10 @@ namespace weft {
 
 void check_export_path(const std::filesystem::path& path, const std::string& field) {
   const std::string ext = path.extension().string();
-  if (ext != ".bsdf" && ext != ".mbsdf" && ext != ".gltf" && ext != ".glb")
-    throw Error(path.string(), field,
-                "unknown format '" + ext + "': the output ends in .bsdf, .mbsdf, .gltf or .glb");
+  if (ext != ".bsdf" && ext != ".mbsdf" && ext != ".gltf" && ext != ".glb" && ext != ".html")
+    throw Error(
+        path.string(), field,
+        "unknown format '" + ext + "': the output ends in .bsdf, .mbsdf, .gltf, .glb or .html");
 }
 
 std::vector<std::string> export_table_warnings(const TabulatedBsdfTable& table,
@@ -42,6 +43,7 @@ ExportReport export_table(const TabulatedBsdfTable& table, const std::filesystem
       return write_rgl_bsdf(table, path, rgl);
     }
     if (ext == ".mbsdf") return write_mbsdf(table, path, options.mbsdf);
+    if (ext == ".html") return write_preview_html(table, path, options.name, options.gltf);
     return write_gltf_material(table, path, options.name, options.gltf);
   } catch (const Error& e) {
     // The writers' option errors name only the field: name the output too.

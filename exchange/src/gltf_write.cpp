@@ -1,13 +1,16 @@
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cstring>
 #include <sstream>
 
+#include "gltf_asset.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/exchange/gltf_material.h"
 
 namespace weft {
+namespace gltf_detail {
 namespace {
 
 template <class T>
@@ -35,45 +38,63 @@ int add_accessor(tinygltf::Model& m, size_t offset, size_t bytes, int component,
   return static_cast<int>(m.accessors.size() - 1);
 }
 
-// The quad: 1 m x 1 m in the x-z plane, facing +y (glTF's up).
-void add_quad(tinygltf::Model& m) {
-  const std::vector<float> pos{-0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 0.5f, 0, -0.5f, -0.5f, 0, -0.5f};
-  const std::vector<float> nrm{0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
-  const std::vector<float> uv{0, 0, 1, 0, 1, 1, 0, 1};
-  const std::vector<uint16_t> idx{0, 1, 2, 0, 2, 3};
-  tinygltf::Buffer buffer;
-  append(buffer.data, pos);
-  append(buffer.data, nrm);
-  append(buffer.data, uv);
-  append(buffer.data, idx);
-  m.buffers.push_back(buffer);
-  const int p = add_accessor(m, 0, 48, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 4,
-                             TINYGLTF_TARGET_ARRAY_BUFFER);
-  m.accessors[static_cast<size_t>(p)].minValues = {-0.5, 0, -0.5};
-  m.accessors[static_cast<size_t>(p)].maxValues = {0.5, 0, 0.5};
-  const int n = add_accessor(m, 48, 48, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC3, 4,
-                             TINYGLTF_TARGET_ARRAY_BUFFER);
-  const int t = add_accessor(m, 96, 32, TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TYPE_VEC2, 4,
-                             TINYGLTF_TARGET_ARRAY_BUFFER);
-  const int i = add_accessor(m, 128, 12, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                             TINYGLTF_TYPE_SCALAR, 6, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+// 'values' appended to the buffer, padded to 4 bytes so that the next view's floats align.
+template <class T>
+size_t append_aligned(std::vector<unsigned char>& out, const std::vector<T>& values) {
+  const size_t at = out.size();
+  append(out, values);
+  out.resize((out.size() + 3) / 4 * 4, 0);
+  return at;
+}
+
+// Mesh 'k' of the asset: its attributes and indices in buffer 0 (16-bit indices where they fit),
+// one primitive with material 0, one node.
+void add_mesh(tinygltf::Model& m, const GltfMesh& mesh) {
+  auto& data = m.buffers[0].data;
+  const size_t n = mesh.vertices();
+  const int f = TINYGLTF_COMPONENT_TYPE_FLOAT, array = TINYGLTF_TARGET_ARRAY_BUFFER;
+  const int p = add_accessor(m, append_aligned(data, mesh.positions_m), n * 12, f,
+                             TINYGLTF_TYPE_VEC3, n, array);
+  std::vector<double> lo(3, 1e30), hi(3, -1e30);
+  for (size_t v = 0; v < n; ++v)
+    for (size_t c = 0; c < 3; ++c) {
+      lo[c] = std::min(lo[c], static_cast<double>(mesh.positions_m[3 * v + c]));
+      hi[c] = std::max(hi[c], static_cast<double>(mesh.positions_m[3 * v + c]));
+    }
+  m.accessors[static_cast<size_t>(p)].minValues = lo;
+  m.accessors[static_cast<size_t>(p)].maxValues = hi;
+  const int nr =
+      add_accessor(m, append_aligned(data, mesh.normals), n * 12, f, TINYGLTF_TYPE_VEC3, n, array);
+  const int t =
+      add_accessor(m, append_aligned(data, mesh.uvs), n * 8, f, TINYGLTF_TYPE_VEC2, n, array);
+  const size_t count = mesh.indices.size();
+  int i = 0;
+  if (n <= 0xffff) {
+    const std::vector<uint16_t> short_indices(mesh.indices.begin(), mesh.indices.end());
+    i = add_accessor(m, append_aligned(data, short_indices), count * 2,
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT, TINYGLTF_TYPE_SCALAR, count,
+                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  } else {
+    i = add_accessor(m, append_aligned(data, mesh.indices), count * 4,
+                     TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TYPE_SCALAR, count,
+                     TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  }
   tinygltf::Primitive prim;
-  prim.attributes = {{"POSITION", p}, {"NORMAL", n}, {"TEXCOORD_0", t}};
+  prim.attributes = {{"POSITION", p}, {"NORMAL", nr}, {"TEXCOORD_0", t}};
   prim.indices = i;
   prim.material = 0;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
-  tinygltf::Mesh mesh;
-  mesh.name = "fabric_sample";
-  mesh.primitives.push_back(prim);
-  m.meshes.push_back(mesh);
+  tinygltf::Mesh gm;
+  gm.name = mesh.name;
+  gm.primitives.push_back(prim);
+  m.meshes.push_back(gm);
   tinygltf::Node node;
-  node.mesh = 0;
-  node.name = "fabric_sample";
+  node.mesh = static_cast<int>(m.meshes.size() - 1);
+  node.name = mesh.name;
+  if (mesh.translation_m != std::array<double, 3>{0, 0, 0})
+    node.translation = {mesh.translation_m[0], mesh.translation_m[1], mesh.translation_m[2]};
   m.nodes.push_back(node);
-  tinygltf::Scene scene;
-  scene.nodes = {0};
-  m.scenes.push_back(scene);
-  m.defaultScene = 0;
+  m.scenes[0].nodes.push_back(static_cast<int>(m.nodes.size() - 1));
 }
 
 tinygltf::Value rgb_value(const Rgb& c) {
@@ -119,12 +140,18 @@ tinygltf::Material make_material(const GltfFit& fit, const std::string& name, do
 
 }  // namespace
 
-ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::filesystem::path& path,
-                                 const std::string& name, const GltfFitOptions& options) {
-  const std::string ext = path.extension().string();
-  if (ext != ".gltf" && ext != ".glb")
-    throw Error(path.string(), "output", "a glTF file ends in .gltf or .glb");
-  const GltfFit fit = fit_gltf_material(table, options);
+GltfMesh sample_quad() {
+  GltfMesh q;
+  q.name = "fabric_sample";
+  q.positions_m = {-0.5f, 0, 0.5f, 0.5f, 0, 0.5f, 0.5f, 0, -0.5f, -0.5f, 0, -0.5f};
+  q.normals = {0, 1, 0, 0, 1, 0, 0, 1, 0, 0, 1, 0};
+  q.uvs = {0, 0, 1, 0, 1, 1, 0, 1};
+  q.indices = {0, 1, 2, 0, 2, 3};
+  return q;
+}
+
+std::string gltf_asset(const GltfFit& fit, const std::string& name, double epsilon_per_sr,
+                       const std::vector<GltfMesh>& meshes, bool glb, const std::string& path) {
   tinygltf::Model m;
   m.asset.version = "2.0";
   m.asset.generator = std::string("Weft ") + WEFT_VERSION + " (weft export)";
@@ -132,13 +159,19 @@ ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::fil
   if (fit.material.transmission > 0) m.extensionsUsed.push_back("KHR_materials_transmission");
   if (fit.material.diffuse_transmission > 0)
     m.extensionsUsed.push_back("KHR_materials_diffuse_transmission");
-  add_quad(m);
-  m.materials.push_back(make_material(fit, name, options.epsilon_per_sr));
+  m.buffers.emplace_back();
+  m.scenes.emplace_back();
+  m.defaultScene = 0;
+  for (const GltfMesh& mesh : meshes) add_mesh(m, mesh);
+  m.materials.push_back(make_material(fit, name, epsilon_per_sr));
   std::ostringstream out;
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToStream(&m, out, true, ext == ".glb"))
-    throw Error(path.string(), "", "tinygltf could not write the asset");
-  write_text_atomically(path, out.str());
+  if (!writer.WriteGltfSceneToStream(&m, out, true, glb))
+    throw Error(path, "", "tinygltf could not write the asset");
+  return out.str();
+}
+
+ExportReport gltf_report(const GltfFit& fit) {
   ExportReport r{"glTF 2.0", {}, {}, {}};
   r.dropped = {"the table's angular detail beyond the fitted lobes (see the fit's error)",
                "anisotropy", "the back side (one material for both sides)"};
@@ -182,6 +215,20 @@ ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::fil
     r.figures.push_back({"transmission fit max relative error", fit.transmission_max_rel});
   }
   return r;
+}
+
+}  // namespace gltf_detail
+
+ExportReport write_gltf_material(const TabulatedBsdfTable& table, const std::filesystem::path& path,
+                                 const std::string& name, const GltfFitOptions& options) {
+  const std::string ext = path.extension().string();
+  if (ext != ".gltf" && ext != ".glb")
+    throw Error(path.string(), "output", "a glTF file ends in .gltf or .glb");
+  using namespace gltf_detail;
+  const GltfFit fit = fit_gltf_material(table, options);
+  write_text_atomically(path, gltf_asset(fit, name, options.epsilon_per_sr, {sample_quad()},
+                                         ext == ".glb", path.string()));
+  return gltf_report(fit);
 }
 
 }  // namespace weft

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "exchange_tables.h"
+#include "glb_reader.h"
 #include "test_util.h"
 #include "weft/core/frame.h"
 #include "weft/exchange/export_table.h"
@@ -18,28 +19,7 @@ namespace weft {
 namespace {
 
 using nlohmann::json;
-
-uint32_t le32(const std::string& d, size_t at) {
-  uint32_t v = 0;
-  for (int k = 0; k < 4; ++k)
-    v |= static_cast<uint32_t>(static_cast<unsigned char>(d[at + k])) << (8 * k);
-  return v;
-}
-
-// GLB (glTF 2.0 "Binary glTF"): 12-byte header 'glTF', version 2, length; chunk 0 JSON, chunk 1
-// BIN; each chunk: length, type, data.
-json read_glb(const std::filesystem::path& p, std::string* bin) {
-  const std::string d = testing::slurp(p);
-  EXPECT_EQ(d.substr(0, 4), "glTF");
-  EXPECT_EQ(le32(d, 4), 2u);
-  EXPECT_EQ(le32(d, 8), d.size());
-  const uint32_t json_length = le32(d, 12);
-  EXPECT_EQ(le32(d, 16), 0x4E4F534Au);  // "JSON"
-  const size_t bin_at = 20 + json_length;
-  EXPECT_EQ(le32(d, bin_at + 4), 0x004E4942u);  // "BIN\0"
-  *bin = d.substr(bin_at + 8, le32(d, bin_at));
-  return json::parse(d.substr(20, json_length));
-}
+using testing::read_glb;
 
 struct Material {
   double base[3], roughness, sheen[3], sheen_roughness, transmission = 0;

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "weft/core/clock.h"
+#include "weft/core/html.h"  // html_escape
 
 namespace weft {
 
@@ -13,30 +14,6 @@ inline std::string fmt(double v, int digits = 3) {
   char b[64];
   std::snprintf(b, sizeof b, "%.*g", digits, v);
   return b;
-}
-
-// Text made safe for an HTML page.
-inline std::string html_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    switch (c) {
-      case '<':
-        o += "&lt;";
-        break;
-      case '>':
-        o += "&gt;";
-        break;
-      case '&':
-        o += "&amp;";
-        break;
-      case '"':
-        o += "&quot;";
-        break;
-      default:
-        o.push_back(c);
-    }
-  }
-  return o;
 }
 
 struct VerifyReport;

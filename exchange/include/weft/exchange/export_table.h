@@ -1,12 +1,14 @@
 #pragma once
 // weft export's one entry point: the format by the output's extension (.bsdf RGL, .mbsdf MDL,
-// .gltf / .glb glTF material). docs/exchange.md says how each renderer loads the file.
+// .gltf / .glb glTF material, .html a page previewing that material). docs/exchange.md says how
+// each renderer loads the file.
 #include <filesystem>
 #include <string>
 
 #include "weft/exchange/export_report.h"
 #include "weft/exchange/gltf_material.h"
 #include "weft/exchange/mbsdf.h"
+#include "weft/exchange/preview_html.h"
 #include "weft/exchange/rgl_bsdf.h"
 
 namespace weft {
@@ -18,7 +20,7 @@ struct ExportOptions {
   std::string name;  // the material's name and the .bsdf description
 };
 
-// Throws weft::Error(path, field, ...) unless the extension is one of the four (commands call it
+// Throws weft::Error(path, field, ...) unless the extension is one of the five (commands call it
 // before any work).
 void check_export_path(const std::filesystem::path& path, const std::string& field);
 

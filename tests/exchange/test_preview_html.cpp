@@ -1,0 +1,255 @@
+// weft export -o X.html (exchange/preview_html.h): the page holds everything it shows (no fetch),
+// its embedded .glb carries the fitted material on a cushion and a draped cloth, the SVG plots the
+// table's curves; and, where headless chromium is installed, the page renders the cloth in its
+// colour. Tests that need the viewer's three.js (scripts/install-viewer.sh) or chromium skip,
+// saying why, without them.
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <nlohmann/json.hpp>
+#include <regex>
+
+#include "exchange_tables.h"
+#include "glb_reader.h"
+#include "test_util.h"
+#include "weft/exchange/export_table.h"
+
+namespace weft {
+namespace {
+
+using nlohmann::json;
+
+// A saturated purple, a colour nothing else on the page has (the plot's lines are red, green and
+// blue, its text black, the background grey), so that its pixels are the cloth's.
+TabulatedBsdfTable purple_table() {
+  return testing::lambert_table(4, {0.5, 0.08, 0.45}, {0, 0, 0});
+}
+
+// The page for 'table', or "" with 'why' set when the viewer's three.js is not installed.
+std::string export_page(const TabulatedBsdfTable& table, const std::filesystem::path& path,
+                        ExportReport* report, std::string* why) {
+  try {
+    load_viewer_modules();
+  } catch (const Error& e) {
+    *why = e.what();
+    return "";
+  }
+  ExportOptions o;
+  o.name = "purple";
+  *report = export_table(table, path, o);
+  return testing::slurp(path);
+}
+
+std::string base64_decode(const std::string& text) {
+  const std::string digits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  uint32_t acc = 0;
+  int bits = 0;
+  for (char c : text) {
+    const size_t d = digits.find(c);
+    if (d == std::string::npos) continue;  // '=' padding, white space
+    acc = (acc << 6) | static_cast<uint32_t>(d);
+    bits += 6;
+    if (bits >= 8) {
+      bits -= 8;
+      out.push_back(static_cast<char>((acc >> bits) & 0xff));
+    }
+  }
+  return out;
+}
+
+// The text between 'open' and the next 'close' after it; "" when absent.
+std::string between(const std::string& s, const std::string& open, const std::string& close) {
+  const size_t a = s.find(open);
+  if (a == std::string::npos) return "";
+  const size_t b = s.find(close, a + open.size());
+  return b == std::string::npos ? "" : s.substr(a + open.size(), b - a - open.size());
+}
+
+size_t count(const std::string& s, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = s.find(what); at != std::string::npos; at = s.find(what, at + 1)) ++n;
+  return n;
+}
+
+double figure(const ExportReport& r, const std::string& name) {
+  for (const auto& [k, v] : r.figures)
+    if (k == name) return v;
+  ADD_FAILURE() << "no figure " << name;
+  return 0;
+}
+
+TEST(PreviewHtml, PageFetchesNothingAndHoldsTheGlbThePlotAndTheFigures) {
+  const auto dir = testing::fresh_test_dir();
+  ExportReport r;
+  std::string why;
+  const std::string page = export_page(purple_table(), dir / "p.html", &r, &why);
+  if (page.empty()) GTEST_SKIP() << "three.js for the preview is not installed: " << why;
+  // Offline: no URL a browser would fetch (the modules are base64, which has no ':').
+  EXPECT_EQ(page.find("http://"), std::string::npos);
+  EXPECT_EQ(page.find("https://"), std::string::npos);
+  EXPECT_EQ(page.find(" src="), std::string::npos);
+  EXPECT_EQ(page.find("href="), std::string::npos);
+  // Balanced: every script ends, the page ends.
+  EXPECT_EQ(count(page, "<script"), count(page, "</script>"));
+  EXPECT_EQ(count(page, "<script"), 3u);  // the import map, the .glb, the page's module
+  EXPECT_NE(page.rfind("</html>"), std::string::npos);
+  // The import map: every module as a data: URL; three's is the pinned build.
+  const json map = json::parse(between(page, "<script type='importmap'>", "</script>"));
+  for (const char* m : {"three", "weft/GLTFLoader", "weft/BufferGeometryUtils",
+                        "weft/OrbitControls", "weft/RoomEnvironment"}) {
+    const std::string url = map.at("imports").at(m);
+    ASSERT_EQ(url.rfind("data:text/javascript;base64,", 0), 0u) << m;
+  }
+  const std::string three = base64_decode(map.at("imports").at("three").get<std::string>().substr(
+      std::strlen("data:text/javascript;base64,")));
+  EXPECT_EQ(three, testing::slurp(std::filesystem::path(WEFT_SOURCE_DIR) /
+                                  "exchange/viewer/node_modules/three/build/three.module.min.js"));
+  const std::string loader =
+      base64_decode(map.at("imports").at("weft/GLTFLoader").get<std::string>().substr(28));
+  EXPECT_EQ(loader.find("from '."), std::string::npos) << "a relative import left in GLTFLoader";
+  EXPECT_NE(loader.find("from 'weft/BufferGeometryUtils'"), std::string::npos);
+  // The SVG: four incidences, three channels each.
+  const std::string svg = between(page, "<svg id='weft-inplane'", "</svg>");
+  EXPECT_EQ(count(svg, "<polyline"), 12u);
+  for (const char* ti : {"0&#176;", "30&#176;", "60&#176;", "75&#176;"})
+    EXPECT_NE(svg.find(std::string("&#952;i = ") + ti), std::string::npos) << ti;
+  // The fit's figures and what the material drops, as the command prints them.
+  EXPECT_NE(page.find("<td>fit RMS log error</td>"), std::string::npos);
+  EXPECT_NE(page.find("What the glTF material drops"), std::string::npos);
+  for (const auto& d : r.dropped) EXPECT_NE(page.find(d), std::string::npos) << d;
+  EXPECT_NEAR(figure(r, "base color R"), 0.5, 0.05);  // a Lambertian fits closely
+}
+
+TEST(PreviewHtml, EmbeddedGlbHasTheCushionAndTheDrapeWithTheFittedMaterial) {
+  const auto dir = testing::fresh_test_dir();
+  ExportReport r;
+  std::string why;
+  const std::string page = export_page(purple_table(), dir / "p.html", &r, &why);
+  if (page.empty()) GTEST_SKIP() << "three.js for the preview is not installed: " << why;
+  std::string bin;
+  const json j =
+      testing::read_glb_bytes(base64_decode(between(page, "id='weft-glb'>", "</script>")), &bin);
+  ASSERT_EQ(j.at("meshes").size(), 2u);
+  EXPECT_EQ(j.at("meshes").at(0).at("name"), "cushion");
+  EXPECT_EQ(j.at("meshes").at(1).at("name"), "draped_cloth");
+  ASSERT_EQ(j.at("materials").size(), 1u);
+  const json& base = j.at("materials").at(0).at("pbrMetallicRoughness").at("baseColorFactor");
+  EXPECT_NEAR(base.at(0).get<double>(), figure(r, "base color R"), 1e-6);
+  EXPECT_NEAR(base.at(2).get<double>(), figure(r, "base color B"), 1e-6);
+  EXPECT_TRUE(j.at("materials").at(0).at("extensions").contains("KHR_materials_sheen"));
+  for (int k = 0; k < 2; ++k) {
+    const json& prim = j.at("meshes").at(k).at("primitives").at(0);
+    EXPECT_EQ(prim.at("material"), 0);
+    ASSERT_TRUE(prim.at("attributes").contains("TEXCOORD_0"));
+    const auto p = testing::accessor_floats(j, bin, prim.at("attributes").at("POSITION"));
+    const auto n = testing::accessor_floats(j, bin, prim.at("attributes").at("NORMAL"));
+    ASSERT_EQ(p.size(), n.size());
+    ASSERT_GT(p.size(), 3000u) << "a smooth mesh, not a few quads";
+    size_t outward = 0;
+    double lowest_m = 1e9, highest_m = -1e9;
+    for (size_t v = 0; v < p.size(); v += 3) {
+      EXPECT_NEAR(std::hypot(n[v], n[v + 1], n[v + 2]), 1, 1e-4);
+      lowest_m = std::min(lowest_m, static_cast<double>(p[v + 1]));
+      highest_m = std::max(highest_m, static_cast<double>(p[v + 1]));
+      // Outward: away from the cushion's centre; the drape's upper side away from the sphere
+      // (its centre 0.28 m below its top at 0.75 m).
+      const double cy = k == 0 ? 0.0 : 0.47;
+      if (p[v] * n[v] + (p[v + 1] - cy) * n[v + 1] + p[v + 2] * n[v + 2] > 0) ++outward;
+    }
+    EXPECT_GT(outward, p.size() / 3 * 9 / 10) << "mesh " << k << ": normals facing outwards";
+    // The cushion (node-translated to rest on the floor) and the drape stay above the floor.
+    const double lift_m = j.at("nodes").at(k).value("translation", json::array({0, 0, 0})).at(1);
+    EXPECT_GE(lowest_m + lift_m, -1e-6) << "mesh " << k;
+    EXPECT_GT(highest_m - lowest_m, 0.15) << "mesh " << k << ": not flat";
+  }
+}
+
+TEST(PreviewHtml, MissingViewerNamesTheFileAndTheInstallScriptAndWritesNothing) {
+  const auto dir = testing::fresh_test_dir();
+  const std::string e = testing::error_of(
+      [&] { write_preview_html(purple_table(), dir / "p.html", "p", {}, {dir}); });
+  EXPECT_NE(e.find("three.module.min.js"), std::string::npos) << e;
+  EXPECT_NE(e.find("scripts/install-viewer.sh"), std::string::npos) << e;
+  EXPECT_FALSE(std::filesystem::exists(dir / "p.html"));
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 0) << "a temporary left";
+}
+
+// The first of the usual names of chromium on the PATH; "" when none is.
+std::string find_chromium() {
+  for (const char* name : {"chromium", "chromium-browser", "google-chrome"})
+    if (std::system(("command -v " + std::string(name) + " >/dev/null 2>&1").c_str()) == 0)
+      return name;
+  return "";
+}
+
+// Headless chromium on 'page' with software WebGL (SwiftShader), virtual time letting the
+// modules load and the first frame draw; 'mode' is "--dump-dom" or "--screenshot=PATH".
+int run_chromium(const std::string& chromium, const std::filesystem::path& page,
+                 const std::string& mode, const std::filesystem::path& out) {
+  const std::string cmd = "timeout 180 " + chromium +
+                          " --headless --no-sandbox --use-gl=angle --use-angle=swiftshader "
+                          "--enable-unsafe-swiftshader --hide-scrollbars --window-size=1400,1000 "
+                          "--virtual-time-budget=30000 " +
+                          mode + " 'file://" + page.string() + "' >'" + out.string() + "' 2>'" +
+                          out.string() + ".err'";
+  return std::system(cmd.c_str());
+}
+
+double srgb_to_linear(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+TEST(PreviewHtml, ChromiumShowsTheClothInItsColour) {
+  const auto dir = testing::fresh_test_dir();
+  ExportReport r;
+  std::string why;
+  const std::string page = export_page(purple_table(), dir / "p.html", &r, &why);
+  if (page.empty()) GTEST_SKIP() << "three.js for the preview is not installed: " << why;
+  const std::string chromium = find_chromium();
+  if (chromium.empty())
+    GTEST_SKIP() << "chromium not found on the PATH (Debian: apt-get install chromium)";
+  // The page says it rendered (preview.js sets data-weft-preview), or why not.
+  ASSERT_EQ(run_chromium(chromium, dir / "p.html", "--dump-dom", dir / "dom.html"), 0)
+      << testing::slurp(dir / "dom.html.err");
+  const std::string dom = testing::slurp(dir / "dom.html");
+  ASSERT_NE(dom.find("data-weft-preview=\"rendered\""), std::string::npos)
+      << between(dom, "id=\"weft-status\">", "</p>");
+  const auto png = dir / "shot.png";
+  ASSERT_EQ(
+      run_chromium(chromium, dir / "p.html", "--screenshot=" + png.string(), dir / "shot.log"), 0)
+      << testing::slurp(dir / "shot.log.err");
+  auto in = OIIO::ImageInput::open(png.string());
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const int w = in->spec().width, h = in->spec().height, nc = in->spec().nchannels;
+  std::vector<uint8_t> px(static_cast<size_t>(w) * h * nc);
+  ASSERT_TRUE(in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, px.data()));
+  // Around the view: the page's first 640 x 480 box, below the heading.
+  size_t purple = 0, grey = 0, pixels = 0;
+  double sum[3] = {0, 0, 0};
+  for (int y = 60; y < std::min(h, 640); ++y)
+    for (int x = 20; x < std::min(w, 700); ++x) {
+      const uint8_t* p = &px[(static_cast<size_t>(y) * w + x) * nc];
+      ++pixels;
+      // The background, linear 0.8 (preview.js): 231 in sRGB.
+      if (std::abs(p[0] - 231) < 4 && std::abs(p[1] - 231) < 4 && std::abs(p[2] - 231) < 4) ++grey;
+      if (p[0] > 2 * p[1] + 10 && p[2] > 2 * p[1] + 10) {
+        ++purple;
+        for (int c = 0; c < 3; ++c) sum[c] += srgb_to_linear(p[c] / 255.0);
+      }
+    }
+  EXPECT_GT(grey, pixels / 10) << "the render's background is not on the screenshot";
+  ASSERT_GT(purple, pixels / 20) << "the cloth's colour is not on the screenshot";
+  // The rendered cloth's chromaticity against the fitted base colour's: the room's light is
+  // near-neutral, so they agree roughly.
+  const double fitted[3] = {figure(r, "base color R"), figure(r, "base color G"),
+                            figure(r, "base color B")};
+  const double fitted_sum = fitted[0] + fitted[1] + fitted[2], seen_sum = sum[0] + sum[1] + sum[2];
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(sum[c] / seen_sum, fitted[c] / fitted_sum, 0.1) << "channel " << c;
+}
+
+}  // namespace
+}  // namespace weft
