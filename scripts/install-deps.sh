@@ -6,8 +6,9 @@
 # (python/) and its tests, slurm-wlm and munge for the single-node Slurm of
 # tests/tools/slurm_test.sh, and nodejs and npm for the glTF validator of the export tests
 # (scripts/install-gltf-validator.sh; only when no npm is on the PATH, which may come from another
-# source than Debian's), and chromium for the screenshot test of the HTML preview. Installs only the packages that are missing; skips apt entirely when none
-# is. --list prints the chosen set, one package a line, and installs nothing.
+# source than Debian's), and chromium for the screenshot test of the HTML preview. Installs only
+# the packages that are missing; skips apt entirely when none is. --list prints the chosen set,
+# one package a line, and installs nothing.
 # Usage: install-deps.sh [--tests] [--list]
 set -euo pipefail
 build_run=(build-essential cmake ninja-build pkg-config
