@@ -358,8 +358,10 @@ void classic_from_table(const std::string& file, const TabulatedBsdfTable& t,
     // A band is a Monte Carlo difference (total albedo minus the lobe's), so a band the dye
     // leaves alone may exceed 1 by its noise (1.00003 at 710 nm on red-cotton at default photons);
     // verify_classic_fiber clips and reports that, as it does the gamut.
+    // An RGB table's channels become the classic colour as they are, so they stay in [0, 1].
     const double v = diffuse[k] / entering;
-    if (!(v >= -kClassicBandNoise && v <= 1 + kClassicBandNoise))
+    const double noise = t.channels == kNumBands ? kClassicBandNoise : 0.0;
+    if (!(v >= -noise && v <= 1 + noise))
       throw Error(file, "--classic-albedo",
                   "the classic baseline's diffuse colour from the table (its total albedo minus "
                   "the Cook-Torrance lobe's, over what the lobe leaves) is " +
