@@ -5,13 +5,4 @@
 # with a message when node or the package is missing. Needs node and npm (Debian: nodejs, npm;
 # scripts/install-deps.sh --tests installs them). Does nothing when the package is present.
 set -euo pipefail
-cd "$(dirname "$0")/../tests/exchange/node"
-if [ -f node_modules/gltf-validator/package.json ]; then
-  echo "install-gltf-validator: present"
-  exit 0
-fi
-command -v npm >/dev/null || {
-  echo "install-gltf-validator: npm not found (install nodejs and npm)" >&2
-  exit 1
-}
-npm ci --no-audit --no-fund
+exec "$(dirname "$0")/npm-pinned.sh" install-gltf-validator tests/exchange/node gltf-validator

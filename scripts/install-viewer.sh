@@ -5,13 +5,4 @@
 # missing). Needs node and npm once (Debian: nodejs, npm; scripts/install-deps.sh --tests installs
 # them); the export itself needs no network. Does nothing when the package is present.
 set -euo pipefail
-cd "$(dirname "$0")/../exchange/viewer"
-if [ -f node_modules/three/package.json ]; then
-  echo "install-viewer: present"
-  exit 0
-fi
-command -v npm >/dev/null || {
-  echo "install-viewer: npm not found (install nodejs and npm)" >&2
-  exit 1
-}
-npm ci --no-audit --no-fund
+exec "$(dirname "$0")/npm-pinned.sh" install-viewer exchange/viewer three
