@@ -12,6 +12,7 @@
 #include "weft/core/error.h"
 #include "weft/core/params.h"
 #include "weft/fabric/fabric_bake.h"
+#include "weft/fabric/fabric_fibers.h"
 #include "weft/fiber/fiber_table_bake.h"
 #include "weft/scenes/weave.h"
 #include "weft_python.h"
@@ -45,9 +46,8 @@ std::shared_ptr<const TabulatedBsdfTable> baked_fiber(const py::object& fiber,
   if (r.fiber_table || r.thread_colours || !r.colour.empty()) return r.fiber_table;
   if (is_path(fiber) && std::filesystem::path(r.fiber).extension() == ".exr") return nullptr;
   const FiberSpec spec = fiber_spec_argument(fiber);
-  FiberTableBakeOptions o = fiber_bake_defaults(spec);
-  o.spectral = false;
-  return bake_fiber_checked(spec, o, r.limits.yes_long, print).shared();
+  return bake_fiber_checked(spec, fabric_fiber_bake_options(spec), r.limits.yes_long, print)
+      .shared();
 }
 
 // The woven sample's options: None (the bundled poplin), a weave options file or a dict of them.

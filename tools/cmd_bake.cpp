@@ -20,6 +20,8 @@ struct FiberBakeCliOptions {
 // The summary of a bake (or of a merge of its shards) on stdout.
 int report_fiber_bake(const nlohmann::json& j, bool json) {
   const bool cancelled = j["interrupted"].get<bool>();
+  for (const auto& w : j.value("warnings", nlohmann::json::array()))
+    std::fprintf(stderr, "weft: warning: %s\n", w.get<std::string>().c_str());
   if (json) {
     std::cout << j.dump(2) << "\n";
   } else {

@@ -63,11 +63,20 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
 
 }  // namespace
 
+FiberTableBakeOptions fabric_fiber_bake_options(const FiberSpec& spec) {
+  FiberTableBakeOptions o = fiber_bake_defaults(spec);
+  // A dye's absorption is a spectrum: its RGB table leaves the sRGB gamut (the bundled red
+  // cotton's has linear-sRGB values down to -0.46, clipped, and a paler congo red a channel
+  // albedo of 1.12, which the ray trace refuses), so a dyed fiber is traced by band. An undyed or
+  // thread-coloured one (smooth absorbers) stays RGB, a third of the memory.
+  o.spectral = !spec.dyes.empty();
+  return o;
+}
+
 TabulatedBsdfTable cached_fabric_fiber(const FiberSpec& spec, const std::string& source,
                                        const std::string& option, const RunLimits& limits,
                                        const ProgressCallback& progress) {
-  FiberTableBakeOptions o = fiber_bake_defaults(spec);
-  o.spectral = false;
+  const FiberTableBakeOptions o = fabric_fiber_bake_options(spec);
   return TabulatedBsdfTable::read_exr(
       cached_fiber_table(".weft-cache", spec, o, progress, nullptr, [&] {
         check_fiber_bake(limits, o, kNumBands, {source, option, option});

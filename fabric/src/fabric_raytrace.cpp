@@ -300,12 +300,9 @@ uint64_t sample_units(const Tracer& t, uint64_t items_per_task, int bin) {
 }
 
 // A fiber sends out at most the light that hits it: a table's total albedo (the bake's exit
-// fraction) is at most 1. Above it, path weights grow from fiber to fiber, and the trace would run
-// for minutes before they overflow (a synthetic table of total albedo 1.9 did: tens of CPU
-// minutes), so it is refused before any work. The allowance is for a table's tabulation error:
-// the classic fiber at reflectance 1 (lossless, total albedo 1 by construction) tabulates to
-// at most kFiberAlbedoAllowance above 1 (test_fabric_raytrace.cpp).
-constexpr double kFiberAlbedoAllowance = 0.01;
+// fraction) is at most 1, within kFiberAlbedoAllowance (fiber_table_bake.h). Above it, path
+// weights grow from fiber to fiber, and the trace would run for minutes before they overflow (a
+// synthetic table of total albedo 1.9 did: tens of CPU minutes), so it is refused before any work.
 
 void check_fiber_energy(const TabulatedBsdfTable& t, const std::string& field) {
   const std::vector<double> a = t.total_albedo();
@@ -317,7 +314,10 @@ void check_fiber_energy(const TabulatedBsdfTable& t, const std::string& field) {
                   std::string("the fiber table's total albedo is ") + v + " in channel " +
                       std::to_string(c) +
                       ": a fiber sends out at most the light that hits it (at most 1, the bake's "
-                      "exit fraction); bake it with weft bake fiber");
+                      "exit fraction); bake it with weft bake fiber" +
+                      (t.channels == 3 ? std::string(" (a saturated colour's RGB table can exceed "
+                                                     "1: --bands spectral keeps it as it is)")
+                                       : std::string()));
     }
 }
 

@@ -224,6 +224,32 @@ FiberBakeOutcome run_fiber_bake(const FiberBakePlan& p, const FiberBakeHooks& ho
   return out;
 }
 
+namespace {
+
+// An RGB table of a saturated colour is not the fiber: its negative linear-sRGB values were set
+// to 0, and a channel can send out more light than hits it (the fabric ray trace refuses that).
+std::vector<std::string> rgb_gamut_warnings(const FiberTableBakeResult& r,
+                                            const FiberTableBakeOptions& o) {
+  std::vector<std::string> out;
+  if (o.spectral) return out;
+  const std::string keep = "; --bands spectral keeps the colour as it is";
+  if (r.rgb_negative_clipped > 0)
+    out.push_back(
+        "the fiber's colour lies outside the sRGB gamut: the table's linear-sRGB values of f "
+        "down to -" +
+        ParamReader::fmt(r.rgb_negative_clipped) + " /sr were set to 0" + keep);
+  const std::vector<double> albedo = r.table.total_albedo();
+  for (size_t c = 0; c < albedo.size(); ++c)
+    if (albedo[c] > 1 + kFiberAlbedoAllowance)
+      out.push_back("the RGB table's total albedo is " + ParamReader::fmt(albedo[c]) +
+                    " in channel " + std::to_string(c) +
+                    ", above 1 by more than its tabulation error: a fabric ray trace refuses it" +
+                    keep);
+  return out;
+}
+
+}  // namespace
+
 nlohmann::json fiber_bake_summary(const FiberTableBakeResult& r, const FiberSpec& spec,
                                   const FiberTableBakeOptions& o, const std::string& output,
                                   double seconds) {
@@ -244,20 +270,22 @@ nlohmann::json fiber_bake_summary(const FiberTableBakeResult& r, const FiberSpec
                      {"energy_balance", b.energy_balance},
                      {"energy_scale", b.energy_scale},
                      {"table_energy", b.energy_table}});
-  return {{"output", output},
-          {"spec", spec.name},
-          {"spec_hash", fiber_spec_hash_hex(spec)},
-          {"resolution", o.resolution},
-          {"bands", name_of(kFiberBakeBands, o.spectral)},
-          {"route", name_of(kFiberBakeRoutes, o.route)},
-          {"photons", r.photons},
-          {"scattering_events", r.scattering_events},
-          {"seconds", seconds},
-          {"events_per_s", seconds > 0 ? r.scattering_events / seconds : 0.0},
-          {"photons_per_s", seconds > 0 ? r.photons / seconds : 0.0},
-          {"interrupted", r.cancelled},
-          {"rgb_negative_clipped", r.rgb_negative_clipped},
-          {"per_band", bands}};
+  nlohmann::json j = {{"output", output},
+                      {"spec", spec.name},
+                      {"spec_hash", fiber_spec_hash_hex(spec)},
+                      {"resolution", o.resolution},
+                      {"bands", name_of(kFiberBakeBands, o.spectral)},
+                      {"route", name_of(kFiberBakeRoutes, o.route)},
+                      {"photons", r.photons},
+                      {"scattering_events", r.scattering_events},
+                      {"seconds", seconds},
+                      {"events_per_s", seconds > 0 ? r.scattering_events / seconds : 0.0},
+                      {"photons_per_s", seconds > 0 ? r.photons / seconds : 0.0},
+                      {"interrupted", r.cancelled},
+                      {"rgb_negative_clipped", r.rgb_negative_clipped},
+                      {"per_band", bands}};
+  j["warnings"] = rgb_gamut_warnings(r, o);
+  return j;
 }
 
 FiberBakeOutcome merge_fiber_bake_parts(const JobPart& all, const std::string& output) {

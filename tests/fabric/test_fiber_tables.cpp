@@ -10,8 +10,10 @@
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/fabric/fabric_fibers.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/raytrace_steps.h"
+#include "weft/fiber/thread_colour.h"
 #include "weft/scenes/render_scene.h"
 #include "weft/scenes/weave.h"
 
@@ -208,4 +210,22 @@ TEST(FiberTables, BadTablesAndMapsAreRefusedByName) {
             std::string::npos);
   // No tables at all.
   EXPECT_NE(message(FiberTables{}, o).find("takes 1 to"), std::string::npos);
+}
+
+// A spec's fabric fiber table: a dye's measured absorption leaves the sRGB gamut (the RGB table
+// of the bundled red cotton has negative values, FiberTableBake.RgbTableOfASaturatedDyeWarns...),
+// so a dyed spec is baked by band; undyed and thread-coloured fibers, whose absorbers are smooth
+// and inside the gamut by construction (docs/fabric-bsdf.md), stay RGB.
+TEST(FiberTables, DyedSpecsAreBakedSpectralAndUndyedOnesRgb) {
+  EXPECT_TRUE(fabric_fiber_bake_options(load_fiber_spec("red-cotton")).spectral);
+  const FiberSpec white = load_fiber_spec("white-cotton");
+  EXPECT_FALSE(fabric_fiber_bake_options(white).spectral);
+  EXPECT_FALSE(
+      fabric_fiber_bake_options(thread_colour_spec(white, {0.6, 0.1, 0.1}, "--thread-colours"))
+          .spectral);
+  // Everything else is the bake's defaults for the spec.
+  FiberTableBakeOptions defaults = fiber_bake_defaults(white);
+  const FiberTableBakeOptions o = fabric_fiber_bake_options(white);
+  EXPECT_EQ(o.resolution, defaults.resolution);
+  EXPECT_EQ(o.photons_per_band, defaults.photons_per_band);
 }

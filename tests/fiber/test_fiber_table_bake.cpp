@@ -100,6 +100,32 @@ TEST(FiberTableBake, RedCottonBooksBalanceAndAbsorbsInTheGreen) {
   EXPECT_GT(r.bands[14].absorbed_fraction, 3 * r.bands[31].absorbed_fraction);
 }
 
+// Congo red's measured spectrum (fiber/data/dyes/congo-red.json) is more saturated than sRGB:
+// the RGB reduction of the red cotton's table has negative values, which are set to 0, so its
+// summary warns and names --bands spectral; the spectral table of the same spec keeps every band
+// and has nothing to warn of. The undyed white cotton's RGB table is inside the gamut.
+TEST(FiberTableBake, RgbTableOfASaturatedDyeWarnsThatItLeftTheGamut) {
+  FiberTableBakeOptions o;
+  o.resolution = 4;
+  o.photons_per_band = 1000;
+  o.passes = 1;
+  o.spectral = false;
+  const FiberSpec red = load_fiber_spec("red-cotton");
+  const auto rgb = bake_fiber_table(red, o);
+  EXPECT_GT(rgb.rgb_negative_clipped, 0.0);
+  const nlohmann::json warned = fiber_bake_summary(rgb, red, o, "red.exr", 0)["warnings"];
+  ASSERT_FALSE(warned.empty());
+  EXPECT_NE(warned[0].get<std::string>().find("outside the sRGB gamut"), std::string::npos);
+  EXPECT_NE(warned[0].get<std::string>().find("--bands spectral"), std::string::npos);
+  o.spectral = true;
+  EXPECT_TRUE(
+      fiber_bake_summary(bake_fiber_table(red, o), red, o, "red.exr", 0)["warnings"].empty());
+  o.spectral = false;
+  const FiberSpec white = load_fiber_spec("white-cotton");
+  EXPECT_TRUE(
+      fiber_bake_summary(bake_fiber_table(white, o), white, o, "white.exr", 0)["warnings"].empty());
+}
+
 TEST(FiberTableBake, DirectAndBssrdfRoutesAgreeWithinStatisticalError) {
   // One band of a scattering, absorbing fiber (mu_s R ~ 5), R = 3 (18 x 18 cells), the paper's
   // route at its default grid (64 x 64 incident bins, 180 offsets around the axis).

@@ -11,6 +11,7 @@
 #include "weft/core/run_limits.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fiber/fiber_spec.h"
+#include "weft/fiber/fiber_table_bake.h"
 
 namespace weft {
 
@@ -47,14 +48,16 @@ FabricFibers load_fabric_fibers(const FabricFiberOptions& o, const WovenSample& 
 
 // Whether --fiber names a fiber table file (.exr) rather than a spec or preset.
 bool is_fiber_table_file(const std::string& fiber);
-// The RGB table of a spec, baked once into ./.weft-cache; 'source' and 'option' name it in the
-// bake's checks.
+// How a fabric bakes the fiber table of a spec: at the bake's defaults, spectral (33 bands) for a
+// dyed spec, whose colour an RGB table cannot hold without clipping, else RGB.
+FiberTableBakeOptions fabric_fiber_bake_options(const FiberSpec& spec);
+// That table, baked once into ./.weft-cache; 'source' and 'option' name it in the bake's checks.
 TabulatedBsdfTable cached_fabric_fiber(const FiberSpec& spec, const std::string& source,
                                        const std::string& option, const RunLimits& limits,
                                        const ProgressCallback& progress);
 
 // One fiber table: a table file (.exr), or a fiber spec or preset baked once into ./.weft-cache
-// (RGB); 'option' names it in the bake's checks.
+// (cached_fabric_fiber); 'option' names it in the bake's checks.
 TabulatedBsdfTable named_fiber_table(const std::string& fiber, const std::string& option,
                                      const RunLimits& limits, const ProgressCallback& progress);
 
