@@ -26,11 +26,17 @@ int run_export(const ExportCliOptions& o, const RunLimits& limits) {
     std::fprintf(stderr, "weft: warning: %s\n", w.c_str());
   ExportOptions options;
   options.name = o.name.empty() ? std::filesystem::path(o.table).stem().string() : o.name;
-  const ExportReport r = export_table(table, o.output, options);
-  if (o.json) {
+  return print_export_report(export_table(table, o.output, options), o.output, o.table, o.json);
+}
+
+}  // namespace
+
+int print_export_report(const ExportReport& r, const std::string& output, const std::string& table,
+                        bool json) {
+  if (json) {
     nlohmann::json figures = nlohmann::json::object();
     for (const auto& [k, v] : r.figures) figures[k] = v;
-    std::cout << nlohmann::json{{"output", o.output},
+    std::cout << nlohmann::json{{"output", output},
                                 {"format", r.format},
                                 {"dropped", r.dropped},
                                 {"notes", r.notes},
@@ -39,14 +45,12 @@ int run_export(const ExportCliOptions& o, const RunLimits& limits) {
               << "\n";
     return 0;
   }
-  std::cout << "wrote " << o.output << " (" << r.format << ") from " << o.table << "\n";
+  std::cout << "wrote " << output << " (" << r.format << ") from " << table << "\n";
   for (const auto& [k, v] : r.figures) std::cout << "  " << k << ": " << v << "\n";
   for (const auto& d : r.dropped) std::cout << "  dropped: " << d << "\n";
   for (const auto& n : r.notes) std::cout << "  note: " << n << "\n";
   return 0;
 }
-
-}  // namespace
 
 void add_export_command(CLI::App& app, Commands& commands) {
   auto o = std::make_shared<ExportCliOptions>();

@@ -4,6 +4,7 @@
 
 #include "cli_util.h"
 #include "weft/core/job_part.h"
+#include "weft/exchange/export_report.h"
 
 namespace weft::cli {
 
@@ -14,7 +15,7 @@ using AddCommand = void(CLI::App& parent, Commands& commands);
 AddCommand add_slab_command, add_spectrum_command, add_bake_command, add_bench_command,
     add_mie_command, add_medium_command, add_table_command, add_render_command, add_sweep_command,
     add_weave_command, add_compare_command, add_merge_command, add_slurm_command, add_scene_command,
-    add_export_command;
+    add_export_command, add_view_command;
 
 // The "fabric" subcommand of the "bake" group (cmd_bake_fabric.cpp).
 AddCommand add_bake_fabric_command;
@@ -47,5 +48,9 @@ int merge_fabric_bake(const JobPart& all, const std::string& output, const std::
                       bool json);
 int merge_sweep(const JobPart& all, const std::string& output, bool json);
 int merge_verify(const JobPart& all, const std::string& output, bool json);
+
+// What an export or a page wrote (weft export, weft view): its summary, or the same as JSON.
+int print_export_report(const ExportReport& r, const std::string& output, const std::string& table,
+                        bool json);
 
 }  // namespace weft::cli

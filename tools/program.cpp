@@ -34,7 +34,8 @@ std::unique_ptr<Program> make_program() {
        {add_slab_command, add_spectrum_command, add_bake_command, add_bench_command,
         add_mie_command, add_medium_command, add_table_command, add_render_command,
         add_sweep_command, add_weave_command, add_compare_command, add_merge_command,
-        add_slurm_command, add_verify_command, add_scene_command, add_export_command})
+        add_slurm_command, add_verify_command, add_scene_command, add_export_command,
+        add_view_command})
     add(app, p->commands);
   check_seeds(app);
   return p;

@@ -106,31 +106,87 @@ td { padding: 0.1em 0.8em 0.1em 0; }
 </style>
 )";
 
-std::string page(const std::string& name, const std::vector<ViewerModule>& modules,
-                 const std::string& glb, const std::string& svg, const ExportReport& r,
-                 const std::string& three) {
+// A script inlined in a <script> element, which the first "</script" in it would end.
+void check_inlinable(const std::string& source, const std::filesystem::path& file) {
+  if (source.find("</script") != std::string::npos)
+    throw Error(file.string(), "", "holds '</script', which ends the page's script");
+}
+
+// The part of the page that shows the table's curves and the control choosing their incidence.
+std::string curves_figure(const TabulatedBsdfTable& table, const PreviewPage& p) {
+  std::ostringstream h;
+  const auto& inc = p.incidences_deg;
+  h << "<figure>" << inplane_svg(table, inc, inc.front())
+    << "<p><label for='weft-incidence'>Light at &#952;i = <output id='weft-incidence-value'>"
+    << inc.front() << "&#176;</output></label><br><input type='range' id='weft-incidence' min='0' "
+    << "max='" << inc.size() - 1 << "' step='1' value='0' style='width: 380px'></p>\n"
+    << "<figcaption>The table's in-plane curves";
+  if (p.material) h << " (not the fit's)";
+  h << ": &#946; = &#960; f per channel (R, G, B), light at &#952;i (" << inc.front()
+    << "&#176; to " << inc.back() << "&#176;, chosen above), averaged over the azimuth";
+  if (table.kind == "fiber")
+    h << "; in the frame of a point on the fiber (z its outward normal, x the fiber's axis), as "
+         "the "
+         "fiber table stores it";
+  h << ".</figcaption></figure>\n";
+  return h.str();
+}
+
+// The preview's .glb: the fitted material on the cushion and the drape, placed side by side.
+std::string preview_glb(const GltfFit& fit, const std::string& name, double epsilon_per_sr,
+                        const std::string& path) {
+  using namespace gltf_detail;
+  GltfMesh cushion = cushion_mesh();
+  cushion.translation_m[0] = -0.8;
+  GltfMesh drape = drape_mesh();
+  drape.translation_m = {0.35, 0, -0.1};
+  return gltf_asset(fit, name, epsilon_per_sr, {cushion, drape}, true, path);
+}
+
+struct PageParts {
+  std::string name, svg_figure, inplane_js;
+  // With the material: three.js and preview.js, the .glb, the fit's report, three's version.
+  std::vector<ViewerModule> modules;
+  std::string glb, three;
+  ExportReport report;
+};
+
+std::string page(const PageParts& p, bool material) {
   std::ostringstream h;
   h << "<!doctype html>\n<html lang='en'>\n<head>\n<meta charset='utf-8'>\n<title>Weft preview: "
-    << html_escape(name) << "</title>\n"
-    << kStyle << "<script type='importmap'>" << import_map(modules)
-    << "</script>\n</head>\n<body>\n"
-    << "<h1>" << html_escape(name) << ": the glTF material fitted to the table</h1>\n"
-    << "<div class='weft-row'>\n<div><div id='weft-view'></div>\n"
-    << "<p id='weft-status'>Loading the preview (it needs JavaScript and WebGL).</p></div>\n"
-    << "<figure>" << svg << "<figcaption>The table's in-plane curves (not the fit's): &#946; = "
-    << "&#960; f per channel (R, G, B), light at &#952;i, averaged over the azimuth.</figcaption>"
-    << "</figure>\n</div>\n"
-    << fit_section(r)
-    << "<p>The material (KHR_materials_sheen; three.js shows no "
-       "KHR_materials_diffuse_transmission, "
-    << "so a translucent cloth is shown opaque) on a cushion and a cloth draped over a sphere, "
-    << "lit by three.js's RoomEnvironment. Viewer: three.js " << html_escape(three)
-    << " (MIT licence, &#169; three.js authors), inlined.</p>\n"
-    << "<script type='application/octet-stream' id='weft-glb'>" << bytes_base64(glb)
-    << "</script>\n<script type='module'>\n";
-  for (const auto& m : modules)
-    if (m.specifier.empty()) h << m.source;
-  h << "</script>\n</body>\n</html>\n";
+    << html_escape(p.name) << "</title>\n"
+    << kStyle;
+  if (material) h << "<script type='importmap'>" << import_map(p.modules) << "</script>\n";
+  h << "</head>\n<body>\n";
+  if (material) {
+    h << "<h1>" << html_escape(p.name) << ": the glTF material fitted to the table</h1>\n"
+      << "<div class='weft-row'>\n<div><div id='weft-view'></div>\n"
+      << "<p id='weft-status'>Loading the preview (it needs JavaScript and WebGL).</p></div>\n"
+      << p.svg_figure << "</div>\n"
+      << fit_section(p.report)
+      << "<p>The material (KHR_materials_sheen; three.js shows no "
+         "KHR_materials_diffuse_transmission, "
+      << "so a translucent cloth is shown opaque) on a cushion and a cloth draped over a sphere, "
+      << "lit by three.js's RoomEnvironment. Viewer: three.js " << html_escape(p.three)
+      << " (MIT licence, &#169; three.js authors), inlined.</p>\n"
+      << "<script type='application/octet-stream' id='weft-glb'>" << bytes_base64(p.glb)
+      << "</script>\n";
+  } else {
+    h << "<h1>" << html_escape(p.name) << ": the table's in-plane curves</h1>\n"
+      << "<div class='weft-row'>\n"
+      << p.svg_figure << "</div>\n<ul>\n";
+    for (const auto& n : p.report.notes) h << "<li>" << html_escape(n) << "</li>\n";
+    h << "</ul>\n";
+  }
+  // A classic script, so that the curves switch even where modules or WebGL fail.
+  h << "<script>\n" << p.inplane_js << "</script>\n";
+  if (material) {
+    h << "<script type='module'>\n";
+    for (const auto& m : p.modules)
+      if (m.specifier.empty()) h << m.source;
+    h << "</script>\n";
+  }
+  h << "</body>\n</html>\n";
   return h.str();
 }
 
@@ -146,36 +202,57 @@ std::vector<ViewerModule> load_viewer_modules(const std::vector<std::filesystem:
     modules.push_back(std::move(m));
   }
   ViewerModule own{"", read_viewer_file(roots, kViewerDir / "preview.js")};
-  // Inlined in a <script> element, which the first "</script" would end.
-  if (own.source.find("</script") != std::string::npos)
-    throw Error((kViewerDir / "preview.js").string(), "",
-                "holds '</script', which ends the page's script");
+  check_inlinable(own.source, kViewerDir / "preview.js");
   modules.push_back(std::move(own));
   return modules;
 }
 
+std::string load_inplane_script(const std::vector<std::filesystem::path>& roots) {
+  const auto file = kViewerDir / "inplane.js";
+  std::string source = read_viewer_file(roots, file);
+  check_inlinable(source, file);
+  return source;
+}
+
 ExportReport write_preview_html(const TabulatedBsdfTable& table, const std::filesystem::path& path,
                                 const std::string& name, const GltfFitOptions& options,
-                                const std::vector<std::filesystem::path>& roots) {
+                                const std::vector<std::filesystem::path>& roots,
+                                const PreviewPage& shows) {
   using namespace gltf_detail;
   if (path.extension() != ".html")
     throw Error(path.string(), "output", "a preview page ends in .html");
+  if (shows.incidences_deg.empty())
+    throw Error(path.string(), "incidences", "the page needs at least one incidence");
+  for (double t : shows.incidences_deg)
+    if (!(t >= 0 && t < 90))
+      throw Error(path.string(), "incidences", "an incidence lies in [0, 90) degrees");
+  PageParts parts;
+  parts.name = name;
   // Before the fit: a missing viewer fails at once.
-  const auto modules = load_viewer_modules(roots);
-  const std::string three = three_version(roots);
-  const GltfFit fit = fit_gltf_material(table, options);
-  GltfMesh cushion = cushion_mesh();
-  cushion.translation_m[0] = -0.8;
-  GltfMesh drape = drape_mesh();
-  drape.translation_m = {0.35, 0, -0.1};
-  const std::string glb =
-      gltf_asset(fit, name, options.epsilon_per_sr, {cushion, drape}, true, path.string());
-  ExportReport r = gltf_report(fit);
-  r.format = "HTML preview of the glTF 2.0 material";
-  r.notes.push_back("the page inlines the .glb (a cushion and a draped cloth), three.js " + three +
-                    " (MIT) and the table's in-plane curves; it fetches nothing");
-  write_text_atomically(path, page(name, modules, glb, inplane_svg(table), r, three));
-  return r;
+  if (shows.material) {
+    parts.modules = load_viewer_modules(roots);
+    parts.three = three_version(roots);
+  }
+  parts.inplane_js = load_inplane_script(roots);
+  if (shows.material) {
+    const GltfFit fit = fit_gltf_material(table, options);
+    parts.glb = preview_glb(fit, name, options.epsilon_per_sr, path.string());
+    parts.report = gltf_report(fit);
+    parts.report.format = "HTML preview of the glTF 2.0 material";
+    parts.report.notes.push_back(
+        "the page inlines the .glb (a cushion and a draped cloth), three.js " + parts.three +
+        " (MIT) and the table's in-plane curves; it fetches nothing");
+  } else {
+    parts.report.format = "HTML page of the table's in-plane curves";
+    parts.report.notes.push_back(
+        "the page holds the table's in-plane curves at " +
+        std::to_string(shows.incidences_deg.size()) +
+        " incidences, one shown at a time, and no 3-D view; it fetches nothing");
+  }
+  for (const auto& n : shows.notes) parts.report.notes.push_back(n);
+  parts.svg_figure = curves_figure(table, shows);
+  write_text_atomically(path, page(parts, shows.material));
+  return parts.report;
 }
 
 }  // namespace weft

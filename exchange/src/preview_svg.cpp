@@ -1,4 +1,5 @@
-// The preview's in-plane plot, drawn as SVG text so that the page needs no script to show it.
+// The preview's in-plane plot, drawn as SVG text so that the page needs no script to show it: every
+// incidence is drawn, one shown at a time; the page's control (viewer/inplane.js) switches them.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,7 +15,6 @@ constexpr double kWidthPx = 520, kHeightPx = 340;
 constexpr double kLeftPx = 56, kRightPx = 130, kTopPx = 16, kBottomPx = 44;  // margins
 constexpr int kAzimuths = 16;  // the isotropic average, as verify's curves and the exporters
 constexpr std::array<const char*, 3> kChannelColour = {"#d62728", "#2ca02c", "#1f77b4"};
-constexpr std::array<const char*, 4> kDash = {"", "8 4", "3 3", "10 3 2 3"};
 
 // A round step for an axis spanning 'span': 1, 2 or 5 times a power of ten, about 5 ticks.
 double tick_step(double span) {
@@ -50,8 +50,14 @@ std::string axes(double beta_max, double x0, double y0, double w, double h) {
 
 }  // namespace
 
-std::string inplane_svg(const TabulatedBsdfTable& table,
-                        const std::vector<double>& incidences_deg) {
+std::vector<double> preview_incidences_deg() {
+  std::vector<double> out;
+  for (int t = 0; t < 90; t += 5) out.push_back(t);
+  return out;
+}
+
+std::string inplane_svg(const TabulatedBsdfTable& table, const std::vector<double>& incidences_deg,
+                        double shown_deg) {
   const TabulatedBsdfTable rgb = table_to_rgb(table);
   std::vector<double> views_deg;
   for (int v = -89; v <= 89; ++v) views_deg.push_back(v);
@@ -61,19 +67,34 @@ std::string inplane_svg(const TabulatedBsdfTable& table,
     curves.push_back(inplane_beta(rgb, ti, views_deg, kAzimuths));
     for (const Rgb& b : curves.back()) beta_max = std::max({beta_max, b.r, b.g, b.b});
   }
+  // One scale for every incidence, so that switching among them shows how much the light
+  // returned changes, not only its shape.
   beta_max = beta_max > 0 ? std::ceil(beta_max / tick_step(beta_max)) * tick_step(beta_max) : 1;
   const double w = kWidthPx - kLeftPx - kRightPx, h = kHeightPx - kTopPx - kBottomPx;
-  const double x0 = kLeftPx, y0 = kTopPx + h;
+  const double x0 = kLeftPx, y0 = kTopPx + h, lx = kWidthPx - kRightPx;
   std::ostringstream s;
   s << "<svg id='weft-inplane' width='" << kWidthPx << "' height='" << kHeightPx
     << "' viewBox='0 0 " << kWidthPx << ' ' << kHeightPx
     << "' font-family='sans-serif' font-size='12' role='img'>\n"
     << axes(beta_max, x0, y0, w, h);
+  static constexpr std::array<const char*, 3> kChannel = {"R", "G", "B"};
+  for (int c = 0; c < 3; ++c) {
+    const double ly = kTopPx + 34 + 20 * c;
+    s << "<line x1='" << lx + 10 << "' y1='" << ly << "' x2='" << lx + 40 << "' y2='" << ly
+      << "' stroke='" << kChannelColour[c] << "' stroke-width='1.5'/><text x='" << lx + 46
+      << "' y='" << ly + 4 << "'>" << kChannel[c] << "</text>\n";
+  }
+  // The incidence nearest 'shown_deg' is the one a page without script shows.
+  size_t shown = 0;
+  for (size_t i = 0; i < incidences_deg.size(); ++i)
+    if (std::abs(incidences_deg[i] - shown_deg) < std::abs(incidences_deg[shown] - shown_deg))
+      shown = i;
   for (size_t i = 0; i < curves.size(); ++i) {
+    s << "<g class='weft-incidence' data-incidence='" << incidences_deg[i] << "' display='"
+      << (i == shown ? "inline" : "none") << "'>\n<text x='" << lx + 10 << "' y='" << kTopPx + 10
+      << "'>&#952;i = " << incidences_deg[i] << "&#176;</text>\n";
     for (int c = 0; c < 3; ++c) {
-      s << "<polyline fill='none' stroke-width='1.5' stroke='" << kChannelColour[c] << "'";
-      if (*kDash[i % kDash.size()]) s << " stroke-dasharray='" << kDash[i % kDash.size()] << "'";
-      s << " points='";
+      s << "<polyline fill='none' stroke-width='1.5' stroke='" << kChannelColour[c] << "' points='";
       for (size_t v = 0; v < views_deg.size(); ++v) {
         // Clipped to the frame: a negative component (a spectral colour outside sRGB) sits on 0.
         const double b = std::clamp(curves[i][v][c], 0.0, beta_max);
@@ -81,12 +102,7 @@ std::string inplane_svg(const TabulatedBsdfTable& table,
       }
       s << "'/>\n";
     }
-    const double ly = kTopPx + 14 + 20 * static_cast<double>(i);
-    s << "<line x1='" << kWidthPx - kRightPx + 10 << "' y1='" << ly << "' x2='"
-      << kWidthPx - kRightPx + 40 << "' y2='" << ly << "' stroke='#333' stroke-width='1.5'";
-    if (*kDash[i % kDash.size()]) s << " stroke-dasharray='" << kDash[i % kDash.size()] << "'";
-    s << "/><text x='" << kWidthPx - kRightPx + 46 << "' y='" << ly + 4
-      << "'>&#952;i = " << incidences_deg[i] << "&#176;</text>\n";
+    s << "</g>\n";
   }
   s << "</svg>\n";
   return s.str();

@@ -2,7 +2,6 @@
 // its material evaluated from the specifications (glTF 2.0 Appendix B, KHR_materials_sheen), not
 // with the writer's model.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
 #include <cstdlib>
 #include <cstring>
@@ -11,6 +10,7 @@
 
 #include "exchange_tables.h"
 #include "glb_reader.h"
+#include "gltf_validator.h"
 #include "test_util.h"
 #include "weft/core/frame.h"
 #include "weft/exchange/export_table.h"
@@ -264,28 +264,6 @@ TEST(GltfMaterial, RedClothBackLightIsTheTablesTransmittedColour) {
   EXPECT_NEAR(std::sqrt(sum / n), stated_rms, 0.002);
 }
 
-// The Khronos glTF validator's report on a file (tests/exchange/node/validate.js); empty when
-// node or the validator is missing, with the reason in 'why'.
-json khronos_report(const std::filesystem::path& file, std::string* why) {
-  const std::filesystem::path script =
-      std::filesystem::path(WEFT_SOURCE_DIR) / "tests/exchange/node/validate.js";
-  if (std::system("node --version >/dev/null 2>&1") != 0) {
-    *why = "node not found on the PATH (install nodejs, then scripts/install-gltf-validator.sh)";
-    return {};
-  }
-  const auto out = file.parent_path() / (file.filename().string() + ".report.json");
-  const auto err = file.parent_path() / (file.filename().string() + ".report.err");
-  const int rc = std::system(("node '" + script.string() + "' '" + file.string() + "' >'" +
-                              out.string() + "' 2>'" + err.string() + "'")
-                                 .c_str());
-  if (WIFEXITED(rc) && WEXITSTATUS(rc) == 77) {
-    *why = testing::slurp(err);
-    return {};
-  }
-  EXPECT_EQ(rc, 0) << testing::slurp(err);
-  return json::parse(testing::slurp(out));
-}
-
 TEST(GltfMaterial, ExportPassesTheKhronosValidator) {
   const auto dir = testing::fresh_test_dir();
   ExportOptions o;
@@ -296,7 +274,7 @@ TEST(GltfMaterial, ExportPassesTheKhronosValidator) {
         std::pair{std::string("lambert.glb"), testing::lambert_rgb(4)}}) {
     export_table(table, dir / name, o);
     std::string why;
-    const json r = khronos_report(dir / name, &why);
+    const json r = testing::khronos_report(dir / name, &why);
     if (r.is_null()) GTEST_SKIP() << "the Khronos glTF validator is not available: " << why;
     EXPECT_EQ(r.at("errors"), 0) << name << ": " << r.dump(1);
     EXPECT_EQ(r.at("warnings"), 0) << name << ": " << r.dump(1);

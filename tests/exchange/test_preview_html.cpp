@@ -13,8 +13,10 @@
 
 #include "exchange_tables.h"
 #include "glb_reader.h"
+#include "gltf_validator.h"
 #include "test_util.h"
 #include "weft/exchange/export_table.h"
+#include "weft/exchange/view_request.h"
 
 namespace weft {
 namespace {
@@ -94,7 +96,8 @@ TEST(PreviewHtml, PageFetchesNothingAndHoldsTheGlbThePlotAndTheFigures) {
   EXPECT_EQ(page.find("href="), std::string::npos);
   // Balanced: every script ends, the page ends.
   EXPECT_EQ(count(page, "<script"), count(page, "</script>"));
-  EXPECT_EQ(count(page, "<script"), 3u);  // the import map, the .glb, the page's module
+  // The import map, the .glb, the curves' control, the page's module.
+  EXPECT_EQ(count(page, "<script"), 4u);
   EXPECT_NE(page.rfind("</html>"), std::string::npos);
   // The import map: every module as a data: URL; three's is the pinned build.
   const json map = json::parse(between(page, "<script type='importmap'>", "</script>"));
@@ -111,11 +114,15 @@ TEST(PreviewHtml, PageFetchesNothingAndHoldsTheGlbThePlotAndTheFigures) {
       base64_decode(map.at("imports").at("weft/GLTFLoader").get<std::string>().substr(28));
   EXPECT_EQ(loader.find("from '."), std::string::npos) << "a relative import left in GLTFLoader";
   EXPECT_NE(loader.find("from 'weft/BufferGeometryUtils'"), std::string::npos);
-  // The SVG: four incidences, three channels each.
+  // The SVG: every 5 degrees from 0 to 85, three channels each, the first shown alone.
   const std::string svg = between(page, "<svg id='weft-inplane'", "</svg>");
-  EXPECT_EQ(count(svg, "<polyline"), 12u);
-  for (const char* ti : {"0&#176;", "30&#176;", "60&#176;", "75&#176;"})
+  EXPECT_EQ(count(svg, "<polyline"), 18u * 3);
+  EXPECT_EQ(count(svg, "<g class='weft-incidence'"), 18u);
+  EXPECT_EQ(count(svg, "display='inline'"), 1u);
+  EXPECT_NE(svg.find("data-incidence='0' display='inline'"), std::string::npos);
+  for (const char* ti : {"0&#176;", "30&#176;", "60&#176;", "85&#176;"})
     EXPECT_NE(svg.find(std::string("&#952;i = ") + ti), std::string::npos) << ti;
+  EXPECT_NE(page.find("id='weft-incidence' min='0' max='17'"), std::string::npos);
   // The fit's figures and what the material drops, as the command prints them.
   EXPECT_NE(page.find("<td>fit RMS log error</td>"), std::string::npos);
   EXPECT_NE(page.find("What the glTF material drops"), std::string::npos);
@@ -249,6 +256,285 @@ TEST(PreviewHtml, ChromiumShowsTheClothInItsColour) {
   const double fitted_sum = fitted[0] + fitted[1] + fitted[2], seen_sum = sum[0] + sum[1] + sum[2];
   for (int c = 0; c < 3; ++c)
     EXPECT_NEAR(sum[c] / seen_sum, fitted[c] / fitted_sum, 0.1) << "channel " << c;
+}
+
+// The points of the red curve drawn for incidence 'deg' in a page's SVG.
+std::string red_points(const std::string& page, int deg) {
+  const std::string group = between(page, "data-incidence='" + std::to_string(deg) + "'", "</g>");
+  return between(group, "stroke='#d62728' points='", "'");
+}
+
+// A fabric table with a sheen and a back-scatter lobe: its in-plane curves change with the
+// incidence (a Lambertian's would not).
+TabulatedBsdfTable lobed_fabric() {
+  TabulatedBsdfTable t = testing::fabric_rgb(6);
+  t.kind = "fabric";
+  return t;
+}
+
+TEST(ViewPage, FabricTableGetsTheMaterialAndCurvesThatChangeWithTheIncidence) {
+  const auto dir = testing::fresh_test_dir();
+  std::string why;
+  try {
+    load_viewer_modules();
+  } catch (const Error& e) {
+    GTEST_SKIP() << "three.js for the preview is not installed: " << e.what();
+  }
+  lobed_fabric().write_exr(dir / "cloth.exr");
+  ViewRequest q;
+  q.table = (dir / "cloth.exr").string();
+  q.output = (dir / "cloth.html").string();
+  const ViewPlan plan = plan_view(q);
+  EXPECT_TRUE(plan.shows.material);
+  EXPECT_EQ(plan.name, "cloth");
+  const ExportReport r = run_view(plan);
+  EXPECT_EQ(r.format, "HTML preview of the glTF 2.0 material");
+  const std::string page = testing::slurp(dir / "cloth.html");
+  EXPECT_NE(page.find("id='weft-glb'"), std::string::npos);
+  EXPECT_NE(page.find("<script type='importmap'>"), std::string::npos);
+  // Every incidence drawn, and the curves differ between them.
+  EXPECT_EQ(count(page, "<g class='weft-incidence'"), 18u);
+  ASSERT_FALSE(red_points(page, 0).empty());
+  ASSERT_FALSE(red_points(page, 60).empty());
+  EXPECT_NE(red_points(page, 0), red_points(page, 60));
+  // The control's script is inline and complete.
+  EXPECT_NE(page.find(load_inplane_script()), std::string::npos);
+}
+
+TEST(ViewPage, FiberTableGetsItsCurvesAloneAndNeedsNoThreeJs) {
+  const auto dir = testing::fresh_test_dir();
+  TabulatedBsdfTable fiber = testing::fabric_rgb(6);
+  ASSERT_EQ(fiber.kind, "fiber");  // what a fiber bake and weft table bake write by default
+  fiber.write_exr(dir / "fiber.exr");
+  // A viewer folder with the control's script and no three.js.
+  const auto viewer = dir / "share";
+  std::filesystem::create_directories(viewer / "exchange/viewer");
+  std::filesystem::copy_file(std::filesystem::path(WEFT_SOURCE_DIR) / "exchange/viewer/inplane.js",
+                             viewer / "exchange/viewer/inplane.js");
+  ViewRequest q;
+  q.table = (dir / "fiber.exr").string();
+  q.output = (dir / "fiber.html").string();
+  q.name = "a <fiber>";
+  q.viewer_roots = {viewer};
+  const ViewPlan plan = plan_view(q);
+  EXPECT_FALSE(plan.shows.material);
+  const ExportReport r = run_view(plan);
+  EXPECT_TRUE(r.figures.empty()) << "no fit";
+  const std::string page = testing::slurp(dir / "fiber.html");
+  EXPECT_EQ(page.find("importmap"), std::string::npos);
+  EXPECT_EQ(page.find("weft-glb"), std::string::npos);
+  EXPECT_EQ(page.find("id='weft-view'"), std::string::npos);
+  EXPECT_EQ(count(page, "<script"), 1u);  // the curves' control
+  EXPECT_EQ(count(page, "<script"), count(page, "</script>"));
+  EXPECT_EQ(count(page, "<polyline"), 18u * 3);
+  EXPECT_NE(red_points(page, 0), red_points(page, 60));
+  EXPECT_NE(page.find("<h1>a &lt;fiber&gt;: "), std::string::npos);  // the name escaped
+  EXPECT_NE(page.find("frame of a point on the fiber"), std::string::npos);
+  EXPECT_NE(page.find("a fiber table (kind &quot;fiber&quot;)"), std::string::npos);
+  EXPECT_EQ(page.find("http"), std::string::npos);
+}
+
+TEST(ViewPage, BadInputIsNamedAndNothingIsWritten) {
+  const auto dir = testing::fresh_test_dir();
+  lobed_fabric().write_exr(dir / "cloth.exr");
+  testing::write_file(dir / "notes.exr", "not a table");
+  std::filesystem::create_symlink(dir / "cloth.exr", dir / "link.html");
+  // A viewer folder with the control's script and no three.js.
+  const auto viewer = dir / "share";
+  std::filesystem::create_directories(viewer / "exchange/viewer");
+  std::filesystem::copy_file(std::filesystem::path(WEFT_SOURCE_DIR) / "exchange/viewer/inplane.js",
+                             viewer / "exchange/viewer/inplane.js");
+  const auto view = [&](const std::string& table, const std::string& output,
+                        std::vector<std::filesystem::path> roots = bundled_data_roots()) {
+    ViewRequest q;
+    q.table = (dir / table).string();
+    q.output = (dir / output).string();
+    q.viewer_roots = std::move(roots);
+    return testing::error_of([&] { run_view(plan_view(q)); });
+  };
+  const std::string missing = view("absent.exr", "p.html");
+  EXPECT_NE(missing.find("absent.exr"), std::string::npos) << missing;
+  const std::string not_table = view("notes.exr", "p.html");
+  EXPECT_NE(not_table.find("notes.exr"), std::string::npos) << not_table;
+  // The output is the table itself, through a link.
+  const std::string same = view("cloth.exr", "link.html");
+  EXPECT_NE(same.find("link.html"), std::string::npos) << same;
+  EXPECT_NE(same.find("cloth.exr"), std::string::npos) << same;
+  const std::string ext = view("cloth.exr", "p.htm");
+  EXPECT_NE(ext.find("--output"), std::string::npos) << ext;
+  // No viewer: the first missing file and how to install it.
+  const std::string no_viewer = view("cloth.exr", "p.html", {viewer});
+  EXPECT_NE(no_viewer.find("three.module.min.js"), std::string::npos) << no_viewer;
+  EXPECT_NE(no_viewer.find("scripts/install-viewer.sh"), std::string::npos) << no_viewer;
+  EXPECT_FALSE(std::filesystem::exists(dir / "p.html"));
+  EXPECT_FALSE(std::filesystem::exists(dir / "p.htm"));
+  EXPECT_TRUE(std::filesystem::is_symlink(dir / "link.html"));
+  EXPECT_EQ(TabulatedBsdfTable::read_exr(dir / "cloth.exr").checksum(), lobed_fabric().checksum());
+  EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), {}), 4) << "a file left";
+}
+
+// The columns of a screenshot's plot area (x >= 'x_from') with the mean height of the red curve's
+// pixels in each, -1 where the column holds none.
+std::vector<double> red_curve_heights(const std::filesystem::path& png, int x_from) {
+  auto in = OIIO::ImageInput::open(png.string());
+  if (!in) {
+    ADD_FAILURE() << OIIO::geterror();
+    return {};
+  }
+  const int w = in->spec().width, h = in->spec().height, nc = in->spec().nchannels;
+  std::vector<uint8_t> px(static_cast<size_t>(w) * h * nc);
+  EXPECT_TRUE(in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, px.data()));
+  std::vector<double> out;
+  for (int x = x_from; x < w; ++x) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < h; ++y) {
+      const uint8_t* p = &px[(static_cast<size_t>(y) * w + x) * nc];
+      if (p[0] > 150 && p[1] < 110 && p[2] < 110) sum += y, ++n;  // #d62728
+    }
+    out.push_back(n ? sum / n : -1);
+  }
+  return out;
+}
+
+// Where the screenshots of the chromium tests are kept for a person to look at: the folder
+// WEFT_VIEW_SHOTS names, when set.
+void keep_shot(const std::filesystem::path& png, const std::string& name) {
+  const char* keep = std::getenv("WEFT_VIEW_SHOTS");
+  if (!keep || !*keep || !std::filesystem::exists(png)) return;
+  std::filesystem::create_directories(keep);
+  std::filesystem::copy_file(png, std::filesystem::path(keep) / name,
+                             std::filesystem::copy_options::overwrite_existing);
+}
+
+TEST(ViewPage, ChromiumShowsTheCurvesOfTheIncidenceChosen) {
+  const auto dir = testing::fresh_test_dir();
+  try {
+    load_viewer_modules();
+  } catch (const Error& e) {
+    GTEST_SKIP() << "three.js for the preview is not installed: " << e.what();
+  }
+  const std::string chromium = find_chromium();
+  if (chromium.empty())
+    GTEST_SKIP() << "chromium not found on the PATH (Debian: apt-get install chromium)";
+  lobed_fabric().write_exr(dir / "cloth.exr");
+  ViewRequest q;
+  q.table = (dir / "cloth.exr").string();
+  q.output = (dir / "cloth.html").string();
+  run_view(plan_view(q));
+  // The address chooses the incidence (inplane.js): the page shows that group alone, and its 3-D
+  // view rendered.
+  ASSERT_EQ(run_chromium(chromium, dir / "cloth.html#incidence=60", "--dump-dom", dir / "dom"), 0)
+      << testing::slurp(dir / "dom.err");
+  const std::string dom = testing::slurp(dir / "dom");
+  EXPECT_NE(dom.find("data-weft-incidence=\"60\""), std::string::npos);
+  EXPECT_NE(dom.find("data-weft-preview=\"rendered\""), std::string::npos)
+      << between(dom, "id=\"weft-status\">", "</p>");
+  EXPECT_EQ(count(dom, "display=\"inline\""), 1u);
+  EXPECT_NE(dom.find("data-incidence=\"60\" display=\"inline\""), std::string::npos);
+  EXPECT_NE(dom.find("<output id=\"weft-incidence-value\">60"), std::string::npos);
+  // The screenshots at 0 and 60 degrees: the plot (right of the 3-D view) shows a red curve in
+  // each, at other heights; the 3-D view is not blank.
+  std::vector<double> at[2];
+  const int incidence[2] = {0, 60};
+  for (int k = 0; k < 2; ++k) {
+    const auto png = dir / ("view-" + std::to_string(incidence[k]) + ".png");
+    ASSERT_EQ(run_chromium(chromium, dir / ("cloth.html#incidence=" + std::to_string(incidence[k])),
+                           "--screenshot=" + png.string(), dir / "shot.log"),
+              0)
+        << testing::slurp(dir / "shot.log.err");
+    keep_shot(png, "fabric-incidence-" + std::to_string(incidence[k]) + ".png");
+    at[k] = red_curve_heights(png, 690);
+  }
+  ASSERT_EQ(at[0].size(), at[1].size());
+  size_t both = 0, moved = 0;
+  for (size_t x = 0; x < at[0].size(); ++x)
+    if (at[0][x] >= 0 && at[1][x] >= 0) {
+      ++both;
+      if (std::abs(at[0][x] - at[1][x]) > 3) ++moved;
+    }
+  EXPECT_GT(both, 200u) << "the red curve is not on both screenshots";
+  EXPECT_GT(moved, 50u) << "the curve did not change with the incidence";
+  auto in = OIIO::ImageInput::open((dir / "view-0.png").string());
+  ASSERT_TRUE(in);
+  const int w = in->spec().width, nc = in->spec().nchannels;
+  std::vector<uint8_t> px(static_cast<size_t>(w) * in->spec().height * nc);
+  ASSERT_TRUE(in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, px.data()));
+  size_t cloth = 0;
+  for (int y = 100; y < 500; ++y)
+    for (int x = 60; x < 640; ++x) {
+      const uint8_t* p = &px[(static_cast<size_t>(y) * w + x) * nc];
+      if (std::abs(p[0] - 231) + std::abs(p[1] - 231) + std::abs(p[2] - 231) > 30) ++cloth;
+    }
+  EXPECT_GT(cloth, 400u * 580 / 20) << "the 3-D view is blank";
+}
+
+TEST(ViewPage, ChromiumShowsAFiberTablesCurvesAndSwitchesThem) {
+  const auto dir = testing::fresh_test_dir();
+  const std::string chromium = find_chromium();
+  if (chromium.empty())
+    GTEST_SKIP() << "chromium not found on the PATH (Debian: apt-get install chromium)";
+  testing::fabric_rgb(6).write_exr(dir / "fiber.exr");  // kind "fiber"
+  ViewRequest q;
+  q.table = (dir / "fiber.exr").string();
+  q.output = (dir / "fiber.html").string();
+  run_view(plan_view(q));
+  std::vector<double> at[2];
+  const int incidence[2] = {0, 45};
+  for (int k = 0; k < 2; ++k) {
+    const auto png = dir / ("fiber-" + std::to_string(incidence[k]) + ".png");
+    ASSERT_EQ(run_chromium(chromium, dir / ("fiber.html#incidence=" + std::to_string(incidence[k])),
+                           "--screenshot=" + png.string(), dir / "shot.log"),
+              0)
+        << testing::slurp(dir / "shot.log.err");
+    keep_shot(png, "fiber-incidence-" + std::to_string(incidence[k]) + ".png");
+    at[k] = red_curve_heights(png, 0);
+  }
+  size_t both = 0, moved = 0;
+  for (size_t x = 0; x < at[0].size(); ++x)
+    if (at[0][x] >= 0 && at[1][x] >= 0) {
+      ++both;
+      if (std::abs(at[0][x] - at[1][x]) > 3) ++moved;
+    }
+  EXPECT_GT(both, 200u) << "the red curve is not on both screenshots";
+  EXPECT_GT(moved, 50u) << "the curve did not change with the incidence";
+}
+
+TEST(ViewPage, PreviewGlbPassesTheKhronosValidator) {
+  // An opaque cloth with lobes, and a translucent one (the material then carries the diffuse
+  // transmission).
+  const auto dir = testing::fresh_test_dir();
+  const std::pair<std::string, TabulatedBsdfTable> tables[] = {
+      {"lobed", lobed_fabric()},
+      {"translucent", testing::lambert_table(4, {0.5, 0.1, 0.05}, {0.4, 0.08, 0.04})}};
+  for (const auto& [name, table] : tables) {
+    ExportReport r;
+    std::string why;
+    const std::string page = export_page(table, dir / (name + ".html"), &r, &why);
+    if (page.empty()) GTEST_SKIP() << "three.js for the preview is not installed: " << why;
+    const std::string glb = base64_decode(between(page, "id='weft-glb'>", "</script>"));
+    ASSERT_GT(glb.size(), 1000u);
+    testing::write_file(dir / (name + ".glb"), glb);
+    const json report = testing::khronos_report(dir / (name + ".glb"), &why);
+    if (report.is_null()) GTEST_SKIP() << "the Khronos glTF validator is not available: " << why;
+    EXPECT_EQ(report.at("errors"), 0) << name << ": " << report.dump(1);
+    EXPECT_EQ(report.at("warnings"), 0) << name << ": " << report.dump(1);
+    // Only informations are left: the validator of this version cannot check the diffuse
+    // transmission (a release candidate) and says so, and the meshes' texture coordinates, there
+    // for textures a user may add, are unused.
+    for (const json& m : report.at("messages")) {
+      const std::string code = m.at("code"), text = m.at("message"), at = m.value("pointer", "");
+      EXPECT_TRUE(
+          (code == "UNSUPPORTED_EXTENSION" &&
+           text.find("KHR_materials_diffuse_transmission") != std::string::npos) ||
+          (code == "UNUSED_OBJECT" && (at == "/meshes/0/primitives/0/attributes/TEXCOORD_0" ||
+                                       at == "/meshes/1/primitives/0/attributes/TEXCOORD_0")))
+          << name << ": " << m.dump();
+    }
+    if (name == "translucent")
+      EXPECT_NE(report.dump().find("KHR_materials_diffuse_transmission"), std::string::npos)
+          << "the translucent cloth's material has no diffuse transmission";
+  }
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include "cli_run.h"
 #include "test_util.h"
@@ -420,6 +421,42 @@ TEST(Cli, ExportWritesTheFormatItsExtensionNamesAndRefusesOthers) {
     EXPECT_NE(r.err.find("--output"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(dir / bad));
   }
+}
+
+TEST(Cli, ViewWritesAPageForAFiberTableAndRefusesBadInputNamingTheFile) {
+  // The page's contents are checked in tests/exchange (ViewPage.*); here the command: its summary,
+  // and its errors naming the file with nothing written. A fiber table's page needs no three.js,
+  // so this runs without scripts/install-viewer.sh.
+  const fs::path dir = fresh_test_dir();
+  const fs::path table = dir / "lambert.exr";
+  ASSERT_EQ(run_weft_cli(
+                "table bake lambert --params '{\"reflectance\": 0.5}' -R 4 --spp 1 --quiet -o '" +
+                    table.string() + "'",
+                dir)
+                .exit_code,
+            0);
+  const CliRun ok = run_weft_cli(
+      "view --json '" + table.string() + "' -o '" + (dir / "page.html").string() + "'", dir);
+  ASSERT_EQ(ok.exit_code, 0) << ok.err;
+  const auto j = nlohmann::json::parse(ok.out);
+  EXPECT_EQ(j["format"], "HTML page of the table's in-plane curves");
+  EXPECT_NE(j["notes"].dump().find("fiber table"), std::string::npos) << j.dump();
+  EXPECT_NE(slurp(dir / "page.html").find("<svg id='weft-inplane'"), std::string::npos);
+  write_file(dir / "notes.exr", "not a table");
+  fs::create_symlink(table, dir / "link.html");
+  for (const auto& [input, output, named] :
+       {std::tuple{std::string("absent.exr"), std::string("a.html"), std::string("absent.exr")},
+        std::tuple{std::string("notes.exr"), std::string("b.html"), std::string("notes.exr")},
+        // The table itself, through a link named as a page.
+        std::tuple{std::string("lambert.exr"), std::string("link.html"), std::string("table")},
+        std::tuple{std::string("lambert.exr"), std::string("c.png"), std::string("--output")}}) {
+    const CliRun r = run_weft_cli(
+        "view '" + (dir / input).string() + "' -o '" + (dir / output).string() + "'", dir);
+    EXPECT_NE(r.exit_code, 0) << input << " -> " << output;
+    EXPECT_NE(r.err.find(named), std::string::npos) << r.err;
+    if (output != "link.html") EXPECT_FALSE(fs::exists(dir / output)) << output;
+  }
+  EXPECT_EQ(weft::TabulatedBsdfTable::read_exr(table).resolution, 4) << "the table was overwritten";
 }
 
 TEST(Cli, ExportPrintsHowTransmissionIsCarried) {

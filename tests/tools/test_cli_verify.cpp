@@ -89,6 +89,15 @@ TEST(CliVerify, DraftWritesTheWholeReport) {
   const std::string html = slurp(out / "index.html");
   EXPECT_NE(html.find("data:image/png;base64,"), std::string::npos);
   EXPECT_NE(html.find("real fabric (paper, Table 1)"), std::string::npos);
+  // Each fabric table's preview page beside the report, linked (where three.js is installed).
+  if (fs::exists(fs::path(WEFT_SOURCE_DIR) /
+                 "exchange/viewer/node_modules/three/build/three.module.min.js"))
+    for (const char* p : {"preview-computed.html", "preview-classic.html"}) {
+      EXPECT_TRUE(fs::exists(out / p)) << p;
+      EXPECT_NE(html.find(std::string("<a href=\"") + p + "\">"), std::string::npos) << p;
+    }
+  else
+    EXPECT_NE(html.find("No 3-D previews"), std::string::npos);
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().rfind(".tmp-", 0), std::string::npos) << e.path();
   // The renders (paper's Figs. 8-9): computed and classic in both configurations, the measured

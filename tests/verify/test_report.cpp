@@ -4,11 +4,14 @@
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <sstream>
 
 #include "test_util.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/materials/bsdf_table.h"
 #include "weft/verify/report.h"
 
 namespace fs = std::filesystem;
@@ -64,6 +67,38 @@ TEST(VerifyReportFiles, AllOrNone) {
             std::string::npos);
   EXPECT_TRUE(fs::exists(other / "keep.txt"));
   EXPECT_FALSE(fs::exists(other / "metrics.json"));
+}
+
+// Each model's fabric table gets weft view's page beside index.html, which links it; a report
+// without the viewer says why it has none.
+TEST(VerifyReportFiles, EachFabricTableGetsAPreviewPageLinkedFromTheIndex) {
+  const fs::path dir = fresh_test_dir();
+  VerifyReport r = tiny_report();
+  r.classic_fabric = TabulatedBsdfTable::from_function(
+      2, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        for (double& x : v) x = (wo.z > 0 && wi.z > 0) ? 0.4 / kPi : 0.0;
+      },
+      1, 1);
+  std::string skipped;
+  r.previews = write_verify_previews(dir, r, &skipped);
+  if (!skipped.empty()) {
+    EXPECT_TRUE(r.previews.empty());
+    EXPECT_NE(skipped.find("scripts/install-viewer.sh"), std::string::npos) << skipped;
+    r.previews_skipped = skipped;
+    EXPECT_NE(verify_index_html(r, {}).find("No 3-D previews"), std::string::npos);
+    GTEST_SKIP() << "three.js for the preview is not installed: " << skipped;
+  }
+  ASSERT_EQ(r.previews.size(), 1u);  // no computed table in this report
+  EXPECT_EQ(r.previews[0].file, "preview-classic.html");
+  const std::string page = testing::slurp(dir / "preview-classic.html");
+  EXPECT_NE(page.find("id='weft-glb'"), std::string::npos) << "the page shows the material";
+  EXPECT_NE(page.find("<g class='weft-incidence'"), std::string::npos);
+  const std::string index = verify_index_html(r, {});
+  EXPECT_NE(index.find("<a href=\"preview-classic.html\">"), std::string::npos);
+  // Linked, not embedded: the index holds neither three.js nor the .glb.
+  EXPECT_EQ(index.find("weft-glb"), std::string::npos);
+  EXPECT_LT(index.size(), page.size() / 10);
 }
 
 // Against camera (or unknown) RGB the absolute figures and the measurement's colour are marked

@@ -6,10 +6,12 @@
 #include <nlohmann/json.hpp>
 #include <sstream>
 #include <system_error>
+#include <tuple>
 
 #include "common.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
+#include "weft/exchange/preview_html.h"
 
 namespace weft {
 namespace {
@@ -59,6 +61,30 @@ std::string verify_inplane_csv(const VerifyReport& r) {
   return o.str();
 }
 
+std::vector<VerifyPreview> write_verify_previews(const std::filesystem::path& folder,
+                                                 const VerifyReport& report, std::string* skipped) {
+  std::vector<VerifyPreview> out;
+  if (!report.computed_fabric && !report.classic_fabric) return out;
+  try {
+    load_viewer_modules();
+  } catch (const Error& e) {
+    *skipped = e.what();
+    return out;
+  }
+  for (const auto& [table, model, label] :
+       {std::tuple{&report.computed_fabric, "computed", "computed fabric (fiber-level ray trace)"},
+        std::tuple{&report.classic_fabric, "classic", "classic fiber (Lambert + Cook-Torrance)"}}) {
+    if (!*table) continue;
+    VerifyPreview p{model, std::string("preview-") + model + ".html", label};
+    // The page is a cloth's, whatever kind the table was made with.
+    TabulatedBsdfTable fabric = **table;
+    fabric.kind = "fabric";
+    write_preview_html(fabric, folder / p.file, std::string(model) + ": " + label);
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
 void check_verify_output(const std::filesystem::path& dir) {
   namespace fs = std::filesystem;
   std::error_code ec;
@@ -102,6 +128,7 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
       write_png_preview(staging / (v.stem + ".png"), v.image, kVerifyRenderExposure);
     }
     r.seconds["renders"] = seconds_since(t0);
+    r.previews = write_verify_previews(staging, r, &r.previews_skipped);
     write_text_atomically(staging / "inplane.csv", verify_inplane_csv(r));
     write_text_atomically(staging / "metrics.json", verify_metrics_json(r));
     draw(staging);

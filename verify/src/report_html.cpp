@@ -138,6 +138,17 @@ void html_renders(std::ostringstream& h, const VerifyReport& r) {
       h << "</table>\n";
     }
   }
+  if (!r.previews.empty()) {
+    h << "<h2>The fabric tables in 3-D</h2>\n<p>Each model's fabric table as weft view shows it: "
+         "the glTF material fitted to it on a cushion and a draped cloth, beside its in-plane "
+         "curves at an incidence chosen on the page (offline pages beside this one).</p>\n<ul>\n";
+    for (const auto& p : r.previews)
+      h << "<li><a href=\"" << html_escape(p.file) << "\">" << html_escape(p.file)
+        << "</a>: " << html_escape(p.label) << "</li>\n";
+    h << "</ul>\n";
+  } else if (!r.previews_skipped.empty()) {
+    h << "<p>No 3-D previews of the fabric tables: " << html_escape(r.previews_skipped) << "</p>\n";
+  }
 }
 
 // A colour swatch's style: the HSV colour as display RGB.

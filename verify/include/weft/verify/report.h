@@ -42,13 +42,21 @@ VerifyVerdictContext verify_verdict_context(const VerifyReport& report);
 std::string verdict_model_name(const std::string& key);
 
 // Writes DIR whole or not at all: the renders (render_verify_samples: fabric-*.exr, render-*.exr
-// and .png), inplane.csv and metrics.json into a staging folder beside DIR, then draw(staging)
-// (the plots: inplane-*.png and .svg files it writes there), then index.html embedding the plots
-// and linking the renders by relative path, then the staging folder replaces DIR. DIR must not
-// exist, be empty, or hold an earlier report (its metrics.json has "report": "weft verify");
-// anything else is refused (weft::Error naming DIR) and left alone. The check write_verify_report
-// makes first, for callers to make before the work.
+// and .png), the previews (write_verify_previews), inplane.csv and metrics.json into a staging
+// folder beside DIR, then draw(staging) (the plots: inplane-*.png and .svg files it writes there),
+// then index.html embedding the plots and linking the renders by relative path, then the staging
+// folder replaces DIR. DIR must not exist, be empty, or hold an earlier report (its metrics.json
+// has "report": "weft verify"); anything else is refused (weft::Error naming DIR) and left alone.
+// The check write_verify_report makes first, for callers to make before the work.
 void check_verify_output(const std::filesystem::path& dir);
+// The preview page of each fabric table the report holds (computed, classic: the page weft view
+// writes, the glTF fit in 3-D beside the table's curves), preview-MODEL.html in 'folder'. Linked
+// from index.html rather than embedded: each page inlines three.js and the meshes (about 2 MB), so
+// embedding would make index.html several times its size and repeat three.js per model. Without
+// the viewer (scripts/install-viewer.sh) none is written and 'skipped' says why: the report is
+// the verification, the preview an aid.
+std::vector<VerifyPreview> write_verify_previews(const std::filesystem::path& folder,
+                                                 const VerifyReport& report, std::string* skipped);
 void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
                          const std::function<void(const std::filesystem::path& staging)>& draw);
 

@@ -77,6 +77,11 @@ struct ModelCurves {
   CurveMetrics absolute_overall, normalized_overall;
 };
 
+// A model's fabric table as weft view's page (exchange/preview_html.h), written beside index.html.
+struct VerifyPreview {
+  std::string model, file, label;  // "computed", "preview-computed.html", what the table is
+};
+
 struct VerifyReport {
   VerifySettings settings;
   MeasuredInplane measured;
@@ -106,6 +111,9 @@ struct VerifyReport {
   std::shared_ptr<const WovenSample> sample;
   std::optional<TabulatedBsdfTable> computed_fiber, classic_fiber;
   std::vector<VerifyRender> renders;  // made by write_verify_report
+  // Made by write_verify_report (write_verify_previews); why there are none, when there are none.
+  std::vector<VerifyPreview> previews;
+  std::string previews_skipped;
   bool cancelled = false;
 };
 
