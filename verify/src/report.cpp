@@ -128,7 +128,9 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
       write_png_preview(staging / (v.stem + ".png"), v.image, kVerifyRenderExposure);
     }
     r.seconds["renders"] = seconds_since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
     r.previews = write_verify_previews(staging, r, &r.previews_skipped);
+    r.seconds["previews"] = seconds_since(t1);
     write_text_atomically(staging / "inplane.csv", verify_inplane_csv(r));
     write_text_atomically(staging / "metrics.json", verify_metrics_json(r));
     draw(staging);
