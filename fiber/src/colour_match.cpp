@@ -114,6 +114,10 @@ std::vector<double> target_residuals(const ColourTarget& t, const Spectrum& r) {
 
 // How far one step may move a scale from the best reading's (a factor either way).
 constexpr double kTrustFactor = 8;
+// A reading out of reach that brings the best's CIEDE2000 down by less than this share is idle;
+// this many idle readings in a row end the match.
+constexpr double kLeastGain = 0.05;
+constexpr int kIdleReadings = 2;
 
 struct ModelStep {
   std::vector<double> scale;
@@ -248,6 +252,7 @@ ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
   const Spectrum host_mu =
       host_total_absorption_per_um(with_dye_scale(base, m.basis, std::vector<double>(n, 0.0)));
   ModelStep last_step;
+  int idle = 0;  // readings in a row that left the best where it was, while out of reach
   bool stalled = false, interrupted = !take(m.basis.initial_scale);
   // The undyed reading anchors the model; a recipe already on target needs none.
   if (!interrupted && m.best_reading().delta_e00 > options.tolerance_delta_e00)
@@ -258,7 +263,18 @@ ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
     last_step = step;
     stalled = std::any_of(m.readings.begin(), m.readings.end(),
                           [&](const ColourReading& r) { return same_scales(r.scale, step.scale); });
-    if (!stalled) interrupted = !take(step.scale);
+    if (stalled) break;
+    const double before = m.best_reading().delta_e00;
+    interrupted = !take(step.scale);
+    // Out of reach, the model keeps proposing colours about as far as the best reading's (its
+    // optimum, away from the trust region's edge, is itself no closer than the tolerance): a
+    // reading that gains under kLeastGain of the best's distance is idle, and two in a row end
+    // the match, the best reading being then the nearest reachable colour.
+    const bool model_out_of_reach =
+        !step.at_trust_edge && step.delta_e00 > options.tolerance_delta_e00;
+    idle =
+        model_out_of_reach && m.best_reading().delta_e00 > (1 - kLeastGain) * before ? idle + 1 : 0;
+    stalled = idle >= kIdleReadings;
   }
   m.cancelled = interrupted;
   if (m.readings.empty()) return m;
