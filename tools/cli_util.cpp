@@ -28,8 +28,24 @@
 namespace weft::cli {
 namespace {
 std::atomic<bool> g_interrupted{false};  // set by the signal handler only
+// Whether the work polls interrupted() (progress_bar was made). Until then no one reads the flag
+// (a plan only reads and checks; a command without progress never polls): Ctrl-C ends the program
+// at once. Outputs are written atomically, so none is left half-written either way.
+std::atomic<bool> g_polled{false};
+
+// Async-signal-safe: write() and _exit() only.
+[[noreturn]] void exit_interrupted(const char* message, size_t size) {
+  (void)!write(STDERR_FILENO, message, size);
+  _exit(130);
+}
+
 extern "C" void on_sigint(int) {
-  g_interrupted.store(true);
+  static constexpr char kBeforeWork[] = "\nweft: interrupted\n";
+  // A step that does not poll (building a large sample or scene) can take minutes: a second
+  // Ctrl-C does not wait for it.
+  static constexpr char kAgain[] = "\nweft: interrupted again; stopped at once\n";
+  if (!g_polled.load()) exit_interrupted(kBeforeWork, sizeof kBeforeWork - 1);
+  if (g_interrupted.exchange(true)) exit_interrupted(kAgain, sizeof kAgain - 1);
 }
 
 }  // namespace
@@ -44,6 +60,7 @@ bool interrupted() {
 ProgressCallback progress_bar(const RunLimits& limits, bool quiet) {
   work_starts(limits);
   install_interrupt_handler();
+  g_polled.store(true);
   using Clock = std::chrono::steady_clock;
   struct State {
     Clock::time_point start = Clock::now();

@@ -1,5 +1,6 @@
 // weft compare: how far apart two BSDF tables are (relative RMS and largest relative difference,
 // overall, in reflection and in transmission) and their in-plane curves.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -20,8 +21,27 @@ struct CompareCliOptions {
   CompareOptions compare;
 };
 
+// A side where the reference holds no light has no relative difference: null, not 0.
 nlohmann::json to_json(const TableDifference& d) {
-  return {{"rel_rms", d.rel_rms}, {"max_rel", d.max_rel}, {"cells", d.cells}};
+  const auto relative = [&](double v) {
+    return d.reference_has_light ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
+  return {{"rel_rms", relative(d.rel_rms)},
+          {"max_rel", relative(d.max_rel)},
+          {"abs_rms", d.abs_rms},
+          {"reference_zero", !d.reference_has_light},
+          {"cells", d.cells}};
+}
+
+void print_difference(const char* name, const TableDifference& d) {
+  if (d.reference_has_light)
+    std::printf("  %-13s rel_rms %.4f  max_rel %.4f  (%zu cell pairs)\n", name, d.rel_rms,
+                d.max_rel, d.cells);
+  else
+    std::printf(
+        "  %-13s undefined: the reference is zero on this side; B's RMS f there %.4g  "
+        "(%zu cell pairs)\n",
+        name, d.abs_rms, d.cells);
 }
 
 int run_compare(const CompareCliOptions& o, const RunLimits& limits) {
@@ -57,18 +77,21 @@ int run_compare(const CompareCliOptions& o, const RunLimits& limits) {
                                 {"overall", to_json(c.overall)},
                                 {"reflection", to_json(c.reflection)},
                                 {"transmission", to_json(c.transmission)},
-                                {"in_plane_rel_rms", c.in_plane_rel_rms},
+                                {"in_plane_rel_rms", std::isnan(c.in_plane_rel_rms)
+                                                         ? nlohmann::json(nullptr)
+                                                         : nlohmann::json(c.in_plane_rel_rms)},
                                 {"significant", o.compare.significant}}
                      .dump(2)
               << "\n";
   } else {
     std::printf("%s vs %s (reference %s)\n", o.b.c_str(), o.a.c_str(), o.a.c_str());
-    for (const auto& [name, d] :
-         {std::pair{"overall", c.overall}, std::pair{"reflection", c.reflection},
-          std::pair{"transmission", c.transmission}})
-      std::printf("  %-13s rel_rms %.4f  max_rel %.4f  (%zu cell pairs)\n", name, d.rel_rms,
-                  d.max_rel, d.cells);
-    std::printf("  in-plane      rel_rms %.4f\n", c.in_plane_rel_rms);
+    print_difference("overall", c.overall);
+    print_difference("reflection", c.reflection);
+    print_difference("transmission", c.transmission);
+    if (std::isnan(c.in_plane_rel_rms))
+      std::printf("  in-plane      undefined: the reference's in-plane curves are zero\n");
+    else
+      std::printf("  in-plane      rel_rms %.4f\n", c.in_plane_rel_rms);
   }
   return 0;
 }

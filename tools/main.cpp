@@ -9,6 +9,9 @@
 #include "weft/core/error.h"
 
 int main(int argc, char** argv) {
+  // First thing: a Ctrl-C while the command reads its inputs is an orderly exit 130 too, not the
+  // default action's death by signal.
+  weft::cli::install_interrupt_handler();
   const auto program = weft::cli::make_program();
   try {
     program->app.parse(argc, argv);

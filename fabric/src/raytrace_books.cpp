@@ -62,6 +62,32 @@ double fabric_scene_bytes(const WovenSampleSize& z) {
   return kFabricSceneBaseBytes + tubes + fibers;
 }
 
+namespace {
+// Measured (2026-12-05, the shared 2-core machine, CPU time from /usr/bin/time -v), on the draft
+// 8452.wif at fiber detail, which woven_sample_size counts as 7.26 M points and segments (at the
+// default packing; built at the densest packing that fits, 4.0 M): `weft weave` 49 s, so 6.4 us
+// per point counted; `weft bake fabric --method raytrace -R 1 --samples 1` 72 s, so 23 s for the
+// scene, 3.2 us per segment counted. `weft verify --quality draft` on it took 325 s, 60 s above
+// that and the poplin's rates for its particles and camera samples (12 s): its rays took 6 times
+// as long as on a small sample. On the bundled poplin (4 930 segments), the twill draft (13 300)
+// and the plain draft tiled 6 x 6 (124 000) the rays took no longer (29-35 s of CPU each), so the
+// factor grows from there, taken as the structure's depth grows: with the logarithm of the
+// segments, 0.85 per doubling.
+constexpr double kMakeSecondsPerCurvePoint = 6.4e-6;
+constexpr double kBuildSecondsPerSegment = 3.2e-6;
+constexpr double kSegmentsOfUnslowedRays = 1.24e5;
+constexpr double kRayFactorPerDoubling = 0.85;
+}  // namespace
+
+FabricSceneSeconds fabric_scene_seconds(const WovenSampleSize& z) {
+  FabricSceneSeconds c;
+  c.make = z.curve_points * kMakeSecondsPerCurvePoint;
+  c.build = z.curve_segments * kBuildSecondsPerSegment;
+  c.per_ray_factor = 1 + kRayFactorPerDoubling *
+                             std::max(0.0, std::log2(z.curve_segments / kSegmentsOfUnslowedRays));
+  return c;
+}
+
 void FabricRaytraceOptions::validate() const {
   if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
     throw Error("", "resolution",

@@ -19,6 +19,7 @@
 #include "weft/integrators/weave_level.h"
 #include "weft/materials/bound_bsdf.h"
 #include "weft/materials/bsdfs.h"
+#include "zero_polled.h"
 
 namespace weft {
 namespace {
@@ -449,10 +450,18 @@ class WindowRender {
         tiles_(uint64_t(tx_) * ty_),
         tile_rays_(tiles_),
         tile_nonfinite_(tiles_, 0),
-        total_(uint64_t(npx_) * s.spp) {
-    out_.image = film_image();
-    if (s.aov_albedo) out_.albedo = film_image();
-    if (s.aov_normal) out_.normal = film_image();
+        total_(uint64_t(npx_) * s.spp) {}
+
+  // The film's images, zeroed in slices with a poll between them (zero_polled.h); false when
+  // cancelled meanwhile.
+  bool make_film() {
+    const auto keep_going = [this] {
+      report(0);
+      return !cancel_.load();
+    };
+    return film_image(out_.image, keep_going) &&
+           (!s_.aov_albedo || film_image(out_.albedo, keep_going)) &&
+           (!s_.aov_normal || film_image(out_.normal, keep_going));
   }
 
   // Every sample of every pixel in one pass.
@@ -494,10 +503,11 @@ class WindowRender {
   }
 
  private:
-  Image film_image() const {
-    Image im(ww_, wh_);
+  template <class KeepGoing>
+  bool film_image(Image& im, KeepGoing& keep_going) const {
+    im.width = ww_, im.height = wh_;
     im.x0 = win_.x0, im.y0 = win_.y0, im.film_width = s_.width, im.film_height = s_.height;
-    return im;
+    return zero_polled(im.rgb, size_t(3) * npx_, keep_going);
   }
 
   // Samples [k0, k1) of every pixel of the window, tile by tile; 'sums' holds the running sums
@@ -677,10 +687,12 @@ RenderResult render(const RenderScene& scene, const Camera& camera, const Render
   std::optional<RenderScene> leveled;
   if (!levels.empty()) leveled = scene.with_weave_levels(weave_flags(levels));
   WindowRender film(leveled ? *leveled : scene, camera, s, progress, observers, win);
-  if (s.time_limit_s == 0)
-    film.render_all();
-  else
-    film.render_timed();
+  if (film.make_film()) {  // false: cancelled while the film was zeroed, as finish() reports
+    if (s.time_limit_s == 0)
+      film.render_all();
+    else
+      film.render_timed();
+  }
   RenderResult out = film.finish();
   out.weave_levels = std::move(levels);
   return out;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "weft/core/error.h"
@@ -11,11 +12,19 @@
 namespace weft {
 namespace {
 
+constexpr double kUndefined = std::numeric_limits<double>::quiet_NaN();
+
 struct Sums {
-  double diff2 = 0, ref2 = 0, max_rel = 0;
+  double diff2 = 0, ref2 = 0, weight = 0, max_rel = 0;
   size_t cells = 0;
-  TableDifference result() const {
-    return {ref2 > 0 ? std::sqrt(diff2 / ref2) : 0.0, max_rel, cells};
+  TableDifference result(int channels) const {
+    TableDifference d;
+    d.cells = cells;
+    d.abs_rms = weight > 0 ? std::sqrt(diff2 / (channels * weight)) : 0.0;
+    d.reference_has_light = ref2 > 0;
+    d.rel_rms = ref2 > 0 ? std::sqrt(diff2 / ref2) : kUndefined;
+    d.max_rel = ref2 > 0 ? max_rel : kUndefined;
+    return d;
   }
 };
 
@@ -70,13 +79,14 @@ TableComparison compare_tables(const TabulatedBsdfTable& a, const TabulatedBsdfT
           if (va[c] >= threshold && va[c] > 0)
             s->max_rel = std::max(s->max_rel, std::abs(vb[c] - va[c]) / va[c]);
         }
+        s->weight += w;
         ++s->cells;
       }
     }
   TableComparison out;
-  out.overall = all.result();
-  out.reflection = refl.result();
-  out.transmission = trans.result();
+  out.overall = all.result(nc);
+  out.reflection = refl.result(nc);
+  out.transmission = trans.result(nc);
 
   double cd2 = 0, cr2 = 0;
   for (double light : o.light_zenith_deg)
@@ -107,7 +117,7 @@ TableComparison compare_tables(const TabulatedBsdfTable& a, const TabulatedBsdfT
       }
       out.curves.push_back(std::move(c));
     }
-  out.in_plane_rel_rms = cr2 > 0 ? std::sqrt(cd2 / cr2) : 0.0;
+  out.in_plane_rel_rms = cr2 > 0 ? std::sqrt(cd2 / cr2) : kUndefined;
   return out;
 }
 

@@ -2,6 +2,7 @@
 // time whatever the size of its work, and a run's peak memory is within its estimate's reach.
 #include <gtest/gtest.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -11,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <span>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -62,10 +64,11 @@ struct Interrupted {
   double seconds_to_exit = -1;
 };
 
-// Waits for the handler, lets the work run 'run_s', sends SIGINT and times the exit.
-Interrupted interrupt_after(ChildRun c, double run_s) {
+// Waits for the handler (at most 'wait_s'), lets the command run 'run_s', sends SIGINT and times
+// the exit.
+Interrupted interrupt_after(ChildRun c, double run_s, double wait_s = 120) {
   using Clock = std::chrono::steady_clock;
-  const auto give_up = Clock::now() + std::chrono::seconds(120);
+  const auto give_up = Clock::now() + std::chrono::duration<double>(wait_s);
   while (!catches_sigint(c.pid) && Clock::now() < give_up)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   std::this_thread::sleep_for(std::chrono::duration<double>(run_s));
@@ -81,13 +84,23 @@ Interrupted interrupt_after(ChildRun c, double run_s) {
 // by several builds (docs/ARCHITECTURE.md, "Ctrl-C").
 constexpr double kExitWithinSeconds = 2 + 1;
 
-void expect_cancelled(const Interrupted& r, const fs::path& dir, const fs::path& out) {
-  EXPECT_LT(r.seconds_to_exit, kExitWithinSeconds) << slurp(dir / "stderr");
+// What weft says when Ctrl-C comes before its work polls (tools/cli_util.cpp).
+constexpr const char* kInterruptedBeforeWork = "\nweft: interrupted\n";
+
+void expect_nothing_written(const Interrupted& r, const fs::path& dir, const fs::path& out) {
   ASSERT_TRUE(WIFEXITED(r.status)) << "ended by signal " << WTERMSIG(r.status);
   EXPECT_NE(WEXITSTATUS(r.status), 0);
   EXPECT_FALSE(fs::exists(out));
   for (const auto& e : fs::directory_iterator(dir))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+// Stopped by the work's own poll (not before the work began), soon, with nothing written.
+void expect_cancelled(const Interrupted& r, const fs::path& dir, const fs::path& out) {
+  const std::string err = slurp(dir / "stderr");
+  EXPECT_LT(r.seconds_to_exit, kExitWithinSeconds) << err;
+  EXPECT_EQ(err.find(kInterruptedBeforeWork), std::string::npos) << err;
+  expect_nothing_written(r, dir, out);
 }
 
 // A fiber table of little albedo, so that the fabric bake starts its ray trace at once.
@@ -134,6 +147,56 @@ TEST(CliCancel, TimedRenderStopsSoonAtALargeImage) {
   expect_cancelled(r, dir, dir / "out.exr");
 }
 
+TEST(CliCancel, RenderStopsSoonWhileZeroingAHugeFilm) {
+  // 16384 x 16384: 3.2 GB of film, once zeroed in one call before the first poll, which took 41 s
+  // on the shared 2-core machine (2026-12-05); interrupted 0.3 s into it.
+  const fs::path dir = fresh_test_dir();
+  const auto r =
+      interrupt_after(spawn_weft({"render", (kExamples / "lambert-plane.json").string(), "--width",
+                                  "16384", "--height", "16384", "--quiet", "-o", "out.exr"},
+                                 dir),
+                      0.3);
+  expect_cancelled(r, dir, dir / "out.exr");
+}
+
+TEST(CliCancel, SweepStopsSoonAtHugeSamples) {
+  // 2^20 samples per pixel of each view's render.
+  const fs::path dir = fresh_test_dir();
+  const auto r = interrupt_after(
+      spawn_weft({"sweep", (kExamples / "lambert-plane.json").string(), "--spp", "1048576",
+                  "--resolution", "64", "--yes-long", "--quiet", "-o", "out.csv"},
+                 dir),
+      1.0);
+  expect_cancelled(r, dir, dir / "out.csv");
+}
+
+TEST(CliCancel, SweepStopsSoonAtALargeResolution) {
+  // 8192 x 8192 views: 3.5 GB of per-pixel sums for the sample's mask, once zeroed before the
+  // view's render polled.
+  const fs::path dir = fresh_test_dir();
+  const auto r =
+      interrupt_after(spawn_weft({"sweep", (kExamples / "lambert-plane.json").string(), "--spp",
+                                  "1", "--resolution", "8192", "--quiet", "-o", "out.csv"},
+                                 dir),
+                      1.0);
+  expect_cancelled(r, dir, dir / "out.csv");
+}
+
+TEST(CliCancel, CtrlCWhileReadingTheInputsExitsCleanly) {
+  // A scene that never arrives (a named pipe no one writes: an input on a slow file system) keeps
+  // the plan reading. Ctrl-C there once killed weft by the default action, the handler being
+  // installed only where the work starts; now it is installed first thing, and the exit is 130.
+  const fs::path dir = fresh_test_dir();
+  ASSERT_EQ(mkfifo((dir / "scene.json").c_str(), 0600), 0);
+  const auto r = interrupt_after(
+      spawn_weft({"render", "scene.json", "--quiet", "-o", "out.exr"}, dir), 0.3, 10);
+  const std::string err = slurp(dir / "stderr");
+  EXPECT_LT(r.seconds_to_exit, kExitWithinSeconds) << err;
+  expect_nothing_written(r, dir, dir / "out.exr");
+  EXPECT_EQ(WEXITSTATUS(r.status), 130);
+  EXPECT_NE(err.find(kInterruptedBeforeWork), std::string::npos) << err;
+}
+
 // Peak resident memory of the children waited for so far, bytes.
 double children_peak_bytes() {
   rusage u{};
@@ -173,6 +236,55 @@ TEST(CliCancel, TimedRenderPeakIsWithinTwiceItsEstimate) {
   const double measured = big - base;
   EXPECT_GT(measured, estimate / 2) << "peak " << big << ", base " << base;
   EXPECT_LT(measured, estimate * 2) << "peak " << big << ", base " << base;
+}
+
+// CPU seconds (user and system) of the children waited for so far.
+double children_cpu_seconds() {
+  rusage u{};
+  getrusage(RUSAGE_CHILDREN, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) +
+         1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
+// "(24 s of CPU" / "(5 min of CPU" / "(1.2 h of CPU" in weft verify's estimate line, seconds.
+double printed_cpu_seconds(const std::string& err) {
+  const size_t end = err.find(" of CPU");
+  const size_t open = err.rfind('(', end);
+  if (end == std::string::npos || open == std::string::npos) return -1;
+  std::istringstream in(err.substr(open + 1, end - open - 1));
+  double v = -1;
+  std::string unit;
+  in >> v >> unit;
+  return unit == "s" ? v : unit == "min" ? 60 * v : unit == "h" ? 3600 * v : -1;
+}
+
+TEST(CliCancel, VerifyDraftTimeOnAWifSampleIsWithinTwiceItsEstimate) {
+  // The bundled plain draft tiled 6 x 6: 36 times its fibers, so that the sample's own cost
+  // (making it, building its scene for every ray trace and render, slower rays: verify/plan.cpp
+  // estimate_verify) is a good part of the run. The printed CPU time against the run's, user and
+  // system; the 8452 draft's 325 s of CPU was once estimated at 24 s.
+  const fs::path dir = fresh_test_dir();
+  std::ofstream(dir / "weave.json")
+      << R"({"wif": ")" << (fs::path(WEFT_SOURCE_DIR) / "scenes/data/wif/54235-plain.wif").string()
+      << R"(", "repeats": [6, 6]})";
+  const pid_t pid = fork();
+  if (pid == 0) {
+    // A child of its own, so that RUSAGE_CHILDREN is this run's alone.
+    const int code = std::system(("cd '" + dir.string() + "' && '" + WEFT_EXE +
+                                  "' verify --quality draft --threads 2 --weave weave.json "
+                                  "-o report >/dev/null 2>err")
+                                     .c_str());
+    std::ofstream(dir / "cpu") << children_cpu_seconds();
+    _exit(code == 0 ? 0 : 1);
+  }
+  int status = 0;
+  waitpid(pid, &status, 0);
+  const std::string err = slurp(dir / "err");
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << err;
+  const double estimate = printed_cpu_seconds(err), measured = std::stod(slurp(dir / "cpu"));
+  ASSERT_GT(estimate, 0) << err;
+  EXPECT_GT(measured, estimate / 2) << err;
+  EXPECT_LT(measured, estimate * 2) << err;
 }
 
 }  // namespace

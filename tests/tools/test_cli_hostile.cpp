@@ -229,6 +229,39 @@ TEST(CliHostile, CompareRefusesAReferenceOfNoLight) {
   expect_refused_every_way(dir, "compare b.exr zero.exr --csv OUT", "zero.exr");
 }
 
+// A reference with light on one side only (an opaque cloth: nothing in transmission) had its
+// empty side reported as rel_rms 0, a perfect match, whatever B held there: now undefined, with
+// B's own light there.
+TEST(CliHostile, CompareCallsASideWithoutReferenceLightUndefined) {
+  const fs::path dir = fresh_test_dir();
+  auto opaque = weft::TabulatedBsdfTable::from_function(
+      2, 3,
+      [](const weft::Vec3& wo, const weft::Vec3& wi, std::span<double> v) {
+        v[0] = v[1] = v[2] = wo.z * wi.z > 0 ? 0.1 : 0.0;
+      },
+      1, 1);
+  opaque.kind = "fabric";
+  opaque.write_exr(dir / "opaque.exr");
+  write_constant_table(dir / "b.exr", 0.1, "fabric");
+  const CliRun text = run_weft_cli_in("compare opaque.exr b.exr", dir);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("reflection    rel_rms 0.0000"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("transmission  undefined: the reference is zero on this side; B's RMS f "
+                          "there 0.1 "),
+            std::string::npos)
+      << text.out;
+  const CliRun json = run_weft_cli_in("compare opaque.exr b.exr --json", dir);
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto j = nlohmann::json::parse(json.out);
+  EXPECT_TRUE(j["transmission"]["rel_rms"].is_null()) << json.out;
+  EXPECT_TRUE(j["transmission"]["max_rel"].is_null()) << json.out;
+  EXPECT_TRUE(j["transmission"]["reference_zero"].get<bool>());
+  EXPECT_NEAR(j["transmission"]["abs_rms"].get<double>(), 0.1, 1e-6);
+  EXPECT_FALSE(j["reflection"]["reference_zero"].get<bool>());
+  EXPECT_NEAR(j["reflection"]["rel_rms"].get<double>(), 0.0, 1e-6);
+  EXPECT_GT(j["overall"]["rel_rms"].get<double>(), 0.5);  // B's transmission counts there
+}
+
 // --exposure only scales a PNG: with an EXR and no preview it did nothing, silently.
 TEST(CliHostile, ExposureWithNothingToExposeIsAWarning) {
   const fs::path dir = hostile_woven_scene();

@@ -206,7 +206,7 @@ constexpr double kTypicalSecondsPerClassicSample = 1.25e-6;
 }  // namespace
 
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
-                               size_t fit_params, int fit_seeds) {
+                               size_t fit_params, int fit_seeds, const FabricSceneSeconds& scene) {
   VerifyEstimate e;
   e.cores = static_cast<unsigned>(thread_count(s.threads));
   const double bins = 2.0 * s.resolution * s.resolution;
@@ -215,7 +215,7 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
   const double run_particles = 2.0 * double(s.particles_per_bin) * bins;
   e.photons = run_photons;
   e.particles = run_particles;
-  double fit_seconds = 0;
+  double fit_seconds = 0, fit_traces = 0;
   if (fit) {
     const FitInnerSettings inner = fit_inner_settings(s);
     const double inner_bins = 2.0 * inner.resolution * inner.resolution;
@@ -225,14 +225,14 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
     const double computed_evals = seeds * (fit_evaluations + 1 + 2.0 * double(fit_params)) + judged;
     const double classic_evals = seeds * (fit_evaluations + 1 + 8.0) + judged;
     const double inner_photons = computed_evals * double(inner.fiber_photons_per_band) * kNumBands;
-    const double inner_particles =
-        2 * (seeds * kTypicalFitStages + judged) * double(inner.particles_per_bin) * inner_bins;
+    fit_traces = 2 * (seeds * kTypicalFitStages + judged);
+    const double inner_particles = fit_traces * double(inner.particles_per_bin) * inner_bins;
     e.photons += inner_photons + run_photons;
     e.particles += inner_particles + run_particles;
     const double classic_samples =
         classic_evals * double(inner.classic_samples) * inner_bins * inner_bins;
     fit_seconds = inner_photons * kTypicalSecondsPerInnerPhoton +
-                  inner_particles * kTypicalSecondsPerParticle +
+                  inner_particles * kTypicalSecondsPerParticle * scene.per_ray_factor +
                   classic_samples * kTypicalSecondsPerClassicSample +
                   (computed_evals + classic_evals) * kTypicalSecondsPerFitEvaluation;
   }
@@ -240,19 +240,29 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
       double(kWeaveRenders) * s.weave_render_size * s.weave_render_size * s.weave_render_spp;
   // The run's (with the fit: twice, the fitted models at the run's quality) and the fit's.
   const double runs = fit ? 2 : 1;
-  e.typical =
-      runs * (run_photons * kTypicalSecondsPerPhoton + run_particles * kTypicalSecondsPerParticle) +
-      fit_seconds + weave_samples * kTypicalSecondsPerWeaveSample + kTypicalFixedSeconds;
+  // The sample's own cost (fabric_scene_seconds): made once, its scene built for every ray trace
+  // (computed and classic, each batch) and every fiber-level render, every ray slower in a larger
+  // scene.
+  const double run_traces = 2.0 * s.batches + kWeaveRenders;
+  e.typical = runs * (run_photons * kTypicalSecondsPerPhoton +
+                      run_particles * kTypicalSecondsPerParticle * scene.per_ray_factor) +
+              fit_seconds + weave_samples * kTypicalSecondsPerWeaveSample * scene.per_ray_factor +
+              kTypicalFixedSeconds + scene.make + (runs * run_traces + fit_traces) * scene.build;
   e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
   return e;
 }
 
 VerifyEstimate estimate_verify(const VerifyPlan& p) {
-  VerifyEstimate e =
-      estimate_verify(p.settings, !p.fiber_table, p.request.fit, p.fit_options.max_evaluations,
-                      p.fit_names.size(), p.fit_seeds);
-  if (p.weave.pattern != kNonwovenPattern)
-    e.scene_bytes = fabric_scene_bytes(woven_sample_size(p.weave));
+  // A nonwoven mat is small (nonwoven.h): the rates of the bundled poplin cover it.
+  std::optional<WovenSampleSize> z;
+  if (p.weave.pattern != kNonwovenPattern) z = woven_sample_size(p.weave);
+  VerifyEstimate e = estimate_verify(p.settings, !p.fiber_table, p.request.fit,
+                                     p.fit_options.max_evaluations, p.fit_names.size(), p.fit_seeds,
+                                     z ? fabric_scene_seconds(*z) : FabricSceneSeconds{});
+  if (z) {
+    e.scene_bytes = fabric_scene_bytes(*z);
+    e.fiber_segments = z->curve_segments;
+  }
   return e;
 }
 

@@ -98,10 +98,15 @@ std::string verify_estimate_text(const VerifyPlan& p) {
   std::string out;
   append(out,
          "weft verify: quality %s%s, %.3g M photons and %.3g M particles: about %s on %u cores "
-         "(%s of CPU; at least %s)\n",
+         "(%s of CPU; at least %s)",
          r.quality.c_str(), r.fit ? " with --fit" : "", e.photons * 1e-6, e.particles * 1e-6,
          format_seconds(e.typical / e.cores).c_str(), e.cores, format_seconds(e.typical).c_str(),
          format_seconds(e.least / e.cores).c_str());
+  // The sample's size drives its scene's memory and every ray's time: a large draft's own cost.
+  if (e.scene_bytes > 0)
+    append(out, "; a sample of %.3g M fiber segments, its scene about %s", e.fiber_segments * 1e-6,
+           format_bytes(e.scene_bytes).c_str());
+  out += "\n";
   return out;
 }
 

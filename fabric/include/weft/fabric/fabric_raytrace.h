@@ -213,6 +213,18 @@ inline constexpr double kMinSecondsPerFabricParticle = 0.25e-6;
 // bundled samples (docs/PERFORMANCE.md). A front end refuses a run over its memory budget with it.
 double fabric_scene_bytes(const WovenSampleSize& size);
 
+// The CPU time, seconds, that a woven sample of this size costs the work done on it beyond what its
+// particles and camera samples cost on a small sample, from the sample's counts alone, at rates
+// measured on the bundled drafts at fiber detail (raytrace_books.cpp; yarn tubes are not counted):
+// making the sample (once), building the scene of the tiled sample (once per ray trace or render),
+// and every ray's slower way through a larger scene, as a factor on a particle's or camera
+// sample's time (1 on a small sample).
+struct FabricSceneSeconds {
+  double make = 0, build = 0;
+  double per_ray_factor = 1;
+};
+FabricSceneSeconds fabric_scene_seconds(const WovenSampleSize& size);
+
 // The fiber directions seen at the cloth's surface, for the summations: the unit tangents (cloth
 // frame) at the first hits of a rays_per_side x rays_per_side grid of rays along the normal over
 // one repeat, from above (views on the cloth's face) or from below. Each stands for an equal share

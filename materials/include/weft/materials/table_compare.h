@@ -20,6 +20,12 @@ struct TableDifference {
   double rel_rms = 0;  // sqrt(sum (b - a)^2 D_i D_o) / sqrt(sum a^2 D_i D_o), all channels
   double max_rel = 0;  // max |b - a| / a over significant cells and channels
   size_t cells = 0;    // cell pairs compared
+  // sqrt(sum (b - a)^2 D_i D_o / (channels sum D_i D_o)): the difference in units of f.
+  double abs_rms = 0;
+  // False where the reference holds no light on this side (an opaque reference's transmission):
+  // no relative difference is defined there, and rel_rms and max_rel are NaN rather than a 0
+  // that reads as a perfect match; abs_rms says how much light B has there.
+  bool reference_has_light = true;
 };
 
 struct InPlaneCurve {
@@ -32,7 +38,8 @@ struct InPlaneCurve {
 struct TableComparison {
   TableDifference overall, reflection, transmission;
   std::vector<InPlaneCurve> curves;
-  double in_plane_rel_rms = 0;  // over every curve point and channel, against A
+  double in_plane_rel_rms = 0;  // over every curve point and channel, against A; NaN where A's
+                                // curves hold no light (undefined, as a side's rel_rms)
 };
 
 struct CompareOptions {

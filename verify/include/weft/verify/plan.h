@@ -11,6 +11,7 @@
 
 #include "weft/core/colour_target.h"
 #include "weft/core/job_part.h"
+#include "weft/fabric/fabric_raytrace.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
 #include "weft/verify/fit_models.h"
@@ -93,12 +94,16 @@ struct VerifyEstimate {
   // The memory of the scene its ray traces fly through (fabric_scene_bytes of the sample's
   // counts), the largest of a run; 0 for a nonwoven mat. A front end checks it (check_memory).
   double scene_bytes = 0;
+  double fiber_segments = 0;  // the sample's (woven_sample_size), which its own cost grows with
 };
 // The rates of 'least', in words.
 inline constexpr const char* kVerifyLeastRates =
     "0.5 us per photon and 1.25 us per particle per core at least";
+// 'scene': what the woven sample itself costs (fabric_scene_seconds of its counts); the default
+// is a small sample's.
 VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int fit_evaluations,
-                               size_t fit_params, int fit_seeds);
+                               size_t fit_params, int fit_seeds,
+                               const FabricSceneSeconds& scene = {});
 VerifyEstimate estimate_verify(const VerifyPlan& plan);
 
 // A sharded verify's job: the options that fix its result (a merge runs them again for the parts
