@@ -137,7 +137,11 @@ TabulatedBsdfTable summed_fabric_table(const FabricBakePlan& p, const WovenSampl
 FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks& hooks) {
   const FabricBakeRequest& o = p.request;
   FabricBakeResult out;
-  const WovenSample sample = make_woven_sample(p.weave);
+  const WovenSample sample = make_woven_sample(p.weave, hooks.progress);
+  if (sample.cancelled) {
+    out.cancelled = true;
+    return out;
+  }
   std::optional<FabricColourMatch> colour;
   FabricFiberOptions fiber_options = p.fibers;
   if (p.colour) {

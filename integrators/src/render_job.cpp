@@ -60,6 +60,7 @@ RenderJobResult render_to_files(const SceneDescription& desc, const RenderJob& j
       job.mask ? desc.select_object(job.mask_object) : std::vector<uint8_t>();
   RenderSceneOptions scene_options;
   scene_options.material_progress = progress;
+  scene_options.build_progress = progress;
   scene_options.fiber_tables = fiber_tables;
   const RenderScene scene(desc, scene_options);
   RenderResult r;

@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -70,7 +71,8 @@ struct RenderScene::Geometry {
   size_t triangles = 0, curve_segments = 0;
   int64_t fibers = 0;
   FiberGeometry fiber_geometry;
-  bool packets = false;  // the Embree library answers ray packets (rtcIntersect16)
+  bool packets = false;    // the Embree library answers ray packets (rtcIntersect16)
+  bool cancelled = false;  // the build was stopped (RenderSceneOptions::build_progress)
 
   ~Geometry() {
     if (scene) rtcReleaseScene(scene);
@@ -343,10 +345,38 @@ class RenderScene::Builder {
   std::shared_ptr<TableCache> cache_;
   std::vector<AreaLight::Emission> emission_;  // per mesh
   bool tubes_ = false;                         // the fibers are triangle tubes
+
+  // Embree calls the monitor from its build threads, at once: one of them at a time asks the
+  // options' callback (not made for threads), the others go on; once it says stop, all stop.
+  struct Monitor {
+    const ProgressCallback* progress = nullptr;
+    std::mutex mutex;
+    std::atomic<bool> stop{false};
+  } monitor_;
+  static bool on_build_progress(void* user, double fraction);
+  void monitor(RTCScene scene) {
+    rtcSetSceneProgressMonitorFunction(scene, on_build_progress, &monitor_);
+  }
+  // Whether to go on (between geometries, asking the callback as a monitor would).
+  bool keep_going() { return on_build_progress(&monitor_, -1); }
 };
+
+bool RenderScene::Builder::on_build_progress(void* user, double fraction) {
+  auto* m = static_cast<Monitor*>(user);
+  if (m->stop.load()) return false;
+  std::unique_lock lock(m->mutex, std::try_to_lock);
+  if (!lock.owns_lock()) return true;
+  const uint64_t done =
+      fraction < 0 ? 0 : static_cast<uint64_t>(std::clamp(fraction, 0.0, 1.0) * 1000);
+  if (!(*m->progress)(
+          {"scene build", done, fraction < 0 ? uint64_t{0} : uint64_t{1000}, "permille"}))
+    m->stop = true;
+  return !m->stop.load();
+}
 
 RenderScene::Builder::Builder(const SceneDescription& desc, const RenderSceneOptions& options)
     : desc_(desc), options_(options) {
+  monitor_.progress = &options_.build_progress;
   geo_->device = rtcNewDevice(nullptr);
   if (!geo_->device) throw Error(desc.source, "", "cannot create the Embree device");
   rtcSetDeviceErrorFunction(geo_->device, on_embree_error, &geo_->errors);
@@ -354,6 +384,7 @@ RenderScene::Builder::Builder(const SceneDescription& desc, const RenderSceneOpt
   geo_->scene = rtcNewScene(geo_->device);
   rtcSetSceneFlags(geo_->scene, RTC_SCENE_FLAG_ROBUST);  // watertight: no leaks along shared edges
   rtcSetSceneBuildQuality(geo_->scene, RTC_BUILD_QUALITY_HIGH);
+  monitor(geo_->scene);
 
   if (!options.override_shapes.empty() && options.override_shapes.size() != desc.shape_count())
     throw Error(desc.source, "", "override mask does not match the shape count");
@@ -408,6 +439,7 @@ void RenderScene::Builder::add_meshes() {
     geo_->mesh_scene = rtcNewScene(geo_->device);
     rtcSetSceneFlags(geo_->mesh_scene, RTC_SCENE_FLAG_ROBUST);
     rtcSetSceneBuildQuality(geo_->mesh_scene, RTC_BUILD_QUALITY_HIGH);
+    monitor(geo_->mesh_scene);
   }
   for (size_t i = 0; i < desc_.meshes.size(); ++i) {
     const auto& mesh = desc_.meshes[i];
@@ -483,12 +515,13 @@ void RenderScene::Builder::start_curve_sets() {
   geo_->curve_scene = rtcNewScene(geo_->device);
   rtcSetSceneFlags(geo_->curve_scene, RTC_SCENE_FLAG_ROBUST);
   rtcSetSceneBuildQuality(geo_->curve_scene, RTC_BUILD_QUALITY_HIGH);
+  monitor(geo_->curve_scene);
 }
 
 // Fibers: one Embree geometry per curve set, with the filter that ignores the query's fiber.
 void RenderScene::Builder::add_curve_sets() {
   start_curve_sets();
-  for (size_t k = 0; k < desc_.curves.size(); ++k) add_curve_set(k);
+  for (size_t k = 0; k < desc_.curves.size() && keep_going(); ++k) add_curve_set(k);
 }
 
 void RenderScene::Builder::add_curve_set(size_t k) {
@@ -573,8 +606,9 @@ RTCGeometry RenderScene::Builder::round_curve_geometry(CurveRecord& rec, size_t 
 }
 
 void RenderScene::Builder::instance_curve_scene() {
-  if (!geo_->curve_scene) return;
+  if (!geo_->curve_scene || monitor_.stop) return;
   rtcCommitScene(geo_->curve_scene);
+  if (monitor_.stop) return;
   RTCGeometry inst = rtcNewGeometry(geo_->device, RTC_GEOMETRY_TYPE_INSTANCE);
   rtcSetGeometryInstancedScene(inst, geo_->curve_scene);
   const auto inv = static_cast<float>(1 / geo_->curve_scale);
@@ -586,7 +620,12 @@ void RenderScene::Builder::instance_curve_scene() {
 }
 
 std::shared_ptr<const RenderScene::Geometry> RenderScene::Builder::finish() {
-  rtcCommitScene(geo_->scene);
+  if (!monitor_.stop) rtcCommitScene(geo_->scene);
+  // A cancelled build's Embree error (RTC_ERROR_CANCELLED) is no error of the scene's.
+  if (monitor_.stop) {
+    geo_->cancelled = true;
+    return std::move(geo_);
+  }
   if (!geo_->errors.message.empty()) throw Error(desc_.source, "", geo_->errors.message);
   geo_->area_light = AreaLight(desc_.meshes, emission_);
   geo_->source = desc_.source;
@@ -604,6 +643,7 @@ RenderScene::RenderScene(const SceneDescription& desc, const RenderSceneOptions&
   b.add_curve_sets();
   b.instance_curve_scene();
   geo_ = b.finish();
+  if (geo_->cancelled) return;
   packets_ = geo_->packets;
   set_lights(desc.lights);
   find_woven_meshes(desc);
@@ -860,6 +900,9 @@ size_t RenderScene::shape_count() const {
 }
 size_t RenderScene::triangle_count() const {
   return geo_->triangles;
+}
+bool RenderScene::cancelled() const {
+  return geo_->cancelled;
 }
 size_t RenderScene::curve_segment_count() const {
   return geo_->curve_segments;

@@ -618,7 +618,7 @@ WovenSampleSize woven_sample_size(const WeaveOptions& options) {
   return z;
 }
 
-WovenSample make_woven_sample(const WeaveOptions& options) {
+WovenSample make_woven_sample(const WeaveOptions& options, const ProgressCallback& progress) {
   if (options.pattern == kNonwovenPattern) return make_nonwoven_sample(options);
   const auto t0 = std::chrono::steady_clock::now();
   Resolved r = resolve(options);
@@ -668,6 +668,13 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
     // taller than the tube by sqrt(1 + slope^2); crossings pressed together along their whole
     // length (balanced crimp, yarns as wide as their spacing) have no room for that, and the
     // measurement finds it. Then the fibers go in vertical sections, within the tubes.
+    // Once the callback says stop, every later ask says so too and the sample is left partial.
+    auto asker = [&](std::string_view stage, std::string_view unit) {
+      return [&out, &progress, stage, unit](uint64_t done, uint64_t total) {
+        out.cancelled = out.cancelled || !progress({stage, done, total, unit});
+        return !out.cancelled;
+      };
+    };
     double d = 0;
     for (const bool perpendicular : {true, false}) {
       out.fibers = FiberCurves{};
@@ -675,7 +682,9 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
       s.weft_fibers.clear();
       r.fibers.perpendicular = perpendicular;
       try {
-        detail::build_fibers(L, r.fibers, out.fibers, s.warp_fibers, s.weft_fibers);
+        detail::build_fibers(L, r.fibers, out.fibers, s.warp_fibers, s.weft_fibers,
+                             asker("woven sample", "yarns"));
+        if (out.cancelled) return out;
       } catch (const Error& e) {
         if (perpendicular) throw;
         bad(options.fibers_per_yarn ? "fibers-per-yarn" : "packing",
@@ -684,7 +693,8 @@ WovenSample make_woven_sample(const WeaveOptions& options) {
                 " um apart); in vertical sections: " + without_field(e.what()));
       }
       d = min_fiber_distance(out.fibers, L.period_x * kMetresPerMm, L.period_z * kMetresPerMm,
-                             4 * r_m);
+                             4 * r_m, asker("fiber distances", "cells"));
+      if (out.cancelled) return out;
       s.min_fiber_distance_um = d * 1e6;
       s.fiber_sections = perpendicular ? "perpendicular" : "vertical";
       // The layout keeps 2r plus a margin; refuse anything that still comes closer.

@@ -454,12 +454,13 @@ Bundle make_bundle(double w, double t, double slope, double period, const FiberS
 }  // namespace
 
 void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& out,
-                  std::vector<FiberLayoutInfo>& warp_info,
-                  std::vector<FiberLayoutInfo>& weft_info) {
+                  std::vector<FiberLayoutInfo>& warp_info, std::vector<FiberLayoutInfo>& weft_info,
+                  const std::function<bool(uint64_t, uint64_t)>& keep_going) {
   std::map<std::tuple<bool, double, double, double, double>, Bundle> bundles;
   const Vec3 up{0, 1, 0};
   const float radius_m = static_cast<float>(fs.radius_mm * kMetresPerMm);
   for (size_t yi = 0; yi < layout.yarns.size(); ++yi) {
+    if (!keep_going(yi, layout.yarns.size())) return;
     const YarnPath& y = layout.yarns[yi];
     const auto key =
         std::make_tuple(y.warp, y.size.width_mm, y.size.thickness_mm, y.max_slope(), y.period);
@@ -613,7 +614,8 @@ SegmentGrid grid_of(std::vector<Seg> segs, const double extent[3], double ylo, d
 }  // namespace
 
 double min_fiber_distance(const FiberCurves& fibers, double period_x, double period_z,
-                          double cutoff) {
+                          double cutoff,
+                          const std::function<bool(uint64_t, uint64_t)>& keep_going) {
   std::vector<Seg> segs;
   segs.reserve(fibers.segment_count());
   double ylo = 1e300, yhi = -1e300, longest = 0;
@@ -670,7 +672,11 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
   };
   double best = cutoff;
   std::vector<uint64_t> seen;
+  // A cell holds the segments of a few fibers over one cutoff: 4096 of them are well under a
+  // second's work.
+  constexpr size_t kCellsPerPoll = 4096;
   for (size_t k = 0; k < g.keys.size(); ++k) {
+    if (keep_going && k % kCellsPerPoll == 0 && !keep_going(k, g.keys.size())) return best;
     const uint64_t key = g.keys[k];
     const int cz = static_cast<int>(key % g.n[2]), cy = static_cast<int>(key / g.n[2] % g.n[1]),
               cx = static_cast<int>(key / g.n[2] / g.n[1]);

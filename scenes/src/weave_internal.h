@@ -3,6 +3,7 @@
 // fiber bundles; weave_gltf.cpp: output). Lengths in millimetres unless named otherwise.
 #include <array>
 #include <filesystem>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
@@ -80,8 +81,11 @@ struct FiberSettings {
 };
 
 // Fills 'out' with the fibers of every yarn; per distinct yarn section the layout info.
+// 'keep_going' is asked before each yarn (yarns done, yarns in all); false stops with 'out'
+// partly filled.
 void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& out,
-                  std::vector<FiberLayoutInfo>& warp_info, std::vector<FiberLayoutInfo>& weft_info);
+                  std::vector<FiberLayoutInfo>& warp_info, std::vector<FiberLayoutInfo>& weft_info,
+                  const std::function<bool(uint64_t, uint64_t)>& keep_going);
 
 // Distance between the segments p0-p1 and q0-q1 (any units).
 double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);

@@ -191,13 +191,14 @@ VerifyOutcome run_verify_plan(const VerifyPlan& p, const VerifyHooks& hooks, con
   VerifyInputs in;
   in.fiber_name = p.request.fiber;
   const auto t0 = std::chrono::steady_clock::now();
-  const WovenSample sample = make_woven_sample(p.weave);
+  VerifyOutcome cancelled;
+  cancelled.cancelled = true;
+  const WovenSample sample = make_woven_sample(p.weave, hooks.progress);
+  if (sample.cancelled) return cancelled;
   in.sample_name = sample_name(sample.summary);
   if (sample.summary.nonwoven || !sample.summary.notes.empty())
     hooks.note("weft: sample: " + in.sample_name + "\n");
   in.seconds["woven_sample"] = seconds_since(t0);
-  VerifyOutcome cancelled;
-  cancelled.cancelled = true;
   // With a colour, the run verifies the spec dyed to it.
   std::optional<VerifyPlan> dyed;
   if (p.colour) {

@@ -76,6 +76,10 @@ struct RenderSceneOptions {
   // progress of that work.
   FiberTableResolver fiber_tables;
   ProgressCallback material_progress = no_progress();
+  // Told how far the build of the acceleration structure is, and asked whether to go on: a fiber
+  // sample of millions of segments takes tens of seconds. When it says stop, the scene is made
+  // cancelled() and must not be traced.
+  ProgressCallback build_progress = no_progress();
 };
 
 class RenderScene {
@@ -172,6 +176,7 @@ class RenderScene {
   size_t shape_count() const;          // meshes, then curve sets (SurfaceHit::shape)
   size_t triangle_count() const;       // meshes' triangles and the fibers' tube triangles
   size_t curve_segment_count() const;  // round curve segments (0 when fibers are tubes)
+  bool cancelled() const;              // the build was stopped (build_progress); do not trace
   Bounds3 bounds() const;
 
  private:

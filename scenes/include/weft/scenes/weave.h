@@ -42,10 +42,12 @@
 #include <array>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "weft/core/progress.h"
 #include "weft/scenes/curves.h"
 #include "weft/scenes/mesh.h"
 #include "weft/scenes/nonwoven.h"
@@ -152,11 +154,16 @@ struct WovenSample {
   WeaveSummary summary;
   // Per yarn of the sample (warps first, then wefts): its colour from a WIF draft, for extras.
   std::vector<std::array<double, 3>> yarn_rgb;
+  // The progress callback asked to stop: the sample is partial and must not be used.
+  bool cancelled = false;
 };
 
 // Checks everything (Error naming the field, before anything large is allocated) and builds the
-// sample. Deterministic: equal options give equal samples.
-WovenSample make_woven_sample(const WeaveOptions& options);
+// sample. Deterministic: equal options give equal samples. A large fiber sample takes minutes
+// (a WIF draft of 160 threads: about 2 minutes), so 'progress' is told after each yarn and each
+// slice of the fiber-distance check, and may stop the work (WovenSample::cancelled).
+WovenSample make_woven_sample(const WeaveOptions& options,
+                              const ProgressCallback& progress = no_progress());
 
 // The size of the sample make_woven_sample would build, from its options alone: the same checks
 // (weft::Error naming the field) but no geometry, for memory estimates before anything is
@@ -173,9 +180,12 @@ WovenSampleSize woven_sample_size(const WeaveOptions& options);
 
 // Minimum distance between centre-line segments of distinct fibers, periodic copies in x and z
 // included, looked for within 'cutoff_m' with a uniform grid (not all pairs). Returns cutoff_m
-// when no two segments come closer.
+// when no two segments come closer. 'keep_going', when given, is asked between slices of the grid's
+// cells (with the cells done and their total); once it says stop, the search ends and returns what
+// it found so far.
 double min_fiber_distance(const FiberCurves& fibers, double period_x_m, double period_z_m,
-                          double cutoff_m);
+                          double cutoff_m,
+                          const std::function<bool(uint64_t, uint64_t)>& keep_going = {});
 
 // glTF 2.0 of the sample (metres). Yarn detail: meshes "warp_yarns"/"weft_yarns" (triangles with
 // POSITION, NORMAL, TANGENT along the yarn, TEXCOORD_0 with u along the yarn) under node "patch".
