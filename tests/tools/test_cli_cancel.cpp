@@ -126,6 +126,25 @@ TEST(CliCancel, FabricRaytraceStopsSoonAtHugeSamples) {
   expect_cancelled(r, dir, dir / "fabric.exr");
 }
 
+TEST(CliCancel, FabricRaytraceStopsSoonWhileMakingALargeSample) {
+  // The bundled 84 x 100 draft at fiber detail: its sample (4 M segments) took 100-160 s to make
+  // on the shared 2-core machine, and its scene build tens of seconds more, neither polled;
+  // interrupted 2 s in, the stop is the sample's own poll (the plan is done well before).
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = flat_fiber_table(dir);
+  const std::string draft = std::string(WEFT_SOURCE_DIR) + "/scenes/data/wif/8452.wif";
+  const auto r =
+      interrupt_after(spawn_weft({"--max-memory-gb", "64", "bake", "fabric", "--method", "raytrace",
+                                  "--detail", "fiber", "--wif", draft, "--fiber", fiber.string(),
+                                  "-R", "1", "--yes-long", "--quiet", "-o", "fabric.exr"},
+                                 dir),
+                      2.0);
+  expect_cancelled(r, dir, dir / "fabric.exr");
+  EXPECT_EQ(WEXITSTATUS(r.status), 130);
+  EXPECT_NE(slurp(dir / "stderr").find("bake cancelled"), std::string::npos)
+      << slurp(dir / "stderr");
+}
+
 TEST(CliCancel, FiberBakeStopsSoonAtHugePhotons) {
   const fs::path dir = fresh_test_dir();
   const auto r =
