@@ -96,7 +96,9 @@ TEST(ColourMatch, StopsOutOfReachWhenReadingsStopGaining) {
   // The last two readings were idle: each gained under 5 % on the best before it.
   double best = 1e9;
   for (size_t k = 0; k < n; ++k) {
-    if (k + 2 >= n) EXPECT_GT(m.readings[k].delta_e00, 0.95 * best) << k;
+    if (k + 2 >= n) {
+      EXPECT_GT(m.readings[k].delta_e00, 0.95 * best) << k;
+    }
     best = std::min(best, m.readings[k].delta_e00);
   }
 }
