@@ -101,6 +101,32 @@ TEST(VerifyReportFiles, EachFabricTableGetsAPreviewPageLinkedFromTheIndex) {
   EXPECT_LT(index.size(), page.size() / 10);
 }
 
+// --colour-from measured: each unfitted model's absolute figure is its calibrated one
+// (models.<m>.calibrated, docs/colour.md); a fitted model sets its own colour and has none, and a
+// run not calibrated has none at all.
+TEST(VerifyReportFiles, CalibratedRunGivesEachUnfittedModelItsCalibratedFigure) {
+  VerifyReport r = tiny_report();
+  ModelCurves c = r.models[0];
+  c.key = "computed_raytrace";
+  c.beta = {{Rgb(0.5), Rgb(0.4)}};
+  r.models.push_back(c);
+  c.key = "classic_fitted";
+  r.models.push_back(c);
+  for (auto& m : r.models) m.figures = model_figures(m.beta, {}, r.measured, {0, 0});
+  for (const bool calibrated : {false, true}) {
+    r.colour_calibrated = calibrated;
+    const auto j = nlohmann::json::parse(verify_metrics_json(r));
+    const auto& models = j.at("models");
+    for (const char* key : {"classic", "computed_raytrace"}) {
+      ASSERT_EQ(models.at(key).contains("calibrated"), calibrated) << key;
+      if (calibrated)
+        EXPECT_EQ(models.at(key).at("calibrated"), models.at(key).at("absolute")) << key;
+    }
+    EXPECT_FALSE(models.at("classic_fitted").contains("calibrated"));
+    EXPECT_EQ(j.contains("computed_calibrated_rms_log"), calibrated);
+  }
+}
+
 // Against camera (or unknown) RGB the absolute figures and the measurement's colour are marked
 // not comparable in metrics.json and on the page; the shape and the paper's figures are not.
 TEST(VerifyReportFiles, CameraRgbMarksAbsoluteFiguresNotComparable) {

@@ -111,6 +111,11 @@ nlohmann::json models_json(const VerifyReport& r) {
                      {"uncertainty", uncertainty_json(m.figures, r.measured.colour_space)},
                      {"log_floored_points", m.figures.log_floored_points}};
     if (!m.figures.fits.empty()) models[m.key]["shape"] = shape_json(m.figures.shape, r.measured);
+    // Calibrated (--colour-from measured): every unfitted model is made of the fiber dyed to the
+    // measurement's own d/8 reading, so its absolute figure has had that one calibration and no
+    // per-channel gain; the fitted models set their colour themselves and have none.
+    if (r.colour_calibrated && !is_fitted_model(m.key))
+      models[m.key]["calibrated"] = metrics_json(m.absolute_overall);
   }
   return models;
 }

@@ -47,5 +47,10 @@ inline const VerifyModelNames& verify_model(VerifyModel m) {
 inline const char* verify_model_key(VerifyModel m) {
   return verify_model(m).key;
 }
+// Whether 'key' is a fitted model's (its colour and shape set by a fit to the measurement).
+inline bool is_fitted_model(const std::string& key) {
+  return key == verify_model_key(VerifyModel::kComputedRaytraceFitted) ||
+         key == verify_model_key(VerifyModel::kClassicFitted);
+}
 
 }  // namespace weft
