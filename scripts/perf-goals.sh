@@ -17,14 +17,18 @@
 #             16 spp, a spectral red-cotton table at R = 8, 200 000 photons, baked once by the
 #             baseline): pixel noise of two seeds and CPU seconds, so noise at equal time follows;
 #   fit       `weft verify --quality default --fit`: wall and CPU time, convergence (this tree
-#             only unless WEFT_FIT_BASELINE=1: the baseline's takes about an hour).
+#             only unless WEFT_FIT_BASELINE=1: the baseline's takes about an hour);
+#   verify    `weft verify --quality default` (scripts/demo.sh's), cold (an empty bake cache) and
+#             warm (the cold run's cache): wall and CPU time, the estimate printed before the work,
+#             and this tree's time by stage (metrics.json "seconds") in verify-stages.md
+#             (WEFT_VERIFY_BASELINE=0: this tree's alone).
 # Writes ${WEFT_OUT:-out/perf-goals}/goals.md (the table) and goals.json, with every program's
 # own output beside them.
 # Environment: WEFT_OUT; WEFT_BASELINE (git revision, default 0c7d278: the code the goals were
 # set against); WEFT_BASELINE_BIN (a weft built from it; else it is built into
 # ${WEFT_BASELINE_BUILD:-build-baseline} from `git archive`); WEFT_BIN (this tree's weft, default
 # build/tools/weft); WEFT_THREADS (default 2); WEFT_SEEDS (default 2); WEFT_GOALS (comma list,
-# default raytrace,bake,render,backlit,fit); WEFT_PARTICLES (default 40000).
+# default raytrace,bake,render,backlit,fit,verify); WEFT_PARTICLES (default 40000).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
@@ -33,7 +37,7 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 threads=${WEFT_THREADS:-2}
 seeds=${WEFT_SEEDS:-2}
-goals=",${WEFT_GOALS:-raytrace,bake,render,backlit,fit},"
+goals=",${WEFT_GOALS:-raytrace,bake,render,backlit,fit,verify},"
 particles=${WEFT_PARTICLES:-40000}
 rev=${WEFT_BASELINE:-0c7d278}
 new=$(realpath "${WEFT_BIN:-build/tools/weft}")
@@ -125,6 +129,20 @@ if [[ $goals == *,fit,* ]]; then
     echo "== verify --quality default --fit (before)"
     timed "fit-before" "$old" verify --quality default --fit --threads "$threads" --yes-long -o fit
   fi
+fi
+
+if [[ $goals == *,verify,* ]]; then
+  whos="before after" && [ "${WEFT_VERIFY_BASELINE:-1}" = 0 ] && whos=after
+  for who in $whos; do
+    bin=$old && [ $who = after ] && bin=$new
+    echo "== verify --quality default ($who: cold, then warm)"
+    rm -rf "$out/verify-cold-$who" "$out/verify-warm-$who"
+    timed "verify-cold-$who" "$bin" verify --quality default --threads "$threads" -o report
+    # Warm: the same run again on the cold run's bake cache (fiber tables, colour matches).
+    mkdir -p "$out/verify-warm-$who"
+    cp -r "$out/verify-cold-$who/.weft-cache" "$out/verify-warm-$who/" 2> /dev/null || true
+    timed "verify-warm-$who" "$bin" verify --quality default --threads "$threads" -o report
+  done
 fi
 
 python3 "$root/scripts/perf_goals_table.py" "$out" "$rev" "$seeds"

@@ -4,6 +4,7 @@ and OUT/goals.json. Usage: perf_goals_table.py OUT BASELINE_REVISION SEEDS"""
 import glob
 import json
 import os
+import re
 import statistics
 import sys
 
@@ -126,6 +127,54 @@ def fit(out):
     return rows
 
 
+def printed_seconds(text):
+    """The wall-clock estimate verify prints before its work ("about 3 min on 2 cores"), seconds:
+    format_seconds (core/src/run_limits.cpp) rounds up to whole seconds or minutes."""
+    m = re.search(r"about ([0-9.]+) (s|min|h|days) on", text)
+    if not m:
+        return None
+    return float(m.group(1)) * {"s": 1, "min": 60, "h": 3600, "days": 86400}[m.group(2)]
+
+
+def verify(out):
+    """weft verify --quality default, cold and warm: wall, CPU and the printed estimate; this
+    tree's stages to verify-stages.md."""
+    rows, stages = [], {}
+    for cache in ("cold", "warm"):
+        walls, cpus, estimates = {}, {}, {}
+        for who in ("before", "after"):
+            name = "verify-%s-%s" % (cache, who)
+            if not have(out, name):
+                continue
+            walls[who] = number(os.path.join(out, name + ".wall"))
+            cpus[who] = number(os.path.join(out, name + ".cpu"))
+            with open(os.path.join(out, name + ".err"), errors="replace") as f:
+                estimates[who] = printed_seconds(f.read())
+            metrics = os.path.join(out, name, "report", "metrics.json")
+            if who == "after" and os.path.exists(metrics):
+                stages[cache] = read_json(metrics).get("seconds", {})
+        if not walls:
+            continue
+        b, a = walls.get("before"), walls.get("after")
+        rows.append(("verify --quality default, %s cache, wall s" % cache, b, a,
+                     b / a if a and b else None))
+        b, a = cpus.get("before"), cpus.get("after")
+        rows.append(("verify --quality default, %s cache, CPU s" % cache, b, a,
+                     b / a if a and b else None))
+        b, a = estimates.get("before"), estimates.get("after")
+        rows.append(("verify --quality default, %s cache, wall s printed before the work" % cache,
+                     b, a, None))
+    if stages:
+        keys = sorted(set(stages.get("cold", {})) | set(stages.get("warm", {})),
+                      key=lambda k: -stages.get("cold", {}).get(k, 0))
+        with open(os.path.join(out, "verify-stages.md"), "w") as f:
+            f.write("| stage (metrics.json seconds) | cold, s | warm, s |\n| --- | --- | --- |\n")
+            for k in keys:
+                f.write("| %s | %s | %s |\n" % (k, fmt(stages.get("cold", {}).get(k)),
+                                                fmt(stages.get("warm", {}).get(k))))
+    return rows
+
+
 def fmt(x):
     if x is None:
         return "–"
@@ -144,6 +193,7 @@ def main():
     if have_backlit(out):
         rows += backlit(out)
     rows += fit(out)
+    rows += verify(out)
     with open(os.path.join(out, "goals.json"), "w") as f:
         json.dump([{"figure": r[0], "before": r[1], "after": r[2], "gain": r[3]} for r in rows], f,
                   indent=2)
