@@ -4,6 +4,7 @@
 
 #include "common.h"
 #include "weft/verify/fit_models.h"
+#include "weft/verify/models.h"
 #include "weft/verify/whole_run.h"
 
 namespace weft {
@@ -144,7 +145,7 @@ bool fit_verify_models(const VerifyPlan& p, const WovenSample& sample, const Ver
       fitted_at_run_quality(p, sample, base, computed, classic, hooks.progress);
   if (!again) return false;
   for (ModelCurves m : again->models) {
-    m.key += "_fitted";
+    m.key += kFittedKeySuffix;
     m.label += ", fitted";
     report.models.push_back(std::move(m));
   }

@@ -211,7 +211,7 @@ nlohmann::json fit_json(const FitResult& f, const std::vector<ModelCurves>& mode
   // The fitted parameters at the run's quality (the same ray trace as the unfitted curves).
   const std::string key = f.model == "computed"
                               ? verify_model_key(VerifyModel::kComputedRaytraceFitted)
-                              : f.model + "_fitted";
+                              : f.model + kFittedKeySuffix;
   for (const auto& m : models)
     if (m.key == key)
       e["at_run_quality"] = {{"model", key},

@@ -10,10 +10,9 @@ std::string verdict_model_name(const std::string& key) {
   for (const VerifyModelNames& m : kVerifyModels)
     if (key == m.key) return std::string("the ") + m.verdict;
   // A model of no row ("computed_summation_fitted"): its base's name, fitted.
-  const std::string fitted = "_fitted";
-  const bool is_fitted = key.size() > fitted.size() &&
-                         key.compare(key.size() - fitted.size(), fitted.size(), fitted) == 0;
-  const std::string base = is_fitted ? key.substr(0, key.size() - fitted.size()) : key;
+  const bool is_fitted = is_fitted_model(key);
+  const std::string base =
+      is_fitted ? key.substr(0, key.size() - std::string(kFittedKeySuffix).size()) : key;
   for (const VerifyModelNames& m : kVerifyModels)
     if (base == m.key) return std::string("the fitted ") + m.verdict;
   return "the " + std::string(is_fitted ? "fitted " : "") + base;

@@ -47,10 +47,13 @@ inline const VerifyModelNames& verify_model(VerifyModel m) {
 inline const char* verify_model_key(VerifyModel m) {
   return verify_model(m).key;
 }
-// Whether 'key' is a fitted model's (its colour and shape set by a fit to the measurement).
+// Whether 'key' is a fitted model's (its colour and shape set by a fit to the measurement): the
+// table's fitted rows and any other model fitted, all keyed "<model>_fitted" (fit_run.cpp).
+inline constexpr const char* kFittedKeySuffix = "_fitted";
 inline bool is_fitted_model(const std::string& key) {
-  return key == verify_model_key(VerifyModel::kComputedRaytraceFitted) ||
-         key == verify_model_key(VerifyModel::kClassicFitted);
+  const std::string suffix = kFittedKeySuffix;
+  return key.size() > suffix.size() &&
+         key.compare(key.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 }  // namespace weft
