@@ -251,7 +251,7 @@ void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t u
   life.books = &tally.books_of(bin);
   Launch l = launch(t.grid, t.slab, bin, rng);  // drawn either way: the stream stays the same
   if (t.o.launch_lattice > 1) l = lattice_launch(t, k, bin);
-  life.st = draw_strategies(t.mis, t.nc, rng);
+  life.st = draw_strategies(t.mis, t.fs.groups, rng);
   life.books->launched += l.w0;
   ++life.books->particles;
   life.first_exit = unit_first;
@@ -271,7 +271,7 @@ void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t u
 void trace_task(const Tracer& t, uint64_t first, uint64_t count, Rng& rng, Tally& task_tally) {
   if (first + count <= t.first_item || first >= t.last_item) return;
   TaskScratch scratch;
-  scratch.s_sum.resize(t.mis ? t.nc : 1);
+  scratch.s_sum.resize(t.mis ? t.fs.groups : 1);
   Tally outside;
   const Tally* last = nullptr;
   size_t unit_first = 0;
@@ -507,11 +507,12 @@ Tracer tracer_for(const RenderScene& scene, const RepeatSlab& slab, int64_t curv
            .grid = DirectionGrid{o.resolution},
            .nc = fiber.channels};
   // Per particle: the channel weights w and, per sampling strategy j, the density p_j of its path
-  // so far relative to their mean. With spectral MIS the strategies are the channels: each
-  // particle draws its path for one hero channel h (uniform), and weights channel c by the balance
-  // heuristic over the channels' path densities (one-sample MIS, docs/fabric-bsdf.md):
-  // w_c = w0 prod f_c / mean_j prod (f_j / S_j), S_j = A_j' + A_j''. The weights do not depend on
-  // h, so roulette on them keeps the estimate unbiased.
+  // so far relative to their mean. With spectral MIS the strategies are the channel groups
+  // (FiberSampler): each particle draws its path for one hero group h (uniform), and weights
+  // channel c by the balance heuristic over the groups' path densities (one-sample MIS,
+  // docs/fabric-bsdf.md): w_c = w0 prod f_c / mean_j prod (g_j / S_j), S_j = A_j' + A_j'', g_j the
+  // mean of f over group j. The weights do not depend on h, so roulette on them keeps the estimate
+  // unbiased.
   t.mis = o.channel_sampling == ChannelSampling::spectral_mis && t.nc > 1;
   t.window = o.channel_sampling != ChannelSampling::mean;
   t.proposal = o.proposal != nullptr;

@@ -22,7 +22,9 @@ double max_cos_in(const DirectionGrid& grid, int b) {
 
 FiberSampler::FiberSampler(const TabulatedBsdfTable& t) : table(&t), grid(t.grid()) {
   const int bins = grid.bins(), nc = t.channels;
-  strategies = nc + 1;
+  group_size = (nc + kChannelGroups - 1) / kChannelGroups;
+  groups = (nc + group_size - 1) / group_size;
+  strategies = groups + 1;
   areas = grid.cosine_weighted_areas();
   max_cos.resize(bins);
   for (int b = 0; b < bins; ++b) max_cos[b] = max_cos_in(grid, b);
@@ -30,15 +32,9 @@ FiberSampler::FiberSampler(const TabulatedBsdfTable& t) : table(&t), grid(t.grid
   rows.resize(static_cast<size_t>(bins) * strategies);
   std::vector<double> w(static_cast<size_t>(strategies) * bins);
   for (int i = 0; i < bins; ++i) {
-    for (int o = 0; o < bins; ++o) {
-      double mean = 0;
-      for (int c = 0; c < nc; ++c) {
-        const double f = t.at(i, o, c);
-        w[static_cast<size_t>(c) * bins + o] = f * areas[o];
-        mean += f;
-      }
-      w[static_cast<size_t>(nc) * bins + o] = mean / nc * areas[o];
-    }
+    for (int o = 0; o < bins; ++o)
+      for (int s = 0; s < strategies; ++s)
+        w[static_cast<size_t>(s) * bins + o] = value(i, o, s) * areas[o];
     for (int s = 0; s < strategies; ++s) {
       const std::span<const double> ws(w.data() + static_cast<size_t>(s) * bins, bins);
       for (double x : ws) albedo[static_cast<size_t>(i) * strategies + s] += x;
@@ -47,12 +43,16 @@ FiberSampler::FiberSampler(const TabulatedBsdfTable& t) : table(&t), grid(t.grid
   }
 }
 
+int FiberSampler::last_channel(int s) const {
+  return s < groups ? std::min(table->channels, (s + 1) * group_size) : table->channels;
+}
+
 double FiberSampler::value(int i, int o, int s) const {
-  const int nc = table->channels;
-  if (s < nc) return table->at(i, o, s);
+  const int first = first_channel(s), last = last_channel(s);
+  if (last - first == 1) return table->at(i, o, first);
   double mean = 0;
-  for (int c = 0; c < nc; ++c) mean += table->at(i, o, c);
-  return mean / nc;
+  for (int c = first; c < last; ++c) mean += table->at(i, o, c);
+  return mean / (last - first);
 }
 
 Vec3 FiberSampler::cosine_direction_in(int b, Rng& rng) const {

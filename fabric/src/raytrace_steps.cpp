@@ -87,12 +87,12 @@ Vec3 lattice_point(const RepeatSlab& slab, const Vec3& p, int m, int count) {
   return q;
 }
 
-Strategies draw_strategies(bool mis, int channels, Rng& rng) {
+Strategies draw_strategies(bool mis, int groups, Rng& rng) {
   Strategies st;
   st.mis = mis;
-  st.count = mis ? channels : 1;
-  st.mean = channels;
-  st.hero = mis ? std::min(channels - 1, static_cast<int>(rng.uniform() * channels)) : st.mean;
+  st.count = mis ? groups : 1;
+  st.mean = groups;
+  st.hero = mis ? std::min(groups - 1, static_cast<int>(rng.uniform() * groups)) : st.mean;
   return st;
 }
 

@@ -35,17 +35,18 @@ WovenSample red_cotton(const char* detail) {
   return make_woven_sample(overlay(red_cotton_weave_options(), o));
 }
 
-// A fiber table of resolution 2 holding value(i, o, c) in every cell.
+// A fiber table of resolution 2 and 'channels' channels holding value(i, o, c) in every cell.
 template <class F>
-TabulatedBsdfTable cell_table(F value) {
+TabulatedBsdfTable cell_table(F value, int channels = 3) {
   TabulatedBsdfTable t;
   t.resolution = 2;
-  t.channels = 3;
+  t.channels = channels;
   t.kind = "fiber";
-  t.values.assign(static_cast<size_t>(t.bins()) * t.bins() * 3, 0.0f);
+  t.values.assign(static_cast<size_t>(t.bins()) * t.bins() * channels, 0.0f);
   for (int i = 0; i < t.bins(); ++i)
     for (int o = 0; o < t.bins(); ++o)
-      for (int c = 0; c < 3; ++c) t.values[t.index(i, o, c)] = static_cast<float>(value(i, o, c));
+      for (int c = 0; c < channels; ++c)
+        t.values[t.index(i, o, c)] = static_cast<float>(value(i, o, c));
   return t;
 }
 
@@ -330,6 +331,67 @@ TEST(RaytraceSteps, ScatteringWeightsAChannelByItsAlbedoWhateverTheHero) {
     }
     EXPECT_NEAR(absorbed, lost / 3, 1e-12);
   }
+}
+
+TEST(RaytraceSteps, ASpectralTablesStrategiesAreThirdsOfItsBands) {
+  // Seven bands: groups of three adjacent bands (the last of one), each drawn in proportion to
+  // its bands' mean; an RGB table keeps a strategy per channel (the test above).
+  const auto t = cell_table([](int i, int o, int c) { return 0.01 * (1 + c) * (1 + (i + o) % 3); }, 7);
+  const FiberSampler fs(t);
+  EXPECT_EQ(fs.groups, 3);
+  EXPECT_EQ(fs.strategies, 4);
+  EXPECT_EQ(fs.first_channel(1), 3);
+  EXPECT_EQ(fs.last_channel(1), 6);
+  EXPECT_EQ(fs.first_channel(2), 6);
+  EXPECT_EQ(fs.last_channel(2), 7);
+  const int i = 2, o = 5;
+  EXPECT_NEAR(fs.value(i, o, 0), (t.at(i, o, 0) + t.at(i, o, 1) + t.at(i, o, 2)) / 3, 1e-9);
+  EXPECT_DOUBLE_EQ(fs.value(i, o, 2), t.at(i, o, 6));
+  double all = 0;
+  for (int c = 0; c < 7; ++c) all += t.at(i, o, c);
+  EXPECT_NEAR(fs.value(i, o, 3), all / 7, 1e-9);  // the mean strategy: every band
+  double a = 0;
+  for (int b = 0; b < t.bins(); ++b) a += fs.value(i, b, 1) * fs.areas[b];
+  EXPECT_NEAR(fs.albedo_of(i, 1), a, 1e-12 * a);
+}
+
+TEST(RaytraceSteps, MisOverBandGroupsBooksEachBandsOwnTableInExpectation) {
+  // Bands of unlike shapes inside one group: band 1 alone sends light to the cells from 4 on,
+  // every other band only below 4 (band 6 alone in its group). A step's weight in band c, booked
+  // in the cell it drew, has the expectation w0 f_c(o) D_o in every cell o, whichever group drew
+  // it. A strategy that stood for its group by one band (band 0) would never draw band 1's cells.
+  const auto t = cell_table(
+      [](int, int o, int c) {
+        if (c == 1) return o >= 4 ? 0.3 : 0.0;
+        return o < 4 ? 0.05 * (1 + c) * (1 + o % 3) : 0.0;
+      },
+      7);
+  const FiberSampler fs(t);
+  const int bins = t.bins(), nc = 7, bin = 3, n = 200000;
+  std::vector<double> sum(static_cast<size_t>(bins) * nc, 0.0), sum2(sum.size(), 0.0);
+  Rng rng(29, 0);
+  for (int k = 0; k < n; ++k) {
+    const Strategies st = draw_strategies(true, fs.groups, rng);
+    Particle s = particle_of_weight(1.0, st, false);
+    s.w.assign(nc, 1.0);
+    std::vector<double> s_sum(fs.groups);
+    const Crossings x = one_point(bin);
+    albedo_sums(fs, st, x, s_sum);
+    const auto draw = draw_scatter(fs, st, x, s_sum, rng);
+    ASSERT_TRUE(draw);
+    weigh_scatter(fs, t, st, bin, draw->exit_bin, s_sum, s);
+    for (int c = 0; c < nc; ++c) {
+      sum[static_cast<size_t>(draw->exit_bin) * nc + c] += s.w[c];
+      sum2[static_cast<size_t>(draw->exit_bin) * nc + c] += s.w[c] * s.w[c];
+    }
+  }
+  for (int o = 0; o < bins; ++o)
+    for (int c = 0; c < nc; ++c) {
+      const size_t v = static_cast<size_t>(o) * nc + c;
+      const double mean = sum[v] / n, se = std::sqrt(std::max(0.0, sum2[v] / n - mean * mean) / n);
+      const double expected = t.at(bin, o, c) * fs.areas[o];
+      EXPECT_NEAR(mean, expected, 5 * se + 1e-12) << "cell " << o << " band " << c;
+    }
 }
 
 TEST(RaytraceSteps, UnderAProposalTheTracedWeightsFollowItsPathsTimesTheRatio) {

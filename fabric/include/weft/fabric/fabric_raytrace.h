@@ -76,8 +76,10 @@ inline constexpr NameTable<StraightThrough, 2> kStraightThroughNames{{
 // fiber. Fiber-detail results are unchanged. The straight-through option (StraightThrough)
 // changed the default's results without a new revision: the table's metadata and a part's job
 // name it where it is exact, so a part or table of revision 3 without it is the sampled
-// estimator's, which the option still gives bit for bit.
-inline constexpr int kFabricRaytraceRevision = 3;
+// estimator's, which the option still gives bit for bit. 4: a spectral table's paths are drawn
+// by three strategies, each a third of its bands (FiberSampler), before which each band had its
+// own; the results are the same in distribution, RGB tables' bit for bit.
+inline constexpr int kFabricRaytraceRevision = 4;
 
 // The most next-event draws per scattering and particles per launch block
 // (FabricRaytraceOptions::next_event_rays, launch_lattice).

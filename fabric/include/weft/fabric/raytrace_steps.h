@@ -82,17 +82,18 @@ Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& r
 Vec3 lattice_point(const RepeatSlab& slab, const Vec3& p, int m, int count);
 
 // The sampling strategies a path is drawn and weighted with (FiberSampler strategy indices). With
-// spectral MIS one per channel, and the particle follows its hero, drawn uniformly; else one, the
-// channels' mean.
+// spectral MIS one per channel group (FiberSampler::groups: a channel of an RGB table, a few
+// adjacent bands of a spectral one), and the particle follows its hero, drawn uniformly; else one,
+// the channels' mean.
 struct Strategies {
   bool mis = false;
   int count = 1;
   int hero = 0;  // the strategy the path follows
-  int mean = 0;  // the channels' mean: the channel count
+  int mean = 0;  // the channels' mean: the group count
   int index(int j) const { return mis ? j : mean; }
   int hero_slot() const { return mis ? hero : 0; }  // the j of the hero
 };
-Strategies draw_strategies(bool mis, int channels, Rng& rng);
+Strategies draw_strategies(bool mis, int groups, Rng& rng);
 
 // The particle as it is launched: weights w0 in every channel (and under the proposal, when
 // 'proposal'), path densities 1.
