@@ -92,12 +92,14 @@ UGrid estimate_ndf(const TableView& view, int nodes) {
   return ndf;
 }
 
-// The incidence angles: theta_k = (k / (count - 1))^2 * 90 deg, and 'grazing' more between the
-// last two, at theta_{n-2} + (90 deg - theta_{n-2}) (1 - (1 - t)^2), t = j / (grazing + 1).
+// The incidence angles: theta_k = k / (count - 1) * 90 deg, and 'grazing' more between the last
+// two, at theta_{n-2} + (90 deg - theta_{n-2}) (1 - (1 - t)^2), t = j / (grazing + 1). Evenly
+// spaced rather than the paper's (k / (count - 1))^2, which is dense at normal incidence where a
+// cloth's values hardly change and 10 deg apart at 70 deg, where the renderers' linear blend of
+// the neighbouring incidences missed a baked fabric's curvature by up to 18 %.
 std::vector<double> incidence_angles(int count, int grazing) {
   std::vector<double> theta;
-  for (int k = 0; k + 1 < count; ++k)
-    theta.push_back(u_to_theta(static_cast<double>(k) / (count - 1)));
+  for (int k = 0; k + 1 < count; ++k) theta.push_back(kPi / 2 * k / (count - 1));
   const double last = theta.back();
   for (int j = 1; j <= grazing; ++j) {
     const double t = static_cast<double>(j) / (grazing + 1);
@@ -107,6 +109,78 @@ std::vector<double> incidence_angles(int count, int grazing) {
   return theta;
 }
 
+// Solves M x = b in place for the 1-D mass matrix of the hat functions on n unit-spaced nodes
+// (2/3 on the diagonal, 1/3 at the two ends, 1/6 beside it), b read with stride 'stride'.
+void solve_mass(double* b, int n, int stride) {
+  std::vector<double> c(static_cast<size_t>(n));  // Thomas algorithm: the reduced upper row
+  auto diag = [n](int j) { return j == 0 || j == n - 1 ? 1.0 / 3 : 2.0 / 3; };
+  double d = diag(0);
+  c[0] = (1.0 / 6) / d;
+  b[0] /= d;
+  for (int j = 1; j < n; ++j) {
+    d = diag(j) - (1.0 / 6) * c[static_cast<size_t>(j - 1)];
+    c[static_cast<size_t>(j)] = (1.0 / 6) / d;
+    b[j * stride] = (b[j * stride] - (1.0 / 6) * b[(j - 1) * stride]) / d;
+  }
+  for (int j = n - 2; j >= 0; --j) b[j * stride] -= c[static_cast<size_t>(j)] * b[(j + 1) * stride];
+}
+
+// The n x n node values whose bilinear interpolant is the L2 projection of a function given on
+// the finer grid of s (n - 1) + 1 points a side that holds the nodes: its integrals against the
+// nodes' hat functions (trapezoid rule on the fine grid) solved through the mass matrix in x,
+// then in y. The integral over the square, the albedo here, is kept (the hats sum to 1); point
+// values lose the function's curvature between the nodes (the interpolant of a peak lies below
+// it), which took 3.6 % of a baked fabric's albedo at 85 deg.
+std::vector<double> project_bilinear(const std::vector<double>& fine, int n, int s) {
+  const int nf = s * (n - 1) + 1;
+  auto weight = [&](int j, int t) {  // node j's hat at fine offset t, times the trapezoid's weight
+    const int k = j * s + t;
+    if (k < 0 || k >= nf) return 0.0;
+    return (1 - std::abs(t) / static_cast<double>(s)) / s * (k == 0 || k == nf - 1 ? 0.5 : 1.0);
+  };
+  const auto at = [](int row, int col, int width) {
+    return static_cast<size_t>(row * width + col);
+  };
+  std::vector<double> rows(static_cast<size_t>(nf * n), 0.0), out(static_cast<size_t>(n * n), 0.0);
+  for (int y = 0; y < nf; ++y)
+    for (int j = 0; j < n; ++j)
+      for (int t = -s; t <= s; ++t)
+        if (const double w = weight(j, t); w != 0)
+          rows[at(y, j, n)] += w * fine[at(y, j * s + t, nf)];
+  for (int i = 0; i < n; ++i)
+    for (int t = -s; t <= s; ++t)
+      if (const double w = weight(i, t); w != 0)
+        for (int x = 0; x < n; ++x) out[at(i, x, n)] += w * rows[at(i * s + t, x, n)];
+  for (int i = 0; i < n; ++i) solve_mass(out.data() + i * n, n, 1);
+  for (int x = 0; x < n; ++x) solve_mass(out.data() + x, n, n);
+  return out;
+}
+
+// The stored value f(w_i, w_o) cos theta_o 4 sigma / D(m) per channel, [channel][y][x], on the
+// warp's sample space at 'side' x 'side' points.
+std::vector<std::vector<double>> sample_values(const TableView& view, const rgl::MarginalWarp& warp,
+                                               const UGrid& ndf, double sigma, const Vec3& wi,
+                                               int side) {
+  const auto nc = static_cast<size_t>(view.channels());
+  std::vector<std::vector<double>> out(nc, std::vector<double>(static_cast<size_t>(side * side)));
+  std::vector<double> f(nc);
+  for (int y = 0; y < side; ++y)
+    for (int x = 0; x < side; ++x) {
+      const Vec2 um =
+          warp.sample({static_cast<double>(x) / (side - 1), static_cast<double>(y) / (side - 1)});
+      const Vec3 m = spherical_direction(u_to_theta(um.x), u_to_phi(um.y));
+      const Vec3 wo = reflect(wi, m);
+      std::fill(f.begin(), f.end(), 0.0);
+      if (wo.z > 0 && dot(wi, m) > 0) {
+        view.isotropic(wi, wo, f);  // Weft's f(view, light): wi here is the view
+        const double scale = wo.z * 4 * sigma / ndf.at(um.x);
+        for (double& v : f) v = std::max(0.0, v) * scale;
+      }
+      for (size_t c = 0; c < nc; ++c) out[c][static_cast<size_t>(y * side + x)] = f[c];
+    }
+  return out;
+}
+
 struct Slices {
   std::vector<float> vndf, luminance, values;  // [theta_i][...]
 };
@@ -114,7 +188,7 @@ struct Slices {
 // One theta_i's vndf, luminance and value tensors, appended to 'out'.
 void add_slice(const TableView& view, const RglOptions& o, const UGrid& ndf, double sigma,
                double theta_i, Slices& out) {
-  const int nv = o.vndf_resolution, ns = o.sample_resolution, nc = view.channels();
+  const int nv = o.vndf_resolution, ns = o.sample_resolution;
   const Vec3 wi = spherical_direction(theta_i, 0);
   std::vector<double> density(static_cast<size_t>(nv * nv));
   for (int y = 0; y < nv; ++y)
@@ -127,25 +201,18 @@ void add_slice(const TableView& view, const RglOptions& o, const UGrid& ndf, dou
       out.vndf.push_back(static_cast<float>(d));
     }
   const rgl::MarginalWarp warp(std::move(density), nv, nv);
-  std::vector<double> f(static_cast<size_t>(nc));
-  std::vector<double> slab(static_cast<size_t>(nc * ns * ns), 0.0);
-  for (int y = 0; y < ns; ++y)
-    for (int x = 0; x < ns; ++x) {
-      const Vec2 um =
-          warp.sample({static_cast<double>(x) / (ns - 1), static_cast<double>(y) / (ns - 1)});
-      const Vec3 m = spherical_direction(u_to_theta(um.x), u_to_phi(um.y));
-      const Vec3 wo = reflect(wi, m);
-      std::fill(f.begin(), f.end(), 0.0);
-      if (wo.z > 0 && dot(wi, m) > 0) {
-        view.isotropic(wi, wo, f);  // Weft's f(view, light): wi here is the view
-        const double scale = wo.z * 4 * sigma / ndf.at(um.x);
-        for (double& v : f) v = std::max(0.0, v) * scale;
-      }
-      out.luminance.push_back(static_cast<float>(view.luminance(f)));
-      for (int c = 0; c < nc; ++c)
-        slab[static_cast<size_t>((c * ns + y) * ns + x)] = f[static_cast<size_t>(c)];
-    }
-  for (double v : slab) out.values.push_back(static_cast<float>(v));
+  const int fine = o.sample_supersampling * (ns - 1) + 1;
+  std::vector<std::vector<double>> values = sample_values(view, warp, ndf, sigma, wi, fine);
+  for (auto& v : values) {
+    if (o.sample_supersampling > 1) v = project_bilinear(v, ns, o.sample_supersampling);
+    for (double& x : v) x = std::max(0.0, x);  // the projection rings below a steep edge
+    out.values.insert(out.values.end(), v.begin(), v.end());
+  }
+  std::vector<double> f(values.size());
+  for (size_t k = 0; k < static_cast<size_t>(ns * ns); ++k) {
+    for (size_t c = 0; c < f.size(); ++c) f[c] = values[c][k];
+    out.luminance.push_back(static_cast<float>(view.luminance(f)));
+  }
   // The luminance only steers sampling; an incidence that reflects nothing is sampled uniformly
   // (an all-zero slice cannot be normalized by the renderers).
   const auto first = out.luminance.end() - ns * ns;
@@ -167,6 +234,8 @@ void RglOptions::validate() const {
     throw Error("", "vndf_resolution", "must be 2..512");
   if (sample_resolution < 2 || sample_resolution > 256)
     throw Error("", "sample_resolution", "must be 2..256");
+  if (sample_supersampling < 1 || sample_supersampling > 8)
+    throw Error("", "sample_supersampling", "must be 1..8");
   if (azimuths < 1) throw Error("", "azimuths", "must be at least 1");
 }
 

@@ -78,4 +78,42 @@ inline TabulatedBsdfTable fabric_rgb(int resolution = 8) {
       2, 1);
 }
 
+// A woven cloth made the way the paper's summation makes one (fabric_summation.h, kPaper: half a
+// fiber along the warp, x, and half along the weft, y, each seen on its top), from a fiber with
+// the lobes of a dyed fiber table: a white specular cone around the mirror of the light's angle
+// to the fiber axis (sin theta_o = -sin theta_i, 4 deg wide), a red forward lobe on that cone
+// (light through the fiber, towards the far side) and a dim diffuse term. What makes a baked
+// fabric table hard to export and the Lambertian and fabric_rgb tables easy: it is anisotropic
+// (the two fiber axes; the export averages rotations), its light at grazing views is a narrow
+// forward lobe (a curved value between the export's sample points), and at R = 8 its cone is
+// resolved only by the table's kinked interpolation between bins.
+inline void woven_reflection(const Vec3& wo, const Vec3& wi, std::span<double> v) {
+  constexpr double kWidth = 0.07, kDiffuse[3] = {0.02, 0.01, 0.015};
+  for (int c = 0; c < 3; ++c) v[static_cast<size_t>(c)] = kDiffuse[c] / kPi;
+  for (const Vec3 t : {Vec3{1, 0, 0}, Vec3{0, 1, 0}}) {
+    const double si = dot(wi, t), so = dot(wo, t);
+    const double cone =
+        std::exp(-sqr(si + so) / (2 * sqr(kWidth))) / (kWidth * std::sqrt(2 * kPi) * 2 * kPi);
+    const Vec3 pi = wi - si * t, po = wo - so * t;  // the directions across the fiber
+    const double across = dot(pi, po) / std::sqrt(std::max(1e-12, dot(pi, pi) * dot(po, po)));
+    const double forward =
+        std::pow((1 - across) / 2, 4);  // 1 with light and view on opposite sides
+    v[0] += 0.5 * cone * (0.04 + forward);
+    v[1] += 0.5 * cone * (0.04 + 0.02 * forward);
+    v[2] += 0.5 * cone * (0.04 + 0.03 * forward);
+  }
+}
+inline TabulatedBsdfTable woven_rgb(int resolution = 8) {
+  return TabulatedBsdfTable::from_function(
+      resolution, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        if (wo.z <= 0 || wi.z <= 0) {
+          v[0] = v[1] = v[2] = 0;
+          return;
+        }
+        woven_reflection(wo, wi, v);
+      },
+      2, 1);
+}
+
 }  // namespace weft::testing

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <iostream>
 #include <map>
 #include <set>
@@ -85,8 +86,9 @@ TEST(RglBsdf, LambertianEvaluatesToRhoOverPiTimesCosine) {
     for (int c = 0; c < 3; ++c) rel.push_back(std::abs(e.eval(v, l, c) / (rho[c] / kPi * l.z) - 1));
   }
   std::sort(rel.begin(), rel.end());
-  // The interpolation error of the 48 x 48 sample grid and 21 incidence angles: measured median
-  // 0.24 %, 95th percentile 1.3 % (the largest, 35 %, at grazing light and view).
+  // The interpolation error of the 48 x 48 sample grid and the incidence angles: measured median
+  // 0.24 %, 95th percentile 1.3 % (the largest, 35 %, at grazing light and view) with 21 angles
+  // spaced as the paper spaces them and point values.
   EXPECT_LT(rel[rel.size() / 2], 0.01);
   EXPECT_LT(rel[rel.size() * 95 / 100], 0.05);
 }
@@ -147,72 +149,113 @@ TEST(RglBsdf, LobeTableAlbedoMatchesTheTable) {
   }
 }
 
-// The export's target: the table's f cos theta_light averaged over the 16 rotations 2 pi k / 16
-// of both directions about the normal (rgl_bsdf.h), from the table's own interpolation.
-double table_f_cos(const TabulatedBsdfTable& t, const Vec3& v, const Vec3& l, int c) {
-  std::vector<double> f(static_cast<size_t>(t.channels));
-  double sum = 0;
-  for (int k = 0; k < 16; ++k) {
-    const double a = 2 * kPi * k / 16, ca = std::cos(a), sa = std::sin(a);
+// The export's target: the table's f cos theta_light per channel, from the table's own
+// interpolation (TabulatedBsdfTable::interpolate, what Weft's renderer evaluates), averaged over
+// 64 rotations 2 pi k / 64 of both directions about the normal: the file is isotropic
+// (rgl_bsdf.h), and the directions drawn here have any azimuth, so this stands for the table's
+// mean over all rotations.
+std::vector<double> table_f_cos(const TabulatedBsdfTable& t, const Vec3& v, const Vec3& l) {
+  constexpr int kTurns = 64;
+  std::vector<double> f(static_cast<size_t>(t.channels)), sum(f.size(), 0.0);
+  for (int k = 0; k < kTurns; ++k) {
+    const double a = 2 * kPi * k / kTurns, ca = std::cos(a), sa = std::sin(a);
     auto turn = [&](const Vec3& w) { return Vec3{ca * w.x - sa * w.y, sa * w.x + ca * w.y, w.z}; };
     t.interpolate(turn(v), turn(l), f);
-    sum += f[static_cast<size_t>(c)];
+    for (size_t c = 0; c < f.size(); ++c) sum[c] += f[c];
   }
-  return sum / 16 * l.z;
+  for (double& x : sum) x *= l.z / kTurns;
+  return sum;
 }
+
+// Relative errors of the export against the table, with a floor under the reference: a value
+// below 2 % of its channel's mean (a dye's near-black channel, the table's noise floor) is
+// judged against that 2 % instead, as a renderer's eye judges it (an absolute error of 0.02 of
+// the channel's mean), so that the ratio of two tiny numbers does not stand for the file.
+struct ErrorSet {
+  std::vector<double> rel;
+  void add(double got, double ref, double channel_mean) {
+    rel.push_back(std::abs(got - ref) / std::max(ref, 0.02 * channel_mean));
+  }
+  double p95() {
+    std::sort(rel.begin(), rel.end());
+    return rel.empty() ? 0 : rel[rel.size() * 95 / 100];
+  }
+};
 
 struct GrazingFigures {
   double p95 = 0;                           // relative error of f cos over directions to 85 deg
   double p95_beyond = 0, worst_beyond = 0;  // views at 85 .. 89.5 deg, lights to 89.5 deg
-  double retro85 = 0;               // relative error of the back-scatter, view and light at 85 deg
-  std::map<double, double> albedo;  // relative error of the albedo per view angle (deg)
+  double retro85 = 0;  // relative error of the back-scatter, view and light at 85 deg (channel 0)
+  std::map<double, double> p95_at;  // per view angle (deg): p95 over lights to 85 deg
+  std::map<double, double> albedo;  // relative error of the albedo per view angle (deg), worst
 };
 
-// Views and lights to 85 deg (cos theta uniform), and the albedo towards views at 0 .. 89.5 deg,
-// each against the table (table_f_cos, the same 64 x 128 rule).
+// A direction with cos theta uniform down to 'theta_max' and a uniform azimuth.
+Vec3 random_direction(Rng& rng, double theta_max) {
+  const double span = 1 - std::cos(theta_max);
+  return spherical_direction(std::acos(1 - span * rng.uniform()), 2 * kPi * rng.uniform());
+}
+
+// The albedo towards 'v' per channel, int f cos d omega_light by the midpoint rule in
+// (cos theta, phi), 64 x 128 points, of the export (got) and of the table (ref).
+void albedo_pair(const TabulatedBsdfTable& t, const RglEvaluator& e, const Vec3& v,
+                 std::vector<double>& got, std::vector<double>& ref) {
+  got.assign(static_cast<size_t>(t.channels), 0.0);
+  ref = got;
+  for (int a = 0; a < 64; ++a)
+    for (int b = 0; b < 128; ++b) {
+      const Vec3 l = spherical_direction(std::acos((a + 0.5) / 64), 2 * kPi * (b + 0.5) / 128);
+      const auto r = table_f_cos(t, v, l);
+      for (int c = 0; c < t.channels; ++c) {
+        ref[static_cast<size_t>(c)] += r[static_cast<size_t>(c)];
+        got[static_cast<size_t>(c)] += e.eval(v, l, c);
+      }
+    }
+}
+
+// Views and lights to 85 deg (cos theta uniform), views at fixed angles with lights to 85 deg,
+// views beyond 85 deg, and the albedo towards views at 0 .. 89.5 deg, each against the table
+// (table_f_cos). The error floor's channel means: the mean of f cos at normal view.
 GrazingFigures grazing_figures(const TabulatedBsdfTable& t, const RglEvaluator& e) {
   GrazingFigures g;
+  const auto nc = static_cast<size_t>(t.channels);
+  std::vector<double> got, normal;  // the albedo sums at normal view
+  albedo_pair(t, e, {0, 0, 1}, got, normal);
+  std::vector<double> mean = normal;
+  for (double& m : mean) m /= 64 * 128;  // the mean of f cos over the grid's directions
   Rng rng(11);
-  std::vector<double> rel;
-  const double span = 1 - std::cos(deg_to_rad(85));
-  for (int n = 0; n < 2000; ++n) {
-    const Vec3 v =
-        spherical_direction(std::acos(1 - span * rng.uniform()), 2 * kPi * rng.uniform());
-    const Vec3 l =
-        spherical_direction(std::acos(1 - span * rng.uniform()), 2 * kPi * rng.uniform());
-    for (int c = 0; c < 3; ++c)
-      rel.push_back(std::abs(e.eval(v, l, c) / table_f_cos(t, v, l, c) - 1));
-  }
-  std::sort(rel.begin(), rel.end());
-  g.p95 = rel[rel.size() * 95 / 100];
-  rel.clear();
-  const double c85 = std::cos(deg_to_rad(85)), c895 = std::cos(deg_to_rad(89.5));
-  for (int n = 0; n < 2000; ++n) {
-    const Vec3 v = spherical_direction(std::acos(c895 + (c85 - c895) * rng.uniform()), 0.0);
-    const Vec3 l =
-        spherical_direction(std::acos(1 - (1 - c895) * rng.uniform()), 2 * kPi * rng.uniform());
-    for (int c = 0; c < 3; ++c) {
-      const double ratio = e.eval(v, l, c) / table_f_cos(t, v, l, c);
-      rel.push_back(std::abs(ratio - 1));
-      g.worst_beyond = std::max({g.worst_beyond, ratio, 1 / ratio});
+  auto errors = [&](auto&& view, double light_max, int pairs, double* worst) {
+    ErrorSet set;
+    for (int n = 0; n < pairs; ++n) {
+      const Vec3 v = view(), l = random_direction(rng, light_max);
+      const auto r = table_f_cos(t, v, l);
+      for (size_t c = 0; c < nc; ++c) {
+        const double x = e.eval(v, l, static_cast<int>(c));
+        set.add(x, r[c], mean[c]);
+        if (worst && r[c] > 0.02 * mean[c]) *worst = std::max({*worst, x / r[c], r[c] / x});
+      }
     }
-  }
-  std::sort(rel.begin(), rel.end());
-  g.p95_beyond = rel[rel.size() * 95 / 100];
-  const Vec3 w85 = spherical_direction(deg_to_rad(85), 0.3);
-  g.retro85 = e.eval(w85, w85, 0) / table_f_cos(t, w85, w85, 0) - 1;
+    return set.p95();
+  };
+  const double d85 = deg_to_rad(85), d895 = deg_to_rad(89.5);
+  g.p95 = errors([&] { return random_direction(rng, d85); }, d85, 2000, nullptr);
+  for (double deg : {0.0, 20.0, 40.0, 60.0, 70.0, 75.0, 80.0, 85.0})
+    g.p95_at[deg] =
+        errors([&] { return spherical_direction(deg_to_rad(deg), 2 * kPi * rng.uniform()); }, d85,
+               400, nullptr);
+  const double c85 = std::cos(d85), c895 = std::cos(d895);
+  g.p95_beyond = errors(
+      [&] { return spherical_direction(std::acos(c895 + (c85 - c895) * rng.uniform()), 0.0); },
+      d895, 2000, &g.worst_beyond);
+  const Vec3 w85 = spherical_direction(d85, 0.3);
+  g.retro85 = e.eval(w85, w85, 0) / table_f_cos(t, w85, w85)[0] - 1;
+  std::vector<double> ref;
   for (double deg : {0.0, 40.0, 70.0, 80.0, 82.5, 85.0, 89.0, 89.5}) {
-    const Vec3 v = spherical_direction(deg_to_rad(deg), 0.3);
+    albedo_pair(t, e, spherical_direction(deg_to_rad(deg), 0.3), got, ref);
     double worst = 0;
-    for (int c = 0; c < 3; ++c) {
-      double ref = 0, got = 0;
-      for (int a = 0; a < 64; ++a)
-        for (int b = 0; b < 128; ++b) {
-          const Vec3 l = spherical_direction(std::acos((a + 0.5) / 64), 2 * kPi * (b + 0.5) / 128);
-          ref += table_f_cos(t, v, l, c);
-          got += e.eval(v, l, c);
-        }
-      const double r = got / ref - 1;
+    for (size_t c = 0; c < nc; ++c) {
+      if (!(ref[c] > 0.02 * normal[c])) continue;  // a near-black channel, as above
+      const double r = got[c] / ref[c] - 1;
       if (std::abs(r) > std::abs(worst)) worst = r;
     }
     g.albedo[deg] = worst;
@@ -221,9 +264,10 @@ GrazingFigures grazing_figures(const TabulatedBsdfTable& t, const RglEvaluator& 
 }
 
 void print_figures(const std::string& name, const GrazingFigures& g) {
-  std::cout << name << ": p95 to 85 deg " << 100 * g.p95 << " %; views 85-89.5 deg: p95 "
-            << 100 * g.p95_beyond << " %, worst factor " << g.worst_beyond
-            << "; back-scatter at 85 deg " << 100 * g.retro85 << " %; albedo";
+  std::cout << name << ": p95 to 85 deg " << 100 * g.p95 << " %; per view angle";
+  for (const auto& [deg, p] : g.p95_at) std::cout << " " << deg << " deg " << 100 * p << " %";
+  std::cout << "; views 85-89.5 deg: p95 " << 100 * g.p95_beyond << " %, worst factor "
+            << g.worst_beyond << "; back-scatter at 85 deg " << 100 * g.retro85 << " %; albedo";
   for (const auto& [deg, r] : g.albedo) std::cout << " " << deg << " deg " << 100 * r << " %";
   std::cout << "\n";
 }
@@ -231,9 +275,11 @@ void print_figures(const std::string& name, const GrazingFigures& g) {
 TEST(RglBsdf, LambertianAndFabricHoldTo85Degrees) {
   // Against the table itself (table_f_cos): p95 of the relative error of f cos over views and
   // lights to 85 deg at most 5 %, the albedo per view angle to 85 deg within 2 %. Measured:
-  // p95 1.9 % (Lambertian) and 3.7 % (fabric), albedo within 0.6 % to 89.5 deg; the writer with
-  // the paper's NDF estimate alone, 17 incidences and 32 x 32 samples gave p95 10 % and albedo
-  // -3 % at 80 deg, -16 % at 85 deg, -27 % at 89.5 deg. Beyond 85 deg: printed, not asserted.
+  // p95 0.8 % (Lambertian) and 1.4 % (fabric), albedo within 0.1 % to 89.5 deg (with 16
+  // rotations, 21 incidences spaced as the paper spaces them and point values: 1.9 % and 3.4 %,
+  // albedo within 0.6 %); the writer with the paper's NDF estimate alone, 17 incidences and
+  // 32 x 32 samples gave p95 10 % and albedo -3 % at 80 deg, -16 % at 85 deg, -27 % at 89.5 deg.
+  // Beyond 85 deg: printed, not asserted.
   for (const auto& [name, table] : {std::pair{std::string("lambert"), testing::lambert_rgb()},
                                     std::pair{std::string("fabric"), testing::fabric_rgb()}}) {
     const RglEvaluator e(export_and_read(table, name + ".bsdf"));
@@ -245,6 +291,38 @@ TEST(RglBsdf, LambertianAndFabricHoldTo85Degrees) {
       EXPECT_LE(std::abs(r), 0.02) << name << " " << deg << " deg";
     }
   }
+}
+
+TEST(RglBsdf, WovenClothHoldsTo85Degrees) {
+  // The same bounds on a table with a baked fabric's features (exchange_tables.h, woven_rgb),
+  // against the table's own interpolation averaged over rotations (table_f_cos), the file read
+  // as Mitsuba 3's `measured` reads it (rgl_reader.h). Its export's errors grew with the view
+  // angle as the baked red-cotton table's did (docs/exchange.md): p95 8.4 % (the baked table
+  // 8.7 %), 11 % at 75 deg; albedo -1.5 % at 85 deg (the baked table -3.7 %) with 16 rotations,
+  // 21 incidences spaced as the paper spaces them and point values. Measured now: p95 1.1 %, at
+  // most 1.6 % per view angle, albedo within 0.4 % to 85 deg.
+  const auto table = testing::woven_rgb();
+  const RglEvaluator e(export_and_read(table, "woven.bsdf"));
+  const GrazingFigures g = grazing_figures(table, e);
+  print_figures("woven", g);
+  EXPECT_LE(g.p95, 0.05);
+  for (const auto& [deg, p] : g.p95_at)
+    if (deg <= 85) EXPECT_LE(p, 0.05) << deg << " deg";
+  for (const auto& [deg, r] : g.albedo)
+    if (deg <= 85) EXPECT_LE(std::abs(r), 0.02) << deg << " deg";
+}
+
+// The same figures for any table file, printed (docs/exchange.md's figures for a baked fabric):
+// WEFT_RGL_TABLE=TABLE.exr build/tests/weft_tests_exchange --gtest_filter='*TableFile*'.
+TEST(RglBsdf, FiguresForATableFile) {
+  const char* path = std::getenv("WEFT_RGL_TABLE");
+  if (!path) GTEST_SKIP() << "set WEFT_RGL_TABLE=TABLE.exr to measure that table's export";
+  const auto table = TabulatedBsdfTable::read_exr(path);
+  const auto file = testing::fresh_test_dir() / "file.bsdf";
+  export_table(table, file, {});
+  std::cout << file << ": " << std::filesystem::file_size(file) << " bytes\n";
+  const RglEvaluator e(testing::read_rgl(file));
+  print_figures(path, grazing_figures(table, e));
 }
 
 TEST(RglBsdf, BadExtensionNamesTheFileAndField) {
