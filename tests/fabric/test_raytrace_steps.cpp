@@ -336,7 +336,8 @@ TEST(RaytraceSteps, ScatteringWeightsAChannelByItsAlbedoWhateverTheHero) {
 TEST(RaytraceSteps, ASpectralTablesStrategiesAreThirdsOfItsBands) {
   // Seven bands: groups of three adjacent bands (the last of one), each drawn in proportion to
   // its bands' mean; an RGB table keeps a strategy per channel (the test above).
-  const auto t = cell_table([](int i, int o, int c) { return 0.01 * (1 + c) * (1 + (i + o) % 3); }, 7);
+  const auto t =
+      cell_table([](int i, int o, int c) { return 0.01 * (1 + c) * (1 + (i + o) % 3); }, 7);
   const FiberSampler fs(t);
   EXPECT_EQ(fs.groups, 3);
   EXPECT_EQ(fs.strategies, 4);

@@ -32,7 +32,7 @@ VerifySettings verify_settings(VerifyQuality q) {
   static const VerifySettings kDefault{.quality = VerifyQuality::kDefault,
                                        .resolution = 8,
                                        .fiber_photons_per_band = 50000,
-                                       .particles_per_bin = 64000,
+                                       .particles_per_bin = 16000,
                                        .batches = 4,
                                        .summation_samples = 8,
                                        .render_size = 128,

@@ -26,9 +26,9 @@ inline constexpr int kChannelGroups = 3;
 struct FiberSampler {
   const TabulatedBsdfTable* table = nullptr;
   DirectionGrid grid;
-  int groups = 0;        // channel groups, one strategy each (the MIS strategies)
-  int strategies = 0;    // groups + 1 (all channels' mean)
-  int group_size = 1;    // channels per group (the last may have fewer)
+  int groups = 0;      // channel groups, one strategy each (the MIS strategies)
+  int strategies = 0;  // groups + 1 (all channels' mean)
+  int group_size = 1;  // channels per group (the last may have fewer)
   std::vector<double> areas, max_cos;
   std::vector<double> albedo;        // [i * strategies + s]
   std::vector<Distribution1D> rows;  // [i * strategies + s]
