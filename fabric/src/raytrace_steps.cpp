@@ -139,8 +139,18 @@ SceneDescription tiled_geometry(const WovenSample& sample) {
     throw Error("", "detail",
                 "the ray-traced estimator needs the sample's geometry (fibers or yarn tubes); "
                 "this sample has none");
-  // Instanced: the neighbours of a yarn-detail repeat cost no memory of their own.
-  SceneDescription d = tiled_woven_description(sample, 1, 1, "woven sample", true);
+  // Instanced: the neighbours of a yarn-detail repeat cost no memory of their own. Nor does the
+  // repeat: the description holds the sample's own meshes, not the copies tiled_woven_description
+  // makes (5e7 triangles of yarn tubes are 2.4 GB, seconds of copying that no poll could stop),
+  // so it and any scene built from it must not outlive 'sample'. The placement is that of
+  // tiled_woven_description, given empty meshes in their stead.
+  WovenSample placement;
+  placement.summary = sample.summary;
+  placement.meshes.resize(sample.meshes.size());
+  SceneDescription d = tiled_woven_description(sample.meshes.empty() ? sample : placement, 1, 1,
+                                               "woven sample", true);
+  for (size_t m = 0; m < sample.meshes.size(); ++m)
+    d.meshes[m] = std::shared_ptr<const TriangleMesh>(std::shared_ptr<void>(), &sample.meshes[m]);
   MaterialBinding any;
   any.type = "lambert";
   any.field = "fabric estimator";

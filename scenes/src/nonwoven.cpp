@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
+#include <string_view>
 
 #include "weave_internal.h"
 #include "weft/core/clock.h"
@@ -221,7 +223,11 @@ std::optional<double> free_height(const Mat& m, const std::vector<Fiber>& placed
   return gaps.back().second;
 }
 
-std::vector<Fiber> place_fibers(const Mat& m, const std::string& thickness_field, int& attempts) {
+// Each placement looks at every fiber placed before, so the largest mat (20 000 fibers) takes tens
+// of seconds: 'keep_going' (fibers placed, fibers in all) is asked before every placement drawn,
+// at most a few milliseconds apart. When it says stop, the fibers placed so far are returned.
+std::vector<Fiber> place_fibers(const Mat& m, const std::string& thickness_field, int& attempts,
+                                const std::function<bool(uint64_t, uint64_t)>& keep_going) {
   std::vector<Fiber> placed;
   placed.reserve(m.fibers);
   Rng rng(m.seed, 0x6e6f6e776f76656eULL);  // "nonwoven"
@@ -229,6 +235,7 @@ std::vector<Fiber> place_fibers(const Mat& m, const std::string& thickness_field
   while (static_cast<int>(placed.size()) < m.fibers) {
     int tries = 0;
     for (;; ++tries) {
+      if (!keep_going(placed.size(), uint64_t(m.fibers))) return placed;
       if (tries == kMaxTriesPerFiber)
         bad(thickness_field,
             "the mat does not fit: no free place for fiber " + std::to_string(placed.size() + 1) +
@@ -285,7 +292,10 @@ FiberCurves cut_into_tile(const Mat& m, const std::vector<Fiber>& fibers) {
 }
 
 // The counts and the measured closest approach; the mat refused when fibers interpenetrate.
-void summarise(const Mat& m, int attempts, WovenSample& s) {
+// 'keep_going' is asked between slices of the distance search (min_fiber_distance); when it says
+// stop, the measurement is left unfinished and unchecked.
+void summarise(const Mat& m, int attempts, WovenSample& s,
+               const std::function<bool(uint64_t, uint64_t)>& keep_going) {
   WeaveSummary& w = s.summary;
   const FiberCurves& f = s.fibers;
   w.source = kNonwovenPattern;
@@ -316,7 +326,8 @@ void summarise(const Mat& m, int attempts, WovenSample& s) {
   n.attempts = attempts;
   n.seed = m.seed;
   w.nonwoven = n;
-  const double d = min_fiber_distance(f, tile_m, tile_m, 4 * r_m);
+  const double d = min_fiber_distance(f, tile_m, tile_m, 4 * r_m, keep_going);
+  if (s.cancelled) return;
   w.min_fiber_distance_um = d * 1e6;
   if (d < 2 * r_m * (1 - 1e-2))
     bad("thickness-mm", "fibers would interpenetrate: closest centre lines " +
@@ -325,15 +336,24 @@ void summarise(const Mat& m, int attempts, WovenSample& s) {
 
 }  // namespace
 
-WovenSample make_nonwoven_sample(const WeaveOptions& options) {
+WovenSample make_nonwoven_sample(const WeaveOptions& options, const ProgressCallback& progress) {
   const auto t0 = std::chrono::steady_clock::now();
   const Mat m = resolve_mat(options);
-  int attempts = 0;
-  const std::vector<Fiber> fibers =
-      place_fibers(m, options.solidity ? "solidity" : "thickness-mm", attempts);
   WovenSample s;
+  // Once the callback says stop, every later ask says so too and the sample is left partial.
+  auto asker = [&](std::string_view stage, std::string_view unit) {
+    return [&s, &progress, stage, unit](uint64_t done, uint64_t total) {
+      s.cancelled = s.cancelled || !progress({stage, done, total, unit});
+      return !s.cancelled;
+    };
+  };
+  int attempts = 0;
+  const std::vector<Fiber> fibers = place_fibers(m, options.solidity ? "solidity" : "thickness-mm",
+                                                 attempts, asker("nonwoven sample", "fibers"));
+  if (s.cancelled) return s;
   s.fibers = cut_into_tile(m, fibers);
-  summarise(m, attempts, s);
+  summarise(m, attempts, s, asker("fiber distances", "cells"));
+  if (s.cancelled) return s;
   s.summary.seconds = seconds_since(t0);
   return s;
 }

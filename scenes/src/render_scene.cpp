@@ -230,7 +230,8 @@ class RenderScene::Builder {
   // The binding of material 'key' on 'shape': the options' override where its mask says so.
   const MaterialBinding& binding(size_t shape, const std::string& key) const;
   // An Embree triangle geometry holding a copy of the mesh's vertices and triangles.
-  RTCGeometry triangle_geometry(const TriangleMesh& m) const;
+  RTCGeometry triangle_geometry(const TriangleMesh& m);        // nullptr when stopped
+  bool copy_polled(void* to, const void* from, size_t bytes);  // false when stopped
   void start_curve_sets();  // the fiber geometry, checks and the curve scene
   void add_curve_set(size_t k);
   RTCGeometry tube_geometry(CurveRecord& rec);
@@ -321,15 +322,30 @@ void RenderScene::Builder::allocation_failed(RTCGeometry g) const {
   throw Error(desc_.source, "", "Embree could not allocate buffers: " + geo_->errors.message);
 }
 
-RTCGeometry RenderScene::Builder::triangle_geometry(const TriangleMesh& m) const {
+bool RenderScene::Builder::copy_polled(void* to, const void* from, size_t bytes) {
+  // 64 MB: tens of milliseconds on a loaded machine, the new pages' faults included.
+  constexpr size_t kSlice = size_t{64} << 20;
+  for (size_t at = 0; at < bytes; at += kSlice) {
+    if (!keep_going()) return false;
+    std::memcpy(static_cast<char*>(to) + at, static_cast<const char*>(from) + at,
+                std::min(kSlice, bytes - at));
+  }
+  return true;
+}
+
+RTCGeometry RenderScene::Builder::triangle_geometry(const TriangleMesh& m) {
   RTCGeometry g = rtcNewGeometry(geo_->device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* vb = static_cast<float*>(rtcSetNewGeometryBuffer(
       g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float), m.vertex_count()));
   auto* ib = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
       g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, 3 * sizeof(uint32_t), m.triangle_count()));
   if (!vb || !ib) allocation_failed(g);
-  std::memcpy(vb, m.positions.data(), m.positions.size() * sizeof(float));
-  std::memcpy(ib, m.indices.data(), m.indices.size() * sizeof(uint32_t));
+  // A yarn sample's mesh is over a gigabyte: copied with polls, so that a stop need not wait.
+  if (!copy_polled(vb, m.positions.data(), m.positions.size() * sizeof(float)) ||
+      !copy_polled(ib, m.indices.data(), m.indices.size() * sizeof(uint32_t))) {
+    rtcReleaseGeometry(g);
+    return nullptr;
+  }
   return g;
 }
 
@@ -340,28 +356,30 @@ void RenderScene::Builder::add_meshes() {
     rtcSetSceneBuildQuality(geo_->mesh_scene, RTC_BUILD_QUALITY_HIGH);
     monitor(geo_->mesh_scene);
   }
-  for (size_t i = 0; i < desc_.meshes.size(); ++i) {
+  // A yarn sample's two meshes hold up to 5e7 triangles: between meshes and within each step on
+  // a mesh's vertices, the build asks whether to go on, and once stopped it adds nothing more.
+  for (size_t i = 0; i < desc_.meshes.size() && keep_going(); ++i) {
     const auto& mesh = desc_.meshes[i];
     const MaterialBinding& b = binding(i, mesh->material);
     Geometry::MeshRecord rec;
     rec.mesh = mesh;
-    rec.unit_normals = unit_vertex_normals(*mesh);
+    rec.unit_normals = unit_vertex_normals(*mesh, [this] { return keep_going(); });
+    if (monitor_.stop) return;
     rec.bsdf = bsdf_index(b);
     const auto info = desc_.gltf_materials.find(mesh->material);
     const GltfMaterialInfo gl =
         info != desc_.gltf_materials.end() ? info->second : GltfMaterialInfo{};
     emission_.push_back({b.emission ? *b.emission : gl.emission,
                          b.double_sided ? *b.double_sided : gl.double_sided});
-    geo_->meshes.push_back(rec);
-    if (desc_.mesh_shifts.empty()) geo_->bounds.expand(mesh->bounds());
-    for (const Vec3& s : desc_.mesh_shifts) {
-      const Bounds3 b = mesh->bounds();
-      geo_->bounds.expand(Bounds3{b.lo + s, b.hi + s});
-    }
+    geo_->meshes.push_back(std::move(rec));
+    const Bounds3 mb = mesh->bounds();  // once: a pass over every vertex
+    if (desc_.mesh_shifts.empty()) geo_->bounds.expand(mb);
+    for (const Vec3& s : desc_.mesh_shifts) geo_->bounds.expand(Bounds3{mb.lo + s, mb.hi + s});
     // Geometry IDs equal mesh indices; an empty mesh simply has no Embree geometry.
     if (mesh->vertex_count() == 0 || mesh->triangle_count() == 0) continue;
 
     RTCGeometry g = triangle_geometry(*mesh);
+    if (!g) return;
     rtcCommitGeometry(g);
     rtcAttachGeometryByID(geo_->mesh_scene ? geo_->mesh_scene : geo_->scene, g,
                           static_cast<unsigned>(i));
@@ -371,7 +389,7 @@ void RenderScene::Builder::add_meshes() {
 }
 
 void RenderScene::Builder::instance_meshes() {
-  if (!geo_->mesh_scene) return;
+  if (!geo_->mesh_scene || monitor_.stop) return;
   for (size_t i = 0; i < emission_.size(); ++i)
     if (!emission_[i].radiance.is_black())
       throw Error(desc_.source, "mesh_shifts",
@@ -443,6 +461,7 @@ void RenderScene::Builder::add_curve_set(size_t k) {
   if (curves->curve_count() == 0) return;
 
   RTCGeometry g = tubes_ ? tube_geometry(rec) : round_curve_geometry(rec, k);
+  if (!g) return;  // stopped (triangle_geometry)
   rtcSetGeometryUserData(g, &rec);
   rtcSetGeometryIntersectFilterFunction(g, fiber_filter);
   rtcSetGeometryOccludedFilterFunction(g, fiber_filter);
@@ -462,6 +481,7 @@ RTCGeometry RenderScene::Builder::tube_geometry(CurveRecord& rec) {
   for (size_t i = 0; i < t->triangle_segment.size(); ++i)
     rec.prim_curve[i] = rec.segments.curve[t->triangle_segment[i]];
   RTCGeometry g = triangle_geometry(t->mesh);
+  if (!g) return nullptr;
   geo_->triangles += t->mesh.triangle_count();
   rec.tube_unit_normals = unit_vertex_normals(t->mesh);
   rec.tubes = std::move(t);

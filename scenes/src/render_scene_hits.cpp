@@ -22,9 +22,11 @@ Vec3 vertex(const TriangleMesh& m, uint32_t i, const Vec3* shift) {
 
 // The mesh's vertex normals made unit in double precision (zero where a normal is degenerate),
 // once per scene: every hit's shadow-terminator lift reads three of them.
-std::vector<Vec3> unit_vertex_normals(const TriangleMesh& m) {
+std::vector<Vec3> unit_vertex_normals(const TriangleMesh& m,
+                                      const std::function<bool()>& keep_going) {
   std::vector<Vec3> out(m.normals.size() / 3);
   for (size_t v = 0; v < out.size(); ++v) {
+    if (keep_going && v % kUnitNormalsPerPoll == 0 && !keep_going()) return out;
     const Vec3 nk{m.normals[3 * v], m.normals[3 * v + 1], m.normals[3 * v + 2]};
     const double nlen = length(nk);
     if (nlen > 1e-12) out[v] = nk / nlen;

@@ -1,6 +1,8 @@
 #pragma once
 // The surface at a RenderScene hit (render_scene.cpp's queries fill SurfaceHit with these).
+#include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "weft/scenes/render_scene.h"
@@ -9,7 +11,11 @@ namespace weft {
 
 // The mesh's vertex normals made unit in double precision (zero where a normal is degenerate),
 // once per scene: every hit's shadow-terminator lift reads three of them.
-std::vector<Vec3> unit_vertex_normals(const TriangleMesh& m);
+// A yarn sample's mesh has tens of millions of vertices: 'keep_going', when given, is asked every
+// kUnitNormalsPerPoll of them (a few milliseconds); once it says stop, the rest are left zero.
+inline constexpr size_t kUnitNormalsPerPoll = size_t{1} << 20;
+std::vector<Vec3> unit_vertex_normals(const TriangleMesh& m,
+                                      const std::function<bool()>& keep_going = {});
 
 // Fills the hit on triangle 'prim' of 'm' (whose unit_vertex_normals are 'unit_normals'), moved
 // by 'shift' (null: in place), at barycentrics (b1, b2).

@@ -414,15 +414,23 @@ struct TubeVertex {
   Vec3 p, n, t;
   double w = 1, u = 0, v = 0;
 };
-void append_tube(TriangleMesh& m, int K, int M,
-                 const std::function<TubeVertex(int k, int j)>& vertex) {
+// A tube of the largest sample holds a good part of its 5e7 triangles (one yarn of 1000 repeats),
+// so 'keep_going' (given the rings made) is asked between rings, about every 64 k vertices: a few
+// milliseconds of work. Each ring's triangles follow it, so a stop leaves whole rings; the order
+// of vertices and triangles is the same either way. Returns false when stopped.
+constexpr int kTubeVerticesPerPoll = 1 << 16;
+bool append_tube(TriangleMesh& m, int K, int M,
+                 const std::function<TubeVertex(int k, int j)>& vertex,
+                 const std::function<bool(int rings)>& keep_going = {}) {
   auto push3 = [](std::vector<float>& v, const Vec3& p) {
     v.push_back(static_cast<float>(p.x));
     v.push_back(static_cast<float>(p.y));
     v.push_back(static_cast<float>(p.z));
   };
   const auto base = static_cast<uint32_t>(m.vertex_count());
-  for (int k = 0; k <= K; ++k)
+  const int rings_per_poll = std::max(1, kTubeVerticesPerPoll / (M + 1));
+  for (int k = 0; k <= K; ++k) {
+    if (keep_going && k % rings_per_poll == 0 && !keep_going(k)) return false;
     for (int j = 0; j <= M; ++j) {
       const TubeVertex v = vertex(k, j);
       push3(m.positions, v.p);
@@ -432,21 +440,24 @@ void append_tube(TriangleMesh& m, int K, int M,
       m.uvs.push_back(static_cast<float>(v.u));
       m.uvs.push_back(static_cast<float>(v.v));
     }
-  for (int k = 0; k < K; ++k)
-    for (int j = 0; j < M; ++j) {
-      const uint32_t a = base + k * (M + 1) + j, b = a + (M + 1), c = b + 1, d = a + 1;
+    if (k == 0) continue;
+    for (int j = 0; j < M; ++j) {  // the quads between ring k - 1 and ring k
+      const uint32_t a = base + (k - 1) * (M + 1) + j, b = a + (M + 1), c = b + 1, d = a + 1;
       m.indices.insert(m.indices.end(), {a, d, b, b, d, c});
     }
+  }
+  return true;
 }
 
 // A yarn of the woven sample as a closed lens tube. Angles run clockwise seen along the yarn
 // (phi = -2 pi (j + 1/2) / M) so that dP/dv x dP/du points outwards; no vertex sits on a lens
 // tip, so the polygon is inscribed in the (convex) lens.
-void append_yarn_tube(TriangleMesh& m, const YarnPath& y, int segments_per_crossing, int M) {
+bool append_yarn_tube(TriangleMesh& m, const YarnPath& y, int segments_per_crossing, int M,
+                      const std::function<bool(int rings)>& keep_going) {
   const int K = static_cast<int>(y.crossing.size()) * segments_per_crossing;
   const double w = y.size.width_mm, t = y.size.thickness_mm;
   const Vec3 up{0, 1, 0};
-  append_tube(m, K, M, [&](int k, int j) {
+  const auto vertex = [&](int k, int j) {
     const double s = y.start + y.period * (k % K) / K;  // ring K repeats ring 0, shifted
     const double shift = k == K ? y.period : 0;
     double slope = 0;
@@ -473,7 +484,8 @@ void append_yarn_tube(TriangleMesh& m, const YarnPath& y, int segments_per_cross
     v.u = double(k) / K;
     v.v = double(j) / M;
     return v;
-  });
+  };
+  return append_tube(m, K, M, vertex, keep_going);
 }
 
 void check_legacy(const WeaveParams& p) {
@@ -618,8 +630,55 @@ WovenSampleSize woven_sample_size(const WeaveOptions& options) {
   return z;
 }
 
+namespace {
+
+// Yarn detail: the warp and weft meshes into out.meshes, every yarn a tube (append_yarn_tube).
+// The largest sample (5e7 triangles) takes tens of seconds, so 'progress' is told the vertices
+// made and asked whether to go on every few milliseconds of work; false when it said stop (then
+// out.cancelled, the meshes partial).
+bool add_yarn_tubes(const Layout& L, WovenSample& out, const ProgressCallback& progress) {
+  TriangleMesh warp, weft;
+  warp.material = "warp";
+  warp.names = {"warp", "patch"};
+  weft.material = "weft";
+  weft.names = {"weft", "patch"};
+  const uint64_t ring = uint64_t(L.sides) + 1;
+  // Reserved whole: a vector of a gigabyte that grew would copy itself between two polls.
+  std::array<uint64_t, 2> vertices{}, quads{};  // warp, weft
+  for (const YarnPath& y : L.yarns) {
+    const uint64_t K = y.crossing.size() * L.segments_per_crossing;
+    vertices[y.warp ? 0 : 1] += (K + 1) * ring;
+    quads[y.warp ? 0 : 1] += K * L.sides;
+  }
+  const uint64_t total = vertices[0] + vertices[1];
+  uint64_t before = 0;  // vertices of the tubes made
+  for (int i = 0; i < 2; ++i) {
+    TriangleMesh& m = i == 0 ? warp : weft;
+    m.positions.reserve(3 * vertices[i]);
+    m.normals.reserve(3 * vertices[i]);
+    m.tangents.reserve(4 * vertices[i]);
+    m.uvs.reserve(2 * vertices[i]);
+    m.indices.reserve(6 * quads[i]);
+  }
+  for (const YarnPath& y : L.yarns) {
+    const auto keep_going = [&](int rings) {
+      return progress({"woven sample", before + uint64_t(rings) * ring, total, "vertices"});
+    };
+    if (!append_yarn_tube(y.warp ? warp : weft, y, L.segments_per_crossing, L.sides, keep_going)) {
+      out.cancelled = true;
+      return false;
+    }
+    before += (y.crossing.size() * L.segments_per_crossing + 1) * ring;
+  }
+  out.meshes.push_back(std::move(warp));
+  out.meshes.push_back(std::move(weft));
+  return true;
+}
+
+}  // namespace
+
 WovenSample make_woven_sample(const WeaveOptions& options, const ProgressCallback& progress) {
-  if (options.pattern == kNonwovenPattern) return make_nonwoven_sample(options);
+  if (options.pattern == kNonwovenPattern) return make_nonwoven_sample(options, progress);
   const auto t0 = std::chrono::steady_clock::now();
   Resolved r = resolve(options);
   const Layout& L = r.layout;
@@ -646,22 +705,14 @@ WovenSample make_woven_sample(const WeaveOptions& options, const ProgressCallbac
   }
   double ylo = 1e300, yhi = -1e300;
   if (!r.fiber_detail) {
-    TriangleMesh warp, weft;
-    warp.material = "warp";
-    warp.names = {"warp", "patch"};
-    weft.material = "weft";
-    weft.names = {"weft", "patch"};
-    for (const YarnPath& y : L.yarns)
-      append_yarn_tube(y.warp ? warp : weft, y, L.segments_per_crossing, L.sides);
-    for (const TriangleMesh* m : {&warp, &weft}) {
-      s.triangles += m->triangle_count();
-      s.vertices += m->vertex_count();
-      const Bounds3 b = m->bounds();
+    if (!add_yarn_tubes(L, out, progress)) return out;
+    for (const TriangleMesh& m : out.meshes) {
+      s.triangles += m.triangle_count();
+      s.vertices += m.vertex_count();
+      const Bounds3 b = m.bounds();
       ylo = std::min(ylo, b.lo.y);
       yhi = std::max(yhi, b.hi.y);
     }
-    out.meshes.push_back(std::move(warp));
-    out.meshes.push_back(std::move(weft));
   } else {
     const double r_m = r.fibers.radius_mm * kMetresPerMm;
     // Perpendicular sections pack denser, but where the centre line slopes the bundle stands

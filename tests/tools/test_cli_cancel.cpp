@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <span>
 #include <sstream>
 #include <string>
@@ -64,12 +65,13 @@ struct Interrupted {
   double seconds_to_exit = -1;
 };
 
-// Waits for the handler (at most 'wait_s'), lets the command run 'run_s', sends SIGINT and times
-// the exit.
-Interrupted interrupt_after(ChildRun c, double run_s, double wait_s = 120) {
+// Waits for the handler and for 'ready' when given (at most 'wait_s' in all), lets the command
+// run 'run_s', sends SIGINT and times the exit.
+Interrupted interrupt_after(ChildRun c, double run_s, double wait_s = 120,
+                            const std::function<bool()>& ready = nullptr) {
   using Clock = std::chrono::steady_clock;
   const auto give_up = Clock::now() + std::chrono::duration<double>(wait_s);
-  while (!catches_sigint(c.pid) && Clock::now() < give_up)
+  while (!(catches_sigint(c.pid) && (!ready || ready())) && Clock::now() < give_up)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   std::this_thread::sleep_for(std::chrono::duration<double>(run_s));
   const auto t0 = Clock::now();
@@ -142,6 +144,66 @@ TEST(CliCancel, FabricRaytraceStopsSoonWhileMakingALargeSample) {
   expect_cancelled(r, dir, dir / "fabric.exr");
   EXPECT_EQ(WEXITSTATUS(r.status), 130);
   EXPECT_NE(slurp(dir / "stderr").find("bake cancelled"), std::string::npos)
+      << slurp(dir / "stderr");
+}
+
+TEST(CliCancel, FabricRaytraceStopsSoonWhileMakingALargeYarnSample) {
+  // Plain weave tiled 110 x 110 at yarn detail: 4.96e7 triangles, just under the limit of 5e7
+  // (weave.cpp). Making its tubes took 17 s on the shared 2-core machine, unpolled: Ctrl-C 2 s in
+  // once ended the run 36 s later (2026-12-05). Now the tubes poll every 64 k vertices.
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = flat_fiber_table(dir);
+  std::ofstream(dir / "weave.json") << R"({"pattern": "plain", "repeats": [110, 110]})";
+  const auto r = interrupt_after(
+      spawn_weft({"--max-memory-gb", "64", "bake", "fabric", "--method", "raytrace", "--detail",
+                  "yarn", "--weave", "weave.json", "--fiber", fiber.string(), "-R", "1",
+                  "--yes-long", "--quiet", "-o", "fabric.exr"},
+                 dir),
+      2.0);
+  expect_cancelled(r, dir, dir / "fabric.exr");
+  EXPECT_EQ(WEXITSTATUS(r.status), 130);
+  EXPECT_NE(slurp(dir / "stderr").find("bake cancelled"), std::string::npos)
+      << slurp(dir / "stderr");
+}
+
+TEST(CliCancel, VerifyStopsSoonWhileMakingANonwovenMat) {
+  // A mat of 19 000 fibers (the limit is 20 000), each placed against all before it: 15 s to make
+  // on the shared 2-core machine, unpolled, so Ctrl-C 2 s in once ended the run 16 s later
+  // (2026-12-05). verify's plan does not make the mat, so 2 s in is the run's own making.
+  const fs::path dir = fresh_test_dir();
+  std::ofstream(dir / "mat.json") << R"({"pattern": "nonwoven", "tile-mm": 3.7})";
+  const auto r = interrupt_after(spawn_weft({"verify", "--quality", "draft", "--threads", "2",
+                                             "--weave", "mat.json", "--quiet", "-o", "report"},
+                                            dir),
+                                 2.0);
+  expect_cancelled(r, dir, dir / "report");
+  EXPECT_EQ(WEXITSTATUS(r.status), 130);
+  EXPECT_NE(slurp(dir / "stderr").find("verify cancelled"), std::string::npos)
+      << slurp(dir / "stderr");
+}
+
+// Whether weft verify has begun its report: the staging folder beside the output exists
+// (atomic_file.h names it ".tmp-<stem>-...").
+bool report_staging_exists(const fs::path& dir, const std::string& stem) {
+  for (const auto& e : fs::directory_iterator(dir))
+    if (e.path().filename().string().rfind(".tmp-" + stem, 0) == 0) return true;
+  return false;
+}
+
+TEST(CliCancel, VerifyStopsSoonWhileRenderingItsReport) {
+  // The report's renders (the patches and the fiber-level renders) come after every poll of the
+  // run; they did not poll, nor did anything after them: Ctrl-C 0.3 s into the report once let the
+  // renders, previews and plots finish and wrote the whole report, exit 0, 15 s later
+  // (2026-12-05). A draft run is about 12 s before its report; a publication render alone takes
+  // minutes.
+  const fs::path dir = fresh_test_dir();
+  const auto r = interrupt_after(
+      spawn_weft({"verify", "--quality", "draft", "--threads", "2", "--quiet", "-o", "report"},
+                 dir),
+      0.3, 600, [&] { return report_staging_exists(dir, "report"); });
+  expect_cancelled(r, dir, dir / "report");
+  EXPECT_EQ(WEXITSTATUS(r.status), 130);
+  EXPECT_NE(slurp(dir / "stderr").find("verify cancelled"), std::string::npos)
       << slurp(dir / "stderr");
 }
 

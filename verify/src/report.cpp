@@ -106,8 +106,9 @@ void check_verify_output(const std::filesystem::path& dir) {
   }
 }
 
-void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
-                         const std::function<void(const std::filesystem::path&)>& draw) {
+bool write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
+                         const std::function<void(const std::filesystem::path&)>& draw,
+                         const ProgressCallback& progress) {
   namespace fs = std::filesystem;
   check_verify_output(dir);
   std::error_code ec;
@@ -122,7 +123,17 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
     // The renders first, so that metrics.json and index.html describe them and their time.
     VerifyReport r = report;
     const auto t0 = std::chrono::steady_clock::now();
-    r.renders = render_verify_samples(staging, r);
+    // Stopped: the staging folder goes, and with it whatever was written. Asked again after the
+    // renders and the previews, so that a stop between steps does not wait for the plots (their
+    // script runs unpolled, and system() ignores SIGINT meanwhile).
+    bool cancelled = false;
+    const auto stopped = [&](uint64_t step) {
+      cancelled = cancelled || !progress({"report", step, 3, "steps"});
+      if (cancelled) fs::remove_all(staging, ec);
+      return cancelled;
+    };
+    r.renders = render_verify_samples(staging, r, progress, &cancelled);
+    if (stopped(1)) return false;
     for (const auto& v : r.renders) {
       write_exr(staging / (v.stem + ".exr"), v.image);
       write_png_preview(staging / (v.stem + ".png"), v.image, kVerifyRenderExposure);
@@ -131,6 +142,7 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
     const auto t1 = std::chrono::steady_clock::now();
     r.previews = write_verify_previews(staging, r, &r.previews_skipped);
     r.seconds["previews"] = seconds_since(t1);
+    if (stopped(2)) return false;
     write_text_atomically(staging / "inplane.csv", verify_inplane_csv(r));
     write_text_atomically(staging / "metrics.json", verify_metrics_json(r));
     draw(staging);
@@ -148,6 +160,7 @@ void write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
     throw;
   }
   fs::remove_all(old, ec);
+  return true;
 }
 
 }  // namespace weft

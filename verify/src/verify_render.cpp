@@ -128,12 +128,20 @@ const char* configuration_name(bool transmission) {
   return transmission ? "transmission" : "reflection";
 }
 
-// Renders a description as `weft render` would, refusing non-finite samples.
-Image render_description(const SceneDescription& desc, const VerifySettings& s) {
-  const RenderScene scene(desc);
+// Renders a description as `weft render` would, refusing non-finite samples. The scene build and
+// the render poll 'progress' as `weft render`'s do (a publication render of a large sample takes
+// minutes); nothing when it said stop.
+std::optional<Image> render_description(const SceneDescription& desc, const VerifySettings& s,
+                                        const ProgressCallback& progress) {
+  RenderSceneOptions options;
+  options.material_progress = progress;
+  options.build_progress = progress;
+  const RenderScene scene(desc, options);
+  if (scene.cancelled()) return std::nullopt;
   RenderSettings rs = render_settings_from(desc);
   rs.threads = s.threads;  // not a description's setting; the image does not depend on it
-  const RenderResult r = render(scene, *desc.camera, rs);
+  const RenderResult r = render(scene, *desc.camera, rs, progress);
+  if (r.cancelled) return std::nullopt;
   if (r.nonfinite_samples > 0)
     throw Error(desc.source, "render", std::to_string(r.nonfinite_samples) + " non-finite samples");
   return r.image;
@@ -147,9 +155,11 @@ Rgb mean_of(const Image& image, int x0, int x1, int y0, int y1) {
   return sum / static_cast<double>(std::max(1, n));
 }
 
-VerifyRender render_one(const std::filesystem::path& folder, const nlohmann::json& material,
-                        const std::string& model, const std::string& label, bool transmission,
-                        const VerifySettings& s) {
+// Nothing when 'progress' said stop.
+std::optional<VerifyRender> render_one(const std::filesystem::path& folder,
+                                       const nlohmann::json& material, const std::string& model,
+                                       const std::string& label, bool transmission,
+                                       const VerifySettings& s, const ProgressCallback& progress) {
   const std::string config = configuration_name(transmission);
   const std::string source = "verify render " + config + " " + model;
   VerifyRender v;
@@ -159,7 +169,9 @@ VerifyRender render_one(const std::filesystem::path& folder, const nlohmann::jso
   v.stem = "render-" + config + "-" + model;
   SceneDescription desc = verify_render_scene(material, transmission, s, folder);
   desc.source = source;
-  v.image = render_description(desc, s);
+  std::optional<Image> image = render_description(desc, s, progress);
+  if (!image) return std::nullopt;
+  v.image = std::move(*image);
   // The central half of the film lies inside the patch (the film is the patch's projection).
   const int w = v.image.width, h = v.image.height;
   v.patch_radiance = mean_of(v.image, w / 4, w - w / 4, h / 4, h - h / 4);
@@ -173,10 +185,13 @@ VerifyRender render_one(const std::filesystem::path& folder, const nlohmann::jso
   return v;
 }
 
-VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path& folder,
-                          const std::string& fiber_file, const std::string& model,
-                          const std::string& label, bool transmission, bool spectral,
-                          const VerifySettings& s) {
+// Nothing when 'progress' said stop.
+std::optional<VerifyRender> render_weave(const WovenSample& sample,
+                                         const std::filesystem::path& folder,
+                                         const std::string& fiber_file, const std::string& model,
+                                         const std::string& label, bool transmission, bool spectral,
+                                         const VerifySettings& s,
+                                         const ProgressCallback& progress) {
   // Read by cell, as the ray trace reads it: the image's mean is then the ray-traced fabric
   // table's value for this view and light (TableLookup).
   const nlohmann::json material = {{"type", "fiber_table"},
@@ -190,7 +205,9 @@ VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path
   v.model = model;
   v.configuration = configuration_name(transmission);
   v.stem = "render-weave-" + v.configuration + "-" + model;
-  v.image = render_description(desc, s);
+  std::optional<Image> image = render_description(desc, s, progress);
+  if (!image) return std::nullopt;
+  v.image = std::move(*image);
   v.mean = mean_of(v.image, 0, v.image.width, 0, v.image.height);
   v.patch_radiance = v.mean;
   const VerifyWeaveFrame f = verify_weave_frame(sample.summary, s.weave_render_size);
@@ -209,9 +226,16 @@ VerifyRender render_weave(const WovenSample& sample, const std::filesystem::path
 }  // namespace
 
 std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& folder,
-                                                const VerifyReport& report) {
+                                                const VerifyReport& report,
+                                                const ProgressCallback& progress, bool* cancelled) {
   std::vector<VerifyRender> out;
   const VerifySettings& s = report.settings;
+  // Keeps a render; false (the renders end there) when it was stopped.
+  const auto keep = [&](std::optional<VerifyRender> v) {
+    if (v) out.push_back(std::move(*v));
+    if (!v && cancelled) *cancelled = true;
+    return v.has_value();
+  };
   struct Table {
     const std::optional<TabulatedBsdfTable>* table;
     const char* model;
@@ -231,7 +255,8 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
     rgb.write_exr(folder / file);
     const nlohmann::json material = {{"type", "fabric_table"}, {"params", {{"file", file}}}};
     for (bool transmission : {false, true})
-      out.push_back(render_one(folder, material, t.model, t.label, transmission, s));
+      if (!keep(render_one(folder, material, t.model, t.label, transmission, s, progress)))
+        return out;
   }
   // The fibers with each model's fiber table, where the report holds the sample at fiber detail.
   if (report.sample && report.sample->fibers.curve_count() > 0) {
@@ -252,8 +277,9 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
       table.write_exr(folder / file);
       const bool spectral = table.channels == kNumBands;
       for (bool transmission : {false, true})
-        out.push_back(render_weave(*report.sample, folder, file, t.model, t.label, transmission,
-                                   spectral, s));
+        if (!keep(render_weave(*report.sample, folder, file, t.model, t.label, transmission,
+                               spectral, s, progress)))
+          return out;
     }
   }
   // The measurement is of reflection only.
@@ -261,8 +287,8 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
     const nlohmann::json material = {
         {"type", "measured_nbrdf"},
         {"params", {{"file", std::filesystem::absolute(report.measured_nbrdf).string()}}}};
-    out.push_back(render_one(folder, material, "measured",
-                             "measured BRDF (neural fit of the measurement)", false, s));
+    keep(render_one(folder, material, "measured", "measured BRDF (neural fit of the measurement)",
+                    false, s, progress));
   }
   return out;
 }

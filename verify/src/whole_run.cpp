@@ -168,11 +168,12 @@ VerifyOutcome run_report(const VerifyPlan& p, const WovenSample& sample, VerifyI
       report.cancelled || (p.request.fit && !fit_verify_models(p, sample, in, report, hooks));
   if (out.cancelled) return out;
   report.seconds["total_before_report"] = seconds_since(hooks.started);
-  write_verify_report(p.request.output, report, [&](const std::filesystem::path& staging) {
+  const auto draw = [&](const std::filesystem::path& staging) {
     const auto tp = std::chrono::steady_clock::now();
     hooks.draw(staging);
     report.seconds["plots"] = seconds_since(tp);
-  });
+  };
+  out.cancelled = !write_verify_report(p.request.output, report, draw, hooks.progress);
   return out;
 }
 

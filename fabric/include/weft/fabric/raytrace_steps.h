@@ -103,7 +103,8 @@ Particle launched_particle(const Launch& l, int channels, const Strategies& st, 
 // The scene the particles fly through: the repeat and its eight neighbours (weave.h
 // tiled_woven_description with one copy on each side; yarn tubes instanced, so the neighbours
 // take no memory of their own), geometry only. weft::Error when the
-// sample has neither fibers nor yarn tubes.
+// sample has neither fibers nor yarn tubes. The yarn tubes are the sample's own, not copies: the
+// description, and any scene built from it, must not outlive 'sample'.
 SceneDescription tiled_geometry(const WovenSample& sample);
 // Along the line p + t d: the distance to the first side of the repeat it crosses (side 0: -x,
 // 1: +x, 2: -z, 3: +z; -1 and infinity for none) and to the slab's face ahead (infinity if none).

@@ -16,6 +16,8 @@
 // options and seed give the same fibers.
 #include <cstdint>
 
+#include "weft/core/progress.h"
+
 namespace weft {
 
 struct WeaveOptions;
@@ -38,6 +40,10 @@ inline constexpr const char* kNonwovenPattern = "nonwoven";
 // Checks the options (weft::Error naming the field: out of range, a woven-only option given, or
 // a mat whose fiber count, estimated before anything is allocated, exceeds 20 000) and builds the
 // mat. Unset options take the bundled acrylic felt's values (scenes/examples/acrylic-felt.json).
-WovenSample make_nonwoven_sample(const WeaveOptions& options);
+// The largest mat takes tens of seconds (each fiber placed against all before it), so 'progress'
+// is told before every placement drawn and between slices of the fiber-distance check, and may
+// stop the work (WovenSample::cancelled: the mat is partial and must not be used).
+WovenSample make_nonwoven_sample(const WeaveOptions& options,
+                                 const ProgressCallback& progress = no_progress());
 
 }  // namespace weft

@@ -159,9 +159,11 @@ struct WovenSample {
 };
 
 // Checks everything (Error naming the field, before anything large is allocated) and builds the
-// sample. Deterministic: equal options give equal samples. A large fiber sample takes minutes
-// (a WIF draft of 160 threads: about 2 minutes), so 'progress' is told after each yarn and each
-// slice of the fiber-distance check, and may stop the work (WovenSample::cancelled).
+// sample. Deterministic: equal options give equal samples. A large sample takes minutes (a WIF
+// draft of 160 threads at fiber detail: about 2 minutes; 5e7 triangles of yarn tubes or a
+// nonwoven mat of 20 000 fibers: tens of seconds), so 'progress' is told as the work goes (after
+// each yarn's fibers, every 64 k vertices of a yarn tube, before each fiber placement drawn in a
+// mat, between slices of the fiber-distance check) and may stop it (WovenSample::cancelled).
 WovenSample make_woven_sample(const WeaveOptions& options,
                               const ProgressCallback& progress = no_progress());
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "weft/core/math.h"
+#include "weft/core/progress.h"
 #include "weft/core/spectrum.h"
 #include "weft/integrators/image.h"
 #include "weft/scenes/description.h"
@@ -100,9 +101,13 @@ inline constexpr const char* kVerifyWeaveRenderSetup =
 // 'folder' first (fabric-computed.exr, fabric-classic.exr, fiber-classic.exr in RGB;
 // fiber-computed.exr as the model has it, spectral, and rendered as a spectral render), where the
 // renderer reads them as any scene's fabric_table or fiber_table; the images are returned, not
-// written.
+// written. Each render's scene build and render poll 'progress' (a publication render of a large
+// sample takes minutes); when it says stop, the renders end there, '*cancelled' (when given) is
+// set and the renders returned are only those finished.
 struct VerifyReport;
 std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& folder,
-                                                const VerifyReport& report);
+                                                const VerifyReport& report,
+                                                const ProgressCallback& progress = no_progress(),
+                                                bool* cancelled = nullptr);
 
 }  // namespace weft

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "weft/core/progress.h"
 #include "weft/verify/run.h"
 #include "weft/verify/verdict.h"
 
@@ -57,7 +58,11 @@ void check_verify_output(const std::filesystem::path& dir);
 // the verification, the preview an aid.
 std::vector<VerifyPreview> write_verify_previews(const std::filesystem::path& folder,
                                                  const VerifyReport& report, std::string* skipped);
-void write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
-                         const std::function<void(const std::filesystem::path& staging)>& draw);
+// The renders poll 'progress', and it is asked again between the later steps; when it says stop,
+// nothing is written (the staging folder is removed, an earlier report left as it was) and the
+// return is false.
+bool write_verify_report(const std::filesystem::path& dir, const VerifyReport& report,
+                         const std::function<void(const std::filesystem::path& staging)>& draw,
+                         const ProgressCallback& progress = no_progress());
 
 }  // namespace weft
