@@ -7,7 +7,7 @@
 //
 // There are kChannelGroups groups: an RGB table's three channels, a spectral table's thirds of
 // adjacent bands (at most kChannelGroups channels: one each). One strategy per band drew the same
-// paths as its neighbours (a dye's spectrum changes little over a few 10 nm bands) for 1.4x the
+// paths as its neighbours (a dye's spectrum changes little over a few 10 nm bands) for 1.1x the
 // CPU: each strategy's rows are what a scattering reads from memory, 9 MB for 33 bands at R = 8,
 // several times the cache (docs/PERFORMANCE.md). Every channel keeps a strategy that draws
 // wherever its f is non-zero (a group's mean is at least f_c over the group's size), so MIS over
