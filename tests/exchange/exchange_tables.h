@@ -65,17 +65,23 @@ inline void fabric_reflection(const Vec3& wo, const Vec3& wi, std::span<double> 
   const double base[3] = {0.55, 0.3, 0.15};
   for (int c = 0; c < 3; ++c) v[static_cast<size_t>(c)] = base[c] / kPi + sheen + back;
 }
-inline TabulatedBsdfTable fabric_rgb(int resolution = 8) {
+// An RGB table of R = resolution that reflects as 'reflection' with light and view above the
+// cloth, and sends nothing else.
+template <class F>
+TabulatedBsdfTable reflection_rgb(int resolution, F reflection) {
   return TabulatedBsdfTable::from_function(
       resolution, 3,
-      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+      [reflection](const Vec3& wo, const Vec3& wi, std::span<double> v) {
         if (wo.z <= 0 || wi.z <= 0) {
           v[0] = v[1] = v[2] = 0;
           return;
         }
-        fabric_reflection(wo, wi, v);
+        reflection(wo, wi, v);
       },
       2, 1);
+}
+inline TabulatedBsdfTable fabric_rgb(int resolution = 8) {
+  return reflection_rgb(resolution, fabric_reflection);
 }
 
 // A woven cloth made the way the paper's summation makes one (fabric_summation.h, kPaper: half a
@@ -104,16 +110,7 @@ inline void woven_reflection(const Vec3& wo, const Vec3& wi, std::span<double> v
   }
 }
 inline TabulatedBsdfTable woven_rgb(int resolution = 8) {
-  return TabulatedBsdfTable::from_function(
-      resolution, 3,
-      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
-        if (wo.z <= 0 || wi.z <= 0) {
-          v[0] = v[1] = v[2] = 0;
-          return;
-        }
-        woven_reflection(wo, wi, v);
-      },
-      2, 1);
+  return reflection_rgb(resolution, woven_reflection);
 }
 
 }  // namespace weft::testing

@@ -105,6 +105,15 @@ void expect_cancelled(const Interrupted& r, const fs::path& dir, const fs::path&
   expect_nothing_written(r, dir, out);
 }
 
+// expect_cancelled, and the command's own stop: exit 130 and "WHAT cancelled" on stderr.
+void expect_stopped(const Interrupted& r, const fs::path& dir, const fs::path& out,
+                    const std::string& what) {
+  expect_cancelled(r, dir, out);
+  EXPECT_EQ(WEXITSTATUS(r.status), 130);
+  EXPECT_NE(slurp(dir / "stderr").find(what + " cancelled"), std::string::npos)
+      << slurp(dir / "stderr");
+}
+
 // A fiber table of little albedo, so that the fabric bake starts its ray trace at once.
 fs::path flat_fiber_table(const fs::path& dir) {
   auto t = weft::TabulatedBsdfTable::from_function(
@@ -141,10 +150,7 @@ TEST(CliCancel, FabricRaytraceStopsSoonWhileMakingALargeSample) {
                                   "-R", "1", "--yes-long", "--quiet", "-o", "fabric.exr"},
                                  dir),
                       2.0);
-  expect_cancelled(r, dir, dir / "fabric.exr");
-  EXPECT_EQ(WEXITSTATUS(r.status), 130);
-  EXPECT_NE(slurp(dir / "stderr").find("bake cancelled"), std::string::npos)
-      << slurp(dir / "stderr");
+  expect_stopped(r, dir, dir / "fabric.exr", "bake");
 }
 
 TEST(CliCancel, FabricRaytraceStopsSoonWhileMakingALargeYarnSample) {
@@ -160,10 +166,7 @@ TEST(CliCancel, FabricRaytraceStopsSoonWhileMakingALargeYarnSample) {
                   "--yes-long", "--quiet", "-o", "fabric.exr"},
                  dir),
       2.0);
-  expect_cancelled(r, dir, dir / "fabric.exr");
-  EXPECT_EQ(WEXITSTATUS(r.status), 130);
-  EXPECT_NE(slurp(dir / "stderr").find("bake cancelled"), std::string::npos)
-      << slurp(dir / "stderr");
+  expect_stopped(r, dir, dir / "fabric.exr", "bake");
 }
 
 TEST(CliCancel, VerifyStopsSoonWhileMakingANonwovenMat) {
@@ -176,10 +179,7 @@ TEST(CliCancel, VerifyStopsSoonWhileMakingANonwovenMat) {
                                              "--weave", "mat.json", "--quiet", "-o", "report"},
                                             dir),
                                  2.0);
-  expect_cancelled(r, dir, dir / "report");
-  EXPECT_EQ(WEXITSTATUS(r.status), 130);
-  EXPECT_NE(slurp(dir / "stderr").find("verify cancelled"), std::string::npos)
-      << slurp(dir / "stderr");
+  expect_stopped(r, dir, dir / "report", "verify");
 }
 
 // Whether weft verify has begun its report: the staging folder beside the output exists
@@ -201,10 +201,7 @@ TEST(CliCancel, VerifyStopsSoonWhileRenderingItsReport) {
       spawn_weft({"verify", "--quality", "draft", "--threads", "2", "--quiet", "-o", "report"},
                  dir),
       0.3, 600, [&] { return report_staging_exists(dir, "report"); });
-  expect_cancelled(r, dir, dir / "report");
-  EXPECT_EQ(WEXITSTATUS(r.status), 130);
-  EXPECT_NE(slurp(dir / "stderr").find("verify cancelled"), std::string::npos)
-      << slurp(dir / "stderr");
+  expect_stopped(r, dir, dir / "report", "verify");
 }
 
 TEST(CliCancel, FiberBakeStopsSoonAtHugePhotons) {
