@@ -340,12 +340,8 @@ WovenSample make_nonwoven_sample(const WeaveOptions& options, const ProgressCall
   const auto t0 = std::chrono::steady_clock::now();
   const Mat m = resolve_mat(options);
   WovenSample s;
-  // Once the callback says stop, every later ask says so too and the sample is left partial.
   auto asker = [&](std::string_view stage, std::string_view unit) {
-    return [&s, &progress, stage, unit](uint64_t done, uint64_t total) {
-      s.cancelled = s.cancelled || !progress({stage, done, total, unit});
-      return !s.cancelled;
-    };
+    return detail::sample_asker(s, progress, stage, unit);
   };
   int attempts = 0;
   const std::vector<Fiber> fibers = place_fibers(m, options.solidity ? "solidity" : "thickness-mm",

@@ -719,12 +719,8 @@ WovenSample make_woven_sample(const WeaveOptions& options, const ProgressCallbac
     // taller than the tube by sqrt(1 + slope^2); crossings pressed together along their whole
     // length (balanced crimp, yarns as wide as their spacing) have no room for that, and the
     // measurement finds it. Then the fibers go in vertical sections, within the tubes.
-    // Once the callback says stop, every later ask says so too and the sample is left partial.
     auto asker = [&](std::string_view stage, std::string_view unit) {
-      return [&out, &progress, stage, unit](uint64_t done, uint64_t total) {
-        out.cancelled = out.cancelled || !progress({stage, done, total, unit});
-        return !out.cancelled;
-      };
+      return detail::sample_asker(out, progress, stage, unit);
     };
     double d = 0;
     for (const bool perpendicular : {true, false}) {

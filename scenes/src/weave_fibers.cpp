@@ -587,15 +587,27 @@ struct SegmentGrid {
   }
 };
 
-// The distance search asks whether to go on every this many segments gathered or sorted (a
-// draft's millions take seconds) and every kPairsPerPoll pairs compared.
-constexpr size_t kSegmentsPerPoll = size_t{1} << 16;
-constexpr uint64_t kPairsPerPoll = uint64_t{1} << 20;
+// The distance search's questions to keep_going: one per 64 k units of work (segments gathered
+// or sorted, pairs compared: a draft's millions take seconds), and once it said stop, stop ever
+// after.
+struct SearchPoll {
+  static constexpr uint64_t kWorkPerPoll = uint64_t{1} << 16;
+  const std::function<bool(uint64_t, uint64_t)>& keep_going;
+  uint64_t work = 0, next = 0;
+  bool halted = false;
+  // 'units' more done; true when the search is to stop. (done, total) go to keep_going.
+  bool stop(uint64_t units, uint64_t done = 0, uint64_t total = 1) {
+    work += units;
+    if (halted || !keep_going || work < next) return halted;
+    next = work + kWorkPerPoll;
+    return halted = !keep_going(done, total);
+  }
+};
 
 // The grid of cells 'size' or larger over the extent, its segments sorted by cell; empty (no
-// keys) when 'stop' says so.
+// keys) when the poll says stop.
 SegmentGrid grid_of(std::vector<Seg> segs, const double extent[3], double ylo, double size,
-                    const std::function<bool()>& stop) {
+                    SearchPoll& poll) {
   SegmentGrid g;
   for (int a = 0; a < 3; ++a) {
     g.n[a] = static_cast<int>(std::clamp(std::floor(extent[a] / size), 1.0, double(1 << 20)));
@@ -604,14 +616,14 @@ SegmentGrid grid_of(std::vector<Seg> segs, const double extent[3], double ylo, d
   g.lo[0] = -0.5 * extent[0], g.lo[1] = ylo, g.lo[2] = -0.5 * extent[2];
   std::vector<std::pair<uint64_t, uint32_t>> by_cell(segs.size());
   for (uint32_t i = 0; i < segs.size(); ++i) {
-    if (i % kSegmentsPerPoll == 0 && stop()) return {};
+    if (poll.stop(1)) return {};
     const Vec3 m = 0.5 * (segs[i].a + segs[i].b);
     by_cell[i] = {g.key(g.index(0, m.x), g.index(1, m.y), g.index(2, m.z)), i};
   }
   std::sort(by_cell.begin(), by_cell.end());
   g.segs.reserve(segs.size());
   for (size_t k = 0; k < by_cell.size(); ++k) {
-    if (k % kSegmentsPerPoll == 0 && stop()) return {};
+    if (poll.stop(1)) return {};
     if (k == 0 || by_cell[k].first != by_cell[k - 1].first) {
       g.keys.push_back(by_cell[k].first);
       g.cell_start.push_back(k);
@@ -630,12 +642,9 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
   std::vector<Seg> segs;
   segs.reserve(fibers.segment_count());
   double ylo = 1e300, yhi = -1e300, longest = 0;
-  size_t last_poll = SIZE_MAX;
+  SearchPoll poll{keep_going};
   for (size_t c = 0; c < fibers.curve_count(); ++c) {
-    if (keep_going && segs.size() / kSegmentsPerPoll != last_poll) {
-      last_poll = segs.size() / kSegmentsPerPoll;
-      if (!keep_going(0, 1)) return cutoff;
-    }
+    if (poll.stop(fibers.curve_points[c])) return cutoff;
     for (uint32_t k = 0; k + 1 < fibers.curve_points[c]; ++k) {
       const Vec3 a = fibers.point(fibers.curve_first[c] + k),
                  b = fibers.point(fibers.curve_first[c] + k + 1);
@@ -655,14 +664,12 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
   const double extent[3] = {period_x, std::max(yhi - ylo, cutoff), period_z};
   double min_segment = 1e300;
   for (const Seg& s : segs) min_segment = std::min(min_segment, length(s.b - s.a));
-  bool halted = false;
-  const auto stop = [&] { return halted = halted || (keep_going && !keep_going(0, 1)); };
-  const SegmentGrid g = grid_of(std::move(segs), extent, ylo, cutoff + longest, stop);
-  if (halted) return cutoff;
+  const SegmentGrid g = grid_of(std::move(segs), extent, ylo, cutoff + longest, poll);
+  if (poll.halted) return cutoff;
   // Segments of a fiber and its continuation within the cutoff of their joint are neighbours
   // along one fiber, not two fibers.
   const std::vector<int64_t> next = continuations(fibers, period_x, period_z);
-  if (stop()) return cutoff;
+  if (poll.stop(fibers.curve_count())) return cutoff;
   const long near = static_cast<long>(std::ceil(cutoff / std::max(min_segment, 1e-15))) + 1;
   // b lies fewer than 'near' segments after a along a's fiber (through the curves continuing it;
   // a nonwoven fiber cut at a corner of the tile continues through a short middle piece).
@@ -693,14 +700,8 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
   };
   double best = cutoff;
   std::vector<uint64_t> seen;
-  uint64_t pairs = 0, next_poll = 0;  // pairs compared, and when to ask next
-  auto stopped = [&](size_t k) {
-    if (!keep_going || pairs < next_poll) return false;
-    next_poll = pairs + kPairsPerPoll;
-    return !keep_going(k, g.keys.size());
-  };
   for (size_t k = 0; k < g.keys.size(); ++k) {
-    if (stopped(k)) return best;
+    if (poll.stop(1, k, g.keys.size())) return best;
     const uint64_t key = g.keys[k];
     const int cz = static_cast<int>(key % g.n[2]), cy = static_cast<int>(key / g.n[2] % g.n[1]),
               cx = static_cast<int>(key / g.n[2] / g.n[1]);
@@ -720,8 +721,9 @@ double min_fiber_distance(const FiberCurves& fibers, double period_x, double per
             const uint64_t first = other == key ? i + 1 : g.cell_start[o];
             for (uint64_t j = first; j < g.cell_start[o + 1]; ++j)
               best = std::min(best, pair_distance(g.segs[i], g.segs[j]));
-            pairs += g.cell_start[o + 1] - std::min(first, g.cell_start[o + 1]);
-            if (stopped(k)) return best;
+            if (poll.stop(g.cell_start[o + 1] - std::min(first, g.cell_start[o + 1]), k,
+                          g.keys.size()))
+              return best;
           }
         }
   }

@@ -6,6 +6,7 @@
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "weft/core/vec.h"
@@ -106,5 +107,18 @@ std::string gltf_text(GltfDocument d);  // buffer embedded as base64
 std::vector<uint8_t> glb_bytes(const GltfDocument& d);
 // .gltf or .glb by extension, atomically.
 void write_gltf(const std::filesystem::path& path, const GltfDocument& d);
+
+// A sample's question "go on?" (done, total) at one stage of its making, put to 'progress':
+// once it says stop, sample.cancelled is set and every later ask says stop too, so the sample is
+// left partial. 'sample' and 'progress' must outlive it.
+inline std::function<bool(uint64_t, uint64_t)> sample_asker(WovenSample& sample,
+                                                            const ProgressCallback& progress,
+                                                            std::string_view stage,
+                                                            std::string_view unit) {
+  return [&sample, &progress, stage, unit](uint64_t done, uint64_t total) {
+    sample.cancelled = sample.cancelled || !progress({stage, done, total, unit});
+    return !sample.cancelled;
+  };
+}
 
 }  // namespace weft::detail
