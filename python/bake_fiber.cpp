@@ -73,11 +73,13 @@ void bind_bake_fiber(py::module_& m) {
       [](const py::object& spec, uint64_t photons, int resolution, uint64_t seed, int threads,
          const std::string& bands, const std::string& route, uint64_t passes,
          std::optional<std::string> estimator, bool mirror_fold, std::optional<int> surface_samples,
-         std::optional<std::string> entry, bool yes_long, bool progress) {
+         std::optional<std::string> entry, const std::string& surface_lobe, bool yes_long,
+         bool progress) {
         FiberBakeRequest r;
         r.photons = photons, r.resolution = resolution, r.seed = seed, r.threads = threads;
         r.bands = bands, r.route = route, r.passes = passes, r.estimator = estimator;
         r.mirror_fold = mirror_fold, r.surface_samples = surface_samples, r.entry = entry;
+        r.surface_lobe = surface_lobe;
         return bake_fiber(spec, std::move(r), yes_long, progress);
       },
       py::arg("spec"), py::kw_only(), py::arg("photons") = d.photons,
@@ -85,10 +87,12 @@ void bind_bake_fiber(py::module_& m) {
       py::arg("threads") = d.threads, py::arg("bands") = d.bands, py::arg("route") = d.route,
       py::arg("passes") = d.passes, py::arg("estimator") = d.estimator,
       py::arg("mirror_fold") = d.mirror_fold, py::arg("surface_samples") = d.surface_samples,
-      py::arg("entry") = d.entry, py::arg("yes_long") = false, py::arg("progress") = false,
+      py::arg("entry") = d.entry, py::arg("surface_lobe") = d.surface_lobe,
+      py::arg("yes_long") = false, py::arg("progress") = false,
       "Bakes a fiber spec (a dict, a spec file or a preset name) into a fiber table, as `weft "
       "bake fiber` does; estimator, surface_samples and entry None: the spec's and route's "
-      "default. Work estimated above an hour needs yes_long=True.");
+      "default; surface_lobe \"sampled\" or \"analytic\" (`--surface-lobe`). Work estimated above "
+      "an hour needs yes_long=True.");
 }
 
 }  // namespace weft::python

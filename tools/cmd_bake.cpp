@@ -122,6 +122,14 @@ void add_fiber_sampling_options(CLI::App& fiber, FiberBakeRequest& r) {
           "how photons' entries are drawn: random or stratified (randomised Sobol' "
           "points per task; direct route); default stratified on the direct route")
       ->check(CLI::IsMember(names_of(kFiberEntrySamplings)));
+  fiber
+      .add_option("--surface-lobe", r.surface_lobe,
+                  "the fiber's first-surface reflection: sampled (the photons' draws, binned) or "
+                  "analytic (named in the table beside the cells, for readers that evaluate it "
+                  "exactly: a smooth filament's lobe is narrower than the bins; smooth boundary, "
+                  "direct route)")
+      ->check(CLI::IsMember(names_of(kFiberSurfaceLobes)))
+      ->capture_default_str();
   fiber.add_option("--seed", r.seed, "random seed");
   fiber
       .add_option("--passes", r.passes,

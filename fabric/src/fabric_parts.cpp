@@ -18,6 +18,11 @@ namespace {
 // The fibers in a job's identity: one table's checksum as ever, or per-yarn tables' checksums and
 // maps ('f' distinct).
 void describe_fibers(const FiberTables& f, nlohmann::json& job) {
+  // The checksum covers the cells; a table that names a surface lobe is traced with the lobe exact
+  // (fabric_raytrace.h), so its lobe is part of what the parts were traced with.
+  for (size_t k = 0; k < f.tables.size(); ++k)
+    if (f.tables[k]->surface_lobe)
+      job["fiber_surface_lobes"][std::to_string(k)] = f.tables[k]->surface_lobe->attributes();
   if (f.tables.size() == 1) {
     job["fiber_checksum"] = f.tables[0]->checksum();
     return;

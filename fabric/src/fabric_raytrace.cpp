@@ -118,7 +118,10 @@ void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Cr
     probe.d = s.d;
     probe.w = s.w, probe.pdf = s.pdf, probe.wp = s.wp;
     const FiberPoint& pt = x.pts[draw->point];
-    weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, scratch.s_sum, probe);
+    if (y.fs->lobe)
+      weigh_scatter_lobe(*y.fs, *y.fiber, life.st, pt, *draw, scratch.s_sum, probe);
+    else
+      weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, scratch.s_sum, probe);
     if (!h.on_fiber() && y.tube) weigh_as_round_fiber(*y.tube, t.tube_proposal, x, s.d, probe);
     leave_fiber(pt.hit, draw->wo_local, probe);
     const std::optional<Vec3> out =
@@ -147,8 +150,9 @@ bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Pa
   }
   const FiberPoint& pt = x.pts[draw->point];
   double mean_pdf = 0;
-  books.absorbed +=
-      weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, s_sum, s, &mean_pdf);
+  books.absorbed += y.fs->lobe ? weigh_scatter_lobe(*y.fs, *y.fiber, life.st, pt, *draw, s_sum, s)
+                               : weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin,
+                                               s_sum, s, &mean_pdf);
   record_op(t, *life.tally, {mean_pdf, pt.bin, draw->exit_bin, PathOp::scatter});
   if (!h.on_fiber() && y.tube) {
     record_op(t, *life.tally,
@@ -468,11 +472,31 @@ void describe_per_yarn(const FiberTables& f, TabulatedBsdfTable& table) {
   if (!f.table_of_mesh.empty()) table.metadata["fiber_table_of_mesh"] = joined(f.table_of_mesh);
 }
 
+// A fiber table's rest and its surface lobe's cells (FiberSampler), held for a run.
+struct HeldLobe {
+  TabulatedBsdfTable rest;
+  std::vector<double> cells;
+};
+
+// The table a scattering weighs with and the sampler it draws from. Where the table names a
+// surface lobe and 'exact' (fiber detail, no proposal): its rest and the exact lobe, so that a
+// filament's first-surface reflection is never averaged over a cell; else the table as it is (its
+// cells include any lobe: a yarn tube's line albedo and a proposal's reweighting take the cells).
+std::pair<const TabulatedBsdfTable*, FiberSampler> shading_tables(const TabulatedBsdfTable& t,
+                                                                  bool exact, int threads,
+                                                                  std::deque<HeldLobe>& held) {
+  if (!exact || !t.surface_lobe) return {&t, FiberSampler(t)};
+  HeldLobe& h = held.emplace_back();
+  h.rest = t.without_surface_lobe("fiber", threads, &h.cells);
+  return {&h.rest, FiberSampler(h.rest, *t.surface_lobe, h.cells)};
+}
+
 // The samplers and line albedos of the per-yarn tables after the first (the tracer's own), held
 // for the run at stable addresses.
 struct PerYarnHeld {
   std::deque<FiberSampler> samplers;
   std::deque<LineAlbedo> tubes;
+  std::deque<HeldLobe> lobes;
 };
 
 // The tracer's shadings for two or more distinct tables f (table 0 the tracer's own fiber, no
@@ -481,8 +505,9 @@ void shade_per_yarn(const WovenSample& sample, const FiberTables& f, Tracer& t, 
   for (size_t k = 0; k < f.tables.size(); ++k) {
     YarnShading y{&t.fs, &t.fiber, t.tube};
     if (k > 0) {
-      y.fs = &held.samplers.emplace_back(*f.tables[k]);
-      y.fiber = f.tables[k];
+      auto [table, sampler] = shading_tables(*f.tables[k], !t.tube, t.o.threads, held.lobes);
+      y.fs = &held.samplers.emplace_back(std::move(sampler));
+      y.fiber = table;
       y.tube = t.tube ? &held.tubes.emplace_back(*f.tables[k]) : nullptr;
     }
     t.shadings.push_back(y);
@@ -645,9 +670,12 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   // With a proposal, paths are drawn from it and the choices that end or split a path are made on
   // the weights it gives (wp); the traced table's weights (w) follow the same path, each step
   // multiplied by its f over the proposal's.
-  const FiberSampler fs(o.proposal ? *o.proposal : fiber);
+  std::deque<HeldLobe> lobes;
+  const bool exact_lobe = sample.meshes.empty() && !o.proposal;
+  const auto [traced, fs] = o.proposal ? std::pair{&fiber, FiberSampler(*o.proposal)}
+                                       : shading_tables(fiber, exact_lobe, o.threads, lobes);
   Tracer t =
-      tracer_for(scene, slab, static_cast<int64_t>(sample.fibers.curve_count()), fs, fiber, o);
+      tracer_for(scene, slab, static_cast<int64_t>(sample.fibers.curve_count()), fs, *traced, o);
   // Yarn tubes stand for round fibers: they return the tables' line albedos.
   std::optional<LineAlbedo> tube, tube_proposal;
   if (!sample.meshes.empty()) {
@@ -692,6 +720,7 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   tabulate(sums, exact, t.grid, nc, t.per_bin, units, result);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
+  if (exact_lobe && fiber.surface_lobe) result.table.metadata["fiber_surface_lobe"] = "exact";
   if (record) keep_record(t, fiber, exact, units, result, *record);
   if (per_yarn) describe_per_yarn(f, result.table);
   if (weave) {

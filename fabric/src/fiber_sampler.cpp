@@ -43,6 +43,58 @@ FiberSampler::FiberSampler(const TabulatedBsdfTable& t) : table(&t), grid(t.grid
   }
 }
 
+FiberSampler::FiberSampler(const TabulatedBsdfTable& rest, const SurfaceLobe& l,
+                           const std::vector<double>& lobe_cells)
+    : FiberSampler(rest) {
+  lobe = &l;
+  const int bins = grid.bins(), nc = rest.channels;
+  const size_t per_bin = static_cast<size_t>(nc);
+  rest_albedo_c.assign(static_cast<size_t>(bins) * per_bin, 0.0);
+  lobe_albedo_c.assign(static_cast<size_t>(bins) * per_bin, 0.0);
+  for (int i = 0; i < bins; ++i)
+    for (int o = 0; o < bins; ++o)
+      for (int c = 0; c < nc; ++c) {
+        const size_t k = static_cast<size_t>(i) * per_bin + static_cast<size_t>(c);
+        rest_albedo_c[k] += rest.at(i, o, c) * areas[o];
+        lobe_albedo_c[k] +=
+            lobe_cells[(static_cast<size_t>(i) * bins + o) * per_bin + static_cast<size_t>(c)] *
+            areas[o];
+      }
+  lobe_albedo.assign(static_cast<size_t>(bins) * strategies, 0.0);
+  for (int i = 0; i < bins; ++i)
+    for (int s = 0; s < strategies; ++s)
+      lobe_albedo[static_cast<size_t>(i) * strategies + s] =
+          group_mean({lobe_albedo_c.data() + static_cast<size_t>(i) * per_bin, per_bin}, s);
+  std::vector<double> indices;
+  for (double n : l.ior) {
+    size_t k = 0;
+    while (k < indices.size() && indices[k] != n) ++k;
+    if (k == indices.size()) {
+      indices.push_back(n);
+      lobe_albedo_tables.emplace_back(l.distribution.model, l.distribution.alpha, n);
+    }
+    albedo_table_of_channel.push_back(static_cast<int>(k));
+  }
+}
+
+double FiberSampler::group_mean(std::span<const double> x, int s) const {
+  const int first = first_channel(s), last = last_channel(s);
+  double mean = 0;
+  for (int c = first; c < last; ++c) mean += x[static_cast<size_t>(c)];
+  return mean / (last - first);
+}
+
+void FiberSampler::exact_lobe_split(int bin, const Vec3& wi, std::span<double> rho,
+                                    std::span<double> k) const {
+  const size_t nc = rho.size(), base = static_cast<size_t>(bin) * nc;
+  for (size_t c = 0; c < nc; ++c) {
+    rho[c] =
+        wi.z > 0 ? lobe_albedo_tables[static_cast<size_t>(albedo_table_of_channel[c])](wi.z) : 0.0;
+    const double a = rest_albedo_c[base + c], l = lobe_albedo_c[base + c];
+    k[c] = a > 0 ? std::max(0.0, a + l - rho[c]) / a : 0.0;
+  }
+}
+
 int FiberSampler::last_channel(int s) const {
   return s < groups ? std::min(table->channels, (s + 1) * group_size) : table->channels;
 }

@@ -236,8 +236,21 @@ void albedo_sums(const FiberSampler& fs, const Strategies& st, const Crossings& 
                  std::span<double> s_sum) {
   for (int j = 0; j < st.count; ++j) {
     s_sum[j] = 0;
-    for (int q = 0; q < x.count; ++q) s_sum[j] += fs.albedo_of(x.pts[q].bin, st.index(j));
+    for (int q = 0; q < x.count; ++q)
+      s_sum[j] +=
+          fs.albedo_of(x.pts[q].bin, st.index(j)) + fs.lobe_albedo_of(x.pts[q].bin, st.index(j));
   }
+}
+
+// With the exact lobe: the probability that strategy s draws point q's exit from the lobe, its
+// channels' rho(wi) over their albedo there (1 where the rest has none).
+double lobe_share(const FiberSampler& fs, int s, const FiberPoint& q) {
+  std::array<double, kNumBands> rho{}, k{};
+  const size_t nc = static_cast<size_t>(fs.table->channels);
+  fs.exact_lobe_split(q.bin, q.wi_local, {rho.data(), nc}, {k.data(), nc});
+  const double total = fs.albedo_of(q.bin, s) + fs.lobe_albedo_of(q.bin, s);
+  if (!(fs.albedo_of(q.bin, s) > 0)) return 1.0;
+  return std::min(1.0, fs.group_mean({rho.data(), nc}, s) / total);
 }
 
 std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies& st,
@@ -245,11 +258,23 @@ std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies
                                         Rng& rng) {
   // With probability (A_h(q) / S_h) (f_h D_o / A_h(q)) = f_h D_o / S_h.
   const double s_hero = s_sum[st.hero_slot()];
-  const double a_hero0 = fs.albedo_of(x.pts[0].bin, st.hero);
+  const double a_hero0 =
+      fs.albedo_of(x.pts[0].bin, st.hero) + fs.lobe_albedo_of(x.pts[0].bin, st.hero);
   if (!(s_hero > 0)) return std::nullopt;
   ScatterDraw draw;
   draw.point = x.count == 2 && rng.uniform() * s_hero >= a_hero0 ? 1 : 0;
   const int bin = x.pts[draw.point].bin;
+  if (fs.lobe) {
+    if (rng.uniform() < lobe_share(fs, st.hero, x.pts[draw.point])) {
+      double pdf = 0;
+      const Vec2 u{rng.uniform(), rng.uniform()};
+      const auto wo = fs.lobe->sample(x.pts[draw.point].wi_local, u, &pdf);
+      if (!wo) return std::nullopt;
+      draw.wo_local = *wo;
+      draw.exit_bin = fs.grid.bin_of(*wo);
+      return draw;
+    }
+  }
   draw.exit_bin = static_cast<int>(fs.row(bin, st.hero).sample_discrete(rng.uniform()));
   draw.wo_local = fs.cosine_direction_in(draw.exit_bin, rng);
   return draw;
@@ -279,6 +304,44 @@ double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, co
     for (int c = 0; c < nc; ++c) s.wp[c] *= fs.table->at(bin, exit_bin, c) / mean_pdf;
   for (double& x : s.pdf) x /= mean_pdf;
   if (mean_pdf_out) *mean_pdf_out = mean_pdf;
+  return (before - after) / nc;
+}
+
+double weigh_scatter_lobe(const FiberSampler& fs, const TabulatedBsdfTable& rest,
+                          const Strategies& st, const FiberPoint& pt, const ScatterDraw& draw,
+                          std::span<const double> s_sum, Particle& s) {
+  const Vec3& wi = pt.wi_local;
+  const Vec3& wo = draw.wo_local;
+  const int bin = pt.bin, o = draw.exit_bin;
+  const double cos_o = std::abs(wo.z);
+  const double p_lobe = fs.lobe->pdf(wi, wo);
+  // Strategy j: the point with T_j / S_j, then the lobe with share P_j (p_lobe) or the rest's
+  // row (g_j D_o / A_j, then |cos| / D_o in the cell).
+  double mean_pdf = 0;
+  for (int j = 0; j < st.count; ++j) {
+    const int k = st.index(j);
+    const double a = fs.albedo_of(bin, k), total = a + fs.lobe_albedo_of(bin, k);
+    const double share = lobe_share(fs, k, pt);
+    const double rest_density = a > 0 ? fs.value(bin, o, k) * cos_o / a : 0.0;
+    const double p =
+        s_sum[j] > 0 ? total / s_sum[j] * (share * p_lobe + (1 - share) * rest_density) : 0.0;
+    s.pdf[j] *= p;
+    mean_pdf += s.pdf[j];
+  }
+  mean_pdf /= st.count;
+  const int nc = rest.channels;
+  const size_t n = static_cast<size_t>(nc);
+  std::array<double, kNumBands> lobe_f{}, rho{}, scale{};
+  fs.lobe->eval(wo, wi, {lobe_f.data(), n});
+  fs.exact_lobe_split(bin, wi, {rho.data(), n}, {scale.data(), n});
+  double before = 0, after = 0;
+  for (int c = 0; c < nc; ++c) {
+    const size_t u = static_cast<size_t>(c);
+    before += s.w[c];
+    s.w[c] *= (rest.at(bin, o, c) * scale[u] + lobe_f[u]) * cos_o / mean_pdf;
+    after += s.w[c];
+  }
+  for (double& x : s.pdf) x /= mean_pdf;
   return (before - after) / nc;
 }
 

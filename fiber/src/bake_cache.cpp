@@ -22,8 +22,10 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
   const std::string key =
       canonical_json(spec) + "|R" + std::to_string(o.resolution) + "|N" +
       std::to_string(o.photons_per_band) + "|S" + std::to_string(o.seed) + "|P" +
-      std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") + "|v" +
-      std::to_string(TabulatedBsdfTable::kFormatVersion) +
+      std::to_string(o.passes) + (o.spectral ? "|spectral" : "|rgb") +
+      // Format 4 only added the optional surface lobe, which has its own part of the key below:
+      // entries keep the names format 3 gave them.
+      "|v3" +
       // Only when not the former defaults (plain, unfolded, one surface sample, random entries),
       // so entries baked with them keep their names and are never read for other options.
       (o.weight_mode == WeightMode::absorption_weight ? "|absorption_weight" : "") +
@@ -34,6 +36,7 @@ std::filesystem::path fiber_table_cache_file(const std::filesystem::path& dir,
            ? std::string("|") + fiber_exit_estimator_name(o.estimator) + "|walk_energy"
            : "") +
       (o.mirror_fold ? "|mirror_fold" : "") +
+      (o.surface_lobe == FiberSurfaceLobe::kAnalytic ? "|surface_lobe_analytic" : "") +
       (o.surface_samples != 1 ? "|surface_samples" + std::to_string(o.surface_samples) : "") +
       (o.entry != FiberEntrySampling::kRandom
            ? std::string("|entry_") + fiber_entry_sampling_name(o.entry)

@@ -179,7 +179,8 @@ FiberBandTable bake_fiber_band_direct(const FiberBandPhysics& fiber, const Fiber
           // half.
           const double p = 2 * e.u[2] - 1;  // in units of R
           const double phi_a = std::atan2(safe_sqrt(1 - p * p), p);
-          enter_fiber(fiber, phi_a, omega, 1.0, rng, sink, sink, tally.books, e.lobe);
+          enter_fiber(fiber, phi_a, omega, 1.0, rng, s.book_surface ? sink : ExitSink{}, sink,
+                      tally.books, e.lobe);
         }
       },
       [&](const DirectTally& t) {

@@ -59,6 +59,13 @@ FiberTableBakeOptions fiber_request_options(const FiberBakeRequest& r, const Fib
     o.surface_samples = *r.surface_samples;
   }
   if (r.entry) o.entry = parse_fiber_entry_sampling(*r.entry, fiber_option_name(r, "entry"));
+  o.surface_lobe =
+      value_of(kFiberSurfaceLobes, r.surface_lobe, "", fiber_option_name(r, "surface_lobe"));
+  if (o.surface_lobe == FiberSurfaceLobe::kAnalytic &&
+      (spec.boundary != FiberBoundary::kSmooth || route != FiberBakeRoute::kDirect))
+    throw Error("", fiber_option_name(r, "surface_lobe"),
+                "analytic needs the smooth boundary and the direct route (the rough dielectric's "
+                "surface part is its microsurface walk, not one Cook-Torrance lobe)");
   return o;
 }
 
@@ -83,6 +90,8 @@ JobPart fiber_bake_job(const std::string& spec_arg, const FiberSpec& spec,
   if (o.mirror_fold) p.job["mirror_fold"] = true;
   if (o.surface_samples != 1) p.job["surface_samples"] = o.surface_samples;
   if (o.entry != FiberEntrySampling::kRandom) p.job["entry"] = fiber_entry_sampling_name(o.entry);
+  if (o.surface_lobe != FiberSurfaceLobe::kSampled)
+    p.job["surface_lobe"] = name_of(kFiberSurfaceLobes, o.surface_lobe);
   p.units_total = kNumBands;
   p.shard = shard;
   // The spec as given (a merge makes the table's metadata from it; its hash is checked).
@@ -307,6 +316,9 @@ FiberBakeOutcome merge_fiber_bake_parts(const JobPart& all, const std::string& o
   o.mirror_fold = job.boolean("mirror_fold", false);
   o.surface_samples = static_cast<int>(job.count("surface_samples", 1, 1, kMaxFiberSurfaceSamples));
   o.entry = parse_fiber_entry_sampling(job.string("entry", "random"), "entry");
+  o.surface_lobe =
+      value_of(kFiberSurfaceLobes, job.choice("surface_lobe", "sampled", {"sampled", "analytic"}),
+               "", "surface_lobe");
   const uint64_t passes = std::clamp<uint64_t>(o.passes, 1, o.photons_per_band);
   std::vector<FiberBandState> states;
   for (const auto& [band, v] : all.units) {

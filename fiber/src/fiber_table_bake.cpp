@@ -30,9 +30,31 @@ void validate(const FiberTableBakeOptions& o) {
     throw Error("", "entry", "a stratified entry is for the direct route");
   if (o.surface_samples < 1 || o.surface_samples > 1024)
     throw Error("", "surface_samples", "must lie in [1, 1024]");
+  if (o.surface_lobe == FiberSurfaceLobe::kAnalytic && o.route != FiberBakeRoute::kDirect)
+    throw Error("", "surface_lobe", "an analytic surface lobe is for the direct route");
+}
+
+void check_analytic_lobe(const FiberSpec& spec, const FiberTableBakeOptions& o) {
+  if (o.surface_lobe == FiberSurfaceLobe::kAnalytic && spec.boundary != FiberBoundary::kSmooth)
+    throw Error("", "surface_lobe",
+                "an analytic surface lobe needs the smooth boundary (the rough dielectric's "
+                "surface part is its microsurface walk, not one Cook-Torrance lobe)");
 }
 
 }  // namespace
+
+SurfaceLobe fiber_surface_lobe(const FiberSpec& spec, bool spectral) {
+  SurfaceLobe lobe;
+  lobe.distribution = {spec.roughness_distribution, spec.roughness_alpha};
+  if (spectral) {
+    for (int b = 0; b < kNumBands; ++b) lobe.ior.push_back(spec.host_n[b]);
+  } else {
+    for (double nm : {610.0, 550.0, 460.0})
+      lobe.ior.push_back(
+          spec.host_n[static_cast<int>(std::lround((nm - band_wavelength_nm(0)) / 10))]);
+  }
+  return lobe;
+}
 
 FiberTableBakeOptions fiber_bake_defaults(const FiberSpec& spec, FiberBakeRoute route) {
   FiberTableBakeOptions o;
@@ -59,6 +81,7 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
   validate(o);
   if (work.first_band < 0 || work.last_band > kNumBands || work.first_band >= work.last_band)
     throw Error("", "bands", "band range must lie in [0, " + std::to_string(kNumBands) + ")");
+  check_analytic_lobe(spec, o);
   const int nb = work.last_band - work.first_band;
   if (!work.start.empty() && work.start.size() != static_cast<size_t>(nb))
     throw Error("", "bands", "a resumed bake needs one state per band");
@@ -118,6 +141,7 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
       settings.seed = mix64(mix64(o.seed) ^ (pass * kNumBands + static_cast<uint64_t>(band)));
       settings.threads = o.threads;
       settings.entry = o.entry;
+      settings.book_surface = o.surface_lobe == FiberSurfaceLobe::kSampled;
       const uint64_t base = units_done;
       // A stop request may arrive after a band's last task: remember it for the loops here.
       ProgressCallback band_progress = [&](const ProgressUpdate& u) {
@@ -183,6 +207,26 @@ std::map<std::string, std::string> fiber_table_metadata(const FiberSpec& spec,
   return m;
 }
 
+// The analytic lobe's cells added to the table, and their energy to each band's (the table's
+// energy per band, sum f D_i D_o / pi: the lobe's at the band's index).
+void add_analytic_lobe(const FiberSpec& spec, const FiberTableBakeOptions& o,
+                       TabulatedBsdfTable& table, std::vector<FiberBandSummary>& bands) {
+  const SurfaceLobe lobe = fiber_surface_lobe(spec, o.spectral);
+  table.add_surface_lobe(lobe, o.threads);
+  const SurfaceLobe per_band = fiber_surface_lobe(spec, true);
+  std::map<double, double> energy_by_ior;
+  for (double n : per_band.ior) energy_by_ior[n] = 0;
+  for (auto& [n, energy] : energy_by_ior) {
+    const SurfaceLobe one{per_band.distribution, {n}};
+    const std::vector<double> cells = one.cell_averages(table.grid(), o.threads);
+    const auto d = table.grid().cosine_weighted_areas();
+    const size_t b = d.size();
+    for (size_t k = 0; k < cells.size(); ++k) energy += cells[k] * d[k / b] * d[k % b];
+    energy /= kPi;
+  }
+  for (auto& s : bands) s.energy_table += energy_by_ior[per_band.ior[static_cast<size_t>(s.band)]];
+}
+
 }  // namespace
 
 double fiber_bake_min_seconds_per_photon(const FiberTableBakeOptions& o) {
@@ -191,9 +235,11 @@ double fiber_bake_min_seconds_per_photon(const FiberTableBakeOptions& o) {
              : kMinSecondsPerPhoton;
 }
 
-double fiber_walk_energy_scale(const FiberBandState& st) {
-  if (st.exit_excess == 0 || !(st.exit > 0)) return 1;
-  return (st.exit - st.exit_excess) / st.exit;
+double fiber_walk_energy_scale(const FiberBandState& st, FiberSurfaceLobe lobe) {
+  // With the analytic lobe the sums hold the volume's exits alone.
+  const double booked = lobe == FiberSurfaceLobe::kAnalytic ? st.exit - st.surface : st.exit;
+  if (st.exit_excess == 0 || !(booked > 0)) return 1;
+  return (booked - st.exit_excess) / booked;
 }
 
 std::vector<double> fiber_band_averages(const FiberBandState& st, int resolution, bool mirror_fold,
@@ -249,7 +295,7 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
       s.expected_exit_excess = st.exit_excess * inv;
       s.energy_balance = s.exit_fraction + s.absorbed_fraction + s.roulette_net + s.lost_fraction -
                          s.surface_sampling_excess - s.expected_exit_excess;
-      s.energy_scale = fiber_walk_energy_scale(st);
+      s.energy_scale = fiber_walk_energy_scale(st, o.surface_lobe);
       s.energy_table = st.energy * inv * s.energy_scale;
       band_f[band] = fiber_band_averages(st, R, o.mirror_fold, s.energy_scale);
     }
@@ -282,6 +328,10 @@ FiberTableBakeResult finish_fiber_table(const FiberSpec& spec, const FiberTableB
     }
   }
   result.rgb_negative_clipped = gamut.largest;
+  if (o.surface_lobe == FiberSurfaceLobe::kAnalytic) {
+    check_analytic_lobe(spec, o);
+    add_analytic_lobe(spec, o, table, result.bands);
+  }
   table.metadata = fiber_table_metadata(spec, o, min_photons, result.cancelled);
   if (!o.spectral)
     table.metadata["rgb_negative_clipped"] = std::to_string(result.rgb_negative_clipped);

@@ -34,6 +34,37 @@ std::vector<double> TabulatedBsdfTable::averages_from_weighted_sums(
   return out;
 }
 
+TabulatedBsdfTable TabulatedBsdfTable::without_surface_lobe(const std::string& file, int threads,
+                                                            std::vector<double>* lobe_cells) const {
+  TabulatedBsdfTable rest = *this;
+  if (!surface_lobe) return rest;
+  rest.surface_lobe.reset();
+  std::vector<double> lobe = surface_lobe->cell_averages(grid(), threads);
+  for (size_t k = 0; k < values.size(); ++k) {
+    const double v = static_cast<double>(values[k]) - lobe[k];
+    if (v < -1e-6 * lobe[k]) {
+      const size_t cell = k / static_cast<size_t>(channels), b = static_cast<size_t>(bins());
+      throw Error(file,
+                  "values[wi " + std::to_string(cell / b) + "][wo " + std::to_string(cell % b) +
+                      "][" + channel_names()[k % static_cast<size_t>(channels)] + "]",
+                  "holds " + std::to_string(values[k]) + ", less than its surface lobe's " +
+                      std::to_string(lobe[k]) + ": the cells must include the lobe");
+    }
+    rest.values[k] = static_cast<float>(std::max(0.0, v));
+  }
+  if (lobe_cells) *lobe_cells = std::move(lobe);
+  return rest;
+}
+
+void TabulatedBsdfTable::add_surface_lobe(const SurfaceLobe& lobe, int threads) {
+  if (surface_lobe) throw Error("", "surface_lobe", "the table has a surface lobe already");
+  lobe.validate(channels, "");
+  const std::vector<double> cells = lobe.cell_averages(grid(), threads);
+  for (size_t k = 0; k < values.size(); ++k)
+    values[k] = static_cast<float>(static_cast<double>(values[k]) + cells[k]);
+  surface_lobe = lobe;
+}
+
 void TabulatedBsdfTable::interpolate(const Vec3& wo, const Vec3& wi, std::span<double> out) const {
   std::fill(out.begin(), out.end(), 0.0);
   for_each_interpolated_cell(grid(), wo, wi, [&](int i, int o, double w) {
@@ -85,7 +116,7 @@ const std::set<std::string>& reserved_attribute_names() {
 }  // namespace
 
 bool TabulatedBsdfTable::is_reserved_attribute(const std::string& name) {
-  return reserved_attribute_names().count(name) > 0;
+  return reserved_attribute_names().count(name) > 0 || SurfaceLobe::is_attribute(name);
 }
 
 void TabulatedBsdfTable::validate(const std::string& file) const {
@@ -105,9 +136,10 @@ void TabulatedBsdfTable::validate(const std::string& file) const {
                 "holds " + std::to_string(values.size()) + " numbers, expected " +
                     std::to_string(expected));
   for (const auto& [key, value] : metadata) {
-    if (key.empty() || reserved_attribute_names().count(key))
+    if (key.empty() || is_reserved_attribute(key))
       throw Error(file, "metadata." + key, "name is reserved by the table format");
   }
+  if (surface_lobe) surface_lobe->validate(channels, file);
   for (size_t i = 0; i < values.size(); ++i) {
     const float v = values[i];
     if (std::isfinite(v) && v >= 0) continue;

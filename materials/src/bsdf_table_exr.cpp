@@ -28,9 +28,10 @@ std::string read_table_format(const Imf::Header& h, const std::string& file,
                     ": an octahedral-grid table whose bins straddle the horizon; re-bake it with "
                     "this version (format " +
                     std::to_string(T::kFormatVersion) + ")");
-  if (version != T::kFormatVersion)
+  if (version < T::kOldestReadableVersion || version > T::kFormatVersion)
     throw Error(file, "weft_format_version",
-                "is " + std::to_string(version) + "; this program reads version " +
+                "is " + std::to_string(version) + "; this program reads versions " +
+                    std::to_string(T::kOldestReadableVersion) + " to " +
                     std::to_string(T::kFormatVersion));
   if (string_attr("parameterization") != T::kParameterization)
     throw Error(file, "parameterization",
@@ -97,6 +98,9 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
       header.insert("units", Imf::StringAttribute(kUnits));
       header.insert("kind", Imf::StringAttribute(kind));
       for (const auto& [key, value] : metadata) header.insert(key, Imf::StringAttribute(value));
+      if (surface_lobe)
+        for (const auto& [key, value] : surface_lobe->attributes())
+          header.insert(key, Imf::StringAttribute(value));
       exr_io::write_image(tmp, header, channel_names(), values);
     } catch (const Error&) {
       throw;
@@ -123,6 +127,12 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
     exr_io::check_channels(h, file, names, bands);
     table.values = exr_io::read_pixels(in, file, names, table.bins(), table.bins());
     table.metadata = exr_io::string_attributes(h, is_reserved_attribute);
+    // Version 3 knew no lobe: its attributes there would be metadata of another program's.
+    if (exr_io::int_attribute(h, file, "weft_format_version") >= 4)
+      table.surface_lobe = SurfaceLobe::from_attributes(
+          exr_io::string_attributes(
+              h, [](const std::string& n) { return !SurfaceLobe::is_attribute(n); }),
+          table.channels, file);
     if (exr_io::string_attribute(h, file, "cell_average") != kCellAverage)
       throw Error(file, "cell_average",
                   "is \"" + exr_io::string_attribute(h, file, "cell_average") +

@@ -1,8 +1,10 @@
 #include "weft/materials/cook_torrance.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 
+#include "weft/core/math.h"
 #include "weft/materials/fresnel.h"
 
 namespace weft {
@@ -69,6 +71,33 @@ std::optional<BsdfSample> CookTorranceBsdf::sample(const Vec3& wo, Vec2 u, doubl
   const double f = eval_upper(up.wo, wi);
   if (up.flipped) wi.z = -wi.z;
   return BsdfSample{wi, tint * (f * std::abs(wi.z) / pdf), pdf, false};
+}
+
+SurfaceAlbedoTable::SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes,
+                                       int samples_per_side) {
+  const CookTorranceBsdf ct{{model, alpha}, ior, Rgb(1.0)};
+  albedo_.resize(nodes);
+  for (int k = 0; k < nodes; ++k) {
+    // Nodes uniform in sqrt(cos theta): dense at grazing angles, where a smooth lobe's albedo
+    // changes fastest (uniform cos nodes left 1.5 % errors there at alpha = 0.01).
+    const double u = static_cast<double>(k) / (nodes - 1);
+    const double cos_t = std::max(1e-6, u * u);
+    const Vec3 w{safe_sqrt(1 - cos_t * cos_t), 0, cos_t};
+    double sum = 0;
+    for (int a = 0; a < samples_per_side; ++a)
+      for (int b = 0; b < samples_per_side; ++b) {
+        const Vec2 u{(a + 0.5) / samples_per_side, (b + 0.5) / samples_per_side};
+        if (const auto s = ct.sample(w, u, 0.5)) sum += s->weight.r;
+      }
+    albedo_[k] = sum / (samples_per_side * samples_per_side);
+  }
+}
+
+double SurfaceAlbedoTable::operator()(double cos_theta) const {
+  const double x = std::sqrt(std::clamp(cos_theta, 0.0, 1.0)) * (albedo_.size() - 1);
+  const size_t i = std::min(static_cast<size_t>(x), albedo_.size() - 2);
+  const double t = x - i;
+  return (1 - t) * albedo_[i] + t * albedo_[i + 1];
 }
 
 }  // namespace weft

@@ -19,21 +19,24 @@ nlohmann::json table_info(const TabulatedBsdfTable& t, const std::string& file) 
   const auto view = t.directional_albedo_seen_from(g.bin_of({0, 0, 1}));
   std::vector<double> albedo(t.channels);
   for (int c = 0; c < t.channels; ++c) albedo[c] = normal.total(c);
-  return {{"file", file},
-          {"format_version", TabulatedBsdfTable::kFormatVersion},
-          {"resolution", t.resolution},
-          {"bins", g.bins()},
-          {"bands", t.bands()},
-          {"kind", t.kind},
-          {"metadata", t.metadata},
-          {"checksum", t.checksum()},
-          {"min_per_sr", lo},
-          {"max_per_sr", hi},
-          {"albedo_normal_incidence", albedo},
-          {"reflectance_normal_incidence", normal.reflectance},
-          {"transmittance_normal_incidence", normal.transmittance},
-          {"reflectance_normal_view", view.reflectance},
-          {"transmittance_normal_view", view.transmittance}};
+  nlohmann::json info = {{"file", file},
+                         {"format_version", TabulatedBsdfTable::kFormatVersion},
+                         {"resolution", t.resolution},
+                         {"bins", g.bins()},
+                         {"bands", t.bands()},
+                         {"kind", t.kind},
+                         {"metadata", t.metadata},
+                         {"checksum", t.checksum()},
+                         {"min_per_sr", lo},
+                         {"max_per_sr", hi},
+                         {"albedo_normal_incidence", albedo},
+                         {"reflectance_normal_incidence", normal.reflectance},
+                         {"transmittance_normal_incidence", normal.transmittance},
+                         {"reflectance_normal_view", view.reflectance},
+                         {"transmittance_normal_view", view.transmittance}};
+  // The analytic lobe the cells include (surface_lobe.h), as the file names it.
+  if (t.surface_lobe) info["surface_lobe"] = t.surface_lobe->attributes();
+  return info;
 }
 
 TableBakePlan plan_table_bake(const TableBakeRequest& r) {

@@ -234,7 +234,9 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
          const std::string junk(600, '\x5a');
          f.write(junk.data(), static_cast<std::streamsize>(junk.size()));
        }},
-      {"version.exr", "weft_format_version", with_int("weft_format_version", 4)},
+      {"version.exr", "weft_format_version", with_int("weft_format_version", 5)},
+      // A lobe named by a version 4 header must be whole.
+      {"lobe.exr", "surface_lobe_distribution", with_string("surface_lobe", "cook-torrance")},
       // The stored quantity must be the one every reader assumes.
       {"plain_average.exr", "cell_average", with_string("cell_average", "plain")},
       {"no_cell_average.exr", "cell_average", without("cell_average")},
@@ -267,6 +269,9 @@ TEST(TableExr, DamagedFilesNameTheFileAndTheFault) {
              p, 2, rgb, [](Imf::Header&) {}, [](std::vector<float>& v) { v[5] = -0.5f; });
        }},
   };
+  // Version 3 (no lobe) still loads.
+  with_int("weft_format_version", 3)(dir / "v3.exr");
+  EXPECT_FALSE(TabulatedBsdfTable::read_exr(dir / "v3.exr").surface_lobe);
   for (const auto& c : cases) {
     const fs::path p = dir / c.name;
     c.make(p);

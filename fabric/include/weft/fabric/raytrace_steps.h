@@ -174,6 +174,10 @@ void albedo_sums(const FiberSampler& fs, const Strategies& st, const Crossings& 
 // The hero's choice: B' or B'' (point) in proportion to its albedo there, an exit cell from its row
 // there and a direction in the cell (fiber frame); with probability f_h D_o / S_h. None (and no
 // draw) when the hero's S is 0: the fiber absorbs all of its light.
+// With the sampler's exact lobe (FiberSampler::lobe) the point is chosen in proportion to its
+// albedo and its lobe's, and the lobe with probability its share there: the exit is then the
+// lobe's own draw (exit_bin its cell), or none when that draw leaves the lit side (the lobe's
+// density is what the weights divide by, so the estimate stays unbiased).
 struct ScatterDraw {
   int point = 0;
   int exit_bin = 0;
@@ -190,6 +194,12 @@ std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies
 double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, const Strategies& st,
                      int bin, int exit_bin, std::span<const double> s_sum, Particle& s,
                      double* mean_pdf_out = nullptr);
+// The same with the sampler's exact lobe: f_c = the rest's cell value + the lobe's f_c at (wi, wo)
+// of the point drawn, over the strategies' mean density of the step, (g_j |cos theta_o| + lobe
+// albedo_j p_lobe) / S_j (every strategy's density now differs by more than a common factor).
+double weigh_scatter_lobe(const FiberSampler& fs, const TabulatedBsdfTable& rest,
+                          const Strategies& st, const FiberPoint& pt, const ScatterDraw& draw,
+                          std::span<const double> s_sum, Particle& s);
 // A yarn tube stands for a round fiber: the weights after scattering at the tube's crossing x of
 // the line along d are scaled per channel by L_c / S_c, L the table's line albedo for d
 // (line_albedo.h, axial cosine with the yarn's tangent at x.pts[0]) and S_c the albedos summed

@@ -39,6 +39,9 @@ struct FiberBakeSettings {
   int far_field_s_bins = 0;
   int far_field_psi_bins = 0;
   FiberEntrySampling entry = FiberEntrySampling::kRandom;  // the direct route's entries
+  // Whether the surface lobe's draws are booked into the cells (false: the table adds the lobe
+  // analytically, FiberSurfaceLobe::kAnalytic); they are counted in the books either way.
+  bool book_surface = true;
 };
 
 // The cosine-weighted cell averages of one band: value[i * R^2 + o] with i the incident (light)

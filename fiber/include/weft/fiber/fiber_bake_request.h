@@ -40,6 +40,7 @@ struct FiberBakeRequest {
   bool mirror_fold = FiberTableBakeOptions{}.mirror_fold;
   std::optional<int> surface_samples;
   std::optional<std::string> entry;
+  std::string surface_lobe = name_of(kFiberSurfaceLobes, FiberTableBakeOptions{}.surface_lobe);
   uint64_t seed = FiberTableBakeOptions{}.seed;
   uint64_t passes = FiberTableBakeOptions{}.passes;
   int threads = FiberTableBakeOptions{}.threads;

@@ -21,6 +21,7 @@
 #include "weft/fiber/medium.h"
 #include "weft/fiber/rough_dielectric.h"
 #include "weft/fiber/transport.h"
+#include "weft/materials/cook_torrance.h"
 #include "weft/materials/microfacet.h"
 
 namespace weft {
@@ -73,19 +74,6 @@ struct FiberBandPhysics {
 // engine's own launch_external.
 FiberBandPhysics smooth_fiber_physics(const TransportMedium& medium, double radius,
                                       double n_outside, TransportOptions options = {});
-
-// Directional albedo of a Cook-Torrance lobe at cos theta, tabulated at nodes uniform in
-// sqrt(cos theta) (dense at grazing angles) and interpolated linearly; computed by a
-// deterministic stratified quadrature of the sample weights.
-class SurfaceAlbedoTable {
- public:
-  SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes = 129,
-                     int samples_per_side = 64);
-  double operator()(double cos_theta) const;
-
- private:
-  std::vector<double> albedo_;
-};
 
 // How the interior's exits are tallied: one by one as photons leave (plain), or by next-event
 // estimation at every flight's start (TransportOptions::expected_exits; smooth boundary only).

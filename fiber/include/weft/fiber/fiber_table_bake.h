@@ -29,6 +29,23 @@ inline constexpr NameTable<bool, 2> kFiberBakeBands = {{
     {false, "rgb", "linear sRGB, D65"},
 }};
 
+// How the fiber's first-surface reflection (the smooth boundary's Cook-Torrance lobe, docs/
+// fiber-bsdf.md) enters the table. sampled: the photons' lobe draws are booked into the cells like
+// every exit. analytic: the cells get the lobe's cell averages by quadrature instead and the
+// table names the lobe (materials/surface_lobe.h), so a reader can evaluate and sample it
+// exactly: on a smooth filament (GGX alpha 0.1) the lobe is narrower than an R 8 table's bins.
+// Both tables hold the same f in expectation; analytic needs the smooth boundary and the direct
+// route.
+enum class FiberSurfaceLobe : uint8_t { kSampled, kAnalytic };
+inline constexpr NameTable<FiberSurfaceLobe, 2> kFiberSurfaceLobes = {{
+    {FiberSurfaceLobe::kSampled, "sampled", "the photons' draws, binned"},
+    {FiberSurfaceLobe::kAnalytic, "analytic", "named beside the cells, cells by quadrature"},
+}};
+// The lobe of a table baked with FiberSurfaceLobe::kAnalytic: the spec's roughness, the host's
+// index per band (spectral) or at 610, 550 and 460 nm (RGB: the index changes the lobe's Fresnel
+// by well under 1 % across a channel).
+SurfaceLobe fiber_surface_lobe(const FiberSpec& spec, bool spectral);
+
 // Upper bound on photons per band that any front end accepts (about a day of work per band).
 inline constexpr uint64_t kMaxPhotonsPerBand = uint64_t{1} << 40;
 
@@ -61,6 +78,7 @@ struct FiberTableBakeOptions {
   int surface_samples = 4;
   // How photons' entries are drawn (FiberEntrySampling; direct route only).
   FiberEntrySampling entry = FiberEntrySampling::kStratified;
+  FiberSurfaceLobe surface_lobe = FiberSurfaceLobe::kSampled;
 };
 
 // The defaults for a spec and route: FiberTableBakeOptions{}, less the variance reductions that do
@@ -164,8 +182,10 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
 // own (mean zero, noise 1/sqrt(N)), so a lossless fiber's table would land above a total albedo
 // of 1 as often as below; scaled, it has the energy a plain bake would have, its books exact, for
 // a ratio estimator's bias of order 1/N, far below the cells' noise (docs/fiber-bsdf.md, "The
-// energy of a next-event table"). Plain tables keep their bits.
-double fiber_walk_energy_scale(const FiberBandState& band);
+// energy of a next-event table"). Plain tables keep their bits. With the analytic surface lobe
+// the sums hold the volume's exits alone, and so does the ratio.
+double fiber_walk_energy_scale(const FiberBandState& band,
+                               FiberSurfaceLobe lobe = FiberSurfaceLobe::kSampled);
 
 // A band's cell averages (the table's values for that band) from its running sums over photons
 // > 0, each sum times 'scale' (fiber_walk_energy_scale), mirror-folded if asked.

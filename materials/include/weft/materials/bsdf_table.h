@@ -17,18 +17,21 @@
 // File: one scanline OpenEXR image, height 2 R^2 (row = wi bin), width 2 R^2 (column = wo bin),
 // FLOAT channels R,G,B or w390..w710 (one per 10 nm band), ZIP compression (lossless, so round
 // trips are bit-exact). Header attributes:
-//   weft_format_version (int) = 3, parameterization (string) = kParameterization,
+//   weft_format_version (int) = 4, parameterization (string) = kParameterization,
 //   cell_average (string) = "cosine-weighted" (the stored quantity; readers reject any other),
 //   resolution (int) = R, bands (string) = "rgb" | "390:710:10", units (string) = "1/sr",
 //   kind (string) = "fiber" | "fabric", values_fnv1a64 (string, 16 hex digits) = checksum() of the
 //   values (EXR itself has no checksum: an uncompressible table is stored raw, and damaged bytes
 //   would read back as other finite numbers),
 //   and every entry of 'metadata' as a string attribute (conventional keys: spec_hash, photons,
-//   seed, program_version).
+//   seed, program_version); since version 4, optionally the analytic surface lobe the cells
+//   include (surface_lobe.h: "surface_lobe", "surface_lobe_distribution", "surface_lobe_alpha",
+//   "surface_lobe_ior"). Version 3 files (no lobe) still load.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
 #include <map>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -36,6 +39,7 @@
 #include "weft/core/direction_grid.h"
 #include "weft/core/progress.h"
 #include "weft/core/vec.h"
+#include "weft/materials/surface_lobe.h"
 
 namespace weft {
 
@@ -62,8 +66,10 @@ using TableFunction = std::function<void(const Vec3& wo, const Vec3& wi, std::sp
 struct TabulatedBsdfTable {
   // 3: the hemispherical DirectionGrid (versions 1 and 2 used an octahedral grid whose bins
   // straddled the horizon; they are refused with a request to re-bake). Since version 2 the
-  // stored quantity is stated (cell_average).
-  static constexpr int kFormatVersion = 3;
+  // stored quantity is stated (cell_average). 4: an optional analytic surface lobe beside the
+  // cells (surface_lobe); version 3 tables have none and still load.
+  static constexpr int kFormatVersion = 4;
+  static constexpr int kOldestReadableVersion = 3;
   static constexpr const char* kCellAverage = "cosine-weighted";
   static constexpr const char* kParameterization =
       "equal-area hemispheres (octahedral, turned 45 deg; upper then lower) for wi and wo, local "
@@ -76,6 +82,10 @@ struct TabulatedBsdfTable {
   std::string kind = "fiber";  // "fiber" | "fabric"
   std::map<std::string, std::string> metadata;  // spec_hash, photons, seed, program_version, ...
   std::vector<float> values;                    // [wi_bin][wo_bin][channel]
+  // The analytic part of f the cells include (surface_lobe.h), if the table names one: a reader
+  // may evaluate it exactly (f = cells less its cell averages, interpolated, + the lobe) or ignore
+  // it (the cells are the whole f).
+  std::optional<SurfaceLobe> surface_lobe;
 
   DirectionGrid grid() const { return {resolution}; }
   int bins() const { return 2 * resolution * resolution; }
@@ -121,6 +131,19 @@ struct TabulatedBsdfTable {
   // is [wi_bin][wo_bin] for one channel; returns the cell averages in the same order.
   static std::vector<double> averages_from_weighted_sums(int resolution,
                                                          const std::vector<double>& weighted_sums);
+
+  // The table without its surface lobe: the cells less the lobe's cell averages
+  // (SurfaceLobe::cell_averages), the rest of f, which a reader that evaluates the lobe exactly
+  // interpolates. Differences below float rounding of a cell (1e-6 of the lobe's value) are
+  // rounding and become 0; a cell holding less than its lobe by more is an Error naming the cell
+  // (such a table was not made by adding the lobe). A table without a lobe comes back as it is.
+  // 'lobe_cells' (optional) receives the lobe's cell averages.
+  TabulatedBsdfTable without_surface_lobe(const std::string& file_for_errors, int threads = 0,
+                                          std::vector<double>* lobe_cells = nullptr) const;
+  // Adds the lobe's cell averages to the cells and names the lobe (what a baker that left the
+  // lobe's light out of its sums does). Error if the table has one already or the lobe's channels
+  // differ.
+  void add_surface_lobe(const SurfaceLobe& lobe, int threads = 0);
 
   // f(wo, wi) per channel, interpolated like the table material does (for_each_interpolated_cell);
   // 'out' holds 'channels' values.

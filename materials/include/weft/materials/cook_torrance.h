@@ -7,6 +7,7 @@
 // Reflection only, on either side: for wo.z < 0 both directions are mirrored through the surface
 // plane, so the back side is the same interface seen from below.
 #include <optional>
+#include <vector>
 
 #include "weft/materials/bsdf.h"
 #include "weft/materials/microfacet.h"
@@ -28,6 +29,19 @@ struct CookTorranceBsdf {
   double eval_upper(const Vec3& wo, const Vec3& wi) const;
   // The density of sample for wo.z > 0, wi.z > 0 (0 otherwise).
   double pdf_upper(const Vec3& wo, const Vec3& wi) const;
+};
+
+// Directional albedo of a Cook-Torrance lobe (a fiber's surface, surface_lobe.h) at cos theta,
+// tabulated at nodes uniform in sqrt(cos theta) (dense at grazing angles) and interpolated
+// linearly; computed by a deterministic stratified quadrature of the sample weights.
+class SurfaceAlbedoTable {
+ public:
+  SurfaceAlbedoTable(MicrofacetModel model, double alpha, double ior, int nodes = 129,
+                     int samples_per_side = 64);
+  double operator()(double cos_theta) const;
+
+ private:
+  std::vector<double> albedo_;
 };
 
 }  // namespace weft
