@@ -130,6 +130,14 @@ void bind_table(py::module_& m) {
           "wavelengths", [](const Table& t) { return wavelengths(t.get()); },
           "band centres in nm (None for an RGB table)")
       .def_property_readonly("metadata", [](const Table& t) { return t.get().metadata; })
+      .def_property_readonly(
+          "surface_lobe",
+          [](const Table& t) -> std::optional<std::map<std::string, std::string>> {
+            if (!t.get().surface_lobe) return std::nullopt;
+            return t.get().surface_lobe->attributes();
+          },
+          "the analytic surface lobe the cells include, as the file names it (None: none; "
+          "docs/fiber-bsdf.md)")
       .def_property_readonly("checksum", [](const Table& t) { return t.get().checksum(); })
       .def(
           "bin_of",

@@ -159,6 +159,29 @@ TEST(FabricRaytrace, FiberLevelBitIdenticalAtOneAndTwoThreads) {
   EXPECT_EQ(a.scatterings, b.scatterings);
 }
 
+// A fiber table that names a surface lobe is traced with the lobe exact at fiber detail (the
+// table's metadata says so), with the same bits at any thread count; at yarn detail the tubes'
+// line albedo reads the cells, and so does the trace.
+TEST(FabricRaytrace, AnExactSurfaceLobeTracesTheSameBitsAtOneAndTwoThreads) {
+  auto fiber = uniform_fiber(3, 0.3 * kInvPi);
+  fiber.add_surface_lobe(SurfaceLobe{{MicrofacetModel::kGgx, 0.1}, {1.6, 1.6, 1.6}}, 1);
+  FabricRaytraceOptions o = options(2, 300);
+  o.threads = 1;
+  const auto a = raytrace_fabric_table(default_sample("fiber"), fiber, o);
+  o.threads = 2;
+  const auto b = raytrace_fabric_table(default_sample("fiber"), fiber, o);
+  EXPECT_EQ(a.table.values, b.table.values);
+  EXPECT_EQ(a.exited, b.exited);
+  EXPECT_EQ(a.table.metadata.at("fiber_surface_lobe"), "exact");
+  auto cells = fiber;
+  cells.surface_lobe.reset();
+  const auto c = raytrace_fabric_table(default_sample("fiber"), cells, o);
+  EXPECT_NE(a.table.values, c.table.values);
+  EXPECT_EQ(c.table.metadata.count("fiber_surface_lobe"), 0u);
+  const auto yarn = raytrace_fabric_table(default_sample("yarn"), fiber, o);
+  EXPECT_EQ(yarn.table.metadata.count("fiber_surface_lobe"), 0u);
+}
+
 TEST(FabricRaytrace, TablesAreReciprocalWithinTheirNoise) {
   // With a reciprocal fiber table the fabric's is reciprocal: f(wi, wo) = f(wo, wi). Cell pair
   // (i, o) against (o, i), each with its stated standard error: the z-scores have rms about 1

@@ -49,6 +49,18 @@ def test_baked_table_shape_header_and_values(spectral):
         spectral.values[0, 0, 0] = 1
 
 
+def test_an_analytic_surface_lobe_is_named_by_the_table_and_survives_a_file(tmp_path, spectral):
+    # bake fiber --surface-lobe analytic: the table names its lobe (docs/fiber-bsdf.md); the
+    # cells still hold the whole f, about the sampled table's.
+    lobe = weft.bake_fiber("red-cotton", surface_lobe="analytic", **TINY)
+    assert spectral.surface_lobe is None
+    assert lobe.surface_lobe["surface_lobe"] == "cook-torrance"
+    assert len(lobe.surface_lobe["surface_lobe_ior"].split(",")) == 33
+    assert abs(lobe.values.sum() / spectral.values.sum() - 1) < 0.1
+    lobe.save(tmp_path / "lobe.exr")
+    assert weft.load_table(tmp_path / "lobe.exr").surface_lobe == lobe.surface_lobe
+
+
 def test_same_seed_same_bits_at_any_thread_count():
     a = weft.bake_fiber("red-cotton", bands="rgb", threads=1, **TINY)
     b = weft.bake_fiber("red-cotton", bands="rgb", threads=2, **TINY)
