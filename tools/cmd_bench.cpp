@@ -9,6 +9,7 @@ void add_bench_command(CLI::App& app, Commands& commands) {
   add_bench_bake_command(*bench, commands);
   add_bench_render_command(*bench, commands);
   add_bench_flatten_command(*bench, commands);
+  add_bench_sheen_command(*bench, commands);
 }
 
 }  // namespace weft::cli

@@ -22,7 +22,8 @@ AddCommand add_bake_fabric_command;
 AddCommand add_verify_command;  // cmd_verify.cpp
 
 // The subcommands of "bench" (cmd_bench.cpp makes the group).
-AddCommand add_bench_bake_command, add_bench_render_command, add_bench_flatten_command;
+AddCommand add_bench_bake_command, add_bench_render_command, add_bench_flatten_command,
+    add_bench_sheen_command;
 
 // The weft program: global options (--max-memory-gb, --yes-long) and every subcommand
 // (program.cpp). main() parses and runs one; weft slurm parses the command it wraps with another.

@@ -1,0 +1,63 @@
+#pragma once
+// How much of a cloth's mirror peak (its sheen) a fabric table keeps: the peak of a table's
+// in-plane curve against a brute-force reference, the fiber-level ray trace at a fine grid (R 32
+// by default, bins about 3.5 degrees across) of only the light bins the in-plane curves read
+// (weft bench sheen; docs/fabric-bsdf.md, "Sharp sheen: what a table keeps").
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "weft/core/progress.h"
+#include "weft/materials/bsdf_table.h"
+#include "weft/scenes/weave.h"
+
+namespace weft {
+
+// A table's mirror peak in one plane of incidence: beta = pi f (the channels' mean, interpolated
+// as the renderer reads the table) at views on the mirror side every 0.5 degree; the peak is the
+// largest beta within 10 degrees of the mirror view, the base the smaller beta 20 degrees either
+// side of the mirror, the width (FWHM) that of the views around the peak above base + (peak -
+// base) / 2.
+struct InplanePeak {
+  double beta = 0, view_deg = 0, base = 0, fwhm_deg = 0;
+};
+InplanePeak inplane_peak(const TabulatedBsdfTable& table, double theta_i_deg, double azimuth_deg);
+
+struct SheenRequest {
+  std::string fiber;  // the fiber table (.exr) the reference traces (its surface lobe exact)
+  std::string weave = "scenes/examples/polyester-satin-weave.json";  // woven sample options
+  int resolution = 32;                                               // the reference's grid
+  uint64_t particles_per_bin = 50000;                                // per light bin and batch
+  int batches = 2;  // independent traces (seeds seed, seed + 1, ...)
+  uint64_t seed = 1;
+  std::vector<double> incidences_deg = {30, 45, 60};
+  std::vector<double> azimuths_deg = {0, 90};  // planes of incidence (0: the warp's)
+  std::vector<std::string> tables;             // fabric tables to measure against it
+  int threads = 0;
+};
+
+struct SheenPlan {
+  SheenRequest request;
+  TabulatedBsdfTable fiber;
+  WovenSample sample;
+  std::vector<TabulatedBsdfTable> tables;
+  std::vector<int> rows;  // the reference's light bins: the in-plane curves' footprints
+};
+// Reads and checks everything before any work: weft::Error naming the option.
+SheenPlan plan_sheen(const SheenRequest& request);
+
+struct SheenCase {
+  double incidence_deg = 0, azimuth_deg = 0;
+  InplanePeak reference;         // of the batches' mean table
+  double reference_beta_se = 0;  // standard error of the peak over the batches
+  std::vector<InplanePeak> tables;
+};
+struct SheenResult {
+  std::vector<SheenCase> cases;
+  TabulatedBsdfTable reference;  // the batches' mean (only the plan's rows traced)
+  double cpu_seconds = 0;
+  bool cancelled = false;
+};
+SheenResult run_sheen(const SheenPlan& plan, const ProgressCallback& progress = no_progress());
+
+}  // namespace weft

@@ -1,0 +1,141 @@
+#include "weft/fabric/sheen.h"
+
+#include <algorithm>
+#include <cmath>
+#include <ctime>
+#include <set>
+
+#include "weft/core/error.h"
+#include "weft/core/math.h"
+#include "weft/fabric/fabric_raytrace.h"
+
+namespace weft {
+namespace {
+
+Vec3 inplane(double theta_deg, double azimuth_deg, bool mirror) {
+  const double t = deg_to_rad(theta_deg), p = deg_to_rad(azimuth_deg), s = mirror ? -1 : 1;
+  return {s * std::sin(t) * std::cos(p), s * std::sin(t) * std::sin(p), std::cos(t)};
+}
+
+double beta_at(const TabulatedBsdfTable& t, double theta_i, double azimuth, double view) {
+  std::vector<double> f(static_cast<size_t>(t.channels));
+  t.interpolate(inplane(view, azimuth, true), inplane(theta_i, azimuth, false), f);
+  double mean = 0;
+  for (double x : f) mean += x;
+  return kPi * mean / t.channels;
+}
+
+void check_angles(const std::vector<double>& angles, double lo, double hi, const char* field) {
+  if (angles.empty()) throw Error("", field, "needs at least one angle");
+  for (double a : angles)
+    if (!(a >= lo && a <= hi))
+      throw Error("", field,
+                  "angle " + std::to_string(a) + " is outside [" + std::to_string(lo) + ", " +
+                      std::to_string(hi) + "] degrees");
+}
+
+}  // namespace
+
+InplanePeak inplane_peak(const TabulatedBsdfTable& t, double theta_i, double azimuth) {
+  std::vector<double> views, beta;
+  for (double v = 0; v <= 89.0; v += 0.5)
+    views.push_back(v), beta.push_back(beta_at(t, theta_i, azimuth, v));
+  InplanePeak p;
+  size_t k = views.size();
+  for (size_t i = 0; i < views.size(); ++i)
+    if (std::abs(views[i] - theta_i) <= 10 && (k == views.size() || beta[i] > beta[k])) k = i;
+  p.beta = beta[k], p.view_deg = views[k];
+  p.base = std::min(beta_at(t, theta_i, azimuth, std::max(0.0, theta_i - 20)),
+                    beta_at(t, theta_i, azimuth, std::min(89.0, theta_i + 20)));
+  const double half = p.base + 0.5 * (p.beta - p.base);
+  size_t a = k, b = k;
+  while (a > 0 && beta[a - 1] > half) --a;
+  while (b + 1 < beta.size() && beta[b + 1] > half) ++b;
+  p.fwhm_deg = views[b] - views[a] + 0.5;
+  return p;
+}
+
+SheenPlan plan_sheen(const SheenRequest& r) {
+  SheenPlan p;
+  p.request = r;
+  if (r.resolution < 2 || r.resolution > TabulatedBsdfTable::kMaxResolution)
+    throw Error("", "--resolution", "must lie in [2, 32]");
+  if (r.particles_per_bin < 1 || r.particles_per_bin > (uint64_t{1} << 32))
+    throw Error("", "--particles", "must lie in [1, 2^32]");
+  if (r.batches < 2 || r.batches > 64)
+    throw Error("", "--batches", "must lie in [2, 64] (the peak's uncertainty needs two)");
+  check_angles(r.incidences_deg, 10, 75, "--incidence");
+  check_angles(r.azimuths_deg, 0, 360, "--azimuth");
+  if (r.fiber.empty()) throw Error("", "--fiber", "a fiber table (.exr) is required");
+  p.fiber = TabulatedBsdfTable::read_exr(r.fiber);
+  if (p.fiber.kind != "fiber") throw Error(r.fiber, "kind", "must be a fiber table");
+  for (const std::string& f : r.tables) {
+    p.tables.push_back(TabulatedBsdfTable::read_exr(f));
+    if (p.tables.back().kind != "fabric") throw Error(f, "kind", "must be a fabric table");
+  }
+  p.sample = make_woven_sample(read_weave_options(r.weave));
+  const DirectionGrid g{r.resolution};
+  std::set<int> rows;
+  for (double phi : r.azimuths_deg)
+    for (double ti : r.incidences_deg) {
+      const auto fp = g.bilinear(DirectionGrid::to_chart(inplane(ti, phi, false)));
+      for (int k = 0; k < 4; ++k)
+        if (fp.weight[k] > 0) rows.insert(fp.bin[k]);
+    }
+  p.rows.assign(rows.begin(), rows.end());
+  return p;
+}
+
+SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
+  const SheenRequest& r = p.request;
+  SheenResult out;
+  const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
+  std::vector<TabulatedBsdfTable> batch_tables;
+  const uint64_t total = static_cast<uint64_t>(r.batches) * p.rows.size();
+  uint64_t done = 0;
+  for (int b = 0; b < r.batches; ++b) {
+    TabulatedBsdfTable sum;
+    for (int row : p.rows) {
+      FabricRaytraceOptions o;
+      o.resolution = r.resolution;
+      o.particles_per_bin = r.particles_per_bin;
+      o.seed = r.seed + static_cast<uint64_t>(b);
+      o.threads = r.threads;
+      o.first_bin = row, o.bin_count = 1;
+      const FabricRaytraceResult t = raytrace_fabric_table(p.sample, p.fiber, o, progress);
+      if (t.cancelled || !progress({"reference rows", ++done, total})) {
+        out.cancelled = true;
+        return out;
+      }
+      // Each row has a whole run's bits; the others are zero.
+      if (sum.values.empty())
+        sum = t.table;
+      else
+        for (size_t k = 0; k < sum.values.size(); ++k) sum.values[k] += t.table.values[k];
+    }
+    batch_tables.push_back(std::move(sum));
+  }
+  out.reference = batch_tables[0];
+  for (size_t k = 0; k < out.reference.values.size(); ++k) {
+    double mean = 0;
+    for (const auto& t : batch_tables) mean += t.values[k];
+    out.reference.values[k] = static_cast<float>(mean / r.batches);
+  }
+  for (double phi : r.azimuths_deg)
+    for (double ti : r.incidences_deg) {
+      SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, {}};
+      double s = 0, s2 = 0;
+      for (const auto& t : batch_tables) {
+        const double v = inplane_peak(t, ti, phi).beta;
+        s += v, s2 += v * v;
+      }
+      const double n = r.batches, mean = s / n;
+      c.reference_beta_se = std::sqrt(std::max(0.0, s2 / n - mean * mean) / (n - 1));
+      for (const auto& t : p.tables) c.tables.push_back(inplane_peak(t, ti, phi));
+      out.cases.push_back(c);
+    }
+  out.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  return out;
+}
+
+}  // namespace weft

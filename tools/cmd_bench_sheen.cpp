@@ -1,0 +1,97 @@
+// weft bench sheen: how much of a cloth's mirror peak fabric tables keep, against the brute-force
+// reference (fabric/sheen.h; docs/fabric-bsdf.md, "Sharp sheen: what a table keeps").
+#include <cstdio>
+#include <iostream>
+#include <nlohmann/json.hpp>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "weft/core/params.h"
+#include "weft/fabric/sheen.h"
+
+namespace weft::cli {
+namespace {
+
+struct SheenOptions {
+  SheenRequest request;
+  std::string incidences = "30,45,60", azimuths = "0,90", reference_out;
+  bool json = false;
+};
+
+nlohmann::json peak_json(const InplanePeak& p) {
+  return {{"beta", p.beta}, {"view_deg", p.view_deg}, {"base", p.base}, {"fwhm_deg", p.fwhm_deg}};
+}
+
+void print(const SheenRequest& r, const SheenResult& res, bool json) {
+  if (json) {
+    nlohmann::json cases = nlohmann::json::array();
+    for (const SheenCase& c : res.cases) {
+      nlohmann::json tables = nlohmann::json::array();
+      for (size_t k = 0; k < c.tables.size(); ++k)
+        tables.push_back({{"file", r.tables[k]},
+                          {"peak", peak_json(c.tables[k])},
+                          {"peak_ratio", c.tables[k].beta / c.reference.beta}});
+      cases.push_back({{"incidence_deg", c.incidence_deg},
+                       {"azimuth_deg", c.azimuth_deg},
+                       {"reference", peak_json(c.reference)},
+                       {"reference_beta_se", c.reference_beta_se},
+                       {"tables", tables}});
+    }
+    std::cout << nlohmann::json{{"cases", cases}, {"cpu_seconds", res.cpu_seconds}}.dump(2) << "\n";
+    return;
+  }
+  std::printf("reference: R %d, %llu particles per bin x %d batches, %.0f CPU s\n", r.resolution,
+              static_cast<unsigned long long>(r.particles_per_bin), r.batches, res.cpu_seconds);
+  for (const SheenCase& c : res.cases) {
+    std::printf(
+        "incidence %2.0f, azimuth %3.0f: reference peak %.3f +- %.3f at %.1f deg, FWHM %.1f"
+        " deg (base %.3f)\n",
+        c.incidence_deg, c.azimuth_deg, c.reference.beta, c.reference_beta_se, c.reference.view_deg,
+        c.reference.fwhm_deg, c.reference.base);
+    for (size_t k = 0; k < c.tables.size(); ++k)
+      std::printf("  %s: peak %.3f (%.2f of the reference) at %.1f deg, FWHM %.1f deg\n",
+                  r.tables[k].c_str(), c.tables[k].beta, c.tables[k].beta / c.reference.beta,
+                  c.tables[k].view_deg, c.tables[k].fwhm_deg);
+  }
+}
+
+}  // namespace
+
+void add_bench_sheen_command(CLI::App& bench, Commands& commands) {
+  auto o = std::make_shared<SheenOptions>();
+  SheenRequest& r = o->request;
+  auto* cmd = bench.add_subcommand(
+      "sheen", "How much of a cloth's mirror peak fabric tables keep, against a fine reference");
+  cmd->add_option("--fiber", r.fiber, "fiber table (.exr) the reference traces")->required();
+  cmd->add_option("--weave", r.weave, "woven sample options (.json)")->capture_default_str();
+  cmd->add_option("--table", r.tables, "fabric table(s) (.exr) to measure against the reference");
+  cmd->add_option("-R,--resolution", r.resolution, "the reference's grid")->capture_default_str();
+  cmd->add_option("--particles", r.particles_per_bin, "particles per light bin and batch")
+      ->capture_default_str();
+  cmd->add_option("--batches", r.batches, "independent traces (the peak's standard error)")
+      ->capture_default_str();
+  cmd->add_option("--incidence", o->incidences, "light zeniths, degrees (a,b,c)")
+      ->capture_default_str();
+  cmd->add_option("--azimuth", o->azimuths, "planes of incidence, degrees (0: the warp's)")
+      ->capture_default_str();
+  cmd->add_option("--reference-out", o->reference_out, "write the reference's rows (.exr)");
+  cmd->add_option("--seed", r.seed, "seed of the first batch")->capture_default_str();
+  cmd->add_option("--threads", r.threads, "threads (0 = all cores)")->capture_default_str();
+  cmd->add_flag("--json", o->json, "print JSON");
+  commands.push_back({cmd, [o](const RunLimits& limits) {
+                        SheenRequest req = o->request;
+                        req.incidences_deg = parse_range(o->incidences, "--incidence", 64);
+                        req.azimuths_deg = parse_range(o->azimuths, "--azimuth", 64);
+                        if (!o->reference_out.empty())
+                          TabulatedBsdfTable::check_output_path(o->reference_out,
+                                                                "--reference-out");
+                        const SheenPlan plan = plan_sheen(req);
+                        const SheenResult res = run_sheen(plan, progress_bar(limits, false));
+                        if (res.cancelled) return 130;
+                        if (!o->reference_out.empty()) res.reference.write_exr(o->reference_out);
+                        print(req, res, o->json);
+                        return 0;
+                      }});
+}
+
+}  // namespace weft::cli
