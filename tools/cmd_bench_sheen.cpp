@@ -1,5 +1,5 @@
 // weft bench sheen: how much of a cloth's mirror peak fabric tables keep, against the brute-force
-// reference (fabric/sheen.h; docs/fabric-bsdf.md, "Sharp sheen: what a table keeps").
+// reference (bench/sheen_bench.h; docs/fabric-bsdf.md, "Sharp sheen: what a table keeps").
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -7,7 +7,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "weft/core/params.h"
-#include "weft/fabric/sheen.h"
+#include "weft/bench/sheen_bench.h"
 
 namespace weft::cli {
 namespace {

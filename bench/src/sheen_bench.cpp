@@ -1,4 +1,4 @@
-#include "weft/fabric/sheen.h"
+#include "weft/bench/sheen_bench.h"
 
 #include <algorithm>
 #include <cmath>

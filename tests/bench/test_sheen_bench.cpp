@@ -1,4 +1,4 @@
-// How much of a mirror peak a table keeps (fabric/sheen.h): the peak's measure on an analytic
+// How much of a mirror peak a table keeps (bench/sheen_bench.h): the peak's measure on an analytic
 // lobe, and the plan's checks and rows.
 #include <gtest/gtest.h>
 
@@ -7,7 +7,7 @@
 #include "test_util.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
-#include "weft/fabric/sheen.h"
+#include "weft/bench/sheen_bench.h"
 
 using namespace weft;
 using namespace weft::testing;
