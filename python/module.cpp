@@ -69,4 +69,5 @@ PYBIND11_MODULE(weft, m) {
   bind_bake_fiber(m);
   bind_bake_fabric(m);
   bind_verify(m);
+  bind_view(m);
 }

@@ -71,5 +71,6 @@ void bind_table(py::module_& m);
 void bind_bake_fiber(py::module_& m);
 void bind_bake_fabric(py::module_& m);
 void bind_verify(py::module_& m);
+void bind_view(py::module_& m);
 
 }  // namespace weft::python

@@ -1,5 +1,6 @@
 """The Python module and the command line bind one request per command (fiber/fiber_bake_request.h,
-fabric/fabric_bake.h, verify/plan.h): every option of `weft bake fiber`, `weft bake fabric` and
+fabric/fabric_bake.h, verify/plan.h, exchange/view_request.h): every option of `weft bake fiber`,
+`weft bake fabric`, `weft view` and
 `weft verify` but those only a command line has exists as a keyword of weft.bake_fiber,
 weft.bake_fabric and weft.verify and back, with the default the command's help states; the fiber
 bake's help states none, so both front ends bake with their defaults and must give the same table.
@@ -159,3 +160,17 @@ def test_the_check_fails_when_a_front_end_lacks_an_option():
     # The walk itself can fail: a command with an option Python lacks is caught.
     with pytest.raises(AssertionError, match="only in the CLI"):
         check_both_ways(("bake", "fabric"), weft.bake_fiber, cli_only={"help"})
+
+
+def test_view_takes_the_commands_options(tmp_path):
+    # weft.view is `weft view` without --json (Python returns the report); a page it writes holds
+    # the in-plane curves of the table.
+    check_both_ways(("view",), weft.view, cli_only={"help", "json"}, python_only=set())
+    fiber = weft.bake_fiber("white-cotton", photons=2000, resolution=4, bands="rgb")
+    fiber.save(tmp_path / "fiber.exr")
+    report = weft.view(tmp_path / "fiber.exr", tmp_path / "page.html", name="white cotton")
+    page = (tmp_path / "page.html").read_text()
+    assert page.lower().startswith("<!doctype html>") and "white cotton" in page
+    assert report["format"] and isinstance(report["figures"], dict)
+    with pytest.raises(weft.Error, match="output"):
+        weft.view(tmp_path / "fiber.exr", tmp_path / "page.txt")
