@@ -1,9 +1,9 @@
 """The Python module and the command line bind one request per command (fiber/fiber_bake_request.h,
 fabric/fabric_bake.h, verify/plan.h, exchange/view_request.h): every option of `weft bake fiber`,
-`weft bake fabric`, `weft view` and
-`weft verify` but those only a command line has exists as a keyword of weft.bake_fiber,
-weft.bake_fabric and weft.verify and back, with the default the command's help states; the fiber
-bake's help states none, so both front ends bake with their defaults and must give the same table.
+`weft bake fabric`, `weft verify` and `weft view` but those only a command line has exists as a
+keyword of weft.bake_fiber, weft.bake_fabric, weft.verify and weft.view and back, with the
+default the command's help states; the fiber bake's help states none, so both front ends bake
+with their defaults and must give the same table.
 
 Run by ctest (python_cli_test) with WEFT_BINARY at the built weft; by hand:
   WEFT_BINARY=build/tools/weft PYTHONPATH=build/python /usr/bin/python3 -m pytest tests/python
