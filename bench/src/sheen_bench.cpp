@@ -93,6 +93,10 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
   std::vector<TabulatedBsdfTable> batch_tables;
   const uint64_t total = static_cast<uint64_t>(r.batches) * p.rows.size();
   uint64_t done = 0;
+  // One stage, rows: a row's own stages (scene build, particles) only ask whether to go on.
+  const ProgressCallback per_row = [&](const ProgressUpdate&) {
+    return progress({"reference rows", done, total});
+  };
   for (int b = 0; b < r.batches; ++b) {
     TabulatedBsdfTable sum;
     for (int row : p.rows) {
@@ -102,7 +106,7 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
       o.seed = r.seed + static_cast<uint64_t>(b);
       o.threads = r.threads;
       o.first_bin = row, o.bin_count = 1;
-      const FabricRaytraceResult t = raytrace_fabric_table(p.sample, p.fiber, o, progress);
+      const FabricRaytraceResult t = raytrace_fabric_table(p.sample, p.fiber, o, per_row);
       if (t.cancelled || !progress({"reference rows", ++done, total})) {
         out.cancelled = true;
         return out;
