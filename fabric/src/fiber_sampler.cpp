@@ -65,16 +65,10 @@ FiberSampler::FiberSampler(const TabulatedBsdfTable& rest, const SurfaceLobe& l,
     for (int s = 0; s < strategies; ++s)
       lobe_albedo[static_cast<size_t>(i) * strategies + s] =
           group_mean({lobe_albedo_c.data() + static_cast<size_t>(i) * per_bin, per_bin}, s);
-  std::vector<double> indices;
-  for (double n : l.ior) {
-    size_t k = 0;
-    while (k < indices.size() && indices[k] != n) ++k;
-    if (k == indices.size()) {
-      indices.push_back(n);
-      lobe_albedo_tables.emplace_back(l.distribution.model, l.distribution.alpha, n);
-    }
-    albedo_table_of_channel.push_back(static_cast<int>(k));
-  }
+  const SurfaceLobe::DistinctIndices indices = l.distinct_indices();
+  for (double n : indices.ior)
+    lobe_albedo_tables.emplace_back(l.distribution.model, l.distribution.alpha, n);
+  albedo_table_of_channel = indices.of_channel;
 }
 
 double FiberSampler::group_mean(std::span<const double> x, int s) const {

@@ -242,16 +242,23 @@ void albedo_sums(const FiberSampler& fs, const Strategies& st, const Crossings& 
   }
 }
 
-// With the exact lobe: the probability that strategy s draws point q's exit from the lobe, its
-// channels' rho(wi) over their albedo there (1 where the rest has none).
-double lobe_share(const FiberSampler& fs, int s, const FiberPoint& q) {
+// With the exact lobe, for light from wi in 'bin': the lobe's albedo rho_c(wi) and the rest's
+// scale k_c(wi) per channel (FiberSampler::exact_lobe_split), computed once per point.
+struct LobeSplit {
   std::array<double, kNumBands> rho{}, k{};
-  const size_t nc = static_cast<size_t>(fs.table->channels);
-  fs.exact_lobe_split(q.bin, q.wi_local, {rho.data(), nc}, {k.data(), nc});
-  const double total = fs.albedo_of(q.bin, s) + fs.lobe_albedo_of(q.bin, s);
-  if (!(fs.albedo_of(q.bin, s) > 0)) return 1.0;
-  return std::min(1.0, fs.group_mean({rho.data(), nc}, s) / total);
-}
+  size_t channels = 0;
+  LobeSplit(const FiberSampler& fs, int bin, const Vec3& wi)
+      : channels(static_cast<size_t>(fs.table->channels)) {
+    fs.exact_lobe_split(bin, wi, {rho.data(), channels}, {k.data(), channels});
+  }
+  // The probability that strategy s draws the exit from the lobe: its channels' rho(wi) over
+  // their albedo in 'bin' (1 where the rest has none).
+  double share(const FiberSampler& fs, int s, int bin) const {
+    const double total = fs.albedo_of(bin, s) + fs.lobe_albedo_of(bin, s);
+    if (!(fs.albedo_of(bin, s) > 0)) return 1.0;
+    return std::min(1.0, fs.group_mean({rho.data(), channels}, s) / total);
+  }
+};
 
 std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies& st,
                                         const Crossings& x, std::span<const double> s_sum,
@@ -265,10 +272,11 @@ std::optional<ScatterDraw> draw_scatter(const FiberSampler& fs, const Strategies
   draw.point = x.count == 2 && rng.uniform() * s_hero >= a_hero0 ? 1 : 0;
   const int bin = x.pts[draw.point].bin;
   if (fs.lobe) {
-    if (rng.uniform() < lobe_share(fs, st.hero, x.pts[draw.point])) {
+    const FiberPoint& q = x.pts[draw.point];
+    if (rng.uniform() < LobeSplit(fs, q.bin, q.wi_local).share(fs, st.hero, q.bin)) {
       double pdf = 0;
       const Vec2 u{rng.uniform(), rng.uniform()};
-      const auto wo = fs.lobe->sample(x.pts[draw.point].wi_local, u, &pdf);
+      const auto wo = fs.lobe->sample(q.wi_local, u, &pdf);
       if (!wo) return std::nullopt;
       draw.wo_local = *wo;
       draw.exit_bin = fs.grid.bin_of(*wo);
@@ -317,11 +325,12 @@ double weigh_scatter_lobe(const FiberSampler& fs, const TabulatedBsdfTable& rest
   const double p_lobe = fs.lobe->pdf(wi, wo);
   // Strategy j: the point with T_j / S_j, then the lobe with share P_j (p_lobe) or the rest's
   // row (g_j D_o / A_j, then |cos| / D_o in the cell).
+  const LobeSplit split(fs, bin, wi);
   double mean_pdf = 0;
   for (int j = 0; j < st.count; ++j) {
     const int k = st.index(j);
     const double a = fs.albedo_of(bin, k), total = a + fs.lobe_albedo_of(bin, k);
-    const double share = lobe_share(fs, k, pt);
+    const double share = split.share(fs, k, bin);
     const double rest_density = a > 0 ? fs.value(bin, o, k) * cos_o / a : 0.0;
     const double p =
         s_sum[j] > 0 ? total / s_sum[j] * (share * p_lobe + (1 - share) * rest_density) : 0.0;
@@ -331,14 +340,13 @@ double weigh_scatter_lobe(const FiberSampler& fs, const TabulatedBsdfTable& rest
   mean_pdf /= st.count;
   const int nc = rest.channels;
   const size_t n = static_cast<size_t>(nc);
-  std::array<double, kNumBands> lobe_f{}, rho{}, scale{};
+  std::array<double, kNumBands> lobe_f{};
   fs.lobe->eval(wo, wi, {lobe_f.data(), n});
-  fs.exact_lobe_split(bin, wi, {rho.data(), n}, {scale.data(), n});
   double before = 0, after = 0;
   for (int c = 0; c < nc; ++c) {
     const size_t u = static_cast<size_t>(c);
     before += s.w[c];
-    s.w[c] *= (rest.at(bin, o, c) * scale[u] + lobe_f[u]) * cos_o / mean_pdf;
+    s.w[c] *= (rest.at(bin, o, c) * split.k[u] + lobe_f[u]) * cos_o / mean_pdf;
     after += s.w[c];
   }
   for (double& x : s.pdf) x /= mean_pdf;

@@ -211,20 +211,22 @@ std::map<std::string, std::string> fiber_table_metadata(const FiberSpec& spec,
 // energy per band, sum f D_i D_o / pi: the lobe's at the band's index).
 void add_analytic_lobe(const FiberSpec& spec, const FiberTableBakeOptions& o,
                        TabulatedBsdfTable& table, std::vector<FiberBandSummary>& bands) {
-  const SurfaceLobe lobe = fiber_surface_lobe(spec, o.spectral);
-  table.add_surface_lobe(lobe, o.threads);
+  // One quadrature per band's lobe (bands of one index share its draws): the bands' energies,
+  // and a spectral table's cells.
   const SurfaceLobe per_band = fiber_surface_lobe(spec, true);
-  std::map<double, double> energy_by_ior;
-  for (double n : per_band.ior) energy_by_ior[n] = 0;
-  for (auto& [n, energy] : energy_by_ior) {
-    const SurfaceLobe one{per_band.distribution, {n}};
-    const std::vector<double> cells = one.cell_averages(table.grid(), o.threads);
-    const auto d = table.grid().cosine_weighted_areas();
-    const size_t b = d.size();
-    for (size_t k = 0; k < cells.size(); ++k) energy += cells[k] * d[k / b] * d[k % b];
-    energy /= kPi;
+  const std::vector<double> band_cells = per_band.cell_averages(table.grid(), o.threads);
+  if (o.spectral)
+    table.add_surface_lobe(per_band, o.threads, &band_cells);
+  else
+    table.add_surface_lobe(fiber_surface_lobe(spec, false), o.threads);
+  const auto d = table.grid().cosine_weighted_areas();
+  const size_t b = d.size(), nb = static_cast<size_t>(kNumBands);
+  for (auto& s : bands) {
+    const size_t band = static_cast<size_t>(s.band);
+    double energy = 0;
+    for (size_t k = 0; k < b * b; ++k) energy += band_cells[k * nb + band] * d[k / b] * d[k % b];
+    s.energy_table += energy / kPi;
   }
-  for (auto& s : bands) s.energy_table += energy_by_ior[per_band.ior[static_cast<size_t>(s.band)]];
 }
 
 }  // namespace

@@ -56,10 +56,15 @@ TabulatedBsdfTable TabulatedBsdfTable::without_surface_lobe(const std::string& f
   return rest;
 }
 
-void TabulatedBsdfTable::add_surface_lobe(const SurfaceLobe& lobe, int threads) {
+void TabulatedBsdfTable::add_surface_lobe(const SurfaceLobe& lobe, int threads,
+                                          const std::vector<double>* given) {
   if (surface_lobe) throw Error("", "surface_lobe", "the table has a surface lobe already");
   lobe.validate(channels, "");
-  const std::vector<double> cells = lobe.cell_averages(grid(), threads);
+  const std::vector<double> computed =
+      given ? std::vector<double>{} : lobe.cell_averages(grid(), threads);
+  const std::vector<double>& cells = given ? *given : computed;
+  if (cells.size() != values.size())
+    throw Error("", "surface_lobe", "the lobe's cells do not fit the table");
   for (size_t k = 0; k < values.size(); ++k)
     values[k] = static_cast<float>(static_cast<double>(values[k]) + cells[k]);
   surface_lobe = lobe;

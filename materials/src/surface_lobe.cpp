@@ -28,13 +28,10 @@ CookTorranceBsdf lobe_of(const SurfaceLobe& l, int channel) {
   return CookTorranceBsdf{l.distribution, l.ior[static_cast<size_t>(channel)], Rgb(1.0)};
 }
 
-// The channels' distinct indices, and for each channel which of them it has.
-struct IndexGroups {
-  std::vector<double> ior;
-  std::vector<int> of_channel;
-};
-IndexGroups index_groups(const std::vector<double>& ior) {
-  IndexGroups g;
+}  // namespace
+
+SurfaceLobe::DistinctIndices SurfaceLobe::distinct_indices() const {
+  DistinctIndices g;
   for (double n : ior) {
     size_t k = 0;
     while (k < g.ior.size() && g.ior[k] != n) ++k;
@@ -43,8 +40,6 @@ IndexGroups index_groups(const std::vector<double>& ior) {
   }
   return g;
 }
-
-}  // namespace
 
 double SurfaceLobe::eval(const Vec3& wo, const Vec3& wi, int channel) const {
   return lobe_of(*this, channel).eval_upper(wo, wi);
@@ -81,7 +76,7 @@ std::vector<double> SurfaceLobe::cell_averages(const DirectionGrid& grid, int th
   const size_t bins = static_cast<size_t>(grid.bins());
   std::vector<double> out(bins * bins * static_cast<size_t>(nc), 0.0);
   const auto d = grid.cosine_weighted_areas();
-  const IndexGroups groups = index_groups(ior);
+  const DistinctIndices groups = distinct_indices();
   const size_t ng = groups.ior.size();
   const int upper = grid.resolution * grid.resolution;
   parallel_for(static_cast<uint64_t>(upper), threads, [&](uint64_t task) {

@@ -142,8 +142,9 @@ struct TabulatedBsdfTable {
                                           std::vector<double>* lobe_cells = nullptr) const;
   // Adds the lobe's cell averages to the cells and names the lobe (what a baker that left the
   // lobe's light out of its sums does). Error if the table has one already or the lobe's channels
-  // differ.
-  void add_surface_lobe(const SurfaceLobe& lobe, int threads = 0);
+  // differ. 'cells' (optional): lobe.cell_averages(grid()) already computed by the caller.
+  void add_surface_lobe(const SurfaceLobe& lobe, int threads = 0,
+                        const std::vector<double>* cells = nullptr);
 
   // f(wo, wi) per channel, interpolated like the table material does (for_each_interpolated_cell);
   // 'out' holds 'channels' values.

@@ -31,6 +31,13 @@ struct SurfaceLobe {
   std::vector<double> ior;  // per channel of the table, outside index 1
 
   int channels() const { return static_cast<int>(ior.size()); }
+  // The channels' distinct indices (in order of first use), and which of them each channel has:
+  // Fresnel is all that differs between channels, so readers compute per distinct index.
+  struct DistinctIndices {
+    std::vector<double> ior;
+    std::vector<int> of_channel;
+  };
+  DistinctIndices distinct_indices() const;
   // f of one channel (1/sr).
   double eval(const Vec3& wo, const Vec3& wi, int channel) const;
   // f of every channel into 'out' (channels() values).
