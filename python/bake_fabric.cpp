@@ -94,7 +94,8 @@ void bind_bake_fabric(py::module_& m) {
          std::optional<int> launch_lattice, std::optional<std::string> straight_through,
          std::optional<double> split_threshold, std::optional<int> max_scatterings,
          std::optional<std::filesystem::path> weave_out, std::optional<Positions> weave_positions,
-         std::optional<int> weave_resolution, uint64_t seed, int threads, bool yes_long,
+         std::optional<int> weave_resolution, std::optional<int> sheen_resolution,
+         std::optional<int> sheen_window, uint64_t seed, int threads, bool yes_long,
          bool progress) {
         FabricBakeRequest r;
         r.method = method;
@@ -120,6 +121,7 @@ void bind_bake_fabric(py::module_& m) {
               },
               *weave_positions);
         r.weave_resolution = weave_resolution;
+        r.sheen_resolution = sheen_resolution, r.sheen_window = sheen_window;
         r.seed = seed, r.threads = threads;
         r.front_end = "python";
         r.limits = call_limits(yes_long);
@@ -135,6 +137,7 @@ void bind_bake_fabric(py::module_& m) {
       py::arg("straight_through") = py::none(), py::arg("split_threshold") = py::none(),
       py::arg("max_scatterings") = py::none(), py::arg("weave_out") = py::none(),
       py::arg("weave_positions") = py::none(), py::arg("weave_resolution") = py::none(),
+      py::arg("sheen_resolution") = py::none(), py::arg("sheen_window") = py::none(),
       py::arg("seed") = d.seed, py::arg("threads") = d.threads, py::arg("yes_long") = false,
       py::arg("progress") = false,
       "A fabric table, as `weft bake fabric` makes it (its options are the keyword arguments, with "

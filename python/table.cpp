@@ -138,6 +138,14 @@ void bind_table(py::module_& m) {
           },
           "the analytic surface lobe the cells include, as the file names it (None: none; "
           "docs/fiber-bsdf.md)")
+      .def_property_readonly(
+          "sheen",
+          [](const Table& t) -> std::optional<std::map<std::string, std::string>> {
+            if (!t.get().sheen) return std::nullopt;
+            return t.get().sheen->attributes();
+          },
+          "the sheen over half vectors the cells include, as the file names it (None: none; "
+          "docs/fabric-bsdf.md)")
       .def_property_readonly("checksum", [](const Table& t) { return t.get().checksum(); })
       .def(
           "bin_of",

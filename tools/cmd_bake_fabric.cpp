@@ -107,6 +107,15 @@ void add_raytrace_options(CLI::App* sub, FabricBakeRequest& o) {
                   "raytrace: exact (the light passing between the fibers computed, the particles "
                   "book what meets a fiber; the default) | sampled (booked by the particles too)")
       ->check(CLI::IsMember(names_of(kStraightThroughNames)));
+  sub->add_option("--sheen-resolution", o.sheen_resolution,
+                  "raytrace, fiber detail, a fiber table with an analytic surface lobe: the "
+                  "fibers' first-surface reflection booked apart over half vectors on a grid of "
+                  "this resolution (e.g. 64: 2.2 degree bins), so that the table keeps a mirror "
+                  "peak narrower than its bins; off unless given");
+  sub->add_option("--sheen-window", o.sheen_window,
+                  "raytrace, with --sheen-resolution: bins per side of the half vectors' window "
+                  "about the normal (default " +
+                      std::to_string(FabricRaytraceOptions{}.sheen_window) + ")");
   sub->add_option("--split-threshold", o.split_threshold,
                   "raytrace, hero: split a particle whose largest channel weight exceeds this "
                   "(default " +

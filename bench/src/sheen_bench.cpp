@@ -17,12 +17,23 @@ Vec3 inplane(double theta_deg, double azimuth_deg, bool mirror) {
   return {s * std::sin(t) * std::cos(p), s * std::sin(t) * std::sin(p), std::cos(t)};
 }
 
-double beta_at(const TabulatedBsdfTable& t, double theta_i, double azimuth, double view) {
-  std::vector<double> f(static_cast<size_t>(t.channels));
-  t.interpolate(inplane(view, azimuth, true), inplane(theta_i, azimuth, false), f);
+// A table as a reader that knows its sheen takes it: the rest interpolated, plus the sheen.
+struct SheenReader {
+  TabulatedBsdfTable rest;
+  std::optional<HalfVectorLobe> sheen;
+  explicit SheenReader(const TabulatedBsdfTable& t)
+      : rest(t.without_sheen("", 0)), sheen(t.sheen) {}
+};
+
+double beta_at(const SheenReader& t, double theta_i, double azimuth, double view) {
+  const size_t nc = static_cast<size_t>(t.rest.channels);
+  std::vector<double> f(nc), s(nc, 0.0);
+  const Vec3 wo = inplane(view, azimuth, true), wi = inplane(theta_i, azimuth, false);
+  t.rest.interpolate(wo, wi, f);
+  if (t.sheen) t.sheen->eval(wo, wi, s);
   double mean = 0;
-  for (double x : f) mean += x;
-  return kPi * mean / t.channels;
+  for (size_t c = 0; c < nc; ++c) mean += f[c] + s[c];
+  return kPi * mean / static_cast<double>(nc);
 }
 
 void check_angles(const std::vector<double>& angles, double lo, double hi, const char* field) {
@@ -36,7 +47,8 @@ void check_angles(const std::vector<double>& angles, double lo, double hi, const
 
 }  // namespace
 
-InplanePeak inplane_peak(const TabulatedBsdfTable& t, double theta_i, double azimuth) {
+InplanePeak inplane_peak(const TabulatedBsdfTable& table, double theta_i, double azimuth) {
+  const SheenReader t(table);
   std::vector<double> views, beta;
   for (double v = 0; v <= 89.0; v += 0.5)
     views.push_back(v), beta.push_back(beta_at(t, theta_i, azimuth, v));

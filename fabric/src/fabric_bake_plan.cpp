@@ -155,6 +155,20 @@ FabricRaytraceOptions raytrace_options(const FabricBakeRequest& o) {
                       std::to_string(r.split_threshold));
   }
   if (o.max_scatterings) r.max_scatterings = *o.max_scatterings;
+  if (o.sheen_window && !o.sheen_resolution)
+    throw Error("", "--sheen-window", "sizes the sheen's window: give --sheen-resolution too");
+  if (o.sheen_resolution) {
+    if (o.detail != "fiber")
+      throw Error("", "--sheen-resolution",
+                  "books the fibers' surface lobe: it needs --detail fiber");
+    if (!o.shard.empty() || o.resume)
+      throw Error("", "--sheen-resolution",
+                  "is booked for a whole table only: not with --shard or --resume");
+    r.sheen_h_resolution = *o.sheen_resolution;
+    if (o.sheen_window) r.sheen_window = *o.sheen_window;
+    HalfVectorLobe::check_shape(r.sheen_h_resolution, r.sheen_window, "", "--sheen-resolution",
+                                "--sheen-window");
+  }
   weave_tally_options(o, r);
   r.validate();
   return r;

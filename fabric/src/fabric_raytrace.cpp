@@ -56,6 +56,10 @@ struct Tracer {
   std::vector<int> table_of_curve{}, table_of_mesh{};
   const WeaveLayout* weave = nullptr;  // the weave tally, when on
   bool record = false;                 // the steps into each task's path_ops (recorded_paths.h)
+  // The sheen's window when it is booked apart (its shape; FabricRaytraceOptions::
+  // sheen_h_resolution): its cells follow the table's in the tally, from sheen_first_cell on.
+  const HalfVectorLobe* sheen = nullptr;
+  uint64_t sheen_first_cell = 0;
 };
 
 // A step of the particle's life into its task's record, when recording.
@@ -79,6 +83,7 @@ struct Life {
   Strategies st;
   Tally* tally = nullptr;
   FabricBinBooks* books = nullptr;
+  Vec3 wi;                // towards the light, in the cloth's frame
   size_t first_exit = 0;  // its exits are merged per cell from here on (tally_exit)
   int copies = 0;
 };
@@ -91,13 +96,39 @@ struct TaskScratch {
   Particle probe;  // a next-event draw's particle (its vectors reused)
 };
 
-// An exit along d whose line passes through p, with weights w: into the table's tally and, when on,
-// the weave's.
-void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d,
-               std::span<const double> w) {
+// The sheen's part of an exit along d with weights w whose shares sheen_share were reflected off
+// the first fiber's surface (Particle::sheen): booked into the window bin of its half vector, the
+// rest into 'rest'. False when the exit leaves none there ('rest' then unset).
+bool book_sheen(const Tracer& t, Life& life, const Vec3& d, std::span<const double> w,
+                std::span<const double> sheen_share, std::span<double> rest) {
+  if (!t.sheen || sheen_share.empty()) return false;
+  const Vec3 wo = world_to_cloth(d), sum = life.wi + wo;
+  if (!(wo.z * life.wi.z > 0) || !(length(sum) > 0)) return false;
+  const Vec3 h = sum / length(sum);
+  const int k = t.sheen->window_bin_of(h);
+  if (k < 0) return false;
+  std::array<double, kNumBands> part{};
+  for (size_t c = 0; c < w.size(); ++c) {
+    part[c] = w[c] * sheen_share[c];
+    rest[c] = w[c] * (1 - sheen_share[c]);
+  }
+  const uint64_t cell = t.sheen_first_cell +
+                        static_cast<uint64_t>(life.bin) * t.sheen->window_bins() +
+                        static_cast<uint64_t>(k);
+  tally_exit(*life.tally, life.first_exit, cell, std::span<const double>(part.data(), w.size()));
+  return true;
+}
+
+// An exit along d whose line passes through p, with weights w: into the table's tally (its
+// sheen's part, when booked apart, into the sheen's window) and, when on, the weave's.
+void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d, std::span<const double> w,
+               std::span<const double> sheen_share) {
   const uint64_t cell = exit_cell(t.grid, life.bin, d);
   record_op(t, *life.tally, {0, static_cast<int64_t>(cell), 0, PathOp::book});
-  tally_exit(*life.tally, life.first_exit, cell, w);
+  std::array<double, kNumBands> rest{};
+  const std::span<double> r(rest.data(), w.size());
+  tally_exit(*life.tally, life.first_exit, cell,
+             book_sheen(t, life, d, w, sheen_share, r) ? std::span<const double>(r) : w);
   if (t.weave) {
     const int exit_bin = static_cast<int>(cell - static_cast<uint64_t>(life.bin) * t.grid.bins());
     tally_weave_exit(*t.weave, life.tally->weave, life.first_exit, life.bin, exit_bin, p, d, w);
@@ -118,8 +149,9 @@ void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Cr
     probe.d = s.d;
     probe.w = s.w, probe.pdf = s.pdf, probe.wp = s.wp;
     const FiberPoint& pt = x.pts[draw->point];
+    probe.sheen.assign(t.sheen && !s.scattered && y.fs->lobe ? s.w.size() : 0, 0.0);
     if (y.fs->lobe)
-      weigh_scatter_lobe(*y.fs, *y.fiber, life.st, pt, *draw, scratch.s_sum, probe);
+      weigh_scatter_lobe(*y.fs, *y.fiber, life.st, pt, *draw, scratch.s_sum, probe, probe.sheen);
     else
       weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, scratch.s_sum, probe);
     if (!h.on_fiber() && y.tube) weigh_as_round_fiber(*y.tube, t.tube_proposal, x, s.d, probe);
@@ -128,7 +160,7 @@ void book_next_events(const Tracer& t, Life& life, const SurfaceHit& h, const Cr
         escape_direction(t.scene, t.slab, t.curves, probe, 100 * t.o.max_scatterings);
     if (!out) continue;
     for (double& w : probe.w) w *= share;
-    book_exit(t, life, probe.p, *out, probe.w);
+    book_exit(t, life, probe.p, *out, probe.w, probe.sheen);
   }
 }
 
@@ -150,9 +182,12 @@ bool scatter(const Tracer& t, Life& life, const SurfaceHit& h, double mean_w, Pa
   }
   const FiberPoint& pt = x.pts[draw->point];
   double mean_pdf = 0;
-  books.absorbed += y.fs->lobe ? weigh_scatter_lobe(*y.fs, *y.fiber, life.st, pt, *draw, s_sum, s)
-                               : weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin,
-                                               s_sum, s, &mean_pdf);
+  // The sheen is the first scattering's lobe light, while it scatters no more.
+  s.sheen.assign(t.sheen && !s.scattered && y.fs->lobe ? s.w.size() : 0, 0.0);
+  books.absorbed +=
+      y.fs->lobe
+          ? weigh_scatter_lobe(*y.fs, *y.fiber, life.st, pt, *draw, s_sum, s, s.sheen)
+          : weigh_scatter(*y.fs, *y.fiber, life.st, pt.bin, draw->exit_bin, s_sum, s, &mean_pdf);
   record_op(t, *life.tally, {mean_pdf, pt.bin, draw->exit_bin, PathOp::scatter});
   if (!h.on_fiber() && y.tube) {
     record_op(t, *life.tally,
@@ -207,7 +242,7 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
       // or, having met nothing, the straight-through part is computed (straight_through.h)
       const bool binned =
           s.scattered ? t.o.next_event_rays == 0 : t.o.straight_through == StraightThrough::sampled;
-      if (binned) book_exit(t, life, s.p, s.d, s.w);
+      if (binned) book_exit(t, life, s.p, s.d, s.w, s.sheen);
       books.exited += mean_w;
       return;
     }
@@ -255,6 +290,7 @@ void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t u
   life.books = &tally.books_of(bin);
   Launch l = launch(t.grid, t.slab, bin, rng);  // drawn either way: the stream stays the same
   if (t.o.launch_lattice > 1) l = lattice_launch(t, k, bin);
+  life.wi = -world_to_cloth(l.d);
   life.st = draw_strategies(t.mis, t.fs.groups, rng);
   life.books->launched += l.w0;
   ++life.books->particles;
@@ -472,6 +508,35 @@ void describe_per_yarn(const FiberTables& f, TabulatedBsdfTable& table) {
   if (!f.table_of_mesh.empty()) table.metadata["fiber_table_of_mesh"] = joined(f.table_of_mesh);
 }
 
+// The sheen is booked apart only where the exact lobe is traced, for the whole table (its cell
+// averages blend neighbouring light bins) and not into recorded paths.
+void check_sheen_trace(const FabricRaytraceOptions& o, int bins, bool exact_lobe, bool record) {
+  if (!exact_lobe)
+    throw Error("", "sheen_h_resolution",
+                "books the fibers' surface lobe: it needs fiber detail, one fiber table with an "
+                "analytic surface lobe (weft bake fiber --surface-lobe analytic) and no proposal");
+  if (o.first_bin != 0 || (o.bin_count != 0 && o.bin_count != bins))
+    throw Error("", "sheen_h_resolution",
+                "is booked for a whole table only: not with --shard or --resume");
+  if (record) throw Error("", "sheen_h_resolution", "is not kept in recorded paths");
+}
+
+// The sheen's booked sums (after the table's cells in 'sums', channels per window bin) as Q =
+// sum / (particles per bin x window bin solid angle x mean wi . h) (HalfVectorLobe::
+// mean_projections: the light each (light bin, window bin) booked is the light its cell averages
+// carry), added to the table: its cell averages join the cells, which hold the rest.
+void add_booked_sheen(const CellSums& sums, uint64_t per_bin, int threads, HalfVectorLobe sheen,
+                      TabulatedBsdfTable& table) {
+  const size_t first = table.values.size(), nc = static_cast<size_t>(sheen.channels);
+  const std::vector<double> projection = sheen.mean_projections(threads);
+  const double scale = 1.0 / (static_cast<double>(per_bin) * sheen.window_bin_solid_angle());
+  for (size_t k = 0; k < sheen.values.size(); ++k) {
+    const double m = projection[k / nc];
+    sheen.values[k] = m > 0 ? static_cast<float>(sums.sum[first + k] * scale / m) : 0.0f;
+  }
+  table.add_sheen(std::move(sheen), threads);
+}
+
 // A fiber table's rest and its surface lobe's cells (FiberSampler), held for a run.
 struct HeldLobe {
   TabulatedBsdfTable rest;
@@ -655,6 +720,10 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
     throw Error("", "proposal",
                 "the likelihood-ratio proposal takes one fiber table; this trace has " +
                     std::to_string(f.tables.size()) + " distinct per-yarn tables");
+  if (o.sheen_h_resolution > 0)
+    check_sheen_trace(o, DirectionGrid{o.resolution}.bins(),
+                      sample.meshes.empty() && !o.proposal && fiber.surface_lobe && !per_yarn,
+                      record != nullptr);
   const RepeatSlab slab = repeat_slab_of(sample);
   if (!(slab.px > 0 && slab.pz > 0 && slab.y1 > slab.y0))
     throw Error("", "sample", "the woven sample has no period or no thickness");
@@ -686,8 +755,16 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   if (per_yarn) shade_per_yarn(sample, f, t, held);
   t.record = record != nullptr;
   const int bins = t.grid.bins(), nc = t.nc;
-  CellSums sums{std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0),
-                std::vector<double>(static_cast<size_t>(bins) * bins * nc, 0.0)};
+  std::optional<HalfVectorLobe> sheen;
+  if (o.sheen_h_resolution > 0) {
+    sheen = HalfVectorLobe::zeros(o.resolution, o.sheen_h_resolution, o.sheen_window, nc);
+    t.sheen = &*sheen;
+    t.sheen_first_cell = static_cast<uint64_t>(bins) * bins;
+  }
+  const size_t values =
+      (static_cast<size_t>(bins) * bins + (sheen ? sheen->values.size() / nc : 0)) *
+      static_cast<size_t>(nc);
+  CellSums sums{std::vector<double>(values, 0.0), std::vector<double>(values, 0.0)};
   FabricRaytraceResult result;
   result.bin_books.resize(bins);
   std::optional<WeaveLayout> weave;
@@ -718,6 +795,7 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   const CellSums exact = straight_through_sums(t, weave_exact, progress, result.cancelled);
   if (result.cancelled) return result;
   tabulate(sums, exact, t.grid, nc, t.per_bin, units, result);
+  if (sheen) add_booked_sheen(sums, t.per_bin, o.threads, std::move(*sheen), result.table);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   if (exact_lobe && fiber.surface_lobe) result.table.metadata["fiber_surface_lobe"] = "exact";

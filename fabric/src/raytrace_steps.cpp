@@ -317,7 +317,8 @@ double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, co
 
 double weigh_scatter_lobe(const FiberSampler& fs, const TabulatedBsdfTable& rest,
                           const Strategies& st, const FiberPoint& pt, const ScatterDraw& draw,
-                          std::span<const double> s_sum, Particle& s) {
+                          std::span<const double> s_sum, Particle& s,
+                          std::span<double> lobe_share) {
   const Vec3& wi = pt.wi_local;
   const Vec3& wo = draw.wo_local;
   const int bin = pt.bin, o = draw.exit_bin;
@@ -346,8 +347,10 @@ double weigh_scatter_lobe(const FiberSampler& fs, const TabulatedBsdfTable& rest
   for (int c = 0; c < nc; ++c) {
     const size_t u = static_cast<size_t>(c);
     before += s.w[c];
-    s.w[c] *= (rest.at(bin, o, c) * split.k[u] + lobe_f[u]) * cos_o / mean_pdf;
+    const double f = rest.at(bin, o, c) * split.k[u] + lobe_f[u];
+    s.w[c] *= f * cos_o / mean_pdf;
     after += s.w[c];
+    if (!lobe_share.empty()) lobe_share[u] = f > 0 ? lobe_f[u] / f : 0.0;
   }
   for (double& x : s.pdf) x /= mean_pdf;
   return (before - after) / nc;

@@ -34,24 +34,42 @@ std::vector<double> TabulatedBsdfTable::averages_from_weighted_sums(
   return out;
 }
 
+namespace {
+
+// The table's cells less an analytic part's cell averages ('what' names it in the message): the
+// rest of f. Differences below float rounding become 0; more is an Error naming the cell.
+void subtract_cells(TabulatedBsdfTable& t, const std::vector<double>& part, const std::string& file,
+                    const std::string& what, const std::string& short_name) {
+  for (size_t k = 0; k < t.values.size(); ++k) {
+    const double v = static_cast<double>(t.values[k]) - part[k];
+    if (v < -1e-6 * part[k]) {
+      const size_t cell = k / static_cast<size_t>(t.channels), b = static_cast<size_t>(t.bins());
+      throw Error(file,
+                  "values[wi " + std::to_string(cell / b) + "][wo " + std::to_string(cell % b) +
+                      "][" + t.channel_names()[k % static_cast<size_t>(t.channels)] + "]",
+                  "holds " + std::to_string(t.values[k]) + ", less than its " + what + "'s " +
+                      std::to_string(part[k]) + ": the cells must include the " + short_name);
+    }
+    t.values[k] = static_cast<float>(std::max(0.0, v));
+  }
+}
+
+void add_cells(TabulatedBsdfTable& t, const std::vector<double>& part, const char* field) {
+  if (part.size() != t.values.size())
+    throw Error("", field, "the part's cells do not fit the table");
+  for (size_t k = 0; k < t.values.size(); ++k)
+    t.values[k] = static_cast<float>(static_cast<double>(t.values[k]) + part[k]);
+}
+
+}  // namespace
+
 TabulatedBsdfTable TabulatedBsdfTable::without_surface_lobe(const std::string& file, int threads,
                                                             std::vector<double>* lobe_cells) const {
   TabulatedBsdfTable rest = *this;
   if (!surface_lobe) return rest;
   rest.surface_lobe.reset();
   std::vector<double> lobe = surface_lobe->cell_averages(grid(), threads);
-  for (size_t k = 0; k < values.size(); ++k) {
-    const double v = static_cast<double>(values[k]) - lobe[k];
-    if (v < -1e-6 * lobe[k]) {
-      const size_t cell = k / static_cast<size_t>(channels), b = static_cast<size_t>(bins());
-      throw Error(file,
-                  "values[wi " + std::to_string(cell / b) + "][wo " + std::to_string(cell % b) +
-                      "][" + channel_names()[k % static_cast<size_t>(channels)] + "]",
-                  "holds " + std::to_string(values[k]) + ", less than its surface lobe's " +
-                      std::to_string(lobe[k]) + ": the cells must include the lobe");
-    }
-    rest.values[k] = static_cast<float>(std::max(0.0, v));
-  }
+  subtract_cells(rest, lobe, file, "surface lobe", "lobe");
   if (lobe_cells) *lobe_cells = std::move(lobe);
   return rest;
 }
@@ -62,12 +80,26 @@ void TabulatedBsdfTable::add_surface_lobe(const SurfaceLobe& lobe, int threads,
   lobe.validate(channels, "");
   const std::vector<double> computed =
       given ? std::vector<double>{} : lobe.cell_averages(grid(), threads);
-  const std::vector<double>& cells = given ? *given : computed;
-  if (cells.size() != values.size())
-    throw Error("", "surface_lobe", "the lobe's cells do not fit the table");
-  for (size_t k = 0; k < values.size(); ++k)
-    values[k] = static_cast<float>(static_cast<double>(values[k]) + cells[k]);
+  add_cells(*this, given ? *given : computed, "surface_lobe");
   surface_lobe = lobe;
+}
+
+TabulatedBsdfTable TabulatedBsdfTable::without_sheen(const std::string& file, int threads,
+                                                     std::vector<double>* sheen_cells) const {
+  TabulatedBsdfTable rest = *this;
+  if (!sheen) return rest;
+  rest.sheen.reset();
+  std::vector<double> part = sheen->cell_averages(threads);
+  subtract_cells(rest, part, file, "sheen", "sheen");
+  if (sheen_cells) *sheen_cells = std::move(part);
+  return rest;
+}
+
+void TabulatedBsdfTable::add_sheen(HalfVectorLobe lobe, int threads) {
+  if (sheen) throw Error("", "sheen", "the table has a sheen already");
+  lobe.validate(resolution, channels, "");
+  add_cells(*this, lobe.cell_averages(threads), "sheen");
+  sheen = std::move(lobe);
 }
 
 void TabulatedBsdfTable::interpolate(const Vec3& wo, const Vec3& wi, std::span<double> out) const {
@@ -78,7 +110,10 @@ void TabulatedBsdfTable::interpolate(const Vec3& wo, const Vec3& wi, std::span<d
 }
 
 std::string TabulatedBsdfTable::checksum() const {
-  return exr_io::checksum(values);
+  if (!sheen) return exr_io::checksum(values);
+  std::vector<float> all = values;
+  all.insert(all.end(), sheen->values.begin(), sheen->values.end());
+  return exr_io::checksum(all);
 }
 
 std::string TabulatedBsdfTable::bands() const {
@@ -121,7 +156,8 @@ const std::set<std::string>& reserved_attribute_names() {
 }  // namespace
 
 bool TabulatedBsdfTable::is_reserved_attribute(const std::string& name) {
-  return reserved_attribute_names().count(name) > 0 || SurfaceLobe::is_attribute(name);
+  return reserved_attribute_names().count(name) > 0 || SurfaceLobe::is_attribute(name) ||
+         HalfVectorLobe::is_attribute(name);
 }
 
 void TabulatedBsdfTable::validate(const std::string& file) const {
@@ -145,6 +181,7 @@ void TabulatedBsdfTable::validate(const std::string& file) const {
       throw Error(file, "metadata." + key, "name is reserved by the table format");
   }
   if (surface_lobe) surface_lobe->validate(channels, file);
+  if (sheen) sheen->validate(resolution, channels, file);
   for (size_t i = 0; i < values.size(); ++i) {
     const float v = values[i];
     if (std::isfinite(v) && v >= 0) continue;

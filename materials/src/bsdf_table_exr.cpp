@@ -58,15 +58,55 @@ std::string read_table_format(const Imf::Header& h, const std::string& file,
   return bands;
 }
 
+// The image's width: the cells' 2 R^2 columns, then the sheen's window bins when there is one.
+int image_width(const TabulatedBsdfTable& t) {
+  return t.bins() + (t.sheen ? t.sheen->window_bins() : 0);
+}
+
 // The data window must be the table's, and the file large enough to hold its pixels.
 void check_pixel_size(const Imf::Header& h, const std::filesystem::path& path,
                       const std::string& file, const TabulatedBsdfTable& table,
                       const std::string& bands) {
-  const int n = table.bins();
-  exr_io::check_data_window(h, file, n, n, "resolution " + std::to_string(table.resolution));
+  const int n = table.bins(), width = image_width(table);
+  std::string why = "resolution " + std::to_string(table.resolution);
+  if (table.sheen) why += " and sheen window " + std::to_string(table.sheen->window);
+  exr_io::check_data_window(h, file, width, n, why);
   // The pixels must be in the file before their buffer is allocated.
-  exr_io::check_fits_file(path, file, "resolution", double(n) * n * table.channels * sizeof(float),
+  exr_io::check_fits_file(path, file, "resolution",
+                          double(width) * n * table.channels * sizeof(float),
                           std::to_string(table.resolution) + " and bands " + bands);
+}
+
+// The image's pixels: each row a light bin's cells, then its sheen's window bins.
+std::vector<float> image_of(const TabulatedBsdfTable& t) {
+  if (!t.sheen) return t.values;
+  const size_t nc = static_cast<size_t>(t.channels), row = static_cast<size_t>(t.bins()) * nc;
+  const size_t extra = static_cast<size_t>(t.sheen->window_bins()) * nc;
+  std::vector<float> out;
+  out.reserve(t.values.size() + t.sheen->values.size());
+  for (size_t a = 0; a < static_cast<size_t>(t.bins()); ++a) {
+    out.insert(out.end(), t.values.begin() + a * row, t.values.begin() + (a + 1) * row);
+    out.insert(out.end(), t.sheen->values.begin() + a * extra,
+               t.sheen->values.begin() + (a + 1) * extra);
+  }
+  return out;
+}
+
+// The inverse of image_of into the table's values and sheen values.
+void split_image(const std::vector<float>& image, TabulatedBsdfTable& t) {
+  if (!t.sheen) {
+    t.values = image;
+    return;
+  }
+  const size_t nc = static_cast<size_t>(t.channels), row = static_cast<size_t>(t.bins()) * nc;
+  const size_t extra = static_cast<size_t>(t.sheen->window_bins()) * nc;
+  t.values.clear(), t.sheen->values.clear();
+  for (size_t a = 0; a < static_cast<size_t>(t.bins()); ++a) {
+    const auto first = image.begin() + static_cast<std::ptrdiff_t>(a * (row + extra));
+    t.values.insert(t.values.end(), first, first + static_cast<std::ptrdiff_t>(row));
+    t.sheen->values.insert(t.sheen->values.end(), first + static_cast<std::ptrdiff_t>(row),
+                           first + static_cast<std::ptrdiff_t>(row + extra));
+  }
 }
 
 }  // namespace
@@ -89,7 +129,7 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
   validate(file);
   write_atomically(path, [&](const std::filesystem::path& tmp) {
     try {
-      Imf::Header header(bins(), bins());
+      Imf::Header header(image_width(*this), bins());
       header.insert("weft_format_version", Imf::IntAttribute(kFormatVersion));
       header.insert("cell_average", Imf::StringAttribute(kCellAverage));
       header.insert("parameterization", Imf::StringAttribute(kParameterization));
@@ -101,7 +141,10 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
       if (surface_lobe)
         for (const auto& [key, value] : surface_lobe->attributes())
           header.insert(key, Imf::StringAttribute(value));
-      exr_io::write_image(tmp, header, channel_names(), values);
+      if (sheen)
+        for (const auto& [key, value] : sheen->attributes())
+          header.insert(key, Imf::StringAttribute(value));
+      exr_io::write_image(tmp, header, channel_names(), image_of(*this));
     } catch (const Error&) {
       throw;
     } catch (const std::exception& e) {
@@ -112,27 +155,35 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
 
 TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& path) {
   const std::string file = path.string();
-  // The largest table: 2 R^2 bins a side.
+  // The largest table: 2 R^2 bins a side, and a row's sheen window at most R_h^2 bins more.
   const int64_t max_bins = 2 * int64_t{kMaxResolution} * kMaxResolution;
+  const int64_t max_window =
+      int64_t{HalfVectorLobe::kMaxHResolution} * HalfVectorLobe::kMaxHResolution;
   exr_io::check_magic(path, file);
-  exr_io::check_header(path, file, max_bins, max_bins);
+  exr_io::check_header(path, file, max_bins + max_window, max_bins);
 
   TabulatedBsdfTable table;
   try {
     Imf::InputFile in(file.c_str());
     const Imf::Header& h = in.header();
     const std::string bands = read_table_format(h, file, table);
+    const int version = exr_io::int_attribute(h, file, "weft_format_version");
+    // Versions 3 and 4 knew no sheen, version 3 no lobe: their attributes there would be
+    // metadata of another program's.
+    auto attributes_of = [&](bool (*is)(const std::string&)) {
+      return exr_io::string_attributes(h, [is](const std::string& n) { return !is(n); });
+    };
+    if (version >= 5)
+      table.sheen = HalfVectorLobe::from_attributes(attributes_of(HalfVectorLobe::is_attribute),
+                                                    table.resolution, table.channels, file);
     check_pixel_size(h, path, file, table, bands);
     const std::vector<std::string> names = table.channel_names();
     exr_io::check_channels(h, file, names, bands);
-    table.values = exr_io::read_pixels(in, file, names, table.bins(), table.bins());
+    split_image(exr_io::read_pixels(in, file, names, image_width(table), table.bins()), table);
     table.metadata = exr_io::string_attributes(h, is_reserved_attribute);
-    // Version 3 knew no lobe: its attributes there would be metadata of another program's.
-    if (exr_io::int_attribute(h, file, "weft_format_version") >= 4)
-      table.surface_lobe = SurfaceLobe::from_attributes(
-          exr_io::string_attributes(
-              h, [](const std::string& n) { return !SurfaceLobe::is_attribute(n); }),
-          table.channels, file);
+    if (version >= 4)
+      table.surface_lobe = SurfaceLobe::from_attributes(attributes_of(SurfaceLobe::is_attribute),
+                                                        table.channels, file);
     if (exr_io::string_attribute(h, file, "cell_average") != kCellAverage)
       throw Error(file, "cell_average",
                   "is \"" + exr_io::string_attribute(h, file, "cell_average") +

@@ -36,6 +36,8 @@ nlohmann::json table_info(const TabulatedBsdfTable& t, const std::string& file) 
                          {"transmittance_normal_view", view.transmittance}};
   // The analytic lobe the cells include (surface_lobe.h), as the file names it.
   if (t.surface_lobe) info["surface_lobe"] = t.surface_lobe->attributes();
+  // The sheen over half vectors the cells include (half_vector_lobe.h), as the file names it.
+  if (t.sheen) info["sheen"] = t.sheen->attributes();
   return info;
 }
 

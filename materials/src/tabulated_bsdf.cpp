@@ -252,6 +252,55 @@ Distribution2D wi_sampling(const DirectionGrid& grid, int wo, const std::vector<
   return Distribution2D(w, static_cast<size_t>(fine.fr), static_cast<size_t>(2 * fine.fr));
 }
 
+// The sheen's RGB (a spectral one reduced like the cells) into data, the rest's values into rgb and
+// bands, and the sheen's draws: per wo bin b its window bins in proportion to the light booked
+// there for light from b (the table taken as reciprocal), and its share of the draws, half the
+// sheen's share of the light arriving at b (sheen_cells: its cell averages).
+void prepare_sheen(const TabulatedBsdfTable& table, const TabulatedBsdfTable& rest,
+                   const std::vector<double>& sheen_cells, TabulatedBsdfData& data) {
+  reduce_to_rgb(rest, data);
+  const HalfVectorLobe& s = *table.sheen;
+  const size_t nc = static_cast<size_t>(table.channels), pairs = s.values.size() / nc;
+  HalfVectorLobe rgb = s;
+  rgb.channels = 3;
+  rgb.values.resize(pairs * 3);
+  GamutClip gamut;
+  for (size_t p = 0; p < pairs; ++p) {
+    const float* v = &s.values[p * nc];
+    Rgb c = nc == 3 ? Rgb{v[0], v[1], v[2]} : bands_to_linear_srgb([v](int b) { return v[b]; });
+    if (nc != 3) gamut.clip(c);
+    rgb.values[p * 3] = static_cast<float>(c.r);
+    rgb.values[p * 3 + 1] = static_cast<float>(c.g);
+    rgb.values[p * 3 + 2] = static_cast<float>(c.b);
+  }
+  data.clamped_components += gamut.components;
+  if (nc == kNumBands) data.sheen_bands = s;
+  const std::vector<double> m = s.mean_projections();
+  const int n = data.grid.bins();
+  const size_t nk = static_cast<size_t>(s.window_bins());
+  const std::vector<double> d = data.grid.cosine_weighted_areas();
+  data.sheen_sampling.resize(static_cast<size_t>(n));
+  data.sheen_share.assign(static_cast<size_t>(n), 0.0);
+  for (int b = 0; b < n; ++b) {
+    std::vector<double> w(nk);
+    for (size_t k = 0; k < nk; ++k) {
+      const size_t at = (static_cast<size_t>(b) * nk + k) * 3;
+      w[k] = (rgb.values[at] + rgb.values[at + 1] + rgb.values[at + 2]) * m[b * nk + k];
+    }
+    data.sheen_sampling[b] = Distribution1D(w);
+    double part = 0, whole = 0;
+    for (int i = 0; i < n; ++i)
+      for (size_t c = 0; c < nc; ++c) {
+        const size_t v = (static_cast<size_t>(i) * n + static_cast<size_t>(b)) * nc + c;
+        part += sheen_cells[v] * d[i];
+        whole += table.values[v] * d[i];
+      }
+    if (data.sheen_sampling[b].integral() > 0 && whole > 0)
+      data.sheen_share[b] = 0.5 * std::min(1.0, part / whole);
+  }
+  data.sheen_rgb = std::move(rgb);
+}
+
 }  // namespace
 
 std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
@@ -281,6 +330,11 @@ std::shared_ptr<const TabulatedBsdfData> TabulatedBsdfData::prepare(
     const int wo = static_cast<int>(task);
     data->sampling[wo] = wi_sampling(grid, wo, mean, blur, cos_avg, fine, TableLookup::bilinear);
   });
+  if (table.sheen) {
+    std::vector<double> sheen_cells;
+    const TabulatedBsdfTable rest = table.without_sheen("", 0, &sheen_cells);
+    prepare_sheen(table, rest, sheen_cells, *data);
+  }
   return data;
 }
 
@@ -304,9 +358,14 @@ const std::vector<Distribution2D>& TabulatedBsdfData::cell_sampling() const {
 }
 
 Rgb TabulatedBsdf::eval_table(const Vec3& wo, const Vec3& wi) const {
-  if (lookup == TableLookup::cell)
-    return data->lookup(data->grid.bin_of(wi), data->grid.bin_of(wo)) * scale;
   Rgb sum;
+  if (data->sheen_rgb) {
+    std::array<double, 3> s{};
+    data->sheen_rgb->eval(wo, wi, s);
+    sum = {s[0], s[1], s[2]};
+  }
+  if (lookup == TableLookup::cell)
+    return (sum + data->lookup(data->grid.bin_of(wi), data->grid.bin_of(wo))) * scale;
   for_each_interpolated_cell(data->grid, wo, wi,
                              [&](int i, int o, double w) { sum += data->lookup(i, o) * w; });
   return sum * scale;
@@ -324,6 +383,11 @@ void TabulatedBsdf::eval_bands(const Vec3& wo, const Vec3& wi, Spectrum& out) co
   else
     for_each_interpolated_cell(data->grid, wo, wi,
                                [&](int i, int o, double w) { add(i, o, w * scale.r); });
+  if (data->sheen_bands) {
+    Spectrum s;
+    data->sheen_bands->eval(wo, wi, s);
+    for (int b = 0; b < kNumBands; ++b) out[b] += scale.r * s[b];
+  }
 }
 
 Rgb TabulatedBsdf::eval_backing(const Vec3& wo, const Vec3& wi) const {
@@ -383,9 +447,39 @@ double TabulatedBsdf::pdf_backed(const BackedLobes& l, const Vec3& wo, const Vec
   return p;
 }
 
+double TabulatedBsdf::sheen_share(const Vec3& wo) const {
+  if (backing || data->sheen_share.empty()) return 0;
+  return data->sheen_share[static_cast<size_t>(data->grid.bin_of(wo))];
+}
+
+double TabulatedBsdf::pdf_sheen(const Vec3& wo, const Vec3& wi) const {
+  const HalfVectorLobe& s = *data->sheen_rgb;
+  const Vec3 sum = wo + wi;
+  if (!(wo.z * wi.z > 0) || !(length(sum) > 0)) return 0;
+  const Vec3 h = sum / length(sum);
+  const int k = s.window_bin_of(h);
+  if (k < 0) return 0;
+  const Distribution1D& d = data->sheen_sampling[static_cast<size_t>(data->grid.bin_of(wo))];
+  return d.pmf(static_cast<size_t>(k)) / (s.window_bin_solid_angle() * 4 * std::abs(dot(wo, h)));
+}
+
+std::optional<Vec3> TabulatedBsdf::sample_sheen(const Vec3& wo, Vec2 u, double u_bin) const {
+  const HalfVectorLobe& s = *data->sheen_rgb;
+  const Distribution1D& d = data->sheen_sampling[static_cast<size_t>(data->grid.bin_of(wo))];
+  Vec3 h = s.window_point(static_cast<int>(d.sample_discrete(u_bin)), u.x, u.y);
+  if (wo.z < 0) h.z = -h.z;
+  const double wo_h = dot(wo, h);
+  const Vec3 wi = 2 * wo_h * h - wo;
+  if (!(wo_h > 0) || !(wi.z * wo.z > 0)) return std::nullopt;
+  return normalize(wi);
+}
+
 double TabulatedBsdf::pdf(const Vec3& wo, const Vec3& wi) const {
   if (!data) return 0;
-  if (!backing) return pdf_table(wo, wi);
+  if (!backing) {
+    const double s = sheen_share(wo);
+    return s > 0 ? (1 - s) * pdf_table(wo, wi) + s * pdf_sheen(wo, wi) : pdf_table(wo, wi);
+  }
   if (!(wo.z > 0) || !(wi.z > 0)) return 0;
   return pdf_backed(backed_lobes(wo), wo, wi);
 }
@@ -396,9 +490,16 @@ std::optional<BsdfSample> TabulatedBsdf::sample(const Vec3& wo, Vec2 u, double u
   Vec3 wi;
   double p = 0;
   if (!backing) {
-    if (dist.integral() == 0) return std::nullopt;
-    wi = DirectionGrid::to_direction(dist.sample(u).p);
-    p = pdf_table(wo, wi);
+    const double s = sheen_share(wo);
+    if (u_lobe < s) {
+      const std::optional<Vec3> drawn = sample_sheen(wo, u, u_lobe / s);
+      if (!drawn) return std::nullopt;
+      wi = *drawn;
+    } else {
+      if (dist.integral() == 0) return std::nullopt;
+      wi = DirectionGrid::to_direction(dist.sample(u).p);
+    }
+    p = pdf(wo, wi);
   } else {
     if (!(wo.z > 0)) return std::nullopt;
     const BackedLobes l = backed_lobes(wo);

@@ -65,10 +65,10 @@ const Vec3 kTableWo[] = {spherical_direction(deg_to_rad(30), 0.4),
                          spherical_direction(deg_to_rad(125), -1.0)};
 const double kMeasuredAngles[] = {20, 70, 45};
 
-constexpr int kChi2Tests = 1 /* self-test acceptance */ + std::size(kLambertAngles) +
-                           std::size(kCookTorranceCases) + std::size(kClassicFiberCases) +
-                           3 * std::size(kTableWo) + 2 /* backed table, wo above */ +
-                           std::size(kMeasuredAngles);
+constexpr int kChi2Tests =
+    1 /* self-test acceptance */ + std::size(kLambertAngles) + std::size(kCookTorranceCases) +
+    std::size(kClassicFiberCases) + 3 * std::size(kTableWo) + 2 /* backed table, wo above */ +
+    std::size(kTableWo) /* table with a sheen */ + std::size(kMeasuredAngles);
 const double kSignificance = sidak_significance(0.01, kChi2Tests);
 
 void expect_chi2(const Bsdf& bsdf, const Vec3& wo, uint64_t seed, const std::string& what) {
@@ -106,6 +106,24 @@ TabulatedBsdf fabric_like_table(std::optional<Rgb> backing = std::nullopt) {
   TabulatedBsdf b{TabulatedBsdfData::prepare(table), Rgb(1.0)};
   if (backing) b.backing = TableBacking::make(*b.data, b.scale, *backing);
   return b;
+}
+
+// The same cells with a sheen over half vectors (half_vector_lobe.h) added: R_h 16, a window of
+// 8 x 8 bins (each about 9 degrees), Q drawn per light bin and window bin.
+TabulatedBsdfTable fabric_table_with_sheen() {
+  auto table = TabulatedBsdfTable::from_function(
+      8, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        const double f = wo.z * wi.z > 0 ? 0.15 : 0.02;
+        v[0] = f, v[1] = 0.8 * f, v[2] = 0.5 * f;
+      },
+      1, 11);
+  table.kind = "fabric";
+  HalfVectorLobe sheen = HalfVectorLobe::zeros(8, 16, 8, 3);
+  Rng rng(12, 0, 0);
+  for (float& v : sheen.values) v = static_cast<float>(0.5 * rng.uniform());
+  table.add_sheen(std::move(sheen));
+  return table;
 }
 
 }  // namespace
@@ -186,6 +204,22 @@ TEST(Chi2, FiberAndFabricTables) {
     const auto r = chi2_test(bsdf_sampler(backed, wo), bsdf_pdf(backed, wo), grid, kSamples,
                              kSignificance, seed++);
     EXPECT_TRUE(r.passed) << "backed table, wo " << wo << ": " << r.message;
+  }
+}
+
+// A table with a sheen: the cells' distribution or the sheen's own window draws (the pdf then
+// changes at the window bins' edges: a histogram of R 16 cells, each integrated on 16 x 16
+// points).
+TEST(Chi2, FabricTableWithASheen) {
+  const TabulatedBsdfTable table = fabric_table_with_sheen();
+  const TabulatedBsdf t{TabulatedBsdfData::prepare(table), Rgb(1.0)};
+  ASSERT_TRUE(t.data->sheen_rgb);
+  const Bsdf b(t);
+  uint64_t seed = 450;
+  for (const Vec3& wo : kTableWo) {
+    const auto r = chi2_test(bsdf_sampler(b, wo), bsdf_pdf(b, wo), DirectionGridBins{16, 16},
+                             kSamples, kSignificance, seed++);
+    EXPECT_TRUE(r.passed) << "table with a sheen, wo " << wo << ": " << r.message;
   }
 }
 

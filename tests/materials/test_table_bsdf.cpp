@@ -272,3 +272,33 @@ TEST(TableBsdf, CellSamplingFollowsTheCellReadOfAPeakedTable) {
   EXPECT_GT(worst[0], 2.5);
   EXPECT_LT(worst[1], 2.0);
 }
+
+// A fabric table with a sheen (half_vector_lobe.h) is read as the cells less the sheen's cell
+// averages, interpolated, plus the sheen: sharp where the cells alone blur it; its draws (the
+// cells' distribution or the sheen's window bins) weigh eval / pdf, so their mean is the
+// quadrature's albedo.
+TEST(TableBsdf, ASheenIsReadSharpOverTheRest) {
+  TabulatedBsdfTable table = rgb_table(
+      8, [](const Vec3& wo, const Vec3& wi) { return Rgb(wo.z * wi.z > 0 ? 0.1 : 0.02); });
+  table.kind = "fabric";
+  HalfVectorLobe sheen = HalfVectorLobe::zeros(8, 16, 8, 3);
+  Rng rng(3, 0, 0);
+  for (float& v : sheen.values) v = static_cast<float>(0.5 * rng.uniform());
+  const TabulatedBsdfTable plain = table;
+  table.add_sheen(sheen);
+  const Bsdf with = bsdf_of(table), without = bsdf_of(plain);
+  std::vector<double> s(3);
+  for (const Vec3& wo : kWos) {
+    const Vec3 wi = normalize(Vec3{-wo.x + 0.05, -wo.y, wo.z});  // near the mirror
+    sheen.eval(wo, wi, s);
+    ASSERT_GT(s[0], 0.0);
+    const Rgb f = with.eval(wo, wi), rest = without.eval(wo, wi);
+    EXPECT_NEAR(f.g, rest.g + s[1], 1e-6 * f.g) << wo;
+  }
+  uint64_t seed = 60;
+  for (const Vec3& wo : kWos) {
+    const auto a = estimate_albedo(with, wo, 200000, seed++);
+    const double q = albedo_by_quadrature(with, wo);
+    EXPECT_NEAR(a.mean.g, q, 4 * a.standard_error.g + 2e-3 * q) << wo;
+  }
+}

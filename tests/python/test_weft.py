@@ -61,6 +61,22 @@ def test_an_analytic_surface_lobe_is_named_by_the_table_and_survives_a_file(tmp_
     assert weft.load_table(tmp_path / "lobe.exr").surface_lobe == lobe.surface_lobe
 
 
+def test_a_fabric_table_keeps_its_sheen_through_a_file(tmp_path):
+    # bake_fabric(sheen_resolution=...) books the filament's first-surface reflection apart over
+    # half vectors (docs/fabric-bsdf.md); the table names it, and a file keeps it.
+    fiber = weft.bake_fiber("polyester-filament", bands="rgb", surface_lobe="analytic", photons=400,
+                            resolution=2)
+    fabric = weft.bake_fabric(fiber, "raytrace", detail="fiber", sheen_resolution=16,
+                              sheen_window=4, resolution=2, samples=20)
+    assert fabric.sheen == {"sheen": "half-vector window", "sheen_h_resolution": "16",
+                            "sheen_window": "4"}
+    fabric.save(tmp_path / "sheen.exr")
+    back = weft.load_table(tmp_path / "sheen.exr")
+    assert back.sheen == fabric.sheen and back.checksum == fabric.checksum
+    with pytest.raises(weft.Error, match="sheen_resolution"):
+        weft.bake_fabric(fiber, "raytrace", sheen_resolution=16, resolution=2, samples=20)
+
+
 def test_same_seed_same_bits_at_any_thread_count():
     a = weft.bake_fiber("red-cotton", bands="rgb", threads=1, **TINY)
     b = weft.bake_fiber("red-cotton", bands="rgb", threads=2, **TINY)

@@ -492,3 +492,38 @@ TEST(Cli, ExportPrintsHowTransmissionIsCarried) {
   EXPECT_NEAR(m["figures"]["transmittance either way (file)"].get<double>(),
               (0.4 + 0.08 + 0.04) / 3, 1e-3);
 }
+
+TEST(Cli, BakeFabricBooksTheSheenApartWhereItCan) {
+  // --sheen-resolution reaches the ray trace at fiber detail from a fiber table with an analytic
+  // surface lobe: the table holds the sheen. Where it cannot be booked (yarn detail, parts) or
+  // its window is bad, it is refused by name before any work, with nothing written.
+  const fs::path dir = fresh_test_dir();
+  const fs::path fiber = dir / "filament.exr";
+  const CliRun f = run_weft_cli(
+      "bake fiber polyester-filament --bands rgb --surface-lobe analytic "
+      "--resolution 2 --photons 400 --quiet -o '" +
+          fiber.string() + "'",
+      dir);
+  ASSERT_EQ(f.exit_code, 0) << f.err;
+  const std::string base = "bake fabric --fiber '" + fiber.string() +
+                           "' --method raytrace -R 2 --samples 20 --weave '" + WEFT_SOURCE_DIR +
+                           "/scenes/examples/polyester-satin-weave.json'";
+  const fs::path out = dir / "refused.exr";
+  expect_refused(base + " --sheen-resolution 16", out, "--sheen-resolution", dir);  // yarn detail
+  const std::string fiber_detail = base + " --detail fiber";
+  expect_refused(fiber_detail + " --sheen-window 4", out, "--sheen-window", dir);
+  expect_refused(fiber_detail + " --sheen-resolution 15", out, "--sheen-resolution", dir);
+  expect_refused(fiber_detail + " --sheen-resolution 16 --sheen-window 18", out, "--sheen-window",
+                 dir);
+  expect_refused(fiber_detail + " --sheen-resolution 16 --shard 1/2", out, "--sheen-resolution",
+                 dir);
+  const fs::path sheen = dir / "sheen.exr";
+  const CliRun r = run_weft_cli(
+      fiber_detail + " --sheen-resolution 16 --sheen-window 4 --json -o '" + sheen.string() + "'",
+      dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto t = weft::TabulatedBsdfTable::read_exr(sheen);
+  ASSERT_TRUE(t.sheen);
+  EXPECT_EQ(t.sheen->h_resolution, 16);
+  EXPECT_EQ(t.sheen->window, 4);
+}

@@ -17,7 +17,8 @@ namespace weft {
 // as the renderer reads the table) at views on the mirror side every 0.5 degree; the peak is the
 // largest beta within 10 degrees of the mirror view, the base the smaller beta 20 degrees either
 // side of the mirror, the width (FWHM) that of the views around the peak above base + (peak -
-// base) / 2.
+// base) / 2. A table with a sheen (half_vector_lobe.h) is read with it: the cells less the
+// sheen's cell averages, interpolated, plus the sheen.
 struct InplanePeak {
   double beta = 0, view_deg = 0, base = 0, fwhm_deg = 0;
 };

@@ -139,6 +139,15 @@ struct FabricRaytraceOptions {
   // result's weave table. It draws no random number, so the table keeps its bits either way.
   int weave_positions_u = 0, weave_positions_v = 0;
   int weave_resolution = 4;
+  // The sheen booked apart (0: off): the light that the first fiber a particle meets reflects off
+  // its surface lobe and that leaves at once, binned per incident bin by its half vector on
+  // DirectionGrid{sheen_h_resolution}'s window of sheen_window bins a side about the pole: the
+  // table's sheen (materials/half_vector_lobe.h), which holds a mirror peak narrower than the
+  // table's bins. Needs fiber detail and a fiber table with an analytic surface lobe (weft bake
+  // fiber --surface-lobe analytic), traced whole (not in parts). Draws no random number: the
+  // cells plus the sheen's cell averages estimate what the cells alone do.
+  int sheen_h_resolution = 0;
+  int sheen_window = 16;
 
   void validate() const;  // weft::Error naming the field
 };

@@ -59,6 +59,10 @@ struct Particle {
   std::vector<double> pdf;    // per strategy, the path's density relative to their mean
   std::vector<double> wp;     // the weights under the proposal (with one; else empty)
   bool scattered = false;     // by a fiber since its launch
+  // With the sheen booked apart (FabricRaytraceOptions::sheen_h_resolution): per channel the
+  // share of w that its first scattering reflected off the fiber's surface lobe, while that is
+  // its only scattering; empty otherwise.
+  std::vector<double> sheen;
 };
 
 // The mean of the channel weights (the power the books count).
@@ -197,9 +201,12 @@ double weigh_scatter(const FiberSampler& fs, const TabulatedBsdfTable& fiber, co
 // The same with the sampler's exact lobe: f_c = the rest's cell value + the lobe's f_c at (wi, wo)
 // of the point drawn, over the strategies' mean density of the step, (g_j |cos theta_o| + lobe
 // albedo_j p_lobe) / S_j (every strategy's density now differs by more than a common factor).
+// With 'lobe_share' (channels values; empty: not asked) the share of each channel's new weight
+// that the lobe's f gives.
 double weigh_scatter_lobe(const FiberSampler& fs, const TabulatedBsdfTable& rest,
                           const Strategies& st, const FiberPoint& pt, const ScatterDraw& draw,
-                          std::span<const double> s_sum, Particle& s);
+                          std::span<const double> s_sum, Particle& s,
+                          std::span<double> lobe_share = {});
 // A yarn tube stands for a round fiber: the weights after scattering at the tube's crossing x of
 // the line along d are scaled per channel by L_c / S_c, L the table's line albedo for d
 // (line_albedo.h, axial cosine with the yarn's tangent at x.pts[0]) and S_c the albedos summed

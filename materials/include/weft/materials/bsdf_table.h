@@ -26,7 +26,10 @@
 //   and every entry of 'metadata' as a string attribute (conventional keys: spec_hash, photons,
 //   seed, program_version); since version 4, optionally the analytic surface lobe the cells
 //   include (surface_lobe.h: "surface_lobe", "surface_lobe_distribution", "surface_lobe_alpha",
-//   "surface_lobe_ior"). Version 3 files (no lobe) still load.
+//   "surface_lobe_ior"). Since version 5, optionally a fabric table's sheen in half-vector space
+//   (half_vector_lobe.h: "sheen", "sheen_h_resolution", "sheen_window"): the image is then wider,
+//   each row's columns past the 2 R^2 cells holding that light bin's W x W window bins, and
+//   values_fnv1a64 covers every pixel. Version 3 and 4 files still load.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -39,6 +42,7 @@
 #include "weft/core/direction_grid.h"
 #include "weft/core/progress.h"
 #include "weft/core/vec.h"
+#include "weft/materials/half_vector_lobe.h"
 #include "weft/materials/surface_lobe.h"
 
 namespace weft {
@@ -67,8 +71,9 @@ struct TabulatedBsdfTable {
   // 3: the hemispherical DirectionGrid (versions 1 and 2 used an octahedral grid whose bins
   // straddled the horizon; they are refused with a request to re-bake). Since version 2 the
   // stored quantity is stated (cell_average). 4: an optional analytic surface lobe beside the
-  // cells (surface_lobe); version 3 tables have none and still load.
-  static constexpr int kFormatVersion = 4;
+  // cells (surface_lobe); version 3 tables have none and still load. 5: an optional sheen in
+  // half-vector space beside the cells (sheen).
+  static constexpr int kFormatVersion = 5;
   static constexpr int kOldestReadableVersion = 3;
   static constexpr const char* kCellAverage = "cosine-weighted";
   static constexpr const char* kParameterization =
@@ -86,6 +91,9 @@ struct TabulatedBsdfTable {
   // may evaluate it exactly (f = cells less its cell averages, interpolated, + the lobe) or ignore
   // it (the cells are the whole f).
   std::optional<SurfaceLobe> surface_lobe;
+  // A fabric table's first-surface reflection per light bin over a fine half-vector window
+  // (half_vector_lobe.h), if it holds one: like the surface lobe, the cells include it.
+  std::optional<HalfVectorLobe> sheen;
 
   DirectionGrid grid() const { return {resolution}; }
   int bins() const { return 2 * resolution * resolution; }
@@ -98,8 +106,8 @@ struct TabulatedBsdfTable {
   float at(int wi_bin, int wo_bin, int channel) const {
     return values[index(wi_bin, wo_bin, channel)];
   }
-  // 64-bit FNV-1a over the values' bytes (IEEE binary32, little-endian, in index order), as 16
-  // lower-case hex digits.
+  // 64-bit FNV-1a over the values' bytes (IEEE binary32, little-endian, in index order), then the
+  // sheen's values when there is one, as 16 lower-case hex digits.
   std::string checksum() const;
   // "rgb" or "390:710:10"; channel names "R","G","B" or "w390".."w710".
   std::string bands() const;
@@ -145,6 +153,16 @@ struct TabulatedBsdfTable {
   // differ. 'cells' (optional): lobe.cell_averages(grid()) already computed by the caller.
   void add_surface_lobe(const SurfaceLobe& lobe, int threads = 0,
                         const std::vector<double>* cells = nullptr);
+
+  // The same for the sheen (HalfVectorLobe::cell_averages): the cells less the sheen's cell
+  // averages, the sheen removed; an Error naming the cell where a cell holds less than its sheen
+  // by more than float rounding. 'sheen_cells' (optional) receives them.
+  TabulatedBsdfTable without_sheen(const std::string& file_for_errors, int threads = 0,
+                                   std::vector<double>* sheen_cells = nullptr) const;
+  // Adds the sheen's cell averages to the cells and keeps the sheen (the fabric ray trace, which
+  // booked the sheen's light apart from the cells). Error if the table has one already or the
+  // shapes differ.
+  void add_sheen(HalfVectorLobe lobe, int threads = 0);
 
   // f(wo, wi) per channel, interpolated like the table material does (for_each_interpolated_cell);
   // 'out' holds 'channels' values.

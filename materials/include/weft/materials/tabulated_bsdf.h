@@ -48,6 +48,15 @@
 // Sampling with a backing: the table's reflection part (its sampling distribution restricted to
 // wi above the cloth) or a cosine lobe for the backing term, chosen with probability in
 // proportion to each part's albedo for this wo.
+//
+// Sheen (a fabric table's half-vector lobe, half_vector_lobe.h): eval reads the cells less the
+// sheen's cell averages, interpolated, plus the sheen itself, so a mirror peak narrower than the
+// bins stays sharp (read by cell, the rest's cell plus the sheen). The sampling
+// distributions and the albedos above are the whole cells' (they cover the sheen's cells); without
+// a backing, a share of the draws, half the sheen's share of the light arriving at wo's bin, takes
+// the sheen's own: a window bin in proportion to the light the table booked there for wo's bin
+// (the table taken as reciprocal), h uniform in it, wi = wo mirrored about h, density
+// p(bin) / (its solid angle x 4 |wo . h|). With a backing only the cells' distribution samples.
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -87,6 +96,12 @@ struct TabulatedBsdfData {
   // Spectral tables: how many RGB components were negative (out of the sRGB gamut) after the
   // D65 band reduction and were set to 0. Always 0 for RGB tables.
   size_t clamped_components = 0;
+  // The table's sheen (the top of this file), its light out of rgb and bands: sheen_rgb in RGB,
+  // sheen_bands a spectral table's as stored; per wo bin the draw of its window bins and the share
+  // of the draws it takes. Empty when the table has none.
+  std::optional<HalfVectorLobe> sheen_rgb, sheen_bands;
+  std::vector<Distribution1D> sheen_sampling;
+  std::vector<double> sheen_share;
 
   // Reduces a (validated) table to RGB and builds the per-wo-bin sampling distributions.
   static std::shared_ptr<const TabulatedBsdfData> prepare(const TabulatedBsdfTable& table);
@@ -169,6 +184,10 @@ struct TabulatedBsdf {
  private:
   Rgb eval_table(const Vec3& wo, const Vec3& wi) const;
   double pdf_table(const Vec3& wo, const Vec3& wi) const;
+  double pdf_sheen(const Vec3& wo, const Vec3& wi) const;
+  std::optional<Vec3> sample_sheen(const Vec3& wo, Vec2 u, double u_bin) const;
+  // The sheen's share of the draws for wo: 0 without a sheen, with a backing or read by cell.
+  double sheen_share(const Vec3& wo) const;
   const Distribution2D& distribution(const Vec3& wo) const;
   // With a backing: the probability of sampling the table's reflection part for wo, and that
   // part's share of the table's sampling distribution (wi above the cloth).

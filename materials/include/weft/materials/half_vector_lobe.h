@@ -1,0 +1,96 @@
+#pragma once
+// A fabric table's sheen held sharp: the light its fibers reflect off their first surface and that
+// leaves the cloth at once, tabulated per light bin over the half vector h = (wi + wo) / |wi + wo|
+// on a fine grid about the pole, beside the table's cells.
+//
+// Why the half vector: a mirror-like reflection off fibers sends light from wi along wo with h
+// near the fibers' surface normals, which do not move with wi. Over a light bin (about 18 degrees
+// across at R 8) the peak in wo moves twice as far as wi, and the cells average it away; over h it
+// stays put, so a fine h grid per coarse light bin holds a peak a few degrees wide (docs/fabric-
+// bsdf.md, "Sharp sheen").
+//
+// The grid: DirectionGrid at h_resolution (R_h), of which only the window of W x W bins about the
+// pole of the upper square is kept (at R_h 64 and W 16, 2.2 degrees a bin, a cap of about 20
+// degrees). Half vectors outside it are the cells' alone. Light from below (wi.z < 0) reflects
+// off the lower face: its h is mirrored through z = 0 into the window.
+//
+// What is stored: Q[light bin][window bin][channel] with f(wi, wo) = Q(wi, h) / (4 |cos_i| |cos_o|)
+// for wi, wo on the same side (zero otherwise): the microfacet form F D G, so that the value varies
+// slowly with wi; Q(wi, h) is bilinear over the light bins (DirectionGrid::bilinear) and constant
+// over a window bin (no second blur). A booking of Q (the fabric ray trace) divides the light of
+// each (light bin, window bin) by the mean (wi . h) over them (mean_projections), so that the
+// cell averages carry the light booked there. The cells of the table include the lobe (like a
+// surface lobe, surface_lobe.h): a reader that ignores it reads the whole f as before, one that
+// uses it takes the cells less cell_averages(), interpolated, plus eval().
+#include <map>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "weft/core/direction_grid.h"
+#include "weft/core/vec.h"
+
+namespace weft {
+
+struct HalfVectorLobe {
+  int resolution = 0;    // R of the table's grid: the light bins
+  int h_resolution = 0;  // R_h of the half vectors' DirectionGrid (even)
+  int window = 0;        // W: bins per side of the window about the pole (even, <= R_h)
+  int channels = 3;
+  std::vector<float> values;  // [light bin][window bin][channel]: Q
+
+  static constexpr int kMaxHResolution = 256;
+
+  int window_bins() const { return window * window; }
+  size_t index(int light_bin, int window_bin, int channel) const {
+    return (static_cast<size_t>(light_bin) * static_cast<size_t>(window_bins()) +
+            static_cast<size_t>(window_bin)) *
+               static_cast<size_t>(channels) +
+           static_cast<size_t>(channel);
+  }
+  // An empty lobe (every Q zero) of the given shape.
+  static HalfVectorLobe zeros(int resolution, int h_resolution, int window, int channels);
+  // The window bin of h, mirrored into the upper hemisphere when h.z < 0; -1 outside the window.
+  int window_bin_of(const Vec3& h) const;
+  // The solid angle of each window bin (DirectionGrid{h_resolution}.bin_solid_angle()).
+  double window_bin_solid_angle() const;
+  // The direction at offsets (fx, fy) in [0, 1] across window bin k (upper hemisphere).
+  Vec3 window_point(int k, double fx, double fy) const;
+
+  // f of every channel into 'out' (channels values, 1/sr).
+  void eval(const Vec3& wo, const Vec3& wi, std::span<double> out) const;
+
+  // The lobe's cosine-weighted cell averages on the table's grid, [wi bin][wo bin][channel] like a
+  // table's values: a deterministic quadrature (per light bin 16 x 16 wi, per window bin 3 x 3 half
+  // vectors), the same bits at any thread count.
+  std::vector<double> cell_averages(int threads = 0) const;
+
+  // What a booking of the lobe's light needs (the fabric ray trace): per light bin a and window
+  // bin k the mean of (wi . h) over wi in a and h in k where wo = reflect(wi, h) lies on wi's side,
+  // zero elsewhere, by the quadrature of cell_averages; [light bin][window bin]. A particle from
+  // a that leaves with weight w and half vector in k estimates the cell's light, so Q =
+  // (sum of w) / (particles x solid angle of k x this mean) gives the cell's cell averages that
+  // light exactly (with Q constant over the light bin).
+  std::vector<double> mean_projections(int threads = 0) const;
+
+  // Header attributes of a table file: "sheen" = "half-vector window", "sheen_h_resolution",
+  // "sheen_window"; the values are the image's columns past the cells (bsdf_table.h).
+  static constexpr const char* kKindAttribute = "sheen";
+  static bool is_attribute(const std::string& name);
+  std::map<std::string, std::string> attributes() const;
+  // The shape from the header (values empty, to be read), nothing when it names no sheen;
+  // weft::Error naming the file and attribute when malformed.
+  static std::optional<HalfVectorLobe> from_attributes(const std::map<std::string, std::string>& a,
+                                                       int resolution, int channels,
+                                                       const std::string& file);
+  // Throws weft::Error(file, "sheen...", ...) unless the shape is valid for a table of
+  // 'resolution' and 'channels' and every value is finite and >= 0.
+  void validate(int resolution, int channels, const std::string& file) const;
+  // Throws weft::Error(file, h_field or window_field, ...) unless R_h is even in
+  // [2, kMaxHResolution] and the window even in [2, R_h].
+  static void check_shape(int h_resolution, int window, const std::string& file,
+                          const std::string& h_field, const std::string& window_field);
+};
+
+}  // namespace weft

@@ -1,0 +1,230 @@
+#include "weft/materials/half_vector_lobe.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "weft/core/error.h"
+#include "weft/core/parallel.h"
+#include "weft/core/params.h"
+
+namespace weft {
+namespace {
+
+constexpr const char* kHResolution = "sheen_h_resolution";
+constexpr const char* kWindow = "sheen_window";
+constexpr const char* kWindowKind = "half-vector window";
+// The quadrature of cell_averages: wi directions per light bin side, half vectors per window bin
+// side.
+constexpr int kQuadWiSide = 16, kQuadHSide = 3;
+
+// The first row and column of the window in the upper square of DirectionGrid{h_resolution}.
+int window_origin(const HalfVectorLobe& l) {
+  return (l.h_resolution - l.window) / 2;
+}
+
+}  // namespace
+
+HalfVectorLobe HalfVectorLobe::zeros(int resolution, int h_resolution, int window, int channels) {
+  check_shape(h_resolution, window, "", "sheen_h_resolution", "sheen_window");
+  HalfVectorLobe l;
+  l.resolution = resolution, l.h_resolution = h_resolution, l.window = window;
+  l.channels = channels;
+  l.values.assign(static_cast<size_t>(DirectionGrid{resolution}.bins()) * l.window_bins() *
+                      static_cast<size_t>(channels),
+                  0.0f);
+  return l;
+}
+
+int HalfVectorLobe::window_bin_of(const Vec3& h) const {
+  const DirectionGrid g{h_resolution};
+  const int bin = g.bin_of({h.x, h.y, std::abs(h.z)});
+  const int row = bin / h_resolution - window_origin(*this);
+  const int col = bin % h_resolution - window_origin(*this);
+  if (row < 0 || col < 0 || row >= window || col >= window) return -1;
+  return row * window + col;
+}
+
+double HalfVectorLobe::window_bin_solid_angle() const {
+  return DirectionGrid{h_resolution}.bin_solid_angle();
+}
+
+Vec3 HalfVectorLobe::window_point(int k, double fx, double fy) const {
+  const int o = window_origin(*this);
+  const int bin = (k / window + o) * h_resolution + k % window + o;
+  return DirectionGrid::to_direction(DirectionGrid{h_resolution}.chart_point(bin, fx, fy));
+}
+
+void HalfVectorLobe::eval(const Vec3& wo, const Vec3& wi, std::span<double> out) const {
+  std::fill(out.begin(), out.end(), 0.0);
+  if (!(wi.z * wo.z > 0)) return;  // reflection only, neither direction on the horizon
+  const Vec3 sum = wi + wo;
+  const double len = length(sum);
+  if (!(len > 0)) return;
+  const int k = window_bin_of(sum / len);
+  if (k < 0) return;
+  const DirectionGrid::Footprint fp =
+      DirectionGrid{resolution}.bilinear(DirectionGrid::to_chart(wi));
+  const double scale = 1.0 / (4 * std::abs(wi.z) * std::abs(wo.z));
+  for (int j = 0; j < 4; ++j) {
+    if (fp.weight[j] == 0) continue;
+    for (int c = 0; c < channels; ++c)
+      out[static_cast<size_t>(c)] += fp.weight[j] * values[index(fp.bin[j], k, c)] * scale;
+  }
+}
+
+namespace {
+
+// The quadrature's half vectors (window bin k's kQuadHSide^2 points), the same for every wi.
+std::vector<Vec3> quadrature_half_vectors(const HalfVectorLobe& l) {
+  std::vector<Vec3> hs;
+  for (int k = 0; k < l.window_bins(); ++k)
+    for (int j = 0; j < kQuadHSide * kQuadHSide; ++j)
+      hs.push_back(l.window_point(k, (j % kQuadHSide + 0.5) / kQuadHSide,
+                                  (j / kQuadHSide + 0.5) / kQuadHSide));
+  return hs;
+}
+
+// The quadrature's wi in light bin a (point i) and its chart position.
+Vec2 quadrature_chart(const DirectionGrid& grid, int a, int i) {
+  return grid.chart_point(a, (i % kQuadWiSide + 0.5) / kQuadWiSide,
+                          (i / kQuadWiSide + 0.5) / kQuadWiSide);
+}
+
+// For h of the window (upper) and wi: h on wi's side, wi . h, and wo = reflect(wi, h); false
+// when wo does not leave on wi's side.
+bool reflect_about(const Vec3& wi, const Vec3& window_h, Vec3& wo, double& wi_h) {
+  const Vec3 h = wi.z < 0 ? Vec3{window_h.x, window_h.y, -window_h.z} : window_h;
+  wi_h = dot(wi, h);
+  wo = 2 * wi_h * h - wi;
+  return wi_h > 0 && wo.z * wi.z > 0;
+}
+
+}  // namespace
+
+std::vector<double> HalfVectorLobe::mean_projections(int threads) const {
+  const DirectionGrid grid{resolution};
+  const size_t nk = static_cast<size_t>(window_bins());
+  std::vector<double> out(static_cast<size_t>(grid.bins()) * nk, 0.0);
+  const std::vector<Vec3> hs = quadrature_half_vectors(*this);
+  const double n = kQuadWiSide * kQuadWiSide * kQuadHSide * kQuadHSide;
+  parallel_for(static_cast<uint64_t>(grid.bins()), threads, [&](uint64_t task) {
+    const int a = static_cast<int>(task);
+    for (int i = 0; i < kQuadWiSide * kQuadWiSide; ++i) {
+      const Vec3 wi = DirectionGrid::to_direction(quadrature_chart(grid, a, i));
+      Vec3 wo;
+      double wi_h = 0;
+      for (size_t m = 0; m < hs.size(); ++m)
+        if (reflect_about(wi, hs[m], wo, wi_h))
+          out[task * nk + m / (kQuadHSide * kQuadHSide)] += wi_h / n;
+    }
+  });
+  return out;
+}
+
+std::vector<double> HalfVectorLobe::cell_averages(int threads) const {
+  const DirectionGrid grid{resolution};
+  const size_t bins = static_cast<size_t>(grid.bins()), nc = static_cast<size_t>(channels);
+  std::vector<double> out(bins * bins * nc, 0.0);
+  const auto d = grid.cosine_weighted_areas();
+  const double omega_wi = grid.bin_solid_angle() / (kQuadWiSide * kQuadWiSide);
+  const double omega_h = window_bin_solid_angle() / (kQuadHSide * kQuadHSide);
+  const std::vector<Vec3> hs = quadrature_half_vectors(*this);
+  parallel_for(bins, threads, [&](uint64_t task) {
+    const int a = static_cast<int>(task);
+    std::vector<double> row(bins * nc, 0.0), q(static_cast<size_t>(window_bins()) * nc);
+    for (int i = 0; i < kQuadWiSide * kQuadWiSide; ++i) {
+      const Vec2 chart = quadrature_chart(grid, a, i);
+      const Vec3 wi = DirectionGrid::to_direction(chart);
+      if (wi.z == 0) continue;
+      // Q(wi, .) over the window, as eval interpolates it between the light bins.
+      const DirectionGrid::Footprint fp = grid.bilinear(chart);
+      std::fill(q.begin(), q.end(), 0.0);
+      for (int j = 0; j < 4; ++j)
+        for (size_t k = 0; fp.weight[j] != 0 && k < q.size(); ++k)
+          q[k] += fp.weight[j] * values[index(fp.bin[j], 0, 0) + k];
+      // f |cos_o| d wo = Q (wi . h) / |cos_i| d h, and the cell average weighs by |cos_i|.
+      Vec3 wo;
+      double wi_h = 0;
+      for (size_t m = 0; m < hs.size(); ++m) {
+        if (!reflect_about(wi, hs[m], wo, wi_h)) continue;
+        const size_t o = static_cast<size_t>(grid.bin_of(wo));
+        const size_t k = m / (kQuadHSide * kQuadHSide);
+        for (size_t c = 0; c < nc; ++c) row[o * nc + c] += q[k * nc + c] * wi_h;
+      }
+    }
+    for (size_t o = 0; o < bins; ++o)
+      for (size_t c = 0; c < nc; ++c)
+        out[(static_cast<size_t>(a) * bins + o) * nc + c] =
+            row[o * nc + c] * omega_wi * omega_h / (d[task] * d[o]);
+  });
+  return out;
+}
+
+bool HalfVectorLobe::is_attribute(const std::string& name) {
+  return name == kKindAttribute || name == kHResolution || name == kWindow;
+}
+
+std::map<std::string, std::string> HalfVectorLobe::attributes() const {
+  return {{kKindAttribute, kWindowKind},
+          {kHResolution, std::to_string(h_resolution)},
+          {kWindow, std::to_string(window)}};
+}
+
+std::optional<HalfVectorLobe> HalfVectorLobe::from_attributes(
+    const std::map<std::string, std::string>& a, int resolution, int channels,
+    const std::string& file) {
+  const auto kind = a.find(kKindAttribute);
+  if (kind == a.end()) {
+    for (const auto& [key, value] : a)
+      if (is_attribute(key)) throw Error(file, key, "given without \"sheen\"");
+    return std::nullopt;
+  }
+  if (kind->second != kWindowKind)
+    throw Error(file, kKindAttribute,
+                std::string("must be \"") + kWindowKind + "\", got \"" + kind->second + "\"");
+  auto integer = [&](const char* key) {
+    const auto it = a.find(key);
+    if (it == a.end()) throw Error(file, key, "is required with \"sheen\"");
+    const auto n = finite_number(it->second);
+    if (!n || *n != std::floor(*n) || std::abs(*n) > 1e6)
+      throw Error(file, key, "is not an integer: \"" + it->second + "\"");
+    return static_cast<int>(*n);
+  };
+  HalfVectorLobe l;
+  l.resolution = resolution, l.channels = channels;
+  l.h_resolution = integer(kHResolution);
+  l.window = integer(kWindow);
+  check_shape(l.h_resolution, l.window, file, kHResolution, kWindow);
+  return l;
+}
+
+void HalfVectorLobe::check_shape(int h_resolution, int window, const std::string& file,
+                                 const std::string& h_field, const std::string& window_field) {
+  if (h_resolution < 2 || h_resolution > kMaxHResolution || h_resolution % 2)
+    throw Error(file, h_field,
+                "the half vectors' resolution must be even, in [2, " +
+                    std::to_string(kMaxHResolution) + "], got " + std::to_string(h_resolution));
+  if (window < 2 || window > h_resolution || window % 2)
+    throw Error(file, window_field,
+                "the window must be even, in [2, " + std::to_string(h_resolution) + "], got " +
+                    std::to_string(window));
+}
+
+void HalfVectorLobe::validate(int table_resolution, int table_channels,
+                              const std::string& file) const {
+  check_shape(h_resolution, window, file, kHResolution, kWindow);
+  if (resolution != table_resolution || channels != table_channels)
+    throw Error(file, kKindAttribute, "does not match the table's resolution and channels");
+  const size_t expected = static_cast<size_t>(DirectionGrid{resolution}.bins()) * window_bins() *
+                          static_cast<size_t>(channels);
+  if (values.size() != expected)
+    throw Error(
+        file, kKindAttribute,
+        "holds " + std::to_string(values.size()) + " values, expected " + std::to_string(expected));
+  for (size_t k = 0; k < values.size(); ++k)
+    if (!(std::isfinite(values[k]) && values[k] >= 0))
+      throw Error(file, "sheen values[" + std::to_string(k) + "]",
+                  "must be finite and >= 0, got " + std::to_string(values[k]));
+}
+
+}  // namespace weft
