@@ -107,7 +107,7 @@ bool book_sheen(const Tracer& t, Life& life, const Vec3& d, std::span<const doub
   const Vec3 h = sum / length(sum);
   const int k = t.sheen->window_bin_of(h);
   if (k < 0) return false;
-  std::array<double, kNumBands> part{};
+  std::array<double, kNumBands> part;  // the first w.size() are written and read
   for (size_t c = 0; c < w.size(); ++c) {
     part[c] = w[c] * sheen_share[c];
     rest[c] = w[c] * (1 - sheen_share[c]);
@@ -125,7 +125,7 @@ void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d, std::s
                std::span<const double> sheen_share) {
   const uint64_t cell = exit_cell(t.grid, life.bin, d);
   record_op(t, *life.tally, {0, static_cast<int64_t>(cell), 0, PathOp::book});
-  std::array<double, kNumBands> rest{};
+  std::array<double, kNumBands> rest;  // written by book_sheen before any read
   const std::span<double> r(rest.data(), w.size());
   tally_exit(*life.tally, life.first_exit, cell,
              book_sheen(t, life, d, w, sheen_share, r) ? std::span<const double>(r) : w);
