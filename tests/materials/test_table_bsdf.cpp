@@ -302,3 +302,31 @@ TEST(TableBsdf, ASheenIsReadSharpOverTheRest) {
     EXPECT_NEAR(a.mean.g, q, 4 * a.standard_error.g + 2e-3 * q) << wo;
   }
 }
+
+// A spectral table's sheen is read per band by a spectral render (eval_bands: the rest's bands
+// plus the sheen's) and reduced to RGB under D65 like the cells for an RGB one.
+TEST(TableBsdf, ASpectralSheenIsReadPerBand) {
+  TabulatedBsdfTable t;
+  t.resolution = 4, t.channels = kNumBands, t.kind = "fabric";
+  t.values.assign(static_cast<size_t>(t.bins()) * t.bins() * kNumBands, 0.05f);
+  const TabulatedBsdfTable plain = t;
+  HalfVectorLobe sheen = HalfVectorLobe::zeros(4, 16, 8, kNumBands);
+  Rng rng(9, 0, 0);
+  for (float& v : sheen.values) v = static_cast<float>(0.4 * rng.uniform());
+  t.add_sheen(sheen);
+  const TabulatedBsdf with{TabulatedBsdfData::prepare(t), Rgb(1.0)};
+  const TabulatedBsdf without{TabulatedBsdfData::prepare(plain), Rgb(1.0)};
+  ASSERT_TRUE(with.data->sheen_bands && with.data->sheen_rgb);
+  const Vec3 wo = spherical_direction(0.6, 0.3);
+  const Vec3 wi = normalize(Vec3{-wo.x, -wo.y + 0.02, wo.z});
+  Spectrum a, b, s;
+  with.eval_bands(wo, wi, a);
+  without.eval_bands(wo, wi, b);
+  sheen.eval(wo, wi, s);
+  ASSERT_GT(s[16], 0.0);
+  for (int k = 0; k < kNumBands; ++k) EXPECT_NEAR(a[k], b[k] + s[k], 1e-5 * a[k]) << k;
+  // The RGB read: the rest's RGB plus the sheen's bands reduced under D65.
+  const Rgb rgb = with.eval(wo, wi), rest = without.eval(wo, wi);
+  const Rgb reduced = bands_to_linear_srgb([&](int k) { return s[k]; });
+  EXPECT_NEAR(rgb.g, rest.g + reduced.g, 1e-3 * rgb.g);
+}
