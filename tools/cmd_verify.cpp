@@ -230,7 +230,7 @@ void add_verify_command(CLI::App& app, Commands& commands) {
                         if (!o->suite) return run(*o);
                         for (const char* name :
                              {"--measured", "--fiber", "--weave", "--pattern", "--wif", "--shard",
-                              "--fit", "--classic-albedo", "--colour", "--colour-from"})
+                              "--colour-space", "--fit", "--classic-albedo", "--colour"})
                           if (sub->count(name) > 0) o->per_fabric_given.push_back(name);
                         return run_suite(*o);
                       }});

@@ -461,6 +461,10 @@ TEST(CliVerify, SuiteWritesAReportPerFabricAndOnePage) {
   r = run_weft("verify --quiet --quality draft --suite --measured x.csv -o suite", dir);
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("--measured"), std::string::npos) << r.err;
+  // The suite file states each measurement's colour space: one given for all would be dropped.
+  r = run_weft("verify --quiet --quality draft --suite --colour-space srgb -o suite", dir);
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("--colour-space"), std::string::npos) << r.err;
 
   std::ofstream(dir / "one.json") << "{\"title\": \"one\", \"fabrics\": [" << fabric("w", poplin)
                                   << "]}";

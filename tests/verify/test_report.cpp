@@ -124,6 +124,32 @@ TEST(VerifyReportFiles, CalibratedRunGivesEachUnfittedModelItsCalibratedFigure) 
     }
     EXPECT_FALSE(models.at("classic_fitted").contains("calibrated"));
     EXPECT_EQ(j.contains("computed_calibrated_rms_log"), calibrated);
+    EXPECT_EQ(j.at("colour_calibrated"), calibrated);
+  }
+}
+
+// Against camera RGB a calibrated run's absolute figure is judged: both models' colour came from
+// the measurement's own reading, in its own space; uncalibrated it stays not comparable.
+TEST(VerifyReportFiles, CalibratedRunJudgesTheAbsoluteFigureInCameraRgb) {
+  for (const bool calibrated : {false, true}) {
+    VerifyReport r = tiny_report();
+    r.measured.colour_space = MeasuredColourSpace::kCamera;
+    r.colour_calibrated = calibrated;
+    ModelCurves c = r.models[0];
+    c.key = "computed_raytrace";
+    c.beta = {{Rgb(0.5), Rgb(0.4)}};
+    r.models.push_back(c);
+    for (auto& m : r.models) m.figures = model_figures(m.beta, {}, r.measured, {0, 0});
+    const auto j = nlohmann::json::parse(verify_metrics_json(r));
+    EXPECT_EQ(j.at("absolute_comparable"), calibrated);
+    ASSERT_EQ(j.at("verdict").at("absolute").size(), 1u);
+    const auto& v = j.at("verdict").at("absolute")[0];
+    EXPECT_EQ(v.at("comparable"), calibrated);
+    EXPECT_EQ(v.at("text").get<std::string>().find("calibrated") != std::string::npos, calibrated);
+    EXPECT_EQ(
+        j.at("models").at("computed_raytrace").at("uncertainty").at("absolute").at("comparable"),
+        calibrated);
+    EXPECT_EQ(verify_index_html(r, {}).find("(not comparable)") != std::string::npos, !calibrated);
   }
 }
 

@@ -241,6 +241,58 @@ TEST(VerifySuitePage, CountsFirstThenACompactRowPerFabric) {
     EXPECT_NE(html.find(rule), std::string::npos) << rule;
 }
 
+// --colour-from measured over a suite: each fabric is calibrated to its own measurement (the
+// request carries it), and the page names the absolute figure "calibrated", judges it in camera
+// RGB too (the colour came from the measurement itself) and shows the recipe as matched.
+TEST(VerifySuitePage, ACalibratedSuiteJudgesTheCalibratedFigureAndShowsTheMatchedRecipe) {
+  VerifyRequest base;
+  base.colour_from = "measured";
+  const SuiteFabric fabric{"a", "m.csv", "red-cotton", "", "", "", "camera", "k"};
+  EXPECT_EQ(suite_request(fabric, base, "/tmp/out").colour_from, "measured");
+
+  VerifySuite s;
+  s.title = "calibrated";
+  SuiteRow row = scoreboard_row("alpha", "k");
+  row.fabric.colour_space = "camera";
+  row.metrics["absolute_comparable"] = false;
+  row.metrics["colour_calibrated"] = true;
+  row.metrics["models"]["computed_raytrace"]["calibrated"] = {{"rms_log", 0.5}};
+  row.metrics["verdict"]["absolute"] = nlohmann::json::parse(
+      R"([{"a": "computed_raytrace", "b": "classic", "resolved": true, "comparable": true,
+           "closer": "computed_raytrace", "text": "Absolute: computed closer [calibrated]"}])");
+  row.metrics["colour_match"] = nlohmann::json::parse(
+      R"j({"basis": "the recipe's dyes (% owf)", "delta_e00": 5.69, "outside_reach": true,
+          "dye_scale": [{"dye": "congo-red", "scale": 0.75}, {"dye": "curcumin", "scale": 0.34}]})j");
+  const auto j = nlohmann::json::parse(verify_suite_json(s, {row}));
+  EXPECT_EQ(j.at("colour_calibrated"), true);
+  EXPECT_EQ(j.at("fabrics")[0].at("closer").at("absolute"), "computed");
+  EXPECT_EQ(j.at("figure_summary").at("absolute").at("computed_closer"), 1);
+  EXPECT_DOUBLE_EQ(j.at("fabrics")[0]
+                       .at("models")
+                       .at("computed_raytrace")
+                       .at("calibrated_rms_log")
+                       .get<double>(),
+                   0.5);
+  EXPECT_EQ(j.at("fabrics")[0].at("colour_match").at("dyes"),
+            "congo-red 0.75 % + curcumin 0.34 % owf");
+  const std::string html = verify_suite_html(s, {row});
+  EXPECT_NE(html.find("<b>calibrated</b>: <span class=\"computed\">computed 1</span>"),
+            std::string::npos);
+  EXPECT_EQ(html.find("<b>absolute</b>:"), std::string::npos);
+  EXPECT_NE(html.find("<th>calibrated</th>"), std::string::npos);
+  EXPECT_NE(html.find("matched congo-red 0.75 % + curcumin 0.34 % owf (&Delta;E00 5.69, out of "
+                      "reach)"),
+            std::string::npos);
+  const std::string text = verify_suite_text({row});
+  EXPECT_NE(text.find("calibrated"), std::string::npos);
+  EXPECT_NE(text.find("Calibrated (each fabric's colour from its measurement's d/8 reading), "
+                      "computed vs classic: computed closer on 1"),
+            std::string::npos);
+  // Without calibration the same page keeps "absolute".
+  EXPECT_NE(verify_suite_html(s, {scoreboard_row("beta", "k")}).find("<th>absolute</th>"),
+            std::string::npos);
+}
+
 TEST(VerifySuitePage, PathsAreShownRelativeNeverAbsolute) {
   const fs::path dir = fresh_test_dir();
   fs::create_directories(dir / "suite" / "fibers");

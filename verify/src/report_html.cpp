@@ -28,9 +28,8 @@ void html_metrics(std::ostringstream& h, const VerifyReport& r) {
   h << "<h2>All metrics (over every view, incidence and channel)</h2>\n<table><tr><th>model</th>"
        "<th>RMS log ratio, normalized</th><th>RMS relative, normalized</th><th>RMS log ratio, "
        "absolute"
-    << (absolute_comparable(r.measured.colour_space) ? "" : " (not comparable)")
-    << "</th><th>RMS relative, absolute"
-    << (absolute_comparable(r.measured.colour_space) ? "" : " (not comparable)")
+    << (absolute_judged(r) ? "" : " (not comparable)") << "</th><th>RMS relative, absolute"
+    << (absolute_judged(r) ? "" : " (not comparable)")
     << "</th><th>normalization factor (R, G, B)</th>"
        "<th>points (excluded)</th></tr>\n";
   for (const auto& m : r.models)

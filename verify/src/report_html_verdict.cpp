@@ -21,8 +21,7 @@ void figures_table(std::ostringstream& h, const VerifyReport& r) {
     << "&deg;)</th><th>shape beyond " << fmt(kShapeMaxViewDeg)
     << "&deg; (same gains)</th><th>shape gains (R, G, B)</th><th>paper's one-point "
        "normalization, RMS log</th><th>absolute, RMS log"
-    << (absolute_comparable(r.measured.colour_space) ? "" : " (not comparable)")
-    << "</th><th>points floored</th></tr>\n";
+    << (absolute_judged(r) ? "" : " (not comparable)") << "</th><th>points floored</th></tr>\n";
   for (const auto& m : r.models) {
     if (m.figures.fits.empty()) continue;
     const ShapeFigure& s = m.figures.shape;
@@ -57,7 +56,7 @@ void html_verdict(std::ostringstream& h, const VerifyReport& r) {
     h << "<p><b>No model here describes this sample</b>: every model's shape figure is above "
       << fmt(kNoModelShapeRmsLog) << " RMS log, so no verdict names a closer model.</p>\n";
   for (int f = 0; f < 3; ++f) {
-    const bool shown_apart = f == kAbsoluteFigure && !absolute_comparable(r.measured.colour_space);
+    const bool shown_apart = f == kAbsoluteFigure && !absolute_judged(r);
     h << "<p><b>" << html_escape(figure_label(static_cast<FigureKind>(f))) << "</b>"
       << (shown_apart ? " &mdash; <b>" + html_escape(not_comparable_note(r.measured.colour_space)) +
                             "</b> (shown for what it is)"

@@ -77,12 +77,12 @@ nlohmann::json figure_json(const FigureSamples& f, const std::vector<std::string
           {"comparable", comparable}};
 }
 
-nlohmann::json uncertainty_json(const ModelFigures& f, MeasuredColourSpace space) {
+nlohmann::json uncertainty_json(const ModelFigures& f, bool absolute_is_judged) {
   nlohmann::json u = {{"fits", f.fits}};
   if (f.fits.empty()) return u;
   for (int k = 0; k < 3; ++k)
     u[kFigureKeys[k]] =
-        figure_json(f.figure[k], f.fits, k != kAbsoluteFigure || absolute_comparable(space));
+        figure_json(f.figure[k], f.fits, k != kAbsoluteFigure || absolute_is_judged);
   return u;
 }
 
@@ -108,7 +108,7 @@ nlohmann::json models_json(const VerifyReport& r) {
                      {"absolute", metrics_json(m.absolute_overall)},
                      {"normalized", metrics_json(m.normalized_overall)},
                      {"per_incidence", per},
-                     {"uncertainty", uncertainty_json(m.figures, r.measured.colour_space)},
+                     {"uncertainty", uncertainty_json(m.figures, absolute_judged(r))},
                      {"log_floored_points", m.figures.log_floored_points}};
     if (!m.figures.fits.empty()) models[m.key]["shape"] = shape_json(m.figures.shape, r.measured);
     // Calibrated (--colour-from measured): every unfitted model is made of the fiber dyed to the
@@ -311,14 +311,16 @@ nlohmann::json verify_metrics(const VerifyReport& r) {
   // The measurement's RGB space, and whether the figures that include the colour's level (the
   // absolute ones, the colour table's absolute colour) compare with the models' linear sRGB.
   j["colour_space"] = colour_space_name(r.measured.colour_space);
-  j["absolute_comparable"] = absolute_comparable(r.measured.colour_space);
-  if (!absolute_comparable(r.measured.colour_space))
+  j["absolute_comparable"] = absolute_judged(r);
+  if (!absolute_judged(r))
     j["absolute_note"] =
         not_comparable_note(r.measured.colour_space) +
         "; the shape and the paper's normalized figures stay comparable (per-channel "
         "gains absorb the diagonal part of a change of RGB space)";
   j["fiber"] = r.fiber_name;
   if (!r.colour_match.is_null()) j["colour_match"] = r.colour_match;
+  // --colour-from measured: the absolute figures are the calibrated ones (computed_calibrated_*).
+  j["colour_calibrated"] = r.colour_calibrated;
   j["sample"] = r.sample_name;
   const VerifySettings& s = r.settings;
   j["settings"] = settings_json(s);

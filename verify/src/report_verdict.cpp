@@ -51,7 +51,12 @@ std::vector<Verdict> verify_verdicts(const VerifyReport& r) {
       Verdict v = compare_figure(kind, ka, verdict_model_name(ka), a->figures.figure[f], kb,
                                  verdict_model_name(kb), b->figures.figure[f],
                                  {context.measured_spread[f], context.no_model_describes});
-      if (kind == kAbsoluteFigure && !absolute_comparable(r.measured.colour_space)) {
+      // Calibrated, both models' colour was set from the measurement's own d/8 reading, in the
+      // measurement's space: what the absolute figure then judges is everything that one reading
+      // does not set (the angles, the dye's spectral shape), which any RGB space shows.
+      if (kind == kAbsoluteFigure && r.colour_calibrated) {
+        v.text += " [calibrated: the colour from the measurement's own d/8 reading]";
+      } else if (kind == kAbsoluteFigure && !absolute_judged(r)) {
         v.comparable = false;
         v.text += " [" + not_comparable_note(r.measured.colour_space) + "]";
       }

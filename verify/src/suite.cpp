@@ -112,6 +112,8 @@ VerifyRequest suite_request(const SuiteFabric& f, const VerifyRequest& base,
   r.weave = f.weave;
   r.pattern = f.pattern;
   r.wif = f.wif;
+  // Calibrated, each fabric's colour is its own measurement's reading: a colour is per fabric.
+  r.colour_from = base.colour_from;
   r.output = (output / f.name).string();
   return r;
 }

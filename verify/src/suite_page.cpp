@@ -38,6 +38,11 @@ constexpr SuiteFigure kSuiteFigures[] = {{kFigureKeys[0], "shape", "shape_rms_lo
                                          {kFigureKeys[1], "paper's", "paper_rms_log"},
                                          {kFigureKeys[2], "absolute", "absolute_rms_log"}};
 
+// A figure's column head: the absolute figure of a calibrated suite is its calibrated one.
+std::string figure_head(const SuiteFigure& figure, bool calibrated) {
+  return calibrated && std::string(figure.key) == kFigureKeys[2] ? "calibrated" : figure.head;
+}
+
 // A number of a JSON object, or NaN when absent or not a number.
 double number_at(const nlohmann::json& j, const nlohmann::json::json_pointer& p) {
   if (!j.contains(p)) return std::nan("");
@@ -68,7 +73,8 @@ nlohmann::json model_figures(const nlohmann::json& m, const SuiteModel& model) {
             {"G", at("/shape/rms_log_channel/G")},
             {"B", at("/shape/rms_log_channel/B")}}},
           {"paper_rms_log", at("/normalized/rms_log")},
-          {"absolute_rms_log", at("/absolute/rms_log")}};
+          {"absolute_rms_log", at("/absolute/rms_log")},
+          {"calibrated_rms_log", at("/calibrated/rms_log")}};
 }
 
 // The report's verdicts on one figure ("shape", "paper_normalized", "absolute"): their texts.
@@ -143,6 +149,22 @@ std::string suite_fiber_dyes(const std::string& fiber) {
   }
 }
 
+// A calibrated fabric's colour match, short: the dyes as matched ("congo-red 1.2 % + curcumin
+// 0.3 % owf"), the distance reached and whether the target was out of the dyes' reach.
+nlohmann::json suite_colour_match(const nlohmann::json& metrics) {
+  const nlohmann::json& m = metrics.at("colour_match");
+  std::string dyes;
+  if (m.contains("dye_scale") && m.at("dye_scale").is_array())
+    for (const auto& d : m.at("dye_scale"))
+      if (d.contains("dye") && d.contains("scale") && d.at("scale").is_number())
+        dyes += (dyes.empty() ? "" : " + ") + d.value("dye", std::string()) + " " +
+                fmt(d.at("scale").get<double>(), 3) + " %";
+  const bool recipe = m.value("basis", std::string()).rfind("the recipe", 0) == 0;
+  return {{"dyes", dyes.empty() ? "" : dyes + (recipe ? " owf" : " (thread-colour absorbers)")},
+          {"delta_e00", m.contains("delta_e00") ? m.at("delta_e00") : nlohmann::json()},
+          {"outside_reach", m.value("outside_reach", false)}};
+}
+
 nlohmann::json suite_row_json(const SuiteRow& r, const fs::path& suite_dir) {
   nlohmann::json j = {{"name", r.fabric.name},
                       {"measured", r.fabric.measured},
@@ -186,6 +208,8 @@ nlohmann::json suite_row_json(const SuiteRow& r, const fs::path& suite_dir) {
                                               verify_model_key(VerifyModel::kComputedRaytrace) +
                                               "/log_floored_points")));
   j["no_model_describes"] = j["shape_closer"] == "no_model";
+  j["colour_calibrated"] = r.metrics.value("colour_calibrated", false);
+  if (r.metrics.contains("colour_match")) j["colour_match"] = suite_colour_match(r.metrics);
   if (r.metrics.contains("verdict")) j["verdict"] = r.metrics.at("verdict");
   return j;
 }
@@ -232,6 +256,13 @@ nlohmann::json figure_counts(const nlohmann::json& rows, const std::string& figu
           {"without_verdict", not_run}};
 }
 
+// Whether the suite ran calibrated (--colour-from measured): its fabrics' reports say so.
+bool suite_calibrated(const nlohmann::json& rows) {
+  for (const auto& row : rows)
+    if (row.value("colour_calibrated", false)) return true;
+  return false;
+}
+
 std::string summary_sentence(const nlohmann::json& s) {
   const int undefined =
       s["unresolved"].get<int>() - s["tie"].get<int>() - s["no_model_describes"].get<int>();
@@ -263,6 +294,9 @@ std::string verify_suite_json(const VerifySuite& suite, const std::vector<SuiteR
       "shape_seed_se, the seed's standard error; shape_fit_min..shape_fit_max, the figure against "
       "each of the measurement's fits";
   const nlohmann::json list = suite_rows_json(suite, rows);
+  // --colour-from measured: each fabric calibrated to its measurement's own d/8 reading, so the
+  // absolute figure and its verdicts are the calibrated ones.
+  j["colour_calibrated"] = suite_calibrated(list);
   j["fabrics"] = list;
   j["shape_summary"] = figure_counts(list, "shape");
   nlohmann::json per_figure = nlohmann::json::object();
@@ -274,13 +308,15 @@ std::string verify_suite_json(const VerifySuite& suite, const std::vector<SuiteR
 std::string verify_suite_text(const std::vector<SuiteRow>& rows) {
   std::ostringstream out;
   char buf[256];
-  std::snprintf(buf, sizeof buf, "  %-28s %-30s %8s %8s %8s\n", "fabric", "model", "shape",
-                "paper's", "absolute");
-  out << buf;
   nlohmann::json list = nlohmann::json::array();
-  for (const auto& r : rows) {
-    const nlohmann::json row = suite_row_json(r, fs::path());
-    list.push_back(row);
+  for (const auto& r : rows) list.push_back(suite_row_json(r, fs::path()));
+  const bool calibrated = suite_calibrated(list);
+  std::snprintf(buf, sizeof buf, "  %-28s %-30s %8s %8s %10s\n", "fabric", "model", "shape",
+                "paper's", calibrated ? "calibrated" : "absolute");
+  out << buf;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const SuiteRow& r = rows[k];
+    const nlohmann::json& row = list[k];
     if (row.contains("error")) {
       out << "  " << r.fabric.name << ": failed: " << r.error << "\n";
       continue;
@@ -291,7 +327,7 @@ std::string verify_suite_text(const std::vector<SuiteRow>& rows) {
       const auto num = [](const nlohmann::json& v) {
         return v.is_number() ? v.get<double>() : std::nan("");
       };
-      std::snprintf(buf, sizeof buf, "  %-28s %-30s %8.3f %8.3f %8.3f\n", r.fabric.name.c_str(),
+      std::snprintf(buf, sizeof buf, "  %-28s %-30s %8.3f %8.3f %10.3f\n", r.fabric.name.c_str(),
                     model.label, num(f["shape_rms_log"]), num(f["paper_rms_log"]),
                     num(f["absolute_rms_log"]));
       out << buf;
@@ -300,6 +336,13 @@ std::string verify_suite_text(const std::vector<SuiteRow>& rows) {
       out << "  " << r.fabric.name << ": " << v.get<std::string>() << "\n";
   }
   out << "  " << summary_sentence(figure_counts(list, "shape")) << "\n";
+  if (calibrated) {
+    const nlohmann::json c = figure_counts(list, kFigureKeys[2]);
+    out << "  Calibrated (each fabric's colour from its measurement's d/8 reading), computed vs "
+           "classic: computed closer on "
+        << c["computed_closer"].get<int>() << ", classic closer on "
+        << c["classic_closer"].get<int>() << ", a tie on " << c["tie"].get<int>() << ".\n";
+  }
   return out.str();
 }
 
@@ -394,8 +437,15 @@ std::string suite_channel_cells(const nlohmann::json& row) {
 std::string suite_known_cell(const nlohmann::json& row) {
   const nlohmann::json& shown = row["shown"];
   std::string brief = "fiber " + html_escape(shown["fiber"].get<std::string>());
-  if (!row["dyes"].get<std::string>().empty())
+  if (row.contains("colour_match") && !row["colour_match"]["dyes"].get<std::string>().empty()) {
+    const nlohmann::json& m = row["colour_match"];
+    brief += " &middot; matched " + html_escape(m["dyes"].get<std::string>());
+    if (m["delta_e00"].is_number())
+      brief += " (&Delta;E00 " + fmt(m["delta_e00"].get<double>(), 3) +
+               (m["outside_reach"].get<bool>() ? ", out of reach)" : ")");
+  } else if (!row["dyes"].get<std::string>().empty()) {
     brief += " &middot; " + html_escape(row["dyes"].get<std::string>());
+  }
   if (!row["pattern"].get<std::string>().empty())
     brief += " &middot; pattern " + html_escape(row["pattern"].get<std::string>());
   // The files last: the weave is the same few for many fabrics, so the ellipsis may take it.
@@ -435,6 +485,7 @@ std::string suite_html_row(const nlohmann::json& row) {
 
 // One line per figure: on how many fabrics each model is closer, ties, and the rest.
 std::string suite_counts(const nlohmann::json& rows) {
+  const bool calibrated = suite_calibrated(rows);
   std::string h =
       "<p class=\"counts\" id=\"counts\">Fabrics on which the computed model (ray trace) or the "
       "classic model is closer to the measurement, beyond the uncertainty:";
@@ -443,7 +494,7 @@ std::string suite_counts(const nlohmann::json& rows) {
     const auto count = [&](const char* key) { return std::to_string(c[key].get<int>()); };
     const int undefined =
         c["unresolved"].get<int>() - c["tie"].get<int>() - c["no_model_describes"].get<int>();
-    h += std::string("<br><b>") + figure.head + "</b>: <span class=\"computed\">computed " +
+    h += "<br><b>" + figure_head(figure, calibrated) + "</b>: <span class=\"computed\">computed " +
          count("computed_closer") + "</span> <span class=\"classic\">classic " +
          count("classic_closer") + "</span> <span class=\"tie\">tie " + count("tie") +
          "</span> <span class=\"no_model\">no model describes " + count("no_model_describes") +
@@ -458,28 +509,40 @@ std::string suite_counts(const nlohmann::json& rows) {
   return h + "</p>\n";
 }
 
-std::string suite_table_head() {
+std::string suite_table_head(bool calibrated) {
   std::string h =
       "<table>\n<thead><tr><th rowspan=\"2\">fabric</th><th rowspan=\"2\">what is known</th>"
       "<th colspan=\"3\">closer: computed (ray trace) / classic figures</th>"
       "<th colspan=\"3\">computed shape R G B</th><th colspan=\"3\">classic shape R G B</th>"
       "</tr>\n<tr>";
-  for (const SuiteFigure& figure : kSuiteFigures) h += std::string("<th>") + figure.head + "</th>";
+  for (const SuiteFigure& figure : kSuiteFigures)
+    h += "<th>" + figure_head(figure, calibrated) + "</th>";
   for (int k = 0; k < 2; ++k) h += "<th>R</th><th>G</th><th>B</th>";
   return h + "</tr></thead>\n<tbody>\n";
 }
 
 // What the figures are and how a verdict is reached, below the table.
-std::string suite_details() {
+std::string suite_details(bool calibrated) {
+  const std::string level =
+      calibrated
+          ? "<b>calibrated</b> (the suite ran with --colour-from measured: each fabric's dyes "
+            "were scaled so that the cloth's d/8 reading meets its own measurement's, and every "
+            "unfitted model is made of that fiber; then no scaling at all: the absolute figure "
+            "after that one calibration, judged in every colour space, since the colour came "
+            "from the measurement itself; the matched recipe and its &Delta;E00 are in the "
+            "second column)"
+          : "<b>absolute</b> (includes the colour level: comparable only where model and "
+            "measurement share a colour space; in brackets and &ldquo;not comparable&rdquo; "
+            "otherwise)";
   return "<p class=\"details\">Each fabric is verified with what is known of its sample "
          "(construction, fiber, colour space), never with its measured curve; hover a cell for "
          "the source's words and every model's figures. Figures are RMS of ln(model / measured) "
          "over views up to 80&deg;: <b>shape</b> after one least-squares gain per channel, the "
          "same procedure for every model (the headline; per channel R G B in the last columns); "
          "<b>paper's</b> one-point normalization (Voloboy et al. 2010: hinges on the "
-         "normal-incidence, normal-view point); <b>absolute</b> (includes the colour level: "
-         "comparable only where model and measurement share a colour space; in brackets and "
-         "&ldquo;not comparable&rdquo; otherwise). Linear sRGB is not clipped: a channel outside "
+         "normal-incidence, normal-view point); " +
+         level +
+         ". Linear sRGB is not clipped: a channel outside "
          "the gamut is kept, and the logs floor each channel at " +
          fmt(kLogFloorFraction) +
          " of its own maximum. A verdict names a closer model (green: the computed model, red: "
@@ -499,9 +562,9 @@ std::string verify_suite_html(const VerifySuite& suite, const std::vector<SuiteR
   h << "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>weft verify suite: "
     << html_escape(suite.title) << "</title>\n<style>" << kSuitePageCss
     << "</style></head><body>\n<h1>" << html_escape(suite.title) << "</h1>\n"
-    << suite_counts(list) << suite_table_head();
+    << suite_counts(list) << suite_table_head(suite_calibrated(list));
   for (const auto& row : list) h << suite_html_row(row);
-  h << "</tbody></table>\n" << suite_details() << "</body></html>\n";
+  h << "</tbody></table>\n" << suite_details(suite_calibrated(list)) << "</body></html>\n";
   return h.str();
 }
 

@@ -117,6 +117,13 @@ struct VerifyReport {
   bool cancelled = false;
 };
 
+// Whether the absolute figures are judged: the measurement is in the models' space (linear sRGB),
+// or the run was calibrated to the measurement's own d/8 reading (--colour-from measured), so that
+// the colour level came from the measurement itself and the figure judges the rest.
+inline bool absolute_judged(const VerifyReport& r) {
+  return r.colour_calibrated || absolute_comparable(r.measured.colour_space);
+}
+
 // The ray traces of a verification, most of its time: per model, settings.batches independent
 // raytrace_fabric_table runs of every incident bin ("computed": of the fiber table; "classic": of
 // verify_classic_fiber's table). In run_verify's order: the computed batches, then the classic.
