@@ -7,6 +7,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/params.h"
+#include "weft/fabric/fiber_colour.h"
 #include "weft/fiber/bake_cache.h"
 #include "weft/fiber/fiber_bake_request.h"
 #include "weft/fiber/fiber_table_bake.h"
@@ -44,13 +45,13 @@ Table bake_fiber(const py::object& spec, FiberBakeRequest r, bool yes_long, bool
     r.spec = py::isinstance<py::str>(spec) ? spec.cast<std::string>()
                                            : spec.cast<std::filesystem::path>().string();
   r.limits = call_limits(yes_long);
-  const FiberBakePlan plan = plan_fiber_bake(r);
+  const ColouredFiberBakePlan plan = plan_coloured_fiber_bake(r);
   CallProgress progress(print);
   FiberBakeHooks hooks{progress.callback(), [&progress] { return progress.interrupted(); }};
   FiberBakeOutcome out;
   {
     py::gil_scoped_release release;
-    out = run_fiber_bake(plan, hooks);
+    out = run_coloured_fiber_bake(plan, hooks);
   }
   progress.raise_if_interrupted();
   out.table->table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION + " (python)";
@@ -73,13 +74,13 @@ void bind_bake_fiber(py::module_& m) {
       [](const py::object& spec, uint64_t photons, int resolution, uint64_t seed, int threads,
          const std::string& bands, const std::string& route, uint64_t passes,
          std::optional<std::string> estimator, bool mirror_fold, std::optional<int> surface_samples,
-         std::optional<std::string> entry, const std::string& surface_lobe, bool yes_long,
-         bool progress) {
+         std::optional<std::string> entry, const std::string& surface_lobe,
+         const std::string& colour, const std::string& colour_weave, bool yes_long, bool progress) {
         FiberBakeRequest r;
         r.photons = photons, r.resolution = resolution, r.seed = seed, r.threads = threads;
         r.bands = bands, r.route = route, r.passes = passes, r.estimator = estimator;
         r.mirror_fold = mirror_fold, r.surface_samples = surface_samples, r.entry = entry;
-        r.surface_lobe = surface_lobe;
+        r.surface_lobe = surface_lobe, r.colour = colour, r.colour_weave = colour_weave;
         return bake_fiber(spec, std::move(r), yes_long, progress);
       },
       py::arg("spec"), py::kw_only(), py::arg("photons") = d.photons,
@@ -88,11 +89,14 @@ void bind_bake_fiber(py::module_& m) {
       py::arg("passes") = d.passes, py::arg("estimator") = d.estimator,
       py::arg("mirror_fold") = d.mirror_fold, py::arg("surface_samples") = d.surface_samples,
       py::arg("entry") = d.entry, py::arg("surface_lobe") = d.surface_lobe,
+      py::arg("colour") = d.colour, py::arg("colour_weave") = d.colour_weave,
       py::arg("yes_long") = false, py::arg("progress") = false,
       "Bakes a fiber spec (a dict, a spec file or a preset name) into a fiber table, as `weft "
       "bake fiber` does; estimator, surface_samples and entry None: the spec's and route's "
-      "default; surface_lobe \"sampled\" or \"analytic\" (`--surface-lobe`). Work estimated above "
-      "an hour needs yes_long=True.");
+      "default; surface_lobe \"sampled\" or \"analytic\" (`--surface-lobe`); colour (any "
+      "`--colour` form) scales the spec's dyes first so that a cloth of the fiber (colour_weave, "
+      "the bundled poplin when empty) meets it, the table's metadata \"colour\" says how near. "
+      "Work estimated above an hour needs yes_long=True.");
 }
 
 }  // namespace weft::python

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "weft/fabric/fiber_colour.h"
 #include "weft/fiber/fiber_bake_request.h"
 #include "weft/fiber/fiber_spec.h"
 
@@ -30,6 +31,8 @@ int report_fiber_bake(const nlohmann::json& j, bool json) {
     const double seconds = j["seconds"].get<double>();
     std::printf("baked %s (%s) -> %s\n", j["spec"].get<std::string>().c_str(),
                 j["spec_hash"].get<std::string>().c_str(), j["output"].get<std::string>().c_str());
+    if (j.contains("colour_match"))
+      std::printf("%s\n", j["colour_match"]["note"].get<std::string>().c_str());
     std::printf("%llu photons, %llu scattering events in %.1f s (%.3g events/s)%s\n", photons,
                 events, seconds, j["events_per_s"].get<double>(),
                 cancelled ? "  [interrupted: table holds the finished passes]" : "");
@@ -49,12 +52,13 @@ int run_bake_fiber(const FiberBakeCliOptions& o, const RunLimits& program) {
   FiberBakeRequest r = o.request;
   r.limits = quieted(program, o.quiet);
   r.option_prefix = "--";
-  const FiberBakePlan plan = plan_fiber_bake(
+  const ColouredFiberBakePlan coloured = plan_coloured_fiber_bake(
       r, [](const std::string& w) { std::fprintf(stderr, "weft: warning: %s\n", w.c_str()); });
+  const FiberBakePlan& plan = coloured.fiber;
   FiberBakeHooks hooks;
   if (plan.bands.last > plan.bands.first) hooks.progress = progress_bar(r.limits, o.quiet);
   hooks.interrupted = interrupted;
-  const FiberBakeOutcome out = run_fiber_bake(plan, hooks);
+  const FiberBakeOutcome out = run_coloured_fiber_bake(coloured, hooks);
   if (out.interrupted_before_work) {
     std::fprintf(stderr, "\nweft: interrupted before any photon; nothing was written\n");
     return 130;
@@ -130,6 +134,14 @@ void add_fiber_sampling_options(CLI::App& fiber, FiberBakeRequest& r) {
                   "direct route)")
       ->check(CLI::IsMember(names_of(kFiberSurfaceLobes)))
       ->capture_default_str();
+  fiber.add_option("--colour", r.colour,
+                   "the colour a cloth of the fiber should have as a d/8 instrument reads it "
+                   "(srgb:#RRGGBB, lab:L,a,b, lab10:L,a,b, spectrum:FILE.csv, measured:NAME, "
+                   "table:FILE.exr): the spec's dyes are scaled first to meet it, read through a "
+                   "fiber-level ray trace of --colour-weave (docs/colour.md)");
+  fiber.add_option("--colour-weave", r.colour_weave,
+                   "woven sample options (.json) of the cloth that reads --colour (default: the "
+                   "bundled poplin)");
   fiber.add_option("--seed", r.seed, "random seed");
   fiber
       .add_option("--passes", r.passes,

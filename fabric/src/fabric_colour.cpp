@@ -202,13 +202,17 @@ nlohmann::json colour_summary(const FabricColourMatch& c, const TabulatedBsdfTab
   return j;
 }
 
-void describe_colour_match(const FabricColourMatch& c, TabulatedBsdfTable& table,
-                           FabricBakeResult& out) {
+std::string colour_metadata(const FabricColourMatch& c) {
+  char de[32];
+  std::snprintf(de, sizeof de, "%.2f", c.match.best_reading().delta_e00);
+  return c.match.target.spec + " (CIEDE2000 " + de + " at normal incidence)";
+}
+
+std::string colour_match_note(const FabricColourMatch& c) {
   const ColourMatch& m = c.match;
   const ColourReading& best = m.best_reading();
   char de[32];
   std::snprintf(de, sizeof de, "%.2f", best.delta_e00);
-  table.metadata["colour"] = m.target.spec + " (CIEDE2000 " + de + " at normal incidence)";
   std::string scales;
   for (size_t d = 0; d < m.basis.names.size(); ++d) {
     char v[64];
@@ -219,13 +223,16 @@ void describe_colour_match(const FabricColourMatch& c, TabulatedBsdfTable& table
   const std::string how =
       c.cached ? "from the cache" : std::to_string(m.readings.size()) + " readings";
   if (m.reached)
-    out.notes.push_back("colour " + m.target.spec + " reached: CIEDE2000 " + de + " (" + how +
-                        "); " + scales);
-  else
-    out.notes.push_back("colour " + m.target.spec +
-                        (m.outside_reach ? " is outside what the dyes can reach" : " not reached") +
-                        ": nearest " + format_lab(best.lab) + " at CIEDE2000 " + de + " (" + how +
-                        "); " + scales);
+    return "colour " + m.target.spec + " reached: CIEDE2000 " + de + " (" + how + "); " + scales;
+  return "colour " + m.target.spec +
+         (m.outside_reach ? " is outside what the dyes can reach" : " not reached") + ": nearest " +
+         format_lab(best.lab) + " at CIEDE2000 " + de + " (" + how + "); " + scales;
+}
+
+void describe_colour_match(const FabricColourMatch& c, TabulatedBsdfTable& table,
+                           FabricBakeResult& out) {
+  table.metadata["colour"] = colour_metadata(c);
+  out.notes.push_back(colour_match_note(c));
 }
 
 }  // namespace weft

@@ -140,11 +140,13 @@ FiberBandState decode_fiber_band(const std::vector<double>& v, FiberExitEstimato
 }
 
 // The table of a finished or interrupted whole bake, written to 'output' when there is one.
-FiberTableBakeResult write_fiber_table(const FiberSpec& spec, const FiberTableBakeOptions& o,
-                                       const std::vector<FiberBandState>& bands, bool cancelled,
-                                       const std::string& output) {
+FiberTableBakeResult write_fiber_table(
+    const FiberSpec& spec, const FiberTableBakeOptions& o, const std::vector<FiberBandState>& bands,
+    bool cancelled, const std::string& output,
+    const std::vector<std::pair<std::string, std::string>>& metadata = {}) {
   FiberTableBakeResult r = finish_fiber_table(spec, o, bands, cancelled);
   r.table.metadata["program_version"] = std::string("weft ") + WEFT_VERSION;
+  for (const auto& [key, value] : metadata) r.table.metadata[key] = value;
   if (!output.empty()) r.table.write_exr(output);
   return r;
 }
@@ -156,6 +158,11 @@ FiberBakePlan plan_fiber_bake(const FiberBakeRequest& request,
   const FiberBakeRequest& r = request;
   FiberBakePlan p;
   p.request = r;
+  // The colour's match is a fabric's reading: fabric/fiber_colour.h plans it, then this bake of
+  // the matched spec. Here it would be dropped without a word.
+  if (!r.colour.empty() || !r.colour_weave.empty())
+    throw Error("", fiber_option_name(r, r.colour.empty() ? "colour_weave" : "colour"),
+                "is matched by the coloured fiber bake (plan_coloured_fiber_bake), not here");
   const bool writes = !r.output.empty();
   const std::string output_option = fiber_option_name(r, "output");
   if (writes) {
@@ -227,7 +234,8 @@ FiberBakeOutcome run_fiber_bake(const FiberBakePlan& p, const FiberBakeHooks& ho
     out.part_written = true;
     return out;
   }
-  out.table = write_fiber_table(p.spec, p.options, traced.bands, traced.cancelled, r.output);
+  out.table = write_fiber_table(p.spec, p.options, traced.bands, traced.cancelled, r.output,
+                                r.table_metadata);
   if (!r.output.empty() && !traced.cancelled) std::filesystem::remove(checkpoint_path(r.output));
   out.summary = fiber_bake_summary(*out.table, p.spec, p.options, r.output, out.seconds);
   return out;

@@ -6,6 +6,7 @@
 #include "../test_util.h"
 #include "weft/core/colorimetry.h"
 #include "weft/fabric/fabric_colour.h"
+#include "weft/fabric/fiber_colour.h"
 
 using namespace weft;
 using namespace weft::testing;
@@ -73,4 +74,70 @@ TEST(FabricColour, TheMatchedTableReadsTheTargetAndTheMatchIsCached) {
   const FabricBakeResult second = run_fabric_bake(plan_fabric_bake(small_trace(spec)), {});
   EXPECT_EQ(second.summary.at("colour_match").at("cached"), true);
   EXPECT_EQ(second.table.checksum(), first.table.checksum());
+}
+
+// `weft bake fiber --colour` (fabric/fiber_colour.h): what it cannot match is refused before any
+// work, and the fiber library alone never drops a colour without a word.
+TEST(FiberColour, PlanRefusesWhatItCannotMatch) {
+  FiberBakeRequest r;
+  r.spec = "red-cotton";
+  r.option_prefix = "--";
+  r.colour_weave = "weave.json";
+  EXPECT_NE(error_of([&] { plan_coloured_fiber_bake(r); }).find("field '--colour-weave'"),
+            std::string::npos);
+  r.colour_weave.clear();
+  r.colour = "lab:40,20,10";
+  EXPECT_NE(error_of([&] { plan_fiber_bake(r); }).find("field '--colour'"), std::string::npos);
+  r.shard = "1/2";
+  EXPECT_NE(error_of([&] { plan_coloured_fiber_bake(r); }).find("sharded or resumed"),
+            std::string::npos);
+  r.shard.clear();
+  r.spec_read = load_fiber_spec("red-cotton");
+  EXPECT_NE(error_of([&] { plan_coloured_fiber_bake(r); }).find("give the spec as a file"),
+            std::string::npos);
+  r.spec_read.reset();
+  r.colour = "lab:400,20,10";
+  EXPECT_NE(error_of([&] { plan_coloured_fiber_bake(r); }).find("field '--colour'"),
+            std::string::npos);
+  // Without a colour it is the plain bake's plan.
+  r.colour.clear();
+  EXPECT_FALSE(plan_coloured_fiber_bake(r).reading);
+}
+
+// The fiber's colour is read through a cloth: a target that the recipe as written meets (the
+// cloth's own reading) takes one reading, the table says how near in its metadata, and the match
+// is cached by its inputs.
+TEST(FiberColour, TheRecipeOnTargetTakesOneReadingAndIsCached) {
+  const auto dir = fresh_test_dir();
+  InFolder in(dir);
+  FiberBakeRequest r;
+  r.spec = "red-cotton";
+  r.photons = 2000;
+  r.resolution = 4;
+  r.colour = "lab:50,0,0";
+  const ColouredFiberBakePlan probe = plan_coloured_fiber_bake(r);
+  ASSERT_TRUE(probe.reading);
+  EXPECT_EQ(probe.reading->method, FabricMethod::kRaytrace);
+  const WovenSample sample = make_woven_sample(probe.reading->weave);
+  const std::optional<Spectrum> reading =
+      fabric_d8_reading(*probe.reading, sample, load_fiber_spec("red-cotton"), no_progress());
+  ASSERT_TRUE(reading);
+  const Lab lab = reflectance_to_lab(*reading, Observer::kCie1931TwoDegree);
+  char spec[96];
+  std::snprintf(spec, sizeof spec, "lab:%.5f,%.5f,%.5f", lab.l, lab.a, lab.b);
+  r.colour = spec;
+
+  const FiberBakeOutcome first = run_coloured_fiber_bake(plan_coloured_fiber_bake(r));
+  ASSERT_TRUE(first.table);
+  const nlohmann::json& m = first.summary.at("colour_match");
+  EXPECT_EQ(m.at("reached"), true);
+  EXPECT_EQ(m.at("iterations"), 1);
+  EXPECT_EQ(m.at("cached"), false);
+  EXPECT_LT(m.at("delta_e00").get<double>(), 1e-3);
+  EXPECT_NE(first.table->table.metadata.at("colour").find(spec), std::string::npos);
+  EXPECT_EQ(first.table->table.resolution, 4);  // the request's own settings, not the reading's
+
+  const FiberBakeOutcome second = run_coloured_fiber_bake(plan_coloured_fiber_bake(r));
+  EXPECT_EQ(second.summary.at("colour_match").at("cached"), true);
+  EXPECT_EQ(second.table->table.checksum(), first.table->table.checksum());
 }

@@ -256,6 +256,15 @@ def test_bake_fabric_per_yarn_fibers(rgb, tmp_path):
         weft.bake_fabric("white-cotton", "raytrace", thread_colours=True, **TINY_TRACE)
 
 
+def test_bake_fiber_colour_is_refused_where_it_cannot_be_matched():
+    # The match bakes the spec by name through a cloth (fabric/fiber_colour.h): a dict cannot be,
+    # and a cloth without a colour to read is a mistake, both said before any work.
+    with pytest.raises(weft.Error, match=r"field 'colour'.*give the spec as a file"):
+        weft.bake_fiber(red_cotton_spec(), colour="lab:40,20,10", **TINY)
+    with pytest.raises(weft.Error, match=r"field 'colour_weave'"):
+        weft.bake_fiber("red-cotton", colour_weave="weave.json", **TINY)
+
+
 def test_bake_fabric_weave_table(rgb, tmp_path):
     out = tmp_path / "weave.exr"
     fabric = weft.bake_fabric(rgb, "raytrace", weave_out=out, weave_positions="2x3",

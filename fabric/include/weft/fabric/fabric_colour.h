@@ -59,7 +59,11 @@ Lab table_d8_lab(const TabulatedBsdfTable& table, const ColourTarget& target);
 // --json's colour_match: the match's summary (colour_match_summary), whether it came from the
 // cache, and the written table's own reading and its distance to the target.
 nlohmann::json colour_summary(const FabricColourMatch& colour, const TabulatedBsdfTable& table);
-// The table's metadata "colour" (the target and the delta E reached) and the result's note.
+// The table's metadata "colour" (the target and the delta E reached), and the note for the user
+// (reached or how near, how many readings, the dyes' depths).
+std::string colour_metadata(const FabricColourMatch& colour);
+std::string colour_match_note(const FabricColourMatch& colour);
+// Both, into the table and the result's notes.
 void describe_colour_match(const FabricColourMatch& colour, TabulatedBsdfTable& table,
                            FabricBakeResult& out);
 

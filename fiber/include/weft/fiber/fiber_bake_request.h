@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "weft/core/job_part.h"
@@ -46,6 +47,14 @@ struct FiberBakeRequest {
   int threads = FiberTableBakeOptions{}.threads;
   std::string shard;    // "K/N": only shard K of N's bands, into a part file (empty: all)
   bool resume = false;  // checkpoint every pass beside the output, continue from one there
+  // The colour a cloth made of the fiber should have (any --colour form, core/colour_target.h):
+  // the spec's dyes are scaled to meet it before the bake, through the cloth of 'colour_weave'
+  // (fabric/fiber_colour.h: the fiber bake with a colour is planned and run there, since the
+  // reading is a fabric's); "" = the recipe as written.
+  std::string colour;
+  std::string colour_weave;  // woven sample options (.json) that read the colour; "" = the poplin
+  // Written into the table's metadata beside the bake's own keys (a colour match's "colour").
+  std::vector<std::pair<std::string, std::string>> table_metadata;
   // How refusals name the options: "--" on the command line ("--surface-samples"), "" in Python
   // ("surface_samples").
   std::string option_prefix;
