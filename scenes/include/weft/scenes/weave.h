@@ -219,6 +219,13 @@ SceneDescription fiber_patch_description(WeaveOptions options, const std::string
 // memory of one repeat instead of (2 half_x + 1) (2 half_z + 1); fibers are copied either way.
 SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, int half_z,
                                          const std::string& source, bool instanced = false);
+// The same, the fibers' copies made a slice of points at a time with 'progress' told (stage
+// "scene copies") and asked between slices (near the limit of 3e7 points, nine copies took tens
+// of seconds unpolled); nothing when it said stop. The same bits as the call above.
+std::optional<SceneDescription> tiled_woven_description(const WovenSample& sample, int half_x,
+                                                        int half_z, const std::string& source,
+                                                        bool instanced,
+                                                        const ProgressCallback& progress);
 
 // ---------------------------------------------------------------------------------------------
 // The open-mesh plain-weave patch of earlier versions (circular tubes around sinusoidal centre
