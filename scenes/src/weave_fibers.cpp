@@ -500,6 +500,26 @@ void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& ou
   }
 }
 
+FiberCount count_fibers(const Layout& layout, const FiberSettings& fs) {
+  std::map<std::tuple<bool, double, double, double, double>, int> fibers_of;  // as build_fibers
+  FiberCount n;
+  for (const YarnPath& y : layout.yarns) {
+    const auto key =
+        std::make_tuple(y.warp, y.size.width_mm, y.size.thickness_mm, y.max_slope(), y.period);
+    auto it = fibers_of.find(key);
+    if (it == fibers_of.end())
+      it = fibers_of
+               .emplace(key, make_bundle(y.size.width_mm, y.size.thickness_mm, y.max_slope(),
+                                         y.period, fs, y.warp ? "warp" : "weft")
+                                 .fibers)
+               .first;
+    const double K = double(y.crossing.size()) * layout.segments_per_crossing;
+    n.curves += it->second;
+    n.points += it->second * (K + 1);
+  }
+  return n;
+}
+
 }  // namespace weft::detail
 
 namespace weft {
