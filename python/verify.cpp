@@ -78,8 +78,13 @@ py::dict verify(VerifyArgs a) {
   const std::string output = a.request.output;
   const int threads = a.request.threads;
   if (a.plots)
-    hooks.draw = [output, threads](const std::filesystem::path& staging) {
-      plot_verify_figures(staging, output, threads);
+    // Polled through the callback, which looks for Ctrl-C on the caller's thread (the script
+    // runs in a process group of its own, which a Ctrl-C at the terminal does not reach).
+    hooks.draw = [output, threads,
+                  poll = progress.callback()](const std::filesystem::path& staging) {
+      plot_verify_figures(staging, output, threads, [&poll] {
+        return poll({"report", 2, 3, "steps"});
+      });
     };
   VerifyOutcome out;
   {

@@ -57,6 +57,12 @@ bool interrupted() {
   return g_interrupted.load();
 }
 
+std::function<bool()> polled_interrupt() {
+  install_interrupt_handler();
+  g_polled.store(true);
+  return [] { return !g_interrupted.load(); };
+}
+
 ProgressCallback progress_bar(const RunLimits& limits, bool quiet) {
   work_starts(limits);
   install_interrupt_handler();

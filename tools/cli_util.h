@@ -44,6 +44,9 @@ ProgressCallback progress_bar(const RunLimits& limits, bool quiet);
 // and a second Ctrl-C ends the program at once.
 void install_interrupt_handler();
 bool interrupted();
+// From here on Ctrl-C sets interrupted(), as after progress_bar, for a command without progress
+// whose step must clean up after itself (a child process to end: a plot script); the poll.
+std::function<bool()> polled_interrupt();
 
 // A scene description just loaded (commands that render it): its warnings on stderr; unless
 // 'quiet', its notes and lights too.

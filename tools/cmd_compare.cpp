@@ -6,6 +6,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "cli_util.h"
 #include "commands.h"
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
@@ -66,10 +67,14 @@ int run_compare(const CompareCliOptions& o, const RunLimits& limits) {
       }
     } remove{tmp};
     write_text_atomically(tmp, curves);
-    run_plot_script("plot_compare.py",
-                    {tmp.string(), o.plot, std::filesystem::path(o.a).filename().string(),
-                     std::filesystem::path(o.b).filename().string()},
-                    o.plot);
+    // Ctrl-C ends the script (which writes the plot whole or not at all) and the command.
+    if (!run_plot_script("plot_compare.py",
+                         {tmp.string(), o.plot, std::filesystem::path(o.a).filename().string(),
+                          std::filesystem::path(o.b).filename().string()},
+                         o.plot, polled_interrupt())) {
+      std::fprintf(stderr, "\nweft: compare cancelled; the plot was not written\n");
+      return 130;
+    }
   }
   if (o.json) {
     std::cout << nlohmann::json{{"a", o.a},

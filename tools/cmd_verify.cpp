@@ -55,8 +55,9 @@ VerifyHooks verify_hooks(const VerifyCliOptions& o, const VerifyPlan& p,
   hooks.note = [quiet = o.quiet](const std::string& line) {
     if (!quiet) std::fputs(line.c_str(), stderr);
   };
+  // Ended early on Ctrl-C (the report then stops after it: write_verify_report).
   hooks.draw = [output = r.output, threads = r.threads](const std::filesystem::path& staging) {
-    plot_verify_figures(staging, output, threads);
+    plot_verify_figures(staging, output, threads, [] { return !interrupted(); });
   };
   hooks.started = t_all;
   return hooks;

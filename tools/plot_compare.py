@@ -6,6 +6,8 @@ Reads the CSV of `weft compare --csv` (columns light_zenith_deg, plane_azimuth_d
 view_zenith_deg, a_<channel>..., b_<channel>...) and writes a PNG (or SVG, by extension).
 """
 import csv
+import os
+import signal
 import sys
 
 import matplotlib
@@ -14,7 +16,20 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
+def save_whole(fig, out):
+    """The figure at 'out' whole or not at all: drawn beside it, then moved in. weft ends the
+    script with SIGTERM on Ctrl-C (main turns that into SystemExit, so the draft is removed)."""
+    draft = f"{out}.tmp-{os.getpid()}{os.path.splitext(out)[1]}"
+    try:
+        fig.savefig(draft)
+        os.replace(draft, out)
+    finally:
+        if os.path.exists(draft):
+            os.remove(draft)
+
+
 def main():
+    signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(128 + signum))
     if len(sys.argv) != 5:
         sys.exit("usage: plot_compare.py CURVES.csv OUT.png LABEL_A LABEL_B")
     src, out, label_a, label_b = sys.argv[1:]
@@ -44,7 +59,7 @@ def main():
         ax.set_ylabel("beta / pi")
         ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out)
+    save_whole(fig, out)
 
 
 if __name__ == "__main__":

@@ -60,9 +60,11 @@ WeaveOptions fitted_weave_options(const RunLimits& limits, WeaveOptions w, const
     }
   const bool yarn = z.detail == "yarn";
   *bytes = fabric_scene_bytes(z);
+  // The curve points the sample will hold (fabric_scene_bytes counts those).
+  const double points = z.made_curve_points > 0 ? z.made_curve_points : z.curve_points;
   check_memory(limits, *bytes, draft, "--detail",
                "the scene at " + z.detail + " detail (" +
-                   ParamReader::fmt(yarn ? z.triangles : z.curve_points) +
+                   ParamReader::fmt(yarn ? z.triangles : points) +
                    (yarn ? " triangles" : " curve points") + ")");
   return w;
 }

@@ -116,9 +116,10 @@ bool trace_fabric(const FabricBakePlan& p, const WovenSample& sample, const Fabr
 
 }  // namespace
 
-TabulatedBsdfTable summed_fabric_table(const FabricBakePlan& p, const WovenSample& sample,
-                                       const TabulatedBsdfTable& fiber,
-                                       const ProgressCallback& progress) {
+std::optional<TabulatedBsdfTable> summed_fabric_table(const FabricBakePlan& p,
+                                                      const WovenSample& sample,
+                                                      const TabulatedBsdfTable& fiber,
+                                                      const ProgressCallback& progress) {
   const FabricBakeRequest& o = p.request;
   FabricSummationOptions s;
   s.method =
@@ -128,10 +129,24 @@ TabulatedBsdfTable summed_fabric_table(const FabricBakePlan& p, const WovenSampl
   s.seed = o.seed;
   s.threads = o.threads;
   if (s.method == FabricSummation::kVisible) {
-    s.top = bake_orientations(visible_fiber_tangents(sample, true));
-    s.bottom = bake_orientations(visible_fiber_tangents(sample, false));
+    // One scene for both sides, polled (at 5e7 triangles its build takes tens of seconds).
+    std::optional<VisibleFiberTangents> seen = visible_fiber_tangents(sample, progress);
+    if (!seen) return std::nullopt;
+    s.top = bake_orientations(seen->top);
+    s.bottom = bake_orientations(seen->bottom);
   }
-  return sum_fabric_table(fiber, s, progress);
+  // The table stops with an error when its callback says stop (from_function): a stop of ours.
+  bool stopped = false;
+  const ProgressCallback asked = [&](const ProgressUpdate& u) {
+    stopped = stopped || !progress(u);
+    return !stopped;
+  };
+  try {
+    return sum_fabric_table(fiber, s, asked);
+  } catch (const Error&) {
+    if (stopped) return std::nullopt;
+    throw;
+  }
 }
 
 FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks& hooks) {
@@ -166,7 +181,13 @@ FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks&
     if (!trace_fabric(p, sample, fibers, weave_bytes, hooks, out, extra, noise_per_channel))
       return out;
   } else {
-    out.table = summed_fabric_table(p, sample, fibers.first(), hooks.progress);
+    std::optional<TabulatedBsdfTable> summed =
+        summed_fabric_table(p, sample, fibers.first(), hooks.progress);
+    if (!summed) {
+      out.cancelled = true;
+      return out;
+    }
+    out.table = std::move(*summed);
   }
   const double seconds = seconds_since(t0);
   TabulatedBsdfTable& table = out.table;

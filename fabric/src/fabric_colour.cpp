@@ -120,9 +120,9 @@ std::optional<Spectrum> fabric_d8_reading(const FabricBakePlan& p, const WovenSa
   const TabulatedBsdfTable fiber = colour_fiber_table(p, spec, progress);
   if (p.method == FabricMethod::kRaytrace)
     return raytrace_d8_reading(sample, fiber, p.raytrace, progress);
-  TabulatedBsdfTable table;
-  { table = summed_fabric_table(p, sample, fiber, progress); }
-  const auto albedo = table.directional_albedo(fiber.grid().bin_of({0, 0, 1}));
+  const std::optional<TabulatedBsdfTable> table = summed_fabric_table(p, sample, fiber, progress);
+  if (!table) return std::nullopt;
+  const auto albedo = table->directional_albedo(fiber.grid().bin_of({0, 0, 1}));
   Spectrum out{};
   for (int b = 0; b < kNumBands; ++b) out[b] = albedo.reflectance[b];
   return out;

@@ -727,14 +727,14 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   const RepeatSlab slab = repeat_slab_of(sample);
   if (!(slab.px > 0 && slab.pz > 0 && slab.y1 > slab.y0))
     throw Error("", "sample", "the woven sample has no period or no thickness");
+  FabricRaytraceResult cancelled;
+  cancelled.cancelled = true;
+  const std::optional<SceneDescription> geometry = tiled_geometry(sample, progress);
+  if (!geometry) return cancelled;
   RenderSceneOptions build;
   build.build_progress = progress;
-  const RenderScene scene(tiled_geometry(sample), build);
-  if (scene.cancelled()) {
-    FabricRaytraceResult cancelled;
-    cancelled.cancelled = true;
-    return cancelled;
-  }
+  const RenderScene scene(*geometry, build);
+  if (scene.cancelled()) return cancelled;
   if (o.proposal) check_proposal(*o.proposal, fiber);
   // With a proposal, paths are drawn from it and the choices that end or split a path are made on
   // the weights it gives (wp); the traced table's weights (w) follow the same path, each step

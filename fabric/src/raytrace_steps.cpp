@@ -135,6 +135,11 @@ Vec3 wrap_through_side(const RepeatSlab& slab, const Vec3& p, const Vec3& d, dou
 }
 
 SceneDescription tiled_geometry(const WovenSample& sample) {
+  return *tiled_geometry(sample, no_progress());
+}
+
+std::optional<SceneDescription> tiled_geometry(const WovenSample& sample,
+                                               const ProgressCallback& progress) {
   if (sample.fibers.curve_count() == 0 && sample.meshes.empty())
     throw Error("", "detail",
                 "the ray-traced estimator needs the sample's geometry (fibers or yarn tubes); "
@@ -147,14 +152,15 @@ SceneDescription tiled_geometry(const WovenSample& sample) {
   WovenSample placement;
   placement.summary = sample.summary;
   placement.meshes.resize(sample.meshes.size());
-  SceneDescription d = tiled_woven_description(sample.meshes.empty() ? sample : placement, 1, 1,
-                                               "woven sample", true);
+  std::optional<SceneDescription> d = tiled_woven_description(
+      sample.meshes.empty() ? sample : placement, 1, 1, "woven sample", true, progress);
+  if (!d) return std::nullopt;
   for (size_t m = 0; m < sample.meshes.size(); ++m)
-    d.meshes[m] = std::shared_ptr<const TriangleMesh>(std::shared_ptr<void>(), &sample.meshes[m]);
+    d->meshes[m] = std::shared_ptr<const TriangleMesh>(std::shared_ptr<void>(), &sample.meshes[m]);
   MaterialBinding any;
   any.type = "lambert";
   any.field = "fabric estimator";
-  d.default_material = any;
+  d->default_material = any;
   return d;
 }
 

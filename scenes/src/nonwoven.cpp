@@ -354,4 +354,19 @@ WovenSample make_nonwoven_sample(const WeaveOptions& options, const ProgressCall
   return s;
 }
 
+NonwovenSize nonwoven_sample_size(const WeaveOptions& options) {
+  const Mat m = resolve_mat(options);
+  // A fiber is cut once where it crosses a side of the tile (its length is at most half the
+  // tile's). With its centre uniform in the tile, it crosses the sides across x with probability
+  // (its extent along x) / P: L cos(theta) |cos(phi)| / P, whose mean over the uniform in-plane
+  // angle is (2 / pi) L cos(theta) / P, and as much across z. The inclination's cosine is taken at
+  // its mean under the normal law, exp(-sd^2 / 2) (the redraws beyond 80 degrees ignored).
+  const double cos_theta = std::exp(-0.5 * m.inclination_sd * m.inclination_sd);
+  const double pieces = 1 + 2 * (2 / kPi) * m.length * cos_theta / m.tile;
+  NonwovenSize z;
+  z.fibers = m.fibers;
+  z.curves = std::round(m.fibers * pieces);
+  return z;
+}
+
 }  // namespace weft

@@ -236,6 +236,7 @@ class RenderScene::Builder {
   void add_curve_set(size_t k);
   RTCGeometry tube_geometry(CurveRecord& rec);
   RTCGeometry round_curve_geometry(CurveRecord& rec, size_t k);
+  bool index_segments_polled(const FiberCurves& curves, FiberSegmentIndex& out);
   [[noreturn]] void allocation_failed(RTCGeometry g) const;
 
   const SceneDescription& desc_;
@@ -447,7 +448,7 @@ void RenderScene::Builder::add_curve_set(size_t k) {
   CurveRecord& rec = geo_->curve_sets.emplace_back();
   rec.curves = curves;
   rec.scale = tubes_ ? 1.0 : geo_->curve_scale;
-  rec.segments = index_segments(*curves);
+  if (!index_segments_polled(*curves, rec.segments)) return;
   rec.first_fiber = geo_->fibers;
   geo_->fibers += static_cast<int64_t>(curves->curve_count());
   for (const std::string& key : curves->yarn_material) {
@@ -488,6 +489,27 @@ RTCGeometry RenderScene::Builder::tube_geometry(CurveRecord& rec) {
   return g;
 }
 
+// index_segments, asked to go on every million segments: near the limit of 3e7 curve points the
+// index is 240 MB of new pages, seconds on a loaded machine. False when stopped ('out' partial).
+bool RenderScene::Builder::index_segments_polled(const FiberCurves& curves,
+                                                 FiberSegmentIndex& out) {
+  constexpr size_t kSegmentsPerPoll = size_t(1) << 20;
+  out.first_point.reserve(curves.segment_count());
+  out.curve.reserve(curves.segment_count());
+  size_t next_poll = kSegmentsPerPoll;
+  for (size_t c = 0; c < curves.curve_count(); ++c) {
+    for (uint32_t k = 0; k + 1 < curves.curve_points[c]; ++k) {
+      out.first_point.push_back(curves.curve_first[c] + k);
+      out.curve.push_back(static_cast<uint32_t>(c));
+    }
+    if (out.curve.size() >= next_poll) {
+      if (!keep_going()) return false;
+      next_poll = out.curve.size() + kSegmentsPerPoll;
+    }
+  }
+  return true;
+}
+
 RTCGeometry RenderScene::Builder::round_curve_geometry(CurveRecord& rec, size_t k) {
   const FiberCurves& curves = *rec.curves;
   rec.prim_curve = rec.segments.curve;
@@ -503,22 +525,35 @@ RTCGeometry RenderScene::Builder::round_curve_geometry(CurveRecord& rec, size_t 
   if (!(vb && ib && fb)) allocation_failed(g);
   const auto scale = static_cast<float>(geo_->curve_scale);
   bool in_range = true;
+  // Polled every 8 MB of the buffers: near the limit of 3e7 points they are 650 MB of new pages
+  // per curve set, seconds each on a loaded machine.
+  constexpr size_t kPerPoll = size_t(1) << 21;
+  const auto stopped = [&](size_t i) {
+    if ((i + 1) % kPerPoll != 0 || keep_going()) return false;
+    rtcReleaseGeometry(g);
+    return true;
+  };
   for (size_t i = 0; i < curves.points.size(); ++i) {
     vb[i] = curves.points[i] * scale;  // exact: a power of two
     in_range = in_range && std::abs(vb[i]) < 1e37f;
+    if (stopped(i)) return nullptr;
   }
   if (!in_range) {
     rtcReleaseGeometry(g);
     throw Error(desc_.source, "curves[" + std::to_string(k) + "]",
                 "fiber coordinates too large for their radii");
   }
-  std::memcpy(ib, rec.segments.first_point.data(), nseg * sizeof(uint32_t));
+  if (!copy_polled(ib, rec.segments.first_point.data(), nseg * sizeof(uint32_t))) {
+    rtcReleaseGeometry(g);
+    return nullptr;
+  }
   for (size_t s = 0; s < nseg; ++s) {
     const uint32_t c = rec.segments.curve[s], first = curves.curve_first[c];
     const uint32_t last = first + curves.curve_points[c] - 2;  // its last segment's start
     const uint32_t at = rec.segments.first_point[s];
     fb[s] = static_cast<uint8_t>((at > first ? RTC_CURVE_FLAG_NEIGHBOR_LEFT : 0) |
                                  (at < last ? RTC_CURVE_FLAG_NEIGHBOR_RIGHT : 0));
+    if (stopped(s)) return nullptr;
   }
   geo_->curve_segments += nseg;
   return g;

@@ -407,6 +407,38 @@ void check_crossings(const Layout& L, int repeat_warps, int repeat_wefts) {
     }
 }
 
+// Whether the fibers keep their distances in sections perpendicular to the yarns, which
+// make_woven_sample tries first (then vertical sections, sparser): such a bundle stands taller
+// than its tube by sqrt(1 + slope^2) where the centre line slopes, so each crossing is checked as
+// check_crossings checks the tubes, each lens grown so, against the fibers' clearance (2 % of a
+// radius). A prediction before anything is built; the bundled samples and drafts end in the
+// sections it predicts (test_mesh_shifts.cpp).
+bool perpendicular_sections_fit(const Layout& L, int repeat_warps, int repeat_wefts,
+                                double radius_mm) {
+  constexpr int kN = 24;
+  const int nw = L.tile.warps;
+  for (int i = 0; i < repeat_warps; ++i)
+    for (int j = 0; j < repeat_wefts; ++j) {
+      const YarnPath &w = L.yarns[i], &f = L.yarns[nw + j];
+      const bool warp_over = L.tile.over(i, j);
+      for (int a = 0; a <= kN; ++a)
+        for (int b = 0; b <= kN; ++b) {
+          const double dx = f.size.width_mm * (double(a) / kN - 0.5);
+          const double dz = w.size.width_mm * (double(b) / kN - 0.5);
+          const double x = f.centre + dx, z = w.centre + dz;
+          double sw = 0, sf = 0;
+          const double hw = w.height_at(x, &sw), hf = f.height_at(z, &sf);
+          const double ew = detail::lens_half_thickness(w.size.width_mm, w.size.thickness_mm, dz) *
+                            std::sqrt(1 + sw * sw);
+          const double ef = detail::lens_half_thickness(f.size.width_mm, f.size.thickness_mm, dx) *
+                            std::sqrt(1 + sf * sf);
+          const double sep = warp_over ? (hw - ew) - (hf + ef) : (hf - ef) - (hw + ew);
+          if (sep < -0.02 * radius_mm) return false;
+        }
+    }
+  return true;
+}
+
 // One tube: rings k = 0..K along, vertices j = 0..M around (the seam repeats j = 0), triangles
 // (a, d, b), (b, d, c) with a = (k, j), d = (k, j + 1), b = (k + 1, j): front-facing outwards when
 // dP/dv x dP/du points out.
@@ -604,11 +636,11 @@ nlohmann::json summary_object(const WeaveSummary& s) {
 
 WovenSampleSize woven_sample_size(const WeaveOptions& options) {
   WovenSampleSize z;
-  if (options.pattern == kNonwovenPattern) {  // a small mat (nonwoven.h): its counts as built
-    const WeaveSummary s = make_nonwoven_sample(options).summary;
-    z.detail = s.detail;
-    z.curves = double(s.curves), z.curve_points = double(s.curve_points);
-    z.curve_segments = double(s.curve_segments);
+  if (options.pattern == kNonwovenPattern) {  // a mat (nonwoven.h): straight pieces, two points
+    const NonwovenSize n = nonwoven_sample_size(options);
+    z.detail = "fiber";
+    z.curves = n.curves, z.curve_points = 2 * n.curves, z.curve_segments = n.curves;
+    z.made_curve_points = z.curve_points, z.made_curve_segments = z.curve_segments;
     return z;
   }
   const Resolved r = resolve(options);
@@ -619,6 +651,19 @@ WovenSampleSize woven_sample_size(const WeaveOptions& options) {
   if (r.fiber_detail) {
     z.curves = r.curves, z.curve_points = r.curve_points;
     z.curve_segments = r.curve_points - r.curves;
+    // What make_woven_sample will hold: the sections predicted and the bundles' own counts
+    // (8452.wif: 7.26 M points at the default packing, 4.0 M made in vertical sections). A bundle
+    // that does not fit is make_woven_sample's error to report, with its fallback's words.
+    detail::FiberSettings fs = r.fibers;
+    fs.perpendicular =
+        perpendicular_sections_fit(L, r.repeat.warps, r.repeat.wefts, r.fibers.radius_mm);
+    z.fiber_sections = fs.perpendicular ? "perpendicular" : "vertical";
+    try {
+      const detail::FiberCount n = detail::count_fibers(L, fs);
+      z.made_curve_points = n.points, z.made_curve_segments = n.points - n.curves;
+    } catch (const Error&) {
+      z.made_curve_points = z.curve_points, z.made_curve_segments = z.curve_segments;
+    }
     return z;
   }
   // Each yarn a tube of K = crossings x segments rings of M sides (append_yarn_tube).

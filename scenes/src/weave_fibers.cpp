@@ -500,6 +500,26 @@ void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& ou
   }
 }
 
+FiberCount count_fibers(const Layout& layout, const FiberSettings& fs) {
+  std::map<std::tuple<bool, double, double, double, double>, int> fibers_of;  // as build_fibers
+  FiberCount n;
+  for (const YarnPath& y : layout.yarns) {
+    const auto key =
+        std::make_tuple(y.warp, y.size.width_mm, y.size.thickness_mm, y.max_slope(), y.period);
+    auto it = fibers_of.find(key);
+    if (it == fibers_of.end())
+      it = fibers_of
+               .emplace(key, make_bundle(y.size.width_mm, y.size.thickness_mm, y.max_slope(),
+                                         y.period, fs, y.warp ? "warp" : "weft")
+                                 .fibers)
+               .first;
+    const double K = double(y.crossing.size()) * layout.segments_per_crossing;
+    n.curves += it->second;
+    n.points += it->second * (K + 1);
+  }
+  return n;
+}
+
 }  // namespace weft::detail
 
 namespace weft {
@@ -741,8 +761,47 @@ SceneDescription fiber_patch_description(WeaveOptions options, const std::string
   return d;
 }
 
+namespace {
+
+// One copy of the fibers into 'c', its points shifted by (dx, 0, dz) a slice at a time, 'progress'
+// told the points copied and asked between slices. Near the limit of 3e7 points
+// a copy is 480 MB, and new pages came at 60-80 MB/s on the project's shared 2-core machine
+// (integrators/src/zero_polled.h): seconds per copy, nine copies or more. False when it said
+// stop. The sums are those of one pass (float + float, point by point): the bits do not depend on
+// the slices.
+bool copy_fibers_polled(const FiberCurves& from, float dx, float dz, uint64_t done_before,
+                        uint64_t total, const ProgressCallback& progress, FiberCurves& c) {
+  constexpr size_t kSlicePoints = size_t(1) << 19;  // 8 MB of points
+  c.curve_first = from.curve_first;
+  c.curve_points = from.curve_points;
+  c.curve_yarn = from.curve_yarn;
+  c.yarn_material = from.yarn_material;
+  c.names = from.names;
+  const size_t n = from.point_count();
+  c.points.reserve(4 * n);
+  for (size_t v0 = 0; v0 < n; v0 += kSlicePoints) {
+    const size_t v1 = std::min(n, v0 + kSlicePoints);
+    c.points.insert(c.points.end(), from.points.begin() + 4 * v0, from.points.begin() + 4 * v1);
+    for (size_t v = v0; v < v1; ++v) {
+      c.points[4 * v] += dx;
+      c.points[4 * v + 2] += dz;
+    }
+    if (!progress({"scene copies", done_before + v1, total, "fiber points"})) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, int half_z,
                                          const std::string& source, bool instanced) {
+  return *tiled_woven_description(sample, half_x, half_z, source, instanced, no_progress());
+}
+
+std::optional<SceneDescription> tiled_woven_description(const WovenSample& sample, int half_x,
+                                                        int half_z, const std::string& source,
+                                                        bool instanced,
+                                                        const ProgressCallback& progress) {
   for (const auto& [half, field] : {std::pair{half_x, "half_x"}, std::pair{half_z, "half_z"}})
     if (half < 0 || half > 64)
       throw Error(source, field, "copies on each side must lie in [0, 64]");
@@ -758,18 +817,19 @@ SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, 
   const auto shift = [&](int i, int k) {
     return std::pair{static_cast<float>(i * px), static_cast<float>(k * pz)};
   };
-  if (fibers)
+  if (fibers) {
+    const uint64_t per_copy = sample.fibers.point_count();
+    const uint64_t total = per_copy * uint64_t(2 * half_x + 1) * uint64_t(2 * half_z + 1);
+    uint64_t done = 0;
     for (int i = -half_x; i <= half_x; ++i)
-      for (int k = -half_z; k <= half_z; ++k) {
+      for (int k = -half_z; k <= half_z; ++k, done += per_copy) {
         const auto [dx, dz] = shift(i, k);
-        FiberCurves c = sample.fibers;
-        for (size_t v = 0; v < c.point_count(); ++v) {
-          c.points[4 * v] += dx;
-          c.points[4 * v + 2] += dz;
-        }
+        FiberCurves c;
+        if (!copy_fibers_polled(sample.fibers, dx, dz, done, total, progress, c))
+          return std::nullopt;
         d.curves.push_back(std::make_shared<const FiberCurves>(std::move(c)));
       }
-  else if (instanced) {
+  } else if (instanced) {
     for (const auto& mesh : sample.meshes) d.meshes.push_back(std::make_shared<TriangleMesh>(mesh));
     for (int i = -half_x; i <= half_x; ++i)
       for (int k = -half_z; k <= half_z; ++k) {

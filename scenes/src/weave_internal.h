@@ -88,6 +88,13 @@ void build_fibers(const Layout& layout, const FiberSettings& fs, FiberCurves& ou
                   std::vector<FiberLayoutInfo>& warp_info, std::vector<FiberLayoutInfo>& weft_info,
                   const std::function<bool(uint64_t, uint64_t)>& keep_going);
 
+// The fibers and curve points build_fibers makes with these settings, from the yarns' bundles
+// alone (no fiber placed): the same errors as build_fibers where a bundle does not fit.
+struct FiberCount {
+  double curves = 0, points = 0;
+};
+FiberCount count_fibers(const Layout& layout, const FiberSettings& fs);
+
 // Distance between the segments p0-p1 and q0-q1 (any units).
 double segment_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
 

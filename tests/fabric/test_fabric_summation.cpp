@@ -2,11 +2,15 @@
 // extension, against analytic fiber tables whose fabric is known in closed form.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 #include "raytrace_test_util.h"
 #include "test_util.h"
 #include "weft/core/math.h"
+#include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/fabric_summation.h"
 
 using namespace weft;
@@ -216,3 +220,43 @@ TEST(FabricSummation, WeaveTurnedBy90DegreesTurnsTheTable) {
   EXPECT_LT(worst, 1e-9);
   EXPECT_GT(differs, 0.01);  // the sample is not symmetric by itself: the turn is needed
 }
+
+namespace {
+
+// visible_fiber_tangents for summation-visible: both sides from one scene, the same tangents as
+// one side at a time; it stops (nothing) at each kind of poll: the fibers' copies, the scene
+// build and the rays.
+TEST(FabricSummation, VisibleTangentsOfBothSidesAreTheSidesAndStopWhenAsked) {
+  for (const char* detail : {"yarn", "fiber"}) {
+    SCOPED_TRACE(detail);
+    const WovenSample sample = weft::testing::default_sample(detail);
+    std::vector<std::string> stages;
+    const auto both = visible_fiber_tangents(sample, [&](const ProgressUpdate& u) {
+      if (stages.empty() || stages.back() != u.stage) stages.emplace_back(u.stage);
+      return true;
+    });
+    ASSERT_TRUE(both);
+    const auto same = [](const std::vector<Vec3>& a, const std::vector<Vec3>& b) {
+      if (a.size() != b.size()) return false;
+      for (size_t k = 0; k < a.size(); ++k)
+        if (a[k].x != b[k].x || a[k].y != b[k].y || a[k].z != b[k].z) return false;
+      return true;
+    };
+    EXPECT_TRUE(same(both->top, visible_fiber_tangents(sample, true)));
+    EXPECT_TRUE(same(both->bottom, visible_fiber_tangents(sample, false)));
+    EXPECT_FALSE(both->top.empty());
+    for (const std::string& stage : stages) {
+      SCOPED_TRACE(stage);
+      const auto stopped =
+          visible_fiber_tangents(sample, [&](const ProgressUpdate& u) { return u.stage != stage; });
+      EXPECT_FALSE(stopped);
+    }
+    // Each kind of work polls: the copies (fibers only), the build and the rays.
+    EXPECT_NE(std::find(stages.begin(), stages.end(), "scene build"), stages.end());
+    EXPECT_NE(std::find(stages.begin(), stages.end(), "visible fibers"), stages.end());
+    EXPECT_EQ(std::find(stages.begin(), stages.end(), "scene copies") != stages.end(),
+              std::string(detail) == "fiber");
+  }
+}
+
+}  // namespace

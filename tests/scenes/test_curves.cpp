@@ -546,3 +546,47 @@ TEST(Curves, MeshesAndCurvesTogetherKeepTheirIds) {
   o.override_shapes = {1, 0};
   EXPECT_THROW(RenderScene(d, o), Error);
 }
+
+// A curve set's own work polls the build's callback (between geometries it asks with no total;
+// Embree's monitor gives a total of 1000): its segment index and Embree buffers every few million
+// entries, so that a set near the limit of 3e7 points, hundreds of MB of new pages, is stopped
+// within it. Polled without a stop, the scene is whole; stopped at any of those polls, cancelled.
+TEST(Curves, ALargeCurveSetPollsWhileItIsCopied) {
+  // 3 M points: 3072 straight fibers of 1024 points side by side.
+  constexpr uint32_t kCurves = 3072, kPointsPerCurve = 1024;
+  auto curves = std::make_shared<FiberCurves>();
+  curves->points.reserve(4 * size_t(kCurves) * kPointsPerCurve);
+  for (uint32_t c = 0; c < kCurves; ++c) {
+    curves->curve_first.push_back(c * kPointsPerCurve);
+    curves->curve_points.push_back(kPointsPerCurve);
+    curves->curve_yarn.push_back(0);
+    for (uint32_t i = 0; i < kPointsPerCurve; ++i)
+      curves->points.insert(curves->points.end(), {float(i) * 1e-3f, 0, float(c) * 1e-3f, 1e-4f});
+  }
+  curves->yarn_material = {"m"};
+  SceneDescription d;
+  d.source = "long.json";
+  d.curves.push_back(curves);
+  MaterialBinding any;
+  any.type = "lambert";
+  d.default_material = any;
+  int between = 0;  // asks without a total: between geometries and within the curve set
+  RenderSceneOptions counted;
+  counted.build_progress = [&](const ProgressUpdate& u) {
+    between += u.total == 0;
+    return true;
+  };
+  const RenderScene whole(d, counted);
+  EXPECT_FALSE(whole.cancelled());
+  // Before the set, then 3 M segments indexed (3 asks), 12 M floats copied (6) and 3 M flags (1).
+  EXPECT_GE(between, 1 + 3 + 6 + 1);
+  for (const int stop_at : {2, 5, between - 1}) {
+    SCOPED_TRACE(stop_at);
+    int asked = 0;
+    RenderSceneOptions stopping;
+    stopping.build_progress = [&](const ProgressUpdate& u) {
+      return !(u.total == 0 && ++asked >= stop_at);
+    };
+    EXPECT_TRUE(RenderScene(d, stopping).cancelled());
+  }
+}

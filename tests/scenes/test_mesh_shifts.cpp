@@ -110,7 +110,8 @@ TEST(MeshShifts, EmissiveMeshesAreNotShifted) {
 
 // woven_sample_size: at yarn detail the triangles and vertices make_woven_sample builds, exactly;
 // at fiber detail the fibers exactly and the curve points as the limit estimates them (every
-// fiber one curve of crossings x segments + 1 points), without building anything.
+// fiber one curve of crossings x segments + 1 points), and the sections and points the sample will
+// hold, without building anything.
 TEST(MeshShifts, SampleSizeCountsTheSampleBeforeBuildingIt) {
   for (const char* draft : {"54235-plain.wif", "8452.wif"}) {
     WeaveOptions o;
@@ -136,6 +137,34 @@ TEST(MeshShifts, SampleSizeCountsTheSampleBeforeBuildingIt) {
   EXPECT_EQ(zf.curves, double(sf.summary.curves));
   EXPECT_EQ(zf.curve_points, double(sf.summary.curve_points));
   EXPECT_EQ(zf.curve_segments, double(sf.summary.curve_segments));
+  // The sections the fibers end in, predicted, and the points then made, exactly: the bundled
+  // samples and drafts (the poplin keeps perpendicular sections; the others fall back).
+  for (const std::string& file :
+       {std::string("examples/red-cotton-weave.json"),
+        std::string("examples/polyester-satin-weave.json"),
+        std::string("examples/polyester-twill-weave.json"), std::string("data/wif/54235-plain.wif"),
+        std::string("data/wif/red-white-twill.wif")}) {
+    SCOPED_TRACE(file);
+    const std::filesystem::path path = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes" / file;
+    WeaveOptions o = path.extension() == ".wif" ? WeaveOptions{} : read_weave_options(path);
+    if (path.extension() == ".wif") o.wif = path.string();
+    o.detail = "fiber";
+    const WovenSampleSize z = woven_sample_size(o);
+    const WovenSample s = make_woven_sample(o);
+    EXPECT_EQ(z.fiber_sections, s.summary.fiber_sections);
+    EXPECT_EQ(z.made_curve_points, double(s.summary.curve_points));
+    EXPECT_EQ(z.made_curve_segments, double(s.summary.curve_segments));
+  }
+  // The 84 x 100 draft (not made here: minutes): 7.26 M points at the default packing, 4.0 M made
+  // in vertical sections at packing 0.31 (`weft weave --wif scenes/data/wif/8452.wif --detail
+  // fiber --json`, 2026-12-05, docs/verify.md).
+  WeaveOptions large;
+  large.wif = (kWifDir / "8452.wif").string();
+  large.detail = "fiber";
+  const WovenSampleSize zl = woven_sample_size(large);
+  EXPECT_EQ(zl.fiber_sections, "vertical");
+  EXPECT_NEAR(zl.curve_points, 7.26e6, 0.01e6);
+  EXPECT_NEAR(zl.made_curve_points, 4.0e6, 0.05e6);
   WeaveOptions bad;
   bad.sides = 2;
   EXPECT_NE(weft::testing::error_of([&] { woven_sample_size(bad); }).find("sides"),

@@ -183,3 +183,22 @@ TEST(Nonwoven, BundledFeltIsTheDefault) {
   EXPECT_NEAR(a.summary.nonwoven->areal_density_gsm, 170, 0.5);
   EXPECT_EQ(a.summary.period_x_mm, 1.2);
 }
+
+// nonwoven_sample_size (what a plan counts, the mat not made): the fibers exactly and the curves
+// (fibers cut at the tile's sides) as expected: 766 against 742 made for the small mat (540
+// fibers: the cuts' own spread is about 2 %), 2 602 against 2 595 for the bundled felt.
+TEST(Nonwoven, SizeBeforeTheMatIsMadeIsClose) {
+  const auto felt = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/examples/acrylic-felt.json";
+  for (const WeaveOptions& o : {small_mat(), read_weave_options(felt)}) {
+    const NonwovenSize z = nonwoven_sample_size(o);
+    const WovenSample s = make_woven_sample(o);
+    ASSERT_TRUE(s.summary.nonwoven);
+    EXPECT_EQ(z.fibers, s.summary.nonwoven->fibers);
+    EXPECT_NEAR(z.curves / double(s.summary.curves), 1.0, 0.05)
+        << s.summary.curves << " made, " << z.curves << " expected";
+    const WovenSampleSize w = woven_sample_size(o);
+    EXPECT_EQ(w.curves, z.curves);
+    EXPECT_EQ(w.curve_points, 2 * z.curves);
+    EXPECT_EQ(w.curve_segments, z.curves);
+  }
+}

@@ -11,6 +11,7 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 
 #include "lambert_scene.h"
@@ -744,4 +745,35 @@ TEST(Woven, TiledCopiesAreShiftedByThePeriods) {
               tiled_woven_description(WovenSample{}, 1, 1, "tiled");
             }).find("tiled"),
             std::string::npos);
+}
+
+// The polled tiling: the same bits as the plain call, and nothing once the callback says stop
+// (asked between slices of each copy's points: stopped at the first, the first copy is unfinished).
+TEST(Woven, PolledTilingIsTheSameAndStops) {
+  WeaveOptions o;
+  o.detail = "fiber";
+  const WovenSample s = make_woven_sample(overlay(red_cotton_weave_options(), o));
+  const SceneDescription plain = tiled_woven_description(s, 1, 2, "tiled");
+  uint64_t asked = 0, last_done = 0, total = 0;
+  const std::optional<SceneDescription> polled =
+      tiled_woven_description(s, 1, 2, "tiled", false, [&](const ProgressUpdate& u) {
+        ++asked;
+        last_done = u.done, total = u.total;
+        return true;
+      });
+  ASSERT_TRUE(polled);
+  ASSERT_EQ(polled->curves.size(), plain.curves.size());
+  for (size_t k = 0; k < plain.curves.size(); ++k) {
+    EXPECT_EQ(polled->curves[k]->points, plain.curves[k]->points);
+    EXPECT_EQ(polled->curves[k]->curve_first, plain.curves[k]->curve_first);
+    EXPECT_EQ(polled->curves[k]->curve_points, plain.curves[k]->curve_points);
+    EXPECT_EQ(polled->curves[k]->curve_yarn, plain.curves[k]->curve_yarn);
+  }
+  EXPECT_GE(asked, plain.curves.size());  // at least once a copy
+  EXPECT_EQ(total, 15 * s.fibers.point_count());
+  EXPECT_EQ(last_done, total);
+  int calls = 0;
+  const auto stop = [&](const ProgressUpdate&) { return ++calls < 1; };
+  EXPECT_FALSE(tiled_woven_description(s, 1, 2, "tiled", false, stop));
+  EXPECT_EQ(calls, 1);
 }

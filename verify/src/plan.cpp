@@ -261,7 +261,8 @@ VerifyEstimate estimate_verify(const VerifyPlan& p) {
                                      z ? fabric_scene_seconds(*z) : FabricSceneSeconds{});
   if (z) {
     e.scene_bytes = fabric_scene_bytes(*z);
-    e.fiber_segments = z->curve_segments;
+    // The segments the sample will hold (its memory's count, not the packing's estimate).
+    e.fiber_segments = z->made_curve_segments > 0 ? z->made_curve_segments : z->curve_segments;
   }
   return e;
 }

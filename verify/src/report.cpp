@@ -123,9 +123,9 @@ bool write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
     // The renders first, so that metrics.json and index.html describe them and their time.
     VerifyReport r = report;
     const auto t0 = std::chrono::steady_clock::now();
-    // Stopped: the staging folder goes, and with it whatever was written. Asked again after the
-    // renders and the previews, so that a stop between steps does not wait for the plots (their
-    // script runs unpolled, and system() ignores SIGINT meanwhile).
+    // Stopped: the staging folder goes, and with it whatever was written. Asked after the
+    // renders, the previews and the plots (draw() ends its script early on the front end's own
+    // poll), so that a stop between steps does not wait for the next.
     bool cancelled = false;
     const auto stopped = [&](uint64_t step) {
       cancelled = cancelled || !progress({"report", step, 3, "steps"});
@@ -146,6 +146,7 @@ bool write_verify_report(const std::filesystem::path& dir, const VerifyReport& r
     write_text_atomically(staging / "inplane.csv", verify_inplane_csv(r));
     write_text_atomically(staging / "metrics.json", verify_metrics_json(r));
     draw(staging);
+    if (stopped(3)) return false;
     write_text_atomically(staging / "index.html", verify_index_html(r, embedded_plots(staging)));
     // The earlier report (if any) is moved aside, the new one moved in, the old one removed.
     if (fs::exists(target, ec)) {

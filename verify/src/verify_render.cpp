@@ -89,9 +89,11 @@ VerifyWeaveFrame verify_weave_frame(const WeaveSummary& sample, int size) {
   return f;
 }
 
-SceneDescription verify_weave_scene(const WovenSample& sample, const nlohmann::json& material,
-                                    bool transmission, const VerifySettings& s,
-                                    const std::filesystem::path& base_dir) {
+std::optional<SceneDescription> verify_weave_scene(const WovenSample& sample,
+                                                   const nlohmann::json& material,
+                                                   bool transmission, const VerifySettings& s,
+                                                   const std::filesystem::path& base_dir,
+                                                   const ProgressCallback& progress) {
   if (sample.fibers.curve_count() == 0)
     throw Error("", "sample", "the fiber-level render needs the woven sample at fiber detail");
   const VerifyWeaveFrame f = verify_weave_frame(sample.summary, s.weave_render_size);
@@ -99,7 +101,10 @@ SceneDescription verify_weave_scene(const WovenSample& sample, const nlohmann::j
       std::string("verify weave render ") + (transmission ? "transmission" : "reflection");
   // Made in place rather than parsed: the description parser wants its geometry from glTF files
   // or inline objects, and the fibers are the tiled sample's.
-  SceneDescription d = tiled_woven_description(sample, f.copies_x, f.copies_z, source);
+  std::optional<SceneDescription> tiled =
+      tiled_woven_description(sample, f.copies_x, f.copies_z, source, false, progress);
+  if (!tiled) return std::nullopt;
+  SceneDescription d = std::move(*tiled);
   d.base_dir = base_dir;
   for (const char* key : {"warp", "weft"}) d.materials[key] = binding_of(material, key);
   // glTF's frame (weave.h): the cloth's normal is +y, the warp +x. The light as the patch's.
@@ -196,7 +201,10 @@ std::optional<VerifyRender> render_weave(const WovenSample& sample,
   // table's value for this view and light (TableLookup).
   const nlohmann::json material = {{"type", "fiber_table"},
                                    {"params", {{"file", fiber_file}, {"interpolation", "cell"}}}};
-  SceneDescription desc = verify_weave_scene(sample, material, transmission, s, folder);
+  std::optional<SceneDescription> tiled =
+      verify_weave_scene(sample, material, transmission, s, folder, progress);
+  if (!tiled) return std::nullopt;
+  SceneDescription& desc = *tiled;
   // A spectral fiber table is rendered band by band, as the ray trace traces it: light that
   // scatters many times in a coloured fiber is not the RGB transport of the reduced table.
   (*desc.render)["spectral"] = spectral;

@@ -128,10 +128,12 @@ struct FabricBakeResult {
 FabricBakeResult run_fabric_bake(const FabricBakePlan& plan, const FabricBakeHooks& hooks);
 
 // A summation plan's table of 'sample' made of 'fiber' (the plan's method, resolution, samples,
-// seed and threads).
-TabulatedBsdfTable summed_fabric_table(const FabricBakePlan& plan, const WovenSample& sample,
-                                       const TabulatedBsdfTable& fiber,
-                                       const ProgressCallback& progress);
+// seed and threads); nothing when 'progress' said stop (summation-visible's scene and rays poll
+// it, as the table's rows do).
+std::optional<TabulatedBsdfTable> summed_fabric_table(const FabricBakePlan& plan,
+                                                      const WovenSample& sample,
+                                                      const TabulatedBsdfTable& fiber,
+                                                      const ProgressCallback& progress);
 
 // `weft merge` of a ray trace's parts ('all', merge_job_parts): the table written to 'output' and
 // the weave table to 'weave_out' (which the parts must carry exactly when given); the summary.

@@ -27,6 +27,7 @@
 // is in the cloth frame x = warp, z = the cloth's normal (+y), y = z x x (= -z in glTF).
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -242,6 +243,15 @@ FabricSceneSeconds fabric_scene_seconds(const WovenSampleSize& size);
 // of the cloth's area.
 std::vector<Vec3> visible_fiber_tangents(const WovenSample& sample, bool from_above,
                                          int rays_per_side = 64);
+// Both sides' at once, from one scene, as summation-visible takes them: the scene's copies and
+// build poll 'progress', and so do the rays, a row at a time; nothing when it said stop. The same
+// tangents as the call above on either side.
+struct VisibleFiberTangents {
+  std::vector<Vec3> top, bottom;
+};
+std::optional<VisibleFiberTangents> visible_fiber_tangents(const WovenSample& sample,
+                                                           const ProgressCallback& progress,
+                                                           int rays_per_side = 64);
 
 FabricRaytraceResult raytrace_fabric_table(const WovenSample& sample,
                                            const TabulatedBsdfTable& fiber,

@@ -110,6 +110,10 @@ Particle launched_particle(const Launch& l, int channels, const Strategies& st, 
 // sample has neither fibers nor yarn tubes. The yarn tubes are the sample's own, not copies: the
 // description, and any scene built from it, must not outlive 'sample'.
 SceneDescription tiled_geometry(const WovenSample& sample);
+// The same, the fibers' copies polling 'progress' (tiled_woven_description); nothing when it said
+// stop.
+std::optional<SceneDescription> tiled_geometry(const WovenSample& sample,
+                                               const ProgressCallback& progress);
 // Along the line p + t d: the distance to the first side of the repeat it crosses (side 0: -x,
 // 1: +x, 2: -z, 3: +z; -1 and infinity for none) and to the slab's face ahead (infinity if none).
 struct Boundaries {

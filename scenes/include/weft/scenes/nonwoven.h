@@ -46,4 +46,13 @@ inline constexpr const char* kNonwovenPattern = "nonwoven";
 WovenSample make_nonwoven_sample(const WeaveOptions& options,
                                  const ProgressCallback& progress = no_progress());
 
+// The mat's size before it is made, from its options alone (the checks above, weft::Error naming
+// the field): its fibers exactly, its curves (fibers cut at the tile's sides, two points each) as
+// expected from the fibers' length, inclination and the tile (within a few percent of the mat
+// made; placing the largest mat takes tens of seconds).
+struct NonwovenSize {
+  double fibers = 0, curves = 0;
+};
+NonwovenSize nonwoven_sample_size(const WeaveOptions& options);
+
 }  // namespace weft

@@ -171,12 +171,20 @@ WovenSample make_woven_sample(const WeaveOptions& options,
 // (weft::Error naming the field) but no geometry, for memory estimates before anything is
 // allocated. Yarn detail: its tubes' triangles and vertices exactly, with the tessellation they
 // take; fiber detail: its fibers and curve points as estimated from the packing (the count the
-// curve-point limit is checked on). A nonwoven mat (at most 20 000 fibers) is built and counted.
+// curve-point limit is checked on). A nonwoven mat: its curves as expected (nonwoven_sample_size),
+// not made (the largest takes tens of seconds).
 struct WovenSampleSize {
   std::string detail;
   int sides = 0, segments_per_crossing = 0;  // yarn detail's tessellation
   double triangles = 0, vertices = 0;
   double curves = 0, curve_points = 0, curve_segments = 0;
+  // Woven fiber detail: the sections the fibers are predicted to end in ("perpendicular", or
+  // "vertical" where those would bring fibers too close: WeaveSummary::fiber_sections) and the
+  // curve points and segments the sample then holds, from its yarns' bundles (no fiber placed).
+  // The packing estimate above can be twice as high where the sample falls back to vertical
+  // sections; memory is estimated from these. A nonwoven mat: the same as above.
+  std::string fiber_sections;
+  double made_curve_points = 0, made_curve_segments = 0;
 };
 WovenSampleSize woven_sample_size(const WeaveOptions& options);
 
@@ -219,6 +227,13 @@ SceneDescription fiber_patch_description(WeaveOptions options, const std::string
 // memory of one repeat instead of (2 half_x + 1) (2 half_z + 1); fibers are copied either way.
 SceneDescription tiled_woven_description(const WovenSample& sample, int half_x, int half_z,
                                          const std::string& source, bool instanced = false);
+// The same, the fibers' copies made a slice of points at a time with 'progress' told (stage
+// "scene copies") and asked between slices (near the limit of 3e7 points, nine copies took tens
+// of seconds unpolled); nothing when it said stop. The same bits as the call above.
+std::optional<SceneDescription> tiled_woven_description(const WovenSample& sample, int half_x,
+                                                        int half_z, const std::string& source,
+                                                        bool instanced,
+                                                        const ProgressCallback& progress);
 
 // ---------------------------------------------------------------------------------------------
 // The open-mesh plain-weave patch of earlier versions (circular tubes around sinusoidal centre

@@ -4,6 +4,7 @@
 // fiber table.
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -81,9 +82,14 @@ VerifyWeaveFrame verify_weave_frame(const WeaveSummary& sample, int size);
 // The scene (in memory): the tiled fibers, materials "warp" and "weft" bound to 'material' (its
 // relative paths resolve against 'base_dir'), the light, the camera and the render settings
 // (weave_render_size, weave_render_spp, seed). weft::Error when the sample is not at fiber detail.
-SceneDescription verify_weave_scene(const WovenSample& sample, const nlohmann::json& material,
-                                    bool transmission, const VerifySettings& settings,
-                                    const std::filesystem::path& base_dir);
+// The fibers' copies poll 'progress' (near the limit of 3e7 points they take seconds each);
+// nothing when it said stop.
+std::optional<SceneDescription> verify_weave_scene(const WovenSample& sample,
+                                                   const nlohmann::json& material,
+                                                   bool transmission,
+                                                   const VerifySettings& settings,
+                                                   const std::filesystem::path& base_dir,
+                                                   const ProgressCallback& progress);
 inline constexpr const char* kVerifyWeaveRenderSetup =
     "The woven sample at fiber detail, tiled, every fiber an Embree round curve with the model's "
     "fiber table (shaded as weft render shades fibers: the whole-fiber table, no occlusion by the "
