@@ -19,6 +19,11 @@ const TabulatedBsdf& Table::bsdf() const {
   return *bsdf_;
 }
 
+const TableReader& Table::reader() const {
+  if (!reader_) reader_ = std::make_shared<const TableReader>(*table_);
+  return *reader_;
+}
+
 namespace {
 
 // A direction argument: three finite numbers, not all zero; made a unit vector.
@@ -173,12 +178,12 @@ void bind_table(py::module_& m) {
           "eval",
           [](const Table& t, const std::vector<double>& wo, const std::vector<double>& wi) {
             std::vector<double> out(static_cast<size_t>(t.get().channels));
-            t.get().interpolate(direction(wo, "wo"), direction(wi, "wi"), out);
+            t.reader().eval(direction(wo, "wo"), direction(wi, "wi"), out);
             return to_array(out);
           },
           py::arg("wo"), py::arg("wi"),
-          "f(wo, wi) per channel, interpolated as the renderer reads the table (local frame: x the "
-          "fiber or warp axis, z the normal)")
+          "f(wo, wi) per channel, as the renderer reads the table: interpolated, plus its sheen "
+          "when it holds one (local frame: x the fiber or warp axis, z the normal)")
       .def("sample", &sample, py::arg("wo"), py::arg("u1"), py::arg("u2"), py::arg("u_lobe") = 0.5,
            "The renderer's sampling for wo (RGB): dict wi, weight = f |cos| / pdf, pdf; or None")
       .def(

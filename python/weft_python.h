@@ -14,6 +14,7 @@
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/fiber_table_bake.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/table_reader.h"
 #include "weft/materials/tabulated_bsdf.h"
 
 namespace weft::python {
@@ -30,10 +31,14 @@ class Table {
   std::shared_ptr<const TabulatedBsdfTable> shared() const { return table_; }
   // TabulatedBsdfData::prepare's result, made once (the GIL guards it).
   const TabulatedBsdf& bsdf() const;
+  // The table read with its sheen (TableReader), made once (the GIL guards it); it reads table_,
+  // which lives as long as this object.
+  const TableReader& reader() const;
 
  private:
   std::shared_ptr<const TabulatedBsdfTable> table_;
   mutable std::shared_ptr<TabulatedBsdf> bsdf_;
+  mutable std::shared_ptr<const TableReader> reader_;
 };
 
 // The progress of one long call, made with the GIL held; the library's callback may run on any

@@ -8,6 +8,7 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/fabric/fabric_raytrace.h"
+#include "weft/materials/table_reader.h"
 
 namespace weft {
 namespace {
@@ -17,24 +18,14 @@ Vec3 inplane(double theta_deg, double azimuth_deg, bool mirror) {
   return {s * std::sin(t) * std::cos(p), s * std::sin(t) * std::sin(p), std::cos(t)};
 }
 
-// A table as a reader that knows its sheen takes it: the rest interpolated, plus the sheen. The
-// rest (a quadrature of the sheen's cell averages) is made once per table, and only with a sheen.
-struct SheenReader {
-  const TabulatedBsdfTable& table;
-  std::optional<TabulatedBsdfTable> rest;
-  explicit SheenReader(const TabulatedBsdfTable& t) : table(t) {
-    if (t.sheen) rest = t.without_sheen("", 0);
-  }
-};
-
-double beta_at(const SheenReader& t, double theta_i, double azimuth, double view) {
-  const size_t nc = static_cast<size_t>(t.table.channels);
-  std::vector<double> f(nc), s(nc, 0.0);
-  const Vec3 wo = inplane(view, azimuth, true), wi = inplane(theta_i, azimuth, false);
-  (t.rest ? *t.rest : t.table).interpolate(wo, wi, f);
-  if (t.table.sheen) t.table.sheen->eval(wo, wi, s);
+// A table as a reader that knows its sheen takes it (TableReader: the rest, made once per table
+// and only with a sheen, interpolated, plus the sheen).
+double beta_at(const TableReader& t, double theta_i, double azimuth, double view) {
+  const size_t nc = static_cast<size_t>(t.channels());
+  std::vector<double> f(nc);
+  t.eval(inplane(view, azimuth, true), inplane(theta_i, azimuth, false), f);
   double mean = 0;
-  for (size_t c = 0; c < nc; ++c) mean += f[c] + s[c];
+  for (size_t c = 0; c < nc; ++c) mean += f[c];
   return kPi * mean / static_cast<double>(nc);
 }
 
@@ -47,7 +38,7 @@ void check_angles(const std::vector<double>& angles, double lo, double hi, const
                       std::to_string(hi) + "] degrees");
 }
 
-InplanePeak peak_of(const SheenReader& t, double theta_i, double azimuth) {
+InplanePeak peak_of(const TableReader& t, double theta_i, double azimuth) {
   std::vector<double> views, beta;
   for (double v = 0; v <= 89.0; v += 0.5)
     views.push_back(v), beta.push_back(beta_at(t, theta_i, azimuth, v));
@@ -69,7 +60,7 @@ InplanePeak peak_of(const SheenReader& t, double theta_i, double azimuth) {
 }  // namespace
 
 InplanePeak inplane_peak(const TabulatedBsdfTable& table, double theta_i, double azimuth) {
-  return peak_of(SheenReader(table), theta_i, azimuth);
+  return peak_of(TableReader(table), theta_i, azimuth);
 }
 
 SheenPlan plan_sheen(const SheenRequest& r) {
@@ -93,8 +84,6 @@ SheenPlan plan_sheen(const SheenRequest& r) {
   p.sample = make_woven_sample(read_weave_options(r.weave));
   const DirectionGrid g{r.resolution};
   std::set<int> rows;
-  std::vector<SheenReader> readers;
-  for (const auto& t : p.tables) readers.emplace_back(t);
   for (double phi : r.azimuths_deg)
     for (double ti : r.incidences_deg) {
       const auto fp = g.bilinear(DirectionGrid::to_chart(inplane(ti, phi, false)));
@@ -144,8 +133,8 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
     for (const auto& t : batch_tables) mean += t.values[k];
     out.reference.values[k] = static_cast<float>(mean / r.batches);
   }
-  std::vector<SheenReader> readers;
-  for (const auto& t : p.tables) readers.emplace_back(t);
+  std::vector<TableReader> readers;
+  for (const auto& t : p.tables) readers.emplace_back(t, r.threads);
   for (double phi : r.azimuths_deg)
     for (double ti : r.incidences_deg) {
       SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, {}};
@@ -156,7 +145,7 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
       }
       const double n = r.batches, mean = s / n;
       c.reference_beta_se = std::sqrt(std::max(0.0, s2 / n - mean * mean) / (n - 1));
-      for (const SheenReader& t : readers) c.tables.push_back(peak_of(t, ti, phi));
+      for (const TableReader& t : readers) c.tables.push_back(peak_of(t, ti, phi));
       out.cases.push_back(c);
     }
   out.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;

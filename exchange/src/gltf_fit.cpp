@@ -18,7 +18,9 @@ struct Pair {
 };
 
 // The comparison grid: view and light at the centres of the upper bins of a grid of resolution
-// min(R, max_resolution), the table interpolated there (its cell values where the grids agree).
+// min(R, max_resolution), the table read there as the renderer reads it (TableReader: its cell
+// values where the grids agree, plus its sheen when it holds one) and averaged over the view's
+// rotations.
 std::vector<Pair> comparison_pairs(const TableView& view, int max_resolution) {
   const auto& table = view.table();
   const DirectionGrid grid{std::min(table.resolution, max_resolution)};
@@ -28,7 +30,7 @@ std::vector<Pair> comparison_pairs(const TableView& view, int max_resolution) {
   for (int o = 0; o < upper; ++o)
     for (int i = 0; i < upper; ++i) {
       const Vec3 wo = grid.bin_center(o), wi = grid.bin_center(i);
-      table.interpolate(wo, wi, f);
+      view.isotropic(wo, wi, f);
       pairs.push_back({wo, wi, view.rgb(f)});
     }
   return pairs;
@@ -64,7 +66,7 @@ TableTransmission table_transmission(const TableView& view) {
     const auto a = table.directional_albedo_seen_from(o);
     double tt = 0, rr = 0, straight = 0;
     const Vec3 v = grid.bin_center(o);
-    table.interpolate(v, -v, f);
+    view.reader().eval(v, -v, f);
     for (int c = 0; c < table.channels; ++c) {
       tt += a.transmittance[static_cast<size_t>(c)];
       rr += a.reflectance[static_cast<size_t>(c)];
@@ -146,7 +148,8 @@ void fit_transmission_color(const TableTransmission& t, GltfFit& fit) {
 GltfFit fit_gltf_material(const TabulatedBsdfTable& table, const GltfFitOptions& o) {
   if (o.max_resolution < 1) throw Error("", "max_resolution", "must be at least 1");
   if (!(o.epsilon_per_sr > 0)) throw Error("", "epsilon_per_sr", "must be > 0");
-  const TableView view(table, 1);
+  if (o.azimuths < 1) throw Error("", "azimuths", "must be at least 1");
+  const TableView view(table, o.azimuths);
   const std::vector<Pair> pairs = comparison_pairs(view, o.max_resolution);
   GltfFit fit;
   fit.points = static_cast<int>(pairs.size());

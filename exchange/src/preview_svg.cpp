@@ -58,7 +58,7 @@ std::vector<double> preview_incidences_deg() {
 
 std::string inplane_svg(const TabulatedBsdfTable& table, const std::vector<double>& incidences_deg,
                         double shown_deg) {
-  const TabulatedBsdfTable rgb = table_to_rgb(table);
+  const TableReader rgb = table_to_rgb(TableReader(table));
   std::vector<double> views_deg;
   for (int v = -89; v <= 89; ++v) views_deg.push_back(v);
   std::vector<std::vector<Rgb>> curves;

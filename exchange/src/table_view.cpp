@@ -7,7 +7,8 @@
 
 namespace weft {
 
-TableView::TableView(const TabulatedBsdfTable& table, int azimuths) : table_(table) {
+TableView::TableView(const TabulatedBsdfTable& table, int azimuths)
+    : table_(table), reader_(table) {
   if (azimuths < 1) throw Error("", "azimuths", "needs at least one rotation");
   for (int k = 0; k < azimuths; ++k) {
     const double phi = 2 * kPi * k / azimuths;
@@ -32,7 +33,7 @@ void TableView::isotropic(const Vec3& wo, const Vec3& wi, std::span<double> out)
     const double c = cos_[k], s = sin_[k];
     const Vec3 ro{c * wo.x - s * wo.y, s * wo.x + c * wo.y, wo.z};
     const Vec3 ri{c * wi.x - s * wi.y, s * wi.x + c * wi.y, wi.z};
-    table_.interpolate(ro, ri, one);
+    reader_.eval(ro, ri, one);
     for (size_t j = 0; j < out.size(); ++j) out[j] += one[j];
   }
   for (double& v : out) v /= static_cast<double>(cos_.size());

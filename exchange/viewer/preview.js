@@ -44,9 +44,45 @@ try {
     render();
   });
 
+  // three.js has no KHR_materials_diffuse_transmission: the material's own shader gets its term,
+  // the glTF's diffuse BTDF lit by the environment's irradiance from behind the surface, mixed
+  // with the diffuse reflection by the factor (the extension's base = mix(diffuse_brdf,
+  // diffuse_btdf, factor); the BTDF's Fresnel weight is left out).
+  const showDiffuseTransmission = (gltf) => {
+    const defs = gltf.parser.json.materials || [];
+    gltf.scene.traverse((object) => {
+      if (!object.isMesh) return;
+      const found = gltf.parser.associations.get(object.material);
+      const def = found && defs[found.materials];
+      const ext = def && def.extensions && def.extensions.KHR_materials_diffuse_transmission;
+      if (!ext || object.material.userData.weftDiffuseTransmission) return;
+      const factor = ext.diffuseTransmissionFactor ?? 0;
+      const colour = ext.diffuseTransmissionColorFactor ?? [1, 1, 1];
+      object.material.userData.weftDiffuseTransmission = true;
+      object.material.onBeforeCompile = (shader) => {
+        // The chunk of three.js 0.160's physical shader after which the lights are summed; the
+        // page says whether it was found (a three.js that moved it would show the cloth opaque).
+        const chunk = '#include <lights_fragment_end>';
+        const found = shader.fragmentShader.includes(chunk);
+        document.body.dataset.weftDiffuseTransmission = found ? 'shown' : 'not shown';
+        shader.uniforms.weftTransmission = { value: factor };
+        shader.uniforms.weftTransmissionColour = { value: new THREE.Vector3(...colour) };
+        shader.fragmentShader =
+          'uniform float weftTransmission;\nuniform vec3 weftTransmissionColour;\n' +
+          shader.fragmentShader.replace(chunk, `${chunk}
+#if defined( USE_ENVMAP ) && defined( ENVMAP_TYPE_CUBE_UV )
+  reflectedLight.indirectDiffuse = mix( reflectedLight.indirectDiffuse,
+    weftTransmissionColour * RECIPROCAL_PI * getIBLIrradiance( - geometryNormal ), weftTransmission );
+#endif`);
+      };
+      object.material.needsUpdate = true;
+    });
+  };
+
   const text = document.getElementById('weft-glb').textContent.trim();
   const bytes = Uint8Array.from(atob(text), (c) => c.charCodeAt(0));
   new GLTFLoader().parse(bytes.buffer, '', (gltf) => {
+    showDiffuseTransmission(gltf);
     scene.add(gltf.scene);
     render();
     status.textContent = 'Drag to orbit, scroll to zoom, right-drag to pan.';

@@ -8,6 +8,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/materials/table_reader.h"
 
 namespace weft {
 namespace {
@@ -62,14 +63,16 @@ TableComparison compare_tables(const TabulatedBsdfTable& a, const TabulatedBsdfT
   mean /= static_cast<double>(a.values.size());
   const double threshold = o.significant * mean;
 
+  // Read as the renderer reads them: a table with a sheen, its rest interpolated plus the sheen.
+  const TableReader ra(a), rb(b);
   std::vector<Vec3> centre(bins);
   for (int k = 0; k < bins; ++k) centre[k] = g.bin_center(k);
   Sums all, refl, trans;
   std::vector<double> va(nc), vb(nc);
   for (int i = 0; i < bins; ++i)
     for (int k = 0; k < bins; ++k) {
-      a.interpolate(centre[k], centre[i], va);
-      b.interpolate(centre[k], centre[i], vb);
+      ra.eval(centre[k], centre[i], va);
+      rb.eval(centre[k], centre[i], vb);
       Sums& side = g.upper(i) == g.upper(k) ? refl : trans;
       const double w = d[i] * d[k];
       for (Sums* s : {&all, &side}) {
@@ -102,8 +105,8 @@ TableComparison compare_tables(const TabulatedBsdfTable& a, const TabulatedBsdfT
         // Positive views lie on the mirror side, opposite the light.
         const double tv = deg_to_rad(v);
         const Vec3 wo = -std::sin(tv) * across + Vec3{0, 0, std::cos(tv)};
-        a.interpolate(wo, wi, va);
-        b.interpolate(wo, wi, vb);
+        ra.eval(wo, wi, va);
+        rb.eval(wo, wi, vb);
         c.view_zenith_deg.push_back(v);
         std::vector<double> ba(nc), bb(nc);
         for (int ch = 0; ch < nc; ++ch) {

@@ -5,6 +5,7 @@
 
 #include <cstdlib>
 #include <cstring>
+#include <iostream>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -14,6 +15,7 @@
 #include "test_util.h"
 #include "weft/core/frame.h"
 #include "weft/exchange/export_table.h"
+#include "weft/exchange/table_view.h"
 
 namespace weft {
 namespace {
@@ -290,6 +292,58 @@ TEST(GltfMaterial, ExportPassesTheKhronosValidator) {
           << name << ": " << m.dump();
     }
   }
+}
+
+// The fitted material's RMS log error (the fit's measure, eps 0.01 / sr) against the table's mean
+// over 256 rotations about the normal (TableView), the most an isotropic material can follow, on
+// the fit's grid (the upper bin centres at min(R, 8)), RGB (the writer's gltf_brdf).
+double rms_log_against_rotations(const GltfMaterial& m, const TabulatedBsdfTable& t) {
+  const TableView view(t, 256);
+  const DirectionGrid g{std::min(t.resolution, 8)};
+  const SheenAlbedo e(m.sheen_roughness);
+  std::vector<double> f(static_cast<size_t>(t.channels));
+  double sum = 0;
+  int n = 0;
+  for (int o = 0; o < g.resolution * g.resolution; ++o)
+    for (int i = 0; i < g.resolution * g.resolution; ++i) {
+      view.isotropic(g.bin_center(o), g.bin_center(i), f);
+      const Rgb target = view.rgb(f), got = gltf_brdf(m, e, g.bin_center(o), g.bin_center(i));
+      for (int c = 0; c < 3; ++c, ++n) sum += sqr(std::log((got[c] + 0.01) / (target[c] + 0.01)));
+    }
+  return std::sqrt(sum / n);
+}
+
+// Fits to the table's own values (1 rotation) and to its mean over 16 and 64: each fit's own
+// error and its error against the mean over 256 rotations, printed; the latter returned.
+std::map<int, double> gltf_rotation_study(const TabulatedBsdfTable& t) {
+  std::map<int, double> out;
+  for (int n : {1, 16, 64}) {
+    GltfFitOptions o;
+    o.azimuths = n;
+    const GltfFit fit = fit_gltf_material(t, o);
+    out[n] = rms_log_against_rotations(fit.material, t);
+    std::cout << "fit to " << n << " rotations: its RMS log error " << fit.rms_log
+              << ", against 256 rotations " << out[n] << "\n";
+  }
+  return out;
+}
+
+TEST(GltfMaterial, FitsTheTablesMeanOverRotations) {
+  // The woven cloth (exchange_tables.h woven_rgb) is anisotropic; an isotropic material can follow
+  // at best its mean over rotations. Against the mean over 256 rotations, RMS log (measured): the
+  // fit to the table's own values 0.266, to its mean over 16 rotations 0.263, over 64 (the
+  // default) 0.263. Bound: the default's no worse than the fit to the table's own values.
+  EXPECT_EQ(GltfFitOptions{}.azimuths, 64);
+  const auto s = gltf_rotation_study(testing::woven_rgb());
+  EXPECT_LE(s.at(64), s.at(1));
+}
+
+// The same figures for any table file, printed (docs/exchange.md):
+// WEFT_GLTF_TABLE=TABLE.exr build/tests/weft_tests_exchange --gtest_filter='GltfMaterial.*File*'.
+TEST(GltfMaterial, FiguresForATableFile) {
+  const char* path = std::getenv("WEFT_GLTF_TABLE");
+  if (!path) GTEST_SKIP() << "set WEFT_GLTF_TABLE=TABLE.exr to measure that table's fit";
+  gltf_rotation_study(TabulatedBsdfTable::read_exr(path));
 }
 
 }  // namespace

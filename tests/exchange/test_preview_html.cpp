@@ -272,6 +272,55 @@ TabulatedBsdfTable lobed_fabric() {
   return t;
 }
 
+// three.js has no KHR_materials_diffuse_transmission, so the page adds its term to the material's
+// shader (preview.js): the diffuse BTDF in its own colour, lit from behind the surface. A cloth
+// that reflects blue and transmits red shows red: the linear red share of its pixels lies well
+// above its fitted base colour's (measured: 0.33 against 0.10; without the term 0.16).
+TEST(PreviewHtml, ChromiumShowsTheDiffuseTransmissionsColour) {
+  const auto dir = testing::fresh_test_dir();
+  ExportReport r;
+  std::string why;
+  const std::string page = export_page(
+      testing::lambert_table(4, {0.05, 0.05, 0.6}, {0.6, 0.05, 0.05}), dir / "t.html", &r, &why);
+  if (page.empty()) GTEST_SKIP() << "three.js for the preview is not installed: " << why;
+  const std::string chromium = find_chromium();
+  if (chromium.empty())
+    GTEST_SKIP() << "chromium not found on the PATH (Debian: apt-get install chromium)";
+  ASSERT_GT(figure(r, "diffuse transmission"), 0.1);
+  ASSERT_EQ(run_chromium(chromium, dir / "t.html", "--dump-dom", dir / "dom.html"), 0)
+      << testing::slurp(dir / "dom.html.err");
+  const std::string dom = testing::slurp(dir / "dom.html");
+  ASSERT_NE(dom.find("data-weft-preview=\"rendered\""), std::string::npos)
+      << between(dom, "id=\"weft-status\">", "</p>");
+  EXPECT_NE(dom.find("data-weft-diffuse-transmission=\"shown\""), std::string::npos);
+  const auto png = dir / "shot.png";
+  ASSERT_EQ(
+      run_chromium(chromium, dir / "t.html", "--screenshot=" + png.string(), dir / "shot.log"), 0)
+      << testing::slurp(dir / "shot.log.err");
+  auto in = OIIO::ImageInput::open(png.string());
+  ASSERT_TRUE(in) << OIIO::geterror();
+  const int w = in->spec().width, h = in->spec().height, nc = in->spec().nchannels;
+  std::vector<uint8_t> px(static_cast<size_t>(w) * h * nc);
+  ASSERT_TRUE(in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, px.data()));
+  // The view's box, as above; the cloth's pixels are the coloured ones (the background is grey).
+  size_t cloth = 0;
+  double sum[3] = {0, 0, 0};
+  for (int y = 60; y < std::min(h, 640); ++y)
+    for (int x = 20; x < std::min(w, 700); ++x) {
+      const uint8_t* p = &px[(static_cast<size_t>(y) * w + x) * nc];
+      if (std::max({p[0], p[1], p[2]}) - std::min({p[0], p[1], p[2]}) < 40) continue;
+      ++cloth;
+      for (int c = 0; c < 3; ++c) sum[c] += srgb_to_linear(p[c] / 255.0);
+    }
+  ASSERT_GT(cloth, 1000u) << "the cloth is not on the screenshot";
+  const double base[3] = {figure(r, "base color R"), figure(r, "base color G"),
+                          figure(r, "base color B")};
+  const double seen = sum[0] / (sum[0] + sum[1] + sum[2]);
+  const double fitted = base[0] / (base[0] + base[1] + base[2]);
+  std::printf("red share: seen %.3f, fitted base colour %.3f\n", seen, fitted);
+  EXPECT_GT(seen, fitted + 0.15);
+}
+
 TEST(ViewPage, FabricTableGetsTheMaterialAndCurvesThatChangeWithTheIncidence) {
   const auto dir = testing::fresh_test_dir();
   std::string why;

@@ -16,7 +16,7 @@ namespace {
 TEST(VerifyInplane, ConstantTableGivesItsBetaEverywhere) {
   const TabulatedBsdfTable t = constant_table(4, 3, 0.37);
   for (double ti : {0.0, 30.0, 70.0}) {
-    const auto b = inplane_beta(t, ti, {-85, -30, 0, 5, 45, 85}, 7);
+    const auto b = inplane_beta(TableReader(t), ti, {-85, -30, 0, 5, 45, 85}, 7);
     for (const Rgb& c : b) {
       EXPECT_NEAR(c.r, 0.37, 1e-6);
       EXPECT_NEAR(c.b, 0.37, 1e-6);
@@ -37,7 +37,7 @@ TEST(VerifyInplane, InPlaneDirectionsFollowThePapersSign) {
         for (double& x : v) x = f;
       },
       4, 1, 1);
-  const auto b = inplane_beta(t, 45, {-45, 45}, 1);
+  const auto b = inplane_beta(TableReader(t), 45, {-45, 45}, 1);
   EXPECT_EQ(b[0].r, 0.0);
   EXPECT_GT(b[1].r, 0.5);
 }

@@ -71,7 +71,7 @@ TracedCurves trace_curves(const WovenSample& sample, const TabulatedBsdfTable& f
       out.mean = r.table;
     }
     for (size_t i = 0; i < sum.size(); ++i) sum[i] += r.table.values[i];
-    const TabulatedBsdfTable rgb = table_to_rgb(r.table);
+    const TableReader rgb = table_to_rgb(TableReader(r.table, s.threads));
     auto& curves = per_batch.emplace_back();
     for (const auto& c : measured.curves)
       curves.push_back(inplane_beta(rgb, c.theta_i_deg, c.view_deg, s.azimuths));
@@ -198,7 +198,7 @@ void add_computed_raytrace(VerifyReport& rep, const TracedCurves& computed, cons
 // The paper's summation (deterministic up to its stratified cell sampling): no error bars.
 ModelCurves summation_curves(const TabulatedBsdfTable& summation, const MeasuredInplane& measured,
                              int azimuths) {
-  const TabulatedBsdfTable rgb = table_to_rgb(summation);
+  const TableReader rgb = table_to_rgb(TableReader(summation));
   ModelCurves m = model_curves(verify_model(VerifyModel::kComputedSummation).key,
                                verify_model(VerifyModel::kComputedSummation).label, {}, {});
   for (const auto& c : measured.curves) {

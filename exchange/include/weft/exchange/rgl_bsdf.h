@@ -20,12 +20,12 @@
 //  - luminance and rgb / spectra: per theta_i, on an n x n grid of the VNDF warp's sample space,
 //    the value f(w_i, w_o) cos theta_o 4 sigma(w_i) / D(m) (the file's 'jacobian' = 1), with
 //    w_o the mirror of w_i about the microfacet normal m the warp maps the grid point to; f is the
-//    Weft table interpolated (TableView::isotropic). The renderers multiply back by
-//    D(m) / (4 sigma(w_i)) and interpolate bilinearly, and the albedo towards w_i is the integral
-//    of the values over the sample space, so the grid holds the L2 projection onto bilinear
-//    functions of the value sampled on a grid 'sample_supersampling' times finer: it keeps the
-//    albedo, which point values at the grid points lose where the value is curved.
-//    The luminance steers sampling only; an incidence that reflects nothing gets a uniform one.
+//    Weft table as the renderer reads it, its sheen included (TableView::isotropic). The renderers
+//    multiply back by D(m) / (4 sigma(w_i)) and interpolate bilinearly, and the albedo towards w_i
+//    is the integral of the values over the sample space, so the grid holds the L2 projection onto
+//    bilinear functions of the value sampled on a grid 'sample_supersampling' times finer: it keeps
+//    the albedo, which point values at the grid points lose where the value is curved. The
+//    luminance steers sampling only; an incidence that reflects nothing gets a uniform one.
 // Here w_i is the direction the renderer conditions on (towards the viewer, Weft's wo) and w_o
 // the other (towards the light, Weft's wi): the renderers gather f cos theta_light.
 // Spectral tables write 'spectra' + 'wavelengths' (the 33 band centres, 390..710 nm), which both

@@ -2,12 +2,14 @@
 // A Weft table as the exchange formats see it. Every format here is isotropic or written
 // isotropic: f(wo, wi) is averaged over rotations of both directions about the normal (the
 // table's anisotropy, the fiber / warp axis along x, is dropped). wo is the direction towards the
-// viewer and wi towards the light (bsdf_table.h: values[wi_bin][wo_bin], f in 1/sr).
+// viewer and wi towards the light (bsdf_table.h: values[wi_bin][wo_bin], f in 1/sr). The table
+// is read with its sheen, as the renderer reads it (materials/table_reader.h).
 #include <span>
 #include <vector>
 
 #include "weft/core/spectrum.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/table_reader.h"
 
 namespace weft {
 
@@ -17,10 +19,12 @@ class TableView {
   explicit TableView(const TabulatedBsdfTable& table, int azimuths = 16);
 
   const TabulatedBsdfTable& table() const { return table_; }
+  // f(wo, wi) of the table itself, at one rotation (TableReader::eval).
+  const TableReader& reader() const { return reader_; }
   int channels() const { return table_.channels; }
   bool spectral() const { return table_.channels == kNumBands; }
-  // The mean over the rotations of the table's interpolated f(wo, wi) (TabulatedBsdfTable::
-  // interpolate), one value per channel.
+  // The mean over the rotations of the table's f(wo, wi) (TableReader::eval: the cells
+  // interpolated, with the sheen when the table holds one), one value per channel.
   void isotropic(const Vec3& wo, const Vec3& wi, std::span<double> out) const;
   // Y of one value per channel: the Y row of the sRGB (IEC 61966-2-1) matrix for an RGB table,
   // CIE 1931 y-bar under D65 (normalized so that a white reflector has Y = 1) for a spectral one.
@@ -31,6 +35,7 @@ class TableView {
 
  private:
   const TabulatedBsdfTable& table_;
+  TableReader reader_;
   std::vector<double> cos_, sin_;
   std::vector<double> y_weights_;
 };

@@ -4,11 +4,12 @@
 // split into reflection (light and view on one side) and transmission, and in-plane curves of the
 // radiance coefficient beta = pi f at given incidences in the warp (x z) and weft (y z) planes.
 //
-// Both tables are read through TabulatedBsdfTable::interpolate, so tables of other resolutions
-// compare too; the differences are taken at the cell centres of the finer grid and weighted by
-// D_i D_o (the cosine-weighted cell areas), which makes rel_rms an energy-weighted measure: noise
-// in cells that hold no light does not dominate it. max_rel counts cells whose reference value is
-// at least 'significant' times the reference's mean (smaller ones are noise-dominated).
+// Both tables are read as the renderer reads them (table_reader.h: interpolated, with the sheen
+// of a table that holds one), so tables of other resolutions compare too; the differences are taken
+// at the cell centres of the finer grid and weighted by D_i D_o (the cosine-weighted cell areas),
+// which makes rel_rms an energy-weighted measure: noise in cells that hold no light does not
+// dominate it. max_rel counts cells whose reference value is at least 'significant' times the
+// reference's mean (smaller ones are noise-dominated).
 #include <string>
 #include <vector>
 

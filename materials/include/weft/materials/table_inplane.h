@@ -14,12 +14,13 @@
 
 #include "weft/core/spectrum.h"
 #include "weft/materials/bsdf_table.h"
+#include "weft/materials/table_reader.h"
 
 namespace weft {
 
-// beta = pi f of an RGB table (3 channels), averaged over 'azimuths' planes of incidence, for
-// each view of 'views_deg' (paper's sign).
-std::vector<Rgb> inplane_beta(const TabulatedBsdfTable& rgb_table, double theta_i_deg,
+// beta = pi f of an RGB table (3 channels) read with its sheen (table_reader.h), averaged over
+// 'azimuths' planes of incidence, for each view of 'views_deg' (paper's sign).
+std::vector<Rgb> inplane_beta(const TableReader& rgb_table, double theta_i_deg,
                               const std::vector<double>& views_deg, int azimuths);
 
 // What a spectral table's reduction to linear sRGB left outside the gamut: components below 0
@@ -35,5 +36,9 @@ struct OutOfGamut {
 // is returned as it is.
 TabulatedBsdfTable table_to_rgb(const TabulatedBsdfTable& table,
                                 OutOfGamut* out_of_gamut = nullptr);
+// The same for a reader: its cells (the rest, with a sheen) and its sheen each reduced alike, so
+// that the reduced reader's f is the reduction of the reader's (the reduction is linear). A
+// 3-channel reader is returned as it is.
+TableReader table_to_rgb(const TableReader& table, OutOfGamut* out_of_gamut = nullptr);
 
 }  // namespace weft
