@@ -87,20 +87,21 @@ void bind_bake_fabric(py::module_& m) {
       "bake_fabric",
       [](const py::object& fiber, const std::string& method, std::optional<std::string> warp_fiber,
          std::optional<std::string> weft_fiber, bool thread_colours,
-         std::optional<std::string> colour, const py::object& sample,
-         std::optional<std::string> pattern, std::optional<std::string> wif,
-         const std::string& detail, int resolution, std::optional<uint64_t> samples,
-         std::optional<std::string> estimator, std::optional<int> next_event_rays,
-         std::optional<int> launch_lattice, std::optional<std::string> straight_through,
-         std::optional<double> split_threshold, std::optional<int> max_scatterings,
-         std::optional<std::filesystem::path> weave_out, std::optional<Positions> weave_positions,
-         std::optional<int> weave_resolution, std::optional<int> sheen_resolution,
-         std::optional<int> sheen_window, uint64_t seed, int threads, bool yes_long,
-         bool progress) {
+         std::optional<std::string> thread_colour_method, std::optional<std::string> colour,
+         const py::object& sample, std::optional<std::string> pattern,
+         std::optional<std::string> wif, const std::string& detail, int resolution,
+         std::optional<uint64_t> samples, std::optional<std::string> estimator,
+         std::optional<int> next_event_rays, std::optional<int> launch_lattice,
+         std::optional<std::string> straight_through, std::optional<double> split_threshold,
+         std::optional<int> max_scatterings, std::optional<std::filesystem::path> weave_out,
+         std::optional<Positions> weave_positions, std::optional<int> weave_resolution,
+         std::optional<int> sheen_resolution, std::optional<int> sheen_window, uint64_t seed,
+         int threads, bool yes_long, bool progress) {
         FabricBakeRequest r;
         r.method = method;
         r.warp_fiber = warp_fiber.value_or(""), r.weft_fiber = weft_fiber.value_or("");
         r.thread_colours = thread_colours;
+        r.thread_colour_method = std::move(thread_colour_method);
         r.colour = colour.value_or("");
         r.pattern = pattern.value_or(""), r.wif = wif.value_or("");
         r.detail = detail;
@@ -129,21 +130,22 @@ void bind_bake_fabric(py::module_& m) {
       },
       py::arg("fiber") = d.fiber, py::arg("method") = d.method, py::kw_only(),
       py::arg("warp_fiber") = py::none(), py::arg("weft_fiber") = py::none(),
-      py::arg("thread_colours") = d.thread_colours, py::arg("colour") = py::none(),
-      py::arg("sample") = py::none(), py::arg("pattern") = py::none(), py::arg("wif") = py::none(),
-      py::arg("detail") = d.detail, py::arg("resolution") = d.resolution,
-      py::arg("samples") = py::none(), py::arg("estimator") = py::none(),
-      py::arg("next_event_rays") = py::none(), py::arg("launch_lattice") = py::none(),
-      py::arg("straight_through") = py::none(), py::arg("split_threshold") = py::none(),
-      py::arg("max_scatterings") = py::none(), py::arg("weave_out") = py::none(),
-      py::arg("weave_positions") = py::none(), py::arg("weave_resolution") = py::none(),
-      py::arg("sheen_resolution") = py::none(), py::arg("sheen_window") = py::none(),
-      py::arg("seed") = d.seed, py::arg("threads") = d.threads, py::arg("yes_long") = false,
-      py::arg("progress") = false,
+      py::arg("thread_colours") = d.thread_colours, py::arg("thread_colour_method") = py::none(),
+      py::arg("colour") = py::none(), py::arg("sample") = py::none(),
+      py::arg("pattern") = py::none(), py::arg("wif") = py::none(), py::arg("detail") = d.detail,
+      py::arg("resolution") = d.resolution, py::arg("samples") = py::none(),
+      py::arg("estimator") = py::none(), py::arg("next_event_rays") = py::none(),
+      py::arg("launch_lattice") = py::none(), py::arg("straight_through") = py::none(),
+      py::arg("split_threshold") = py::none(), py::arg("max_scatterings") = py::none(),
+      py::arg("weave_out") = py::none(), py::arg("weave_positions") = py::none(),
+      py::arg("weave_resolution") = py::none(), py::arg("sheen_resolution") = py::none(),
+      py::arg("sheen_window") = py::none(), py::arg("seed") = d.seed,
+      py::arg("threads") = d.threads, py::arg("yes_long") = false, py::arg("progress") = false,
       "A fabric table, as `weft bake fabric` makes it (its options are the keyword arguments, with "
       "its defaults): from a fiber (a Table, a .exr file, or a spec baked in RGB at the bake's "
       "defaults; warp_fiber, weft_fiber and thread_colours' dyes are baked into ./.weft-cache as "
-      "the command bakes them; colour: the cloth's colour, 'srgb:#RRGGBB', 'lab:L,a,b', "
+      "the command bakes them; thread_colour_method 'match' (None: the default) or 'rule', as "
+      "--thread-colour-method; colour: the cloth's colour, 'srgb:#RRGGBB', 'lab:L,a,b', "
       "'lab10:L,a,b' or "
       "'spectrum:FILE.csv', the fiber's dyes scaled to meet it) and a woven sample (None: the "
       "bundled poplin; a weave options file "

@@ -166,6 +166,12 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
                 "raytrace: one fiber per thread colour of the WIF draft, --fiber dyed to the "
                 "colour (docs/fabric-bsdf.md; at most " +
                     std::to_string(kMaxThreadColours) + " colours)");
+  sub->add_option_function<std::string>(
+         "--thread-colour-method", [&o](const std::string& v) { o.thread_colour_method = v; },
+         "how --thread-colours dyes --fiber: match (each colour's absorbers solved so that a cloth "
+         "of that thread alone reads the colour; default) or rule (the colour's smooth uplift, no "
+         "readings: darker and more saturated than the swatch)")
+      ->check(CLI::IsMember(names_of(kThreadColourMethods)));
   sub->add_option("--method", o.method, "summation | summation-visible | raytrace")
       ->check(CLI::IsMember(names_of(kFabricMethods)))
       ->capture_default_str();

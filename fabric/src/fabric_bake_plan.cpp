@@ -247,7 +247,16 @@ FabricBakePlan plan_fabric_bake(const FabricBakeRequest& o) {
               .thread_colours = o.thread_colours,
               .draft = o.wif.empty() ? weave_wif : o.wif,
               .limits = o.limits};
+  if (o.thread_colour_method) {
+    if (!o.thread_colours)
+      throw Error("", "--thread-colour-method",
+                  "chooses how --thread-colours dyes the fiber: give --thread-colours");
+    p.fibers.thread_colour_method =
+        value_of(kThreadColourMethods, *o.thread_colour_method, "", "--thread-colour-method");
+  }
   check_fabric_fiber_options(p.fibers, p.method == FabricMethod::kRaytrace);
+  if (o.thread_colours && p.fibers.thread_colour_method == ThreadColourMethod::kMatch)
+    check_thread_colour_match(o, thread_colour_count(p.fibers.draft));
   if (!o.colour.empty()) p.colour = check_fabric_colour(o, p.method);
   validate_output_paths(
       o.limits,

@@ -159,6 +159,16 @@ FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks&
   }
   std::optional<FabricColourMatch> colour;
   FabricFiberOptions fiber_options = p.fibers;
+  nlohmann::json thread_matches;
+  if (p.fibers.thread_colours && p.fibers.thread_colour_method == ThreadColourMethod::kMatch) {
+    std::optional<std::vector<FiberSpec>> specs =
+        match_thread_colours(p, sample, hooks.progress, thread_matches);
+    if (!specs) {
+      out.cancelled = true;
+      return out;
+    }
+    fiber_options.thread_specs = std::move(*specs);
+  }
   if (p.colour) {
     colour = match_fabric_colour(p, sample, hooks.progress);
     if (colour->match.cancelled) {
@@ -215,6 +225,7 @@ FabricBakeResult run_fabric_bake(const FabricBakePlan& p, const FabricBakeHooks&
         noise_cost_summary(noise_per_channel, p.raytrace.particles_per_bin, cpu_seconds);
   if (!p.note.empty()) j["notes"] = {p.note};
   if (colour) j["colour_match"] = colour_summary(*colour, table);
+  if (!thread_matches.is_null()) j["thread_colour_match"] = thread_matches;
   if (p.scene_bytes > 0) j["scene_memory_estimate_bytes"] = p.scene_bytes;
   return out;
 }

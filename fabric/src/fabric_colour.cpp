@@ -8,6 +8,7 @@
 #include "weft/core/hash.h"
 #include "weft/fiber/bake_cache.h"
 #include "weft/fiber/fiber_table_bake.h"
+#include "weft/fiber/thread_colour.h"
 #include "weft/materials/colour_reading.h"
 
 namespace weft {
@@ -154,6 +155,55 @@ FabricColourMatch match_fabric_colour(const FabricBakePlan& p, const WovenSample
   return cached_colour_match(
       reading_inputs(p, sample), load_fiber_spec(p.request.fiber), p.colour.value(),
       [&](const FiberSpec& spec) { return fabric_d8_reading(p, sample, spec, progress); });
+}
+
+std::optional<std::vector<FiberSpec>> match_thread_colours(const FabricBakePlan& p,
+                                                           const WovenSample& sample,
+                                                           const ProgressCallback& progress,
+                                                           nlohmann::json& summary) {
+  std::vector<std::array<double, 3>> colours;
+  fiber_tables_by_colour(sample, colours, "--thread-colours");
+  const FiberSpec base = load_fiber_spec(p.request.fiber);
+  const nlohmann::json inputs = reading_inputs(p, sample);
+  std::vector<FiberSpec> specs;
+  summary = nlohmann::json::array();
+  for (const auto& c : colours) {
+    const std::string hex = srgb_hex(c);
+    // White reads the cloth's own paleness, which no absorber raises: the undyed fibre.
+    if (c == std::array<double, 3>{1, 1, 1}) {
+      specs.push_back(base);
+      summary.push_back({{"colour", hex}, {"note", "white: the undyed fiber"}});
+      continue;
+    }
+    const FabricColourMatch m = cached_colour_match(
+        inputs, base, read_colour_target("srgb:" + hex, "--thread-colours"),
+        [&](const FiberSpec& s) { return fabric_d8_reading(p, sample, s, progress); });
+    if (m.match.cancelled) return std::nullopt;
+    nlohmann::json j = colour_match_summary(m.match);
+    j["colour"] = hex;
+    j["cached"] = m.cached;
+    j["note"] = colour_match_note(m);
+    summary.push_back(j);
+    specs.push_back(m.match.spec);
+    specs.back().name = base.name + " " + hex;  // as the rule names it: the thread's colour
+  }
+  return specs;
+}
+
+void check_thread_colour_match(const FabricBakeRequest& o, size_t colours) {
+  const char* option = "--thread-colour-method";
+  const FiberSpec spec = load_fiber_spec(o.fiber);
+  if (!spec.dyes.empty())
+    throw Error(o.fiber, option,
+                "match solves the thread-colour absorbers of an undyed --fiber; '" + spec.name +
+                    "' has dyes of its own, which the match would fight: give the undyed fiber "
+                    "(such as white-cotton), or --thread-colour-method rule");
+  FiberTableBakeOptions bake = reading_fiber_options(spec, FabricBakePlan{.request = o});
+  bake.photons_per_band *= kFabricColourReadings * colours;
+  check_fiber_bake(o.limits, bake, kNumBands, {o.fiber, option, option});
+  check_fabric_bake(o.limits, FabricMethod::kRaytrace, o.resolution,
+                    kFabricColourReadings * static_cast<int>(colours), o.samples, o.threads,
+                    option);
 }
 
 ColourTarget check_fabric_colour(const FabricBakeRequest& o, FabricMethod method) {

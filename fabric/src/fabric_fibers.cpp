@@ -26,14 +26,10 @@ void check_draft_colours(const FabricFiberOptions& o) {
     throw Error(o.draft, "WARP COLORS",
                 "the draft states no thread colour ([WARP]/[WEFT] Color, [WARP COLORS], "
                 "[WEFT COLORS]): --thread-colours has nothing to dye");
-  std::vector<std::array<double, 3>> distinct;
-  for (const auto* threads : {&draft.warp, &draft.weft})
-    for (const WifThread& t : *threads)
-      if (std::find(distinct.begin(), distinct.end(), t.rgb) == distinct.end())
-        distinct.push_back(t.rgb);
-  if (distinct.size() > static_cast<size_t>(kMaxThreadColours))
+  const size_t distinct = thread_colour_count(o.draft);
+  if (distinct > static_cast<size_t>(kMaxThreadColours))
     throw Error(o.draft, "WARP COLORS",
-                "the threads have " + std::to_string(distinct.size()) +
+                "the threads have " + std::to_string(distinct) +
                     " distinct colours ([WARP COLORS], [WEFT COLORS]); --thread-colours takes at "
                     "most " +
                     std::to_string(kMaxThreadColours) + ", a fiber table baked for each");
@@ -53,8 +49,9 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
   for (size_t k = 0; k < colours.size(); ++k) {
     const std::string name = srgb_hex(colours[k]);
     const std::string option = "--thread-colours " + name;
-    f.held.push_back(cached_fabric_fiber(thread_colour_spec(base, colours[k], option), option,
-                                         option, o.limits, progress));
+    const FiberSpec spec = o.thread_specs.empty() ? thread_colour_spec(base, colours[k], option)
+                                                  : o.thread_specs.at(k);
+    f.held.push_back(cached_fabric_fiber(spec, option, option, o.limits, progress));
     f.map.tables[k] = &f.held.back();
     f.map.names.push_back(name);
   }
@@ -62,6 +59,16 @@ FabricFibers colour_fibers(const FabricFiberOptions& o, const WovenSample& sampl
 }
 
 }  // namespace
+
+size_t thread_colour_count(const std::string& draft_file) {
+  const WifDraft draft = read_wif(draft_file);
+  std::vector<std::array<double, 3>> distinct;
+  for (const auto* threads : {&draft.warp, &draft.weft})
+    for (const WifThread& t : *threads)
+      if (std::find(distinct.begin(), distinct.end(), t.rgb) == distinct.end())
+        distinct.push_back(t.rgb);
+  return distinct.size();
+}
 
 FiberTableBakeOptions fabric_fiber_bake_options(const FiberSpec& spec) {
   FiberTableBakeOptions o = fiber_bake_defaults(spec);

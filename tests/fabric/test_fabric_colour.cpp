@@ -7,6 +7,8 @@
 #include "weft/core/colorimetry.h"
 #include "weft/fabric/fabric_colour.h"
 #include "weft/fabric/fiber_colour.h"
+#include "weft/fiber/thread_colour.h"
+#include "weft/materials/colour_reading.h"
 
 using namespace weft;
 using namespace weft::testing;
@@ -140,4 +142,52 @@ TEST(FiberColour, TheRecipeOnTargetTakesOneReadingAndIsCached) {
   const FiberBakeOutcome second = run_coloured_fiber_bake(plan_coloured_fiber_bake(r));
   EXPECT_EQ(second.summary.at("colour_match").at("cached"), true);
   EXPECT_EQ(second.table->table.checksum(), first.table->table.checksum());
+}
+
+// --thread-colours match: each thread colour's absorbers are solved through a cloth of that thread
+// alone, so the cloth comes nearer the draft's swatch than the rule's one-pass uplift, which makes
+// it darker and more saturated (fiber/thread_colour.h); white stays the undyed fibre.
+TEST(FabricColour, MatchedThreadColoursComeNearerTheSwatchThanTheRule) {
+  const auto dir = fresh_test_dir();
+  InFolder in(dir);
+  FabricBakeRequest r;
+  r.fiber = "white-cotton";
+  r.method = "raytrace";
+  r.detail = "yarn";
+  r.resolution = 2;
+  r.samples = 2000;
+  r.wif = (std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/data/wif/red-white-twill.wif").string();
+  r.thread_colours = true;
+  const FabricBakePlan plan = plan_fabric_bake(r);
+  EXPECT_EQ(plan.fibers.thread_colour_method, ThreadColourMethod::kMatch);
+  const WovenSample sample = make_woven_sample(plan.weave);
+  nlohmann::json summary;
+  const auto specs = match_thread_colours(plan, sample, no_progress(), summary);
+  ASSERT_TRUE(specs);
+  // [COLOR TABLE] 1 = 200,30,30 (warps), 2 = 255,255,255 (wefts), warps first.
+  ASSERT_EQ(specs->size(), 2u);
+  EXPECT_EQ(summary[0].at("colour"), "#c81e1e");
+  EXPECT_EQ((*specs)[1].name, "white-cotton");
+  const double matched = summary[0].at("delta_e00").get<double>();
+  const std::array<double, 3> red{200 / 255.0, 30 / 255.0, 30 / 255.0};
+  const ColourTarget target = read_colour_target("srgb:#c81e1e", "test");
+  const FiberSpec base = load_fiber_spec("white-cotton");
+  const std::optional<Spectrum> rule =
+      fabric_d8_reading(plan, sample, thread_colour_spec(base, red, "test"), no_progress());
+  ASSERT_TRUE(rule);
+  const double by_rule = delta_e00(target.lab, target.lab_of(*rule));
+  EXPECT_LT(matched, by_rule) << "rule " << by_rule;
+  std::printf(
+      "#c81e1e on the red/white twill: CIEDE2000 %.2f matched (%d readings), %.2f by rule\n",
+      matched, summary[0].at("iterations").get<int>(), by_rule);
+  // Refused before any work: a dyed --fiber (its own dyes would fight the match), and the
+  // method without --thread-colours.
+  r.fiber = "red-cotton";
+  EXPECT_NE(error_of([&] { plan_fabric_bake(r); }).find("--thread-colour-method"),
+            std::string::npos);
+  r.fiber = "white-cotton";
+  r.thread_colours = false;
+  r.thread_colour_method = "rule";
+  EXPECT_NE(error_of([&] { plan_fabric_bake(r); }).find("give --thread-colours"),
+            std::string::npos);
 }

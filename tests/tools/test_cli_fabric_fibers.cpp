@@ -100,7 +100,10 @@ TEST(CliFabricFibers, ThreadColoursBakeOneFiberPerColourOfTheDraft) {
       "bake fabric --method raytrace --detail yarn -R 2 --samples 300 "
       "--quiet --json --fiber clear.json --wif '" +
       draft + "'";
-  const CliRun r = run_weft_cli_in(base + " --thread-colours -o dyed.exr", dir);
+  // The rule: this test is of the mapping of colours to yarns (the match is tested in
+  // tests/fabric/test_fabric_colour.cpp).
+  const CliRun r =
+      run_weft_cli_in(base + " --thread-colours --thread-colour-method rule -o dyed.exr", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("fiber_tables").size(), 2u);

@@ -56,6 +56,8 @@ struct FabricBakeRequest {
   std::shared_ptr<const TabulatedBsdfTable> fiber_table;
   std::string warp_fiber, weft_fiber;  // per-yarn fibers (raytrace); "" = fiber
   bool thread_colours = false;         // a fiber per colour of the WIF draft's threads
+  // How each thread colour dyes --fiber (kThreadColourMethods); not given: match.
+  std::optional<std::string> thread_colour_method;
   // The colour the cloth should have (core/colour_target.h): --fiber's dyes are scaled to meet
   // it (fabric_colour.h); "" = the recipe as written.
   std::string colour;

@@ -4,6 +4,7 @@
 // the bake makes, the directional reflectance of its normal's incident bin, per band.
 #include <filesystem>
 #include <optional>
+#include <vector>
 
 #include "weft/core/progress.h"
 #include "weft/fabric/fabric_bake.h"
@@ -52,6 +53,19 @@ FabricColourMatch cached_colour_match(const nlohmann::json& inputs, const FiberS
 // (fiber spec, target, sample, method and settings) was made before, else solved and stored.
 FabricColourMatch match_fabric_colour(const FabricBakePlan& plan, const WovenSample& sample,
                                       const ProgressCallback& progress);
+
+// --thread-colours match: per distinct colour of the sample's threads (fiber_tables_by_colour's
+// order), --fiber with the thread-colour absorbers solved so that a cloth of that thread alone
+// (the plan's sample, method and settings) reads the colour, each match cached as a fabric bake's
+// is; white is the undyed fiber itself. 'summary' gets each colour's colour_match. Nothing when
+// interrupted.
+std::optional<std::vector<FiberSpec>> match_thread_colours(const FabricBakePlan& plan,
+                                                           const WovenSample& sample,
+                                                           const ProgressCallback& progress,
+                                                           nlohmann::json& summary);
+// Checked before any work: --fiber undyed (its thread colours are its dyes) and the readings'
+// time for 'colours' matches. weft::Error naming --thread-colour-method.
+void check_thread_colour_match(const FabricBakeRequest& request, size_t colours);
 
 // The table's own reading at normal incidence: the target's colour of its spectrum, or of its
 // linear sRGB for an RGB table (then under the 2-degree observer whatever the target's).

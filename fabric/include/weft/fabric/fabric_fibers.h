@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "weft/core/names.h"
 #include "weft/core/progress.h"
 #include "weft/core/run_limits.h"
 #include "weft/fabric/fabric_raytrace.h"
@@ -15,11 +16,27 @@
 
 namespace weft {
 
+// How --thread-colours dyes --fiber to a thread's colour (docs/fabric-bsdf.md "Thread colours").
+enum class ThreadColourMethod { kMatch, kRule };
+inline constexpr NameTable<ThreadColourMethod, 2> kThreadColourMethods{{
+    {ThreadColourMethod::kMatch, "match",
+     "each colour's absorbers solved so that a cloth of that thread alone reads the colour "
+     "(fabric_colour.h)"},
+    {ThreadColourMethod::kRule, "rule",
+     "the colour's smooth uplift, one pass across the fibre (fiber/thread_colour.h: no readings; "
+     "the cloth comes out darker and more saturated than the swatch)"},
+}};
+
 struct FabricFiberOptions {
   std::string fiber, warp_fiber, weft_fiber;  // warp/weft: "" = --fiber
   // --fiber's table when the caller holds it already (Python's Table): 'fiber' then only names it.
   std::shared_ptr<const TabulatedBsdfTable> fiber_table;
   bool thread_colours = false;
+  ThreadColourMethod thread_colour_method = ThreadColourMethod::kMatch;
+  // --thread-colours match: the matched spec of each distinct colour of the draft (in
+  // fiber_tables_by_colour's order; the run fills it in before loading the tables); empty: the
+  // rule's.
+  std::vector<FiberSpec> thread_specs;
   std::string draft;  // the WIF draft (--wif, or the one --weave names); "" when none
   RunLimits limits;   // a bake on first use is checked under these
 };
@@ -30,6 +47,8 @@ inline constexpr int kMaxThreadColours = 8;
 // Checked before any work: the options that need a ray trace, a draft, or exclude each other
 // (weft::Error naming the option). 'raytrace': --method raytrace.
 void check_fabric_fiber_options(const FabricFiberOptions& o, bool raytrace);
+// The distinct thread colours of a draft (at most kMaxThreadColours, checked above).
+size_t thread_colour_count(const std::string& draft);
 // True when the run traces more than one fiber (per-yarn tables may still turn out equal).
 bool per_yarn_fibers(const FabricFiberOptions& o);
 
