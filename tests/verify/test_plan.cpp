@@ -237,5 +237,21 @@ TEST(VerifyPlan, EstimateCoversTheSamplesSize) {
   EXPECT_EQ(large.particles, poplin.particles);
 }
 
+// A calibrated run's estimate counts its colour readings: the bundled suite's calibrated draft
+// run (2026-12-06, 2 threads, a loaded machine) took 4.7-11.5 s of wall time for its colour
+// match per fabric (metrics.json seconds.colour_match), against 0 without a colour.
+TEST(VerifyPlan, EstimateCountsTheColourReadings) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.threads = 2;
+  const VerifyEstimate plain = estimate_verify(plan_verify(r));
+  r.colour_from = "measured";
+  const VerifyEstimate calibrated = estimate_verify(plan_verify(r));
+  const double readings = calibrated.typical - plain.typical;
+  EXPECT_GT(readings / plain.cores, 4.7 / 2);
+  EXPECT_LT(readings / plain.cores, 11.5 * 2);
+  EXPECT_GT(calibrated.least, plain.least);
+}
+
 }  // namespace
 }  // namespace weft

@@ -199,6 +199,9 @@ constexpr double kLeastSecondsPerParticle = 1.25e-6;
 constexpr double kTypicalSecondsPerInnerPhoton = 3.1e-6;
 constexpr double kTypicalFitStages = 4;
 constexpr double kTypicalSecondsPerFitEvaluation = 0.04;
+// A colour match's readings (--colour, --colour-from): 4 to 8 of at most 8 in the figures of
+// docs/colour.md.
+constexpr double kTypicalColourReadings = 6;
 // The classic inner fiber table's Cook-Torrance samples (0.026 s of CPU for R = 6 at 4 per cell
 // pair, docs/verify.md "The fit's time and the inner model's noise").
 constexpr double kTypicalSecondsPerClassicSample = 1.25e-6;
@@ -259,6 +262,21 @@ VerifyEstimate estimate_verify(const VerifyPlan& p) {
   VerifyEstimate e = estimate_verify(p.settings, !p.fiber_table, p.request.fit,
                                      p.fit_options.max_evaluations, p.fit_names.size(), p.fit_seeds,
                                      z ? fabric_scene_seconds(*z) : FabricSceneSeconds{});
+  if (p.colour) {
+    // The colour match's readings (whole_run.cpp verify_colour_match): each a spectral fiber bake
+    // at the run's photons and the normal's incident bin at the first batch's particles; typically
+    // 4 to 8 of the at most kFabricColourReadings (docs/colour.md), so the typical count is 6 and
+    // the least 2 (the recipe and the undyed fibre).
+    const VerifySettings& s = p.settings;
+    const double photons = double(s.fiber_photons_per_band) * kNumBands;
+    const double particles = double(s.particles_per_bin) / double(s.batches);
+    const FabricSceneSeconds scene = z ? fabric_scene_seconds(*z) : FabricSceneSeconds{};
+    const double reading = photons * kTypicalSecondsPerPhoton +
+                           particles * kTypicalSecondsPerParticle * scene.per_ray_factor +
+                           scene.build;
+    e.typical += kTypicalColourReadings * reading;
+    e.least += 2 * (photons * kMinSecondsPerPhoton + particles * kLeastSecondsPerParticle);
+  }
   if (z) {
     e.scene_bytes = fabric_scene_bytes(*z);
     // The segments the sample will hold (its memory's count, not the packing's estimate).
