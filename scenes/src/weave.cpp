@@ -374,29 +374,39 @@ Resolved resolve(const WeaveOptions& o) {
   return r;
 }
 
-// Every crossing of the repeat: the upper yarn's lower surface must not go below the lower
-// yarn's upper surface anywhere over the crossing (sampled densely; the model makes the
-// smallest separation zero at the centre). Error naming the share otherwise.
-void check_crossings(const Layout& L, int repeat_warps, int repeat_wefts) {
+// The smallest separation over the crossing of warp i and pick j: the upper yarn's lower surface
+// above the lower yarn's upper surface, sampled densely (the model makes it zero at the centre).
+// 'slope_grown': each lens grown by sqrt(1 + slope^2) where the centre line slopes, as a bundle
+// of fibers in sections perpendicular to the yarn stands taller than its tube.
+double crossing_separation(const Layout& L, int i, int j, bool slope_grown) {
   constexpr int kN = 24;
-  const int nw = L.tile.warps;
+  const YarnPath &w = L.yarns[i], &f = L.yarns[L.tile.warps + j];
+  const bool warp_over = L.tile.over(i, j);
+  double worst = 1e300;
+  for (int a = 0; a <= kN; ++a)
+    for (int b = 0; b <= kN; ++b) {
+      const double dx = f.size.width_mm * (double(a) / kN - 0.5);
+      const double dz = w.size.width_mm * (double(b) / kN - 0.5);
+      const double x = f.centre + dx, z = w.centre + dz;
+      double sw = 0, sf = 0;
+      const double hw = w.height_at(x, &sw), hf = f.height_at(z, &sf);
+      const double ew = detail::lens_half_thickness(w.size.width_mm, w.size.thickness_mm, dz) *
+                        (slope_grown ? std::sqrt(1 + sw * sw) : 1.0);
+      const double ef = detail::lens_half_thickness(f.size.width_mm, f.size.thickness_mm, dx) *
+                        (slope_grown ? std::sqrt(1 + sf * sf) : 1.0);
+      worst = std::min(worst, warp_over ? (hw - ew) - (hf + ef) : (hf - ef) - (hw + ew));
+    }
+  return worst;
+}
+
+// Every crossing of the repeat: the tubes must not interpenetrate anywhere over it. Error naming
+// the share otherwise.
+void check_crossings(const Layout& L, int repeat_warps, int repeat_wefts) {
   for (int i = 0; i < repeat_warps; ++i)
     for (int j = 0; j < repeat_wefts; ++j) {
-      const YarnPath &w = L.yarns[i], &f = L.yarns[nw + j];
-      const bool warp_over = L.tile.over(i, j);
+      const YarnPath &w = L.yarns[i], &f = L.yarns[L.tile.warps + j];
       const double tol = 1e-9 * (w.size.thickness_mm + f.size.thickness_mm);
-      double worst = 1e300;
-      for (int a = 0; a <= kN; ++a)
-        for (int b = 0; b <= kN; ++b) {
-          const double dx = f.size.width_mm * (double(a) / kN - 0.5);
-          const double dz = w.size.width_mm * (double(b) / kN - 0.5);
-          const double x = f.centre + dx, z = w.centre + dz;
-          const double ew = detail::lens_half_thickness(w.size.width_mm, w.size.thickness_mm, dz);
-          const double ef = detail::lens_half_thickness(f.size.width_mm, f.size.thickness_mm, dx);
-          const double hw = w.height_at(x), hf = f.height_at(z);
-          const double sep = warp_over ? (hw - ew) - (hf + ef) : (hf - ef) - (hw + ew);
-          worst = std::min(worst, sep);
-        }
+      const double worst = crossing_separation(L, i, j, false);
       if (worst < -tol)
         bad("warp-crimp-share",
             "warp " + std::to_string(i + 1) + " and pick " + std::to_string(j + 1) +
@@ -408,34 +418,15 @@ void check_crossings(const Layout& L, int repeat_warps, int repeat_wefts) {
 }
 
 // Whether the fibers keep their distances in sections perpendicular to the yarns, which
-// make_woven_sample tries first (then vertical sections, sparser): such a bundle stands taller
-// than its tube by sqrt(1 + slope^2) where the centre line slopes, so each crossing is checked as
-// check_crossings checks the tubes, each lens grown so, against the fibers' clearance (2 % of a
-// radius). A prediction before anything is built; the bundled samples and drafts end in the
-// sections it predicts (test_mesh_shifts.cpp).
+// make_woven_sample tries first (then vertical sections, sparser): each crossing checked as
+// check_crossings checks the tubes, each lens grown by the slope, against the fibers' clearance
+// (2 % of a radius). A prediction before anything is built; the bundled samples and drafts end in
+// the sections it predicts (test_mesh_shifts.cpp).
 bool perpendicular_sections_fit(const Layout& L, int repeat_warps, int repeat_wefts,
                                 double radius_mm) {
-  constexpr int kN = 24;
-  const int nw = L.tile.warps;
   for (int i = 0; i < repeat_warps; ++i)
-    for (int j = 0; j < repeat_wefts; ++j) {
-      const YarnPath &w = L.yarns[i], &f = L.yarns[nw + j];
-      const bool warp_over = L.tile.over(i, j);
-      for (int a = 0; a <= kN; ++a)
-        for (int b = 0; b <= kN; ++b) {
-          const double dx = f.size.width_mm * (double(a) / kN - 0.5);
-          const double dz = w.size.width_mm * (double(b) / kN - 0.5);
-          const double x = f.centre + dx, z = w.centre + dz;
-          double sw = 0, sf = 0;
-          const double hw = w.height_at(x, &sw), hf = f.height_at(z, &sf);
-          const double ew = detail::lens_half_thickness(w.size.width_mm, w.size.thickness_mm, dz) *
-                            std::sqrt(1 + sw * sw);
-          const double ef = detail::lens_half_thickness(f.size.width_mm, f.size.thickness_mm, dx) *
-                            std::sqrt(1 + sf * sf);
-          const double sep = warp_over ? (hw - ew) - (hf + ef) : (hf - ef) - (hw + ew);
-          if (sep < -0.02 * radius_mm) return false;
-        }
-    }
+    for (int j = 0; j < repeat_wefts; ++j)
+      if (crossing_separation(L, i, j, true) < -0.02 * radius_mm) return false;
   return true;
 }
 
