@@ -237,6 +237,21 @@ TEST(VerifyPlan, EstimateCoversTheSamplesSize) {
   EXPECT_EQ(large.particles, poplin.particles);
 }
 
+// A felt's rays walk long: the bundled suite's felts took 4.7-5.7x the time of a poplin of the
+// same fibre at draft quality (2026-12-06: white 274 s against 52-60, pink 201-243 against
+// 47-52, metrics.json seconds.total_before_report), and the estimate says so within 2x.
+TEST(VerifyPlan, EstimateOfAFeltCountsItsLongerPaths) {
+  VerifyRequest r;
+  r.quality = "draft";
+  r.threads = 2;
+  r.fiber = "white-cotton";
+  const VerifyEstimate poplin = estimate_verify(plan_verify(r));
+  r.weave = (fs::path(WEFT_SOURCE_DIR) / "scenes/examples/acrylic-felt.json").string();
+  const VerifyEstimate felt = estimate_verify(plan_verify(r));
+  EXPECT_GT(felt.typical / poplin.typical, 4.7 / 2);
+  EXPECT_LT(felt.typical / poplin.typical, 5.7 * 2);
+}
+
 // A calibrated run's estimate counts its colour readings: the bundled suite's calibrated draft
 // run (2026-12-06, 2 threads, a loaded machine) took 4.7-11.5 s of wall time for its colour
 // match per fabric (metrics.json seconds.colour_match), against 0 without a colour.

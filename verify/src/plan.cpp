@@ -199,6 +199,10 @@ constexpr double kLeastSecondsPerParticle = 1.25e-6;
 constexpr double kTypicalSecondsPerInnerPhoton = 3.1e-6;
 constexpr double kTypicalFitStages = 4;
 constexpr double kTypicalSecondsPerFitEvaluation = 0.04;
+// The bundled acrylic felt's ray traces against the poplin's of the same fibre at draft quality
+// (the bundled suite, 2026-12-06, metrics.json seconds.raytrace_computed): white 241 s against
+// 37-48, pink 166-188 against 35; light walks long in a mat of 1 845 fibres.
+constexpr double kNonwovenRayFactor = 5;
 // A colour match's readings (--colour, --colour-from): 4 to 8 of at most 8 in the figures of
 // docs/colour.md.
 constexpr double kTypicalColourReadings = 6;
@@ -256,12 +260,19 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
 }
 
 VerifyEstimate estimate_verify(const VerifyPlan& p) {
-  // A nonwoven mat is small (nonwoven.h): the rates of the bundled poplin cover it.
+  // A nonwoven mat is small (nonwoven.h), but light walks long in it: its rays cost the
+  // poplin's times kNonwovenRayFactor.
   std::optional<WovenSampleSize> z;
-  if (p.weave.pattern != kNonwovenPattern) z = woven_sample_size(p.weave);
-  VerifyEstimate e = estimate_verify(p.settings, !p.fiber_table, p.request.fit,
-                                     p.fit_options.max_evaluations, p.fit_names.size(), p.fit_seeds,
-                                     z ? fabric_scene_seconds(*z) : FabricSceneSeconds{});
+  FabricSceneSeconds scene;
+  if (p.weave.pattern != kNonwovenPattern) {
+    z = woven_sample_size(p.weave);
+    scene = fabric_scene_seconds(*z);
+  } else {
+    scene.per_ray_factor = kNonwovenRayFactor;
+  }
+  VerifyEstimate e =
+      estimate_verify(p.settings, !p.fiber_table, p.request.fit, p.fit_options.max_evaluations,
+                      p.fit_names.size(), p.fit_seeds, scene);
   if (p.colour) {
     // The colour match's readings (whole_run.cpp verify_colour_match): each a spectral fiber bake
     // at the run's photons and the normal's incident bin at the first batch's particles; typically
@@ -270,7 +281,6 @@ VerifyEstimate estimate_verify(const VerifyPlan& p) {
     const VerifySettings& s = p.settings;
     const double photons = double(s.fiber_photons_per_band) * kNumBands;
     const double particles = double(s.particles_per_bin) / double(s.batches);
-    const FabricSceneSeconds scene = z ? fabric_scene_seconds(*z) : FabricSceneSeconds{};
     const double reading = photons * kTypicalSecondsPerPhoton +
                            particles * kTypicalSecondsPerParticle * scene.per_ray_factor +
                            scene.build;
