@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "weft/fiber/colour_match.h"
@@ -114,6 +115,27 @@ TEST(ColourMatch, DyesAnUndyedFiberWithTheThreadColourAbsorbers) {
       match_colour(white, lab_target_of(white, {2.0, 0.5, 0.3}), counted(calls), {});
   EXPECT_TRUE(m.reached) << m.best_reading().delta_e00;
   EXPECT_LE(calls, 8);
+}
+
+// A pale target between the undyed fibre and the recipe as written (scale 1 of each absorber is
+// far too dark): the undyed reading is the nearer of the first two, and the steps must still reach
+// the depths between them, a factor 30 above the smallest scale. The bundled MERL white fabric,
+// calibrated, needs about these scales (0.03, 0.08, 0.16); the trust region once held every step
+// within a factor 8 of the undyed reading there and gave up 18 CIEDE2000 away.
+TEST(ColourMatch, ReachesAPaleTargetBetweenTheUndyedFibreAndTheRecipe) {
+  const FiberSpec white = load_fiber_spec("white-cotton");
+  int calls = 0;
+  const ColourMatch m =
+      match_colour(white, lab_target_of(white, {0.03, 0.08, 0.16}), counted(calls), {});
+  EXPECT_TRUE(m.reached) << m.best_reading().delta_e00;
+  EXPECT_LT(m.readings[1].delta_e00, m.readings[0].delta_e00);  // the undyed reading is nearer
+  EXPECT_LE(calls, 8);
+  // The third reading (the first the model steers) goes into the span between the two first,
+  // past a factor 8 of the smallest scale (max_scale / 1e4), where the model interpolates.
+  ASSERT_GE(m.readings.size(), 3u);
+  const double smallest = dye_basis(white).max_scale[2] * 1e-4;
+  EXPECT_GT(*std::max_element(m.readings[2].scale.begin(), m.readings[2].scale.end()),
+            8.01 * smallest);
 }
 
 TEST(ColourMatch, MatchesASpectrumWithTheRecipesMixture) {
