@@ -6,15 +6,6 @@
 namespace weft {
 namespace {
 
-// An option as the request's front end names it ("--colour-weave" or "colour_weave").
-std::string option_name(const FiberBakeRequest& r, const std::string& field) {
-  std::string name = field;
-  if (!r.option_prefix.empty())
-    for (char& c : name)
-      if (c == '_') c = '-';
-  return r.option_prefix + name;
-}
-
 // The fabric bake whose normal-incidence reading is the cloth's colour: the fiber-level ray trace
 // of the colour's sample at a fabric bake's defaults, writing nothing.
 FabricBakeRequest reading_request(const FiberBakeRequest& r) {
@@ -40,12 +31,13 @@ ColouredFiberBakePlan plan_coloured_fiber_bake(
   ColouredFiberBakePlan p;
   if (request.colour.empty()) {
     if (!request.colour_weave.empty())
-      throw Error(request.colour_weave, option_name(request, "colour_weave"),
-                  "is the cloth that reads " + option_name(request, "colour") + ": give both");
+      throw Error(
+          request.colour_weave, fiber_option_name(request, "colour_weave"),
+          "is the cloth that reads " + fiber_option_name(request, "colour") + ": give both");
     p.fiber = plan_fiber_bake(bake, warn);
     return p;
   }
-  const std::string colour = option_name(request, "colour");
+  const std::string colour = fiber_option_name(request, "colour");
   if (request.spec_read)
     throw Error("", colour,
                 "matches a spec's dyes through its file or preset name (the cloth's reading "

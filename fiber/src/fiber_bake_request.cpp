@@ -15,13 +15,12 @@
 
 namespace weft {
 
-namespace {
-
-// An option as the request's front end names it: "--surface-samples" or "surface_samples".
 std::string fiber_option_name(const FiberBakeRequest& r, std::string field) {
   if (!r.option_prefix.empty()) std::replace(field.begin(), field.end(), '_', '-');
   return r.option_prefix + field;
 }
+
+namespace {
 
 template <class T>
 void check_fiber_range(const FiberBakeRequest& r, const std::string& field, T value, T lo, T hi,

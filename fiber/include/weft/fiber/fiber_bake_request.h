@@ -61,6 +61,9 @@ struct FiberBakeRequest {
   RunLimits limits;
 };
 
+// An option as the request's front end names it: "--surface-samples" or "surface_samples".
+std::string fiber_option_name(const FiberBakeRequest& r, std::string field);
+
 // A request's inputs, read and checked.
 struct FiberBakePlan {
   FiberBakeRequest request;
