@@ -632,6 +632,7 @@ WovenSampleSize woven_sample_size(const WeaveOptions& options) {
     z.detail = "fiber";
     z.curves = n.curves, z.curve_points = 2 * n.curves, z.curve_segments = n.curves;
     z.made_curve_points = z.curve_points, z.made_curve_segments = z.curve_segments;
+    z.placement_crossing_checks = n.crossing_checks, z.placement_copy_checks = n.copy_checks;
     return z;
   }
   const Resolved r = resolve(options);

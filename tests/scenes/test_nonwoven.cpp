@@ -186,7 +186,10 @@ TEST(Nonwoven, BundledFeltIsTheDefault) {
 
 // nonwoven_sample_size (what a plan counts, the mat not made): the fibers exactly and the curves
 // (fibers cut at the tile's sides) as expected: 766 against 742 made for the small mat (540
-// fibers: the cuts' own spread is about 2 %), 2 602 against 2 595 for the bundled felt.
+// fibers: the cuts' own spread is about 2 %), 2 602 against 2 595 for the bundled felt. And the
+// placement tries its making time is estimated from (NonwovenSize): within 2x of those the
+// placement took (the small mat about 1 a fiber, the felt about 3.1; the estimate once counted the
+// felt's points alone and put the largest mat at under a second against 37 s of CPU).
 TEST(Nonwoven, SizeBeforeTheMatIsMadeIsClose) {
   const auto felt = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes/examples/acrylic-felt.json";
   for (const WeaveOptions& o : {small_mat(), read_weave_options(felt)}) {
@@ -200,5 +203,11 @@ TEST(Nonwoven, SizeBeforeTheMatIsMadeIsClose) {
     EXPECT_EQ(w.curves, z.curves);
     EXPECT_EQ(w.curve_points, 2 * z.curves);
     EXPECT_EQ(w.curve_segments, z.curves);
+    const double tries = s.summary.nonwoven->attempts;
+    EXPECT_GT(z.placement_tries, 0.5 * tries) << tries << " tries made";
+    EXPECT_LT(z.placement_tries, 2.0 * tries) << tries << " tries made";
+    EXPECT_GE(z.placement_tries, z.fibers);
+    EXPECT_GT(w.placement_crossing_checks, 0);
+    EXPECT_GT(w.placement_copy_checks, 0);
   }
 }

@@ -149,7 +149,7 @@ VerifyPlan plan_verify(const VerifyRequest& o) {
   }
   // The sample's pattern, draft and sizes checked now, not when the run comes to make it (a
   // suite's later fabric after the earlier ones' work).
-  if (p.weave.pattern != kNonwovenPattern) (void)woven_sample_size(p.weave);
+  (void)woven_sample_size(p.weave);
   plan_fit(o, p);
   if (!o.shard.empty()) p.shard = parse_shard(o.shard, "--shard");
   p.colour = plan_verify_colour(o, p);
@@ -261,15 +261,10 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
 
 VerifyEstimate estimate_verify(const VerifyPlan& p) {
   // A nonwoven mat is small (nonwoven.h), but light walks long in it: its rays cost the
-  // poplin's times kNonwovenRayFactor.
-  std::optional<WovenSampleSize> z;
-  FabricSceneSeconds scene;
-  if (p.weave.pattern != kNonwovenPattern) {
-    z = woven_sample_size(p.weave);
-    scene = fabric_scene_seconds(*z);
-  } else {
-    scene.per_ray_factor = kNonwovenRayFactor;
-  }
+  // poplin's times kNonwovenRayFactor. Its making is counted from its placement work.
+  const WovenSampleSize z = woven_sample_size(p.weave);
+  FabricSceneSeconds scene = fabric_scene_seconds(z);
+  if (p.weave.pattern == kNonwovenPattern) scene.per_ray_factor = kNonwovenRayFactor;
   VerifyEstimate e =
       estimate_verify(p.settings, !p.fiber_table, p.request.fit, p.fit_options.max_evaluations,
                       p.fit_names.size(), p.fit_seeds, scene);
@@ -287,11 +282,9 @@ VerifyEstimate estimate_verify(const VerifyPlan& p) {
     e.typical += kTypicalColourReadings * reading;
     e.least += 2 * (photons * kMinSecondsPerPhoton + particles * kLeastSecondsPerParticle);
   }
-  if (z) {
-    e.scene_bytes = fabric_scene_bytes(*z);
-    // The segments the sample will hold (its memory's count, not the packing's estimate).
-    e.fiber_segments = z->made_curve_segments > 0 ? z->made_curve_segments : z->curve_segments;
-  }
+  e.scene_bytes = fabric_scene_bytes(z);
+  // The segments the sample will hold (its memory's count, not the packing's estimate).
+  e.fiber_segments = z.made_curve_segments > 0 ? z.made_curve_segments : z.curve_segments;
   return e;
 }
 

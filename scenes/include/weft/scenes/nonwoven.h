@@ -49,9 +49,14 @@ WovenSample make_nonwoven_sample(const WeaveOptions& options,
 // The mat's size before it is made, from its options alone (the checks above, weft::Error naming
 // the field): its fibers exactly, its curves (fibers cut at the tile's sides, two points each) as
 // expected from the fibers' length, inclination and the tile (within a few percent of the mat
-// made; placing the largest mat takes tens of seconds).
+// made; placing the largest mat takes tens of seconds). And the work of placing them, expected:
+// each placement tried looks at every fiber placed (nine periodic copies, most left at a glance)
+// and searches the heights blocked by those that cross it seen from above; a try fails when they
+// block the whole column. 'placement_tries' is the tries expected, 'crossing_checks' the crossing
+// fibers searched over them and 'copy_checks' the copies glanced at (make time: ray trace books).
 struct NonwovenSize {
   double fibers = 0, curves = 0;
+  double placement_tries = 0, crossing_checks = 0, copy_checks = 0;
 };
 NonwovenSize nonwoven_sample_size(const WeaveOptions& options);
 

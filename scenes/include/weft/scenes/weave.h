@@ -185,6 +185,9 @@ struct WovenSampleSize {
   // sections; memory is estimated from these. A nonwoven mat: the same as above.
   std::string fiber_sections;
   double made_curve_points = 0, made_curve_segments = 0;
+  // A nonwoven mat: the work of placing its fibers (NonwovenSize), which its making time follows
+  // rather than its points.
+  double placement_crossing_checks = 0, placement_copy_checks = 0;
 };
 WovenSampleSize woven_sample_size(const WeaveOptions& options);
 

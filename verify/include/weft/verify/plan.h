@@ -92,7 +92,7 @@ struct VerifyEstimate {
   double photons = 0, particles = 0;
   unsigned cores = 1;  // the run's threads, or the machine's cores
   // The memory of the scene its ray traces fly through (fabric_scene_bytes of the sample's
-  // counts), the largest of a run; 0 for a nonwoven mat. A front end checks it (check_memory).
+  // counts), the largest of a run. A front end checks it (check_memory).
   double scene_bytes = 0;
   double fiber_segments = 0;  // the sample's (woven_sample_size), which its own cost grows with
 };
