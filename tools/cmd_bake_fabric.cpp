@@ -178,9 +178,10 @@ void add_bake_fabric_command(CLI::App& bake, Commands& commands) {
   sub->add_option("--weave", o.weave, "woven sample options (.json; default: the bundled poplin)");
   sub->add_option("--pattern", o.pattern, "weave pattern: plain, twill:N/M, satin:N");
   sub->add_option("--wif", o.wif, "WIF weaving draft");
-  sub->add_option("--detail", o.detail, "sample detail for the ray tracer: yarn or fiber")
-      ->check(CLI::IsMember({"yarn", "fiber"}))
-      ->capture_default_str();
+  sub->add_option("--detail", o.detail,
+                  "sample detail for the ray tracer: yarn or fiber (default: the --weave file's, "
+                  "else yarn)")
+      ->check(CLI::IsMember({"yarn", "fiber"}));
   sub->add_option("-R,--resolution", o.resolution, "fabric table bins per hemisphere side")
       ->check(CLI::Range(1, TabulatedBsdfTable::kMaxResolution))
       ->capture_default_str();

@@ -160,9 +160,6 @@ FabricRaytraceOptions raytrace_options(const FabricBakeRequest& o) {
   if (o.sheen_window && !o.sheen_resolution)
     throw Error("", "--sheen-window", "sizes the sheen's window: give --sheen-resolution too");
   if (o.sheen_resolution) {
-    if (o.detail != "fiber")
-      throw Error("", "--sheen-resolution",
-                  "books the fibers' surface lobe: it needs --detail fiber");
     if (!o.shard.empty() || o.resume)
       throw Error("", "--sheen-resolution",
                   "is booked for a whole table only: not with --shard or --resume");
@@ -193,8 +190,8 @@ void check_fabric_work(const FabricBakePlan& p) {
 // ends that have none (Python).
 FabricMethod checked_choices(const FabricBakeRequest& o) {
   const FabricMethod method = value_of(kFabricMethods, o.method, "", "--method");
-  if (o.detail != "yarn" && o.detail != "fiber")
-    throw Error("", "--detail", "must be 'yarn' or 'fiber', got '" + o.detail + "'");
+  if (o.detail && *o.detail != "yarn" && *o.detail != "fiber")
+    throw Error("", "--detail", "must be 'yarn' or 'fiber', got '" + *o.detail + "'");
   if (o.resolution < 1 || o.resolution > TabulatedBsdfTable::kMaxResolution)
     throw Error("", "--resolution",
                 "must be in [1, " + std::to_string(TabulatedBsdfTable::kMaxResolution) + "], got " +
@@ -274,6 +271,9 @@ FabricBakePlan plan_fabric_bake(const FabricBakeRequest& o) {
     throw Error(o.output, "", "the fabric table must be written to a .exr file");
   check_fabric_work(p);
   plan_sample(p, weave_wif);
+  if (o.sheen_resolution && p.weave.detail.value_or("yarn") != "fiber")
+    throw Error("", "--sheen-resolution",
+                "books the fibers' surface lobe: it needs --detail fiber");
   return p;
 }
 

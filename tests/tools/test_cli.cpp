@@ -509,8 +509,9 @@ TEST(Cli, BakeFabricBooksTheSheenApartWhereItCan) {
                            "' --method raytrace -R 2 --samples 20 --weave '" + WEFT_SOURCE_DIR +
                            "/scenes/examples/polyester-satin-weave.json'";
   const fs::path out = dir / "refused.exr";
-  expect_refused(base + " --sheen-resolution 16", out, "--sheen-resolution", dir);  // yarn detail
-  const std::string fiber_detail = base + " --detail fiber";
+  expect_refused(base + " --detail yarn --sheen-resolution 16", out, "--sheen-resolution", dir);
+  // The sample file's own detail (fiber) holds where --detail is not given.
+  const std::string fiber_detail = base;
   expect_refused(fiber_detail + " --sheen-window 4", out, "--sheen-window", dir);
   expect_refused(fiber_detail + " --sheen-resolution 15", out, "--sheen-resolution", dir);
   expect_refused(fiber_detail + " --sheen-resolution 16 --sheen-window 18", out, "--sheen-window",

@@ -65,7 +65,9 @@ struct FabricBakeRequest {
   std::string weave;                          // woven sample options (.json); "" = bundled poplin
   std::optional<WeaveOptions> weave_options;  // in place of the file (Python's dict)
   std::string pattern, wif;                   // over the sample's; "" = not given
-  std::string detail = "yarn";
+  // "yarn" or "fiber" over the sample's own; not given: the sample's, else yarn (a felt's file
+  // says fiber, its only detail).
+  std::optional<std::string> detail;
   int resolution = 8;                           // fabric table bins per hemisphere side
   std::optional<uint64_t> samples;              // the method's default unless given
   std::optional<std::string> estimator;         // kFabricEstimators; hero unless given
