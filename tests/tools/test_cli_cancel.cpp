@@ -237,6 +237,19 @@ TEST(CliCancel, VerifyStopsSoonWhileDrawingItsPlots) {
   EXPECT_FALSE(plot_script_running(dir, "plot_verify.py"));
 }
 
+TEST(CliCancel, CompareStopsSoonWhileDrawingItsPlot) {
+  // The plot script runs in a process group of its own (core/child_process.h), which compare ends
+  // on its own poll: exit 130, no plot, the script gone, its temporary curves removed.
+  const fs::path dir = fresh_test_dir();
+  const fs::path a = flat_fiber_table(dir), b = dir / "b.exr";
+  fs::copy_file(a, b);
+  const auto r = interrupt_after(
+      spawn_weft({"compare", a.string(), b.string(), "--plot", (dir / "curves.png").string()}, dir),
+      0.2, 120, [&] { return plot_script_running(dir, "plot_compare.py"); });
+  expect_stopped(r, dir, dir / "curves.png", "compare");
+  EXPECT_FALSE(plot_script_running(dir, "plot_compare.py"));
+}
+
 TEST(CliCancel, FiberBakeStopsSoonAtHugePhotons) {
   const fs::path dir = fresh_test_dir();
   const auto r =
