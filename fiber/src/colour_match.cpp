@@ -149,8 +149,15 @@ ModelStep model_step(const ColourMatch& m, const Spectrum& host_mu,
     for (size_t d = 0; d < u.size(); ++d)
       lo[d] = std::min(lo[d], u[d]), hi[d] = std::max(hi[d], u[d]);
   }
+  // A dye added to the recipe (trichromatic_recipe) is at 0 in the first readings: until it has
+  // been read above 0 it may go as deep as the recipe's deepest dye.
+  const double deepest =
+      *std::max_element(m.basis.initial_scale.begin(), m.basis.initial_scale.end());
+  const std::vector<double> u_deepest =
+      map.unit(std::vector<double>(u_best.size(), std::max(deepest, 1e-300)));
   const double reach = std::log(kTrustFactor) / std::log(ScaleMap::kRange);
   for (size_t d = 0; d < u_best.size(); ++d) {
+    if (hi[d] <= 0) hi[d] = u_deepest[d];
     lo[d] = std::max(0.0, lo[d] - reach);
     hi[d] = std::min(1.0, hi[d] + reach);
     v0[d] = (u_best[d] - lo[d]) / (hi[d] - lo[d]);
@@ -220,6 +227,39 @@ DyeBasis dye_basis(const FiberSpec& spec) {
   return basis;
 }
 
+FiberSpec trichromatic_recipe(const FiberSpec& spec) {
+  if (spec.dyes.empty()) return spec;
+  const std::string dye_class =
+      bundled_dye(spec.dyes.front().dye, spec.name, "host.dyes").dye_class;
+  bool has[3] = {false, false, false};
+  for (const DyeComponent& c : spec.dyes) {
+    const DyeSpectrum& d = bundled_dye(c.dye, spec.name, "host.dyes");
+    if (d.dye_class.empty() || d.dye_class != dye_class) return spec;
+    has[static_cast<int>(dye_hue(d))] = true;
+  }
+  constexpr double kHueMiddleNm[3] = {440, 520, 620};
+  FiberSpec out = spec;
+  for (int h = 0; h < 3; ++h) {
+    if (has[h]) continue;
+    std::string best;
+    double best_distance = 0;
+    for (const std::string& name : bundled_dye_names()) {
+      const DyeSpectrum& d = bundled_dye(name, "", "dye");
+      if (d.dye_class != dye_class || static_cast<int>(dye_hue(d)) != h) continue;
+      const auto& e = d.epsilon_per_M_per_cm;
+      const double peak_nm =
+          band_wavelength_nm(static_cast<int>(std::max_element(e.begin(), e.end()) - e.begin()));
+      const double distance = std::abs(peak_nm - kHueMiddleNm[h]);
+      if (best.empty() || distance < best_distance) best = name, best_distance = distance;
+    }
+    if (!best.empty())
+      out.dyes.push_back({.dye = best,
+                          .concentration_owf_percent = 0,
+                          .uptake_fraction = spec.dyes.front().uptake_fraction});
+  }
+  return out;
+}
+
 FiberSpec with_dye_scale(const FiberSpec& base, const DyeBasis& basis,
                          const std::vector<double>& scale) {
   FiberSpec s = base;
@@ -239,14 +279,17 @@ ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
   options.validate();
   ColourMatch m;
   m.target = target;
-  m.basis = dye_basis(base);
+  const FiberSpec recipe = options.complete_hues ? trichromatic_recipe(base) : base;
+  m.basis = dye_basis(recipe);
+  for (size_t d = base.dyes.size(); d < recipe.dyes.size(); ++d)
+    m.added_dyes.push_back(recipe.dyes[d].dye);
   const size_t n = m.basis.names.size();
   const ScaleMap map{m.basis.max_scale};
   Absorptions mu;
   // Takes a reading at 'scale'; false when interrupted.
   const auto take = [&](const std::vector<double>& scale) {
     const std::clock_t cpu0 = std::clock();
-    const FiberSpec spec = with_dye_scale(base, m.basis, scale);
+    const FiberSpec spec = with_dye_scale(recipe, m.basis, scale);
     const std::optional<Spectrum> r = read(spec);
     if (!r) return false;
     ColourReading reading{scale, *r, target.lab_of(*r), 0,
@@ -258,7 +301,7 @@ ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
     return true;
   };
   const Spectrum host_mu =
-      host_total_absorption_per_um(with_dye_scale(base, m.basis, std::vector<double>(n, 0.0)));
+      host_total_absorption_per_um(with_dye_scale(recipe, m.basis, std::vector<double>(n, 0.0)));
   ModelStep last_step;
   int idle = 0;  // readings in a row that left the best where it was, while out of reach
   bool stalled = false, interrupted = !take(m.basis.initial_scale);
@@ -290,7 +333,7 @@ ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
   // Outside reach: even the model, free to move, stays away from the target.
   m.outside_reach = !m.reached && !m.cancelled && !last_step.at_trust_edge &&
                     last_step.delta_e00 > options.tolerance_delta_e00;
-  m.spec = with_dye_scale(base, m.basis, m.best_reading().scale);
+  m.spec = with_dye_scale(recipe, m.basis, m.best_reading().scale);
   return m;
 }
 
@@ -302,7 +345,12 @@ nlohmann::json colour_match_summary(const ColourMatch& m) {
       {"lab", lab(m.target.lab)},
       {"observer", m.target.observer == Observer::kCie1964TenDegree ? "CIE 1964 10 degrees"
                                                                     : "CIE 1931 2 degrees"}};
-  j["basis"] = m.basis.recipe ? "the recipe's dyes (% owf)" : "thread-colour absorbers";
+  std::string added;
+  for (const std::string& d : m.added_dyes) added += (added.empty() ? "" : ", ") + d;
+  j["basis"] = !m.basis.recipe ? "thread-colour absorbers"
+               : added.empty() ? "the recipe's dyes (% owf)"
+                               : "the recipe's dyes and " + added + " to make three hues (% owf)";
+  j["added_dyes"] = m.added_dyes;
   j["reached"] = m.reached;
   j["outside_reach"] = m.outside_reach;
   j["cancelled"] = m.cancelled;

@@ -125,6 +125,10 @@ DyeSpectrum parse_dye_spectrum(const std::string& json_text, const std::string& 
   d.colour_index = p.string("colour_index");
   for (const char* key : {"use", "formula", "solvent", "source"}) (void)p.string(key);
   d.molar_mass_g_per_mol = p.number("molar_mass_g_per_mol", 1, 1e5);
+  if (p.has("dye_class")) {
+    d.dye_class = p.string("dye_class");
+    if (d.dye_class.empty()) throw Error(file, "dye_class", "must not be empty when given");
+  }
   const bool table = p.has(kDyeSpectrumKey), bands = p.has("bands");
   if (table == bands)
     throw Error(file, table ? "bands" : kDyeSpectrumKey,
@@ -141,6 +145,14 @@ DyeSpectrum parse_dye_spectrum(const std::string& json_text, const std::string& 
   }
   p.finish();
   return d;
+}
+
+DyeHue dye_hue(const DyeSpectrum& dye) {
+  const auto peak =
+      std::max_element(dye.epsilon_per_M_per_cm.begin(), dye.epsilon_per_M_per_cm.end());
+  const double peak_nm =
+      band_wavelength_nm(static_cast<int>(peak - dye.epsilon_per_M_per_cm.begin()));
+  return peak_nm < 470 ? DyeHue::kYellow : peak_nm < 570 ? DyeHue::kRed : DyeHue::kBlue;
 }
 
 std::vector<std::string> bundled_dye_names() {

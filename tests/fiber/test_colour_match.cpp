@@ -36,6 +36,13 @@ ColourTarget lab_target_of(const FiberSpec& base, const std::vector<double>& sca
   return parse_colour_target(spec, "--colour");
 }
 
+// The recipe's own dyes, not completed to three hues: what these tests ask of two dyes.
+ColourMatchOptions recipe_dyes_only() {
+  ColourMatchOptions o;
+  o.complete_hues = false;
+  return o;
+}
+
 }  // namespace
 
 TEST(ColourMatch, FindsTheRecipesDepthsOfAReachableColour) {
@@ -43,7 +50,8 @@ TEST(ColourMatch, FindsTheRecipesDepthsOfAReachableColour) {
   for (const std::vector<double>& truth :
        {std::vector<double>{0.3, 0.05}, std::vector<double>{6.0, 1.0}, {0.05, 0.4}}) {
     int calls = 0;
-    const ColourMatch m = match_colour(red, lab_target_of(red, truth), counted(calls), {});
+    const ColourMatch m =
+        match_colour(red, lab_target_of(red, truth), counted(calls), recipe_dyes_only());
     ASSERT_TRUE(m.reached) << truth[0] << ", " << truth[1] << ": " << m.best_reading().delta_e00;
     EXPECT_LE(m.best_reading().delta_e00, 1.0);
     EXPECT_FALSE(m.outside_reach);
@@ -56,11 +64,12 @@ TEST(ColourMatch, FindsTheRecipesDepthsOfAReachableColour) {
 }
 
 TEST(ColourMatch, SaysWhenTheDyesCannotReachTheTarget) {
-  // A blue from a red recipe: the nearest reachable colour is a reading, its distance stated.
+  // A blue from a red recipe's two dyes: the nearest reachable colour is a reading, its distance
+  // stated.
   const FiberSpec red = load_fiber_spec("red-cotton");
   int calls = 0;
-  const ColourMatch m =
-      match_colour(red, parse_colour_target("lab:40,0,-45", "--colour"), counted(calls), {});
+  const ColourMatch m = match_colour(red, parse_colour_target("lab:40,0,-45", "--colour"),
+                                     counted(calls), recipe_dyes_only());
   EXPECT_FALSE(m.reached);
   EXPECT_TRUE(m.outside_reach);
   EXPECT_FALSE(m.cancelled);
@@ -88,7 +97,7 @@ TEST(ColourMatch, StopsOutOfReachWhenReadingsStopGaining) {
   // Redder than congo red and curcumin make this cloth: the best readings sit at CIEDE2000 5.3,
   // and without the rule the match took all 8 readings to gain 0.3 % on the fourth's.
   const ColourMatch m =
-      match_colour(red, parse_colour_target("lab:30,40,25", "--colour"), noisy, {});
+      match_colour(red, parse_colour_target("lab:30,40,25", "--colour"), noisy, recipe_dyes_only());
   ASSERT_TRUE(m.outside_reach) << m.best_reading().delta_e00;
   EXPECT_GT(m.best_reading().delta_e00, 5);
   const size_t n = m.readings.size();
@@ -152,7 +161,7 @@ TEST(ColourMatch, MatchesASpectrumWithTheRecipesMixture) {
   // Congo red's measured spectrum absorbs in the violet too (fiber/data/dyes/README.md), where
   // curcumin does, so the two depths are told apart by smaller colour differences: the default
   // tolerance (CIEDE2000 1) is met 8 % off the truth; a tighter one recovers the mixture.
-  ColourMatchOptions tight;
+  ColourMatchOptions tight = recipe_dyes_only();
   tight.tolerance_delta_e00 = 0.1;
   int calls = 0;
   const ColourMatch m = match_colour(red, t, counted(calls), tight);
@@ -182,4 +191,75 @@ TEST(ColourMatch, RefusesBadOptions) {
   o = {};
   o.tolerance_delta_e00 = std::nan("");
   EXPECT_THROW(o.validate(), Error);
+}
+
+// The bundled dyes' hues from their measured peaks (fiber/data/dyes/README.md): curcumin 425 nm
+// and auramine O 431 nm yellow; Congo red 483 nm and rhodamine B 543 nm red; Evans blue 606 nm,
+// crystal violet 590 nm and methylene blue 656 nm blue.
+TEST(ColourMatch, TheBundledDyesHuesFollowTheirPeaks) {
+  const std::pair<const char*, DyeHue> hues[] = {
+      {"curcumin", DyeHue::kYellow},    {"auramine-o", DyeHue::kYellow},
+      {"congo-red", DyeHue::kRed},      {"rhodamine-b", DyeHue::kRed},
+      {"evans-blue", DyeHue::kBlue},    {"crystal-violet", DyeHue::kBlue},
+      {"methylene-blue", DyeHue::kBlue}};
+  for (const auto& [name, hue] : hues) {
+    const DyeSpectrum& d = bundled_dye(name, "", "dye");
+    EXPECT_EQ(dye_hue(d), hue) << name;
+    EXPECT_FALSE(d.dye_class.empty()) << name;
+  }
+  EXPECT_EQ(bundled_dye("congo-red", "", "dye").dye_class, "direct");
+  EXPECT_EQ(bundled_dye("rhodamine-b", "", "dye").dye_class, "basic");
+}
+
+TEST(ColourMatch, ARecipeIsCompletedToThreeHuesOfItsClass) {
+  // Red cotton (Congo red, curcumin: direct dyes) lacks a blue: Evans blue at 0, its uptake.
+  const FiberSpec red = load_fiber_spec("red-cotton");
+  const FiberSpec red3 = trichromatic_recipe(red);
+  ASSERT_EQ(red3.dyes.size(), 3u);
+  EXPECT_EQ(red3.dyes[2].dye, "evans-blue");
+  EXPECT_EQ(red3.dyes[2].concentration_owf_percent, 0);
+  EXPECT_EQ(red3.dyes[2].uptake_fraction, red.dyes[0].uptake_fraction);
+  EXPECT_EQ(red3.dyes[0].concentration_owf_percent, red.dyes[0].concentration_owf_percent);
+  // Crystal violet alone (a basic blue): a yellow and a red of the basic class.
+  FiberSpec purple = load_fiber_spec("acrylic");
+  purple.dyes = {{.dye = "crystal-violet", .concentration_owf_percent = 1, .uptake_fraction = 0.9}};
+  purple.density_g_cm3 = 1.17;
+  const FiberSpec purple3 = trichromatic_recipe(purple);
+  ASSERT_EQ(purple3.dyes.size(), 3u);
+  EXPECT_EQ(purple3.dyes[1].dye, "auramine-o");
+  EXPECT_EQ(purple3.dyes[2].dye, "rhodamine-b");
+  // Unchanged: no dyes; every hue present; classes mixed (no one bath dyes them).
+  EXPECT_TRUE(trichromatic_recipe(load_fiber_spec("white-cotton")).dyes.empty());
+  FiberSpec three = red3;
+  three.dyes[2].concentration_owf_percent = 1;
+  EXPECT_EQ(trichromatic_recipe(three).dyes.size(), 3u);
+  FiberSpec mixed = red;
+  mixed.dyes[1].dye = "auramine-o";
+  EXPECT_EQ(trichromatic_recipe(mixed).dyes.size(), 2u);
+}
+
+// A dull red (the analytic cloth of Congo red, curcumin and a touch of Evans blue) lies off the
+// surface that the red recipe's two dyes reach: matched with those alone it stays several
+// CIEDE2000 away; completed with a blue it is reached, the blue's depth found from 0.
+TEST(ColourMatch, AThirdHueReachesADullRedTheRecipesTwoDyesCannot) {
+  const FiberSpec red = load_fiber_spec("red-cotton");
+  const FiberSpec red3 = trichromatic_recipe(red);
+  const std::vector<double> truth{0.7, 1.2, 0.05};
+  const Lab lab = reflectance_to_lab(analytic_cloth(with_dye_scale(red3, dye_basis(red3), truth)),
+                                     Observer::kCie1931TwoDegree);
+  char spec[96];
+  std::snprintf(spec, sizeof spec, "lab:%.4f,%.4f,%.4f", lab.l, lab.a, lab.b);
+  const ColourTarget target = parse_colour_target(spec, "--colour");
+  int two_calls = 0, three_calls = 0;
+  const ColourMatch two = match_colour(red, target, counted(two_calls), recipe_dyes_only());
+  EXPECT_FALSE(two.reached);
+  EXPECT_GT(two.best_reading().delta_e00, 3) << colour_match_summary(two).dump();
+  const ColourMatch three = match_colour(red, target, counted(three_calls), {});
+  ASSERT_TRUE(three.reached) << colour_match_summary(three).dump();
+  EXPECT_LE(three_calls, 8);
+  ASSERT_EQ(three.added_dyes, std::vector<std::string>{"evans-blue"});
+  EXPECT_GT(three.best_reading().scale[2], 0);
+  EXPECT_EQ(three.spec.dyes.size(), 3u);
+  const nlohmann::json j = colour_match_summary(three);
+  EXPECT_NE(j["basis"].get<std::string>().find("evans-blue"), std::string::npos);
 }

@@ -33,6 +33,13 @@ struct DyeBasis {
   bool recipe = true;                       // the spec's dyes (else the thread-colour blocks)
 };
 DyeBasis dye_basis(const FiberSpec& spec);
+// The recipe completed to a trichromatic set (dye.h DyeHue), as a dyehouse matches a shade: where
+// every dye of the recipe is of one class and a hue of the three has none, that class's bundled
+// dye of the hue (its peak nearest the hue's middle: 440, 520, 620 nm) is added at 0 % owf, with
+// the recipe's first uptake. Two dyes reach only a surface of the colours; three reach the
+// colours between them (a dull red: red, yellow and a touch of blue). Unchanged: no dyes, mixed
+// or unnamed classes, or every hue present.
+FiberSpec trichromatic_recipe(const FiberSpec& spec);
 // 'base' with its dyes at these scales (or the blocks' absorption added), named "<base> dyed".
 FiberSpec with_dye_scale(const FiberSpec& base, const DyeBasis& basis,
                          const std::vector<double>& scale);
@@ -40,6 +47,7 @@ FiberSpec with_dye_scale(const FiberSpec& base, const DyeBasis& basis,
 struct ColourMatchOptions {
   double tolerance_delta_e00 = 1.0;  // stop at a reading this close (a just-noticeable difference)
   int max_readings = 8;              // readings in all, the two first ones included
+  bool complete_hues = true;         // scale trichromatic_recipe(base), not base's dyes alone
   void validate() const;             // weft::Error naming the field
 };
 
@@ -61,7 +69,8 @@ struct ColourMatch {
   // Not reached with a scale at its bound: the target lies outside what the dyes can give; the
   // best reading is then the nearest reachable colour.
   bool outside_reach = false;
-  FiberSpec spec;  // the base with best's scales
+  FiberSpec spec;                       // the base with best's scales (and the dyes added to it)
+  std::vector<std::string> added_dyes;  // by trichromatic_recipe, at the basis's end
   const ColourReading& best_reading() const { return readings.at(best); }
 };
 
@@ -71,6 +80,8 @@ using ColourReadingFunction = std::function<std::optional<Spectrum>(const FiberS
 
 // Readings at the recipe as written (scale 1) and without dyes, then at the scales the model
 // steers to until one is within the tolerance, max_readings are taken, or a step stops moving.
+// The dyes scaled are those of trichromatic_recipe(base) (options.complete_hues): the added ones
+// start at 0.
 ColourMatch match_colour(const FiberSpec& base, const ColourTarget& target,
                          const ColourReadingFunction& read, const ColourMatchOptions& options);
 

@@ -11,9 +11,9 @@
 //   mu_a(lambda) = ln(10) * epsilon(lambda) * c * 1e-4   per um
 // (epsilon in L mol^-1 cm^-1 is decadic and per cm; 1e-4 turns per cm into per um).
 //
-// Dye file layout (every key required, and the absorption as one of two keys):
+// Dye file layout (every key required but "dye_class", and the absorption as one of two keys):
 // {"name": "congo-red", "colour_index": "...", "use": "...", "formula": "...",
-//  "molar_mass_g_per_mol": 696.66, "solvent": "...", "source": "...",
+//  "molar_mass_g_per_mol": 696.66, "solvent": "...", "source": "...", "dye_class": "direct",
 //  "spectrum_nm_epsilon_per_M_per_cm": [[380, 25371], [381, 25043], ...]}
 // A tabulated spectrum (a measured one, as the bundled dyes carry): rows of wavelength (nm,
 // increasing) and epsilon, joined linearly and averaged over each band; epsilon is 0 past the
@@ -37,7 +37,18 @@ struct DyeSpectrum {
   double molar_mass_g_per_mol = 0;
   Spectrum epsilon_per_M_per_cm{};  // decadic molar absorption coefficient per band
   bool tabulated = false;           // from a tabulated spectrum (else from Gaussian bands)
+  // The application class dyers sort dyes by ("direct" for cotton, "basic" for acrylic): dyes of
+  // one class go on one fibre in one bath. Optional key "dye_class"; "" where not given.
+  std::string dye_class;
 };
+
+// A dye's place in a trichromatic set, by the band it absorbs most (its peak): yellow below
+// 470 nm (absorbs blue), red 470-570 nm (absorbs green), blue above 570 nm (absorbs orange and
+// red). Three dyes of one class, one of each, reach the colours between them; dyehouses match a
+// shade with such a set.
+enum class DyeHue { kYellow, kRed, kBlue };
+inline constexpr const char* kDyeHueNames[] = {"yellow", "red", "blue"};
+DyeHue dye_hue(const DyeSpectrum& dye);
 
 // The tabulated spectrum's key and bounds. Spectrophotometers read 190-1100 nm; a 0.1 nm table of
 // that range has about 9000 rows, and 10 000 refuses absurd ones. The strongest dyes reach
