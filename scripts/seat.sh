@@ -104,9 +104,10 @@ bake red-cotton-fabric fabric "$fiber raytrace fiber $particles weave=$weave col
 /usr/bin/python3 -c "
 import json; j = json.load(open('$out/fabric.json'))
 n = ' / '.join(f'{100 * x:.2f}' for x in j['relative_noise_per_channel'])
+per = 'channel (R / G / B)' if len(j['relative_noise_per_channel']) == 3 else 'band'
 print(f\"ray trace: {j['particles']} particles ({$particles} per incident bin), \"
       f\"{j['cpu_seconds']:.1f} CPU-s, {j['wall_seconds']:.0f} s wall, \"
-      f\"relative noise R / G / B {n} %\")
+      f\"relative noise per {per} {n} %\")
 if j.get('weave'):
     w = j['weave']
     print(f\"weave table: {w.get('positions')} positions, resolution {w.get('resolution')}, \"
@@ -117,16 +118,24 @@ repeat_dir=$(mktemp -d)
 trap 'rm -rf "$repeat_dir"' EXIT
 "$weft" weave -o "$repeat_dir/poplin.glb" --json > "$repeat_dir/poplin.json"
 describe() {  # the descriptions, with the weave level where $weave is 1
-  /usr/bin/python3 - "$scene_dir" "$out" "$backing" "$weave" "$repeat_dir/poplin.json" \
+  /usr/bin/python3 - "$weft" "$scene_dir" "$out" "$backing" "$weave" "$repeat_dir/poplin.json" \
     "${WEFT_HEIGHT:-}" "${variants[@]}" <<'PY'
-import json, math, sys
-scene_dir, out, backing, weave, poplin, height = sys.argv[1:7]
-variants = sys.argv[7:]
+import json, math, subprocess, sys
+weft, scene_dir, out, backing, weave, poplin, height = sys.argv[1:8]
+variants = sys.argv[8:]
 base = json.load(open(f"{scene_dir}/car-seat.json"))
 base["gltf"] = f"{out}/seat.glb"
 height = int(height) if height else base["render"]["height"]
-rho = [min(1.0, max(0.0, v))
-       for v in json.load(open(f"{out}/fabric.json"))["reflectance_normal_incidence"]]
+rho = json.load(open(f"{out}/fabric.json"))["reflectance_normal_incidence"]
+if len(rho) != 3:  # a spectral table (a matched colour is one): its linear sRGB under D65
+    rho = json.loads(subprocess.run([weft, "spectrum", *map(str, rho)], check=True,
+                                    capture_output=True, text=True).stdout)["linear_srgb"]
+# The classic material's colour is a reflectance in [0, 1]; a saturated red's linear sRGB can
+# leave it (a negative green or blue), which the classic model cannot hold: said, not hidden.
+inside = [min(1.0, max(0.0, v)) for v in rho]
+if inside != rho:
+    print(f"classic diffuse colour: linear sRGB {rho} lies outside [0, 1]; taken as {inside}")
+rho = inside
 # Upholstery cloth lies on foam: the light the table transmits comes back through it.
 foam = {} if backing == "none" else {"backing_reflectance": float(backing)}
 computed = {"file": f"{out}/red-cotton-fabric.exr", **foam}
