@@ -84,13 +84,17 @@ std::vector<BandCurve> band_curves(const std::vector<ColourReading>& readings,
   return curves;
 }
 
-// The scales' map from the unit cube, logarithmic from 1e-4 of the largest scale to it.
+// The scales' map from the unit cube, logarithmic from 1e-4 of the largest scale to it; the
+// cube's floor is no dye at all. (It once was 1e-4 of the largest, 0.002 % owf: a dye the model
+// left out was still read at that depth, and in a felt, where light walks long, 0.002 % of
+// crystal violet and rhodamine B darkened a yellow by 5 L*.)
 struct ScaleMap {
   std::vector<double> max_scale;
   static constexpr double kRange = 1e4;
   std::vector<double> scale(const std::vector<double>& u) const {
     std::vector<double> s(u.size());
-    for (size_t d = 0; d < u.size(); ++d) s[d] = max_scale[d] * std::pow(kRange, u[d] - 1);
+    for (size_t d = 0; d < u.size(); ++d)
+      s[d] = u[d] <= 0 ? 0.0 : max_scale[d] * std::pow(kRange, u[d] - 1);
     return s;
   }
   std::vector<double> unit(const std::vector<double>& s) const {

@@ -263,3 +263,31 @@ TEST(ColourMatch, AThirdHueReachesADullRedTheRecipesTwoDyesCannot) {
   const nlohmann::json j = colour_match_summary(three);
   EXPECT_NE(j["basis"].get<std::string>().find("evans-blue"), std::string::npos);
 }
+
+// A cloth in which light walks long (a felt: 2 mm of fibre in the analytic cloth's form): a dye
+// at 0.002 % owf darkens it visibly. A yellow of the acrylic recipe's one dye, completed with a
+// red and a blue it does not need: the match reaches it with those left at no depth. (The scales'
+// map once had 1e-4 of the bound, 0.002 % owf, as its floor: the bundled yellow felt's added dyes
+// were read there and its match ended 8 CIEDE2000 away.)
+TEST(ColourMatch, ADyeLeftOutIsReadAtNoDepth) {
+  FiberSpec yellow = load_fiber_spec("acrylic");
+  yellow.dyes = {{.dye = "auramine-o", .concentration_owf_percent = 1, .uptake_fraction = 0.9}};
+  yellow.density_g_cm3 = 1.17;
+  const auto felt = [](const FiberSpec& spec) -> std::optional<Spectrum> {
+    const Spectrum mu = host_total_absorption_per_um(spec);
+    Spectrum r{};
+    for (int b = 0; b < kNumBands; ++b) r[b] = 0.02 + 0.85 * std::exp(-2 * std::sqrt(mu[b] * 2e3));
+    return r;
+  };
+  FiberSpec truth = yellow;
+  truth.dyes[0].concentration_owf_percent = 0.3;
+  const Lab lab = reflectance_to_lab(*felt(truth), Observer::kCie1931TwoDegree);
+  char spec[96];
+  std::snprintf(spec, sizeof spec, "lab:%.4f,%.4f,%.4f", lab.l, lab.a, lab.b);
+  const ColourMatch m = match_colour(yellow, parse_colour_target(spec, "--colour"), felt, {});
+  ASSERT_EQ(m.added_dyes.size(), 2u);
+  EXPECT_TRUE(m.reached) << colour_match_summary(m).dump();
+  for (const ColourReading& r : m.readings)
+    for (size_t d = 1; d < r.scale.size(); ++d)
+      EXPECT_TRUE(r.scale[d] == 0 || r.scale[d] > 0.01) << colour_match_summary(m).dump();
+}
