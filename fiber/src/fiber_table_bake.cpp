@@ -62,8 +62,8 @@ void add_band_pass(FiberBandState& st, const FiberBandTable& t) {
 }
 
 // The progress of a pass whose bands run on several threads: each band counts its photons here,
-// and only the thread that started the bake calls the caller's callback (a front end's callback
-// need not be thread-safe, and Python's signal check works on the main thread alone). A stop it
+// and only the thread that started the bake calls the caller's callback, so its calls come one at
+// a time (a front end's need not be thread-safe) with a count that never goes back. A stop it
 // returns is seen by every band at its next wave.
 class BandPassProgress {
  public:
@@ -192,9 +192,11 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
     // The bands of a pass side by side, each on one thread: a band's pass is a few tasks (two at
     // the defaults, 4 096 and 2 154 photons), too few to share out, so one thread waited on the
     // other at every band. One thread per band leaves the bits as they were (each band's tasks
-    // and their order are the same at any thread count).
+    // and their order are the same at any thread count). Fewer bands than threads (a shard of a
+    // few bands) go one after another, each on every thread, as before.
+    const bool side_by_side = todo.size() >= static_cast<size_t>(thread_count(o.threads));
     std::vector<std::optional<FiberBandTable>> tables(static_cast<size_t>(nb));
-    parallel_for(todo.size(), o.threads, [&](uint64_t j) {
+    parallel_for(todo.size(), side_by_side ? o.threads : 1, [&](uint64_t j) {
       const int i = todo[j];
       if (pass_progress.stopped()) return;
       FiberBakeSettings settings;
@@ -203,7 +205,7 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
       // Disjoint random streams per (seed, pass, band).
       const int band = work.first_band + i;
       settings.seed = mix64(mix64(o.seed) ^ (pass * kNumBands + static_cast<uint64_t>(band)));
-      settings.threads = 1;
+      settings.threads = side_by_side ? 1 : o.threads;
       settings.entry = o.entry;
       settings.book_surface = o.surface_lobe == FiberSurfaceLobe::kSampled;
       const ProgressCallback band_progress = pass_progress.for_band();
