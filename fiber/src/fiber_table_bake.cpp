@@ -1,12 +1,16 @@
 #include "weft/fiber/fiber_table_bake.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <thread>
 
 #include "weft/core/error.h"
+#include "weft/core/parallel.h"
 #include "weft/core/spectrum.h"
 #include "weft/fiber/fiber_bake.h"
 #include "weft/fiber/medium.h"
@@ -40,6 +44,57 @@ void check_analytic_lobe(const FiberSpec& spec, const FiberTableBakeOptions& o) 
                 "an analytic surface lobe needs the smooth boundary (the rough dielectric's "
                 "surface part is its microsurface walk, not one Cook-Torrance lobe)");
 }
+
+// A band's pass added to its running sums (weighted by the pass's photons).
+void add_band_pass(FiberBandState& st, const FiberBandTable& t) {
+  const double n = static_cast<double>(t.photons);
+  for (size_t k = 0; k < st.weighted_sum.size(); ++k) st.weighted_sum[k] += t.weighted_sum[k] * n;
+  st.surface += t.surface_fraction * n;
+  st.exit += t.exit_fraction * n;
+  st.lost += t.lost_fraction * n;
+  st.absorbed += t.absorbed_fraction * n;
+  st.roulette += t.roulette_net * n;
+  st.excess += t.surface_sampling_excess * n;
+  st.exit_excess += t.expected_exit_excess * n;
+  st.energy += fiber_table_energy(t) / kPi * n;
+  st.photons += t.photons;
+  st.events += t.scattering_events;
+}
+
+// The progress of a pass whose bands run on several threads: each band counts its photons here,
+// and only the thread that started the bake calls the caller's callback, so its calls come one at
+// a time (a front end's need not be thread-safe) with a count that never goes back. A stop it
+// returns is seen by every band at its next wave.
+class BandPassProgress {
+ public:
+  BandPassProgress(const ProgressCallback& progress, uint64_t total_units)
+      : progress_(progress), total_units_(total_units), caller_(std::this_thread::get_id()) {}
+
+  void start_pass(uint64_t units_done) {
+    units_done_ = units_done;
+    traced_ = 0;
+  }
+  bool stopped() const { return stop_.load(); }
+
+  // A band's callback: its photons so far (u.done) are added to the pass's count.
+  ProgressCallback for_band() {
+    return [this, last = uint64_t{0}](const ProgressUpdate& u) mutable {
+      traced_ += u.done - last;
+      last = u.done;
+      if (progress_ && std::this_thread::get_id() == caller_ &&
+          !progress_({"photons", units_done_ + traced_.load(), total_units_}))
+        stop_ = true;
+      return !stop_.load();
+    };
+  }
+
+ private:
+  const ProgressCallback& progress_;
+  uint64_t total_units_ = 0, units_done_ = 0;
+  std::thread::id caller_;
+  std::atomic<uint64_t> traced_{0};
+  std::atomic<bool> stop_{false};
+};
 
 }  // namespace
 
@@ -124,51 +179,51 @@ FiberBandsResult trace_fiber_bands(const FiberSpec& spec, const FiberTableBakeOp
   const uint64_t total_units = o.photons_per_band * static_cast<uint64_t>(nb);
   uint64_t units_done = 0;
   for (const auto& st : states) units_done += st.photons;
-  bool stop_requested = false;
+  BandPassProgress pass_progress(progress, total_units);
   uint64_t first_pass = passes;
   for (const auto& st : states) first_pass = std::min(first_pass, st.passes_done);
   for (uint64_t pass = first_pass; pass < passes && !result.cancelled; ++pass) {
     const uint64_t first = o.photons_per_band * pass / passes;
     const uint64_t count = o.photons_per_band * (pass + 1) / passes - first;
-    for (int i = 0; i < nb && !result.cancelled; ++i) {
-      FiberBandState& st = states[i];
-      if (st.passes_done > pass) continue;
-      const int band = work.first_band + i;
+    std::vector<int> todo;
+    for (int i = 0; i < nb; ++i)
+      if (states[i].passes_done <= pass) todo.push_back(i);
+    pass_progress.start_pass(units_done);
+    // The bands of a pass side by side, each on one thread: a band's pass is a few tasks (two at
+    // the defaults, 4 096 and 2 154 photons), too few to share out, so one thread waited on the
+    // other at every band. One thread per band leaves the bits as they were (each band's tasks
+    // and their order are the same at any thread count). Fewer bands than threads (a shard of a
+    // few bands) go one after another, each on every thread, as before.
+    const bool side_by_side = todo.size() >= static_cast<size_t>(thread_count(o.threads));
+    std::vector<std::optional<FiberBandTable>> tables(static_cast<size_t>(nb));
+    parallel_for(todo.size(), side_by_side ? o.threads : 1, [&](uint64_t j) {
+      const int i = todo[j];
+      if (pass_progress.stopped()) return;
       FiberBakeSettings settings;
       settings.resolution = R;
       settings.photons = count;
       // Disjoint random streams per (seed, pass, band).
+      const int band = work.first_band + i;
       settings.seed = mix64(mix64(o.seed) ^ (pass * kNumBands + static_cast<uint64_t>(band)));
-      settings.threads = o.threads;
+      settings.threads = side_by_side ? 1 : o.threads;
       settings.entry = o.entry;
       settings.book_surface = o.surface_lobe == FiberSurfaceLobe::kSampled;
-      const uint64_t base = units_done;
-      // A stop request may arrive after a band's last task: remember it for the loops here.
-      ProgressCallback band_progress = [&](const ProgressUpdate& u) {
-        if (progress && !progress({"photons", base + u.done, total_units})) stop_requested = true;
-        return !stop_requested;
-      };
-      const FiberBandTable t =
+      const ProgressCallback band_progress = pass_progress.for_band();
+      tables[i] =
           o.route == FiberBakeRoute::kDirect
               ? bake_fiber_band_direct(physics[i], settings, band_progress)
               : bake_fiber_band_bssrdf(physics[i], settings, BssrdfRouteSettings{}, band_progress);
-      const double n = static_cast<double>(t.photons);
-      for (size_t k = 0; k < st.weighted_sum.size(); ++k)
-        st.weighted_sum[k] += t.weighted_sum[k] * n;
-      st.surface += t.surface_fraction * n;
-      st.exit += t.exit_fraction * n;
-      st.lost += t.lost_fraction * n;
-      st.absorbed += t.absorbed_fraction * n;
-      st.roulette += t.roulette_net * n;
-      st.excess += t.surface_sampling_excess * n;
-      st.exit_excess += t.expected_exit_excess * n;
-      st.energy += fiber_table_energy(t) / kPi * n;
-      st.photons += t.photons;
-      st.events += t.scattering_events;
-      units_done += t.photons;
-      result.cancelled = t.cancelled || stop_requested;
-      if (!result.cancelled) st.passes_done = pass + 1;
+    });
+    for (const int i : todo) {
+      if (!tables[i]) continue;  // not started: a stop came first
+      add_band_pass(states[i], *tables[i]);
+      units_done += tables[i]->photons;
+      // A band whose photons were all traced has finished the pass, whenever the stop came.
+      if (!tables[i]->cancelled) states[i].passes_done = pass + 1;
     }
+    for (const int i : todo)
+      if (states[i].passes_done <= pass) result.cancelled = true;
+    if (pass_progress.stopped()) result.cancelled = true;
     if (!result.cancelled && work.on_pass) work.on_pass(states);
   }
   return result;

@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <set>
+#include <thread>
 #include <vector>
 
 #include "chi2.h"
@@ -375,6 +376,49 @@ TEST(FiberTableBake, BitIdenticalAtOneAndTwoThreads) {
   EXPECT_EQ(a.table.checksum(), b.table.checksum());
   for (size_t i = 0; i < a.table.values.size(); ++i)
     ASSERT_EQ(a.table.values[i], b.table.values[i]);
+}
+
+// The bands of a pass run side by side, one thread each (trace_fiber_bands): the caller's
+// progress callback is still called for the photons on the calling thread alone (a front end's
+// need not be thread-safe), and a stop it returns mid-bake keeps the passes every band finished:
+// resumed from the last checkpoint, the bake ends with the sums of one that was never stopped,
+// bit for bit.
+TEST(FiberTableBake, BandsSideBySideReportOnTheCallingThreadAndResumeToTheSameBits) {
+  const FiberSpec spec = load_fiber_spec("red-cotton");
+  const FiberTableBakeOptions o{
+      .resolution = 4, .photons_per_band = 600, .threads = 2, .passes = 3};
+  const auto caller = std::this_thread::get_id();
+  int calls = 0, calls_elsewhere = 0;
+  const FiberBandsResult whole = trace_fiber_bands(spec, o, {}, [&](const ProgressUpdate& u) {
+    if (u.stage != "photons") return true;  // the medium's stage reports from its own threads
+    ++calls;
+    if (std::this_thread::get_id() != caller) ++calls_elsewhere;
+    return true;
+  });
+  ASSERT_FALSE(whole.cancelled);
+  EXPECT_GT(calls, 0);
+  EXPECT_EQ(calls_elsewhere, 0);
+  // Stopped once half the photons are reported; each finished pass checkpointed.
+  FiberBandWork work;
+  std::vector<FiberBandState> checkpoint;
+  work.on_pass = [&](const std::vector<FiberBandState>& states) { checkpoint = states; };
+  const uint64_t total = o.photons_per_band * kNumBands;
+  const FiberBandsResult stopped = trace_fiber_bands(spec, o, work, [&](const ProgressUpdate& u) {
+    return !(u.stage == "photons" && u.done >= total / 2);
+  });
+  ASSERT_TRUE(stopped.cancelled);
+  ASSERT_EQ(checkpoint.size(), static_cast<size_t>(kNumBands));  // the first pass: a third
+  for (const FiberBandState& b : checkpoint) EXPECT_LT(b.passes_done, o.passes);
+  work.start = checkpoint;
+  work.on_pass = nullptr;
+  const FiberBandsResult resumed = trace_fiber_bands(spec, o, work);
+  ASSERT_FALSE(resumed.cancelled);
+  for (int b = 0; b < kNumBands; ++b) {
+    EXPECT_EQ(resumed.bands[b].photons, whole.bands[b].photons) << b;
+    EXPECT_EQ(resumed.bands[b].passes_done, o.passes) << b;
+    EXPECT_TRUE(resumed.bands[b].weighted_sum == whole.bands[b].weighted_sum) << b;
+    EXPECT_EQ(resumed.bands[b].exit, whole.bands[b].exit) << b;
+  }
 }
 
 TEST(FiberTableBake, RoughDielectricBoundaryIsBitIdenticalAtOneAndTwoThreads) {

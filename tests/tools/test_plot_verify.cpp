@@ -141,6 +141,13 @@ TEST(PlotVerify, OneReadableFigurePerIncidence) {
       EXPECT_EQ(p.at("yscale"), p.at("kind") == "absolute" ? "log" : "linear");
       EXPECT_EQ(p.at("mirror_deg").get<double>(), ti);
       EXPECT_EQ(p.at("mirror_label"), "mirror " + std::to_string(static_cast<int>(ti)) + "\u00b0");
+      // The title is placed, not measured (plot_verify.py draw_panel): above the mirror label,
+      // which is above the panel. Measured at the script's 25 pt pad: 0.011 of the figure's
+      // height between the label's top and the title's bottom on these inputs.
+      const auto &title = p.at("title_box"), &mirror = p.at("mirror_label_box");
+      EXPECT_FALSE(overlap(title, mirror)) << f.at("file");
+      EXPECT_GE(title[1].get<double>(), mirror[3].get<double>()) << f.at("file");
+      EXPECT_GE(mirror[1].get<double>(), p.at("axes_box")[3].get<double>()) << f.at("file");
     }
     // Every curve named once, the models with their factors (the CSV's norm_factor).
     const auto& labels = f.at("legend_labels");

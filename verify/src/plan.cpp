@@ -178,17 +178,21 @@ Rgb parse_classic_albedo(const std::string& text) {
 namespace {
 
 // Measured (docs/verify.md "Time"): red-cotton's full bake at the bake's defaults (next-event
-// estimation and 4 surface samples), 9.1-11 s of CPU for 50 000 photons in each of 33 bands, so
-// 6 us per photon (docs/PERFORMANCE.md); the bundled poplin's fiber-level ray traces at default
-// quality, computed and classic together, 316 s of CPU for 16.4 M particles and 6.6 M photons, so
-// 18 us per particle; the plots and the rest, about 10 s of CPU whatever the quality.
-constexpr double kTypicalSecondsPerPhoton = 6e-6;
+// estimation and 4 surface samples), 8.6 s of CPU for 50 000 photons in each of 33 bands on 2
+// threads (2026-12-06, `weft bake fiber red-cotton --bands spectral`), so 5.2 us per photon; the
+// bundled poplin's fiber-level ray traces at default quality, computed and classic together, 316 s
+// of CPU for 16.4 M particles and 6.6 M photons, so 18 us per particle; the plots and the rest,
+// 9-11 s of CPU (tools/plot_verify.py --jobs 2 on a default run's nine incidences, 2026-12-06)
+// whatever the quality.
+constexpr double kTypicalSecondsPerPhoton = 5.2e-6;
 constexpr double kTypicalSecondsPerParticle = 18e-6;
 constexpr double kTypicalFixedSeconds = 10;
-// The fiber-level renders (docs/verify.md "Renders"): 23 s of CPU at default quality for the four
-// renders' 3.64 M camera samples on the bundled poplin, so 6.5 us per sample; counted here on a
-// square film of weave_render_size (an upper bound: the film is whole repeats, one side shorter).
-constexpr double kTypicalSecondsPerWeaveSample = 6.5e-6;
+// The fiber-level renders (docs/PERFORMANCE.md "Profile of `weft verify`"): the renders stage of
+// `weft verify --quality default --threads 2` took 16.8 s on 2 idle cores, about 33 s of CPU, for
+// the four renders at 16 spp, 4.19 M samples of square films (2026-12-06), so 8 us per sample;
+// counted on a square film of weave_render_size (an upper bound: the film is whole repeats, one
+// side shorter), the patches' renders included.
+constexpr double kTypicalSecondsPerWeaveSample = 8e-6;
 constexpr int kWeaveRenders = 4;  // computed and classic, reflection and transmission
 constexpr double kLeastSecondsPerParticle = 1.25e-6;
 // The fit (docs/verify.md "Fitting"): its inner bake (RGB, absorption as a weight, so no roulette)

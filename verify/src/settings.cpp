@@ -38,7 +38,7 @@ VerifySettings verify_settings(VerifyQuality q) {
                                        .render_size = 128,
                                        .render_spp = 4,
                                        .weave_render_size = 256,
-                                       .weave_render_spp = 16};
+                                       .weave_render_spp = 8};
   static const VerifySettings kPublication{.quality = VerifyQuality::kPublication,
                                            .resolution = 12,
                                            .fiber_photons_per_band = 250000,
