@@ -50,8 +50,11 @@ extern "C" void on_sigint(int) {
 
 }  // namespace
 
+// SIGTERM as SIGINT: a batch scheduler's stop (Slurm's scancel or time limit, `timeout`) asks as
+// politely as Ctrl-C, and killed at once weft left its plot script's process group running.
 void install_interrupt_handler() {
   std::signal(SIGINT, on_sigint);
+  std::signal(SIGTERM, on_sigint);
 }
 bool interrupted() {
   return g_interrupted.load();

@@ -38,7 +38,8 @@ using Commands = std::vector<Command>;
 // at the next task boundary and keeps what it has. Made where the work starts: throws
 // WorkWouldStart in a check-only run (work_starts).
 ProgressCallback progress_bar(const RunLimits& limits, bool quiet);
-// Installs the SIGINT handler (idempotent; main does it first thing): until a progress_bar is
+// Installs the SIGINT handler, for SIGTERM too (idempotent; main does it first thing): until a
+// progress_bar is
 // made, Ctrl-C ends the program at once with exit code 130 (nothing has been written: a plan only
 // reads and checks); after it, Ctrl-C sets interrupted() for the work to stop at its next poll,
 // and a second Ctrl-C ends the program at once.

@@ -69,14 +69,14 @@ struct Interrupted {
 // Waits for the handler and for 'ready' when given (at most 'wait_s' in all), lets the command
 // run 'run_s', sends SIGINT and times the exit.
 Interrupted interrupt_after(ChildRun c, double run_s, double wait_s = 120,
-                            const std::function<bool()>& ready = nullptr) {
+                            const std::function<bool()>& ready = nullptr, int signal = SIGINT) {
   using Clock = std::chrono::steady_clock;
   const auto give_up = Clock::now() + std::chrono::duration<double>(wait_s);
   while (!(catches_sigint(c.pid) && (!ready || ready())) && Clock::now() < give_up)
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   std::this_thread::sleep_for(std::chrono::duration<double>(run_s));
   const auto t0 = Clock::now();
-  kill(c.pid, SIGINT);
+  kill(c.pid, signal);
   Interrupted r;
   waitpid(c.pid, &r.status, 0);
   r.seconds_to_exit = std::chrono::duration<double>(Clock::now() - t0).count();
@@ -246,6 +246,20 @@ TEST(CliCancel, CompareStopsSoonWhileDrawingItsPlot) {
   const auto r = interrupt_after(
       spawn_weft({"compare", a.string(), b.string(), "--plot", (dir / "curves.png").string()}, dir),
       0.2, 120, [&] { return plot_script_running(dir, "plot_compare.py"); });
+  expect_stopped(r, dir, dir / "curves.png", "compare");
+  EXPECT_FALSE(plot_script_running(dir, "plot_compare.py"));
+}
+
+TEST(CliCancel, SigtermStopsAsCtrlCDoesAndEndsThePlotScript) {
+  // A batch scheduler's stop (scancel, a time limit, `timeout`) is SIGTERM: weft once died at
+  // once and left its plot script running. It now stops as on Ctrl-C: exit 130, nothing written,
+  // the script's group ended.
+  const fs::path dir = fresh_test_dir();
+  const fs::path a = flat_fiber_table(dir), b = dir / "b.exr";
+  fs::copy_file(a, b);
+  const auto r = interrupt_after(
+      spawn_weft({"compare", a.string(), b.string(), "--plot", (dir / "curves.png").string()}, dir),
+      0.2, 120, [&] { return plot_script_running(dir, "plot_compare.py"); }, SIGTERM);
   expect_stopped(r, dir, dir / "curves.png", "compare");
   EXPECT_FALSE(plot_script_running(dir, "plot_compare.py"));
 }
