@@ -237,31 +237,28 @@ TEST(CliCancel, VerifyStopsSoonWhileDrawingItsPlots) {
   EXPECT_FALSE(plot_script_running(dir, "plot_verify.py"));
 }
 
-TEST(CliCancel, CompareStopsSoonWhileDrawingItsPlot) {
-  // The plot script runs in a process group of its own (core/child_process.h), which compare ends
-  // on its own poll: exit 130, no plot, the script gone, its temporary curves removed.
+// weft compare --plot sent 'signal' while its plot script draws: the script runs in a process
+// group of its own (core/child_process.h), which compare ends on its own poll: exit 130, no plot,
+// the script gone.
+void expect_compare_plot_stopped_by(int signal) {
   const fs::path dir = fresh_test_dir();
   const fs::path a = flat_fiber_table(dir), b = dir / "b.exr";
   fs::copy_file(a, b);
   const auto r = interrupt_after(
       spawn_weft({"compare", a.string(), b.string(), "--plot", (dir / "curves.png").string()}, dir),
-      0.2, 120, [&] { return plot_script_running(dir, "plot_compare.py"); });
+      0.2, 120, [&] { return plot_script_running(dir, "plot_compare.py"); }, signal);
   expect_stopped(r, dir, dir / "curves.png", "compare");
   EXPECT_FALSE(plot_script_running(dir, "plot_compare.py"));
 }
 
+TEST(CliCancel, CompareStopsSoonWhileDrawingItsPlot) {
+  expect_compare_plot_stopped_by(SIGINT);
+}
+
+// A batch scheduler's stop (scancel, a time limit, `timeout`) is SIGTERM: weft once died at once
+// and left its plot script running. It now stops as on Ctrl-C.
 TEST(CliCancel, SigtermStopsAsCtrlCDoesAndEndsThePlotScript) {
-  // A batch scheduler's stop (scancel, a time limit, `timeout`) is SIGTERM: weft once died at
-  // once and left its plot script running. It now stops as on Ctrl-C: exit 130, nothing written,
-  // the script's group ended.
-  const fs::path dir = fresh_test_dir();
-  const fs::path a = flat_fiber_table(dir), b = dir / "b.exr";
-  fs::copy_file(a, b);
-  const auto r = interrupt_after(
-      spawn_weft({"compare", a.string(), b.string(), "--plot", (dir / "curves.png").string()}, dir),
-      0.2, 120, [&] { return plot_script_running(dir, "plot_compare.py"); }, SIGTERM);
-  expect_stopped(r, dir, dir / "curves.png", "compare");
-  EXPECT_FALSE(plot_script_running(dir, "plot_compare.py"));
+  expect_compare_plot_stopped_by(SIGTERM);
 }
 
 TEST(CliCancel, FiberBakeStopsSoonAtHugePhotons) {
