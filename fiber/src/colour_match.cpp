@@ -250,10 +250,7 @@ FiberSpec trichromatic_recipe(const FiberSpec& spec) {
     for (const std::string& name : bundled_dye_names()) {
       const DyeSpectrum& d = bundled_dye(name, "", "dye");
       if (d.dye_class != dye_class || static_cast<int>(dye_hue(d)) != h) continue;
-      const auto& e = d.epsilon_per_M_per_cm;
-      const double peak_nm =
-          band_wavelength_nm(static_cast<int>(std::max_element(e.begin(), e.end()) - e.begin()));
-      const double distance = std::abs(peak_nm - kHueMiddleNm[h]);
+      const double distance = std::abs(dye_peak_nm(d) - kHueMiddleNm[h]);
       if (best.empty() || distance < best_distance) best = name, best_distance = distance;
     }
     if (!best.empty())

@@ -147,11 +147,13 @@ DyeSpectrum parse_dye_spectrum(const std::string& json_text, const std::string& 
   return d;
 }
 
+double dye_peak_nm(const DyeSpectrum& dye) {
+  const Spectrum& e = dye.epsilon_per_M_per_cm;
+  return band_wavelength_nm(static_cast<int>(std::max_element(e.begin(), e.end()) - e.begin()));
+}
+
 DyeHue dye_hue(const DyeSpectrum& dye) {
-  const auto peak =
-      std::max_element(dye.epsilon_per_M_per_cm.begin(), dye.epsilon_per_M_per_cm.end());
-  const double peak_nm =
-      band_wavelength_nm(static_cast<int>(peak - dye.epsilon_per_M_per_cm.begin()));
+  const double peak_nm = dye_peak_nm(dye);
   return peak_nm < 470 ? DyeHue::kYellow : peak_nm < 570 ? DyeHue::kRed : DyeHue::kBlue;
 }
 

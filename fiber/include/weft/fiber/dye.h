@@ -47,8 +47,9 @@ struct DyeSpectrum {
 // red). Three dyes of one class, one of each, reach the colours between them; dyehouses match a
 // shade with such a set.
 enum class DyeHue { kYellow, kRed, kBlue };
-inline constexpr const char* kDyeHueNames[] = {"yellow", "red", "blue"};
 DyeHue dye_hue(const DyeSpectrum& dye);
+// The centre of the band where the dye absorbs most, nm.
+double dye_peak_nm(const DyeSpectrum& dye);
 
 // The tabulated spectrum's key and bounds. Spectrophotometers read 190-1100 nm; a 0.1 nm table of
 // that range has about 9000 rows, and 10 000 refuses absurd ones. The strongest dyes reach
