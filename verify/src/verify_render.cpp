@@ -3,6 +3,7 @@
 // description built in memory, RenderScene, render) as `weft render` would draw it.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,6 +12,7 @@
 #include "weft/core/math.h"
 #include "weft/integrators/path_tracer.h"
 #include "weft/integrators/render_settings.h"
+#include "weft/materials/table_cache.h"
 #include "weft/scenes/camera.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/primitives.h"
@@ -136,9 +138,12 @@ const char* configuration_name(bool transmission) {
 // Renders a description as `weft render` would, refusing non-finite samples. The scene build and
 // the render poll 'progress' as `weft render`'s do (a publication render of a large sample takes
 // minutes); nothing when it said stop.
+// 'tables' is shared by the report's renders, so a table two of them read is prepared once.
 std::optional<Image> render_description(const SceneDescription& desc, const VerifySettings& s,
-                                        const ProgressCallback& progress) {
+                                        const ProgressCallback& progress,
+                                        const std::shared_ptr<TableCache>& tables) {
   RenderSceneOptions options;
+  options.table_cache = tables;
   options.material_progress = progress;
   options.build_progress = progress;
   const RenderScene scene(desc, options);
@@ -164,7 +169,8 @@ Rgb mean_of(const Image& image, int x0, int x1, int y0, int y1) {
 std::optional<VerifyRender> render_one(const std::filesystem::path& folder,
                                        const nlohmann::json& material, const std::string& model,
                                        const std::string& label, bool transmission,
-                                       const VerifySettings& s, const ProgressCallback& progress) {
+                                       const VerifySettings& s, const ProgressCallback& progress,
+                                       const std::shared_ptr<TableCache>& tables) {
   const std::string config = configuration_name(transmission);
   const std::string source = "verify render " + config + " " + model;
   VerifyRender v;
@@ -174,7 +180,7 @@ std::optional<VerifyRender> render_one(const std::filesystem::path& folder,
   v.stem = "render-" + config + "-" + model;
   SceneDescription desc = verify_render_scene(material, transmission, s, folder);
   desc.source = source;
-  std::optional<Image> image = render_description(desc, s, progress);
+  std::optional<Image> image = render_description(desc, s, progress, tables);
   if (!image) return std::nullopt;
   v.image = std::move(*image);
   // The central half of the film lies inside the patch (the film is the patch's projection).
@@ -195,8 +201,8 @@ std::optional<VerifyRender> render_weave(const WovenSample& sample,
                                          const std::filesystem::path& folder,
                                          const std::string& fiber_file, const std::string& model,
                                          const std::string& label, bool transmission, bool spectral,
-                                         const VerifySettings& s,
-                                         const ProgressCallback& progress) {
+                                         const VerifySettings& s, const ProgressCallback& progress,
+                                         const std::shared_ptr<TableCache>& tables) {
   // Read by cell, as the ray trace reads it: the image's mean is then the ray-traced fabric
   // table's value for this view and light (TableLookup).
   const nlohmann::json material = {{"type", "fiber_table"},
@@ -213,7 +219,7 @@ std::optional<VerifyRender> render_weave(const WovenSample& sample,
   v.model = model;
   v.configuration = configuration_name(transmission);
   v.stem = "render-weave-" + v.configuration + "-" + model;
-  std::optional<Image> image = render_description(desc, s, progress);
+  std::optional<Image> image = render_description(desc, s, progress, tables);
   if (!image) return std::nullopt;
   v.image = std::move(*image);
   v.mean = mean_of(v.image, 0, v.image.width, 0, v.image.height);
@@ -238,6 +244,7 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
                                                 const ProgressCallback& progress, bool* cancelled) {
   std::vector<VerifyRender> out;
   const VerifySettings& s = report.settings;
+  const auto tables = std::make_shared<TableCache>();
   // Keeps a render; false (the renders end there) when it was stopped.
   const auto keep = [&](std::optional<VerifyRender> v) {
     if (v) out.push_back(std::move(*v));
@@ -263,7 +270,7 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
     rgb.write_exr(folder / file);
     const nlohmann::json material = {{"type", "fabric_table"}, {"params", {{"file", file}}}};
     for (bool transmission : {false, true})
-      if (!keep(render_one(folder, material, t.model, t.label, transmission, s, progress)))
+      if (!keep(render_one(folder, material, t.model, t.label, transmission, s, progress, tables)))
         return out;
   }
   // The fibers with each model's fiber table, where the report holds the sample at fiber detail.
@@ -286,7 +293,7 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
       const bool spectral = table.channels == kNumBands;
       for (bool transmission : {false, true})
         if (!keep(render_weave(*report.sample, folder, file, t.model, t.label, transmission,
-                               spectral, s, progress)))
+                               spectral, s, progress, tables)))
           return out;
     }
   }
@@ -296,7 +303,7 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
         {"type", "measured_nbrdf"},
         {"params", {{"file", std::filesystem::absolute(report.measured_nbrdf).string()}}}};
     keep(render_one(folder, material, "measured", "measured BRDF (neural fit of the measurement)",
-                    false, s, progress));
+                    false, s, progress, tables));
   }
   return out;
 }
