@@ -466,16 +466,22 @@ TEST(CliVerify, SuiteWritesAReportPerFabricAndOnePage) {
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("--colour-space"), std::string::npos) << r.err;
 
+  // Two fabrics of the same weave options: the second is handed the first's woven sample, made
+  // once (its seconds are the hand-over's), and its report is the one a sample of its own gives.
   std::ofstream(dir / "one.json") << "{\"title\": \"one\", \"fabrics\": [" << fabric("w", poplin)
-                                  << "]}";
+                                  << ", " << fabric("v", poplin) << "]}";
   r = run_weft("verify --quiet --quality draft --threads 2 --suite-file one.json -o suite", dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto s = nlohmann::json::parse(slurp(out / "suite.json"));
   EXPECT_EQ(s.at("report"), "weft verify suite");
-  ASSERT_EQ(s.at("fabrics").size(), 1u);
+  ASSERT_EQ(s.at("fabrics").size(), 2u);
   const auto m = nlohmann::json::parse(slurp(out / "w" / "metrics.json"));
   EXPECT_EQ(s.at("fabrics")[0].at("models").at("classic").at("paper_rms_log"),
             m.at("models").at("classic").at("normalized").at("rms_log"));
+  const auto mv = nlohmann::json::parse(slurp(out / "v" / "metrics.json"));
+  EXPECT_EQ(mv.at("models"), m.at("models"));
+  EXPECT_LT(mv.at("seconds").at("woven_sample").get<double>(),
+            0.25 * m.at("seconds").at("woven_sample").get<double>());
   EXPECT_NE(slurp(out / "index.html").find("w/index.html"), std::string::npos);
   EXPECT_NE(r.out.find("w "), std::string::npos) << r.out;
   // Anything but an earlier suite is refused and left alone.

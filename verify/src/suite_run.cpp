@@ -1,12 +1,14 @@
 // weft verify --suite's plan and run (suite.h): every fabric checked before the first runs.
 #include <algorithm>
 #include <cstdio>
+#include <memory>
 
 #include "weft/core/atomic_file.h"
 #include "weft/core/error.h"
 #include "weft/core/output_guard.h"
 #include "weft/verify/report.h"
 #include "weft/verify/suite.h"
+#include "weft/verify/whole_run.h"
 
 namespace weft {
 
@@ -64,14 +66,42 @@ void check_verify_suite_time(const VerifySuitePlan& p, const RunLimits& limits) 
                   "weft verify --suite at quality " + p.base.quality, kVerifyLeastRates);
 }
 
+namespace {
+
+// The last fabric's woven sample, handed on to the next fabric of the same weave options: the
+// bundled suite's 24 fabrics share three samples, and a felt's mat takes seconds to make. One is
+// kept at a time, so the suite holds no more than its largest fabric does.
+class LastSample {
+ public:
+  std::shared_ptr<const WovenSample> get(const WeaveOptions& options,
+                                         const ProgressCallback& progress) {
+    if (sample_ && options == options_) return sample_;
+    sample_.reset();
+    auto made = std::make_shared<const WovenSample>(make_woven_sample(options, progress));
+    if (!made->cancelled) sample_ = made, options_ = options;
+    return made;
+  }
+
+ private:
+  WeaveOptions options_;
+  std::shared_ptr<const WovenSample> sample_;
+};
+
+}  // namespace
+
 VerifySuiteOutcome run_verify_suite(const VerifySuitePlan& p, const VerifySuiteHooks& hooks) {
   std::filesystem::create_directories(p.base.output);
   VerifySuiteOutcome out;
+  LastSample last;
   for (size_t k = 0; k < p.plans.size(); ++k) {
     SuiteRow row{p.suite.fabrics[k], nullptr, ""};
     hooks.starting(k);
     try {
-      const VerifyOutcome run = run_verify_plan(p.plans[k], hooks.fabric(k));
+      VerifyHooks fabric = hooks.fabric(k);
+      fabric.sample = [&last, progress = fabric.progress](const WeaveOptions& o) {
+        return last.get(o, progress);
+      };
+      const VerifyOutcome run = run_verify_plan(p.plans[k], fabric);
       if (run.cancelled) {
         out.cancelled = true;
         return out;

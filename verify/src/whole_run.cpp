@@ -194,7 +194,11 @@ VerifyOutcome run_verify_plan(const VerifyPlan& p, const VerifyHooks& hooks, con
   const auto t0 = std::chrono::steady_clock::now();
   VerifyOutcome cancelled;
   cancelled.cancelled = true;
-  const WovenSample sample = make_woven_sample(p.weave, hooks.progress);
+  const std::shared_ptr<const WovenSample> made =
+      hooks.sample
+          ? hooks.sample(p.weave)
+          : std::make_shared<const WovenSample>(make_woven_sample(p.weave, hooks.progress));
+  const WovenSample& sample = *made;
   if (sample.cancelled) return cancelled;
   in.sample_name = sample_name(sample.summary);
   if (sample.summary.nonwoven || !sample.summary.notes.empty())

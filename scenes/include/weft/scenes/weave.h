@@ -98,6 +98,8 @@ struct WeaveOptions {
   std::optional<double> tile_mm;             // side of the square tile (the period)
   std::optional<double> fiber_density_g_cm3;
   std::optional<uint64_t> seed;
+
+  bool operator==(const WeaveOptions&) const = default;  // the same sample
 };
 
 // Reads a sample description (a JSON object whose keys are the `weft weave` option names without

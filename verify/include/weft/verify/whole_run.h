@@ -7,6 +7,7 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -28,6 +29,9 @@ struct VerifyHooks {
       [](const std::filesystem::path&) {};
   // When the run began, for the report's "total_before_report" seconds.
   std::chrono::steady_clock::time_point started = std::chrono::steady_clock::now();
+  // The woven sample of the plan's weave options (a cancelled one when stopped); unset: made by
+  // the run. The suite hands on the last fabric's sample to the next one of the same options.
+  std::function<std::shared_ptr<const WovenSample>(const WeaveOptions&)> sample;
 };
 
 struct VerifyOutcome {
