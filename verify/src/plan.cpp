@@ -222,8 +222,8 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
   e.cores = static_cast<unsigned>(thread_count(s.threads));
   const double bins = 2.0 * s.resolution * s.resolution;
   const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
-  // Computed and classic, each 'particles_per_bin' per incident bin over all batches.
-  const double run_particles = 2.0 * double(s.particles_per_bin) * bins;
+  // Computed and classic, each its particles per incident bin over all batches.
+  const double run_particles = double(s.particles_per_bin + s.classic_particles_per_bin) * bins;
   e.photons = run_photons;
   e.particles = run_particles;
   double fit_seconds = 0, fit_traces = 0;
