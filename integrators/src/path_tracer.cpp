@@ -125,6 +125,7 @@ struct ShadowTest {
   Ray ray;
   int64_t ignore_fiber = kNoFiber;
   int decided = -1;  // -1: trace 'ray'
+  int light = 0;     // the light's index in RenderScene::lights
 };
 
 // One path from the camera: its radiance so far (L) and throughput (beta). A vertex's light
@@ -141,7 +142,9 @@ class PathTrace {
 
   PathTrace(const RenderScene& scene, const RenderSettings& settings, Rng& rng, RayCounts& rays,
             const RayObserver* on_ray)
-      : scene_(scene), settings_(settings), rng_(rng), rays_(rays), on_ray_(on_ray) {}
+      : scene_(scene), settings_(settings), rng_(rng), rays_(rays), on_ray_(on_ray) {
+    if (settings.light_groups) by_light_.emplace();
+  }
 
   Rgb run(const Ray& camera_ray, int64_t* first_mesh) {
     if (start(camera_ray, first_mesh, {})) {
@@ -173,7 +176,7 @@ class PathTrace {
         b = blocked[i] != 0;
       else
         b = scene_.occluded(t.ray.o, t.ray.d, t.ray.tmax, t.ignore_fiber);
-      if (!b) L_ += t.contribution;
+      if (!b) add(t.light, t.contribution);
     }
     n_held_ = 0;
   }
@@ -183,6 +186,10 @@ class PathTrace {
       answer_shadows(nullptr);
   }
   Rgb result() const { return Shading::to_rgb(L_); }
+  // With light groups: light k's share of result() into out[k], for every light of the scene.
+  void light_results(Rgb* out) const {
+    for (size_t k = 0; k < scene_.lights().size(); ++k) out[k] = Shading::to_rgb((*by_light_)[k]);
+  }
 
  private:
   // The vertex at 'depth' along ray_: the light its ray finds (a surface light, or the lights at
@@ -196,13 +203,15 @@ class PathTrace {
       found = scene_.intersect(ray_, &hit_, ignore_fiber_);
     if (!found) {
       const LightHit escaped = LightHit::escaped_along(ray_.d);
-      for (const Light& light : scene_.lights()) add_found_light(light, escaped);
+      for (size_t k = 0; k < scene_.lights().size(); ++k)
+        add_found_light(static_cast<int>(k), escaped);
       return false;
     }
     if (first_mesh) *first_mesh = hit_.shape;
     const Vec3 wo_world = -ray_.d;
     if (const Light* light = scene_.surface_light(hit_.shape))
-      add_found_light(*light, LightHit::on_surface(ray_.d, hit_.shape, hit_.prim, hit_.ng, hit_.t));
+      add_found_light(static_cast<int>(light - scene_.lights().data()),
+                      LightHit::on_surface(ray_.d, hit_.shape, hit_.prim, hit_.ng, hit_.t));
     if (depth >= settings_.max_depth) return false;
     vertex_.emplace(PathVertex{hit_, scene_.bsdf_at(hit_), hit_.shading.to_local(wo_world),
                                dot(wo_world, hit_.ng)});
@@ -212,20 +221,27 @@ class PathTrace {
 
   // Radiance from a light that the last BSDF sample found, weighted against next-event estimation
   // of the same light.
-  void add_found_light(const Light& light, const LightHit& at) {
+  void add_found_light(int k, const LightHit& at) {
+    const Light& light = scene_.lights()[static_cast<size_t>(k)];
     const Rgb Le = light.eval(at);
     if (Le.is_black()) return;
     double w = 1;
     if (!specular_)
       w = use_mis_ ? power_heuristic(prev_pdf_, light.pdf(at)) : (nee_area_ ? 0.0 : 1.0);
-    L_ += beta_ * Shading::light(Le) * w;
+    add(k, beta_ * Shading::light(Le) * w);
+  }
+  // Light k's contribution c: to the path's radiance and, with light groups, to light k's share.
+  void add(int k, const Color& c) {
+    L_ += c;
+    if (by_light_) (*by_light_)[static_cast<size_t>(k)] += c;
   }
 
   // Next-event estimation: one sample of every light, held with its shadow test; area lights and
   // the environment weighted against BSDF sampling (lights.h states what a sample holds).
   void sample_lights(const PathVertex& v) {
     const SurfaceHit& hit = v.hit;
-    for (const Light& light : scene_.lights()) {
+    for (size_t k = 0; k < scene_.lights().size(); ++k) {
+      const Light& light = scene_.lights()[k];
       const bool delta = light.is_delta();
       if (!delta && !nee_area_) continue;
       const std::optional<LightSample> ls = light.sample(hit.p, rng_);
@@ -248,6 +264,7 @@ class PathTrace {
       const double w =
           delta || !use_mis_ || !agrees ? 1.0 : power_heuristic(ls->pdf, v.bsdf.pdf(v.wo, wi));
       ShadowTest<Color> t = shadow_test(v, lifted ? &lift : nullptr, *ls);
+      t.light = static_cast<int>(k);
       t.contribution =
           beta_ * f * Shading::light(ls->L) * (std::abs(wi.z) * (w * ls->falloff) / ls->pdf);
       hold(std::move(t));
@@ -317,6 +334,7 @@ class PathTrace {
   const bool use_mis_ = settings_.sampling == LightSampling::mis;
   const bool nee_area_ = settings_.sampling != LightSampling::bsdf_only;
   Color L_ = Color(0.0), beta_ = Color(1.0);
+  std::optional<std::array<Color, kMaxLightGroups>> by_light_;  // with light groups
   Ray ray_;
   bool specular_ = true;  // camera rays and delta bounces are not covered by next-event estimation
   double prev_pdf_ = 0;
@@ -373,11 +391,13 @@ void answer_group_shadows(const RenderScene& scene, std::span<std::optional<Trac
 // of each path as trace_path traces it. Each path does what trace_path does, in the same order,
 // so the bits are the same. out[j]: the path's colour; first_mesh[j] the shape its
 // camera ray meets (-1: none); when first_hits is not null, first_hits[j] is that hit, and
-// found[j] whether there is one.
+// found[j] whether there is one; with light groups, out_by_light[j * kMaxLightGroups + k] the
+// path's colour from light k.
 template <class Shading>
 void trace_camera_group(const RenderScene& scene, std::span<const Ray> rays, Rng* const* rng,
                         const RenderSettings& s, RayCounts& counts, const RayObserver* on_ray,
-                        Rgb* out, int64_t* first_mesh, SurfaceHit* first_hits, bool* found) {
+                        Rgb* out, Rgb* out_by_light, int64_t* first_mesh, SurfaceHit* first_hits,
+                        bool* found) {
   constexpr int kGroup = RenderScene::kPacketRays;
   using Trace = PathTrace<Shading>;
   const int n = static_cast<int>(rays.size());
@@ -401,6 +421,7 @@ void trace_camera_group(const RenderScene& scene, std::span<const Ray> rays, Rng
   for (int j = 0; j < n; ++j) {
     if (alive[j]) trace[j]->go_on();
     out[j] = trace[j]->result();
+    if (s.light_groups) trace[j]->light_results(out_by_light + size_t(j) * kMaxLightGroups);
   }
 }
 
@@ -421,6 +442,8 @@ void check_render_settings(const RenderSettings& s) {
     throw Error("", "render", "width, height, spp and tile size must be positive");
   if (!(s.time_limit_s >= 0) || !std::isfinite(s.time_limit_s))
     throw Error("", "render.time_limit_s", "must be a finite number of seconds >= 0");
+  if (s.light_groups && s.time_limit_s > 0)
+    throw Error("", "render.light_groups", "not with a time limit");
 }
 
 // Per-pixel sums of radiance, albedo and normal, in sample order.
@@ -459,6 +482,9 @@ class WindowRender {
       report(0);
       return !cancel_.load();
     };
+    if (s_.light_groups) out_.light_images.resize(scene_.lights().size());
+    for (Image& im : out_.light_images)
+      if (!film_image(im, keep_going)) return false;
     return film_image(out_.image, keep_going) &&
            (!s_.aov_albedo || film_image(out_.albedo, keep_going)) &&
            (!s_.aov_normal || film_image(out_.normal, keep_going));
@@ -529,15 +555,21 @@ class WindowRender {
           const size_t i = size_t(y) * ww_ + x;
           PixelSums acc;
           PixelSums& into = tile_sums ? (*tile_sums)[b.index(x, y)] : acc;
+          std::array<double, 3 * kMaxLightGroups> by_light{};  // light groups: no time limit
           for (int k = k0; k < k1; k += kPollSamples) {
             const int k_end = k1 - k > kPollSamples ? k + kPollSamples : k1;
-            sample_pixel(win_.x0 + x, win_.y0 + y, k, k_end, into, rays, tile_nonfinite_[tile]);
+            sample_pixel(win_.x0 + x, win_.y0 + y, k, k_end, into,
+                         s_.light_groups ? by_light.data() : nullptr, rays, tile_nonfinite_[tile]);
             unreported += uint64_t(k_end - k);
             if (unreported >= kPollSamples) report(std::exchange(unreported, 0));
             // A cancelled render is discarded anyway: stop at once, not at the tile's end.
             if (cancel_.load(std::memory_order_relaxed)) return;
           }
           if (!sums) store(i, acc, 1.0 / s_.spp);
+          for (size_t k = 0; k < out_.light_images.size(); ++k)
+            for (size_t c = 0; c < 3; ++c)
+              out_.light_images[k].rgb[3 * i + c] =
+                  static_cast<float>(by_light[3 * k + c] / s_.spp);
         }
       }
       tile_rays_[tile] += rays;
@@ -562,9 +594,10 @@ class WindowRender {
     if (!cancel_.load() && !progress_({"render", d, total_, "samples"})) cancel_.store(true);
   }
 
-  // Samples [k0, k1) of film pixel (x, y), added to 'acc', in groups whose camera rays and first
-  // shadow rays are traced together (trace_camera_group: the same bits as one by one).
-  void sample_pixel(int x, int y, int k0, int k1, PixelSums& acc, RayCounts& rays,
+  // Samples [k0, k1) of film pixel (x, y), added to 'acc' (and each light's share to
+  // by_light[3 k + c] with light groups), in groups whose camera rays and first shadow rays are
+  // traced together (trace_camera_group: the same bits as one by one).
+  void sample_pixel(int x, int y, int k0, int k1, PixelSums& acc, double* by_light, RayCounts& rays,
                     uint64_t& nonfinite) const {
     constexpr int kGroup = RenderScene::kPacketRays;
     const uint64_t pixel = uint64_t(y) * s_.width + x;
@@ -572,6 +605,9 @@ class WindowRender {
     std::array<Rng*, kGroup> streams;
     std::array<Ray, kGroup> ray;
     std::array<Rgb, kGroup> L;
+    std::optional<std::array<Rgb, kGroup * kMaxLightGroups>> L_by_light;  // with light groups
+    if (by_light) L_by_light.emplace();
+    Rgb* const out_by_light = by_light ? L_by_light->data() : nullptr;
     std::array<int64_t, kGroup> first;
     std::optional<std::array<SurfaceHit, kGroup>> hits;  // the camera rays' hits, for the AOVs
     if (aov_) hits.emplace();
@@ -589,14 +625,18 @@ class WindowRender {
       SurfaceHit* first_hits = hits ? hits->data() : nullptr;
       if (s_.spectral)
         trace_camera_group<BandShading>(scene_, group, streams.data(), s_, rays, on_ray_, L.data(),
-                                        first.data(), first_hits, found);
+                                        out_by_light, first.data(), first_hits, found);
       else
         trace_camera_group<RgbShading>(scene_, group, streams.data(), s_, rays, on_ray_, L.data(),
-                                       first.data(), first_hits, found);
+                                       out_by_light, first.data(), first_hits, found);
       for (int j = 0; j < n; ++j) {
         if (!finite(L[j])) {
           ++nonfinite;
           L[j] = Rgb(0.0);
+        } else if (by_light) {
+          for (size_t k = 0; k < scene_.lights().size(); ++k)
+            for (int c = 0; c < 3; ++c)
+              by_light[3 * k + c] += (*L_by_light)[size_t(j) * kMaxLightGroups + k][c];
         }
         acc.L[0] += L[j].r, acc.L[1] += L[j].g, acc.L[2] += L[j].b;
         if (observers_.on_sample) observers_.on_sample(pixel, first[j], L[j]);
@@ -678,6 +718,10 @@ double render_bytes(const RenderSettings& s, bool preview, bool mask) {
 RenderResult render(const RenderScene& scene, const Camera& camera, const RenderSettings& s,
                     const ProgressCallback& progress, const RenderObservers& observers) {
   check_render_settings(s);
+  if (s.light_groups && scene.lights().size() > size_t(kMaxLightGroups))
+    throw Error("", "render.light_groups",
+                "at most " + std::to_string(kMaxLightGroups) + " lights (the scene has " +
+                    std::to_string(scene.lights().size()) + ")");
   const PixelWindow win = s.crop.value_or(PixelWindow{0, s.width, 0, s.height});
   check_crop(win, s.width, s.height, "", "render.crop");
   if (s.spectral) scene.check_spectral();

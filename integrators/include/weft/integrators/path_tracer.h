@@ -80,6 +80,9 @@ struct RenderResult : RenderOutcome {
   // the sampled weight f cos / pdf, whose mean is the albedo), and its shading normal in world
   // space turned towards the camera. A camera ray that hits nothing adds zero to both.
   Image albedo, normal;
+  // With RenderSettings::light_groups: per light of the scene (RenderScene::lights' order), the
+  // mean radiance its own light gives, as 'image' (which is their sum).
+  std::vector<Image> light_images;
   // The level each woven mesh was shaded at (weave_level.h); empty when the scene has none.
   std::vector<WeaveLevelChoice> weave_levels;
 };

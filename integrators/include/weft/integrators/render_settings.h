@@ -48,7 +48,13 @@ struct RenderSettings {
   // and every light a grey colour (RenderScene::check_spectral). The image is linear sRGB either
   // way.
   bool spectral = false;
+  // Besides the image, one image per light of the scene (RenderResult::light_images), each the
+  // light that light alone gives: the paths are traced once for all of them. At most
+  // kMaxLightGroups lights, no time limit. A scene's parallel lights draw no random numbers, so
+  // each of their images has the bits of a render with that light alone.
+  bool light_groups = false;
 };
+inline constexpr int kMaxLightGroups = 4;
 
 // A lower bound on the CPU time of one path sample (one pixel sample), seconds: a sample traces at
 // least its camera ray, and the path tracer ran 8.46 M rays/s on 2 threads on the 65 536-triangle
