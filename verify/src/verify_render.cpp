@@ -93,14 +93,13 @@ VerifyWeaveFrame verify_weave_frame(const WeaveSummary& sample, int size) {
 
 std::optional<SceneDescription> verify_weave_scene(const WovenSample& sample,
                                                    const nlohmann::json& material,
-                                                   bool transmission, const VerifySettings& s,
+                                                   const VerifySettings& s,
                                                    const std::filesystem::path& base_dir,
                                                    const ProgressCallback& progress) {
   if (sample.fibers.curve_count() == 0)
     throw Error("", "sample", "the fiber-level render needs the woven sample at fiber detail");
   const VerifyWeaveFrame f = verify_weave_frame(sample.summary, s.weave_render_size);
-  const std::string source =
-      std::string("verify weave render ") + (transmission ? "transmission" : "reflection");
+  const std::string source = "verify weave render";
   // Made in place rather than parsed: the description parser wants its geometry from glTF files
   // or inline objects, and the fibers are the tiled sample's.
   std::optional<SceneDescription> tiled =
@@ -109,11 +108,14 @@ std::optional<SceneDescription> verify_weave_scene(const WovenSample& sample,
   SceneDescription d = std::move(*tiled);
   d.base_dir = base_dir;
   for (const char* key : {"warp", "weft"}) d.materials[key] = binding_of(material, key);
-  // glTF's frame (weave.h): the cloth's normal is +y, the warp +x. The light as the patch's.
-  DirectionalLight light;
-  light.to_light = {0, transmission ? -1.0 : 1.0, 0};
-  light.irradiance = Rgb(kVerifyRenderIrradiance);
-  d.lights.directional.push_back(light);
+  // glTF's frame (weave.h): the cloth's normal is +y, the warp +x. The lights as the patch's:
+  // the first on the viewer's side (reflection), the second behind the cloth (transmission).
+  for (const double side : {1.0, -1.0}) {
+    DirectionalLight light;
+    light.to_light = {0, side, 0};
+    light.irradiance = Rgb(kVerifyRenderIrradiance);
+    d.lights.directional.push_back(light);
+  }
   // Towards the viewer: zenith v from the normal, azimuth 180 deg from the warp, as the patch's
   // camera; the film's centre looks at the sample's centre. A film 1 cm away lies outside the
   // cloth (a fraction of a millimetre thick).
@@ -139,9 +141,12 @@ const char* configuration_name(bool transmission) {
 // the render poll 'progress' as `weft render`'s do (a publication render of a large sample takes
 // minutes); nothing when it said stop.
 // 'tables' is shared by the report's renders, so a table two of them read is prepared once.
-std::optional<Image> render_description(const SceneDescription& desc, const VerifySettings& s,
-                                        const ProgressCallback& progress,
-                                        const std::shared_ptr<TableCache>& tables) {
+// With 'light_groups' the images are each light's (RenderResult::light_images), else the one.
+std::optional<std::vector<Image>> render_description(const SceneDescription& desc,
+                                                     const VerifySettings& s,
+                                                     const ProgressCallback& progress,
+                                                     const std::shared_ptr<TableCache>& tables,
+                                                     bool light_groups = false) {
   RenderSceneOptions options;
   options.table_cache = tables;
   options.material_progress = progress;
@@ -150,11 +155,13 @@ std::optional<Image> render_description(const SceneDescription& desc, const Veri
   if (scene.cancelled()) return std::nullopt;
   RenderSettings rs = render_settings_from(desc);
   rs.threads = s.threads;  // not a description's setting; the image does not depend on it
-  const RenderResult r = render(scene, *desc.camera, rs, progress);
+  rs.light_groups = light_groups;
+  RenderResult r = render(scene, *desc.camera, rs, progress);
   if (r.cancelled) return std::nullopt;
   if (r.nonfinite_samples > 0)
     throw Error(desc.source, "render", std::to_string(r.nonfinite_samples) + " non-finite samples");
-  return r.image;
+  if (light_groups) return std::move(r.light_images);
+  return std::vector<Image>{std::move(r.image)};
 }
 
 Rgb mean_of(const Image& image, int x0, int x1, int y0, int y1) {
@@ -180,9 +187,9 @@ std::optional<VerifyRender> render_one(const std::filesystem::path& folder,
   v.stem = "render-" + config + "-" + model;
   SceneDescription desc = verify_render_scene(material, transmission, s, folder);
   desc.source = source;
-  std::optional<Image> image = render_description(desc, s, progress, tables);
-  if (!image) return std::nullopt;
-  v.image = std::move(*image);
+  std::optional<std::vector<Image>> images = render_description(desc, s, progress, tables);
+  if (!images) return std::nullopt;
+  v.image = std::move(images->front());
   // The central half of the film lies inside the patch (the film is the patch's projection).
   const int w = v.image.width, h = v.image.height;
   v.patch_radiance = mean_of(v.image, w / 4, w - w / 4, h / 4, h - h / 4);
@@ -196,45 +203,46 @@ std::optional<VerifyRender> render_one(const std::filesystem::path& folder,
   return v;
 }
 
-// Nothing when 'progress' said stop.
-std::optional<VerifyRender> render_weave(const WovenSample& sample,
-                                         const std::filesystem::path& folder,
-                                         const std::string& fiber_file, const std::string& model,
-                                         const std::string& label, bool transmission, bool spectral,
-                                         const VerifySettings& s, const ProgressCallback& progress,
-                                         const std::shared_ptr<TableCache>& tables) {
+// Reflection and transmission from one pass of the paths (light groups: each image has the bits
+// of a render lit by its light alone); nothing when 'progress' said stop.
+std::optional<std::vector<VerifyRender>> render_weave(
+    const WovenSample& sample, const std::filesystem::path& folder, const std::string& fiber_file,
+    const std::string& model, const std::string& label, bool spectral, const VerifySettings& s,
+    const ProgressCallback& progress, const std::shared_ptr<TableCache>& tables) {
   // Read by cell, as the ray trace reads it: the image's mean is then the ray-traced fabric
   // table's value for this view and light (TableLookup).
   const nlohmann::json material = {{"type", "fiber_table"},
                                    {"params", {{"file", fiber_file}, {"interpolation", "cell"}}}};
-  std::optional<SceneDescription> tiled =
-      verify_weave_scene(sample, material, transmission, s, folder, progress);
+  std::optional<SceneDescription> tiled = verify_weave_scene(sample, material, s, folder, progress);
   if (!tiled) return std::nullopt;
   SceneDescription& desc = *tiled;
   // A spectral fiber table is rendered band by band, as the ray trace traces it: light that
   // scatters many times in a coloured fiber is not the RGB transport of the reduced table.
   (*desc.render)["spectral"] = spectral;
-  VerifyRender v;
-  v.kind = "weave";
-  v.model = model;
-  v.configuration = configuration_name(transmission);
-  v.stem = "render-weave-" + v.configuration + "-" + model;
-  std::optional<Image> image = render_description(desc, s, progress, tables);
-  if (!image) return std::nullopt;
-  v.image = std::move(*image);
-  v.mean = mean_of(v.image, 0, v.image.width, 0, v.image.height);
-  v.patch_radiance = v.mean;
+  std::optional<std::vector<Image>> images = render_description(desc, s, progress, tables, true);
+  if (!images) return std::nullopt;
   const VerifyWeaveFrame f = verify_weave_frame(sample.summary, s.weave_render_size);
-  v.caption = label + " on every fiber of the woven sample, " +
-              (transmission ? "transmission: light from behind the cloth"
-                            : "reflection: light on the viewer's side") +
-              ", at normal incidence; orthographic view at " +
-              std::to_string(static_cast<int>(kVerifyRenderViewZenithDeg)) +
-              " deg from the normal, the film " + std::to_string(f.repeats_z) +
-              " repeats across the warps by " + std::to_string(f.repeats_x) + " along them; " +
-              std::to_string(s.weave_render_spp) + " spp" +
-              (spectral ? ", light transported in 33 bands" : ", light transported in RGB");
-  return v;
+  std::vector<VerifyRender> out;
+  for (const bool transmission : {false, true}) {
+    VerifyRender& v = out.emplace_back();
+    v.kind = "weave";
+    v.model = model;
+    v.configuration = configuration_name(transmission);
+    v.stem = "render-weave-" + v.configuration + "-" + model;
+    v.image = std::move((*images)[transmission ? 1 : 0]);
+    v.mean = mean_of(v.image, 0, v.image.width, 0, v.image.height);
+    v.patch_radiance = v.mean;
+    v.caption = label + " on every fiber of the woven sample, " +
+                (transmission ? "transmission: light from behind the cloth"
+                              : "reflection: light on the viewer's side") +
+                ", at normal incidence; orthographic view at " +
+                std::to_string(static_cast<int>(kVerifyRenderViewZenithDeg)) +
+                " deg from the normal, the film " + std::to_string(f.repeats_z) +
+                " repeats across the warps by " + std::to_string(f.repeats_x) + " along them; " +
+                std::to_string(s.weave_render_spp) + " spp" +
+                (spectral ? ", light transported in 33 bands" : ", light transported in RGB");
+  }
+  return out;
 }
 
 }  // namespace
@@ -291,10 +299,13 @@ std::vector<VerifyRender> render_verify_samples(const std::filesystem::path& fol
       table.kind = "fiber";
       table.write_exr(folder / file);
       const bool spectral = table.channels == kNumBands;
-      for (bool transmission : {false, true})
-        if (!keep(render_weave(*report.sample, folder, file, t.model, t.label, transmission,
-                               spectral, s, progress, tables)))
-          return out;
+      std::optional<std::vector<VerifyRender>> both = render_weave(
+          *report.sample, folder, file, t.model, t.label, spectral, s, progress, tables);
+      if (!both) {
+        if (cancelled) *cancelled = true;
+        return out;
+      }
+      for (VerifyRender& v : *both) out.push_back(std::move(v));
     }
   }
   // The measurement is of reflection only.

@@ -80,13 +80,14 @@ struct VerifyWeaveFrame {
 // weft::Error when the sample has no period or size < 1.
 VerifyWeaveFrame verify_weave_frame(const WeaveSummary& sample, int size);
 // The scene (in memory): the tiled fibers, materials "warp" and "weft" bound to 'material' (its
-// relative paths resolve against 'base_dir'), the light, the camera and the render settings
-// (weave_render_size, weave_render_spp, seed). weft::Error when the sample is not at fiber detail.
+// relative paths resolve against 'base_dir'), two lights (the first on the viewer's side, the
+// second behind the cloth: rendered with light groups, one pass gives the reflection and the
+// transmission images), the camera and the render settings (weave_render_size,
+// weave_render_spp, seed). weft::Error when the sample is not at fiber detail.
 // The fibers' copies poll 'progress' (near the limit of 3e7 points they take seconds each);
 // nothing when it said stop.
 std::optional<SceneDescription> verify_weave_scene(const WovenSample& sample,
                                                    const nlohmann::json& material,
-                                                   bool transmission,
                                                    const VerifySettings& settings,
                                                    const std::filesystem::path& base_dir,
                                                    const ProgressCallback& progress);
