@@ -45,6 +45,7 @@ STYLE = {
 CHANNELS = ["R", "G", "B"]
 TITLE_PAD_PT = 25  # a panel's title above its top edge, past the mirror label
 KINDS = ["normalized", "absolute"]
+DPI = 80  # the PNG files' resolution
 
 
 def read_inputs(src, metrics_path):
@@ -150,7 +151,9 @@ def box(bb, fig):
 
 def incidence_figure(data, models, labels, ti, out_dir):
     """The figure of one incidence, saved as PNG and SVG; returns its layout entry."""
-    fig, axes = plt.subplots(2, 3, figsize=(13, 8), sharex=True, squeeze=False)
+    # At the files' resolution from the start, so that the layout, the PNG and the layout
+    # description share one renderer and its text measurements.
+    fig, axes = plt.subplots(2, 3, figsize=(13, 8), dpi=DPI, sharex=True, squeeze=False)
     panels = [draw_panel(axes[r][c], data, models, ti, kind, ch)
               for r, kind in enumerate(KINDS) for c, ch in enumerate(CHANNELS)]
     axes[0][0].set_ylabel("beta / pi, normalized", fontsize=11)
@@ -168,7 +171,7 @@ def incidence_figure(data, models, labels, ti, out_dir):
     fig.tight_layout(rect=(0, 0.035 + 0.03 * rows, 1, 0.97))  # room for the legend below
     name = f"inplane-{ti:04.1f}deg"
     for ext in ("png", "svg"):
-        fig.savefig(os.path.join(out_dir, f"{name}.{ext}"), dpi=80)
+        fig.savefig(os.path.join(out_dir, f"{name}.{ext}"))
     renderer = fig.canvas.get_renderer()
     legend_bb = legend.get_window_extent(renderer)
     for p, ax in zip(panels, axes.flat):
