@@ -31,6 +31,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.lines  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
 STYLE = {
@@ -77,6 +78,19 @@ def legend_label(data, ti, model, labels):
     factors = [sorted(data.get((ti, model, ch), [(0, 0, 0, 0, math.nan)]))[0][4]
                for ch in CHANNELS]
     return label + ", normalization \u00d7 " + " / ".join(f"{f:.3g}" for f in factors) + " (R / G / B)"
+
+
+class InViewLogLocator(matplotlib.ticker.LogLocator):
+    """matplotlib's LogLocator less the ticks outside the view. It gives a decade or two beyond
+    each end, which matplotlib makes tick objects for, then updates and formats at every
+    measure and draw, and never draws: most of a log axis's ticks. (A log axis's labels do not
+    depend on the other ticks, so they are the same.)"""
+
+    def tick_values(self, vmin, vmax):
+        ticks = super().tick_values(vmin, vmax)
+        lo, hi = min(vmin, vmax), max(vmin, vmax)
+        # A margin wider than matplotlib's own test of which ticks are in view.
+        return ticks[(ticks >= lo * (1 - 1e-6)) & (ticks <= hi * (1 + 1e-6))]
 
 
 def draw_curve(ax, pts, kind, style):
@@ -126,6 +140,8 @@ def draw_panel(ax, data, models, ti, kind, ch):
             masked += draw_curve(ax, pts, kind, dict(STYLE.get(m, {}), label=m))
     if kind == "absolute":
         ax.set_yscale("log", nonpositive="clip")  # error bars below zero run off the axis
+        ax.yaxis.set_major_locator(InViewLogLocator(10))  # the log scale's locators, in view
+        ax.yaxis.set_minor_locator(InViewLogLocator(10, subs=None))
     title = f"{ch} channel, " + ("paper's normalization" if kind == "normalized" else "absolute")
     if masked:
         title += f"\n({masked} points <= 0 or NaN not shown)"
