@@ -164,6 +164,22 @@ def box(bb, fig):
     return [round(v, 4) for v in (f.x0, f.y0, f.x1, f.y1)]
 
 
+def tight_layout(fig, rows, bottom, top):
+    """fig.tight_layout(rect=(0, bottom, 1, top)) for a grid of 'rows' rows, measured once.
+
+    Given a rect, matplotlib measures every panel (its ticks, labels and title) twice at the same
+    place, once for the margins and again for the spacing within the rect, and the second
+    measurement is the first: half the layout's time. Here the rect is applied as matplotlib
+    applies it, to one measurement: the margins moved in by the rect's, the vertical gap between
+    the rows (in figure fractions) kept."""
+    fig.tight_layout()
+    p = fig.subplotpars
+    gap = p.hspace * (p.top - p.bottom) / (rows + p.hspace * (rows - 1))
+    bottom, top = bottom + p.bottom, top - (1 - p.top)
+    panel = (top - bottom - gap * (rows - 1)) / rows
+    fig.subplots_adjust(bottom=bottom, top=top, hspace=gap / panel)
+
+
 def new_figure():
     """A figure's panels without their curves: what every incidence's figure shares."""
     # At the files' resolution from the start, so that the layout, the PNG and the layout
@@ -222,7 +238,7 @@ def incidence_figure(data, models, labels, ti, out_dir):
                         loc="lower center", ncol=2, fontsize=10, frameon=False)
     fig.suptitle(f"light at {ti:g} deg: beta / pi in the plane of incidence", fontsize=13)
     rows = math.ceil(len(keys) / 2)
-    fig.tight_layout(rect=(0, 0.035 + 0.03 * rows, 1, 0.97))  # room for the legend below
+    tight_layout(fig, len(KINDS), bottom=0.035 + 0.03 * rows, top=0.97)  # the legend below
     name = f"inplane-{ti:04.1f}deg"
     for ext in ("png", "svg"):
         fig.savefig(os.path.join(out_dir, f"{name}.{ext}"))
