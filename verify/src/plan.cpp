@@ -180,20 +180,24 @@ namespace {
 // Measured (docs/verify.md "Time"): red-cotton's full bake at the bake's defaults (next-event
 // estimation and 4 surface samples), 8.6 s of CPU for 50 000 photons in each of 33 bands on 2
 // threads (2026-12-06, `weft bake fiber red-cotton --bands spectral`), so 5.2 us per photon; the
-// bundled poplin's fiber-level ray traces at default quality, computed and classic together, 316 s
-// of CPU for 16.4 M particles and 6.6 M photons, so 18 us per particle; the plots and the rest,
-// 9-11 s of CPU (tools/plot_verify.py --jobs 2 on a default run's nine incidences, 2026-12-06)
-// whatever the quality.
+// bundled poplin's fiber-level ray traces at default quality (docs/PERFORMANCE.md "Profile of
+// `weft verify`", 2026-12-06, 2 idle cores): the computed model's 19.3 s wall for 2.05 M
+// particles, so 19 us per particle of CPU, the classic model's 4.4 s for 1.02 M, 9 us; the plots
+// and the rest, 7 s of CPU (tools/plot_verify.py --jobs 2 on a default run's nine incidences,
+// 5.2 s, and the previews) whatever the quality.
 constexpr double kTypicalSecondsPerPhoton = 5.2e-6;
-constexpr double kTypicalSecondsPerParticle = 18e-6;
-constexpr double kTypicalFixedSeconds = 10;
+constexpr double kTypicalSecondsPerParticle = 19e-6;
+constexpr double kTypicalSecondsPerClassicParticle = 9e-6;
+constexpr double kTypicalFixedSeconds = 7;
 // The fiber-level renders (docs/PERFORMANCE.md "Profile of `weft verify`"): the renders stage of
-// `weft verify --quality default --threads 2` took 16.8 s on 2 idle cores, about 33 s of CPU, for
-// the four renders at 16 spp, 4.19 M samples of square films (2026-12-06), so 8 us per sample;
+// `weft verify --quality default --threads 2` took 5.1 s on 2 idle cores, about 10 s of CPU, for
+// the four images at 8 spp, 2.1 M samples of square films (2026-12-06), so 5 us per image sample;
 // counted on a square film of weave_render_size (an upper bound: the film is whole repeats, one
-// side shorter), the patches' renders included.
-constexpr double kTypicalSecondsPerWeaveSample = 8e-6;
-constexpr int kWeaveRenders = 4;  // computed and classic, reflection and transmission
+// side shorter), the patches' renders included. A model's reflection and transmission images are
+// one pass (light groups): two scene builds.
+constexpr double kTypicalSecondsPerWeaveSample = 5e-6;
+constexpr int kWeaveImages = 4;  // computed and classic, reflection and transmission
+constexpr int kWeavePasses = 2;  // computed and classic
 constexpr double kLeastSecondsPerParticle = 1.25e-6;
 // The fit (docs/verify.md "Fitting"): its inner bake (RGB, absorption as a weight, so no roulette)
 // took 0.51 s of CPU for its 165 000 photons (5 000 in each of the 33 bands) on red-cotton near the
@@ -223,7 +227,9 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
   const double bins = 2.0 * s.resolution * s.resolution;
   const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
   // Computed and classic, each its particles per incident bin over all batches.
-  const double run_particles = double(s.particles_per_bin + s.classic_particles_per_bin) * bins;
+  const double computed_particles = double(s.particles_per_bin) * bins,
+               classic_particles = double(s.classic_particles_per_bin) * bins;
+  const double run_particles = computed_particles + classic_particles;
   e.photons = run_photons;
   e.particles = run_particles;
   double fit_seconds = 0, fit_traces = 0;
@@ -248,15 +254,17 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
                   (computed_evals + classic_evals) * kTypicalSecondsPerFitEvaluation;
   }
   const double weave_samples =
-      double(kWeaveRenders) * s.weave_render_size * s.weave_render_size * s.weave_render_spp;
+      double(kWeaveImages) * s.weave_render_size * s.weave_render_size * s.weave_render_spp;
   // The run's (with the fit: twice, the fitted models at the run's quality) and the fit's.
   const double runs = fit ? 2 : 1;
   // The sample's own cost (fabric_scene_seconds): made once, its scene built for every ray trace
   // (computed and classic, each batch) and every fiber-level render, every ray slower in a larger
   // scene.
-  const double run_traces = 2.0 * s.batches + kWeaveRenders;
+  const double run_traces = 2.0 * s.batches + kWeavePasses;
   e.typical = runs * (run_photons * kTypicalSecondsPerPhoton +
-                      run_particles * kTypicalSecondsPerParticle * scene.per_ray_factor) +
+                      (computed_particles * kTypicalSecondsPerParticle +
+                       classic_particles * kTypicalSecondsPerClassicParticle) *
+                          scene.per_ray_factor) +
               fit_seconds + weave_samples * kTypicalSecondsPerWeaveSample * scene.per_ray_factor +
               kTypicalFixedSeconds + scene.make + (runs * run_traces + fit_traces) * scene.build;
   e.least = e.photons * kMinSecondsPerPhoton + e.particles * kLeastSecondsPerParticle;
