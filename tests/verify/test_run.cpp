@@ -34,7 +34,6 @@ SmallRun small_run(double fiber_albedo) {
              {}};
   r.settings.resolution = 2;
   r.settings.particles_per_bin = 200;
-  r.settings.classic_particles_per_bin = 100;
   r.settings.batches = 2;
   r.settings.azimuths = 3;
   r.inputs.fiber = constant_table(2, kNumBands, fiber_albedo);
@@ -102,32 +101,6 @@ TEST(VerifyRun, SameBitsAtAnyThreadCountAndClassicFromTheVolumeAlbedo) {
 // exists for its logs (figures.h floor_for_log), so the paper's factor and figure are not defined
 // (null in metrics.json) while the run and the other model's figures go on. (A channel with light
 // somewhere but an empty normal bin is floored and has its factor.)
-// The classic model's batches trace half the computed model's particles at every quality (its
-// figures' seed error is about half the computed model's at equal particles: docs/verify.md).
-TEST(VerifyRun, EachModelTracesItsOwnParticles) {
-  for (const VerifyQuality q :
-       {VerifyQuality::kDraft, VerifyQuality::kDefault, VerifyQuality::kPublication}) {
-    const VerifySettings s = verify_settings(q);
-    EXPECT_EQ(2 * s.classic_particles_per_bin, s.particles_per_bin) << quality_name(q);
-    int computed = 0, classic = 0;
-    for (const VerifyTrace& t : verify_traces(s)) {
-      const bool is_classic = t.model == "classic";
-      (is_classic ? classic : computed) += 1;
-      EXPECT_EQ(t.options.particles_per_bin,
-                (is_classic ? s.classic_particles_per_bin : s.particles_per_bin) /
-                    static_cast<uint64_t>(s.batches));
-    }
-    EXPECT_EQ(computed, s.batches);
-    EXPECT_EQ(classic, s.batches);
-  }
-  SmallRun run = small_run(0.2);
-  run.settings.classic_particles_per_bin = 1;
-  EXPECT_NE(error_of([&] {
-              run_verify(run.sample, run.inputs, run.measured, run.settings);
-            }).find("classic_particles_per_bin"),
-            std::string::npos);
-}
-
 TEST(VerifyRun, PaperFigureNotDefinedWhereTheModelsNormalBinIsEmpty) {
   SmallRun run = small_run(0.0);
   run.settings.threads = 2;

@@ -226,9 +226,10 @@ VerifyEstimate estimate_verify(const VerifySettings& s, bool bake, bool fit, int
   e.cores = static_cast<unsigned>(thread_count(s.threads));
   const double bins = 2.0 * s.resolution * s.resolution;
   const double run_photons = bake ? double(s.fiber_photons_per_band) * kNumBands : 0.0;
-  // Computed and classic, each its particles per incident bin over all batches.
+  // Computed and classic, each 'particles_per_bin' per incident bin over all batches (a classic
+  // particle costs less: its paths are shorter).
   const double computed_particles = double(s.particles_per_bin) * bins,
-               classic_particles = double(s.classic_particles_per_bin) * bins;
+               classic_particles = computed_particles;
   const double run_particles = computed_particles + classic_particles;
   e.photons = run_photons;
   e.particles = run_particles;

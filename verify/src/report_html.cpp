@@ -211,8 +211,7 @@ void html_settings(std::ostringstream& h, const VerifyReport& r) {
     << "<tr><td>quality</td><td>" << quality_name(s.quality) << "</td></tr>"
     << "<tr><td>table resolution R</td><td>" << s.resolution << "</td></tr>"
     << "<tr><td>fiber photons per band</td><td>" << s.fiber_photons_per_band << "</td></tr>"
-    << "<tr><td>ray-trace particles per incident bin (all batches): computed, classic</td><td>"
-    << s.particles_per_bin << ", " << s.classic_particles_per_bin
+    << "<tr><td>ray-trace particles per incident bin (all batches)</td><td>" << s.particles_per_bin
     << "</td></tr><tr><td>batches</td><td>" << s.batches
     << "</td></tr><tr><td>summation samples per cell pair</td><td>" << s.summation_samples
     << "</td></tr><tr><td>planes of incidence averaged</td><td>" << s.azimuths

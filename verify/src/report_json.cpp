@@ -25,7 +25,6 @@ nlohmann::json settings_json(const VerifySettings& s) {
           {"resolution", s.resolution},
           {"fiber_photons_per_band", s.fiber_photons_per_band},
           {"particles_per_bin", s.particles_per_bin},
-          {"classic_particles_per_bin", s.classic_particles_per_bin},
           {"batches", s.batches},
           {"summation_samples", s.summation_samples},
           {"azimuths", s.azimuths},

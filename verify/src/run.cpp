@@ -34,8 +34,7 @@ struct TracedCurves {
 FabricRaytraceOptions trace_options(const VerifySettings& s, const std::string& model, int k) {
   FabricRaytraceOptions o;
   o.resolution = s.resolution;
-  o.particles_per_bin = (model == "classic" ? s.classic_particles_per_bin : s.particles_per_bin) /
-                        static_cast<uint64_t>(s.batches);
+  o.particles_per_bin = s.particles_per_bin / static_cast<uint64_t>(s.batches);
   o.seed = batch_seed(s.seed, model, k);
   o.threads = s.threads;
   return o;
@@ -171,8 +170,6 @@ NormalPoint check_run(const VerifyInputs& in, const MeasuredInplane& measured,
   if (s.batches < 2) throw Error("", "batches", "the error bars need at least 2 batches");
   if (s.particles_per_bin < static_cast<uint64_t>(s.batches))
     throw Error("", "particles_per_bin", "fewer particles than batches");
-  if (s.classic_particles_per_bin < static_cast<uint64_t>(s.batches))
-    throw Error("", "classic_particles_per_bin", "fewer particles than batches");
   if (in.fiber.resolution != s.resolution)
     throw Error("", "fiber.resolution", "the fiber table's resolution differs from the settings'");
   const std::optional<NormalIndex> normal = normal_index(measured);

@@ -15,18 +15,13 @@ struct VerifySettings {
   int resolution = 8;                   // of the fiber and fabric tables
   uint64_t fiber_photons_per_band = 0;  // the fiber bake
   uint64_t particles_per_bin = 0;       // ray trace, all batches together
-  // The classic model's, half the computed model's: at equal particles its figures' seed error
-  // is about half the computed model's, so the error of the two models' difference (what the
-  // verdicts weigh) barely moves, and its ray trace takes half the time (docs/verify.md, "The
-  // default's particles").
-  uint64_t classic_particles_per_bin = 0;
-  int batches = 4;              // independent ray traces (the error bars)
-  int summation_samples = 8;    // direction pairs per cell pair (summation, classic)
-  int azimuths = 24;            // planes of incidence averaged
-  int render_size = 96;         // the renders of the sample (pixels per side)
-  int render_spp = 4;           // their samples per pixel
-  int weave_render_size = 160;  // the fiber-level renders (pixels on the longer side)
-  int weave_render_spp = 16;    // their samples per pixel
+  int batches = 4;                      // independent ray traces (the error bars)
+  int summation_samples = 8;            // direction pairs per cell pair (summation, classic)
+  int azimuths = 24;                    // planes of incidence averaged
+  int render_size = 96;                 // the renders of the sample (pixels per side)
+  int render_spp = 4;                   // their samples per pixel
+  int weave_render_size = 160;          // the fiber-level renders (pixels on the longer side)
+  int weave_render_spp = 16;            // their samples per pixel
   uint64_t seed = 1;
   int threads = 0;  // 0 = all cores; results do not depend on it
 };
