@@ -28,14 +28,14 @@
 #include "weft/core/error.h"
 #include "weft/core/math.h"
 #include "weft/core/rng.h"
-#include "weft/integrators/fiber_scattering.h"
-#include "weft/integrators/gonio.h"
-#include "weft/integrators/path_tracer.h"
-#include "weft/materials/bsdf_table.h"
 #include "weft/fiber/fiber_bake.h"
 #include "weft/fiber/fiber_physics.h"
 #include "weft/fiber/fiber_spec.h"
 #include "weft/fiber/medium.h"
+#include "weft/integrators/fiber_scattering.h"
+#include "weft/integrators/gonio.h"
+#include "weft/integrators/path_tracer.h"
+#include "weft/materials/bsdf_table.h"
 #include "weft/scenes/description.h"
 #include "weft/scenes/render_scene.h"
 #include "weft/scenes/weave.h"
@@ -386,6 +386,20 @@ TEST(Fibers, LosslessFiberPatchInAWhiteFurnaceRendersOne) {
   }
 }
 
+namespace {
+
+// A small film at 3 samples per pixel.
+RenderSettings small_film(int width, int height, uint64_t seed) {
+  RenderSettings s;
+  s.width = width;
+  s.height = height;
+  s.spp = 3;
+  s.seed = seed;
+  return s;
+}
+
+}  // namespace
+
 TEST(Fibers, FiberScenesAreBitIdenticalAtOneAndTwoThreads) {
   const fs::path table = write_white_table(weft::testing::fresh_test_dir() / "white.exr");
   MaterialBinding tinted = table_binding(table);
@@ -394,11 +408,7 @@ TEST(Fibers, FiberScenesAreBitIdenticalAtOneAndTwoThreads) {
     SCOPED_TRACE(geometry);
     const SceneDescription d = fiber_patch(tinted, geometry, 0.3, true);
     const RenderScene scene(d);
-    RenderSettings s;
-    s.width = 45;
-    s.height = 37;
-    s.spp = 3;
-    s.seed = 5;
+    RenderSettings s = small_film(45, 37, 5);
     s.threads = 1;
     const RenderResult a = render(scene, *d.camera, s);
     s.threads = 2;
@@ -451,11 +461,7 @@ TEST(Fibers, LightGroupsAreEachLightsOwnRenderInOnePass) {
   const DirectionalLight front{both.frame.direction(deg_to_rad(30), 0), Rgb(2.0)};
   const DirectionalLight back{both.frame.direction(deg_to_rad(160), 1), Rgb(1.5, 1.0, 0.5)};
   both.lights.directional = {front, back};
-  RenderSettings s;
-  s.width = 40;
-  s.height = 32;
-  s.spp = 3;
-  s.seed = 9;
+  RenderSettings s = small_film(40, 32, 9);
   s.threads = 2;
   s.light_groups = true;
   const RenderResult grouped = render(RenderScene(both), *both.camera, s);
