@@ -1,13 +1,14 @@
 // weft bench sheen: how much of a cloth's mirror peak fabric tables keep, against the brute-force
 // reference (bench/sheen_bench.h; docs/fabric-bsdf.md, "Sharp sheen: what a table keeps").
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <nlohmann/json.hpp>
 
 #include "cli_util.h"
 #include "commands.h"
-#include "weft/core/params.h"
 #include "weft/bench/sheen_bench.h"
+#include "weft/core/params.h"
 
 namespace weft::cli {
 namespace {
@@ -20,6 +21,12 @@ struct SheenOptions {
 
 nlohmann::json peak_json(const InplanePeak& p) {
   return {{"beta", p.beta}, {"view_deg", p.view_deg}, {"base", p.base}, {"fwhm_deg", p.fwhm_deg}};
+}
+
+// Batch b's file of --reference-out OUT.exr: OUT-<b + 1>.exr.
+std::filesystem::path batch_path(const std::filesystem::path& out, int b) {
+  return out.parent_path() /
+         (out.stem().string() + "-" + std::to_string(b + 1) + out.extension().string());
 }
 
 void print(const SheenRequest& r, const SheenResult& res, bool json) {
@@ -74,7 +81,10 @@ void add_bench_sheen_command(CLI::App& bench, Commands& commands) {
       ->capture_default_str();
   cmd->add_option("--azimuth", o->azimuths, "planes of incidence, degrees (0: the warp's)")
       ->capture_default_str();
-  cmd->add_option("--reference-out", o->reference_out, "write the reference's rows (.exr)");
+  cmd->add_option("--reference-out", o->reference_out,
+                  "write the reference's batches: OUT.exr names OUT-1.exr, OUT-2.exr, ...");
+  cmd->add_option("--reference", r.reference_batches,
+                  "an earlier run's reference batches (.exr, two or more), read, not traced");
   cmd->add_option("--seed", r.seed, "seed of the first batch")->capture_default_str();
   cmd->add_option("--threads", r.threads, "threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--json", o->json, "print JSON");
@@ -82,14 +92,16 @@ void add_bench_sheen_command(CLI::App& bench, Commands& commands) {
                         SheenRequest req = o->request;
                         req.incidences_deg = parse_range(o->incidences, "--incidence", 64);
                         req.azimuths_deg = parse_range(o->azimuths, "--azimuth", 64);
-                        if (!o->reference_out.empty())
-                          TabulatedBsdfTable::check_output_path(o->reference_out,
-                                                                "--reference-out");
                         const SheenPlan plan = plan_sheen(req);
+                        for (int b = 0; b < plan.request.batches && !o->reference_out.empty(); ++b)
+                          TabulatedBsdfTable::check_output_path(batch_path(o->reference_out, b),
+                                                                "--reference-out");
                         const SheenResult res = run_sheen(plan, progress_bar(limits, false));
                         if (res.cancelled) return 130;
-                        if (!o->reference_out.empty()) res.reference.write_exr(o->reference_out);
-                        print(req, res, o->json);
+                        for (size_t b = 0; b < res.batches.size() && !o->reference_out.empty(); ++b)
+                          res.batches[b].write_exr(
+                              batch_path(o->reference_out, static_cast<int>(b)));
+                        print(plan.request, res, o->json);
                         return 0;
                       }});
 }

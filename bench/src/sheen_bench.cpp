@@ -81,6 +81,22 @@ SheenPlan plan_sheen(const SheenRequest& r) {
     p.tables.push_back(TabulatedBsdfTable::read_exr(f));
     if (p.tables.back().kind != "fabric") throw Error(f, "kind", "must be a fabric table");
   }
+  for (const std::string& f : r.reference_batches) {
+    p.reference_batches.push_back(TabulatedBsdfTable::read_exr(f));
+    const TabulatedBsdfTable& b = p.reference_batches.back();
+    if (b.kind != "fabric") throw Error(f, "kind", "must be a fabric table (a reference batch)");
+    if (b.resolution != p.reference_batches[0].resolution || b.channels != p.fiber.channels)
+      throw Error(f, "resolution",
+                  "a reference batch must share the first batch's grid and the fiber's channels");
+  }
+  if (r.reference_batches.size() == 1)
+    throw Error(r.reference_batches[0], "--reference",
+                "needs two or more batches (the peak's uncertainty)");
+  if (!p.reference_batches.empty()) {
+    p.request.resolution = p.reference_batches[0].resolution;
+    p.request.batches = static_cast<int>(p.reference_batches.size());
+    return p;  // nothing to trace
+  }
   p.sample = make_woven_sample(read_weave_options(r.weave));
   const DirectionGrid g{r.resolution};
   std::set<int> rows;
@@ -98,14 +114,14 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
   const SheenRequest& r = p.request;
   SheenResult out;
   const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
-  std::vector<TabulatedBsdfTable> batch_tables;
+  std::vector<TabulatedBsdfTable> batch_tables = p.reference_batches;
   const uint64_t total = static_cast<uint64_t>(r.batches) * p.rows.size();
   uint64_t done = 0;
   // One stage, rows: a row's own stages (scene build, particles) only ask whether to go on.
   const ProgressCallback per_row = [&](const ProgressUpdate&) {
     return progress({"reference rows", done, total});
   };
-  for (int b = 0; b < r.batches; ++b) {
+  for (int b = 0; b < r.batches && p.reference_batches.empty(); ++b) {
     TabulatedBsdfTable sum;
     for (int row : p.rows) {
       FabricRaytraceOptions o;
@@ -133,6 +149,7 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
     for (const auto& t : batch_tables) mean += t.values[k];
     out.reference.values[k] = static_cast<float>(mean / r.batches);
   }
+  out.batches = batch_tables;
   std::vector<TableReader> readers;
   for (const auto& t : p.tables) readers.emplace_back(t, r.threads);
   for (double phi : r.azimuths_deg)

@@ -5,9 +5,9 @@
 #include <cmath>
 
 #include "test_util.h"
+#include "weft/bench/sheen_bench.h"
 #include "weft/core/error.h"
 #include "weft/core/math.h"
-#include "weft/bench/sheen_bench.h"
 
 using namespace weft;
 using namespace weft::testing;
@@ -77,4 +77,53 @@ TEST(Sheen, PlanChecksItsOptionsAndReadsOnlyTheCurvesRows) {
   EXPECT_LE(p.rows.size(), 24u);
   const DirectionGrid g{32};
   for (int row : p.rows) EXPECT_TRUE(g.upper(row));
+}
+
+// An earlier run's reference batches are read, not traced: the reference is their mean and its
+// peak's standard error theirs. Two bumps, one 1.2 times the other: in-plane peaks scale with the
+// table, so the mean's peak is 1.1 times the first's and the error of two is half their
+// difference, 0.1 times the first's peak.
+TEST(Sheen, ReferenceBatchesAreReadNotTraced) {
+  auto bump = [](double scale) {
+    return [scale](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+      double x = 0;
+      if (wo.z > 0 && wi.z > 0) {
+        const double th = std::acos(std::min(1.0, normalize(wo + wi).z));
+        x = scale * (0.05 + 0.5 * std::exp(-th * th / (2 * 0.04)));
+      }
+      v[0] = v[1] = v[2] = x;
+    };
+  };
+  const std::filesystem::path dir = fresh_test_dir();
+  TabulatedBsdfTable a = TabulatedBsdfTable::from_function(8, 3, bump(1.0), 4, 1, 2);
+  TabulatedBsdfTable b = TabulatedBsdfTable::from_function(8, 3, bump(1.2), 4, 1, 2);
+  a.kind = b.kind = "fabric";
+  a.write_exr(dir / "a.exr");
+  b.write_exr(dir / "b.exr");
+  TabulatedBsdfTable fiber = a;
+  fiber.kind = "fiber";
+  fiber.write_exr(dir / "fiber.exr");
+
+  SheenRequest r;
+  r.fiber = (dir / "fiber.exr").string();
+  r.weave = "never-read.json";  // a read reference needs no sample
+  r.incidences_deg = {30};
+  r.azimuths_deg = {0};
+  r.reference_batches = {(dir / "a.exr").string()};
+  EXPECT_NE(error_of([&] { plan_sheen(r); }).find("two or more"), std::string::npos);
+  r.reference_batches = {(dir / "a.exr").string(), (dir / "fiber.exr").string()};
+  EXPECT_NE(error_of([&] { plan_sheen(r); }).find("must be a fabric table"), std::string::npos);
+
+  r.reference_batches = {(dir / "a.exr").string(), (dir / "b.exr").string()};
+  r.tables = {(dir / "a.exr").string()};
+  const SheenPlan p = plan_sheen(r);
+  EXPECT_EQ(p.request.resolution, 8);
+  EXPECT_EQ(p.request.batches, 2);
+  const SheenResult res = run_sheen(p);
+  ASSERT_EQ(res.cases.size(), 1u);
+  ASSERT_EQ(res.batches.size(), 2u);
+  const double first = inplane_peak(a, 30, 0).beta;
+  EXPECT_NEAR(res.cases[0].reference.beta, 1.1 * first, 1e-5 * first);
+  EXPECT_NEAR(res.cases[0].reference_beta_se, 0.1 * first, 1e-5 * first);
+  EXPECT_NEAR(res.cases[0].tables[0].beta, first, 1e-12);
 }

@@ -34,6 +34,9 @@ struct SheenRequest {
   std::vector<double> incidences_deg = {30, 45, 60};
   std::vector<double> azimuths_deg = {0, 90};  // planes of incidence (0: the warp's)
   std::vector<std::string> tables;             // fabric tables to measure against it
+  // The reference's batches from an earlier run (SheenResult::batches, written by weft bench sheen
+  // --reference-out): read instead of traced, two or more of one grid.
+  std::vector<std::string> reference_batches;
   int threads = 0;
 };
 
@@ -42,6 +45,7 @@ struct SheenPlan {
   TabulatedBsdfTable fiber;
   WovenSample sample;
   std::vector<TabulatedBsdfTable> tables;
+  std::vector<TabulatedBsdfTable> reference_batches;  // read, when the request names them
   std::vector<int> rows;  // the reference's light bins: the in-plane curves' footprints
 };
 // Reads and checks everything before any work: weft::Error naming the option.
@@ -55,7 +59,8 @@ struct SheenCase {
 };
 struct SheenResult {
   std::vector<SheenCase> cases;
-  TabulatedBsdfTable reference;  // the batches' mean (only the plan's rows traced)
+  TabulatedBsdfTable reference;             // the batches' mean (only the plan's rows traced)
+  std::vector<TabulatedBsdfTable> batches;  // each batch's rows
   double cpu_seconds = 0;
   bool cancelled = false;
 };
