@@ -114,6 +114,12 @@ void check_json_depth(std::string_view text, const std::string& file) {
   }
 }
 
+std::string exact_number(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", x);
+  return buf;
+}
+
 std::optional<double> finite_number(const std::string& text) {
   size_t used = 0;
   double v = 0;

@@ -758,6 +758,12 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   std::optional<HalfVectorLobe> sheen;
   if (o.sheen_h_resolution > 0) {
     sheen = HalfVectorLobe::zeros(o.resolution, o.sheen_h_resolution, o.sheen_window, nc);
+    // Values over the fibers' Fresnel reflectance (at their channels' mean index), which varies
+    // faster across the grazing light bins than the rest of the sheen.
+    const std::vector<double>& ior = fiber.surface_lobe->ior;
+    double mean_ior = 0;
+    for (double n : ior) mean_ior += n / static_cast<double>(ior.size());
+    sheen->fresnel_ior = mean_ior;
     t.sheen = &*sheen;
     t.sheen_first_cell = static_cast<uint64_t>(bins) * bins;
   }

@@ -174,8 +174,9 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
       return exr_io::string_attributes(h, [is](const std::string& n) { return !is(n); });
     };
     if (version >= 5)
-      table.sheen = HalfVectorLobe::from_attributes(attributes_of(HalfVectorLobe::is_attribute),
-                                                    table.resolution, table.channels, file);
+      table.sheen =
+          HalfVectorLobe::from_attributes(attributes_of(HalfVectorLobe::is_attribute),
+                                          table.resolution, table.channels, file, version >= 6);
     check_pixel_size(h, path, file, table, bands);
     const std::vector<std::string> names = table.channel_names();
     exr_io::check_channels(h, file, names, bands);

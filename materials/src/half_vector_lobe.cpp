@@ -6,12 +6,14 @@
 #include "weft/core/error.h"
 #include "weft/core/parallel.h"
 #include "weft/core/params.h"
+#include "weft/materials/fresnel.h"
 
 namespace weft {
 namespace {
 
 constexpr const char* kHResolution = "sheen_h_resolution";
 constexpr const char* kWindow = "sheen_window";
+constexpr const char* kFresnelIor = "sheen_fresnel_ior";
 constexpr const char* kWindowKind = "half-vector window";
 // The quadrature of cell_averages: wi directions per light bin side, half vectors per window bin
 // side.
@@ -20,6 +22,14 @@ constexpr int kQuadWiSide = 16, kQuadHSide = 3;
 // The first row and column of the window in the upper square of DirectionGrid{h_resolution}.
 int window_origin(const HalfVectorLobe& l) {
   return (l.h_resolution - l.window) / 2;
+}
+
+// The Fresnel index: 0 (none) or in (1, kMaxFresnelIor].
+void check_fresnel_ior(double ior, const std::string& file) {
+  if (!(ior == 0 || (ior > 1 && ior <= HalfVectorLobe::kMaxFresnelIor)))
+    throw Error(file, kFresnelIor,
+                "must be 0 (none) or in (1, " + ParamReader::fmt(HalfVectorLobe::kMaxFresnelIor) +
+                    "], got " + ParamReader::fmt(ior));
 }
 
 }  // namespace
@@ -54,6 +64,10 @@ Vec3 HalfVectorLobe::window_point(int k, double fx, double fy) const {
   return DirectionGrid::to_direction(DirectionGrid{h_resolution}.chart_point(bin, fx, fy));
 }
 
+double HalfVectorLobe::value_scale(double wi_dot_h) const {
+  return fresnel_ior > 0 ? fresnel_dielectric(std::abs(wi_dot_h), 1.0, fresnel_ior) : 1.0;
+}
+
 void HalfVectorLobe::eval(const Vec3& wo, const Vec3& wi, std::span<double> out) const {
   std::fill(out.begin(), out.end(), 0.0);
   if (!(wi.z * wo.z > 0)) return;  // reflection only, neither direction on the horizon
@@ -64,7 +78,7 @@ void HalfVectorLobe::eval(const Vec3& wo, const Vec3& wi, std::span<double> out)
   if (k < 0) return;
   const DirectionGrid::Footprint fp =
       DirectionGrid{resolution}.bilinear(DirectionGrid::to_chart(wi));
-  const double scale = 1.0 / (4 * std::abs(wi.z) * std::abs(wo.z));
+  const double scale = value_scale(dot(wi, sum) / len) / (4 * std::abs(wi.z) * std::abs(wo.z));
   for (int j = 0; j < 4; ++j) {
     if (fp.weight[j] == 0) continue;
     for (int c = 0; c < channels; ++c)
@@ -115,7 +129,7 @@ std::vector<double> HalfVectorLobe::mean_projections(int threads) const {
       double wi_h = 0;
       for (size_t m = 0; m < hs.size(); ++m)
         if (reflect_about(wi, hs[m], wo, wi_h))
-          out[task * nk + m / (kQuadHSide * kQuadHSide)] += wi_h / n;
+          out[task * nk + m / (kQuadHSide * kQuadHSide)] += wi_h * value_scale(wi_h) / n;
     }
   });
   return out;
@@ -149,7 +163,8 @@ std::vector<double> HalfVectorLobe::cell_averages(int threads) const {
         if (!reflect_about(wi, hs[m], wo, wi_h)) continue;
         const size_t o = static_cast<size_t>(grid.bin_of(wo));
         const size_t k = m / (kQuadHSide * kQuadHSide);
-        for (size_t c = 0; c < nc; ++c) row[o * nc + c] += q[k * nc + c] * wi_h;
+        const double weight = wi_h * value_scale(wi_h);
+        for (size_t c = 0; c < nc; ++c) row[o * nc + c] += q[k * nc + c] * weight;
       }
     }
     for (size_t o = 0; o < bins; ++o)
@@ -161,18 +176,20 @@ std::vector<double> HalfVectorLobe::cell_averages(int threads) const {
 }
 
 bool HalfVectorLobe::is_attribute(const std::string& name) {
-  return name == kKindAttribute || name == kHResolution || name == kWindow;
+  return name == kKindAttribute || name == kHResolution || name == kWindow || name == kFresnelIor;
 }
 
 std::map<std::string, std::string> HalfVectorLobe::attributes() const {
-  return {{kKindAttribute, kWindowKind},
-          {kHResolution, std::to_string(h_resolution)},
-          {kWindow, std::to_string(window)}};
+  std::map<std::string, std::string> a{{kKindAttribute, kWindowKind},
+                                       {kHResolution, std::to_string(h_resolution)},
+                                       {kWindow, std::to_string(window)}};
+  if (fresnel_ior > 0) a[kFresnelIor] = exact_number(fresnel_ior);
+  return a;
 }
 
 std::optional<HalfVectorLobe> HalfVectorLobe::from_attributes(
     const std::map<std::string, std::string>& a, int resolution, int channels,
-    const std::string& file) {
+    const std::string& file, bool fresnel_known) {
   const auto kind = a.find(kKindAttribute);
   if (kind == a.end()) {
     for (const auto& [key, value] : a)
@@ -195,6 +212,13 @@ std::optional<HalfVectorLobe> HalfVectorLobe::from_attributes(
   l.h_resolution = integer(kHResolution);
   l.window = integer(kWindow);
   check_shape(l.h_resolution, l.window, file, kHResolution, kWindow);
+  const auto ior = a.find(kFresnelIor);
+  if (fresnel_known && ior != a.end()) {
+    const auto n = finite_number(ior->second);
+    if (!n) throw Error(file, kFresnelIor, "is not a number: \"" + ior->second + "\"");
+    l.fresnel_ior = *n;
+    check_fresnel_ior(l.fresnel_ior, file);
+  }
   return l;
 }
 
@@ -213,6 +237,7 @@ void HalfVectorLobe::check_shape(int h_resolution, int window, const std::string
 void HalfVectorLobe::validate(int table_resolution, int table_channels,
                               const std::string& file) const {
   check_shape(h_resolution, window, file, kHResolution, kWindow);
+  check_fresnel_ior(fresnel_ior, file);
   if (resolution != table_resolution || channels != table_channels)
     throw Error(file, kKindAttribute, "does not match the table's resolution and channels");
   const size_t expected = static_cast<size_t>(DirectionGrid{resolution}.bins()) * window_bins() *

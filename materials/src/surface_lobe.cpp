@@ -18,12 +18,6 @@ constexpr const char* kCookTorrance = "cook-torrance";
 // The quadrature of cell_averages: wi directions per bin side, lobe draws per lattice side.
 constexpr int kWiSide = 16, kWoSide = 24;
 
-std::string exact(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", x);
-  return buf;
-}
-
 CookTorranceBsdf lobe_of(const SurfaceLobe& l, int channel) {
   return CookTorranceBsdf{l.distribution, l.ior[static_cast<size_t>(channel)], Rgb(1.0)};
 }
@@ -122,10 +116,10 @@ bool SurfaceLobe::is_attribute(const std::string& name) {
 
 std::map<std::string, std::string> SurfaceLobe::attributes() const {
   std::string list;
-  for (size_t c = 0; c < ior.size(); ++c) list += (c ? "," : "") + exact(ior[c]);
+  for (size_t c = 0; c < ior.size(); ++c) list += (c ? "," : "") + exact_number(ior[c]);
   return {{kKindAttribute, kCookTorrance},
           {kDistribution, microfacet_model_name(distribution.model)},
-          {kAlpha, exact(distribution.alpha)},
+          {kAlpha, exact_number(distribution.alpha)},
           {kIor, list}};
 }
 
@@ -175,13 +169,14 @@ std::optional<SurfaceLobe> SurfaceLobe::from_attributes(const std::map<std::stri
 
 void SurfaceLobe::validate(int channels, const std::string& file) const {
   if (!(distribution.alpha >= 1e-3 && distribution.alpha <= 2))
-    throw Error(file, kAlpha, "must lie in [0.001, 2], got " + exact(distribution.alpha));
+    throw Error(file, kAlpha, "must lie in [0.001, 2], got " + exact_number(distribution.alpha));
   if (static_cast<int>(ior.size()) != channels)
     throw Error(
         file, kIor,
         "holds " + std::to_string(ior.size()) + " indices, expected " + std::to_string(channels));
   for (double n : ior)
-    if (!(n >= 1 && n <= 4)) throw Error(file, kIor, "index " + exact(n) + " is outside [1, 4]");
+    if (!(n >= 1 && n <= 4))
+      throw Error(file, kIor, "index " + exact_number(n) + " is outside [1, 4]");
 }
 
 }  // namespace weft

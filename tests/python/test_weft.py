@@ -68,8 +68,11 @@ def test_a_fabric_table_keeps_its_sheen_through_a_file(tmp_path):
                             resolution=2)
     fabric = weft.bake_fabric(fiber, "raytrace", detail="fiber", sheen_resolution=16,
                               sheen_window=4, resolution=2, samples=20)
+    # Held over the fibers' Fresnel reflectance at their surface lobe's index (format 6).
+    ior = float(fiber.surface_lobe["surface_lobe_ior"].split(",")[0])
     assert fabric.sheen == {"sheen": "half-vector window", "sheen_h_resolution": "16",
-                            "sheen_window": "4"}
+                            "sheen_window": "4", "sheen_fresnel_ior": fabric.sheen["sheen_fresnel_ior"]}
+    assert abs(float(fabric.sheen["sheen_fresnel_ior"]) - ior) < 1e-12
     fabric.save(tmp_path / "sheen.exr")
     back = weft.load_table(tmp_path / "sheen.exr")
     assert back.sheen == fabric.sheen and back.checksum == fabric.checksum

@@ -38,6 +38,9 @@ nlohmann::json parse_json(std::string_view text, const std::string& file);
 // The one strict parser of a number in text (options, CSV cells, weight files): the finite number
 // that is the whole of 'text', or nothing ("1.5x", "nan", "inf", "").
 std::optional<double> finite_number(const std::string& text);
+// The shortest-safe text of x that finite_number reads back to the same bits ("%.17g"), for
+// numbers kept in files' headers.
+std::string exact_number(double x);
 
 // Parses "a:b:step" (inclusive) or a single value or "a,b,c" into a list of numbers; at most
 // max_count of them (a range's count is checked before the list is built), no empty items.

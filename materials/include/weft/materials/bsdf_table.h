@@ -17,7 +17,7 @@
 // File: one scanline OpenEXR image, height 2 R^2 (row = wi bin), width 2 R^2 (column = wo bin),
 // FLOAT channels R,G,B or w390..w710 (one per 10 nm band), ZIP compression (lossless, so round
 // trips are bit-exact). Header attributes:
-//   weft_format_version (int) = 4, parameterization (string) = kParameterization,
+//   weft_format_version (int) = kFormatVersion, parameterization (string) = kParameterization,
 //   cell_average (string) = "cosine-weighted" (the stored quantity; readers reject any other),
 //   resolution (int) = R, bands (string) = "rgb" | "390:710:10", units (string) = "1/sr",
 //   kind (string) = "fiber" | "fabric", values_fnv1a64 (string, 16 hex digits) = checksum() of the
@@ -29,7 +29,8 @@
 //   "surface_lobe_ior"). Since version 5, optionally a fabric table's sheen in half-vector space
 //   (half_vector_lobe.h: "sheen", "sheen_h_resolution", "sheen_window"): the image is then wider,
 //   each row's columns past the 2 R^2 cells holding that light bin's W x W window bins, and
-//   values_fnv1a64 covers every pixel. Version 3 and 4 files still load.
+//   values_fnv1a64 covers every pixel. Since version 6, optionally "sheen_fresnel_ior". Version 3
+//   to 5 files still load.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -72,8 +73,9 @@ struct TabulatedBsdfTable {
   // straddled the horizon; they are refused with a request to re-bake). Since version 2 the
   // stored quantity is stated (cell_average). 4: an optional analytic surface lobe beside the
   // cells (surface_lobe); version 3 tables have none and still load. 5: an optional sheen in
-  // half-vector space beside the cells (sheen).
-  static constexpr int kFormatVersion = 5;
+  // half-vector space beside the cells (sheen). 6: the sheen may hold its values over the fibers'
+  // Fresnel reflectance (HalfVectorLobe::fresnel_ior); version 5 sheens have none.
+  static constexpr int kFormatVersion = 6;
   static constexpr int kOldestReadableVersion = 3;
   static constexpr const char* kCellAverage = "cosine-weighted";
   static constexpr const char* kParameterization =

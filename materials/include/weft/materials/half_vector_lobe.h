@@ -17,11 +17,16 @@
 // What is stored: Q[light bin][window bin][channel] with f(wi, wo) = Q(wi, h) / (4 |cos_i| |cos_o|)
 // for wi, wo on the same side (zero otherwise): the microfacet form F D G, so that the value varies
 // slowly with wi; Q(wi, h) is bilinear over the light bins (DirectionGrid::bilinear) and constant
-// over a window bin (no second blur). A booking of Q (the fabric ray trace) divides the light of
-// each (light bin, window bin) by the mean (wi . h) over them (mean_projections), so that the
-// cell averages carry the light booked there. The cells of the table include the lobe (like a
-// surface lobe, surface_lobe.h): a reader that ignores it reads the whole f as before, one that
-// uses it takes the cells less cell_averages(), interpolated, plus eval().
+// over a window bin (no second blur). With a Fresnel index (fresnel_ior > 0, since table format
+// 6) the values are Q / F(wi . h), F the fibers' surface reflectance at that index, and eval
+// multiplies F back: the fibers' Fresnel rises about fourfold from a 55 to a 75 degree light, so Q
+// itself is not slow across the grazing light bins (18 degrees at R 8), and blending it there put
+// a 60 degree light's mirror peak 1.4 times too high (docs/fabric-bsdf.md, "Sharp sheen"). A
+// booking of Q (the fabric ray trace) divides the light of each (light bin, window bin) by the mean
+// (wi . h) over them (mean_projections), so that the cell averages carry the light booked there.
+// The cells of the table include the lobe (like a surface lobe, surface_lobe.h): a reader that
+// ignores it reads the whole f as before, one that uses it takes the cells less cell_averages(),
+// interpolated, plus eval().
 #include <map>
 #include <optional>
 #include <span>
@@ -38,7 +43,10 @@ struct HalfVectorLobe {
   int h_resolution = 0;  // R_h of the half vectors' DirectionGrid (even)
   int window = 0;        // W: bins per side of the window about the pole (even, <= R_h)
   int channels = 3;
-  std::vector<float> values;  // [light bin][window bin][channel]: Q
+  double fresnel_ior = 0;     // > 1: values hold Q / F(wi . h) at this index; 0: Q
+  std::vector<float> values;  // [light bin][window bin][channel]: Q, or Q / F
+
+  static constexpr double kMaxFresnelIor = 4;
 
   static constexpr int kMaxHResolution = 256;
 
@@ -66,26 +74,34 @@ struct HalfVectorLobe {
   // vectors), the same bits at any thread count.
   std::vector<double> cell_averages(int threads = 0) const;
 
+  // The factor eval multiplies the values by at wi . h: F(wi . h) with a Fresnel index, else 1.
+  double value_scale(double wi_dot_h) const;
+
   // What a booking of the lobe's light needs (the fabric ray trace): per light bin a and window
-  // bin k the mean of (wi . h) over wi in a and h in k where wo = reflect(wi, h) lies on wi's side,
-  // zero elsewhere, by the quadrature of cell_averages; [light bin][window bin]. A particle from
+  // bin k the mean of (wi . h) value_scale(wi . h) over wi in a and h in k where wo = reflect(wi,
+  // h) lies on wi's side, zero elsewhere, by the quadrature of cell_averages; [light bin][window
+  // bin]. A particle from
   // a that leaves with weight w and half vector in k estimates the cell's light, so Q =
   // (sum of w) / (particles x solid angle of k x this mean) gives the cell's cell averages that
   // light exactly (with Q constant over the light bin).
   std::vector<double> mean_projections(int threads = 0) const;
 
   // Header attributes of a table file: "sheen" = "half-vector window", "sheen_h_resolution",
-  // "sheen_window"; the values are the image's columns past the cells (bsdf_table.h).
+  // "sheen_window", and with a Fresnel index "sheen_fresnel_ior" (format 6 on); the values are the
+  // image's columns past the cells (bsdf_table.h).
   static constexpr const char* kKindAttribute = "sheen";
   static bool is_attribute(const std::string& name);
   std::map<std::string, std::string> attributes() const;
   // The shape from the header (values empty, to be read), nothing when it names no sheen;
-  // weft::Error naming the file and attribute when malformed.
+  // weft::Error naming the file and attribute when malformed. 'fresnel_known': the file's format
+  // has the Fresnel index (6 on; before, such an attribute is another program's and is ignored).
   static std::optional<HalfVectorLobe> from_attributes(const std::map<std::string, std::string>& a,
                                                        int resolution, int channels,
-                                                       const std::string& file);
+                                                       const std::string& file,
+                                                       bool fresnel_known = true);
   // Throws weft::Error(file, "sheen...", ...) unless the shape is valid for a table of
-  // 'resolution' and 'channels' and every value is finite and >= 0.
+  // 'resolution' and 'channels', the Fresnel index is 0 or in (1, kMaxFresnelIor], and every value
+  // is finite and >= 0.
   void validate(int resolution, int channels, const std::string& file) const;
   // Throws weft::Error(file, h_field or window_field, ...) unless R_h is even in
   // [2, kMaxHResolution] and the window even in [2, R_h].
