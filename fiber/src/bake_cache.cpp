@@ -13,6 +13,7 @@
 
 #include "weft/core/error.h"
 #include "weft/core/hash.h"
+#include "weft/core/params.h"
 
 namespace weft {
 
@@ -52,11 +53,7 @@ std::string volume_albedo_metadata(const FiberTableBakeResult& r) {
   for (const auto& b : r.bands)
     if (b.band >= 0 && b.band < kNumBands) s[b.band] = b.walk_exit_fraction() - b.surface_fraction;
   std::string out;
-  char buf[40];
-  for (double v : s) {
-    std::snprintf(buf, sizeof buf, "%s%.17g", out.empty() ? "" : ",", v);
-    out += buf;
-  }
+  for (double v : s) out += (out.empty() ? "" : ",") + exact_number(v);
   return out;
 }
 

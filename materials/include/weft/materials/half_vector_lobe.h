@@ -20,8 +20,9 @@
 // over a window bin (no second blur). With a Fresnel index (fresnel_ior > 0, since table format
 // 6) the values are Q / F(wi . h), F the fibers' surface reflectance at that index, and eval
 // multiplies F back: the fibers' Fresnel rises about fourfold from a 55 to a 75 degree light, so Q
-// itself is not slow across the grazing light bins (18 degrees at R 8), and blending it there put
-// a 60 degree light's mirror peak 1.4 times too high (docs/fabric-bsdf.md, "Sharp sheen"). A
+// itself is not slow across the grazing light bins (18 degrees at R 8): on a sheen that is Fresnel
+// alone, blending it put a 60 degree light's mirror f 87 % too high (docs/fabric-bsdf.md, "Sharp
+// sheen"). A
 // booking of Q (the fabric ray trace) divides the light of each (light bin, window bin) by the mean
 // (wi . h) over them (mean_projections), so that the cell averages carry the light booked there.
 // The cells of the table include the lobe (like a surface lobe, surface_lobe.h): a reader that
@@ -80,10 +81,9 @@ struct HalfVectorLobe {
   // What a booking of the lobe's light needs (the fabric ray trace): per light bin a and window
   // bin k the mean of (wi . h) value_scale(wi . h) over wi in a and h in k where wo = reflect(wi,
   // h) lies on wi's side, zero elsewhere, by the quadrature of cell_averages; [light bin][window
-  // bin]. A particle from
-  // a that leaves with weight w and half vector in k estimates the cell's light, so Q =
-  // (sum of w) / (particles x solid angle of k x this mean) gives the cell's cell averages that
-  // light exactly (with Q constant over the light bin).
+  // bin]. A particle from a that leaves with weight w and half vector in k estimates the cell's
+  // light, so the value (sum of w) / (particles x solid angle of k x this mean) gives the cell's
+  // cell averages that light exactly (with the value constant over the light bin).
   std::vector<double> mean_projections(int threads = 0) const;
 
   // Header attributes of a table file: "sheen" = "half-vector window", "sheen_h_resolution",
