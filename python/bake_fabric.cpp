@@ -95,8 +95,9 @@ void bind_bake_fabric(py::module_& m) {
          std::optional<std::string> straight_through, std::optional<double> split_threshold,
          std::optional<int> max_scatterings, std::optional<std::filesystem::path> weave_out,
          std::optional<Positions> weave_positions, std::optional<int> weave_resolution,
-         std::optional<int> sheen_resolution, std::optional<int> sheen_window, uint64_t seed,
-         int threads, bool yes_long, bool progress) {
+         std::optional<int> sheen_resolution, std::optional<int> sheen_window,
+         std::optional<int> sheen_light_resolution, std::optional<std::string> sheen_light,
+         uint64_t seed, int threads, bool yes_long, bool progress) {
         FabricBakeRequest r;
         r.method = method;
         r.warp_fiber = warp_fiber.value_or(""), r.weft_fiber = weft_fiber.value_or("");
@@ -123,6 +124,8 @@ void bind_bake_fabric(py::module_& m) {
               *weave_positions);
         r.weave_resolution = weave_resolution;
         r.sheen_resolution = sheen_resolution, r.sheen_window = sheen_window;
+        r.sheen_light_resolution = sheen_light_resolution;
+        r.sheen_light = std::move(sheen_light);
         r.seed = seed, r.threads = threads;
         r.front_end = "python";
         r.limits = call_limits(yes_long);
@@ -139,8 +142,9 @@ void bind_bake_fabric(py::module_& m) {
       py::arg("split_threshold") = py::none(), py::arg("max_scatterings") = py::none(),
       py::arg("weave_out") = py::none(), py::arg("weave_positions") = py::none(),
       py::arg("weave_resolution") = py::none(), py::arg("sheen_resolution") = py::none(),
-      py::arg("sheen_window") = py::none(), py::arg("seed") = d.seed,
-      py::arg("threads") = d.threads, py::arg("yes_long") = false, py::arg("progress") = false,
+      py::arg("sheen_window") = py::none(), py::arg("sheen_light_resolution") = py::none(),
+      py::arg("sheen_light") = py::none(), py::arg("seed") = d.seed, py::arg("threads") = d.threads,
+      py::arg("yes_long") = false, py::arg("progress") = false,
       "A fabric table, as `weft bake fabric` makes it (its options are the keyword arguments, with "
       "its defaults): from a fiber (a Table, a .exr file, or a spec baked in RGB at the bake's "
       "defaults; warp_fiber, weft_fiber and thread_colours' dyes are baked into ./.weft-cache as "

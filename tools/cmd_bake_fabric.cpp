@@ -116,6 +116,15 @@ void add_raytrace_options(CLI::App* sub, FabricBakeRequest& o) {
                   "raytrace, with --sheen-resolution: bins per side of the half vectors' window "
                   "about the normal (default " +
                       std::to_string(FabricRaytraceOptions{}.sheen_window) + ")");
+  sub->add_option("--sheen-light-resolution", o.sheen_light_resolution,
+                  "raytrace, with --sheen-resolution: the sheen's light bins, 2 or 4 times -R "
+                  "(nested in the table's; each table bin's particles launched from them in "
+                  "turn), so that a peak that moves with the light is not blurred across a light "
+                  "bin; default: the table's");
+  sub->add_option("--sheen-light", o.sheen_light,
+                  "raytrace, with --sheen-resolution: first-surface (the first fiber's surface "
+                  "reflection; the default) | reflected (every reflected exit whose half vector "
+                  "lies in the window: a finer grid about the mirror)");
   sub->add_option("--split-threshold", o.split_threshold,
                   "raytrace, hero: split a particle whose largest channel weight exceeds this "
                   "(default " +

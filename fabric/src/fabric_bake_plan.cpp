@@ -159,6 +159,11 @@ FabricRaytraceOptions raytrace_options(const FabricBakeRequest& o) {
   if (o.max_scatterings) r.max_scatterings = *o.max_scatterings;
   if (o.sheen_window && !o.sheen_resolution)
     throw Error("", "--sheen-window", "sizes the sheen's window: give --sheen-resolution too");
+  if (o.sheen_light_resolution && !o.sheen_resolution)
+    throw Error("", "--sheen-light-resolution",
+                "sizes the sheen's light bins: give --sheen-resolution too");
+  if (o.sheen_light && !o.sheen_resolution)
+    throw Error("", "--sheen-light", "chooses the sheen's light: give --sheen-resolution too");
   if (o.sheen_resolution) {
     if (!o.shard.empty() || o.resume)
       throw Error("", "--sheen-resolution",
@@ -167,6 +172,13 @@ FabricRaytraceOptions raytrace_options(const FabricBakeRequest& o) {
     if (o.sheen_window) r.sheen_window = *o.sheen_window;
     HalfVectorLobe::check_shape(r.sheen_h_resolution, r.sheen_window, "", "--sheen-resolution",
                                 "--sheen-window");
+    if (o.sheen_light)
+      r.sheen_light = value_of(kSheenLightNames, *o.sheen_light, "", "--sheen-light");
+    if (o.sheen_light_resolution) {
+      r.sheen_light_resolution = *o.sheen_light_resolution;
+      HalfVectorLobe::check_light_resolution(r.resolution, r.sheen_light_resolution, "",
+                                             "--sheen-light-resolution");
+    }
   }
   weave_tally_options(o, r);
   r.validate();

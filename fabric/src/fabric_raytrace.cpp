@@ -62,6 +62,16 @@ struct Tracer {
   uint64_t sheen_first_cell = 0;
 };
 
+// Where particle idx of its bin is launched: its sub-square of the bin when the sheen's light bins
+// are finer (HalfVectorLobe::light_factor), taken in turn by particle or by launch block, so that
+// each finer bin has its known share of the particles (sheen_particles); 0 otherwise.
+int launch_stratum(const Tracer& t, uint64_t idx) {
+  const int m = t.sheen ? t.sheen->light_factor() : 1;
+  if (m == 1) return 0;
+  const uint64_t unit = idx / static_cast<uint64_t>(t.o.launch_lattice);
+  return static_cast<int>(unit % static_cast<uint64_t>(m * m));
+}
+
 // A step of the particle's life into its task's record, when recording.
 void record_op(const Tracer& t, Tally& tally, PathOp op) {
   if (t.record) tally.path_ops.push_back(op);
@@ -80,6 +90,7 @@ YarnShading shading_at(const Tracer& t, const SurfaceHit& h) {
 // its copies' follow, and how many copies its splits made.
 struct Life {
   int bin = 0;
+  int light_bin = 0;  // of the sheen's light grid, when booked apart (HalfVectorLobe::slot)
   Strategies st;
   Tally* tally = nullptr;
   FabricBinBooks* books = nullptr;
@@ -96,27 +107,33 @@ struct TaskScratch {
   Particle probe;  // a next-event draw's particle (its vectors reused)
 };
 
+// What book_sheen left for the cells.
+enum class CellsBook { whole, rest, none };
+
 // The sheen's part of an exit along d with weights w whose shares sheen_share were reflected off
-// the first fiber's surface (Particle::sheen): booked into the window bin of its half vector, the
-// rest into 'rest'. False when the exit leaves none there ('rest' then unset).
-bool book_sheen(const Tracer& t, Life& life, const Vec3& d, std::span<const double> w,
-                std::span<const double> sheen_share, std::span<double> rest) {
-  if (!t.sheen || sheen_share.empty()) return false;
+// the first fiber's surface (Particle::sheen), or all of it (SheenLight::reflected): booked into
+// the window bin of its half vector, the rest into 'rest'. Says what the cells take: the whole
+// exit (none booked here; 'rest' unset), 'rest', or nothing.
+CellsBook book_sheen(const Tracer& t, Life& life, const Vec3& d, std::span<const double> w,
+                     std::span<const double> sheen_share, std::span<double> rest) {
+  const bool all = t.o.sheen_light == SheenLight::reflected;
+  if (!t.sheen || (!all && sheen_share.empty())) return CellsBook::whole;
   const Vec3 wo = world_to_cloth(d), sum = life.wi + wo;
-  if (!(wo.z * life.wi.z > 0) || !(length(sum) > 0)) return false;
+  if (!(wo.z * life.wi.z > 0) || !(length(sum) > 0)) return CellsBook::whole;
   const Vec3 h = sum / length(sum);
   const int k = t.sheen->window_bin_of(h);
-  if (k < 0) return false;
+  if (k < 0) return CellsBook::whole;
   std::array<double, kNumBands> part;  // the first w.size() are written and read
   for (size_t c = 0; c < w.size(); ++c) {
-    part[c] = w[c] * sheen_share[c];
-    rest[c] = w[c] * (1 - sheen_share[c]);
+    part[c] = all ? w[c] : w[c] * sheen_share[c];
+    rest[c] = w[c] - part[c];
   }
-  const uint64_t cell = t.sheen_first_cell +
-                        static_cast<uint64_t>(life.bin) * t.sheen->window_bins() +
-                        static_cast<uint64_t>(k);
+  const uint64_t cell =
+      t.sheen_first_cell +
+      t.sheen->slot(life.light_bin) * static_cast<uint64_t>(t.sheen->window_bins()) +
+      static_cast<uint64_t>(k);
   tally_exit(*life.tally, life.first_exit, cell, std::span<const double>(part.data(), w.size()));
-  return true;
+  return all ? CellsBook::none : CellsBook::rest;
 }
 
 // An exit along d whose line passes through p, with weights w: into the table's tally (its
@@ -127,8 +144,10 @@ void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d, std::s
   record_op(t, *life.tally, {0, static_cast<int64_t>(cell), 0, PathOp::book});
   std::array<double, kNumBands> rest;  // written by book_sheen before any read
   const std::span<double> r(rest.data(), w.size());
-  tally_exit(*life.tally, life.first_exit, cell,
-             book_sheen(t, life, d, w, sheen_share, r) ? std::span<const double>(r) : w);
+  const CellsBook cells = book_sheen(t, life, d, w, sheen_share, r);
+  if (cells != CellsBook::none)
+    tally_exit(*life.tally, life.first_exit, cell,
+               cells == CellsBook::rest ? std::span<const double>(r) : w);
   if (t.weave) {
     const int exit_bin = static_cast<int>(cell - static_cast<uint64_t>(life.bin) * t.grid.bins());
     tally_weave_exit(*t.weave, life.tally->weave, life.first_exit, life.bin, exit_bin, p, d, w);
@@ -275,7 +294,8 @@ Launch lattice_launch(const Tracer& t, uint64_t k, int bin) {
   const uint64_t idx = k - t.per_bin * static_cast<uint64_t>(bin);
   const uint64_t count = static_cast<uint64_t>(t.o.launch_lattice);
   Rng block(t.o.seed, static_cast<uint64_t>(bin), idx / count + 1);
-  Launch l = launch(t.grid, t.slab, bin, block);
+  const int strata = t.sheen ? t.sheen->light_factor() : 1;
+  Launch l = launch(t.grid, t.slab, bin, block, strata, launch_stratum(t, idx));
   l.p = lattice_point(t.slab, l.p, static_cast<int>(idx % count), t.o.launch_lattice);
   return l;
 }
@@ -288,8 +308,13 @@ void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t u
   life.bin = bin;
   life.tally = &tally;
   life.books = &tally.books_of(bin);
-  Launch l = launch(t.grid, t.slab, bin, rng);  // drawn either way: the stream stays the same
+  const int strata = t.sheen ? t.sheen->light_factor() : 1;
+  const int stratum = launch_stratum(t, k - t.per_bin * static_cast<uint64_t>(bin));
+  // Drawn either way: the stream stays the same.
+  Launch l = launch(t.grid, t.slab, bin, rng, strata, stratum);
   if (t.o.launch_lattice > 1) l = lattice_launch(t, k, bin);
+  if (t.sheen)
+    life.light_bin = t.sheen->light_bin_at(static_cast<size_t>(bin) * (strata * strata) + stratum);
   life.wi = -world_to_cloth(l.d);
   life.st = draw_strategies(t.mis, t.fs.groups, rng);
   life.books->launched += l.w0;
@@ -462,6 +487,8 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
   if (o.launch_lattice > 1) table.metadata["launch_lattice"] = std::to_string(o.launch_lattice);
   if (o.straight_through != StraightThrough::sampled)
     table.metadata["straight_through"] = name_of(kStraightThroughNames, o.straight_through);
+  if (o.sheen_h_resolution > 0 && o.sheen_light != SheenLight::first_surface)
+    table.metadata["sheen_light"] = name_of(kSheenLightNames, o.sheen_light);
   // A table of paths cut short says so (only then, so that other tables keep their bytes).
   if (o.max_scatterings != FabricRaytraceOptions{}.max_scatterings)
     table.metadata["max_scatterings"] = std::to_string(o.max_scatterings);
@@ -521,18 +548,29 @@ void check_sheen_trace(const FabricRaytraceOptions& o, int bins, bool exact_lobe
   if (record) throw Error("", "sheen_h_resolution", "is not kept in recorded paths");
 }
 
+// How many of a bin's particles each launch stratum (launch_stratum) has: the particles of each
+// of the sheen's light bins nested in it, in the order of HalfVectorLobe::slot.
+std::vector<uint64_t> stratum_particles(const Tracer& t) {
+  std::vector<uint64_t> n(static_cast<size_t>(t.sheen->light_bins_per_cell()), 0);
+  for (uint64_t idx = 0; idx < t.per_bin; ++idx) ++n[static_cast<size_t>(launch_stratum(t, idx))];
+  return n;
+}
+
 // The sheen's booked sums (after the table's cells in 'sums', channels per window bin) as Q =
-// sum / (particles per bin x window bin solid angle x mean wi . h) (HalfVectorLobe::
+// sum / (particles of the light bin x window bin solid angle x mean wi . h) (HalfVectorLobe::
 // mean_projections: the light each (light bin, window bin) booked is the light its cell averages
 // carry), added to the table: its cell averages join the cells, which hold the rest.
-void add_booked_sheen(const CellSums& sums, uint64_t per_bin, int threads, HalfVectorLobe sheen,
-                      TabulatedBsdfTable& table) {
+void add_booked_sheen(const CellSums& sums, const std::vector<uint64_t>& per_stratum, int threads,
+                      HalfVectorLobe sheen, TabulatedBsdfTable& table) {
   const size_t first = table.values.size(), nc = static_cast<size_t>(sheen.channels);
+  const size_t per_slot = static_cast<size_t>(sheen.window_bins()) * nc;
   const std::vector<double> projection = sheen.mean_projections(threads);
-  const double scale = 1.0 / (static_cast<double>(per_bin) * sheen.window_bin_solid_angle());
   for (size_t k = 0; k < sheen.values.size(); ++k) {
     const double m = projection[k / nc];
-    sheen.values[k] = m > 0 ? static_cast<float>(sums.sum[first + k] * scale / m) : 0.0f;
+    const double n = static_cast<double>(per_stratum[k / per_slot % per_stratum.size()]);
+    sheen.values[k] =
+        m > 0 ? static_cast<float>(sums.sum[first + k] / (n * sheen.window_bin_solid_angle() * m))
+              : 0.0f;
   }
   table.add_sheen(std::move(sheen), threads);
 }
@@ -757,7 +795,8 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   const int bins = t.grid.bins(), nc = t.nc;
   std::optional<HalfVectorLobe> sheen;
   if (o.sheen_h_resolution > 0) {
-    sheen = HalfVectorLobe::zeros(o.resolution, o.sheen_h_resolution, o.sheen_window, nc);
+    sheen = HalfVectorLobe::zeros(o.resolution, o.sheen_h_resolution, o.sheen_window, nc,
+                                  o.sheen_light_resolution);
     // Values over the fibers' Fresnel reflectance (at their channels' mean index), which varies
     // faster across the grazing light bins than the rest of the sheen.
     const std::vector<double>& ior = fiber.surface_lobe->ior;
@@ -766,6 +805,13 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
     sheen->fresnel_ior = mean_ior;
     t.sheen = &*sheen;
     t.sheen_first_cell = static_cast<uint64_t>(bins) * bins;
+    for (uint64_t n : stratum_particles(t))
+      if (n == 0)
+        throw Error("", "samples",
+                    "too few to launch particles from each of the sheen's " +
+                        std::to_string(sheen->light_bins_per_cell()) +
+                        " light bins per table bin: give at least " +
+                        std::to_string(sheen->light_bins_per_cell() * t.o.launch_lattice));
   }
   const size_t values =
       (static_cast<size_t>(bins) * bins + (sheen ? sheen->values.size() / nc : 0)) *
@@ -801,7 +847,8 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   const CellSums exact = straight_through_sums(t, weave_exact, progress, result.cancelled);
   if (result.cancelled) return result;
   tabulate(sums, exact, t.grid, nc, t.per_bin, units, result);
-  if (sheen) add_booked_sheen(sums, t.per_bin, o.threads, std::move(*sheen), result.table);
+  if (sheen)
+    add_booked_sheen(sums, stratum_particles(t), o.threads, std::move(*sheen), result.table);
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   if (exact_lobe && fiber.surface_lobe) result.table.metadata["fiber_surface_lobe"] = "exact";

@@ -145,9 +145,15 @@ void FabricRaytraceOptions::validate() const {
   if (first_bin < 0 || bin_count < 0 || first_bin + bin_count > bins)
     throw Error("", "bin_count", "incident bins must lie in [0, " + std::to_string(bins) + ")");
   validate_weave_options(*this);
-  if (sheen_h_resolution != 0)
+  if (sheen_h_resolution != 0) {
     HalfVectorLobe::check_shape(sheen_h_resolution, sheen_window, "", "sheen_h_resolution",
                                 "sheen_window");
+    if (sheen_light_resolution != 0)
+      HalfVectorLobe::check_light_resolution(resolution, sheen_light_resolution, "",
+                                             "sheen_light_resolution");
+  } else if (sheen_light_resolution != 0) {
+    throw Error("", "sheen_light_resolution", "sizes the sheen's light bins: it needs a sheen");
+  }
 }
 
 void FabricBinBooks::add(const FabricBinBooks& o) {

@@ -63,11 +63,13 @@ double mean_weight(std::span<const double> w) {
   return mean / static_cast<double>(w.size());
 }
 
-Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& rng) {
+Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& rng, int strata,
+              int stratum) {
   // Which of the two chart draws is made first is the compiler's choice (an unspecified order of
-  // evaluation), kept as it is so that the tables keep their bits.
-  const Vec3 wi_cloth =
-      DirectionGrid::to_direction(grid.chart_point(bin, rng.uniform(), rng.uniform()));
+  // evaluation), kept as it is so that the tables keep their bits ((0 + u) / 1 is u exactly).
+  const double m = strata;
+  const Vec3 wi_cloth = DirectionGrid::to_direction(grid.chart_point(
+      bin, (stratum % strata + rng.uniform()) / m, (stratum / strata + rng.uniform()) / m));
   Launch l;
   l.w0 = std::abs(wi_cloth.z);
   l.d = -cloth_to_world(wi_cloth);

@@ -58,9 +58,14 @@ std::string read_table_format(const Imf::Header& h, const std::string& file,
   return bands;
 }
 
-// The image's width: the cells' 2 R^2 columns, then the sheen's window bins when there is one.
+// A row's sheen columns: the window bins of each of its table bin's light bins.
+int sheen_columns(const HalfVectorLobe& s) {
+  return s.light_bins_per_cell() * s.window_bins();
+}
+
+// The image's width: the cells' 2 R^2 columns, then the sheen's when there is one.
 int image_width(const TabulatedBsdfTable& t) {
-  return t.bins() + (t.sheen ? t.sheen->window_bins() : 0);
+  return t.bins() + (t.sheen ? sheen_columns(*t.sheen) : 0);
 }
 
 // The data window must be the table's, and the file large enough to hold its pixels.
@@ -69,7 +74,11 @@ void check_pixel_size(const Imf::Header& h, const std::filesystem::path& path,
                       const std::string& bands) {
   const int n = table.bins(), width = image_width(table);
   std::string why = "resolution " + std::to_string(table.resolution);
-  if (table.sheen) why += " and sheen window " + std::to_string(table.sheen->window);
+  if (table.sheen) {
+    why += " and sheen window " + std::to_string(table.sheen->window);
+    if (table.sheen->light_factor() > 1)
+      why += " at light resolution " + std::to_string(table.sheen->light_resolution);
+  }
   exr_io::check_data_window(h, file, width, n, why);
   // The pixels must be in the file before their buffer is allocated.
   exr_io::check_fits_file(path, file, "resolution",
@@ -81,7 +90,7 @@ void check_pixel_size(const Imf::Header& h, const std::filesystem::path& path,
 std::vector<float> image_of(const TabulatedBsdfTable& t) {
   if (!t.sheen) return t.values;
   const size_t nc = static_cast<size_t>(t.channels), row = static_cast<size_t>(t.bins()) * nc;
-  const size_t extra = static_cast<size_t>(t.sheen->window_bins()) * nc;
+  const size_t extra = static_cast<size_t>(sheen_columns(*t.sheen)) * nc;
   std::vector<float> out;
   out.reserve(t.values.size() + t.sheen->values.size());
   for (size_t a = 0; a < static_cast<size_t>(t.bins()); ++a) {
@@ -99,7 +108,7 @@ void split_image(const std::vector<float>& image, TabulatedBsdfTable& t) {
     return;
   }
   const size_t nc = static_cast<size_t>(t.channels), row = static_cast<size_t>(t.bins()) * nc;
-  const size_t extra = static_cast<size_t>(t.sheen->window_bins()) * nc;
+  const size_t extra = static_cast<size_t>(sheen_columns(*t.sheen)) * nc;
   t.values.clear(), t.sheen->values.clear();
   for (size_t a = 0; a < static_cast<size_t>(t.bins()); ++a) {
     const auto first = image.begin() + static_cast<std::ptrdiff_t>(a * (row + extra));
@@ -155,10 +164,12 @@ void TabulatedBsdfTable::write_exr(const std::filesystem::path& path) const {
 
 TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& path) {
   const std::string file = path.string();
-  // The largest table: 2 R^2 bins a side, and a row's sheen window at most R_h^2 bins more.
+  // The largest table: 2 R^2 bins a side, and a row's sheen at most (R_l / R)^2 windows of R_h^2
+  // bins more.
   const int64_t max_bins = 2 * int64_t{kMaxResolution} * kMaxResolution;
-  const int64_t max_window =
-      int64_t{HalfVectorLobe::kMaxHResolution} * HalfVectorLobe::kMaxHResolution;
+  const int64_t max_window = int64_t{HalfVectorLobe::kMaxLightFactor} *
+                             HalfVectorLobe::kMaxLightFactor * HalfVectorLobe::kMaxHResolution *
+                             HalfVectorLobe::kMaxHResolution;
   exr_io::check_magic(path, file);
   exr_io::check_header(path, file, max_bins + max_window, max_bins);
 
@@ -169,14 +180,14 @@ TabulatedBsdfTable TabulatedBsdfTable::read_exr(const std::filesystem::path& pat
     const std::string bands = read_table_format(h, file, table);
     const int version = exr_io::int_attribute(h, file, "weft_format_version");
     // Versions 3 and 4 knew no sheen, version 3 no lobe: their attributes there would be
-    // metadata of another program's.
+    // metadata of another program's (and so for the sheen's newer attributes).
     auto attributes_of = [&](bool (*is)(const std::string&)) {
       return exr_io::string_attributes(h, [is](const std::string& n) { return !is(n); });
     };
     if (version >= 5)
       table.sheen =
           HalfVectorLobe::from_attributes(attributes_of(HalfVectorLobe::is_attribute),
-                                          table.resolution, table.channels, file, version >= 6);
+                                          table.resolution, table.channels, file, version);
     check_pixel_size(h, path, file, table, bands);
     const std::vector<std::string> names = table.channel_names();
     exr_io::check_channels(h, file, names, bands);

@@ -253,9 +253,10 @@ Distribution2D wi_sampling(const DirectionGrid& grid, int wo, const std::vector<
 }
 
 // The sheen's RGB (a spectral one reduced like the cells) into data, the rest's values into rgb and
-// bands, and the sheen's draws: per wo bin b its window bins in proportion to the light booked
-// there for light from b (the table taken as reciprocal), and its share of the draws, half the
-// sheen's share of the light arriving at b (sheen_cells: its cell averages).
+// bands, and the sheen's draws: per wo bin b of the sheen's light grid its window bins in
+// proportion to the light booked there for light from b (the table taken as reciprocal), and per
+// table bin its share of the draws, half the sheen's share of the light arriving there
+// (sheen_cells: its cell averages).
 void prepare_sheen(const TabulatedBsdfTable& table, const TabulatedBsdfTable& rest,
                    const std::vector<double>& sheen_cells, TabulatedBsdfData& data) {
   reduce_to_rgb(rest, data);
@@ -276,18 +277,20 @@ void prepare_sheen(const TabulatedBsdfTable& table, const TabulatedBsdfTable& re
   data.clamped_components += gamut.components;
   if (nc == kNumBands) data.sheen_bands = s;
   const std::vector<double> m = s.mean_projections();
-  const int n = data.grid.bins();
+  const int n = data.grid.bins(), n_light = s.light_grid().bins();
   const size_t nk = static_cast<size_t>(s.window_bins());
   const std::vector<double> d = data.grid.cosine_weighted_areas();
-  data.sheen_sampling.resize(static_cast<size_t>(n));
-  data.sheen_share.assign(static_cast<size_t>(n), 0.0);
-  for (int b = 0; b < n; ++b) {
+  data.sheen_sampling.resize(static_cast<size_t>(n_light));
+  for (int b = 0; b < n_light; ++b) {
     std::vector<double> w(nk);
     for (size_t k = 0; k < nk; ++k) {
-      const size_t at = (static_cast<size_t>(b) * nk + k) * 3;
-      w[k] = (rgb.values[at] + rgb.values[at + 1] + rgb.values[at + 2]) * m[b * nk + k];
+      const size_t at = (s.slot(b) * nk + k) * 3;
+      w[k] = (rgb.values[at] + rgb.values[at + 1] + rgb.values[at + 2]) * m[at / 3];
     }
-    data.sheen_sampling[b] = Distribution1D(w);
+    data.sheen_sampling[static_cast<size_t>(b)] = Distribution1D(w);
+  }
+  data.sheen_share.assign(static_cast<size_t>(n), 0.0);
+  for (int b = 0; b < n; ++b) {
     double part = 0, whole = 0;
     for (int i = 0; i < n; ++i)
       for (size_t c = 0; c < nc; ++c) {
@@ -295,8 +298,7 @@ void prepare_sheen(const TabulatedBsdfTable& table, const TabulatedBsdfTable& re
         part += sheen_cells[v] * d[i];
         whole += table.values[v] * d[i];
       }
-    if (data.sheen_sampling[b].integral() > 0 && whole > 0)
-      data.sheen_share[b] = 0.5 * std::min(1.0, part / whole);
+    if (part > 0 && whole > 0) data.sheen_share[b] = 0.5 * std::min(1.0, part / whole);
   }
   data.sheen_rgb = std::move(rgb);
 }
@@ -449,6 +451,9 @@ double TabulatedBsdf::pdf_backed(const BackedLobes& l, const Vec3& wo, const Vec
 
 double TabulatedBsdf::sheen_share(const Vec3& wo) const {
   if (backing || data->sheen_share.empty()) return 0;
+  // Nothing to draw where wo's light bin (of the sheen's own grid) booked no sheen.
+  const size_t light_bin = static_cast<size_t>(data->sheen_rgb->light_grid().bin_of(wo));
+  if (!(data->sheen_sampling[light_bin].integral() > 0)) return 0;
   return data->sheen_share[static_cast<size_t>(data->grid.bin_of(wo))];
 }
 
@@ -459,13 +464,13 @@ double TabulatedBsdf::pdf_sheen(const Vec3& wo, const Vec3& wi) const {
   const Vec3 h = sum / length(sum);
   const int k = s.window_bin_of(h);
   if (k < 0) return 0;
-  const Distribution1D& d = data->sheen_sampling[static_cast<size_t>(data->grid.bin_of(wo))];
+  const Distribution1D& d = data->sheen_sampling[static_cast<size_t>(s.light_grid().bin_of(wo))];
   return d.pmf(static_cast<size_t>(k)) / (s.window_bin_solid_angle() * 4 * std::abs(dot(wo, h)));
 }
 
 std::optional<Vec3> TabulatedBsdf::sample_sheen(const Vec3& wo, Vec2 u, double u_bin) const {
   const HalfVectorLobe& s = *data->sheen_rgb;
-  const Distribution1D& d = data->sheen_sampling[static_cast<size_t>(data->grid.bin_of(wo))];
+  const Distribution1D& d = data->sheen_sampling[static_cast<size_t>(s.light_grid().bin_of(wo))];
   Vec3 h = s.window_point(static_cast<int>(d.sample_discrete(u_bin)), u.x, u.y);
   if (wo.z < 0) h.z = -h.z;
   const double wo_h = dot(wo, h);

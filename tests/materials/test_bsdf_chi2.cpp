@@ -109,8 +109,9 @@ TabulatedBsdf fabric_like_table(std::optional<Rgb> backing = std::nullopt) {
 }
 
 // The same cells with a sheen over half vectors (half_vector_lobe.h) added: R_h 16, a window of
-// 8 x 8 bins (each about 9 degrees), Q drawn per light bin and window bin.
-TabulatedBsdfTable fabric_table_with_sheen() {
+// 8 x 8 bins (each about 9 degrees), Q drawn per light bin and window bin; light bins at
+// light_resolution (0: the table's R 8).
+TabulatedBsdfTable fabric_table_with_sheen(int light_resolution = 0) {
   auto table = TabulatedBsdfTable::from_function(
       8, 3,
       [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
@@ -119,7 +120,7 @@ TabulatedBsdfTable fabric_table_with_sheen() {
       },
       1, 11);
   table.kind = "fabric";
-  HalfVectorLobe sheen = HalfVectorLobe::zeros(8, 16, 8, 3);
+  HalfVectorLobe sheen = HalfVectorLobe::zeros(8, 16, 8, 3, light_resolution);
   Rng rng(12, 0, 0);
   for (float& v : sheen.values) v = static_cast<float>(0.5 * rng.uniform());
   table.add_sheen(std::move(sheen));
@@ -210,16 +211,20 @@ TEST(Chi2, FiberAndFabricTables) {
 // A table with a sheen: the cells' distribution or the sheen's own window draws (the pdf then
 // changes at the window bins' edges: a histogram of R 16 cells, each integrated on 16 x 16
 // points).
+// Light bins of the sheen twice as fine as the table's (R_l 16): its draws per wo bin of R_l.
 TEST(Chi2, FabricTableWithASheen) {
-  const TabulatedBsdfTable table = fabric_table_with_sheen();
-  const TabulatedBsdf t{TabulatedBsdfData::prepare(table), Rgb(1.0)};
-  ASSERT_TRUE(t.data->sheen_rgb);
-  const Bsdf b(t);
   uint64_t seed = 450;
-  for (const Vec3& wo : kTableWo) {
-    const auto r = chi2_test(bsdf_sampler(b, wo), bsdf_pdf(b, wo), DirectionGridBins{16, 16},
-                             kSamples, kSignificance, seed++);
-    EXPECT_TRUE(r.passed) << "table with a sheen, wo " << wo << ": " << r.message;
+  for (int light_resolution : {8, 16}) {
+    const TabulatedBsdfTable table = fabric_table_with_sheen(light_resolution);
+    const TabulatedBsdf t{TabulatedBsdfData::prepare(table), Rgb(1.0)};
+    ASSERT_TRUE(t.data->sheen_rgb);
+    const Bsdf b(t);
+    for (const Vec3& wo : kTableWo) {
+      const auto r = chi2_test(bsdf_sampler(b, wo), bsdf_pdf(b, wo), DirectionGridBins{16, 16},
+                               kSamples, kSignificance, seed++);
+      EXPECT_TRUE(r.passed) << "table with a sheen, R_l " << light_resolution << ", wo " << wo
+                            << ": " << r.message;
+    }
   }
 }
 

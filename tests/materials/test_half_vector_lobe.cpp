@@ -21,8 +21,9 @@ namespace fs = std::filesystem;
 namespace {
 
 HalfVectorLobe random_lobe(int resolution, int h_resolution, int window, int channels,
-                           uint64_t seed) {
-  HalfVectorLobe l = HalfVectorLobe::zeros(resolution, h_resolution, window, channels);
+                           uint64_t seed, int light_resolution = 0) {
+  HalfVectorLobe l =
+      HalfVectorLobe::zeros(resolution, h_resolution, window, channels, light_resolution);
   Rng rng(seed, 0, 0);
   for (float& v : l.values) v = static_cast<float>(rng.uniform());
   return l;
@@ -45,15 +46,24 @@ void cell_averages_match_midpoint_rule(const HalfVectorLobe& l);
 
 }  // namespace
 
+// An even grid's window has the pole at its central corner, an odd one's at its central bin's
+// centre (where a peak about the pole is not split four ways).
 TEST(HalfVectorLobe, WindowBinsAndTheirPointsAgree) {
-  const HalfVectorLobe l = HalfVectorLobe::zeros(2, 16, 6, 3);
-  for (int k = 0; k < l.window_bins(); ++k) {
-    const Vec3 h = l.window_point(k, 0.5, 0.5);
-    EXPECT_EQ(l.window_bin_of(h), k);
-    EXPECT_EQ(l.window_bin_of({h.x, h.y, -h.z}), k);  // the lower face's, mirrored
+  for (const auto& [h_resolution, window] : {std::pair{16, 6}, std::pair{17, 5}}) {
+    const HalfVectorLobe l = HalfVectorLobe::zeros(2, h_resolution, window, 3);
+    for (int k = 0; k < l.window_bins(); ++k) {
+      const Vec3 h = l.window_point(k, 0.5, 0.5);
+      EXPECT_EQ(l.window_bin_of(h), k);
+      EXPECT_EQ(l.window_bin_of({h.x, h.y, -h.z}), k);  // the lower face's, mirrored
+    }
+    EXPECT_GE(l.window_bin_of({0, 0, 1}), 0);                    // the pole is in the window
+    EXPECT_EQ(l.window_bin_of(normalize(Vec3{1, 0, 0.2})), -1);  // far from the pole
+    if (window % 2) {
+      const Vec3 centre = l.window_point(window * window / 2, 0.5, 0.5);
+      EXPECT_NEAR(centre.z, 1.0, 1e-12) << h_resolution;
+    }
   }
-  EXPECT_GE(l.window_bin_of({0, 0, 1}), 0);                    // the pole is in the window
-  EXPECT_EQ(l.window_bin_of(normalize(Vec3{1, 0, 0.2})), -1);  // far from the pole
+  EXPECT_THROW(HalfVectorLobe::zeros(2, 17, 6, 3), Error);  // not centred on the pole
 }
 
 // With Q = q everywhere, light along the normal leaves with int f cos_o d wo = q int_window h.z
@@ -87,10 +97,45 @@ TEST(HalfVectorLobe, NormalLightReflectsTheWindowsProjectedArea) {
 // exit bin, each weighted by its |cos theta| (shares nothing with the quadrature but eval).
 // With and without the Fresnel factor, which both must apply alike.
 TEST(HalfVectorLobe, CellAveragesMatchAMidpointRuleOfEval) {
-  for (double ior : {0.0, 1.6}) {
-    HalfVectorLobe l = random_lobe(2, 16, 8, 3, 7);
-    l.fresnel_ior = ior;
-    cell_averages_match_midpoint_rule(l);
+  for (int light_resolution : {2, 4})
+    for (double ior : {0.0, 1.6}) {
+      if (light_resolution == 4 && ior == 0) continue;  // the finer grid's blend, once
+      SCOPED_TRACE(light_resolution);
+      HalfVectorLobe l = random_lobe(2, 16, 8, 3, 7, light_resolution);
+      l.fresnel_ior = ior;
+      cell_averages_match_midpoint_rule(l);
+    }
+}
+
+// The light bins of R_l = m R nest in the table's: light bin b is kept in its table bin's m^2
+// slots (the table bin holds b's centre), each slot holds one light bin, and a light bin's mean
+// projection is its share of the table bin's quadrature (the m^2 of them average to it).
+TEST(HalfVectorLobe, FinerLightBinsNestInTheTablesBins) {
+  const HalfVectorLobe coarse = HalfVectorLobe::zeros(2, 16, 6, 3);
+  const std::vector<double> whole = coarse.mean_projections(2);
+  for (int light_resolution : {4, 8}) {
+    const HalfVectorLobe l = HalfVectorLobe::zeros(2, 16, 6, 3, light_resolution);
+    const int m2 = l.light_bins_per_cell(), n = l.light_grid().bins();
+    ASSERT_EQ(n, DirectionGrid{2}.bins() * m2);
+    ASSERT_EQ(l.values.size(), static_cast<size_t>(n) * l.window_bins() * 3);
+    std::vector<int> seen(static_cast<size_t>(n), 0);
+    for (int b = 0; b < n; ++b) {
+      const size_t s = l.slot(b);
+      ASSERT_LT(s, static_cast<size_t>(n));
+      ++seen[s];
+      EXPECT_EQ(l.light_bin_at(s), b);
+      EXPECT_EQ(static_cast<int>(s) / m2, DirectionGrid{2}.bin_of(l.light_grid().bin_center(b)))
+          << light_resolution << " " << b;
+    }
+    for (int c : seen) EXPECT_EQ(c, 1);
+    const std::vector<double> fine = l.mean_projections(2);
+    const size_t nk = static_cast<size_t>(l.window_bins());
+    for (size_t a = 0; a < whole.size() / nk; ++a)
+      for (size_t k = 0; k < nk; ++k) {
+        double mean = 0;
+        for (size_t j = 0; j < static_cast<size_t>(m2); ++j) mean += fine[(a * m2 + j) * nk + k];
+        EXPECT_NEAR(mean / m2, whole[a * nk + k], 1e-12) << light_resolution << " " << a;
+      }
   }
 }
 
@@ -150,23 +195,26 @@ TEST(HalfVectorLobe, AddedAndRemovedLeavesTheCells) {
 
 TEST(HalfVectorLobe, TheTableFileKeepsItBitForBit) {
   const fs::path dir = fresh_test_dir();
-  TabulatedBsdfTable t;
-  t.resolution = 2, t.channels = 3, t.kind = "fabric";
-  t.values.assign(static_cast<size_t>(t.bins()) * t.bins() * 3, 0.5f);
-  HalfVectorLobe lobe = random_lobe(2, 16, 8, 3, 5);
-  lobe.fresnel_ior = 1.5700000000000001;
-  t.add_sheen(lobe);
-  const fs::path path = dir / "sheen.exr";
-  t.write_exr(path);
-  const TabulatedBsdfTable back = TabulatedBsdfTable::read_exr(path);
-  ASSERT_TRUE(back.sheen);
-  EXPECT_EQ(back.values, t.values);
-  EXPECT_EQ(back.sheen->values, t.sheen->values);
-  EXPECT_EQ(back.sheen->h_resolution, 16);
-  EXPECT_EQ(back.sheen->window, 8);
-  EXPECT_EQ(back.sheen->fresnel_ior, lobe.fresnel_ior);
-  EXPECT_EQ(back.checksum(), t.checksum());
-  EXPECT_TRUE(back.metadata.empty());
+  for (int light_resolution : {2, 4, 8}) {
+    TabulatedBsdfTable t;
+    t.resolution = 2, t.channels = 3, t.kind = "fabric";
+    t.values.assign(static_cast<size_t>(t.bins()) * t.bins() * 3, 0.5f);
+    HalfVectorLobe lobe = random_lobe(2, 16, 8, 3, 5, light_resolution);
+    lobe.fresnel_ior = 1.5700000000000001;
+    t.add_sheen(lobe);
+    const fs::path path = dir / ("sheen" + std::to_string(light_resolution) + ".exr");
+    t.write_exr(path);
+    const TabulatedBsdfTable back = TabulatedBsdfTable::read_exr(path);
+    ASSERT_TRUE(back.sheen);
+    EXPECT_EQ(back.values, t.values);
+    EXPECT_EQ(back.sheen->values, t.sheen->values);
+    EXPECT_EQ(back.sheen->h_resolution, 16);
+    EXPECT_EQ(back.sheen->window, 8);
+    EXPECT_EQ(back.sheen->fresnel_ior, lobe.fresnel_ior);
+    EXPECT_EQ(back.sheen->light_resolution, light_resolution);
+    EXPECT_EQ(back.checksum(), t.checksum());
+    EXPECT_TRUE(back.metadata.empty());
+  }
 }
 
 TEST(HalfVectorLobe, AMalformedHeaderNamesTheAttribute) {
@@ -204,9 +252,22 @@ TEST(HalfVectorLobe, AMalformedHeaderNamesTheAttribute) {
       HalfVectorLobe::from_attributes(with("sheen_fresnel_ior", "1.5"), 2, 3, "t.exr")->fresnel_ior,
       1.5);
   // Before format 6 such an attribute was another program's: ignored.
-  EXPECT_EQ(HalfVectorLobe::from_attributes(with("sheen_fresnel_ior", "x"), 2, 3, "t.exr", false)
+  EXPECT_EQ(HalfVectorLobe::from_attributes(with("sheen_fresnel_ior", "x"), 2, 3, "t.exr", 5)
                 ->fresnel_ior,
             0.0);
+  // The light bins nest in the table's (R 2 here): 2, 4 or 8, the table's when absent.
+  for (const char* bad : {"1", "3", "6", "16", "0", "-4", "2.5", "x"})
+    EXPECT_NE(error_of(with("sheen_light_resolution", bad)).find("sheen_light_resolution"),
+              std::string::npos)
+        << bad;
+  EXPECT_EQ(HalfVectorLobe::from_attributes(good, 2, 3, "t.exr")->light_resolution, 2);
+  EXPECT_EQ(HalfVectorLobe::from_attributes(with("sheen_light_resolution", "8"), 2, 3, "t.exr")
+                ->light_resolution,
+            8);
+  // Before format 7: another program's, ignored.
+  EXPECT_EQ(HalfVectorLobe::from_attributes(with("sheen_light_resolution", "x"), 2, 3, "t.exr", 6)
+                ->light_resolution,
+            2);
 }
 
 // A sheen whose Q is the fibers' Fresnel reflectance alone (D G = 1 over the window), booked per

@@ -277,11 +277,25 @@ TEST(TableBsdf, CellSamplingFollowsTheCellReadOfAPeakedTable) {
 // averages, interpolated, plus the sheen: sharp where the cells alone blur it; its draws (the
 // cells' distribution or the sheen's window bins) weigh eval / pdf, so their mean is the
 // quadrature's albedo.
+// So with light bins finer than the table's (R_l 16, 32).
+namespace {
+void expect_sheen_read_sharp(int light_resolution, uint64_t& seed);
+}  // namespace
+
 TEST(TableBsdf, ASheenIsReadSharpOverTheRest) {
+  uint64_t seed = 60;
+  for (int light_resolution : {8, 16, 32}) {
+    SCOPED_TRACE(light_resolution);
+    expect_sheen_read_sharp(light_resolution, seed);
+  }
+}
+
+namespace {
+void expect_sheen_read_sharp(int light_resolution, uint64_t& seed) {
   TabulatedBsdfTable table = rgb_table(
       8, [](const Vec3& wo, const Vec3& wi) { return Rgb(wo.z * wi.z > 0 ? 0.1 : 0.02); });
   table.kind = "fabric";
-  HalfVectorLobe sheen = HalfVectorLobe::zeros(8, 16, 8, 3);
+  HalfVectorLobe sheen = HalfVectorLobe::zeros(8, 16, 8, 3, light_resolution);
   Rng rng(3, 0, 0);
   for (float& v : sheen.values) v = static_cast<float>(0.5 * rng.uniform());
   const TabulatedBsdfTable plain = table;
@@ -295,13 +309,13 @@ TEST(TableBsdf, ASheenIsReadSharpOverTheRest) {
     const Rgb f = with.eval(wo, wi), rest = without.eval(wo, wi);
     EXPECT_NEAR(f.g, rest.g + s[1], 1e-6 * f.g) << wo;
   }
-  uint64_t seed = 60;
   for (const Vec3& wo : kWos) {
     const auto a = estimate_albedo(with, wo, 200000, seed++);
     const double q = albedo_by_quadrature(with, wo);
     EXPECT_NEAR(a.mean.g, q, 4 * a.standard_error.g + 2e-3 * q) << wo;
   }
 }
+}  // namespace
 
 // A spectral table's sheen is read per band by a spectral render (eval_bands: the rest's bands
 // plus the sheen's) and reduced to RGB under D65 like the cells for an RGB one.

@@ -78,6 +78,17 @@ def test_a_fabric_table_keeps_its_sheen_through_a_file(tmp_path):
     assert back.sheen == fabric.sheen and back.checksum == fabric.checksum
     with pytest.raises(weft.Error, match="sheen_resolution"):
         weft.bake_fabric(fiber, "raytrace", sheen_resolution=16, resolution=2, samples=20)
+    # Light bins twice as fine as the table's (format 7), every reflected exit in the window.
+    fine = weft.bake_fabric(fiber, "raytrace", detail="fiber", sheen_resolution=16, sheen_window=4,
+                            sheen_light_resolution=4, sheen_light="reflected", resolution=2,
+                            samples=20)
+    assert fine.sheen["sheen_light_resolution"] == "4"
+    assert fine.metadata["sheen_light"] == "reflected"
+    fine.save(tmp_path / "fine.exr")
+    assert weft.load_table(tmp_path / "fine.exr").sheen == fine.sheen
+    with pytest.raises(weft.Error, match="sheen_light_resolution"):
+        weft.bake_fabric(fiber, "raytrace", detail="fiber", sheen_resolution=16,
+                         sheen_light_resolution=3, resolution=2, samples=20)
 
 
 def test_same_seed_same_bits_at_any_thread_count():

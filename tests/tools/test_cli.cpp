@@ -513,18 +513,31 @@ TEST(Cli, BakeFabricBooksTheSheenApartWhereItCan) {
   // The sample file's own detail (fiber) holds where --detail is not given.
   const std::string fiber_detail = base;
   expect_refused(fiber_detail + " --sheen-window 4", out, "--sheen-window", dir);
-  expect_refused(fiber_detail + " --sheen-resolution 15", out, "--sheen-resolution", dir);
+  expect_refused(fiber_detail + " --sheen-resolution 300", out, "--sheen-resolution", dir);
+  expect_refused(fiber_detail + " --sheen-resolution 15", out, "--sheen-window", dir);
   expect_refused(fiber_detail + " --sheen-resolution 16 --sheen-window 18", out, "--sheen-window",
                  dir);
   expect_refused(fiber_detail + " --sheen-resolution 16 --shard 1/2", out, "--sheen-resolution",
                  dir);
+  expect_refused(fiber_detail + " --sheen-light-resolution 4", out, "--sheen-light-resolution",
+                 dir);
+  expect_refused(fiber_detail + " --sheen-resolution 16 --sheen-light-resolution 3", out,
+                 "--sheen-light-resolution", dir);
+  expect_refused(fiber_detail + " --sheen-light reflected", out, "--sheen-light", dir);
+  expect_refused(fiber_detail + " --sheen-resolution 16 --sheen-light mirror", out, "--sheen-light",
+                 dir);
   const fs::path sheen = dir / "sheen.exr";
-  const CliRun r = run_weft_cli(
-      fiber_detail + " --sheen-resolution 16 --sheen-window 4 --json -o '" + sheen.string() + "'",
-      dir);
+  const CliRun r =
+      run_weft_cli(fiber_detail +
+                       " --sheen-resolution 16 --sheen-window 4 "
+                       "--sheen-light-resolution 4 --sheen-light reflected --json -o '" +
+                       sheen.string() + "'",
+                   dir);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto t = weft::TabulatedBsdfTable::read_exr(sheen);
   ASSERT_TRUE(t.sheen);
   EXPECT_EQ(t.sheen->h_resolution, 16);
   EXPECT_EQ(t.sheen->window, 4);
+  EXPECT_EQ(t.sheen->light_resolution, 4);
+  EXPECT_EQ(t.metadata.at("sheen_light"), "reflected");
 }

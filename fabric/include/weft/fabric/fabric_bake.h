@@ -79,9 +79,10 @@ struct FabricBakeRequest {
   std::string weave_out;                        // the weave table (.exr); "" = no weave tally
   std::optional<std::string> weave_positions;   // "N" or "UxV"; kDefaultWeavePositions
   std::optional<int> weave_resolution;          // kDefaultWeaveResolution (at most R)
-  // The sheen booked apart (FabricRaytraceOptions::sheen_h_resolution; not given: off) and its
-  // window (the library's default unless given).
-  std::optional<int> sheen_resolution, sheen_window;
+  // The sheen booked apart (FabricRaytraceOptions::sheen_h_resolution; not given: off), its
+  // window and its light bins (the library's defaults unless given).
+  std::optional<int> sheen_resolution, sheen_window, sheen_light_resolution;
+  std::optional<std::string> sheen_light;  // kSheenLightNames; the library's default
   uint64_t seed = 1;
   int threads = 0;     // 0 = all cores; results do not depend on it
   std::string output;  // the fabric table (.exr), or a shard's part; "" = returned, not written

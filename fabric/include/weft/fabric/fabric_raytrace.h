@@ -66,6 +66,18 @@ inline constexpr NameTable<StraightThrough, 2> kStraightThroughNames{{
     {StraightThrough::sampled, "sampled", "booked by the particles"},
 }};
 
+// Which light the sheen (FabricRaytraceOptions::sheen_h_resolution) books: first-surface, the
+// light the first fiber a particle meets reflects off its surface lobe and that leaves at once
+// (the cells keep the rest); reflected, every exit on the light's side whose half vector lies in
+// the window, whatever its path: a finer grid about the mirror, where a satin's peak also holds
+// light that crossed fibers and light that the first fiber's lobe did not reflect, which an
+// R 8 light bin blurs (docs/fabric-bsdf.md, "Sharp sheen").
+enum class SheenLight { first_surface, reflected };
+inline constexpr NameTable<SheenLight, 2> kSheenLightNames{{
+    {SheenLight::first_surface, "first-surface", "the first fiber's surface reflection"},
+    {SheenLight::reflected, "reflected", "every reflected exit in the window"},
+}};
+
 // The estimator's revision, raised whenever a change alters its results for the same options: it
 // is part of a sharded or resumed run's identity (parts of another revision are refused, not
 // merged) and of the table's metadata. 2: the scene passes rays through fibers they are inside
@@ -149,6 +161,11 @@ struct FabricRaytraceOptions {
   // cells plus the sheen's cell averages estimate what the cells alone do.
   int sheen_h_resolution = 0;
   int sheen_window = 16;
+  // The sheen's light bins (HalfVectorLobe::light_resolution): 0 the table's, or 2 or 4 times its
+  // resolution, the particles of each table bin launched in turn from its nested finer bins.
+  // Finer light bins hold a satin's mirror peak where the light's own bin would blur it.
+  int sheen_light_resolution = 0;
+  SheenLight sheen_light = SheenLight::first_surface;
 
   void validate() const;  // weft::Error naming the field
 };

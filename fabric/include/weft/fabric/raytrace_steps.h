@@ -71,12 +71,15 @@ double mean_weight(std::span<const double> w);
 // --- launch
 // The light of incident bin 'bin': a direction of the bin (uniform in solid angle), entering the
 // slab through the face it faces at a uniform point of the repeat; its flux per unit area is
-// proportional to w0 = |cos theta_i|.
+// proportional to w0 = |cos theta_i|. With strata > 1 the direction is drawn from sub-square
+// 'stratum' (row-major) of the bin's strata x strata in the chart: the finer grid's bin nested
+// there (a sheen's light bins, materials/half_vector_lobe.h).
 struct Launch {
   Vec3 p, d;
   double w0 = 0;
 };
-Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& rng);
+Launch launch(const DirectionGrid& grid, const RepeatSlab& slab, int bin, Rng& rng, int strata = 1,
+              int stratum = 0);
 
 // Point m of the rank-1 lattice of 'count' points over the repeat that contains p (its point 0):
 // the fractions (m / count, m g / count) of the periods added to p's, modulo the periods, g the

@@ -29,8 +29,9 @@
 //   "surface_lobe_ior"). Since version 5, optionally a fabric table's sheen in half-vector space
 //   (half_vector_lobe.h: "sheen", "sheen_h_resolution", "sheen_window"): the image is then wider,
 //   each row's columns past the 2 R^2 cells holding that light bin's W x W window bins, and
-//   values_fnv1a64 covers every pixel. Since version 6, optionally "sheen_fresnel_ior". Version 3
-//   to 5 files still load.
+//   values_fnv1a64 covers every pixel. Since version 6, optionally "sheen_fresnel_ior"; since
+//   version 7, optionally "sheen_light_resolution" R_l = 2 R or 4 R, each row then holding the
+//   windows of the (R_l / R)^2 light bins nested in its bin. Version 3 to 6 files still load.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -74,8 +75,9 @@ struct TabulatedBsdfTable {
   // stored quantity is stated (cell_average). 4: an optional analytic surface lobe beside the
   // cells (surface_lobe); version 3 tables have none and still load. 5: an optional sheen in
   // half-vector space beside the cells (sheen). 6: the sheen may hold its values over the fibers'
-  // Fresnel reflectance (HalfVectorLobe::fresnel_ior); version 5 sheens have none.
-  static constexpr int kFormatVersion = 6;
+  // Fresnel reflectance (HalfVectorLobe::fresnel_ior); version 5 sheens have none. 7: the sheen's
+  // light bins may be finer than the table's (HalfVectorLobe::light_resolution).
+  static constexpr int kFormatVersion = 7;
   static constexpr int kOldestReadableVersion = 3;
   static constexpr const char* kCellAverage = "cosine-weighted";
   static constexpr const char* kParameterization =

@@ -97,8 +97,8 @@ struct TabulatedBsdfData {
   // D65 band reduction and were set to 0. Always 0 for RGB tables.
   size_t clamped_components = 0;
   // The table's sheen (the top of this file), its light out of rgb and bands: sheen_rgb in RGB,
-  // sheen_bands a spectral table's as stored; per wo bin the draw of its window bins and the share
-  // of the draws it takes. Empty when the table has none.
+  // sheen_bands a spectral table's as stored; per wo bin of the sheen's light grid the draw of its
+  // window bins, and per table bin the share of the draws it takes. Empty when the table has none.
   std::optional<HalfVectorLobe> sheen_rgb, sheen_bands;
   std::vector<Distribution1D> sheen_sampling;
   std::vector<double> sheen_share;
