@@ -64,7 +64,7 @@ struct Tracer {
 
 // Where particle idx of its bin is launched: its sub-square of the bin when the sheen's light bins
 // are finer (HalfVectorLobe::light_factor), taken in turn by particle or by launch block, so that
-// each finer bin has its known share of the particles (sheen_particles); 0 otherwise.
+// each finer bin has its known share of the particles (stratum_particles); 0 otherwise.
 int launch_stratum(const Tracer& t, uint64_t idx) {
   const int m = t.sheen ? t.sheen->light_factor() : 1;
   if (m == 1) return 0;
