@@ -1,13 +1,11 @@
 #include "weft/fabric/fabric_raytrace.h"
 
 #include <algorithm>
-#include <charconv>
-#include <cmath>
-#include <cstdio>
 #include <deque>
 #include <optional>
 #include <string>
 
+#include "raytrace_table.h"
 #include "weft/core/direction_grid.h"
 #include "weft/core/error.h"
 #include "weft/core/task_batch.h"
@@ -282,7 +280,7 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
   }
 }
 
-// Particle k's launch when particles are launched in lattice blocks
+// A particle's launch when particles are launched in lattice blocks
 // (FabricRaytraceOptions::launch_lattice): the block's direction, and its point of the block's
 // lattice through the block's entry point, both drawn as a particle's launch from the block's own
 // stream (seed, bin, block + 1; a task's is (seed, task, 0)), so that they do not depend on how the
@@ -290,12 +288,11 @@ void follow(const Tracer& t, Life& life, Particle& s, TaskScratch& scratch, Rng&
 // passes between the fibers depends on where it enters in concert with its direction (the gaps'
 // shadow moves across the repeat as the direction tilts), and on a lattice of one direction the
 // block's lines cover the gaps evenly.
-Launch lattice_launch(const Tracer& t, uint64_t k, int bin) {
-  const uint64_t idx = k - t.per_bin * static_cast<uint64_t>(bin);
+// 'idx' is the particle's place in its bin; its launch stratum is taken as trace_particle gives it.
+Launch lattice_launch(const Tracer& t, uint64_t idx, int bin, int strata, int stratum) {
   const uint64_t count = static_cast<uint64_t>(t.o.launch_lattice);
   Rng block(t.o.seed, static_cast<uint64_t>(bin), idx / count + 1);
-  const int strata = t.sheen ? t.sheen->light_factor() : 1;
-  Launch l = launch(t.grid, t.slab, bin, block, strata, launch_stratum(t, idx));
+  Launch l = launch(t.grid, t.slab, bin, block, strata, stratum);
   l.p = lattice_point(t.slab, l.p, static_cast<int>(idx % count), t.o.launch_lattice);
   return l;
 }
@@ -309,10 +306,11 @@ void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t u
   life.tally = &tally;
   life.books = &tally.books_of(bin);
   const int strata = t.sheen ? t.sheen->light_factor() : 1;
-  const int stratum = launch_stratum(t, k - t.per_bin * static_cast<uint64_t>(bin));
+  const uint64_t idx = k - t.per_bin * static_cast<uint64_t>(bin);
+  const int stratum = launch_stratum(t, idx);
   // Drawn either way: the stream stays the same.
   Launch l = launch(t.grid, t.slab, bin, rng, strata, stratum);
-  if (t.o.launch_lattice > 1) l = lattice_launch(t, k, bin);
+  if (t.o.launch_lattice > 1) l = lattice_launch(t, idx, bin, strata, stratum);
   if (t.sheen)
     life.light_bin = t.sheen->light_bin_at(static_cast<size_t>(bin) * (strata * strata) + stratum);
   life.wi = -world_to_cloth(l.d);
@@ -364,215 +362,12 @@ uint64_t sample_units(const Tracer& t, uint64_t items_per_task, int bin) {
   return units;
 }
 
-// A fiber sends out at most the light that hits it: a table's total albedo (the bake's exit
-// fraction) is at most 1, within kFiberAlbedoAllowance (fiber_table_bake.h). Above it, path
-// weights grow from fiber to fiber, and the trace would run for minutes before they overflow (a
-// synthetic table of total albedo 1.9 did: tens of CPU minutes), so it is refused before any work.
-
-void check_fiber_energy(const TabulatedBsdfTable& t, const std::string& field) {
-  const std::vector<double> a = t.total_albedo();
-  for (size_t c = 0; c < a.size(); ++c)
-    if (!(a[c] <= 1 + kFiberAlbedoAllowance)) {
-      char v[32];
-      std::snprintf(v, sizeof v, "%.4g", a[c]);
-      throw Error("", field,
-                  std::string("the fiber table's total albedo is ") + v + " in channel " +
-                      std::to_string(c) +
-                      ": a fiber sends out at most the light that hits it (at most 1, the bake's "
-                      "exit fraction); bake it with weft bake fiber" +
-                      (t.channels == 3 ? std::string(" (a saturated colour's RGB table can exceed "
-                                                     "1: --bands spectral keeps it as it is)")
-                                       : std::string()));
-    }
-}
-
-// A table that draws or weighs the trace's steps in place of another fiber table (a proposal, or
-// the fiber re-weighting recorded paths): valid, a fiber table of the other's resolution and
-// channels, since the steps index both alike, and no more than lossless.
-void check_fiber_stand_in(const TabulatedBsdfTable& t, int resolution, int channels,
-                          const std::string& field, const char* mismatch) {
-  t.validate("");
-  if (t.kind != "fiber" || t.resolution != resolution || t.channels != channels)
-    throw Error("", field, mismatch);
-  check_fiber_energy(t, field);
-}
-
-void check_proposal(const TabulatedBsdfTable& proposal, const TabulatedBsdfTable& fiber) {
-  check_fiber_stand_in(proposal, fiber.resolution, fiber.channels, "proposal",
-                       "the proposal must be a fiber table of the traced table's resolution and "
-                       "channels");
-}
-
-// The exits' sums of weights and of their squares, per table value (cell pair and channel).
-struct CellSums {
-  std::vector<double> sum, sum2;
-};
-
-void add_task(const Tally& t, int nc, CellSums& sums, FabricRaytraceResult& result) {
-  for (const auto& e : t.exits)
-    for (int c = 0; c < nc; ++c) {
-      const double x = t.weights[e.first + c];
-      sums.sum[e.cell * nc + c] += x;
-      sums.sum2[e.cell * nc + c] += x * x;
-    }
-  for (const auto& [a, b] : t.books) result.bin_books[a].add(b);
-}
-
-// The table from the sums over per_bin particles per incident bin and the exact part (its values'
-// sums and their variance, per cell pair; empty: none), its standard error, and each bin's noise
-// and signal.
-void tabulate(const CellSums& sums, const CellSums& exact, const DirectionGrid& grid, int nc,
-              uint64_t per_bin, const std::vector<uint64_t>& units, FabricRaytraceResult& result) {
-  TabulatedBsdfTable& table = result.table;
-  const int bins = grid.bins();
-  const auto areas = grid.cosine_weighted_areas();
-  table.resolution = grid.resolution;
-  table.channels = nc;
-  table.kind = "fabric";
-  table.values.assign(static_cast<size_t>(bins) * bins * nc, 0.0f);
-  const double n = static_cast<double>(per_bin);
-  const double omega = grid.bin_solid_angle();
-  result.standard_error.assign(table.values.size(), 0.0f);
-  for (int a = 0; a < bins; ++a) {
-    const double u = static_cast<double>(units[a]);
-    std::vector<double>& noise2 = result.bin_books[a].noise2;
-    std::vector<double>& signal2 = result.bin_books[a].signal2;
-    noise2.assign(nc, 0.0);
-    signal2.assign(nc, 0.0);
-    for (int b = 0; b < bins; ++b) {
-      const size_t cell = static_cast<size_t>(a) * bins + b;
-      const double scale = omega / (n * areas[a] * areas[b]);
-      const double w = areas[a] * areas[b];
-      for (int c = 0; c < nc; ++c) {
-        const size_t v = cell * nc + c;
-        const double exact_sum = exact.sum.empty() ? 0.0 : exact.sum[cell];
-        const double f = (sums.sum[v] + exact_sum) * scale;
-        table.values[v] = static_cast<float>(f);
-        // Per sample unit (a particle, or a launch block) the sum of its weights in the cell:
-        // their sample variance.
-        const double m1 = sums.sum[v] / u;
-        double se = std::sqrt(std::max(0.0, sums.sum2[v] / u - m1 * m1) / u) * u * scale;
-        // The exact part's variance, independent of the particles' (its own streams).
-        if (!exact.sum2.empty() && exact.sum2[cell] > 0)
-          se = std::sqrt(se * se + exact.sum2[cell] * scale * scale);
-        result.standard_error[v] = static_cast<float>(se);
-        noise2[c] += se * se * w;
-        signal2[c] += f * f * w;
-      }
-    }
-  }
-  // Weights that overflow mean a fiber table that returns more light than it receives at every
-  // crossing (a baked table conserves energy over the whole fiber): refuse it, not a table of inf.
-  for (float v : table.values)
-    if (!std::isfinite(v))
-      throw Error("", "fiber",
-                  "the ray trace's path weights overflowed: the fiber table returns more light "
-                  "than it receives along paths (its albedo at B' plus B'' stays above 1); bake "
-                  "it with weft bake fiber");
-}
-
-void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
-              const FabricRaytraceOptions& o, TabulatedBsdfTable& table) {
-  table.metadata = {
-      {"method", "raytrace"},
-      {"estimator_revision", std::to_string(kFabricRaytraceRevision)},
-      {"fiber_checksum", fiber.checksum()},
-      {"particles_per_bin", std::to_string(o.particles_per_bin)},
-      {"seed", std::to_string(o.seed)},
-      {"estimator",
-       o.next_event_rays > 0 ? "nee" : name_of(kChannelSamplingNames, o.channel_sampling)},
-      {"sample", sample.summary.source + " (" + sample.summary.detail + ")"}};
-  if (o.proposal) table.metadata["proposal_checksum"] = o.proposal->checksum();
-  if (o.next_event_rays > 0) table.metadata["next_event_rays"] = std::to_string(o.next_event_rays);
-  if (o.launch_lattice > 1) table.metadata["launch_lattice"] = std::to_string(o.launch_lattice);
-  if (o.straight_through != StraightThrough::sampled)
-    table.metadata["straight_through"] = name_of(kStraightThroughNames, o.straight_through);
-  if (o.sheen_h_resolution > 0 && o.sheen_light != SheenLight::first_surface)
-    table.metadata["sheen_light"] = name_of(kSheenLightNames, o.sheen_light);
-  // A table of paths cut short says so (only then, so that other tables keep their bytes).
-  if (o.max_scatterings != FabricRaytraceOptions{}.max_scatterings)
-    table.metadata["max_scatterings"] = std::to_string(o.max_scatterings);
-  if (o.channel_sampling != ChannelSampling::mean) {
-    char text[32];
-    const auto end = std::to_chars(text, text + sizeof text, o.split_threshold).ptr;
-    table.metadata["split_threshold"] = std::string(text, end);
-    table.metadata["max_copies_per_particle"] = std::to_string(o.max_copies_per_particle);
-  }
-  for (const char* key : {"spec_hash", "spec_name"})
-    if (const auto it = fiber.metadata.find(key); it != fiber.metadata.end())
-      table.metadata[std::string("fiber_") + key] = it->second;
-}
-
-// Per-yarn tables in the metadata: in place of the one fiber's checksum and spec, per table
-// "name: checksum (spec name)", "; " between tables, how many of the fibers' yarns take each
-// (a draft has up to 40 000 yarns: counts, not the map) and each mesh's table.
-void describe_per_yarn(const FiberTables& f, TabulatedBsdfTable& table) {
-  std::string list;
-  for (size_t k = 0; k < f.tables.size(); ++k) {
-    const TabulatedBsdfTable& t = *f.tables[k];
-    if (k) list += "; ";
-    list += (f.names.empty() ? std::to_string(k) : f.names[k]) + ": " + t.checksum();
-    if (const auto it = t.metadata.find("spec_name"); it != t.metadata.end())
-      list += " (" + it->second + ")";
-  }
-  table.metadata.erase("fiber_checksum");
-  table.metadata.erase("fiber_spec_hash");
-  table.metadata.erase("fiber_spec_name");
-  table.metadata["fiber_tables"] = list;
-  auto joined = [](const std::vector<int>& v) {
-    std::string out;
-    for (size_t i = 0; i < v.size(); ++i) {
-      if (i) out += ',';
-      out += std::to_string(v[i]);
-    }
-    return out;
-  };
-  if (!f.table_of_yarn.empty()) {
-    std::vector<int> yarns(f.tables.size(), 0);
-    for (int k : f.table_of_yarn) ++yarns[k];
-    table.metadata["fiber_yarns_per_table"] = joined(yarns);
-  }
-  if (!f.table_of_mesh.empty()) table.metadata["fiber_table_of_mesh"] = joined(f.table_of_mesh);
-}
-
-// The sheen is booked apart only where the exact lobe is traced, for the whole table (its cell
-// averages blend neighbouring light bins) and not into recorded paths.
-void check_sheen_trace(const FabricRaytraceOptions& o, int bins, bool exact_lobe, bool record) {
-  if (!exact_lobe)
-    throw Error("", "sheen_h_resolution",
-                "books the fibers' surface lobe: it needs fiber detail, one fiber table with an "
-                "analytic surface lobe (weft bake fiber --surface-lobe analytic) and no proposal");
-  if (o.first_bin != 0 || (o.bin_count != 0 && o.bin_count != bins))
-    throw Error("", "sheen_h_resolution",
-                "is booked for a whole table only: not with --shard or --resume");
-  if (record) throw Error("", "sheen_h_resolution", "is not kept in recorded paths");
-}
-
 // How many of a bin's particles each launch stratum (launch_stratum) has: the particles of each
 // of the sheen's light bins nested in it, in the order of HalfVectorLobe::slot.
 std::vector<uint64_t> stratum_particles(const Tracer& t) {
   std::vector<uint64_t> n(static_cast<size_t>(t.sheen->light_bins_per_cell()), 0);
   for (uint64_t idx = 0; idx < t.per_bin; ++idx) ++n[static_cast<size_t>(launch_stratum(t, idx))];
   return n;
-}
-
-// The sheen's booked sums (after the table's cells in 'sums', channels per window bin) as Q =
-// sum / (particles of the light bin x window bin solid angle x mean wi . h) (HalfVectorLobe::
-// mean_projections: the light each (light bin, window bin) booked is the light its cell averages
-// carry), added to the table: its cell averages join the cells, which hold the rest.
-void add_booked_sheen(const CellSums& sums, const std::vector<uint64_t>& per_stratum, int threads,
-                      HalfVectorLobe sheen, TabulatedBsdfTable& table) {
-  const size_t first = table.values.size(), nc = static_cast<size_t>(sheen.channels);
-  const size_t per_slot = static_cast<size_t>(sheen.window_bins()) * nc;
-  const std::vector<double> projection = sheen.mean_projections(threads);
-  for (size_t k = 0; k < sheen.values.size(); ++k) {
-    const double m = projection[k / nc];
-    const double n = static_cast<double>(per_stratum[k / per_slot % per_stratum.size()]);
-    sheen.values[k] =
-        m > 0 ? static_cast<float>(sums.sum[first + k] / (n * sheen.window_bin_solid_angle() * m))
-              : 0.0f;
-  }
-  table.add_sheen(std::move(sheen), threads);
 }
 
 // A fiber table's rest and its surface lobe's cells (FiberSampler), held for a run.
