@@ -77,7 +77,7 @@ void add_bench_sheen_command(CLI::App& bench, Commands& commands) {
       ->capture_default_str();
   cmd->add_option("--batches", r.batches, "independent traces (the peak's standard error)")
       ->capture_default_str();
-  cmd->add_option("--incidence", o->incidences, "light zeniths, degrees (a,b,c)")
+  cmd->add_option("--incidence", o->incidences, "light zeniths, degrees (a,b,c), each in [10, 85]")
       ->capture_default_str();
   cmd->add_option("--azimuth", o->azimuths, "planes of incidence, degrees (0: the warp's)")
       ->capture_default_str();

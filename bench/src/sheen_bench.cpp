@@ -72,7 +72,9 @@ SheenPlan plan_sheen(const SheenRequest& r) {
     throw Error("", "--particles", "must lie in [1, 2^32]");
   if (r.batches < 2 || r.batches > 64)
     throw Error("", "--batches", "must lie in [2, 64] (the peak's uncertainty needs two)");
-  check_angles(r.incidences_deg, 10, 75, "--incidence");
+  // Up to 85 degrees: the peak is searched up to the 89 degree view, and the satin's grazing
+  // light is where tables and reference part most.
+  check_angles(r.incidences_deg, 10, 85, "--incidence");
   check_angles(r.azimuths_deg, 0, 360, "--azimuth");
   if (r.fiber.empty()) throw Error("", "--fiber", "a fiber table (.exr) is required");
   p.fiber = TabulatedBsdfTable::read_exr(r.fiber);

@@ -55,8 +55,12 @@ TEST(Sheen, PlanChecksItsOptionsAndReadsOnlyTheCurvesRows) {
   bad.batches = 1;
   EXPECT_NE(error_of([&] { plan_sheen(bad); }).find("--batches"), std::string::npos);
   bad = r;
-  bad.incidences_deg = {80};
+  bad.incidences_deg = {86};
   EXPECT_NE(error_of([&] { plan_sheen(bad); }).find("--incidence"), std::string::npos);
+  // Cloth lives at grazing angles: a light at 85 degrees is measured (here the missing fiber
+  // table is what stops it).
+  bad.incidences_deg = {85};
+  EXPECT_NE(error_of([&] { plan_sheen(bad); }).find("missing.exr"), std::string::npos);
   bad = r;
   bad.resolution = 64;
   EXPECT_NE(error_of([&] { plan_sheen(bad); }).find("--resolution"), std::string::npos);
