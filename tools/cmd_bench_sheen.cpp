@@ -16,6 +16,7 @@ namespace {
 struct SheenOptions {
   SheenRequest request;
   std::string incidences = "30,45,60", azimuths = "0,90", reference_out;
+  std::string reference_light = name_of(kSheenReferenceNames, SheenRequest{}.reference);
   bool json = false;
 };
 
@@ -43,12 +44,26 @@ void print(const SheenRequest& r, const SheenResult& res, bool json) {
                        {"reference", peak_json(c.reference)},
                        {"reference_beta_se", c.reference_beta_se},
                        {"tables", tables}});
+      if (!c.reference_curve.beta.empty())
+        cases.back()["reference_curve"] = {{"view_deg", c.reference_curve.view_deg},
+                                           {"beta", c.reference_curve.beta},
+                                           {"beta_se", c.reference_curve.beta_se}};
     }
     std::cout << nlohmann::json{{"cases", cases}, {"cpu_seconds", res.cpu_seconds}}.dump(2) << "\n";
     return;
   }
-  std::printf("reference: R %d, %llu particles per bin x %d batches, %.0f CPU s\n", r.resolution,
-              static_cast<unsigned long long>(r.particles_per_bin), r.batches, res.cpu_seconds);
+  if (r.reference == SheenReference::narrow)
+    std::printf(
+        "reference: a narrow light (cone %g deg), exits in a %g deg band in bins of %g deg, read"
+        " after a %g deg running mean; %llu particles per case x %d batches, %d next-event draws, "
+        "%.0f"
+        " CPU s\n",
+        r.narrow.half_angle_deg, r.narrow.band_deg, r.narrow.bin_deg, r.smooth_deg,
+        static_cast<unsigned long long>(r.narrow_particles), r.batches, r.narrow_next_event_rays,
+        res.cpu_seconds);
+  else
+    std::printf("reference: R %d, %llu particles per bin x %d batches, %.0f CPU s\n", r.resolution,
+                static_cast<unsigned long long>(r.particles_per_bin), r.batches, res.cpu_seconds);
   for (const SheenCase& c : res.cases) {
     std::printf(
         "incidence %2.0f, azimuth %3.0f: reference peak %.3f +- %.3f at %.1f deg, FWHM %.1f"
@@ -72,8 +87,28 @@ void add_bench_sheen_command(CLI::App& bench, Commands& commands) {
   cmd->add_option("--fiber", r.fiber, "fiber table (.exr) the reference traces")->required();
   cmd->add_option("--weave", r.weave, "woven sample options (.json)")->capture_default_str();
   cmd->add_option("--table", r.tables, "fabric table(s) (.exr) to measure against the reference");
-  cmd->add_option("-R,--resolution", r.resolution, "the reference's grid")->capture_default_str();
+  cmd->add_option("--reference-light", o->reference_light,
+                  "the reference: grid (the ray trace's cells at -R, the light bins' beams) | "
+                  "narrow (a narrow light per case, its exits binned in its plane)")
+      ->check(CLI::IsMember(names_of(kSheenReferenceNames)))
+      ->capture_default_str();
+  cmd->add_option("-R,--resolution", r.resolution, "grid: the reference's grid")
+      ->capture_default_str();
   cmd->add_option("--particles", r.particles_per_bin, "particles per light bin and batch")
+      ->capture_default_str();
+  cmd->add_option("--narrow-particles", r.narrow_particles, "narrow: particles per case and batch")
+      ->capture_default_str();
+  cmd->add_option("--nee", r.narrow_next_event_rays,
+                  "narrow: next-event draws per scattering (0: the exits alone)")
+      ->capture_default_str();
+  cmd->add_option("--cone", r.narrow.half_angle_deg,
+                  "narrow: the light's half angle, degrees (0: collimated)")
+      ->capture_default_str();
+  cmd->add_option("--band", r.narrow.band_deg, "narrow: the exits' band across the plane, degrees")
+      ->capture_default_str();
+  cmd->add_option("--bin", r.narrow.bin_deg, "narrow: the exits' bins along the plane, degrees")
+      ->capture_default_str();
+  cmd->add_option("--smooth", r.smooth_deg, "narrow: running mean the peak is read after, degrees")
       ->capture_default_str();
   cmd->add_option("--batches", r.batches, "independent traces (the peak's standard error)")
       ->capture_default_str();
@@ -88,22 +123,28 @@ void add_bench_sheen_command(CLI::App& bench, Commands& commands) {
   cmd->add_option("--seed", r.seed, "seed of the first batch")->capture_default_str();
   cmd->add_option("--threads", r.threads, "threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--json", o->json, "print JSON");
-  commands.push_back({cmd, [o](const RunLimits& limits) {
-                        SheenRequest req = o->request;
-                        req.incidences_deg = parse_range(o->incidences, "--incidence", 64);
-                        req.azimuths_deg = parse_range(o->azimuths, "--azimuth", 64);
-                        const SheenPlan plan = plan_sheen(req);
-                        for (int b = 0; b < plan.request.batches && !o->reference_out.empty(); ++b)
-                          TabulatedBsdfTable::check_output_path(batch_path(o->reference_out, b),
-                                                                "--reference-out");
-                        const SheenResult res = run_sheen(plan, progress_bar(limits, false));
-                        if (res.cancelled) return 130;
-                        for (size_t b = 0; b < res.batches.size() && !o->reference_out.empty(); ++b)
-                          res.batches[b].write_exr(
-                              batch_path(o->reference_out, static_cast<int>(b)));
-                        print(plan.request, res, o->json);
-                        return 0;
-                      }});
+  commands.push_back(
+      {cmd, [o](const RunLimits& limits) {
+         SheenRequest req = o->request;
+         req.incidences_deg = parse_range(o->incidences, "--incidence", 64);
+         req.azimuths_deg = parse_range(o->azimuths, "--azimuth", 64);
+         req.reference =
+             value_of(kSheenReferenceNames, o->reference_light, "", "--reference-light");
+         const SheenPlan plan = plan_sheen(req);
+         if (req.reference == SheenReference::narrow && !o->reference_out.empty())
+           throw Error("", "--reference-out",
+                       "writes a grid reference's batches; a narrow reference's "
+                       "curves are printed with --json");
+         for (int b = 0; b < plan.request.batches && !o->reference_out.empty(); ++b)
+           TabulatedBsdfTable::check_output_path(batch_path(o->reference_out, b),
+                                                 "--reference-out");
+         const SheenResult res = run_sheen(plan, progress_bar(limits, false));
+         if (res.cancelled) return 130;
+         for (size_t b = 0; b < res.batches.size() && !o->reference_out.empty(); ++b)
+           res.batches[b].write_exr(batch_path(o->reference_out, static_cast<int>(b)));
+         print(plan.request, res, o->json);
+         return 0;
+       }});
 }
 
 }  // namespace weft::cli

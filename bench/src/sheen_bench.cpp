@@ -38,23 +38,156 @@ void check_angles(const std::vector<double>& angles, double lo, double hi, const
                       std::to_string(hi) + "] degrees");
 }
 
-InplanePeak peak_of(const TableReader& t, double theta_i, double azimuth) {
-  std::vector<double> views, beta;
-  for (double v = 0; v <= 89.0; v += 0.5)
-    views.push_back(v), beta.push_back(beta_at(t, theta_i, azimuth, v));
+// The narrow reference's options, each named as the command line names it; the light's own
+// checks (FabricRaytraceOptions::validate) follow per case.
+void check_narrow(const SheenRequest& r) {
+  if (!r.reference_batches.empty())
+    throw Error("", "--reference", "reads a grid reference's batches, not a narrow one's");
+  if (r.narrow_particles < 1 || r.narrow_particles > (uint64_t{1} << 32))
+    throw Error("", "--narrow-particles", "must lie in [1, 2^32]");
+  if (r.narrow_next_event_rays < 0 || r.narrow_next_event_rays > kMaxNextEventRays)
+    throw Error("", "--nee", "must lie in [0, " + std::to_string(kMaxNextEventRays) + "]");
+  if (!(r.narrow.half_angle_deg >= 0 && r.narrow.half_angle_deg <= 10))
+    throw Error("", "--cone", "must lie in [0, 10] degrees");
+  if (!(r.narrow.band_deg >= 0.01 && r.narrow.band_deg <= 60))
+    throw Error("", "--band", "must lie in [0.01, 60] degrees");
+  if (!(r.narrow.bin_deg >= 0.05 && r.narrow.bin_deg <= 10))
+    throw Error("", "--bin", "must lie in [0.05, 10] degrees");
+  if (!(r.smooth_deg >= 0 && r.smooth_deg <= 10))
+    throw Error("", "--smooth", "must lie in [0, 10] degrees");
+}
+
+// The peak of a curve beta over ascending views a step apart, with its base given.
+InplanePeak peak_of_curve(const std::vector<double>& views, const std::vector<double>& beta,
+                          double theta_i, double base, double step) {
   InplanePeak p;
   size_t k = views.size();
   for (size_t i = 0; i < views.size(); ++i)
     if (std::abs(views[i] - theta_i) <= 10 && (k == views.size() || beta[i] > beta[k])) k = i;
   p.beta = beta[k], p.view_deg = views[k];
-  p.base = std::min(beta_at(t, theta_i, azimuth, std::max(0.0, theta_i - 20)),
-                    beta_at(t, theta_i, azimuth, std::min(89.0, theta_i + 20)));
+  p.base = base;
   const double half = p.base + 0.5 * (p.beta - p.base);
   size_t a = k, b = k;
   while (a > 0 && beta[a - 1] > half) --a;
   while (b + 1 < beta.size() && beta[b + 1] > half) ++b;
-  p.fwhm_deg = views[b] - views[a] + 0.5;
+  p.fwhm_deg = views[b] - views[a] + step;
   return p;
+}
+
+InplanePeak peak_of(const TableReader& t, double theta_i, double azimuth) {
+  std::vector<double> views, beta;
+  for (double v = 0; v <= 89.0; v += 0.5)
+    views.push_back(v), beta.push_back(beta_at(t, theta_i, azimuth, v));
+  const double base = std::min(beta_at(t, theta_i, azimuth, std::max(0.0, theta_i - 20)),
+                               beta_at(t, theta_i, azimuth, std::min(89.0, theta_i + 20)));
+  return peak_of_curve(views, beta, theta_i, base, 0.5);
+}
+
+// A narrow light's curve on the mirror's side (its plane bins of theta' < 0, views ascending):
+// beta = pi f, the channels' mean, and as its standard error the channels' mean of theirs (an
+// upper bound: the channels share their particles).
+InplaneCurve mirror_curve(const FabricRaytraceResult& t, const NarrowLight& n, int nc) {
+  InplaneCurve c;
+  for (int k = n.plane_bins() - 1; k >= 0; --k) {
+    const double view = NarrowLight::kMaxPlaneDeg - (k + 0.5) * n.bin_deg;
+    if (!(view > 0)) continue;
+    double f = 0, se = 0;
+    for (int ch = 0; ch < nc; ++ch) {
+      f += t.plane_f[static_cast<size_t>(k) * nc + ch];
+      se += t.plane_f_se[static_cast<size_t>(k) * nc + ch];
+    }
+    c.view_deg.push_back(view);
+    c.beta.push_back(kPi * f / nc);
+    c.beta_se.push_back(kPi * se / nc);
+  }
+  return c;
+}
+
+// A narrow curve's peak: its running mean over the bins within smooth_deg / 2 of each, read as
+// a table's curve is, its base the smoothed curve at the views nearest theta_i -+ 20 degrees.
+InplanePeak narrow_peak(const InplaneCurve& c, double theta_i, double smooth_deg, double step) {
+  const int m = static_cast<int>(std::floor(smooth_deg / 2 / step + 1e-9));
+  const int n = static_cast<int>(c.beta.size());
+  std::vector<double> smooth(c.beta.size());
+  for (int i = 0; i < n; ++i) {
+    double s = 0;
+    int count = 0;
+    for (int j = std::max(0, i - m); j <= std::min(n - 1, i + m); ++j) s += c.beta[j], ++count;
+    smooth[i] = s / count;
+  }
+  const auto at = [&](double view) {
+    size_t best = 0;
+    for (size_t i = 1; i < c.view_deg.size(); ++i)
+      if (std::abs(c.view_deg[i] - view) < std::abs(c.view_deg[best] - view)) best = i;
+    return smooth[best];
+  };
+  return peak_of_curve(c.view_deg, smooth, theta_i, std::min(at(theta_i - 20), at(theta_i + 20)),
+                       step);
+}
+
+// The standard error of a mean over n values from their sum and sum of squares.
+double standard_error(double s, double s2, double n) {
+  const double mean = s / n;
+  return std::sqrt(std::max(0.0, s2 / n - mean * mean) / (n - 1));
+}
+
+// The narrow reference: per case, each batch's light traced on its own (seeds seed, seed + 1, ...).
+SheenResult run_narrow(const SheenPlan& p, const ProgressCallback& progress) {
+  const SheenRequest& r = p.request;
+  SheenResult out;
+  const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
+  const uint64_t total =
+      static_cast<uint64_t>(r.batches) * r.incidences_deg.size() * r.azimuths_deg.size();
+  const uint64_t n = r.narrow_particles;
+  uint64_t done = 0;
+  // In particles: at R 1 a light from above is bin 0, the batch's first n particles (the table's
+  // row is not read, and R 1's is the cheapest to keep).
+  const ProgressCallback per_case = [&](const ProgressUpdate& u) {
+    const uint64_t in_case = u.stage == "particles" ? std::min(n, u.done) : 0;
+    return progress({"reference particles", done * n + in_case, total * n});
+  };
+  std::vector<TableReader> readers;
+  for (const auto& t : p.tables) readers.emplace_back(t, r.threads);
+  for (double phi : r.azimuths_deg)
+    for (double ti : r.incidences_deg) {
+      SheenCase c{ti, phi, {}, 0, {}, {}};
+      double s = 0, s2 = 0;
+      for (int b = 0; b < r.batches; ++b) {
+        FabricRaytraceOptions o;
+        o.resolution = 1;
+        o.particles_per_bin = r.narrow_particles;
+        o.seed = r.seed + static_cast<uint64_t>(b);
+        o.threads = r.threads;
+        o.straight_through = StraightThrough::sampled;
+        o.next_event_rays = r.narrow_next_event_rays;
+        o.narrow_light = r.narrow;
+        o.narrow_light->theta_deg = ti, o.narrow_light->azimuth_deg = phi;
+        const FabricRaytraceResult t = raytrace_fabric_table(p.sample, p.fiber, o, per_case);
+        if (t.cancelled || !progress({"reference particles", ++done * n, total * n})) {
+          out.cancelled = true;
+          return out;
+        }
+        const InplaneCurve curve = mirror_curve(t, r.narrow, p.fiber.channels);
+        const double peak = narrow_peak(curve, ti, r.smooth_deg, r.narrow.bin_deg).beta;
+        s += peak, s2 += peak * peak;
+        InplaneCurve& mean = c.reference_curve;
+        if (b == 0) {
+          const std::vector<double> zeros(curve.beta.size(), 0.0);
+          mean = InplaneCurve{curve.view_deg, zeros, zeros};
+        }
+        for (size_t i = 0; i < curve.beta.size(); ++i) {
+          mean.beta[i] += curve.beta[i] / r.batches;
+          mean.beta_se[i] += curve.beta_se[i] * curve.beta_se[i];
+        }
+      }
+      for (double& se : c.reference_curve.beta_se) se = std::sqrt(se) / r.batches;
+      c.reference = narrow_peak(c.reference_curve, ti, r.smooth_deg, r.narrow.bin_deg);
+      c.reference_beta_se = standard_error(s, s2, r.batches);
+      for (const TableReader& t : readers) c.tables.push_back(peak_of(t, ti, phi));
+      out.cases.push_back(std::move(c));
+    }
+  out.cpu_seconds = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  return out;
 }
 
 }  // namespace
@@ -76,6 +209,7 @@ SheenPlan plan_sheen(const SheenRequest& r) {
   // light is where tables and reference part most.
   check_angles(r.incidences_deg, 10, 85, "--incidence");
   check_angles(r.azimuths_deg, 0, 360, "--azimuth");
+  if (r.reference == SheenReference::narrow) check_narrow(r);
   if (r.fiber.empty()) throw Error("", "--fiber", "a fiber table (.exr) is required");
   p.fiber = TabulatedBsdfTable::read_exr(r.fiber);
   if (p.fiber.kind != "fiber") throw Error(r.fiber, "kind", "must be a fiber table");
@@ -94,6 +228,10 @@ SheenPlan plan_sheen(const SheenRequest& r) {
   if (r.reference_batches.size() == 1)
     throw Error(r.reference_batches[0], "--reference",
                 "needs two or more batches (the peak's uncertainty)");
+  if (r.reference == SheenReference::narrow) {
+    p.sample = make_woven_sample(read_weave_options(r.weave));
+    return p;  // one light per case: no rows
+  }
   if (!p.reference_batches.empty()) {
     p.request.resolution = p.reference_batches[0].resolution;
     p.request.batches = static_cast<int>(p.reference_batches.size());
@@ -113,6 +251,7 @@ SheenPlan plan_sheen(const SheenRequest& r) {
 }
 
 SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
+  if (p.request.reference == SheenReference::narrow) return run_narrow(p, progress);
   const SheenRequest& r = p.request;
   SheenResult out;
   const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
@@ -156,14 +295,13 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
   for (const auto& t : p.tables) readers.emplace_back(t, r.threads);
   for (double phi : r.azimuths_deg)
     for (double ti : r.incidences_deg) {
-      SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, {}};
+      SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, {}, {}};
       double s = 0, s2 = 0;
       for (const auto& t : batch_tables) {
         const double v = inplane_peak(t, ti, phi).beta;
         s += v, s2 += v * v;
       }
-      const double n = r.batches, mean = s / n;
-      c.reference_beta_se = std::sqrt(std::max(0.0, s2 / n - mean * mean) / (n - 1));
+      c.reference_beta_se = standard_error(s, s2, r.batches);
       for (const TableReader& t : readers) c.tables.push_back(peak_of(t, ti, phi));
       out.cases.push_back(c);
     }

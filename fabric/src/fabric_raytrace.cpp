@@ -58,6 +58,10 @@ struct Tracer {
   // sheen_h_resolution): its cells follow the table's in the tally, from sheen_first_cell on.
   const HalfVectorLobe* sheen = nullptr;
   uint64_t sheen_first_cell = 0;
+  // The narrow light (FabricRaytraceOptions::narrow_light), when on: its plane's exits follow the
+  // table's cells in the tally, from plane_first_cell on.
+  const LightPlane* plane = nullptr;
+  uint64_t plane_first_cell = 0;
 };
 
 // Where particle idx of its bin is launched: its sub-square of the bin when the sheen's light bins
@@ -134,6 +138,18 @@ CellsBook book_sheen(const Tracer& t, Life& life, const Vec3& d, std::span<const
   return all ? CellsBook::none : CellsBook::rest;
 }
 
+// A reflected exit along d about the narrow light's plane of incidence, with weights w: into its
+// bin of the plane (LightPlane::bin_of), as f over the bin's angles.
+void book_plane_exit(const Tracer& t, Life& life, const Vec3& d, std::span<const double> w) {
+  double factor = 0;
+  const int k = t.plane->bin_of(world_to_cloth(d), factor);
+  if (k < 0) return;
+  std::array<double, kNumBands> f;  // the first w.size() are written and read
+  for (size_t c = 0; c < w.size(); ++c) f[c] = w[c] * factor;
+  tally_exit(*life.tally, life.first_exit, t.plane_first_cell + static_cast<uint64_t>(k),
+             std::span<const double>(f.data(), w.size()));
+}
+
 // An exit along d whose line passes through p, with weights w: into the table's tally (its
 // sheen's part, when booked apart, into the sheen's window) and, when on, the weave's.
 void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d, std::span<const double> w,
@@ -146,6 +162,7 @@ void book_exit(const Tracer& t, Life& life, const Vec3& p, const Vec3& d, std::s
   if (cells != CellsBook::none)
     tally_exit(*life.tally, life.first_exit, cell,
                cells == CellsBook::rest ? std::span<const double>(r) : w);
+  if (t.plane) book_plane_exit(t, life, d, w);
   if (t.weave) {
     const int exit_bin = static_cast<int>(cell - static_cast<uint64_t>(life.bin) * t.grid.bins());
     tally_weave_exit(*t.weave, life.tally->weave, life.first_exit, life.bin, exit_bin, p, d, w);
@@ -311,6 +328,11 @@ void trace_particle(const Tracer& t, uint64_t k, int bin, Tally& tally, size_t u
   // Drawn either way: the stream stays the same.
   Launch l = launch(t.grid, t.slab, bin, rng, strata, stratum);
   if (t.o.launch_lattice > 1) l = lattice_launch(t, idx, bin, strata, stratum);
+  if (t.plane) {  // the narrow light's direction in place of the bin's
+    const Vec3 wi = t.plane->draw(rng);
+    l.w0 = wi.z;
+    l.d = -cloth_to_world(wi);
+  }
   if (t.sheen)
     life.light_bin = t.sheen->light_bin_at(static_cast<size_t>(bin) * (strata * strata) + stratum);
   life.wi = -world_to_cloth(l.d);
@@ -440,9 +462,11 @@ Tracer tracer_for(const RenderScene& scene, const RepeatSlab& slab, int64_t curv
   t.window = o.channel_sampling != ChannelSampling::mean;
   t.proposal = o.proposal != nullptr;
   t.per_bin = o.particles_per_bin;
-  const int bins = t.grid.bins();
-  t.first_item = t.per_bin * static_cast<uint64_t>(o.first_bin);
-  t.last_item = t.per_bin * static_cast<uint64_t>(o.bin_count ? o.first_bin + o.bin_count : bins);
+  // A narrow light traces only the bin holding its direction.
+  const int first = o.narrow_light ? t.grid.bin_of(LightPlane(*o.narrow_light).wi) : o.first_bin;
+  const int last = o.narrow_light ? first + 1 : o.bin_count ? first + o.bin_count : t.grid.bins();
+  t.first_item = t.per_bin * static_cast<uint64_t>(first);
+  t.last_item = t.per_bin * static_cast<uint64_t>(last);
   return t;
 }
 
@@ -608,8 +632,14 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
                         " light bins per table bin: give at least " +
                         std::to_string(sheen->light_bins_per_cell() * t.o.launch_lattice));
   }
+  std::optional<LightPlane> plane;
+  if (o.narrow_light) {
+    t.plane = &plane.emplace(*o.narrow_light);
+    t.plane_first_cell = static_cast<uint64_t>(bins) * bins;
+  }
   const size_t values =
-      (static_cast<size_t>(bins) * bins + (sheen ? sheen->values.size() / nc : 0)) *
+      (static_cast<size_t>(bins) * bins + (sheen ? sheen->values.size() / nc : 0) +
+       (plane ? static_cast<size_t>(plane->light.plane_bins()) : 0)) *
       static_cast<size_t>(nc);
   CellSums sums{std::vector<double>(values, 0.0), std::vector<double>(values, 0.0)};
   FabricRaytraceResult result;
@@ -644,6 +674,11 @@ FabricRaytraceResult trace(const WovenSample& sample, const FiberTables& f,
   tabulate(sums, exact, t.grid, nc, t.per_bin, units, result);
   if (sheen)
     add_booked_sheen(sums, stratum_particles(t), o.threads, std::move(*sheen), result.table);
+  if (plane) {
+    const int bin = static_cast<int>(t.first_item / t.per_bin);
+    tabulate_plane(sums, t.plane_first_cell * nc, *plane, nc, result.bin_books[bin].launched,
+                   units[bin], result);
+  }
   fabric_raytrace_totals(result);
   describe(sample, fiber, o, result.table);
   if (exact_lobe && fiber.surface_lobe) result.table.metadata["fiber_surface_lobe"] = "exact";
@@ -712,6 +747,7 @@ RecordedFabricPaths record_fabric_paths(const WovenSample& sample,
     throw Error("", "next_event_rays", "the next-event estimate's draws are not recorded");
   if (options.weave_positions_u > 0)
     throw Error("", "weave_positions_u", "the weave tally is not recorded");
+  if (options.narrow_light) throw Error("", "narrow_light", "a narrow light is not recorded");
   FabricRaytraceOptions o = options;
   o.proposal = &proposal;
   RecordedFabricPaths record;

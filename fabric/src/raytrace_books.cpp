@@ -120,6 +120,31 @@ FabricSceneSeconds fabric_scene_seconds(const WovenSampleSize& z) {
   return c;
 }
 
+namespace {
+
+// A narrow light is a light of its own: it replaces the bins' beams and what is worked out per bin.
+void validate_narrow_light(const FabricRaytraceOptions& o) {
+  const NarrowLight& n = *o.narrow_light;
+  const auto in = [](double x, double lo, double hi) { return x >= lo && x <= hi; };
+  if (!in(n.theta_deg, 0, 89))
+    throw Error("", "narrow_light.theta_deg", "must lie in [0, 89] (light from above)");
+  if (!in(n.azimuth_deg, -360, 360))
+    throw Error("", "narrow_light.azimuth_deg", "must lie in [-360, 360]");
+  if (!in(n.half_angle_deg, 0, 10))
+    throw Error("", "narrow_light.half_angle_deg", "must lie in [0, 10]");
+  if (!in(n.band_deg, 0.01, 60)) throw Error("", "narrow_light.band_deg", "must lie in [0.01, 60]");
+  if (!in(n.bin_deg, 0.05, 10)) throw Error("", "narrow_light.bin_deg", "must lie in [0.05, 10]");
+  if (o.first_bin != 0 || o.bin_count != 0)
+    throw Error("", "narrow_light", "traces its own bin: leave first_bin and bin_count 0");
+  if (o.straight_through != StraightThrough::sampled)
+    throw Error("", "narrow_light",
+                "needs the straight-through light sampled (its exact part is a bin's beam's)");
+  if (o.sheen_h_resolution != 0 || o.weave_positions_u != 0)
+    throw Error("", "narrow_light", "takes no sheen and no weave tally");
+}
+
+}  // namespace
+
 void FabricRaytraceOptions::validate() const {
   if (resolution < 1 || resolution > TabulatedBsdfTable::kMaxResolution)
     throw Error("", "resolution",
@@ -154,6 +179,11 @@ void FabricRaytraceOptions::validate() const {
   } else if (sheen_light_resolution != 0) {
     throw Error("", "sheen_light_resolution", "sizes the sheen's light bins: it needs a sheen");
   }
+  if (narrow_light) validate_narrow_light(*this);
+}
+
+int NarrowLight::plane_bins() const {
+  return static_cast<int>(std::floor(2 * kMaxPlaneDeg / bin_deg + 1e-9));
 }
 
 void FabricBinBooks::add(const FabricBinBooks& o) {

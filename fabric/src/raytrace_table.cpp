@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "weft/core/error.h"
+#include "weft/core/math.h"
 #include "weft/fiber/fiber_table_bake.h"
 
 namespace weft::raytrace {
@@ -119,6 +120,12 @@ void describe(const WovenSample& sample, const TabulatedBsdfTable& fiber,
     table.metadata["straight_through"] = name_of(kStraightThroughNames, o.straight_through);
   if (o.sheen_h_resolution > 0 && o.sheen_light != SheenLight::first_surface)
     table.metadata["sheen_light"] = name_of(kSheenLightNames, o.sheen_light);
+  if (const auto& n = o.narrow_light) {  // its row is that light's, not the bin's beam's
+    char text[96];
+    std::snprintf(text, sizeof text, "theta %g, azimuth %g, half angle %g deg", n->theta_deg,
+                  n->azimuth_deg, n->half_angle_deg);
+    table.metadata["narrow_light"] = text;
+  }
   // A table of paths cut short says so (only then, so that other tables keep their bytes).
   if (o.max_scatterings != FabricRaytraceOptions{}.max_scatterings)
     table.metadata["max_scatterings"] = std::to_string(o.max_scatterings);
@@ -186,6 +193,49 @@ void add_booked_sheen(const CellSums& sums, const std::vector<uint64_t>& per_str
               : 0.0f;
   }
   table.add_sheen(std::move(sheen), threads);
+}
+
+LightPlane::LightPlane(const NarrowLight& l) : light(l) {
+  const double t = deg_to_rad(l.theta_deg), a = deg_to_rad(l.azimuth_deg);
+  wi = {std::sin(t) * std::cos(a), std::sin(t) * std::sin(a), std::cos(t)};
+  u = {std::cos(a), std::sin(a), 0};
+  v = {-std::sin(a), std::cos(a), 0};
+}
+
+Vec3 LightPlane::draw(Rng& rng) const {
+  const double c = 1 - rng.uniform() * (1 - std::cos(deg_to_rad(light.half_angle_deg)));
+  const double s = std::sqrt(std::max(0.0, 1 - c * c)), p = 2 * kPi * rng.uniform();
+  // e1 completes (e1, v, wi): the light's zenith tilted down the plane.
+  const double t = deg_to_rad(light.theta_deg);
+  const Vec3 e1 = u * std::cos(t) - Vec3{0, 0, std::sin(t)};
+  return normalize(wi * c + e1 * (s * std::cos(p)) + v * (s * std::sin(p)));
+}
+
+int LightPlane::bin_of(const Vec3& wo, double& factor) const {
+  if (!(wo.z > 0)) return -1;
+  const double along = std::clamp(dot(wo, u), -1.0, 1.0);
+  const double theta = std::asin(along), phi = std::atan2(dot(wo, v), wo.z);
+  if (!(std::abs(phi) <= 0.5 * deg_to_rad(light.band_deg))) return -1;
+  const double x = (rad_to_deg(theta) + NarrowLight::kMaxPlaneDeg) / light.bin_deg;
+  if (!(x >= 0 && x < light.plane_bins())) return -1;
+  factor = 1 / (wo.z * std::sqrt(1 - along * along));
+  return static_cast<int>(x);
+}
+
+void tabulate_plane(const CellSums& sums, size_t first_value, const LightPlane& plane, int nc,
+                    double launched, uint64_t units, FabricRaytraceResult& result) {
+  const size_t n = static_cast<size_t>(plane.light.plane_bins()) * nc;
+  const double scale =
+      1 / (launched * deg_to_rad(plane.light.bin_deg) * deg_to_rad(plane.light.band_deg));
+  const double u = static_cast<double>(units);
+  result.plane_f.assign(n, 0.0);
+  result.plane_f_se.assign(n, 0.0);
+  for (size_t k = 0; k < n; ++k) {
+    const double s = sums.sum[first_value + k], m1 = s / u;
+    result.plane_f[k] = s * scale;
+    result.plane_f_se[k] =
+        std::sqrt(std::max(0.0, sums.sum2[first_value + k] / u - m1 * m1) * u) * scale;
+  }
 }
 
 }  // namespace weft::raytrace

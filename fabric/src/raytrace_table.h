@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "weft/core/direction_grid.h"
+#include "weft/core/rng.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/raytrace_steps.h"
 #include "weft/materials/half_vector_lobe.h"
@@ -62,5 +63,24 @@ void check_sheen_trace(const FabricRaytraceOptions& o, int bins, bool exact_lobe
 // carry), added to the table: its cell averages join the cells, which hold the rest.
 void add_booked_sheen(const CellSums& sums, const std::vector<uint64_t>& per_stratum, int threads,
                       HalfVectorLobe sheen, TabulatedBsdfTable& table);
+
+// A narrow light's directions and its plane of incidence's exits (NarrowLight), in the cloth frame.
+struct LightPlane {
+  NarrowLight light;
+  Vec3 wi, u, v;  // towards the light; the plane's horizontal towards it; n x u
+  explicit LightPlane(const NarrowLight& light);
+  // A direction towards the light, uniform over the cone's solid angle (two draws, also when the
+  // beam is collimated, so that the stream does not depend on the cone's width).
+  Vec3 draw(Rng& rng) const;
+  // The plane_f bin of a reflected exit wo, -1 outside the band or the bins; into 'factor' what its
+  // weights are multiplied by to book f over the bin's (theta', phi'): 1 / (wo.z cos theta').
+  int bin_of(const Vec3& wo, double& factor) const;
+};
+
+// The plane's sums (after the table's cells in 'sums', from value first_value on) as plane_f and
+// its standard error: over the power launched and the bin's theta' x phi' extent, and 'units'
+// independent sample units.
+void tabulate_plane(const CellSums& sums, size_t first_value, const LightPlane& plane, int nc,
+                    double launched, uint64_t units, FabricRaytraceResult& result);
 
 }  // namespace weft::raytrace

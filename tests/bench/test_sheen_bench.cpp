@@ -131,3 +131,71 @@ TEST(Sheen, ReferenceBatchesAreReadNotTraced) {
   EXPECT_NEAR(res.cases[0].reference_beta_se, 0.1 * first, 1e-5 * first);
   EXPECT_NEAR(res.cases[0].tables[0].beta, first, 1e-12);
 }
+
+// The narrow reference: its options are checked before any work, and a short run on the bundled
+// satin gives each case the mean curve on the mirror's side, every bin of the plane there, and
+// reads its peak near the mirror.
+TEST(Sheen, TheNarrowReferenceTracesALightPerCaseAndReadsItsCurve) {
+  const std::filesystem::path dir = fresh_test_dir();
+  TabulatedBsdfTable fiber = TabulatedBsdfTable::from_function(
+      4, 3,
+      [](const Vec3& wo, const Vec3& wi, std::span<double> v) {
+        // A glossy fiber: about the mirror in its own frame, over a little diffuse light.
+        const double th = std::acos(std::min(1.0, normalize(wo + wi).z));
+        v[0] = v[1] = v[2] = wo.z > 0 ? 0.03 + 0.3 * std::exp(-th * th / 0.1) : 0.01;
+      },
+      4, 1, 2);
+  fiber.kind = "fiber";
+  fiber.write_exr(dir / "fiber.exr");
+  SheenRequest r;
+  r.fiber = (dir / "fiber.exr").string();
+  r.weave = std::string(WEFT_SOURCE_DIR) + "/scenes/examples/polyester-satin-weave.json";
+  r.reference = SheenReference::narrow;
+  r.incidences_deg = {45};
+  r.azimuths_deg = {0};
+  r.narrow_particles = 2000;
+  r.narrow_next_event_rays = 2;
+  const auto refused = [&](SheenRequest bad, const char* option) {
+    EXPECT_NE(error_of([&] { plan_sheen(bad); }).find(option), std::string::npos) << option;
+  };
+  SheenRequest bad = r;
+  bad.narrow_particles = 0;
+  refused(bad, "--narrow-particles");
+  bad = r;
+  bad.narrow_next_event_rays = kMaxNextEventRays + 1;
+  refused(bad, "--nee");
+  bad = r;
+  bad.narrow.band_deg = 0;
+  refused(bad, "--band");
+  bad = r;
+  bad.narrow.bin_deg = std::nan("");
+  refused(bad, "--bin");
+  bad = r;
+  bad.narrow.half_angle_deg = 20;
+  refused(bad, "--cone");
+  bad = r;
+  bad.smooth_deg = -1;
+  refused(bad, "--smooth");
+  bad = r;
+  bad.reference_batches = {"a.exr", "b.exr"};
+  refused(bad, "--reference");
+
+  const SheenPlan p = plan_sheen(r);
+  EXPECT_TRUE(p.rows.empty());  // a light per case, no light bins
+  const SheenResult res = run_sheen(p);
+  ASSERT_FALSE(res.cancelled);
+  ASSERT_EQ(res.cases.size(), 1u);
+  const SheenCase& c = res.cases[0];
+  const InplaneCurve& curve = c.reference_curve;
+  ASSERT_EQ(curve.view_deg.size(), 178u);  // 89 degrees in bins of 0.5 on the mirror's side
+  EXPECT_DOUBLE_EQ(curve.view_deg.front(), 0.25);
+  EXPECT_DOUBLE_EQ(curve.view_deg.back(), 88.75);
+  for (size_t i = 0; i < curve.beta.size(); ++i) {
+    EXPECT_GE(curve.beta[i], 0) << i;
+    EXPECT_GE(curve.beta_se[i], 0) << i;
+  }
+  EXPECT_NEAR(c.reference.view_deg, 45, 10);
+  EXPECT_GT(c.reference.beta, c.reference.base);
+  EXPECT_TRUE(std::isfinite(c.reference_beta_se));
+  EXPECT_GT(res.cpu_seconds, 0);
+}

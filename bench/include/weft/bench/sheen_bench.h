@@ -1,13 +1,18 @@
 #pragma once
 // How much of a cloth's mirror peak (its sheen) a fabric table keeps: the peak of a table's
-// in-plane curve against a brute-force reference, the fiber-level ray trace at a fine grid (R 32
-// by default, bins about 3.5 degrees across) of only the light bins the in-plane curves read
-// (weft bench sheen; docs/fabric-bsdf.md, "Sharp sheen: what a table keeps").
+// in-plane curve against a brute-force reference (weft bench sheen; docs/fabric-bsdf.md, "Sharp
+// sheen: what a table keeps"). Two references: grid, the fiber-level ray trace at a fine grid (R 32
+// by default, bins about 3.5 degrees across) of only the light bins the in-plane curves read; and
+// narrow, a narrow light at each asked incidence whose reflected exits are booked by their angle in
+// its plane of incidence (NarrowLight, fabric/fabric_raytrace.h), which averages the peak over
+// neither a light bin nor an exit cell (docs/fabric-bsdf.md, "A narrow light").
 #include <cstdint>
 #include <string>
 #include <vector>
 
+#include "weft/core/names.h"
 #include "weft/core/progress.h"
+#include "weft/fabric/fabric_raytrace.h"
 #include "weft/materials/bsdf_table.h"
 #include "weft/scenes/weave.h"
 
@@ -24,6 +29,12 @@ struct InplanePeak {
 };
 InplanePeak inplane_peak(const TabulatedBsdfTable& table, double theta_i_deg, double azimuth_deg);
 
+enum class SheenReference { grid, narrow };
+inline constexpr NameTable<SheenReference, 2> kSheenReferenceNames{{
+    {SheenReference::grid, "grid", "the ray trace's cells at a fine grid"},
+    {SheenReference::narrow, "narrow", "a narrow light's exits in its plane of incidence"},
+}};
+
 struct SheenRequest {
   std::string fiber;  // the fiber table (.exr) the reference traces (its surface lobe exact)
   std::string weave = "scenes/examples/polyester-satin-weave.json";  // woven sample options
@@ -37,6 +48,16 @@ struct SheenRequest {
   // The reference's batches from an earlier run (SheenResult::batches, written by weft bench sheen
   // --reference-out): read instead of traced, two or more of one grid.
   std::vector<std::string> reference_batches;
+  SheenReference reference = SheenReference::grid;
+  // The narrow reference: its light's cone, band and bins (theta and azimuth are each case's),
+  // its particles per case and batch, the next-event draws per scattering (FabricRaytraceOptions::
+  // next_event_rays: on the satin, 16 cut the variance per CPU second 2.2-fold against none), and
+  // the running mean over smooth_deg (the bins within half of it either side of each bin's centre)
+  // its curve is read after.
+  NarrowLight narrow;
+  uint64_t narrow_particles = uint64_t{1} << 18;
+  int narrow_next_event_rays = 16;
+  double smooth_deg = 1;
   int threads = 0;
 };
 
@@ -51,16 +72,23 @@ struct SheenPlan {
 // Reads and checks everything before any work: weft::Error naming the option.
 SheenPlan plan_sheen(const SheenRequest& request);
 
+// The narrow reference's in-plane curve on the mirror's side: beta = pi f (the channels' mean)
+// at each plane bin's view, the batches' mean, with its standard error (from the particles').
+struct InplaneCurve {
+  std::vector<double> view_deg, beta, beta_se;
+};
+
 struct SheenCase {
   double incidence_deg = 0, azimuth_deg = 0;
-  InplanePeak reference;         // of the batches' mean table
+  InplanePeak reference;         // of the batches' mean table (narrow: mean curve, smoothed)
   double reference_beta_se = 0;  // standard error of the peak over the batches
+  InplaneCurve reference_curve;  // narrow only
   std::vector<InplanePeak> tables;
 };
 struct SheenResult {
   std::vector<SheenCase> cases;
-  TabulatedBsdfTable reference;             // the batches' mean (only the plan's rows traced)
-  std::vector<TabulatedBsdfTable> batches;  // each batch's rows
+  TabulatedBsdfTable reference;             // grid: the batches' mean (only the plan's rows)
+  std::vector<TabulatedBsdfTable> batches;  // grid: each batch's rows
   double cpu_seconds = 0;
   bool cancelled = false;
 };

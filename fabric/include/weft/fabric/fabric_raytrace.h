@@ -98,6 +98,23 @@ inline constexpr int kFabricRaytraceRevision = 4;
 // (FabricRaytraceOptions::next_event_rays, launch_lattice).
 inline constexpr int kMaxNextEventRays = 64, kMaxLaunchLattice = 1024;
 
+// A narrow light and the exits about its plane of incidence: a reference for a mirror peak finer
+// than any table's cells (weft bench sheen, bench/sheen_bench.h). Every particle comes from a
+// direction within half_angle_deg of (theta_deg, azimuth_deg) (towards the light, cloth frame;
+// uniform over that cone's solid angle; 0: a collimated beam) and enters anywhere on the repeat;
+// the run traces only the incident bin holding that direction, whose row of the table is then this
+// light's. Besides the table, the reflected exits within band_deg across the plane of incidence
+// are booked by their angle in it in bins of bin_deg (FabricRaytraceResult::plane_f). A table's
+// cells average a peak over their 2 pi / R^2 sr and a light bin over its light; this does neither.
+struct NarrowLight {
+  double theta_deg = 45, azimuth_deg = 0, half_angle_deg = 0;
+  double band_deg = 4, bin_deg = 0.5;
+  // The angles in the plane that plane_f covers: [-kMaxPlaneDeg, kMaxPlaneDeg] (f grows as
+  // 1 / cos^2 there, and a bin reaching 90 degrees would have an unbounded variance).
+  static constexpr double kMaxPlaneDeg = 89;
+  int plane_bins() const;  // kMaxPlaneDeg * 2 / bin_deg, rounded down
+};
+
 struct FabricRaytraceOptions {
   int resolution = 8;                  // of the fabric table (DirectionGrid R)
   uint64_t particles_per_bin = 20000;  // per incident bin
@@ -166,6 +183,10 @@ struct FabricRaytraceOptions {
   // Finer light bins hold a satin's mirror peak where the light's own bin would blur it.
   int sheen_light_resolution = 0;
   SheenLight sheen_light = SheenLight::first_surface;
+  // The narrow light in place of the bins' beams (none: every bin's beam). first_bin and bin_count
+  // stay 0 (its bin is traced), the straight-through light is sampled (its exact part is a bin's
+  // beam's), and it takes no sheen, weave tally or recording.
+  std::optional<NarrowLight> narrow_light;
 
   void validate() const;  // weft::Error naming the field
 };
@@ -221,6 +242,13 @@ struct FabricRaytraceResult {
   WeaveTable weave;
   std::vector<double> weave_mean;
   double weave_relative_noise = 0;
+  // With a narrow light (FabricRaytraceOptions::narrow_light): per bin k of the angle in its plane
+  // of incidence, theta' in [-89 + k bin_deg, -89 + (k + 1) bin_deg) degrees (wo . u = sin theta',
+  // u the plane's horizontal towards the light: a view at v degrees on the mirror's side is
+  // theta' = -v), and channel, the mean of f over the bin's theta' and the band's angle across the
+  // plane (phi', wo = u sin theta' + cos theta' (n cos phi' + v sin phi'), dw = cos theta' dtheta'
+  // dphi'), and its standard error.
+  std::vector<double> plane_f, plane_f_se;
   // The progress callback stopped the trace: the rest of the result is not filled in.
   bool cancelled = false;
 };
