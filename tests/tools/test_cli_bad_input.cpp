@@ -407,6 +407,9 @@ TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
            {"bench bake --target nan", "--target"},
            {"bench render --repeats 0", "--repeats"},
            {"bench render --repeats 1001", "--repeats"},
+           {"bench sheen --fiber f.exr --reference-light bogus", "--reference-light"},
+           {"bench sheen --fiber f.exr --reference-light narrow --band nan", "--band"},
+           {"bench sheen --fiber f.exr --reference-light narrow --nee 65", "--nee"},
        }) {
     const CliRun r = run_weft_cli_in(c.args, dir);
     EXPECT_NE(r.exit_code, 0) << c.args;
