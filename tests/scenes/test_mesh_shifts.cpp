@@ -142,8 +142,9 @@ TEST(MeshShifts, SampleSizeCountsTheSampleBeforeBuildingIt) {
   for (const std::string& file :
        {std::string("examples/red-cotton-weave.json"),
         std::string("examples/polyester-satin-weave.json"),
-        std::string("examples/polyester-twill-weave.json"), std::string("data/wif/54235-plain.wif"),
-        std::string("data/wif/red-white-twill.wif")}) {
+        std::string("examples/polyester-twill-weave.json"),
+        std::string("examples/polyester-taffeta-weave.json"),
+        std::string("data/wif/54235-plain.wif"), std::string("data/wif/red-white-twill.wif")}) {
     SCOPED_TRACE(file);
     const std::filesystem::path path = std::filesystem::path(WEFT_SOURCE_DIR) / "scenes" / file;
     WeaveOptions o = path.extension() == ".wif" ? WeaveOptions{} : read_weave_options(path);
