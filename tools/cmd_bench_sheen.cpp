@@ -8,6 +8,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "weft/bench/sheen_bench.h"
+#include "weft/core/atomic_file.h"
 #include "weft/core/params.h"
 
 namespace weft::cli {
@@ -55,11 +56,11 @@ void print(const SheenRequest& r, const SheenResult& res, bool json) {
   if (r.reference == SheenReference::narrow)
     std::printf(
         "reference: a narrow light (cone %g deg), exits in a %g deg band in bins of %g deg, read"
-        " after a %g deg running mean; %llu particles per case x %d batches, %d next-event draws, "
-        "%.0f"
-        " CPU s\n",
+        " after a %g deg running mean; %llu particles per case x %d batches, %d next-event draws"
+        "%s, %.0f CPU s\n",
         r.narrow.half_angle_deg, r.narrow.band_deg, r.narrow.bin_deg, r.smooth_deg,
         static_cast<unsigned long long>(r.narrow_particles), r.batches, r.narrow_next_event_rays,
+        r.narrow_reference.empty() ? "" : (" (read from " + r.narrow_reference + ")").c_str(),
         res.cpu_seconds);
   else
     std::printf("reference: R %d, %llu particles per bin x %d batches, %.0f CPU s\n", r.resolution,
@@ -75,6 +76,28 @@ void print(const SheenRequest& r, const SheenResult& res, bool json) {
                   r.tables[k].c_str(), c.tables[k].beta, c.tables[k].beta / c.reference.beta,
                   c.tables[k].view_deg, c.tables[k].fwhm_deg);
   }
+}
+
+// Plans, checks the outputs, measures, writes the reference when asked, and prints.
+int run(const SheenOptions& o, const RunLimits& limits) {
+  SheenRequest req = o.request;
+  req.incidences_deg = parse_range(o.incidences, "--incidence", 64);
+  req.azimuths_deg = parse_range(o.azimuths, "--azimuth", 64);
+  req.reference = value_of(kSheenReferenceNames, o.reference_light, "", "--reference-light");
+  const SheenPlan plan = plan_sheen(req);
+  const bool narrow = req.reference == SheenReference::narrow, out = !o.reference_out.empty();
+  if (narrow && out)
+    check_output_paths({{o.reference_out, "--reference-out"}},
+                       {{req.fiber, "--fiber"}, {req.narrow_reference, "--narrow-reference"}});
+  for (int b = 0; b < plan.request.batches && !narrow && out; ++b)
+    TabulatedBsdfTable::check_output_path(batch_path(o.reference_out, b), "--reference-out");
+  const SheenResult res = run_sheen(plan, progress_bar(limits, false));
+  if (res.cancelled) return 130;
+  if (narrow && out) write_narrow_reference(o.reference_out, plan, res);
+  for (size_t b = 0; b < res.batches.size() && out; ++b)
+    res.batches[b].write_exr(batch_path(o.reference_out, static_cast<int>(b)));
+  print(plan.request, res, o.json);
+  return 0;
 }
 
 }  // namespace
@@ -117,34 +140,16 @@ void add_bench_sheen_command(CLI::App& bench, Commands& commands) {
   cmd->add_option("--azimuth", o->azimuths, "planes of incidence, degrees (0: the warp's)")
       ->capture_default_str();
   cmd->add_option("--reference-out", o->reference_out,
-                  "write the reference's batches: OUT.exr names OUT-1.exr, OUT-2.exr, ...");
+                  "write the reference's batches: grid, OUT.exr names OUT-1.exr, OUT-2.exr, ...; "
+                  "narrow, one JSON file of every case's batch curves");
+  cmd->add_option("--narrow-reference", r.narrow_reference,
+                  "narrow: an earlier run's --reference-out (JSON), read, not traced");
   cmd->add_option("--reference", r.reference_batches,
                   "an earlier run's reference batches (.exr, two or more), read, not traced");
   cmd->add_option("--seed", r.seed, "seed of the first batch")->capture_default_str();
   cmd->add_option("--threads", r.threads, "threads (0 = all cores)")->capture_default_str();
   cmd->add_flag("--json", o->json, "print JSON");
-  commands.push_back(
-      {cmd, [o](const RunLimits& limits) {
-         SheenRequest req = o->request;
-         req.incidences_deg = parse_range(o->incidences, "--incidence", 64);
-         req.azimuths_deg = parse_range(o->azimuths, "--azimuth", 64);
-         req.reference =
-             value_of(kSheenReferenceNames, o->reference_light, "", "--reference-light");
-         const SheenPlan plan = plan_sheen(req);
-         if (req.reference == SheenReference::narrow && !o->reference_out.empty())
-           throw Error("", "--reference-out",
-                       "writes a grid reference's batches; a narrow reference's "
-                       "curves are printed with --json");
-         for (int b = 0; b < plan.request.batches && !o->reference_out.empty(); ++b)
-           TabulatedBsdfTable::check_output_path(batch_path(o->reference_out, b),
-                                                 "--reference-out");
-         const SheenResult res = run_sheen(plan, progress_bar(limits, false));
-         if (res.cancelled) return 130;
-         for (size_t b = 0; b < res.batches.size() && !o->reference_out.empty(); ++b)
-           res.batches[b].write_exr(batch_path(o->reference_out, static_cast<int>(b)));
-         print(plan.request, res, o->json);
-         return 0;
-       }});
+  commands.push_back({cmd, [o](const RunLimits& limits) { return run(*o, limits); }});
 }
 
 }  // namespace weft::cli

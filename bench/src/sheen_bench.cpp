@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <ctime>
+#include <optional>
 #include <set>
 
 #include "weft/core/error.h"
 #include "weft/core/math.h"
+#include "weft/core/params.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/materials/table_reader.h"
 
@@ -41,6 +43,11 @@ void check_angles(const std::vector<double>& angles, double lo, double hi, const
 // The narrow reference's options, each named as the command line names it; the light's own
 // checks (FabricRaytraceOptions::validate) follow per case.
 void check_narrow(const SheenRequest& r) {
+  if (r.reference == SheenReference::grid) {
+    if (!r.narrow_reference.empty())
+      throw Error("", "--narrow-reference", "is read with --reference-light narrow");
+    return;
+  }
   if (!r.reference_batches.empty())
     throw Error("", "--reference", "reads a grid reference's batches, not a narrow one's");
   if (r.narrow_particles < 1 || r.narrow_particles > (uint64_t{1} << 32))
@@ -74,6 +81,28 @@ InplanePeak peak_of_curve(const std::vector<double>& views, const std::vector<do
   return p;
 }
 
+// The narrow reference's plan: its curves read (each asked case must be in the file), or the
+// sample its lights are traced on; no rows either way.
+SheenPlan plan_narrow(SheenPlan p) {
+  const SheenRequest& r = p.request;
+  if (r.narrow_reference.empty()) {
+    p.sample = make_woven_sample(read_weave_options(r.weave));
+    return p;
+  }
+  p.narrow_cases = read_narrow_reference(r.narrow_reference, p.request, p.fiber);
+  for (double phi : r.azimuths_deg)
+    for (double ti : r.incidences_deg) {
+      bool found = false;
+      for (const NarrowCase& k : p.narrow_cases)
+        found = found || (k.incidence_deg == ti && k.azimuth_deg == phi);
+      if (!found)
+        throw Error(r.narrow_reference, "cases",
+                    "holds no case at incidence " + ParamReader::fmt(ti) + ", azimuth " +
+                        ParamReader::fmt(phi) + " (--incidence, --azimuth)");
+    }
+  return p;
+}
+
 InplanePeak peak_of(const TableReader& t, double theta_i, double azimuth) {
   std::vector<double> views, beta;
   for (double v = 0; v <= 89.0; v += 0.5)
@@ -89,7 +118,7 @@ InplanePeak peak_of(const TableReader& t, double theta_i, double azimuth) {
 InplaneCurve mirror_curve(const FabricRaytraceResult& t, const NarrowLight& n, int nc) {
   InplaneCurve c;
   for (int k = n.plane_bins() - 1; k >= 0; --k) {
-    const double view = NarrowLight::kMaxPlaneDeg - (k + 0.5) * n.bin_deg;
+    const double view = mirror_view_deg(n, k);
     if (!(view > 0)) continue;
     double f = 0, se = 0;
     for (int ch = 0; ch < nc; ++ch) {
@@ -131,58 +160,82 @@ double standard_error(double s, double s2, double n) {
   return std::sqrt(std::max(0.0, s2 / n - mean * mean) / (n - 1));
 }
 
-// The narrow reference: per case, each batch's light traced on its own (seeds seed, seed + 1, ...).
+// A case of the narrow reference from its batches' curves: their mean (each bin's error
+// combined), its peak read after the running mean, and the peak's standard error over the batches.
+SheenCase narrow_case(double ti, double phi, std::vector<InplaneCurve> batches,
+                      const SheenRequest& r) {
+  SheenCase c{ti, phi, {}, 0, {}, {}, {}};
+  const size_t n = batches[0].beta.size();
+  const double count = static_cast<double>(batches.size());
+  InplaneCurve& mean = c.reference_curve;
+  mean = {batches[0].view_deg, std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
+  double s = 0, s2 = 0;
+  for (const InplaneCurve& b : batches) {
+    const double peak = narrow_peak(b, ti, r.smooth_deg, r.narrow.bin_deg).beta;
+    s += peak, s2 += peak * peak;
+    for (size_t i = 0; i < n; ++i) {
+      mean.beta[i] += b.beta[i] / count;
+      mean.beta_se[i] += b.beta_se[i] * b.beta_se[i];
+    }
+  }
+  for (double& se : mean.beta_se) se = std::sqrt(se) / count;
+  c.reference = narrow_peak(mean, ti, r.smooth_deg, r.narrow.bin_deg);
+  c.reference_beta_se = standard_error(s, s2, count);
+  c.reference_batches = std::move(batches);
+  return c;
+}
+
+// Batch b of a case traced: its light at (ti, phi) on seed + b. Nothing when cancelled.
+std::optional<InplaneCurve> trace_narrow(const SheenPlan& p, double ti, double phi, int b,
+                                         const ProgressCallback& progress) {
+  const SheenRequest& r = p.request;
+  FabricRaytraceOptions o;
+  o.resolution = 1;  // the table's row is not read, and R 1's is the cheapest to keep
+  o.particles_per_bin = r.narrow_particles;
+  o.seed = r.seed + static_cast<uint64_t>(b);
+  o.threads = r.threads;
+  o.straight_through = StraightThrough::sampled;
+  o.next_event_rays = r.narrow_next_event_rays;
+  o.narrow_light = r.narrow;
+  o.narrow_light->theta_deg = ti, o.narrow_light->azimuth_deg = phi;
+  const FabricRaytraceResult t = raytrace_fabric_table(p.sample, p.fiber, o, progress);
+  if (t.cancelled) return std::nullopt;
+  return mirror_curve(t, r.narrow, p.fiber.channels);
+}
+
+// The narrow reference: per case, each batch's light traced on its own (seeds seed, seed + 1,
+// ...), or its curves read.
 SheenResult run_narrow(const SheenPlan& p, const ProgressCallback& progress) {
   const SheenRequest& r = p.request;
   SheenResult out;
   const std::clock_t cpu0 = std::clock();  // the process's CPU time, all threads
-  const uint64_t total =
-      static_cast<uint64_t>(r.batches) * r.incidences_deg.size() * r.azimuths_deg.size();
-  const uint64_t n = r.narrow_particles;
+  const uint64_t n = r.narrow_particles, total = p.narrow_cases.empty()
+                                                     ? static_cast<uint64_t>(r.batches) *
+                                                           r.incidences_deg.size() *
+                                                           r.azimuths_deg.size()
+                                                     : 0;
   uint64_t done = 0;
-  // In particles: at R 1 a light from above is bin 0, the batch's first n particles (the table's
-  // row is not read, and R 1's is the cheapest to keep).
-  const ProgressCallback per_case = [&](const ProgressUpdate& u) {
-    const uint64_t in_case = u.stage == "particles" ? std::min(n, u.done) : 0;
-    return progress({"reference particles", done * n + in_case, total * n});
+  // In particles: at R 1 a light from above is bin 0, the batch's first n particles.
+  const ProgressCallback per_batch = [&](const ProgressUpdate& u) {
+    const uint64_t in_batch = u.stage == "particles" ? std::min(n, u.done) : 0;
+    return progress({"reference particles", done * n + in_batch, total * n});
   };
   std::vector<TableReader> readers;
   for (const auto& t : p.tables) readers.emplace_back(t, r.threads);
   for (double phi : r.azimuths_deg)
     for (double ti : r.incidences_deg) {
-      SheenCase c{ti, phi, {}, 0, {}, {}};
-      double s = 0, s2 = 0;
-      for (int b = 0; b < r.batches; ++b) {
-        FabricRaytraceOptions o;
-        o.resolution = 1;
-        o.particles_per_bin = r.narrow_particles;
-        o.seed = r.seed + static_cast<uint64_t>(b);
-        o.threads = r.threads;
-        o.straight_through = StraightThrough::sampled;
-        o.next_event_rays = r.narrow_next_event_rays;
-        o.narrow_light = r.narrow;
-        o.narrow_light->theta_deg = ti, o.narrow_light->azimuth_deg = phi;
-        const FabricRaytraceResult t = raytrace_fabric_table(p.sample, p.fiber, o, per_case);
-        if (t.cancelled || !progress({"reference particles", ++done * n, total * n})) {
+      std::vector<InplaneCurve> batches;
+      for (const NarrowCase& k : p.narrow_cases)
+        if (k.incidence_deg == ti && k.azimuth_deg == phi) batches = k.batches;
+      for (int b = 0; b < r.batches && p.narrow_cases.empty(); ++b) {
+        std::optional<InplaneCurve> curve = trace_narrow(p, ti, phi, b, per_batch);
+        if (!curve || !progress({"reference particles", ++done * n, total * n})) {
           out.cancelled = true;
           return out;
         }
-        const InplaneCurve curve = mirror_curve(t, r.narrow, p.fiber.channels);
-        const double peak = narrow_peak(curve, ti, r.smooth_deg, r.narrow.bin_deg).beta;
-        s += peak, s2 += peak * peak;
-        InplaneCurve& mean = c.reference_curve;
-        if (b == 0) {
-          const std::vector<double> zeros(curve.beta.size(), 0.0);
-          mean = InplaneCurve{curve.view_deg, zeros, zeros};
-        }
-        for (size_t i = 0; i < curve.beta.size(); ++i) {
-          mean.beta[i] += curve.beta[i] / r.batches;
-          mean.beta_se[i] += curve.beta_se[i] * curve.beta_se[i];
-        }
+        batches.push_back(std::move(*curve));
       }
-      for (double& se : c.reference_curve.beta_se) se = std::sqrt(se) / r.batches;
-      c.reference = narrow_peak(c.reference_curve, ti, r.smooth_deg, r.narrow.bin_deg);
-      c.reference_beta_se = standard_error(s, s2, r.batches);
+      SheenCase c = narrow_case(ti, phi, std::move(batches), r);
       for (const TableReader& t : readers) c.tables.push_back(peak_of(t, ti, phi));
       out.cases.push_back(std::move(c));
     }
@@ -191,6 +244,17 @@ SheenResult run_narrow(const SheenPlan& p, const ProgressCallback& progress) {
 }
 
 }  // namespace
+
+double mirror_view_deg(const NarrowLight& light, int k) {
+  return NarrowLight::kMaxPlaneDeg - (k + 0.5) * light.bin_deg;
+}
+
+std::vector<double> narrow_views_deg(const NarrowLight& light) {
+  std::vector<double> views;
+  for (int k = light.plane_bins() - 1; k >= 0; --k)
+    if (mirror_view_deg(light, k) > 0) views.push_back(mirror_view_deg(light, k));
+  return views;
+}
 
 InplanePeak inplane_peak(const TabulatedBsdfTable& table, double theta_i, double azimuth) {
   return peak_of(TableReader(table), theta_i, azimuth);
@@ -209,7 +273,7 @@ SheenPlan plan_sheen(const SheenRequest& r) {
   // light is where tables and reference part most.
   check_angles(r.incidences_deg, 10, 85, "--incidence");
   check_angles(r.azimuths_deg, 0, 360, "--azimuth");
-  if (r.reference == SheenReference::narrow) check_narrow(r);
+  check_narrow(r);
   if (r.fiber.empty()) throw Error("", "--fiber", "a fiber table (.exr) is required");
   p.fiber = TabulatedBsdfTable::read_exr(r.fiber);
   if (p.fiber.kind != "fiber") throw Error(r.fiber, "kind", "must be a fiber table");
@@ -228,10 +292,7 @@ SheenPlan plan_sheen(const SheenRequest& r) {
   if (r.reference_batches.size() == 1)
     throw Error(r.reference_batches[0], "--reference",
                 "needs two or more batches (the peak's uncertainty)");
-  if (r.reference == SheenReference::narrow) {
-    p.sample = make_woven_sample(read_weave_options(r.weave));
-    return p;  // one light per case: no rows
-  }
+  if (r.reference == SheenReference::narrow) return plan_narrow(std::move(p));
   if (!p.reference_batches.empty()) {
     p.request.resolution = p.reference_batches[0].resolution;
     p.request.batches = static_cast<int>(p.reference_batches.size());
@@ -295,7 +356,7 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
   for (const auto& t : p.tables) readers.emplace_back(t, r.threads);
   for (double phi : r.azimuths_deg)
     for (double ti : r.incidences_deg) {
-      SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, {}, {}};
+      SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, {}, {}, {}};
       double s = 0, s2 = 0;
       for (const auto& t : batch_tables) {
         const double v = inplane_peak(t, ti, phi).beta;

@@ -198,4 +198,49 @@ TEST(Sheen, TheNarrowReferenceTracesALightPerCaseAndReadsItsCurve) {
   EXPECT_GT(c.reference.beta, c.reference.base);
   EXPECT_TRUE(std::isfinite(c.reference_beta_se));
   EXPECT_GT(res.cpu_seconds, 0);
+  ASSERT_EQ(c.reference_batches.size(), 2u);
+
+  // Written and read back: the same curves, so the same peaks to the bit, without a trace.
+  const std::filesystem::path file = dir / "narrow.json";
+  write_narrow_reference(file, p, res);
+  SheenRequest again = r;
+  again.narrow_reference = file.string();
+  again.weave = "never-read.json";  // a read reference needs no sample
+  again.narrow_particles = 7;       // the file's replace the request's
+  const SheenPlan q = plan_sheen(again);
+  EXPECT_EQ(q.request.narrow_particles, 2000u);
+  EXPECT_EQ(q.request.narrow_next_event_rays, 2);
+  const SheenResult read = run_sheen(q);
+  ASSERT_EQ(read.cases.size(), 1u);
+  EXPECT_EQ(read.cases[0].reference.beta, c.reference.beta);
+  EXPECT_EQ(read.cases[0].reference_beta_se, c.reference_beta_se);
+  EXPECT_EQ(read.cases[0].reference_curve.beta, curve.beta);
+
+  // A case the file does not hold, another fiber's reference, and damaged files are refused.
+  bad = again;
+  bad.incidences_deg = {30};
+  refused(bad, "holds no case at incidence 30");
+  TabulatedBsdfTable other = fiber;
+  other.values[0] *= 2;
+  other.write_exr(dir / "other.exr");
+  bad = again;
+  bad.fiber = (dir / "other.exr").string();
+  refused(bad, "fiber_checksum");
+  const std::string text = slurp(file);
+  const auto damaged = [&](const std::string& edited, const char* what) {
+    write_file(dir / "damaged.json", edited);
+    SheenRequest d = again;
+    d.narrow_reference = (dir / "damaged.json").string();
+    refused(d, what);
+  };
+  damaged(text.substr(0, text.size() / 2), "damaged.json");  // truncated
+  std::string edited = text;
+  edited.replace(edited.find("\"beta\""), 6, "\"beta2\"");
+  damaged(edited, "beta");
+  edited = text;
+  edited.replace(edited.find("\"bin_deg\": 0.5"), 14, "\"bin_deg\": 1.0");
+  damaged(edited, "view_deg");
+  bad = again;
+  bad.reference = SheenReference::grid;
+  refused(bad, "--narrow-reference");
 }

@@ -410,6 +410,7 @@ TEST(CliBadInput, NonFiniteEmptyAndWrappingOptionValuesAreRefused) {
            {"bench sheen --fiber f.exr --reference-light bogus", "--reference-light"},
            {"bench sheen --fiber f.exr --reference-light narrow --band nan", "--band"},
            {"bench sheen --fiber f.exr --reference-light narrow --nee 65", "--nee"},
+           {"bench sheen --fiber f.exr --narrow-reference r.json", "--narrow-reference"},
        }) {
     const CliRun r = run_weft_cli_in(c.args, dir);
     EXPECT_NE(r.exit_code, 0) << c.args;

@@ -7,6 +7,7 @@
 // its plane of incidence (NarrowLight, fabric/fabric_raytrace.h), which averages the peak over
 // neither a light bin nor an exit cell (docs/fabric-bsdf.md, "A narrow light").
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,18 @@ struct InplanePeak {
 };
 InplanePeak inplane_peak(const TabulatedBsdfTable& table, double theta_i_deg, double azimuth_deg);
 
+// The narrow reference's in-plane curve on the mirror's side: beta = pi f (the channels' mean)
+// at each plane bin's view (a batch's, or the batches' mean), with its standard error (from the
+// particles').
+struct InplaneCurve {
+  std::vector<double> view_deg, beta, beta_se;
+};
+
+// The views of a narrow light's curve: plane bin k's on the mirror's side is the view
+// kMaxPlaneDeg - (k + 1/2) bin_deg, those above 0 degrees, ascending.
+double mirror_view_deg(const NarrowLight& light, int k);
+std::vector<double> narrow_views_deg(const NarrowLight& light);
+
 enum class SheenReference { grid, narrow };
 inline constexpr NameTable<SheenReference, 2> kSheenReferenceNames{{
     {SheenReference::grid, "grid", "the ray trace's cells at a fine grid"},
@@ -48,6 +61,9 @@ struct SheenRequest {
   // The reference's batches from an earlier run (SheenResult::batches, written by weft bench sheen
   // --reference-out): read instead of traced, two or more of one grid.
   std::vector<std::string> reference_batches;
+  // The narrow reference's curves from an earlier run (write_narrow_reference): read instead of
+  // traced; each asked case must be in it, traced with the same fiber table.
+  std::string narrow_reference;
   SheenReference reference = SheenReference::grid;
   // The narrow reference: its light's cone, band and bins (theta and azimuth are each case's),
   // its particles per case and batch, the next-event draws per scattering (FabricRaytraceOptions::
@@ -61,6 +77,12 @@ struct SheenRequest {
   int threads = 0;
 };
 
+// The narrow reference's batches per case (InplaneCurve each), as a file keeps them.
+struct NarrowCase {
+  double incidence_deg = 0, azimuth_deg = 0;
+  std::vector<InplaneCurve> batches;
+};
+
 struct SheenPlan {
   SheenRequest request;
   TabulatedBsdfTable fiber;
@@ -68,21 +90,17 @@ struct SheenPlan {
   std::vector<TabulatedBsdfTable> tables;
   std::vector<TabulatedBsdfTable> reference_batches;  // read, when the request names them
   std::vector<int> rows;  // the reference's light bins: the in-plane curves' footprints
+  std::vector<NarrowCase> narrow_cases;  // read, when the request names a narrow reference
 };
 // Reads and checks everything before any work: weft::Error naming the option.
 SheenPlan plan_sheen(const SheenRequest& request);
-
-// The narrow reference's in-plane curve on the mirror's side: beta = pi f (the channels' mean)
-// at each plane bin's view, the batches' mean, with its standard error (from the particles').
-struct InplaneCurve {
-  std::vector<double> view_deg, beta, beta_se;
-};
 
 struct SheenCase {
   double incidence_deg = 0, azimuth_deg = 0;
   InplanePeak reference;         // of the batches' mean table (narrow: mean curve, smoothed)
   double reference_beta_se = 0;  // standard error of the peak over the batches
   InplaneCurve reference_curve;  // narrow only
+  std::vector<InplaneCurve> reference_batches;  // narrow only: each batch's curve
   std::vector<InplanePeak> tables;
 };
 struct SheenResult {
@@ -93,5 +111,15 @@ struct SheenResult {
   bool cancelled = false;
 };
 SheenResult run_sheen(const SheenPlan& plan, const ProgressCallback& progress = no_progress());
+
+// A narrow reference's curves (JSON: the fiber table's checksum, the light's cone, band and bins,
+// its particles, next-event draws and seed, and per case each batch's curve), written whole or not
+// at all, and read back: weft::Error naming the file and field on anything malformed or on another
+// fiber table's reference; the file's light, particles, draws, seed and batch count replace the
+// request's.
+void write_narrow_reference(const std::filesystem::path& path, const SheenPlan& plan,
+                            const SheenResult& result);
+std::vector<NarrowCase> read_narrow_reference(const std::string& path, SheenRequest& request,
+                                              const TabulatedBsdfTable& fiber);
 
 }  // namespace weft
