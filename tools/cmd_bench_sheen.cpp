@@ -22,7 +22,11 @@ struct SheenOptions {
 };
 
 nlohmann::json peak_json(const InplanePeak& p) {
-  return {{"beta", p.beta}, {"view_deg", p.view_deg}, {"base", p.base}, {"fwhm_deg", p.fwhm_deg}};
+  return {{"beta", p.beta},
+          {"view_deg", p.view_deg},
+          {"base", p.base},
+          {"fwhm_deg", p.fwhm_deg},
+          {"mirror_beta", p.mirror_beta}};
 }
 
 // Batch b's file of --reference-out OUT.exr: OUT-<b + 1>.exr.
@@ -39,11 +43,13 @@ void print(const SheenRequest& r, const SheenResult& res, bool json) {
       for (size_t k = 0; k < c.tables.size(); ++k)
         tables.push_back({{"file", r.tables[k]},
                           {"peak", peak_json(c.tables[k])},
-                          {"peak_ratio", c.tables[k].beta / c.reference.beta}});
+                          {"peak_ratio", c.tables[k].beta / c.reference.beta},
+                          {"mirror_ratio", c.tables[k].mirror_beta / c.reference.mirror_beta}});
       cases.push_back({{"incidence_deg", c.incidence_deg},
                        {"azimuth_deg", c.azimuth_deg},
                        {"reference", peak_json(c.reference)},
                        {"reference_beta_se", c.reference_beta_se},
+                       {"reference_mirror_se", c.reference_mirror_se},
                        {"tables", tables}});
       if (!c.reference_curve.beta.empty())
         cases.back()["reference_curve"] = {{"view_deg", c.reference_curve.view_deg},
@@ -68,13 +74,16 @@ void print(const SheenRequest& r, const SheenResult& res, bool json) {
   for (const SheenCase& c : res.cases) {
     std::printf(
         "incidence %2.0f, azimuth %3.0f: reference peak %.3f +- %.3f at %.1f deg, FWHM %.1f"
-        " deg (base %.3f)\n",
+        " deg (base %.3f); at the mirror %.3f +- %.3f\n",
         c.incidence_deg, c.azimuth_deg, c.reference.beta, c.reference_beta_se, c.reference.view_deg,
-        c.reference.fwhm_deg, c.reference.base);
+        c.reference.fwhm_deg, c.reference.base, c.reference.mirror_beta, c.reference_mirror_se);
     for (size_t k = 0; k < c.tables.size(); ++k)
-      std::printf("  %s: peak %.3f (%.2f of the reference) at %.1f deg, FWHM %.1f deg\n",
-                  r.tables[k].c_str(), c.tables[k].beta, c.tables[k].beta / c.reference.beta,
-                  c.tables[k].view_deg, c.tables[k].fwhm_deg);
+      std::printf(
+          "  %s: peak %.3f (%.2f of the reference) at %.1f deg, FWHM %.1f deg; at the mirror %.3f"
+          " (%.2f)\n",
+          r.tables[k].c_str(), c.tables[k].beta, c.tables[k].beta / c.reference.beta,
+          c.tables[k].view_deg, c.tables[k].fwhm_deg, c.tables[k].mirror_beta,
+          c.tables[k].mirror_beta / c.reference.mirror_beta);
   }
 }
 

@@ -109,7 +109,9 @@ InplanePeak peak_of(const TableReader& t, double theta_i, double azimuth) {
     views.push_back(v), beta.push_back(beta_at(t, theta_i, azimuth, v));
   const double base = std::min(beta_at(t, theta_i, azimuth, std::max(0.0, theta_i - 20)),
                                beta_at(t, theta_i, azimuth, std::min(89.0, theta_i + 20)));
-  return peak_of_curve(views, beta, theta_i, base, 0.5);
+  InplanePeak p = peak_of_curve(views, beta, theta_i, base, 0.5);
+  p.mirror_beta = beta_at(t, theta_i, azimuth, theta_i);
+  return p;
 }
 
 // A narrow light's curve on the mirror's side (its plane bins of theta' < 0, views ascending):
@@ -150,8 +152,10 @@ InplanePeak narrow_peak(const InplaneCurve& c, double theta_i, double smooth_deg
       if (std::abs(c.view_deg[i] - view) < std::abs(c.view_deg[best] - view)) best = i;
     return smooth[best];
   };
-  return peak_of_curve(c.view_deg, smooth, theta_i, std::min(at(theta_i - 20), at(theta_i + 20)),
-                       step);
+  InplanePeak p = peak_of_curve(c.view_deg, smooth, theta_i,
+                                std::min(at(theta_i - 20), at(theta_i + 20)), step);
+  p.mirror_beta = at(theta_i);
+  return p;
 }
 
 // The standard error of a mean over n values from their sum and sum of squares.
@@ -164,15 +168,16 @@ double standard_error(double s, double s2, double n) {
 // combined), its peak read after the running mean, and the peak's standard error over the batches.
 SheenCase narrow_case(double ti, double phi, std::vector<InplaneCurve> batches,
                       const SheenRequest& r) {
-  SheenCase c{ti, phi, {}, 0, {}, {}, {}};
+  SheenCase c{ti, phi, {}, 0, 0, {}, {}, {}};
   const size_t n = batches[0].beta.size();
   const double count = static_cast<double>(batches.size());
   InplaneCurve& mean = c.reference_curve;
   mean = {batches[0].view_deg, std::vector<double>(n, 0.0), std::vector<double>(n, 0.0)};
-  double s = 0, s2 = 0;
+  double s = 0, s2 = 0, m = 0, m2 = 0;  // the batches' peaks and mirror readings
   for (const InplaneCurve& b : batches) {
-    const double peak = narrow_peak(b, ti, r.smooth_deg, r.narrow.bin_deg).beta;
-    s += peak, s2 += peak * peak;
+    const InplanePeak peak = narrow_peak(b, ti, r.smooth_deg, r.narrow.bin_deg);
+    s += peak.beta, s2 += peak.beta * peak.beta;
+    m += peak.mirror_beta, m2 += peak.mirror_beta * peak.mirror_beta;
     for (size_t i = 0; i < n; ++i) {
       mean.beta[i] += b.beta[i] / count;
       mean.beta_se[i] += b.beta_se[i] * b.beta_se[i];
@@ -181,6 +186,7 @@ SheenCase narrow_case(double ti, double phi, std::vector<InplaneCurve> batches,
   for (double& se : mean.beta_se) se = std::sqrt(se) / count;
   c.reference = narrow_peak(mean, ti, r.smooth_deg, r.narrow.bin_deg);
   c.reference_beta_se = standard_error(s, s2, count);
+  c.reference_mirror_se = standard_error(m, m2, count);
   c.reference_batches = std::move(batches);
   return c;
 }
@@ -356,13 +362,14 @@ SheenResult run_sheen(const SheenPlan& p, const ProgressCallback& progress) {
   for (const auto& t : p.tables) readers.emplace_back(t, r.threads);
   for (double phi : r.azimuths_deg)
     for (double ti : r.incidences_deg) {
-      SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, {}, {}, {}};
-      double s = 0, s2 = 0;
+      SheenCase c{ti, phi, inplane_peak(out.reference, ti, phi), 0, 0, {}, {}, {}};
+      double s = 0, s2 = 0, m = 0, m2 = 0;
       for (const auto& t : batch_tables) {
-        const double v = inplane_peak(t, ti, phi).beta;
-        s += v, s2 += v * v;
+        const InplanePeak v = inplane_peak(t, ti, phi);
+        s += v.beta, s2 += v.beta * v.beta, m += v.mirror_beta, m2 += v.mirror_beta * v.mirror_beta;
       }
       c.reference_beta_se = standard_error(s, s2, r.batches);
+      c.reference_mirror_se = standard_error(m, m2, r.batches);
       for (const TableReader& t : readers) c.tables.push_back(peak_of(t, ti, phi));
       out.cases.push_back(c);
     }

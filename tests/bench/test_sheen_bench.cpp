@@ -39,6 +39,8 @@ TEST(Sheen, PeakOfATabulatedBumpIsTheBumpsOwn) {
         4 * kSigmaDeg * std::sqrt(-2 * std::log((1 + base / (c + a)) / 2 * (c + a) / a - c / a));
     EXPECT_NEAR(p.view_deg, ti, 7) << ti;  // within a bin (R 16: about 7 degrees)
     EXPECT_NEAR(p.beta, kPi * (c + a), 0.15 * kPi * (c + a)) << ti;
+    EXPECT_NEAR(p.mirror_beta, kPi * (c + a), 0.15 * kPi * (c + a)) << ti;  // the bump's top
+    EXPECT_LE(p.mirror_beta, p.beta) << ti;
     EXPECT_NEAR(p.base, kPi * base, 0.15 * kPi * base) << ti;
     EXPECT_NEAR(p.fwhm_deg, fwhm, 0.25 * fwhm) << ti;
     EXPECT_LT(inplane_peak(coarse, ti, 0).beta, 0.9 * p.beta) << ti;
@@ -129,6 +131,8 @@ TEST(Sheen, ReferenceBatchesAreReadNotTraced) {
   const double first = inplane_peak(a, 30, 0).beta;
   EXPECT_NEAR(res.cases[0].reference.beta, 1.1 * first, 1e-5 * first);
   EXPECT_NEAR(res.cases[0].reference_beta_se, 0.1 * first, 1e-5 * first);
+  const double mirror = inplane_peak(a, 30, 0).mirror_beta;
+  EXPECT_NEAR(res.cases[0].reference_mirror_se, 0.1 * mirror, 1e-5 * mirror);
   EXPECT_NEAR(res.cases[0].tables[0].beta, first, 1e-12);
 }
 
@@ -214,6 +218,8 @@ TEST(Sheen, TheNarrowReferenceTracesALightPerCaseAndReadsItsCurve) {
   ASSERT_EQ(read.cases.size(), 1u);
   EXPECT_EQ(read.cases[0].reference.beta, c.reference.beta);
   EXPECT_EQ(read.cases[0].reference_beta_se, c.reference_beta_se);
+  EXPECT_EQ(read.cases[0].reference_mirror_se, c.reference_mirror_se);
+  EXPECT_GT(c.reference.mirror_beta, 0);
   EXPECT_EQ(read.cases[0].reference_curve.beta, curve.beta);
 
   // A case the file does not hold, another fiber's reference, and damaged files are refused.

@@ -23,10 +23,12 @@ namespace weft {
 // as the renderer reads the table) at views on the mirror side every 0.5 degree; the peak is the
 // largest beta within 10 degrees of the mirror view, the base the smaller beta 20 degrees either
 // side of the mirror, the width (FWHM) that of the views around the peak above base + (peak -
-// base) / 2. A table with a sheen (half_vector_lobe.h) is read with it: the cells less the
-// sheen's cell averages, interpolated, plus the sheen.
+// base) / 2; mirror_beta is beta at the mirror view itself (a cloth without a peak, whose largest
+// point near the mirror a noisy reference would read from its noise, is compared there). A table
+// with a sheen (half_vector_lobe.h) is read with it: the cells less the sheen's cell averages,
+// interpolated, plus the sheen.
 struct InplanePeak {
-  double beta = 0, view_deg = 0, base = 0, fwhm_deg = 0;
+  double beta = 0, view_deg = 0, base = 0, fwhm_deg = 0, mirror_beta = 0;
 };
 InplanePeak inplane_peak(const TabulatedBsdfTable& table, double theta_i_deg, double azimuth_deg);
 
@@ -69,7 +71,7 @@ struct SheenRequest {
   // its particles per case and batch, the next-event draws per scattering (FabricRaytraceOptions::
   // next_event_rays: on the satin, 16 cut the variance per CPU second 2.2-fold against none), and
   // the running mean over smooth_deg (the bins within half of it either side of each bin's centre)
-  // its curve is read after.
+  // its curve is read after (its mirror_beta: the running mean at the bin nearest the mirror).
   NarrowLight narrow;
   uint64_t narrow_particles = uint64_t{1} << 18;
   int narrow_next_event_rays = 16;
@@ -97,9 +99,10 @@ SheenPlan plan_sheen(const SheenRequest& request);
 
 struct SheenCase {
   double incidence_deg = 0, azimuth_deg = 0;
-  InplanePeak reference;         // of the batches' mean table (narrow: mean curve, smoothed)
-  double reference_beta_se = 0;  // standard error of the peak over the batches
-  InplaneCurve reference_curve;  // narrow only
+  InplanePeak reference;           // of the batches' mean table (narrow: mean curve, smoothed)
+  double reference_beta_se = 0;    // standard error of the peak over the batches
+  double reference_mirror_se = 0;  // and of mirror_beta
+  InplaneCurve reference_curve;    // narrow only
   std::vector<InplaneCurve> reference_batches;  // narrow only: each batch's curve
   std::vector<InplanePeak> tables;
 };
