@@ -54,12 +54,15 @@ void check_narrow(const SheenRequest& r) {
     throw Error("", "--narrow-particles", "must lie in [1, 2^32]");
   if (r.narrow_next_event_rays < 0 || r.narrow_next_event_rays > kMaxNextEventRays)
     throw Error("", "--nee", "must lie in [0, " + std::to_string(kMaxNextEventRays) + "]");
-  if (!(r.narrow.half_angle_deg >= 0 && r.narrow.half_angle_deg <= 10))
-    throw Error("", "--cone", "must lie in [0, 10] degrees");
-  if (!(r.narrow.band_deg >= 0.01 && r.narrow.band_deg <= 60))
-    throw Error("", "--band", "must lie in [0.01, 60] degrees");
-  if (!(r.narrow.bin_deg >= 0.05 && r.narrow.bin_deg <= 10))
-    throw Error("", "--bin", "must lie in [0.05, 10] degrees");
+  const auto check = [](double x, double lo, double hi, const char* option) {
+    if (!(x >= lo && x <= hi))
+      throw Error(
+          "", option,
+          "must lie in [" + ParamReader::fmt(lo) + ", " + ParamReader::fmt(hi) + "] degrees");
+  };
+  check(r.narrow.half_angle_deg, 0, NarrowLight::kMaxHalfAngleDeg, "--cone");
+  check(r.narrow.band_deg, NarrowLight::kMinBandDeg, NarrowLight::kMaxBandDeg, "--band");
+  check(r.narrow.bin_deg, NarrowLight::kMinBinDeg, NarrowLight::kMaxBinDeg, "--bin");
   if (!(r.smooth_deg >= 0 && r.smooth_deg <= 10))
     throw Error("", "--smooth", "must lie in [0, 10] degrees");
 }

@@ -119,9 +119,9 @@ std::vector<NarrowCase> read_narrow_reference(const std::string& path, SheenRequ
                 "the reference was traced with another fiber table than --fiber " + request.fiber);
   (void)r.string("weave");  // what it was traced on, for the reader
   NarrowLight& light = request.narrow;
-  light.half_angle_deg = r.number("half_angle_deg", 0, 10);
-  light.band_deg = r.number("band_deg", 0.01, 60);
-  light.bin_deg = r.number("bin_deg", 0.05, 10);
+  light.half_angle_deg = r.number("half_angle_deg", 0, NarrowLight::kMaxHalfAngleDeg);
+  light.band_deg = r.number("band_deg", NarrowLight::kMinBandDeg, NarrowLight::kMaxBandDeg);
+  light.bin_deg = r.number("bin_deg", NarrowLight::kMinBinDeg, NarrowLight::kMaxBinDeg);
   request.narrow_particles = r.count("particles", 1, uint64_t{1} << 32);
   request.narrow_next_event_rays =
       static_cast<int>(r.integer("next_event_rays", 0, kMaxNextEventRays));

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "weft/core/error.h"
+#include "weft/core/params.h"
 #include "weft/fabric/fabric_raytrace.h"
 #include "weft/fabric/raytrace_steps.h"
 #include "weft/scenes/render_scene.h"
@@ -130,10 +131,17 @@ void validate_narrow_light(const FabricRaytraceOptions& o) {
     throw Error("", "narrow_light.theta_deg", "must lie in [0, 89] (light from above)");
   if (!in(n.azimuth_deg, -360, 360))
     throw Error("", "narrow_light.azimuth_deg", "must lie in [-360, 360]");
-  if (!in(n.half_angle_deg, 0, 10))
-    throw Error("", "narrow_light.half_angle_deg", "must lie in [0, 10]");
-  if (!in(n.band_deg, 0.01, 60)) throw Error("", "narrow_light.band_deg", "must lie in [0.01, 60]");
-  if (!in(n.bin_deg, 0.05, 10)) throw Error("", "narrow_light.bin_deg", "must lie in [0.05, 10]");
+  const auto range = [](double lo, double hi) {
+    return "must lie in [" + ParamReader::fmt(lo) + ", " + ParamReader::fmt(hi) + "]";
+  };
+  if (!in(n.half_angle_deg, 0, NarrowLight::kMaxHalfAngleDeg))
+    throw Error("", "narrow_light.half_angle_deg", range(0, NarrowLight::kMaxHalfAngleDeg));
+  if (!in(n.band_deg, NarrowLight::kMinBandDeg, NarrowLight::kMaxBandDeg))
+    throw Error("", "narrow_light.band_deg",
+                range(NarrowLight::kMinBandDeg, NarrowLight::kMaxBandDeg));
+  if (!in(n.bin_deg, NarrowLight::kMinBinDeg, NarrowLight::kMaxBinDeg))
+    throw Error("", "narrow_light.bin_deg",
+                range(NarrowLight::kMinBinDeg, NarrowLight::kMaxBinDeg));
   if (o.first_bin != 0 || o.bin_count != 0)
     throw Error("", "narrow_light", "traces its own bin: leave first_bin and bin_count 0");
   if (o.straight_through != StraightThrough::sampled)

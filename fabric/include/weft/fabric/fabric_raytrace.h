@@ -112,6 +112,10 @@ struct NarrowLight {
   // The angles in the plane that plane_f covers: [-kMaxPlaneDeg, kMaxPlaneDeg] (f grows as
   // 1 / cos^2 there, and a bin reaching 90 degrees would have an unbounded variance).
   static constexpr double kMaxPlaneDeg = 89;
+  // The ranges its fields are checked against (FabricRaytraceOptions::validate, and every reader
+  // of them).
+  static constexpr double kMaxHalfAngleDeg = 10, kMinBandDeg = 0.01, kMaxBandDeg = 60;
+  static constexpr double kMinBinDeg = 0.05, kMaxBinDeg = 10;
   int plane_bins() const;  // kMaxPlaneDeg * 2 / bin_deg, rounded down
 };
 
