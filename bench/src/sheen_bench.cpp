@@ -255,7 +255,7 @@ SheenResult run_narrow(const SheenPlan& p, const ProgressCallback& progress) {
 }  // namespace
 
 double mirror_view_deg(const NarrowLight& light, int k) {
-  return NarrowLight::kMaxPlaneDeg - (k + 0.5) * light.bin_deg;
+  return -light.plane_angle_deg(k);
 }
 
 std::vector<double> narrow_views_deg(const NarrowLight& light) {

@@ -30,11 +30,6 @@ FabricRaytraceOptions narrow_options(double theta_deg, double azimuth_deg, doubl
   return o;
 }
 
-// The angle in the plane at the centre of plane bin k, degrees.
-double plane_angle(const NarrowLight& n, int k) {
-  return -NarrowLight::kMaxPlaneDeg + (k + 0.5) * n.bin_deg;
-}
-
 }  // namespace
 
 // A flat sheet whose "fiber" is Lambertian (rho / pi above the point) is a Lambertian surface
@@ -56,7 +51,7 @@ TEST(NarrowLight, FlatLambertSheetIsLambertianInTheLightsPlane) {
     int tested = 0;
     for (int k = 0; k < n.plane_bins(); ++k) {
       // Expected exits in the bin: N rho / pi over the bin of cos^2 theta' cos phi'.
-      const double a = deg_to_rad(plane_angle(n, k)), h = 0.5 * deg_to_rad(n.bin_deg);
+      const double a = deg_to_rad(n.plane_angle_deg(k)), h = 0.5 * deg_to_rad(n.bin_deg);
       const double cos2 = 0.5 * (2 * h + 0.5 * (std::sin(2 * (a + h)) - std::sin(2 * (a - h))));
       const double count = 200000 * rho / kPi * cos2 * 2 * std::sin(0.5 * deg_to_rad(n.band_deg));
       if (count < 25) continue;
@@ -96,7 +91,7 @@ TEST(NarrowLight, AGlossySheetPeaksOnTheMirrorsSide) {
     if (r.plane_f[k * 3] > r.plane_f[peak * 3]) peak = k;
   // The sheet's exits are drawn from the table's cell averages: the peak is a plateau some 25
   // degrees wide (measured: 1.21-1.27 from -36.5 to -26.5 degrees), its largest bin within 12.
-  EXPECT_NEAR(plane_angle(n, peak), -35, 12);
+  EXPECT_NEAR(n.plane_angle_deg(peak), -35, 12);
   const auto bin_at = [&](double a) {
     return static_cast<int>((a + NarrowLight::kMaxPlaneDeg) / n.bin_deg);
   };

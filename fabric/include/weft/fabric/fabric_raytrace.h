@@ -117,6 +117,8 @@ struct NarrowLight {
   static constexpr double kMaxHalfAngleDeg = 10, kMinBandDeg = 0.01, kMaxBandDeg = 60;
   static constexpr double kMinBinDeg = 0.05, kMaxBinDeg = 10;
   int plane_bins() const;  // kMaxPlaneDeg * 2 / bin_deg, rounded down
+  // The angle in the plane at the centre of plane bin k, degrees (negative on the mirror's side).
+  double plane_angle_deg(int k) const { return -kMaxPlaneDeg + (k + 0.5) * bin_deg; }
 };
 
 struct FabricRaytraceOptions {
